@@ -1,0 +1,27 @@
+# Two commands on a fresh machine: `make run` and `make test` (README, quick start).
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+DEFAULT_SCENE := cases/gots_diesel_spinup.toml
+DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
+
+.PHONY: run test install clean
+
+$(STAMP): pyproject.toml
+	python3 -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+# Re-running `make run` replaces the default result on purpose (--force).
+run: $(STAMP)
+	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
+	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+clean:
+	rm -rf $(VENV) results/*.h5 results/*.png

@@ -1,0 +1,79 @@
+"""Speed fluctuation and steady state from a trajectory.
+
+δ = (ω_max − ω_min)/ω_mean over one engine cycle (Gots §2.8, the coefficient of speed
+irregularity); the cycle-mean speed is the cycle angle over the cycle time, exact from t(φ).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+def cycle_boundaries(t: NDArray[np.float64], phi: NDArray[np.float64], cycle: float,
+                     phi0: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Times and angles at which whole engine cycles (from φ0) end, while φ increases."""
+    if phi.size < 2 or np.any(np.diff(phi) <= 0):
+        # φ not monotonic (reversal): use the part after the last backward motion.
+        back = np.nonzero(np.diff(phi) <= 0)[0]
+        start = back[-1] + 1 if back.size else 0
+        t, phi = t[start:], phi[start:]
+        if phi.size < 2:
+            return np.zeros(0), np.zeros(0)
+    k0 = math.ceil((phi[0] - phi0) / cycle - 1e-12)
+    k1 = math.floor((phi[-1] - phi0) / cycle + 1e-12)
+    marks = phi0 + cycle * np.arange(k0, k1 + 1)
+    return np.interp(marks, phi, t), marks
+
+
+def cycle_means(t, phi, cycle, phi0):
+    """Mean speed of each whole cycle [rad/s] and the times the cycles end."""
+    tb, _ = cycle_boundaries(t, phi, cycle, phi0)
+    if tb.size < 2:
+        return np.zeros(0), np.zeros(0)
+    return cycle / np.diff(tb), tb[1:]
+
+
+def steady_state_time(means, ends, rtol: float = 1e-4, cycles: int = 3) -> float:
+    """End time of the first cycle after which the cycle-mean speed changes by < rtol for
+    ``cycles`` cycles in a row; NaN if the run never settles."""
+    if means.size < cycles + 1:
+        return math.nan
+    change = np.abs(np.diff(means)) / np.abs(means[1:])
+    calm = change < rtol
+    for i in range(calm.size - cycles + 1):
+        if calm[i:i + cycles].all():
+            return float(ends[i])
+    return math.nan
+
+
+def fluctuation(t, phi, omega, cycle, phi0) -> float:
+    """δ over the last whole cycle (NaN if there is none)."""
+    tb, _ = cycle_boundaries(t, phi, cycle, phi0)
+    if tb.size < 2:
+        return math.nan
+    sel = (t >= tb[-2]) & (t <= tb[-1])
+    mean = cycle / (tb[-1] - tb[-2])
+    return float((omega[sel].max() - omega[sel].min()) / mean)
+
+
+def summarize(scene, traj: dict[str, NDArray[np.float64]]) -> dict[str, tuple[float, str]]:
+    """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``."""
+    t, phi, omega = traj["t"], traj["phi"], traj["omega"]
+    cycle = scene.mechanism.cycle
+    phi0 = scene.initial.phi
+    means, ends = cycle_means(t, phi, cycle, phi0)
+    out = {
+        "final_omega": (float(omega[-1]), "rad/s"),
+        "final_t": (float(t[-1]), "s"),
+        "revolutions": (float((phi[-1] - phi0) / (2 * math.pi)), "1"),
+        "mean_omega_last_cycle": (float(means[-1]) if means.size else math.nan, "rad/s"),
+        "delta_last_cycle": (fluctuation(t, phi, omega, cycle, phi0), "1"),
+        "steady_state_t": (steady_state_time(means, ends), "s"),
+    }
+    if "M_drive" in traj and means.size:
+        last = (t >= ends[-1] - cycle / means[-1]) & (t <= ends[-1])
+        out["mean_drive_torque_last_cycle"] = (float(np.trapezoid(traj["M_drive"][last],
+                                                                  phi[last]) / cycle), "N m")
+    return out

@@ -1,0 +1,76 @@
+"""Scene → compiled model: packs the mechanism, builds the pressure table and the breakpoints.
+
+One place where the scene's dataclasses meet the unit-free arrays of :mod:`transient.core`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .core.model import Model
+from .forces.gas import PressureTable, mixed_cycle, table_from_points
+
+
+def gas_table(scene) -> PressureTable | None:
+    """The cylinder pressure table of the scene (absolute pressure [Pa] over the local angle)."""
+    gas = scene.gas
+    mech = scene.mechanism
+    if gas.model == "none":
+        return None
+    if gas.model == "table":
+        return table_from_points(np.asarray(gas.phi), np.asarray(gas.p), mech.cycle,
+                                 corners=gas.corners, interpolation=gas.interpolation)
+    stroke_volume = mech.piston_area * mech.stroke()
+    clearance = stroke_volume / (gas.compression_ratio - 1.0)
+    return mixed_cycle(mech.volume_function(clearance), compression_ratio=gas.compression_ratio,
+                       p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
+                       p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes)
+
+
+def gas_phases(scene) -> NDArray[np.float64]:
+    """Shaft angle at which each cylinder's pressure table is at local angle 0.
+
+    Tables are written with 0 at the gas-exchange TDC of a 4-stroke (firing TDC at 360°, the Gots
+    tables' convention) and at the firing TDC of a 2-stroke.
+    """
+    mech = scene.mechanism
+    shift = 2.0 * math.pi if mech.strokes == 4 else 0.0
+    return np.mod(np.asarray(mech.firing_angles) - shift, mech.cycle)
+
+
+def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float
+                ) -> NDArray[np.float64]:
+    """Sorted shaft angles in [0, period) where any cylinder's table has a corner."""
+    if table is None:
+        return np.zeros(0)
+    corners = table.corners[:-1]  # the period's end is the next cycle's 0
+    angles = np.sort(np.mod(np.add.outer(phases, corners).ravel(), period))
+    keep = np.concatenate(([True], np.diff(angles) > 1e-12 * period))
+    angles = angles[keep]
+    if angles.size > 1 and period - angles[-1] < 1e-12 * period:
+        angles = angles[:-1]
+    return angles
+
+
+def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None]:
+    """The compiled model, its breakpoints and the pressure table of a scene."""
+    mech = scene.mechanism
+    table = gas_table(scene)
+    phases = gas_phases(scene)
+    period = mech.cycle
+    n = mech.n_cylinders
+    if table is None:
+        knots, coef, piece_knot = np.array([0.0, period]), np.zeros((1, 4)), np.array([0, 1])
+    else:
+        knots, coef, piece_knot = table.knots, table.coef, table.piece_knot
+    model = Model(
+        kind=mech.kind, mech=mech.pack(), ncyl=n, J0=scene.inertia.total,
+        has_gas=table is not None, gas_phase=phases, gas_scale=np.full(n, mech.piston_area),
+        gas_offset=scene.gas.p0, period=period, knots=knots, coef=coef,
+        piece_knot=piece_knot.astype(np.int64), breakpoints=breakpoints(table, phases, period),
+        load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
+        starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
+        starter_cutout=scene.starter.cutout_speed)
+    return model, model.breakpoints, table

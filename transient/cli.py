@@ -1,0 +1,220 @@
+"""The ``transient`` command (DESIGN §4): run, check, info, plot, kinematics.
+
+Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulation failed (the
+partial result is kept and marked incomplete).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import SceneError, SimulationError
+
+EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except SceneError as exc:
+        print(exc.line(), file=sys.stderr)
+        return EXIT_INVALID
+    except (FileExistsError, PermissionError, FileNotFoundError) as exc:
+        print(str(exc), file=sys.stderr)
+        return EXIT_INVALID
+    except SimulationError as exc:
+        print(f"transient: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        print("transient: interrupted", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="transient", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="simulate a scene and write DIR/<scene stem>.h5")
+    r.add_argument("scene")
+    r.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    r.add_argument("--force", action="store_true", help="overwrite an existing result")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    r.set_defaults(func=cmd_run)
+    c = sub.add_parser("check", help="validate a scene only")
+    c.add_argument("scene")
+    c.set_defaults(func=cmd_check)
+    i = sub.add_parser("info", help="summarise a result file")
+    i.add_argument("result")
+    i.set_defaults(func=cmd_info)
+    pl = sub.add_parser("plot", help="write PNG figures of a result")
+    pl.add_argument("result")
+    pl.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    pl.set_defaults(func=cmd_plot)
+    k = sub.add_parser("kinematics", help="tabulate positions, transfer functions, J and dJ/dφ")
+    k.add_argument("scene")
+    k.add_argument("-o", "--output", default=None, help="CSV file (default: standard output)")
+    k.add_argument("--points", type=int, default=361, help="points over one cycle")
+    k.set_defaults(func=cmd_kinematics)
+    return p
+
+
+def cmd_check(args) -> int:
+    from .scene import load_scene
+
+    scene = load_scene(args.scene)
+    print(f"{args.scene}: ok ({scene.name}: {type(scene.mechanism).__name__}, "
+          f"{scene.mechanism.n_cylinders} cylinder(s), gas {scene.gas.model}, "
+          f"run {scene.run.mode})")
+    return EXIT_OK
+
+
+def cmd_run(args) -> int:
+    from .results import check_writable
+    from .scene import load_scene
+    from .simulate import simulate
+
+    scene = load_scene(args.scene)
+    path = Path(args.output) / f"{Path(args.scene).stem}.h5"
+    check_writable(path, args.force)
+    bar = None
+    if not args.quiet and sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=1000, desc=scene.name, unit="‰", file=sys.stderr, leave=False)
+    progress = (lambda f: bar.update(int(1000 * f) - bar.n)) if bar else None
+    try:
+        data = simulate(scene, path, force=args.force, progress=progress)
+    finally:
+        if bar:
+            bar.close()
+    if not args.quiet:
+        print(f"wrote {path}")
+        _print_summary(data.extra["summary"], data.solver)
+    return EXIT_OK
+
+
+def _print_summary(summary, solver) -> None:
+    rpm = 30.0 / math.pi
+    v = {k: val for k, (val, _) in summary.items()}
+    print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
+          f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
+    print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
+          f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
+    ss = v["steady_state_t"]
+    print("  steady state: " + (f"reached at t = {ss:.6g} s" if math.isfinite(ss)
+                                else "not reached (cycle-mean speed still changing by ≥ 1e-4)"))
+    if "mean_drive_torque_last_cycle" in v:
+        print(f"  mean drive torque required over the last cycle: "
+              f"{v['mean_drive_torque_last_cycle']:.6g} N m")
+    print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
+          f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
+          f"compile/cache load)")
+
+
+def cmd_info(args) -> int:
+    from .results import open_result
+
+    res = _open(args.result)
+    a = res.attrs
+    print(f"{res.path}: scene {a['scene']!r}, transient {a['version']}, format {a['format']}, "
+          f"created {a['created']}, complete = {bool(a['complete'])}")
+    if a.get("message"):
+        print(f"  message: {a['message']}")
+    n = res.trajectory["t"].size
+    print(f"  trajectory: {n} samples; " + ", ".join(f"{k} [{u}]" for k, u in res.units.items()))
+    for name, ev in res.events.items():
+        print(f"  events {name}: {ev['t'].size}")
+    s = res.solver
+    if s:
+        print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
+              f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
+              f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
+    for k, v in res.analysis.items():
+        print(f"  {k} = {v}")
+    return EXIT_OK
+
+
+def _open(path):
+    from .results import open_result
+
+    if not Path(path).is_file():
+        raise FileNotFoundError(f"{path}: no such result file")
+    try:
+        return open_result(path)
+    except (OSError, ValueError) as exc:
+        raise SceneError("(file)", f"not a readable transient result: {exc}", file=str(path))
+
+
+def cmd_plot(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from . import plots
+    from .assemble import gas_table
+
+    res = _open(args.result)
+    scene = res.scene()
+    out = Path(args.output) if args.output else res.path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    stem = res.path.stem
+    traj = res.trajectory
+    written = []
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    plots.speed(a1, traj)
+    plots.acceleration(a2, traj)
+    a1.set_title(f"{scene.name}: speed and acceleration")
+    written.append(_save(fig, out / f"{stem}_speed.png"))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    plots.torques(ax, traj, scene.mechanism.cycle)
+    ax.set_title(f"{scene.name}: moments over the last cycle")
+    written.append(_save(fig, out / f"{stem}_torques.png"))
+    table = gas_table(scene)
+    if table is not None:
+        mech = scene.mechanism
+        clearance = (mech.piston_area * mech.stroke() / (scene.gas.compression_ratio - 1.0)
+                     if scene.gas.model == "mixed-cycle" else 0.0)
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
+        plots.indicator_phi(a1, table)
+        if clearance > 0:
+            plots.indicator_pv(a2, table, mech.volume_function(clearance))
+        else:
+            plots.indicator_pv(a2, table, mech.volume_function(mech.piston_area * mech.stroke() / 17))
+            a2.set_title("p(V), clearance assumed V_h/17", fontsize=9)
+        a1.set_title(f"{scene.name}: indicator diagram")
+        written.append(_save(fig, out / f"{stem}_indicator.png"))
+    for w in written:
+        print(f"wrote {w}")
+    return EXIT_OK
+
+
+def _save(fig, path):
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def cmd_kinematics(args) -> int:
+    from .scene import load_scene
+
+    scene = load_scene(args.scene)
+    mech = scene.mechanism
+    phi = np.linspace(0.0, mech.cycle, args.points)
+    table = mech.kinematics_table(phi)
+    header = ",".join(table)
+    data = np.column_stack(list(table.values()))
+    if args.output:
+        np.savetxt(args.output, data, delimiter=",", header=header, comments="", fmt="%.12g")
+        print(f"wrote {args.output}")
+    else:
+        np.savetxt(sys.stdout, data, delimiter=",", header=header, comments="", fmt="%.12g")
+    return EXIT_OK

@@ -1,0 +1,90 @@
+"""Crank-slider kinematics and reduced inertia, exact (no truncated series).
+
+Frame of one cylinder (Gots §1, Fig. 1): origin on the crank axis, ``y`` along the cylinder axis
+toward the head, ``x`` to the side the crank moves at the top. The local crank angle ``alpha`` is
+measured from the cylinder axis in the direction of rotation; the cylinder axis is offset by ``e``
+toward positive ``x`` (Gots §1.4: "shifted to the right in the direction of rotation").
+
+Crankpin  A = r (sin α, cos α);  piston pin  B = (e, r cos α + l cos β),  sin β = (r sin α − e)/l
+(Gots (2), (13), (17) exact). β is positive when the rod leans in the direction of rotation.
+"""
+from __future__ import annotations
+
+from math import asin, cos, sin, sqrt
+
+from numba import njit
+
+#: Layout of the parameter array ``mp`` of :func:`crank_slider_terms` (filled by
+#: ``transient.mechanisms.crank_slider.CrankSlider.pack``).
+R, L, E, M_PISTON, M_PIN, M_CRANKPIN, M_ROD, ROD_CG, I_ROD, M_CRANK, N_CYL = range(11)
+PHASE0 = 11  # mp[PHASE0 + k]: shaft angle at which cylinder k has local angle 0
+
+
+@njit(cache=True)
+def slider(alpha, r, l, e):
+    """Exact crank-slider kinematics at local crank angle ``alpha`` [rad].
+
+    Returns
+    -------
+    s, ds, dds : float
+        Piston travel from the true top dead centre [m] (Gots (1), (12)) and its first and second
+        derivatives with respect to the crank angle [m/rad, m/rad²]; ``ds`` is positive toward the
+        crank, so a piston force P (positive toward the crank, Gots §2.3) has generalized force P·ds.
+    beta, dbeta, ddbeta : float
+        Rod angle [rad] and its derivatives [1, 1/rad] (Gots (7)–(8), (17)–(19) at ω = 1).
+    """
+    sa = sin(alpha)
+    ca = cos(alpha)
+    sb = (r * sa - e) / l
+    cb = sqrt(1.0 - sb * sb)
+    db = r * ca / (l * cb)
+    ddb = (l * sb * db * db - r * sa) / (l * cb)
+    y_pin = r * ca + l * cb
+    dy_pin = -r * sa - l * sb * db
+    ddy_pin = -r * ca - l * cb * db * db - l * sb * ddb
+    y_tdc = sqrt((l + r) ** 2 - e * e)
+    return y_tdc - y_pin, -dy_pin, -ddy_pin, asin(sb), db, ddb
+
+
+@njit(cache=True)
+def cylinder_terms(alpha, mp):
+    """Reduced inertia of one cylinder's moving parts (piston, rod, crank throw) and its derivative.
+
+    Equations (19), (21) of the swash-plate paper applied to the crank-slider: J = Σ m |v|²/φ̇² +
+    Σ I (β̇/φ̇)²; the rod is a rigid body (mass at its centre of mass G, inertia about G) and/or point
+    masses at the pin and the crankpin (the two-mass model of Gots (20)).
+
+    Returns ``(J, dJ, ds, dds)``: inertia [kg m²], dJ/dα [kg m²/rad], and the piston's transfer
+    function and its derivative.
+    """
+    r = mp[R]
+    l = mp[L]
+    s, ds, dds, beta, db, ddb = slider(alpha, r, mp[L], mp[E])
+    sa = sin(alpha)
+    ca = cos(alpha)
+    # Rod centre of mass G = B + f (A − B), f = |BG|/l; B moves only along the axis (B' = (0, −ds)).
+    f = mp[ROD_CG] / l
+    gx1 = f * r * ca
+    gy1 = (1.0 - f) * (-ds) - f * r * sa
+    gx2 = -f * r * sa
+    gy2 = (1.0 - f) * (-dds) - f * r * ca
+    m_slide = mp[M_PISTON] + mp[M_PIN]
+    m_rot = mp[M_CRANKPIN] + mp[M_CRANK]
+    J = m_slide * ds * ds + m_rot * r * r + mp[M_ROD] * (gx1 * gx1 + gy1 * gy1) + mp[I_ROD] * db * db
+    dJ = 2.0 * (m_slide * ds * dds + mp[M_ROD] * (gx1 * gx2 + gy1 * gy2) + mp[I_ROD] * db * ddb)
+    return J, dJ, ds, dds
+
+
+@njit(cache=True)
+def crank_slider_terms(mp, phi, u, du):
+    """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
+
+    ``u[k] = ds_k/dφ`` and ``du[k] = d²s_k/dφ²`` for cylinder k at local angle φ − mp[PHASE0 + k].
+    """
+    J = 0.0
+    dJ = 0.0
+    for k in range(int(mp[N_CYL])):
+        Jk, dJk, u[k], du[k] = cylinder_terms(phi - mp[PHASE0 + k], mp)
+        J += Jk
+        dJ += dJk
+    return J, dJ

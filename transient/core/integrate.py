@@ -1,0 +1,496 @@
+"""Compiled adaptive DOP853 with dense output, driven segment by segment (DESIGN §2).
+
+The solver loop is compiled together with the right-hand side (``model.derivative``). While
+ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint, so the
+right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal) it
+integrates in time, and a step that would cross a breakpoint is retaken so that it ends on it.
+Switches between the two, starter cut-out, speed reversals and the end of the run are state events
+located on the dense output (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
+
+:func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
+the Python caller can stream results, show progress and react to Ctrl-C between chunks.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from . import dop853_coefficients as dc
+from .model import KINETIC, N_STATE, OMEGA, PHI, T, derivative, inertia, output_row, speed
+
+_A = dc.A[: dc.N_STAGES, : dc.N_STAGES].copy()
+_B = dc.B.copy()
+_C = dc.C[: dc.N_STAGES].copy()
+_E3 = dc.E3.copy()
+_E5 = dc.E5.copy()
+_D = dc.D.copy()
+_A_EXTRA = dc.A[dc.N_STAGES + 1 :].copy()
+_C_EXTRA = dc.C[dc.N_STAGES + 1 :].copy()
+N_STAGES = dc.N_STAGES
+N_STAGES_EXTENDED = dc.N_STAGES_EXTENDED
+
+# Step-size control as in SciPy's DOP853 (error exponent −1/8).
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+
+# cfg[...] — settings (float64 array, filled by transient.simulate)
+C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range(8)
+C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS = range(8, 11)
+N_CFG = 11
+# fst[...] — float stepper state kept between chunks
+F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI = range(5)
+N_FST = 5
+# ist[...] — integer stepper state kept between chunks
+(I_ANGLE_MODE, I_STARTER_ON, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
+ I_NREDO) = range(10)
+N_IST = 10
+
+# advance() return codes
+RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP = 0, 1, 2, 3
+# event codes written to the event buffer as (code, t, phi, omega)
+EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END = range(6)
+EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
+               "speed_reversal", "end")
+
+
+@njit(cache=True)
+def _error_norm(K, h, y, y_new, rtol, atol, ix):
+    """DOP853 error norm with the 5th- and 3rd-order estimators (Hairer's blend).
+
+    The accumulating components (t in crank angle, φ in time) are scaled by their increment over
+    the step, not by their size: relative to |t| the allowed error would grow with the run's length
+    and a long run would lose phase for nothing. The independent variable ``ix`` has no error.
+    """
+    n = y.shape[0]
+    err5 = 0.0
+    err3 = 0.0
+    for i in range(n):
+        if i == ix:
+            continue
+        if i == PHI or i == T:
+            sc = atol + rtol * abs(y_new[i] - y[i])
+        else:
+            sc = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+        e5 = 0.0
+        e3 = 0.0
+        for s in range(N_STAGES + 1):
+            e5 += K[s, i] * _E5[s]
+            e3 += K[s, i] * _E3[s]
+        err5 += (e5 / sc) ** 2
+        err3 += (e3 / sc) ** 2
+    if err5 == 0.0 and err3 == 0.0:
+        return 0.0
+    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (n - 1))
+
+
+@njit(cache=True)
+def _step(m, angle_mode, x, y, f, h, sel, starter_on, K, y_new, tmp, u, du):
+    """One DOP853 step of size h from (x, y) with f = y′; K[0] must hold f.
+
+    Leaves the stages in K (K[12] = f(y_new)) and the new state in y_new.
+    """
+    n = y.shape[0]
+    for s in range(1, N_STAGES):
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += _A[s, j] * K[j, i]
+            tmp[i] = y[i] + h * acc
+        derivative(m, angle_mode, tmp, sel, starter_on, u, du, K[s])
+    for i in range(n):
+        acc = 0.0
+        for j in range(N_STAGES):
+            acc += _B[j] * K[j, i]
+        y_new[i] = y[i] + h * acc
+    # The independent variable advances exactly (exact stops on breakpoints).
+    y_new[PHI if angle_mode else T] = x + h
+    derivative(m, angle_mode, y_new, sel, starter_on, u, du, K[N_STAGES])
+
+
+@njit(cache=True)
+def _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du):
+    """Dense-output coefficients F (7 × n) of the last step (three extra stages)."""
+    n = y.shape[0]
+    for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
+        a = _A_EXTRA[s - N_STAGES - 1]
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += a[j] * K[j, i]
+            tmp[i] = y[i] + h * acc
+        derivative(m, angle_mode, tmp, sel, starter_on, u, du, K[s])
+    for i in range(n):
+        dy = y_new[i] - y[i]
+        F[0, i] = dy
+        F[1, i] = h * K[0, i] - dy
+        F[2, i] = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
+        for r in range(_D.shape[0]):
+            acc = 0.0
+            for j in range(N_STAGES_EXTENDED):
+                acc += _D[r, j] * K[j, i]
+            F[3 + r, i] = h * acc
+
+
+@njit(cache=True)
+def _dense_eval(F, y, theta, out):
+    """State at fraction θ ∈ [0, 1] of the last step."""
+    n = y.shape[0]
+    for i in range(n):
+        acc = 0.0
+        for r in range(F.shape[0] - 1, -1, -1):
+            acc += F[r, i]
+            if (F.shape[0] - 1 - r) % 2 == 0:
+                acc *= theta
+            else:
+                acc *= 1.0 - theta
+        out[i] = y[i] + acc
+
+
+@njit(cache=True)
+def _event_g(m, angle_mode, yv, comp, level, u, du):
+    """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), else y[comp] − level."""
+    if comp == OMEGA:
+        J, _ = inertia(m, yv[PHI], u, du)
+        return speed(J, angle_mode, yv) - level
+    return yv[comp] - level
+
+
+@njit(cache=True)
+def _crossing(m, angle_mode, F, y, comp, level, tmp, u, du):
+    """θ ∈ (0, 1] where the event function crosses zero on the dense output (Illinois method).
+
+    The caller has checked that it changes sign over the step.
+    """
+    a, b = 0.0, 1.0
+    ga = _event_g(m, angle_mode, y, comp, level, u, du)
+    _dense_eval(F, y, 1.0, tmp)
+    gb = _event_g(m, angle_mode, tmp, comp, level, u, du)
+    side = 0
+    for _ in range(100):
+        c = b - gb * (b - a) / (gb - ga)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        _dense_eval(F, y, c, tmp)
+        gc = _event_g(m, angle_mode, tmp, comp, level, u, du)
+        if gc == 0.0 or b - a < 1e-15:
+            return c
+        if (gc > 0.0) == (gb > 0.0):
+            b, gb = c, gc
+            if side == -1:
+                ga *= 0.5
+            side = -1
+        else:
+            a, ga = c, gc
+            if side == 1:
+                gb *= 0.5
+            side = 1
+    return b
+
+
+@njit(cache=True)
+def next_breakpoint(bp, period, phi, upward):
+    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle."""
+    tol = 1e-13 * max(1.0, abs(phi))
+    k = np.floor(phi / period)
+    if upward:
+        for c in range(2):
+            base = (k + c) * period
+            for j in range(bp.shape[0]):
+                v = base + bp[j]
+                if v > phi + tol:
+                    return v
+        return np.inf
+    for c in range(2):
+        base = (k - c) * period
+        for j in range(bp.shape[0] - 1, -1, -1):
+            v = base + bp[j]
+            if v < phi - tol:
+                return v
+    return -np.inf
+
+
+@njit(cache=True)
+def _emit_event(m, evbuf, ist, code, y, u, du):
+    j = ist[I_NEV]
+    if j < evbuf.shape[0]:
+        J, _ = inertia(m, y[PHI], u, du)
+        evbuf[j, 0] = code
+        evbuf[j, 1] = y[T]
+        evbuf[j, 2] = y[PHI]
+        evbuf[j, 3] = speed(J, ist[I_ANGLE_MODE] == 1, y)
+        ist[I_NEV] = j + 1
+
+
+@njit(cache=True)
+def _emit_row(m, y, sel, starter_on, outbuf, ist, fst, u, du):
+    output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, starter_on, u, du, outbuf[ist[I_NOUT]])
+    ist[I_NOUT] += 1
+    fst[F_LAST_T] = y[T]
+    fst[F_LAST_PHI] = y[PHI]
+
+
+@njit(cache=True)
+def _out_spacing(cfg, angle_mode):
+    return cfg[C_DPHI_OUT] if angle_mode else cfg[C_DT_OUT]
+
+
+@njit(cache=True)
+def _reset_output_grid(cfg, ist, fst, y):
+    """Next output sample: the first grid point of the current mode's grid beyond the state."""
+    angle_mode = ist[I_ANGLE_MODE] == 1
+    x = y[PHI] if angle_mode else y[T]
+    d = _out_spacing(cfg, angle_mode)
+    j = np.floor(x / d) + 1.0
+    fst[F_NEXT_OUT] = j * d
+
+
+@njit(cache=True)
+def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
+    """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
+
+    Parameters
+    ----------
+    m : Model
+    cfg : float64[N_CFG]
+        Settings, indices ``C_*``.
+    bp : float64[:]
+        Sorted breakpoints in [0, m.period).
+    y : float64[N_STATE]
+        State, updated in place.
+    fst, ist : float64[N_FST], int64[N_IST]
+        Stepper state kept between calls (zeros before the first call, plus ``ist[I_STARTER_ON]``).
+    outbuf : float64[nbuf, N_OUT_FIXED + ncyl]
+        Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
+    evbuf : float64[nev, 4]
+        Events (code, t, φ, ω); ``ist[I_NEV]`` rows filled.
+
+    Returns
+    -------
+    int
+        RUNNING, FINISHED, FAIL_NONFINITE or FAIL_STEP.
+    """
+    n = N_STATE
+    K = np.empty((N_STAGES_EXTENDED, n))
+    F = np.empty((7, n))
+    f = np.empty(n)
+    y_new = np.empty(n)
+    y_evt = np.empty(n)
+    tmp = np.empty(n)
+    u = np.empty(max(m.ncyl, 1))
+    du = np.empty(max(m.ncyl, 1))
+    rtol = cfg[C_RTOL]
+    atol = cfg[C_ATOL]
+    margin = 300  # rows kept free: a step never spans more than 256 output intervals
+    n_bad = 0  # consecutive non-finite step attempts
+
+    if ist[I_STARTED] == 0:
+        ist[I_STARTED] = 1
+        if y[OMEGA] >= cfg[C_W_HI]:
+            _to_angle_mode(m, y, ist, u, du)
+        fst[F_SEL] = y[PHI]
+        _reset_output_grid(cfg, ist, fst, y)
+        _emit_row(m, y, fst[F_SEL], ist[I_STARTER_ON] == 1, outbuf, ist, fst, u, du)
+
+    ist[I_F_VALID] = 0  # f is local to this call: recompute it once per chunk
+    steps_here = 0
+    while True:
+        if ist[I_NOUT] + margin >= outbuf.shape[0] or ist[I_NEV] + 8 >= evbuf.shape[0]:
+            return RUNNING
+        if steps_here >= cfg[C_CHUNK_STEPS]:
+            return RUNNING
+        angle_mode = ist[I_ANGLE_MODE] == 1
+        starter_on = ist[I_STARTER_ON] == 1
+        ix = PHI if angle_mode else T
+        x = y[ix]
+        if ist[I_F_VALID] == 0:
+            derivative(m, angle_mode, y, y[PHI], starter_on, u, du, f)
+            ist[I_NFEV] += 1
+            ist[I_F_VALID] = 1
+            if fst[F_H] <= 0.0:
+                # Initial step: a fixed fraction of a revolution (angle) or of the output spacing.
+                fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
+        # Where this segment ends: the next breakpoint or the end of the run.
+        up = next_breakpoint(bp, m.period, y[PHI], True)
+        down = next_breakpoint(bp, m.period, y[PHI], False)
+        if angle_mode:
+            x_end = min(up, cfg[C_PHI_END])
+            h_max = min(cfg[C_MAX_STEP_PHI], 256.0 * cfg[C_DPHI_OUT])
+        else:
+            x_end = cfg[C_T_END]
+            h_max = min(cfg[C_MAX_STEP_T], 256.0 * cfg[C_DT_OUT])
+        h = min(fst[F_H], h_max)
+        at_segment_end = False
+        if x + h >= x_end:
+            h = x_end - x
+            at_segment_end = True
+        min_step = 10.0 * (np.nextafter(abs(x), np.inf) - abs(x))
+        if h < min_step:
+            return FAIL_STEP
+        if angle_mode:
+            sel = x + 0.5 * h
+        else:
+            sel = y[PHI] + 0.5 * h * y[OMEGA]
+        for i in range(n):
+            K[0, i] = f[i]
+        _step(m, angle_mode, x, y, f, h, sel, starter_on, K, y_new, tmp, u, du)
+        ist[I_NFEV] += N_STAGES
+        err = _error_norm(K, h, y, y_new, rtol, atol, ix)
+        finite = np.isfinite(err)
+        for i in range(n):
+            finite = finite and np.isfinite(y_new[i])
+        if not finite:
+            # A trial step may leave the physical region (K < 0 in a stage): shrink it; only a
+            # non-finite value that persists at small steps is a failure.
+            n_bad += 1
+            if n_bad > 30:
+                return FAIL_NONFINITE
+            fst[F_H] = 0.2 * h
+            ist[I_NREJECT] += 1
+            steps_here += 1
+            continue
+        n_bad = 0
+        if err > 1.0:
+            fst[F_H] = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+            ist[I_NREJECT] += 1
+            steps_here += 1
+            continue
+        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+        h_next = h * factor
+        dense_ready = False
+        # In time, a step must not cross a breakpoint: retake it so that it ends there.
+        if not angle_mode and (y_new[PHI] > up or y_new[PHI] < down):
+            _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du)
+            ist[I_NFEV] += 3
+            level = up if y_new[PHI] > up else down
+            theta = _crossing(m, angle_mode, F, y, PHI, level, tmp, u, du)
+            if theta * h > min_step and ist[I_NREDO] < 4:
+                fst[F_H] = theta * h
+                ist[I_NREDO] += 1
+                ist[I_NREJECT] += 1
+                steps_here += 1
+                continue
+            dense_ready = True
+        redo_hit_breakpoint = ist[I_NREDO] > 0
+        ist[I_NREDO] = 0
+        # State events on this step: the earliest one truncates it.
+        ev_code = -1
+        ev_theta = 2.0
+        ev_comp = 0
+        ev_level = 0.0
+        # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
+        w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
+        w1 = 1.0 / K[N_STAGES, T] if angle_mode else y_new[OMEGA]
+        for e in range(5):
+            comp = OMEGA
+            level = 0.0
+            hit = False
+            code = -1
+            if e == 0 and starter_on:
+                level = m.starter_cutout
+                hit = w0 < level <= w1
+                code = EV_STARTER_CUTOUT
+            elif e == 1 and angle_mode:
+                level = cfg[C_W_LO]
+                hit = w1 < level <= w0
+                code = EV_TO_TIME
+            elif e == 2 and not angle_mode:
+                level = cfg[C_W_HI]
+                hit = w0 < level <= w1
+                code = EV_TO_ANGLE
+            elif e == 3 and not angle_mode:
+                hit = (w0 > 0.0 and w1 <= 0.0) or (w0 < 0.0 and w1 >= 0.0)
+                code = EV_REVERSAL
+            elif e == 4:
+                comp = T if angle_mode else PHI
+                level = cfg[C_T_END] if angle_mode else cfg[C_PHI_END]
+                hit = y[comp] < level <= y_new[comp]
+                code = EV_END
+            if hit:
+                if not dense_ready:
+                    _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du)
+                    ist[I_NFEV] += 3
+                    dense_ready = True
+                theta = _crossing(m, angle_mode, F, y, comp, level, tmp, u, du)
+                if theta < ev_theta:
+                    ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
+        x_stop = x + h if ev_code < 0 else x + ev_theta * h
+        # Output samples inside the step (dense output), then the step's end state.
+        d_out = _out_spacing(cfg, angle_mode)
+        if fst[F_NEXT_OUT] <= x_stop and not dense_ready:
+            _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du)
+            ist[I_NFEV] += 3
+            dense_ready = True
+        while fst[F_NEXT_OUT] <= x_stop:
+            _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
+            tmp[ix] = fst[F_NEXT_OUT]
+            _emit_row(m, tmp, sel, starter_on, outbuf, ist, fst, u, du)
+            fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
+        ist[I_NSTEPS] += 1
+        steps_here += 1
+        fst[F_H] = h_next
+        fst[F_SEL] = sel
+        if ev_code < 0:
+            for i in range(n):
+                y[i] = y_new[i]
+                f[i] = K[N_STAGES, i]
+            if angle_mode and at_segment_end and x_end == up:
+                _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, u, du)
+            elif redo_hit_breakpoint:
+                _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, u, du)
+            if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
+                return _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du)
+            if not angle_mode and at_segment_end:
+                return _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du)
+            continue
+        # Truncate the step at the event, act on it and restart from there.
+        _dense_eval(F, y, ev_theta, y_evt)
+        y_evt[ix] = x_stop
+        if ev_comp != OMEGA:
+            y_evt[ev_comp] = ev_level
+        elif angle_mode:  # put the speed exactly on the level: K = ½ J ω²
+            J, _ = inertia(m, y_evt[PHI], u, du)
+            y_evt[KINETIC] = 0.5 * J * ev_level * ev_level
+        else:
+            y_evt[OMEGA] = ev_level
+        for i in range(n):
+            y[i] = y_evt[i]
+        ist[I_F_VALID] = 0
+        _emit_event(m, evbuf, ist, ev_code, y, u, du)
+        if ev_code == EV_END:
+            return _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du)
+        if ev_code == EV_STARTER_CUTOUT:
+            ist[I_STARTER_ON] = 0
+        elif ev_code == EV_TO_TIME:
+            _to_time_mode(m, y, ist, u, du)
+            fst[F_H] = h_next / ev_level
+            _reset_output_grid(cfg, ist, fst, y)
+        elif ev_code == EV_TO_ANGLE:
+            _to_angle_mode(m, y, ist, u, du)
+            fst[F_H] = h_next * ev_level
+            _reset_output_grid(cfg, ist, fst, y)
+
+
+@njit(cache=True)
+def _to_angle_mode(m, y, ist, u, du):
+    """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
+    J, _ = inertia(m, y[PHI], u, du)
+    y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
+    ist[I_ANGLE_MODE] = 1
+
+
+@njit(cache=True)
+def _to_time_mode(m, y, ist, u, du):
+    """Time becomes the independent variable; the third state becomes ω."""
+    J, _ = inertia(m, y[PHI], u, du)
+    y[OMEGA] = speed(J, True, y)
+    ist[I_ANGLE_MODE] = 0
+
+
+@njit(cache=True)
+def _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du):
+    """Write the final state as the last sample (unless it already is one) and an end event."""
+    last = outbuf[ist[I_NOUT] - 1] if ist[I_NOUT] > 0 else outbuf[0]
+    if ist[I_NOUT] == 0 or last[0] != y[T] or last[1] != y[PHI]:
+        _emit_row(m, y, sel, starter_on, outbuf, ist, fst, u, du)
+    if ist[I_NEV] == 0 or evbuf[ist[I_NEV] - 1, 0] != EV_END:
+        _emit_event(m, evbuf, ist, EV_END, y, u, du)
+    return FINISHED

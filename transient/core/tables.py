@@ -1,0 +1,156 @@
+"""Compiled look-up of periodic piecewise-cubic tables (cylinder pressure against crank angle).
+
+A table describes one periodic curve over a cycle ``[0, P)``. The cycle is cut at **corners**
+into **pieces**, and inside a piece the curve is a piecewise cubic on knots (C² for a cubic
+spline, C¹ for pchip). A jump or a kink may sit only at a corner, so the integrator, which stops
+on every corner (DESIGN.md §2, "breakpoints ... become segment ends"), only ever steps across
+smooth parts. The layout, shared by the right-hand side and by :mod:`transient.forces.gas`:
+
+``knots``, float64[n + 1]
+    Strictly increasing, ``knots[0] = 0`` and ``knots[n] = P``. Every corner is a knot.
+``coef``, float64[n, 4]
+    Local polynomial of knot interval ``i``: ``c0 + c1*d + c2*d**2 + c3*d**3`` with
+    ``d = x - knots[i]``.
+``piece_knot``, int64[m + 1]
+    Knot index of each corner: piece ``j`` covers knot intervals ``piece_knot[j]`` to
+    ``piece_knot[j + 1] - 1``. ``piece_knot[0] = 0`` and ``piece_knot[m] = n``.
+
+The corners in angle are ``knots[piece_knot]``. Angles are in radians, values in SI (Pa).
+The plain-numpy twin is :meth:`transient.forces.gas.PressureTable.evaluate`.
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def find_piece(knots, piece_knot, x):
+    """Index of the piece that contains the angle `x`.
+
+    Parameters
+    ----------
+    knots : float64[n + 1]
+        Knot angles [rad], ``knots[0] = 0``, ``knots[n] = P``.
+    piece_knot : int64[m + 1]
+        Knot index of each corner.
+    x : float
+        Angle [rad], expected in ``[0, P)``; no wrapping is done here.
+
+    Returns
+    -------
+    int
+        ``j`` in ``[0, m - 1]`` with ``corner[j] <= x < corner[j + 1]``. An `x` exactly on a
+        corner belongs to the piece that starts there. Values below 0 give piece 0 and values
+        at or above ``P`` give the last piece, so a caller that rounds just past the cycle end
+        still gets a valid index.
+    """
+    # Largest j in [0, m-1] with knots[piece_knot[j]] <= x; bisection on the corners only.
+    lo = 0
+    hi = piece_knot.shape[0] - 2
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if knots[piece_knot[mid]] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+@njit(cache=True)
+def table_eval(knots, coef, piece_knot, piece, x):
+    """Value and slope of the table at `x`, using the polynomials of `piece` only.
+
+    The knot interval is found by bisection and clamped into the intervals of `piece`. The
+    integrator chooses `piece` from the midpoint of its step and stops on corners, so a step
+    ending exactly on a corner evaluates the polynomial of the piece it lies in (the left limit
+    of a jump), not the next piece. An `x` a hair outside the piece extrapolates the piece's end
+    polynomial, which is what the stepper wants.
+
+    Parameters
+    ----------
+    knots : float64[n + 1]
+        Knot angles [rad].
+    coef : float64[n, 4]
+        Local cubic coefficients per knot interval (ascending powers of ``x - knots[i]``).
+    piece_knot : int64[m + 1]
+        Knot index of each corner.
+    piece : int
+        Piece to evaluate, in ``[0, m - 1]``.
+    x : float
+        Angle [rad], not wrapped.
+
+    Returns
+    -------
+    value : float
+        Table value (Pa for a pressure table).
+    slope : float
+        Derivative with respect to the angle (Pa/rad).
+    """
+    # Search only the piece's own intervals: the same result as a global search clamped into
+    # the piece, and fewer comparisons.
+    lo = piece_knot[piece]
+    hi = piece_knot[piece + 1] - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if knots[mid] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    d = x - knots[lo]
+    c0 = coef[lo, 0]
+    c1 = coef[lo, 1]
+    c2 = coef[lo, 2]
+    c3 = coef[lo, 3]
+    value = c0 + d * (c1 + d * (c2 + d * c3))
+    slope = c1 + d * (2.0 * c2 + 3.0 * d * c3)
+    return value, slope
+
+
+@njit(cache=True)
+def wrap_angle(x, period):
+    """`x` reduced into ``[0, period)``.
+
+    Parameters
+    ----------
+    x : float
+        Angle [rad], any value (the shaft angle is unwrapped).
+    period : float
+        Cycle length [rad], ``4*pi`` for a 4-stroke and ``2*pi`` for a 2-stroke.
+
+    Returns
+    -------
+    float
+        ``x mod period`` in ``[0, period)``.
+    """
+    y = x - period * math.floor(x / period)
+    # floor() can leave y == period when x is a hair below a multiple of the period.
+    if y >= period:
+        y -= period
+    if y < 0.0:
+        y = 0.0
+    return y
+
+
+@njit(cache=True)
+def table_value(knots, coef, piece_knot, x):
+    """Table value at any angle `x`: wrap into the cycle, find the piece, evaluate.
+
+    Parameters
+    ----------
+    knots, coef, piece_knot
+        The table arrays (see the module docstring).
+    x : float
+        Angle [rad], any value; it is wrapped modulo ``knots[-1]``.
+
+    Returns
+    -------
+    float
+        Value at `x`. At a jump this is the right limit (a corner belongs to the piece that
+        starts there).
+    """
+    y = wrap_angle(x, knots[knots.shape[0] - 1])
+    piece = find_piece(knots, piece_knot, y)
+    value, _ = table_eval(knots, coef, piece_knot, piece, y)
+    return value

@@ -1,0 +1,190 @@
+"""Crank-slider engines (in-line, V, offset): geometry, masses, validation and the kinematics table.
+
+The compiled kinematics live in :mod:`transient.core.crank_slider`; this module holds the scene-side
+description (SI units) and packs it for the kernel.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import asin, degrees, pi
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..core import crank_slider as core
+from ..errors import SceneError
+
+
+@dataclass(frozen=True)
+class CrankSlider:
+    """A crank-slider engine; all cylinders share one geometry (Gots §1, §2.2).
+
+    Attributes
+    ----------
+    crank_radius : float
+        r [m].
+    rod_length : float
+        Connecting-rod length between pin centres, l [m]; λ = r/l < 1.
+    offset : float
+        Cylinder-axis offset e [m], positive in the direction of rotation (Gots §1.4).
+    bore : float
+        Cylinder bore D [m]; piston area π D²/4.
+    piston_mass : float
+        Piston group mass [kg].
+    crank_mass : float
+        Unbalanced crank-throw mass reduced to the crank radius, Gots (28) [kg] (per throw).
+    rod_model : str
+        ``"two-mass"`` (Gots (20): masses at pin and crankpin, rod inertia not kept) or ``"rigid"``.
+    rod_mass : float
+        Connecting-rod mass [kg].
+    rod_cg_from_pin : float
+        Distance from the piston-pin centre to the rod's centre of mass, Gots l₁ [m].
+    rod_inertia_cg : float
+        Rod moment of inertia about its centre of mass [kg m²] (rigid model only).
+    strokes : int
+        2 or 4.
+    firing_angles : tuple of float
+        Shaft angle [rad] at which each cylinder's crank is at local angle 0 (its firing TDC for a
+        central mechanism), in [0, cycle).
+    bank_angles : tuple of float
+        Cylinder-axis angles [rad] from the reference axis, in the direction of rotation (V engines).
+    """
+
+    crank_radius: float
+    rod_length: float
+    offset: float
+    bore: float
+    piston_mass: float
+    crank_mass: float
+    rod_model: str
+    rod_mass: float
+    rod_cg_from_pin: float
+    rod_inertia_cg: float
+    strokes: int
+    firing_angles: tuple[float, ...]
+    bank_angles: tuple[float, ...]
+
+    kind = core_kind = 0
+
+    @property
+    def n_cylinders(self) -> int:
+        return len(self.firing_angles)
+
+    @property
+    def piston_area(self) -> float:
+        return pi * self.bore**2 / 4.0
+
+    @property
+    def cycle(self) -> float:
+        """Cycle length in crank angle [rad]."""
+        return 2.0 * pi * self.strokes / 2.0
+
+    @property
+    def lam(self) -> float:
+        """λ = r/l."""
+        return self.crank_radius / self.rod_length
+
+    def validate(self) -> None:
+        """Raise :class:`SceneError` for a geometry or mass set that cannot work."""
+        r, l, e = self.crank_radius, self.rod_length, self.offset
+        if not r > 0:
+            raise SceneError("mechanism.crank_radius", f"must be > 0, got {r * 1e3:g} mm")
+        if not l > 0:
+            raise SceneError("mechanism.rod_length", f"must be > 0, got {l * 1e3:g} mm")
+        if r / l >= 1.0:
+            raise SceneError("mechanism.rod_length",
+                             f"λ = r/l = {r / l:.4g} must be < 1 (rod longer than the crank radius "
+                             f"{r * 1e3:g} mm)")
+        if abs(e) >= l - r:
+            raise SceneError("mechanism.offset",
+                             f"|offset| = {abs(e) * 1e3:g} mm is too large for the geometry; "
+                             f"allowed |offset| < l − r = {(l - r) * 1e3:g} mm")
+        if not self.bore > 0:
+            raise SceneError("mechanism.bore", f"must be > 0, got {self.bore * 1e3:g} mm")
+        if not self.piston_mass > 0:
+            raise SceneError("mechanism.piston_mass", f"must be > 0 kg, got {self.piston_mass:g}")
+        if not self.crank_mass >= 0:
+            raise SceneError("mechanism.crank_mass", f"must be ≥ 0 kg, got {self.crank_mass:g}")
+        if self.rod_model not in ("two-mass", "rigid"):
+            raise SceneError("mechanism.rod.model",
+                             f"unknown model {self.rod_model!r}; allowed: 'two-mass', 'rigid'")
+        if not self.rod_mass > 0:
+            raise SceneError("mechanism.rod.mass", f"must be > 0 kg, got {self.rod_mass:g}")
+        if not 0.0 <= self.rod_cg_from_pin <= l:
+            raise SceneError("mechanism.rod.cg_from_pin",
+                             f"{self.rod_cg_from_pin * 1e3:g} mm is off the rod; allowed 0 … "
+                             f"{l * 1e3:g} mm (the rod length)")
+        if not self.rod_inertia_cg >= 0:
+            raise SceneError("mechanism.rod.inertia_cg", f"must be ≥ 0, got {self.rod_inertia_cg:g}")
+        if self.strokes not in (2, 4):
+            raise SceneError("mechanism.strokes", f"must be 2 or 4, got {self.strokes}")
+        if self.n_cylinders < 1:
+            raise SceneError("mechanism.cylinders", "must be ≥ 1")
+        for a in self.firing_angles:
+            if not 0.0 <= a < self.cycle:
+                raise SceneError("mechanism.firing_deg",
+                                 f"{degrees(a):g}° is outside the cycle; allowed 0 ≤ angle < "
+                                 f"{degrees(self.cycle):g}°")
+
+    def pack(self) -> NDArray[np.float64]:
+        """Parameter array for :func:`transient.core.crank_slider.crank_slider_terms`."""
+        l = self.rod_length
+        mp = np.zeros(core.PHASE0 + self.n_cylinders)
+        mp[core.R] = self.crank_radius
+        mp[core.L] = l
+        mp[core.E] = self.offset
+        mp[core.M_PISTON] = self.piston_mass
+        mp[core.M_CRANK] = self.crank_mass
+        if self.rod_model == "two-mass":  # Gots (20): m₁ = m(l − l₁)/l at the pin, m₂ = m l₁/l
+            mp[core.M_PIN] = self.rod_mass * (l - self.rod_cg_from_pin) / l
+            mp[core.M_CRANKPIN] = self.rod_mass * self.rod_cg_from_pin / l
+        else:
+            mp[core.M_ROD] = self.rod_mass
+            mp[core.ROD_CG] = self.rod_cg_from_pin
+            mp[core.I_ROD] = self.rod_inertia_cg
+        mp[core.N_CYL] = self.n_cylinders
+        mp[core.PHASE0:] = self.firing_angles
+        return mp
+
+    def tdc_angle(self) -> float:
+        """Local crank angle of the true top dead centre, Gots (9): sin φ₁ = e/(l + r)."""
+        return asin(self.offset / (self.rod_length + self.crank_radius))
+
+    def stroke(self) -> float:
+        """Exact stroke, Gots (11)."""
+        r, l, e = self.crank_radius, self.rod_length, self.offset
+        return np.sqrt((l + r) ** 2 - e**2) - np.sqrt((l - r) ** 2 - e**2)
+
+    def kinematics_table(self, phi: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+        """Positions, transfer functions and J(φ), dJ/dφ of the moving parts over ``phi`` [rad]."""
+        mp = self.pack()
+        n = self.n_cylinders
+        cols: dict[str, list[float]] = {"phi_deg": list(np.degrees(phi)), "J": [], "dJ_dphi": []}
+        per = {f"{name}_{k + 1}": [] for k in range(n) for name in ("s", "u", "du", "beta_deg")}
+        u = np.empty(n)
+        du = np.empty(n)
+        for p in phi:
+            J, dJ = core.crank_slider_terms(mp, p, u, du)
+            cols["J"].append(J)
+            cols["dJ_dphi"].append(dJ)
+            for k in range(n):
+                s, ds, dds, beta, _, _ = core.slider(p - self.firing_angles[k], self.crank_radius,
+                                                     self.rod_length, self.offset)
+                per[f"s_{k + 1}"].append(s)
+                per[f"u_{k + 1}"].append(ds)
+                per[f"du_{k + 1}"].append(dds)
+                per[f"beta_deg_{k + 1}"].append(degrees(beta))
+        cols.update(per)
+        return {k: np.asarray(v) for k, v in cols.items()}
+
+    def volume_function(self, clearance: float):
+        """V(x) = V_c + F_p·s(x) over the local angle x [rad] (vectorised), for the cycle models."""
+        r, l, e, area = self.crank_radius, self.rod_length, self.offset, self.piston_area
+
+        def volume(x):
+            x = np.asarray(x, dtype=float)
+            sb = (r * np.sin(x) - e) / l
+            s = np.sqrt((l + r) ** 2 - e * e) - (r * np.cos(x) + l * np.sqrt(1.0 - sb * sb))
+            return clearance + area * s
+
+        return volume

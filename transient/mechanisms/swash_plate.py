@@ -1,0 +1,370 @@
+"""Swash-plate engines (Antonyuk et al., Fig. 1): geometry, masses, validation, positions, tables.
+
+The compiled kinematics and the frame are described in :mod:`transient.core.swash_plate`; this module
+holds the scene-side description (SI units), packs it for the kernel and gives numpy-level positions
+of every body for plots and checks.
+
+Choices the paper leaves open (``reference/antonyuk-swashplate-dynamics.md``, [D]):
+
+* Cylinder k (k = 0 … z−1; tables label it k + 1 like the paper's i) sits at ψ_Dk = 2πk/z (the
+  even spacing meant by "2π/i"), and its joint on link 9 at the same angle, ψ_k = ψ_Dk. In the
+  inverted motion link 9 turns on the plate by θ = −φ + δ(φ), with δ the Hooke joint's periodic
+  non-uniformity, while the cylinders turn by −φ; ψ_k = ψ_Dk keeps B_k on D_k's meridian on average,
+  so the lateral offset of the rod swings symmetrically about zero. A numeric minimax over ψ_k at
+  α = 21.4° (r₁ = R(1 + cos α)/2, either hinge) finds no better angle within 0.06°; at α = 44°
+  shifts of up to 0.36° lower the worst offset by about 2 %, not worth a second rule.
+* The rod's mass is split statically for the two-mass model: m(ℓ − c)/ℓ at D, m·c/ℓ at B
+  (c = ``rod_cg_from_pin``); this equals a rigid rod with inertia m·c(ℓ − c) about its centre of mass.
+* Link 9's centre of mass is at O (it is symmetric about the plate normal), so it only rotates.
+* ``halves = 2`` adds the mirror image through the plane I–I: plate 4, link 10, cross 15, rods 8 and
+  pistons 6 (opposed pistons in the same cylinders, same gas force).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import cos, degrees, pi, sin
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import brentq
+
+from ..core import swash_plate as core
+from ..errors import SceneError
+
+#: Housing hinge of cross 13 → (phase φ_h of the Hooke relation, hinge axis a = R_x(−φ_h) e_z);
+#: see transient.core.swash_plate.
+HINGES = {"normal": (0.0, (0.0, 0.0, 1.0)), "in-plane": (pi / 2.0, (0.0, 1.0, 0.0))}
+
+
+@dataclass(frozen=True, kw_only=True)
+class SwashPlate:
+    """A swash-plate engine with a Hooke-joint anti-rotation link (Antonyuk et al., Figs. 1–3).
+
+    Attributes
+    ----------
+    swash_angle : float
+        α [rad], tilt of the plate from the plane normal to the shaft; 0 < α < 45°.
+    joint_radius : float
+        R [m], radius of the circle of the joints B on link 9.
+    cylinder_radius : float
+        r₁ [m], radius of the circle of the cylinder axes.
+    rod_length : float
+        ℓ [m], distance between the spherical joints B and D of a rod.
+    bore : float
+        Cylinder bore [m].
+    cylinders : int
+        Cylinders z per half, evenly spaced at ψ_Dk = 2πk/z from Oy.
+    halves : int
+        1, or 2 for the opposed-piston engine with the mirror half (two pistons per cylinder).
+    hinge : str
+        Housing hinge of cross 13: ``"in-plane"`` (along Oy at φ = 0, in the plane of the shaft axis
+        and the plate normal, as the paper's text says) or ``"normal"`` (along Oz, for which the
+        printed (1) tan φ₉,₀ = tan φ₀,₀ cos α holds).
+    piston_mass : float
+        Mass of one piston [kg].
+    rod_model : str
+        ``"two-mass"`` (masses at the joints, split by ``rod_cg_from_pin``) or ``"rigid"``.
+    rod_mass : float
+        Mass of one rod [kg].
+    rod_cg_from_pin : float
+        Distance from the piston joint D to the rod's centre of mass [m], 0 … ℓ.
+    rod_inertia_cg : float
+        Rod moment of inertia about its centre of mass across its axis [kg m²] (rigid model only;
+        spin about the axis of a slender rod is ignored).
+    link_polar_inertia : float
+        Link 9's moment of inertia about the plate normal [kg m²].
+    link_diametral_inertia : float
+        Link 9's moment of inertia about a diameter in the plate plane [kg m²] (isotropic I₉: equal
+        to the polar one).
+    cross_inertia : float
+        I₁₃ [kg m²], cross 13 about its housing hinge.
+    """
+
+    swash_angle: float
+    joint_radius: float
+    cylinder_radius: float
+    rod_length: float
+    bore: float
+    cylinders: int
+    halves: int = 1
+    hinge: str = "in-plane"
+    piston_mass: float
+    rod_model: str = "two-mass"
+    rod_mass: float
+    rod_cg_from_pin: float
+    rod_inertia_cg: float = 0.0
+    link_polar_inertia: float
+    link_diametral_inertia: float
+    cross_inertia: float
+
+    @property
+    def n_cylinders(self) -> int:
+        """Cylinders (gas-force points) z; with two halves each holds two pistons."""
+        return self.cylinders
+
+    @property
+    def piston_area(self) -> float:
+        """π bore²/4 [m²]."""
+        return pi * self.bore**2 / 4.0
+
+    def validate(self) -> None:
+        """Raise :class:`SceneError` for a geometry or mass set that cannot work."""
+        a, R, r1, ell = self.swash_angle, self.joint_radius, self.cylinder_radius, self.rod_length
+        if not 0.0 < a < pi / 4.0:
+            raise SceneError("mechanism.swash_deg", f"{degrees(a):g}° is not allowed; 0° < α < 45°")
+        if not R > 0:
+            raise SceneError("mechanism.joint_radius", f"must be > 0, got {R * 1e3:g} mm")
+        if not isinstance(self.cylinders, (int, np.integer)) or self.cylinders < 1:
+            raise SceneError("mechanism.cylinders", f"must be an integer ≥ 1, got {self.cylinders!r}")
+        if self.halves not in (1, 2):
+            raise SceneError("mechanism.halves",
+                             f"must be 1 or 2 (opposed pistons), got {self.halves!r}")
+        if self.hinge not in HINGES:
+            raise SceneError("mechanism.hinge", f"unknown orientation {self.hinge!r}; allowed: "
+                                                "'in-plane', 'normal'")
+        if not ell > 0:
+            raise SceneError("mechanism.rod_length", f"must be > 0, got {ell * 1e3:g} mm")
+        # Even the best-placed cylinder sees B's distance from the axis swing over R cos α … R.
+        lo, hi = max(R - ell, 0.0), R * cos(a) + ell
+        if not lo < r1 < hi:
+            raise SceneError("mechanism.cylinder_radius",
+                             f"{r1 * 1e3:g} mm cannot be reached by rods of {ell * 1e3:g} mm from "
+                             f"joints at R = {R * 1e3:g} mm; allowed {lo * 1e3:g} < r₁ < "
+                             f"{hi * 1e3:g} mm")
+        reach = max_offset(self)
+        if not reach < ell:
+            raise SceneError("mechanism.rod_length",
+                             f"{ell * 1e3:g} mm is too short: over a turn a rod must bridge a lateral "
+                             f"offset of {reach * 1e3:.4g} mm; allowed ℓ > {reach * 1e3:.4g} mm")
+        if not self.bore > 0:
+            raise SceneError("mechanism.bore", f"must be > 0, got {self.bore * 1e3:g} mm")
+        if self.cylinders > 1 and self.bore >= 2.0 * r1 * sin(pi / self.cylinders):
+            raise SceneError("mechanism.bore",
+                             f"{self.bore * 1e3:g} mm makes neighbouring cylinders overlap; allowed "
+                             f"< {2e3 * r1 * sin(pi / self.cylinders):.4g} mm at r₁ = {r1 * 1e3:g} mm")
+        if self.rod_model not in ("two-mass", "rigid"):
+            raise SceneError("mechanism.rod.model",
+                             f"unknown model {self.rod_model!r}; allowed: 'two-mass', 'rigid'")
+        if not 0.0 <= self.rod_cg_from_pin <= ell:
+            raise SceneError("mechanism.rod.cg_from_pin",
+                             f"{self.rod_cg_from_pin * 1e3:g} mm is off the rod; allowed 0 … "
+                             f"{ell * 1e3:g} mm (the rod length)")
+        for key, value in (("piston_mass", self.piston_mass), ("rod.mass", self.rod_mass),
+                           ("rod.inertia_cg", self.rod_inertia_cg),
+                           ("link_polar_inertia", self.link_polar_inertia),
+                           ("link_diametral_inertia", self.link_diametral_inertia),
+                           ("cross_inertia", self.cross_inertia)):
+            if not value >= 0:
+                raise SceneError(f"mechanism.{key}", f"must be ≥ 0, got {value:g}")
+
+    def pack(self) -> NDArray[np.float64]:
+        """Parameter array for the kernels of :mod:`transient.core.swash_plate` (validates first)."""
+        self.validate()
+        return self._pack()
+
+    def _pack(self) -> NDArray[np.float64]:
+        z, ell, cg = self.cylinders, self.rod_length, self.rod_cg_from_pin
+        mp = np.zeros(core.CYL0 + core.CYL_STRIDE * z)
+        mp[core.ALPHA] = self.swash_angle
+        mp[core.COS_A] = cos(self.swash_angle)
+        mp[core.SIN_A] = sin(self.swash_angle)
+        mp[core.JOINT_R] = self.joint_radius
+        mp[core.CYL_R] = self.cylinder_radius
+        mp[core.ROD_L] = ell
+        mp[core.N_CYL] = z
+        mp[core.HALVES] = self.halves
+        mp[core.HINGE_PHASE] = HINGES[self.hinge][0]
+        mp[core.M_PISTON] = self.piston_mass
+        mp[core.M_ROD] = self.rod_mass
+        mp[core.ROD_CG] = cg
+        # Two masses m(ℓ − c)/ℓ at D and m c/ℓ at B are the rigid rod with I_G = m c (ℓ − c).
+        rigid = self.rod_model == "rigid"
+        mp[core.I_ROD] = self.rod_inertia_cg if rigid else self.rod_mass * cg * (ell - cg)
+        mp[core.J_POLAR] = self.link_polar_inertia
+        mp[core.J_DIAM] = self.link_diametral_inertia
+        mp[core.I_CROSS] = self.cross_inertia
+        psi_d = 2.0 * pi * np.arange(z) / z  # eq. (5) with the even spacing
+        psi = psi_d  # joints on link 9: ψ_k = ψ_Dk (module docstring)
+        cyl = mp[core.CYL0:].reshape(z, core.CYL_STRIDE)
+        cyl[:, core.Y_D] = self.cylinder_radius * np.cos(psi_d)
+        cyl[:, core.Z_D] = self.cylinder_radius * np.sin(psi_d)
+        cyl[:, core.COS_PSI] = np.cos(psi)
+        cyl[:, core.SIN_PSI] = np.sin(psi)
+        return mp
+
+    def kinematics_table(self, phi: ArrayLike) -> dict[str, NDArray[np.float64]]:
+        """See :func:`kinematics_table`."""
+        return kinematics_table(self, phi)
+
+    def stroke(self) -> NDArray[np.float64]:
+        """See :func:`stroke`."""
+        return stroke(self)
+
+
+def antonyuk_example(**changes) -> SwashPlate:
+    """The worked example of Antonyuk et al. §4, completed where the paper is silent.
+
+    From the paper: α = 21.4°, R = 0.136 m, m₅ = 6 kg, m₇ = 1 kg, I₉ = I₁₃ = 0.3 kg m² (isotropic
+    link 9), 4 cylinders per half. Chosen here [D]: r₁ = R(1 + cos α)/2 (the middle of the swing
+    R cos α … R of B's distance from the shaft, which minimises the worst lateral offset), ℓ = 0.30 m
+    (rod tilt ≤ 1.8°, inside the paper's 2°), rod centre of mass mid-way, bore 0.10 m, one half.
+    Keyword arguments replace fields.
+    """
+    alpha, R = np.radians(21.4), 0.136
+    base = dict(swash_angle=alpha, joint_radius=R, cylinder_radius=R * (1.0 + cos(alpha)) / 2.0,
+                rod_length=0.30, bore=0.10, cylinders=4, halves=1, hinge="in-plane",
+                piston_mass=6.0, rod_model="two-mass", rod_mass=1.0, rod_cg_from_pin=0.15,
+                rod_inertia_cg=0.0, link_polar_inertia=0.3, link_diametral_inertia=0.3,
+                cross_inertia=0.3)
+    base.update(changes)
+    return SwashPlate(**base)
+
+
+def _points(mp: NDArray[np.float64], phi: NDArray[np.float64]):
+    """θ(φ) and the joints B, D of half 1 (shape (n, z, 3) each) from the kernel."""
+    z = int(mp[core.N_CYL])
+    theta = np.empty(phi.size)
+    pts = np.empty((phi.size, z, 6))
+    core.swash_points(mp, np.ascontiguousarray(phi, dtype=np.float64), theta, pts)
+    return theta, pts[..., :3], pts[..., 3:]
+
+
+def max_offset(geom: SwashPlate, samples: int = 1441) -> float:
+    """Largest lateral offset |(B − D) × e_x| [m] of any rod over a turn, sampled (no validation).
+
+    It needs no x_D, so it also measures rods too short to reach (which is what validation asks).
+    """
+    _, B, D = _points(geom._pack(), np.linspace(0.0, 2.0 * pi, samples))
+    return float(np.hypot(B[..., 1] - D[..., 1], B[..., 2] - D[..., 2]).max())
+
+
+def _rotation(axis: NDArray[np.float64], angle: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Rotation matrices (n, 3, 3) by ``angle`` (n,) about the unit ``axis`` (3,) (Rodrigues)."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+def positions(geom: SwashPlate, phi: ArrayLike, mirror_x: float | None = None
+              ) -> dict[str, NDArray[np.float64]]:
+    """Positions and orientations of every moving body at shaft angle(s) ``phi`` [rad].
+
+    Parameters
+    ----------
+    geom : SwashPlate
+    phi : float or array (n,)
+        Shaft angles [rad].
+    mirror_x : float, optional
+        x [m] of the symmetry plane I–I for ``halves = 2`` (drawing only: no dynamics depends on it).
+        Default: one bore beyond the farthest reach of the joints D.
+
+    Returns
+    -------
+    dict
+        Arrays with leading axes (n, halves) (n dropped for a scalar ``phi``); half 1 first:
+
+        ``theta`` (n,) θ = φ₉,₀ [rad]; ``normal`` (…, 3) plate normal n; ``Q9`` (…, 3, 3) rotation of
+        link 9 from its pose at φ = 0; ``hinge_axis`` (…, 3) housing hinge a of cross 13;
+        ``cross_axis`` (…, 3) its hinge c on link 9 (a·c = 0 is the Hooke constraint); ``Q13``
+        (…, 3, 3) rotation of cross 13; ``B``, ``D``, ``G`` (…, z, 3) rod joints on link 9, piston
+        joints and rod centres of mass [m]; ``e_x`` (…, 3) the direction in which the gas force
+        pushes the pistons (toward their plate).
+    """
+    scalar = np.ndim(phi) == 0
+    phi = np.atleast_1d(np.asarray(phi, dtype=np.float64))
+    mp = geom.pack()
+    theta, B, D = _points(mp, phi)
+    a = geom.swash_angle
+    n0 = np.array([cos(a), sin(a), 0.0])
+    Rx = _rotation(np.array([1.0, 0.0, 0.0]), phi)
+    Q9 = Rx @ _rotation(n0, theta)
+    # The link-9 hinge c of cross 13 starts along n₀ × a, in the plate plane and across a.
+    hinge = np.array(HINGES[geom.hinge][1])
+    c0 = np.cross(n0, hinge)
+    c0 /= np.linalg.norm(c0)
+    c = Q9 @ c0
+    frame = np.stack([np.broadcast_to(hinge, c.shape), c, np.cross(hinge, c)], axis=-1)
+    frame0 = np.stack([hinge, c0, np.cross(hinge, c0)], axis=-1)
+    out = {"normal": Rx @ n0, "Q9": Q9, "hinge_axis": np.broadcast_to(hinge, c.shape).copy(),
+           "cross_axis": c, "Q13": frame @ frame0.T, "B": B, "D": D,
+           "G": D + geom.rod_cg_from_pin / geom.rod_length * (B - D),
+           "e_x": np.broadcast_to([1.0, 0.0, 0.0], c.shape).copy()}
+    out = {k: v[:, None] for k, v in out.items()}
+    if geom.halves == 2:
+        if mirror_x is None:
+            mirror_x = -(geom.rod_length + geom.joint_radius * sin(a) + geom.bore)
+        P = np.diag([-1.0, 1.0, 1.0])
+        shift = np.array([2.0 * mirror_x, 0.0, 0.0])
+        mirrored = {}
+        for k, v in out.items():
+            if k.startswith("Q"):
+                mirrored[k] = P @ v @ P  # the mirror body's rotation from its own initial pose
+            elif k in ("B", "D", "G"):
+                mirrored[k] = v @ P + shift
+            else:
+                mirrored[k] = v @ P  # directions
+        out = {k: np.concatenate([v, mirrored[k]], axis=1) for k, v in out.items()}
+    out["theta"] = theta
+    if scalar:
+        out = {k: v[0] for k, v in out.items()}
+    return out
+
+
+def stroke(geom: SwashPlate) -> NDArray[np.float64]:
+    """Exact stroke of each cylinder's piston (z,) [m]: x_D max − min over a turn (the opposed
+    piston of ``halves = 2`` moves as far).
+
+    The extremes of x_D are found on a grid and refined as roots of u_k = dx_D/dφ (Brent's method).
+    For ℓ → ∞ every stroke tends to 2R sin α; for finite ℓ the rod's lateral swing changes it slightly
+    and differently per cylinder.
+    """
+    mp = geom.pack()
+    z = geom.cylinders
+    u, du = np.empty(z), np.empty(z)
+
+    def rate(p: float, k: int) -> float:
+        core.swash_terms(mp, p, u, du)
+        return u[k]
+
+    grid = np.linspace(0.0, 2.0 * pi, 721)
+    h = grid[1]
+    x = _points(mp, grid)[2][..., 0]
+    out = np.empty(z)
+    for k in range(z):
+        ends = [brentq(rate, grid[j] - h, grid[j] + h, args=(k,), xtol=1e-15)
+                for j in (np.argmax(x[:, k]), np.argmin(x[:, k]))]
+        xk = _points(mp, np.array(ends))[2][:, k, 0]
+        out[k] = xk[0] - xk[1]
+    return out
+
+
+def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.float64]]:
+    """Positions, transfer functions and J(φ), dJ/dφ over the shaft angles ``phi`` [rad].
+
+    Columns: ``phi_deg``; ``u9`` = |ω₉|/φ̇ and ``u13`` = ω₁₃/φ̇ (eq. (13), derived from positions);
+    per cylinder k = 1 … z: ``x_<k>`` x of piston joint D [m] (negative: the pistons lie on the −x side
+    of the plate centre O), ``u_<k>`` [m/rad] and ``du_<k>`` [m/rad²] as filled by the kernel (summed
+    over both pistons when halves = 2), ``rod_tilt_<k>_deg`` angle between rod and cylinder axis;
+    ``J`` [kg m²], ``dJ_dphi`` [kg m²/rad]: the kernel's parts (all but shaft and plates).
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=np.float64))
+    mp = geom.pack()
+    z = geom.cylinders
+    sa2 = sin(geom.swash_angle) ** 2
+    _, B, D = _points(mp, phi)
+    cols: dict[str, NDArray[np.float64]] = {"phi_deg": np.degrees(phi)}
+    link = np.array([core.hooke(mp, p) for p in phi])
+    cols["u9"] = np.sqrt((cos(geom.swash_angle) + link[:, 1]) ** 2 + sa2)  # see core.hooke
+    cols["u13"] = link[:, 3]
+    u, du = np.empty((phi.size, z)), np.empty((phi.size, z))
+    JdJ = np.array([core.swash_terms(mp, p, u[j], du[j]) for j, p in enumerate(phi)])
+    rod = B - D
+    tilt = np.degrees(np.arctan2(np.hypot(rod[..., 1], rod[..., 2]), rod[..., 0]))
+    for k in range(z):
+        cols[f"x_{k + 1}"] = D[:, k, 0]
+        cols[f"u_{k + 1}"] = u[:, k]
+        cols[f"du_{k + 1}"] = du[:, k]
+        cols[f"rod_tilt_{k + 1}_deg"] = tilt[:, k]
+    cols["J"] = JdJ[:, 0]
+    cols["dJ_dphi"] = JdJ[:, 1]
+    return cols

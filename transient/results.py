@@ -1,0 +1,148 @@
+"""Result files (HDF5, format 1; DESIGN §4): a streaming writer and a reader.
+
+The writer works on a temporary name beside the final one, flushes after every block so that a
+killed run leaves a readable file, and renames it when the run ends — ``complete = True`` after a
+finished run, ``False`` after a failure or an interrupt.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from . import __version__
+
+FORMAT = 1
+
+
+class ResultExists(FileExistsError):
+    """The result file is there already and ``force`` was not given."""
+
+
+def check_writable(path: Path, force: bool) -> None:
+    """Fail before any work if the result exists (without force) or its folder is not writable."""
+    if path.exists() and not force:
+        raise ResultExists(f"{path}: exists; use --force to overwrite it")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not os.access(path.parent, os.W_OK):
+        raise PermissionError(f"{path.parent}: folder is not writable")
+
+
+class ResultWriter:
+    """Streams trajectory blocks into ``/trajectory``; see the module docstring."""
+
+    def __init__(self, path: Path, scene_name: str, scene_toml: str,
+                 columns: dict[str, str], force: bool = False) -> None:
+        self.path = Path(path)
+        check_writable(self.path, force)
+        self.tmp = self.path.with_name(f".{self.path.name}.part")
+        self.f = h5py.File(self.tmp, "w")
+        a = self.f.attrs
+        a["creator"] = "transient"
+        a["version"] = __version__
+        a["format"] = FORMAT
+        a["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+        a["scene"] = scene_name
+        a["complete"] = False
+        self.f.create_group("scene").create_dataset("toml", data=scene_toml)
+        traj = self.f.create_group("trajectory")
+        self.columns = columns
+        for name, unit in columns.items():
+            ds = traj.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
+                                     chunks=(4096,), compression="gzip", compression_opts=4,
+                                     shuffle=True)
+            ds.attrs["unit"] = unit
+        self.f.create_group("events")
+        self.f.create_group("solver")
+        self.f.create_group("analysis")
+        self.f.flush()
+
+    def append(self, block: dict[str, np.ndarray]) -> None:
+        """Append equal-length columns (every column of the file)."""
+        n = len(next(iter(block.values())))
+        if n == 0:
+            return
+        for name in self.columns:
+            ds = self.f["trajectory"][name]
+            ds.resize(ds.shape[0] + n, axis=0)
+            ds[-n:] = block[name]
+        self.f.flush()
+
+    def events(self, events: dict[str, np.ndarray]) -> None:
+        """``events[name]`` is an (n, 2) array of (t, φ)."""
+        for name, rows in events.items():
+            g = self.f["events"].require_group(name)
+            for j, col in enumerate(("t", "phi")):
+                if col in g:
+                    del g[col]
+                g.create_dataset(col, data=np.asarray(rows, dtype=float).reshape(-1, 2)[:, j])
+            g["t"].attrs["unit"] = "s"
+            g["phi"].attrs["unit"] = "rad"
+
+    def solver(self, attrs: dict[str, Any]) -> None:
+        for k, v in attrs.items():
+            self.f["solver"].attrs[k] = v
+
+    def analysis(self, name: str, value: Any, unit: str) -> None:
+        g = self.f["analysis"]
+        if name in g:
+            del g[name]
+        ds = g.create_dataset(name, data=value)
+        ds.attrs["unit"] = unit
+
+    def close(self, complete: bool, message: str = "") -> Path:
+        """Mark the file complete or not, close it and move it to its final name."""
+        self.f.attrs["complete"] = bool(complete)
+        if message:
+            self.f.attrs["message"] = message
+        self.f.close()
+        os.replace(self.tmp, self.path)
+        return self.path
+
+
+@dataclass
+class Result:
+    """A result file read back into memory."""
+
+    path: Path
+    attrs: dict[str, Any]
+    trajectory: dict[str, np.ndarray]
+    units: dict[str, str]
+    events: dict[str, dict[str, np.ndarray]]
+    solver: dict[str, Any]
+    analysis: dict[str, Any]
+    scene_toml: str
+
+    @property
+    def complete(self) -> bool:
+        return bool(self.attrs.get("complete", False))
+
+    def scene(self):
+        """Rebuild the scene from ``/scene/toml``."""
+        from .scene import load_scene
+
+        return load_scene(self.path.with_suffix(".toml"), text=self.scene_toml)
+
+
+def open_result(path: str | Path) -> Result:
+    """Read a result file (complete or not) into a :class:`Result`."""
+    path = Path(path)
+    with h5py.File(path, "r") as f:
+        if f.attrs.get("creator") != "transient":
+            raise ValueError(f"{path}: not a transient result file")
+        traj = {k: f["trajectory"][k][()] for k in f["trajectory"]}
+        units = {k: str(f["trajectory"][k].attrs.get("unit", "")) for k in f["trajectory"]}
+        events = {k: {c: g[c][()] for c in g} for k, g in f["events"].items()}
+        analysis = {}
+        for k, ds in f["analysis"].items():
+            value = ds[()]
+            analysis[k] = (value.decode() if isinstance(value, bytes) else value)
+        toml = f["scene"]["toml"][()]
+        return Result(path=path, attrs=dict(f.attrs), trajectory=traj, units=units, events=events,
+                      solver=dict(f["solver"].attrs), analysis=analysis,
+                      scene_toml=toml.decode() if isinstance(toml, bytes) else str(toml))

@@ -1,0 +1,565 @@
+"""Scenes: TOML → frozen dataclasses, validated before any work, and the resolved scene back to TOML.
+
+Every key may be written in SI (``crank_radius = 0.047``) or with one unit suffix at the edge
+(``crank_radius_mm = 47``); see :mod:`transient.units`. Unknown keys, wrong types and non-physical
+values raise :class:`transient.errors.SceneError` naming the file, the key, what is wrong and what
+is allowed.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import tomllib
+from dataclasses import dataclass, field, fields, is_dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import SceneError
+from .mechanisms.crank_slider import CrankSlider
+from .units import ALL_SUFFIXES, SUFFIXES
+
+_MISSING = object()
+
+
+class Section:
+    """One TOML table being read: takes keys off it, converts units, and reports what is left."""
+
+    def __init__(self, data: Any, path: str) -> None:
+        if not isinstance(data, dict):
+            raise SceneError(path, f"must be a table, got {type(data).__name__}")
+        self.data = dict(data)
+        self.path = path
+        self.known: list[str] = []
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def _take(self, name: str, kind: str | None):
+        """(value, SI factor, key as written) for a quantity given plain or with one unit suffix."""
+        self.known.append(name)
+        found = []
+        if name in self.data:
+            found.append((name, 1.0))
+        for suffix, factor in (SUFFIXES.get(kind, {}) if kind else {}).items():
+            if f"{name}_{suffix}" in self.data:
+                found.append((f"{name}_{suffix}", factor))
+        if len(found) > 1:
+            raise SceneError(self.key(found[1][0]),
+                             f"given twice (also as {found[0][0]!r}); give one of them")
+        if not found:
+            return _MISSING, 1.0, name
+        written, factor = found[0]
+        return self.data.pop(written), factor, written
+
+    def number(self, name: str, kind: str | None = None, default: Any = _MISSING, *,
+               gt: float | None = None, ge: float | None = None, lt: float | None = None,
+               le: float | None = None) -> float:
+        value, factor, written = self._take(name, kind)
+        if value is _MISSING:
+            if default is _MISSING:
+                raise SceneError(self.key(name), f"is missing; {self._unit_hint(name, kind)}")
+            return default
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SceneError(self.key(written), f"must be a number, got {_show(value)}")
+        if not math.isfinite(value):
+            raise SceneError(self.key(written), f"must be finite, got {value}")
+        self._check_range(written, value, gt, ge, lt, le, factor)
+        return float(value) * factor
+
+    def _check_range(self, written, value, gt, ge, lt, le, factor):
+        # Bounds are given in SI; compare in the units the user wrote.
+        for bound, ok, word in ((gt, lambda v, b: v > b, ">"), (ge, lambda v, b: v >= b, "≥"),
+                                (lt, lambda v, b: v < b, "<"), (le, lambda v, b: v <= b, "≤")):
+            if bound is not None and not ok(value * factor, bound):
+                raise SceneError(self.key(written),
+                                 f"must be {word} {bound / factor:g}, got {value:g}")
+
+    def integer(self, name: str, default: Any = _MISSING, *, ge: int | None = None,
+                choices: tuple[int, ...] | None = None) -> int:
+        value, _, written = self._take(name, None)
+        if value is _MISSING:
+            if default is _MISSING:
+                raise SceneError(self.key(name), "is missing; give a whole number")
+            return default
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise SceneError(self.key(written), f"must be a whole number, got {_show(value)}")
+        if ge is not None and value < ge:
+            raise SceneError(self.key(written), f"must be ≥ {ge}, got {value}")
+        if choices is not None and value not in choices:
+            raise SceneError(self.key(written),
+                             f"must be one of {', '.join(map(str, choices))}, got {value}")
+        return value
+
+    def string(self, name: str, default: Any = _MISSING, *,
+               choices: tuple[str, ...] | None = None) -> str:
+        value, _, written = self._take(name, None)
+        if value is _MISSING:
+            if default is _MISSING:
+                allowed = f"; allowed: {', '.join(choices)}" if choices else ""
+                raise SceneError(self.key(name), f"is missing{allowed}")
+            return default
+        if not isinstance(value, str):
+            raise SceneError(self.key(written), f"must be a string, got {_show(value)}")
+        if choices is not None and value not in choices:
+            raise SceneError(self.key(written),
+                             f"unknown value {value!r}; allowed: {', '.join(map(repr, choices))}")
+        return value
+
+    def numbers(self, name: str, kind: str | None = None, default: Any = _MISSING) -> tuple:
+        value, factor, written = self._take(name, kind)
+        if value is _MISSING:
+            if default is _MISSING:
+                raise SceneError(self.key(name), f"is missing; {self._unit_hint(name, kind)} list")
+            return default
+        if not isinstance(value, list) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                for v in value):
+            raise SceneError(self.key(written), f"must be a list of finite numbers, got "
+                                                f"{_show(value)}")
+        return tuple(float(v) * factor for v in value)
+
+    def integers(self, name: str, default: Any = _MISSING) -> tuple:
+        value, _, written = self._take(name, None)
+        if value is _MISSING:
+            if default is _MISSING:
+                raise SceneError(self.key(name), "is missing; give a list of whole numbers")
+            return default
+        if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool)
+                                                  for v in value):
+            raise SceneError(self.key(written), f"must be a list of whole numbers, got "
+                                                f"{_show(value)}")
+        return tuple(value)
+
+    def sub(self, name: str, required: bool = False) -> "Section":
+        self.known.append(name)
+        if name not in self.data:
+            if required:
+                raise SceneError(self.key(name), "is missing (a table)")
+            return Section({}, self.key(name))
+        return Section(self.data.pop(name), self.key(name))
+
+    def has(self, name: str, kind: str | None = None) -> bool:
+        names = [name] + [f"{name}_{s}" for s in SUFFIXES.get(kind, {})] if kind else [name]
+        return any(n in self.data for n in names)
+
+    def finish(self) -> None:
+        """Every key must have been read: anything left is unknown (or has a wrong unit suffix)."""
+        for key in self.data:
+            base, _, suffix = key.rpartition("_")
+            if base in self.known and suffix and suffix not in {s for k in SUFFIXES.values()
+                                                                for s in k}:
+                raise SceneError(self.key(key), f"unknown unit suffix '_{suffix}'; allowed "
+                                                f"suffixes: {', '.join('_' + s for s in ALL_SUFFIXES)}"
+                                                f" (or none, for SI)")
+            if base in self.known:
+                raise SceneError(self.key(key), f"unit suffix '_{suffix}' does not fit this "
+                                                f"quantity; {self._unit_hint(base, None)}")
+            raise SceneError(self.key(key), f"unknown key; allowed here: "
+                                            f"{', '.join(sorted(set(self.known)))}")
+
+    @staticmethod
+    def _unit_hint(name: str, kind: str | None) -> str:
+        options = [name] + [f"{name}_{s}" for s in SUFFIXES.get(kind, {})] if kind else [name]
+        return "give " + " or ".join(repr(o) for o in options)
+
+
+def _show(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+# ----------------------------------------------------------------------------------------------
+# Scene dataclasses (SI). The mechanism classes live in transient.mechanisms.
+
+
+@dataclass(frozen=True)
+class Inertia:
+    """Constant inertias on the shaft [kg m²]."""
+
+    shaft: float = 0.0
+    flywheel: float = 0.0
+    load: float = 0.0
+
+    @property
+    def total(self) -> float:
+        return self.shaft + self.flywheel + self.load
+
+
+@dataclass(frozen=True)
+class Gas:
+    """Cylinder pressure model (angle-only in this version).
+
+    ``model``: ``"none"``, ``"table"`` (indicator diagram p(φ) over one cycle, absolute pressure
+    [Pa]; local angle 0 = gas-exchange TDC for 4-stroke, firing TDC for 2-stroke ... see README) or
+    ``"mixed-cycle"`` (Gots App. 2, Trinkler–Sabathé). ``p0`` is the crankcase pressure [Pa]:
+    piston force (p − p0)·F_p, Gots (33).
+    """
+
+    model: str = "none"
+    p0: float = 1.0e5
+    phi: tuple[float, ...] = ()
+    p: tuple[float, ...] = ()
+    corners: tuple[float, ...] = ()
+    interpolation: str = "pchip"
+    compression_ratio: float = 0.0
+    p_a: float = 0.0
+    n1: float = 0.0
+    p_z: float = 0.0
+    rho: float = 0.0
+    n2: float = 0.0
+    p_intake: float = 0.0
+    p_exhaust: float = 0.0
+
+
+@dataclass(frozen=True)
+class Load:
+    """Resisting moments: −torque − linear·ω − fan·ω|ω| [N m] (signs as Gots §1: + with rotation)."""
+
+    torque: float = 0.0
+    linear: float = 0.0
+    fan: float = 0.0
+
+
+@dataclass(frozen=True)
+class Starter:
+    """Starter: M = torque·(1 − ω/noload_speed) until ω first reaches cutout_speed [N m, rad/s]."""
+
+    torque: float = 0.0
+    noload_speed: float = 1.0
+    cutout_speed: float = 1.0
+
+
+@dataclass(frozen=True)
+class Initial:
+    """Initial shaft angle [rad] and speed [rad/s]."""
+
+    phi: float = 0.0
+    omega: float = 0.0
+
+
+@dataclass(frozen=True)
+class Run:
+    """What to run: ``dynamic`` (integrate (18)) or ``prescribed-speed`` (inverse dynamics).
+
+    The run ends at ``t_end`` [s] or after ``revolutions`` of the shaft, whichever comes first
+    (``inf`` = not set). For prescribed speed: ``speed`` [rad/s] constant, or a table ``time`` [s],
+    ``speed_table`` [rad/s] interpolated by a cubic spline.
+    """
+
+    mode: str = "dynamic"
+    t_end: float = math.inf
+    revolutions: float = math.inf
+    speed: float = 0.0
+    time: tuple[float, ...] = ()
+    speed_table: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Solver:
+    """Integration settings. ``switch_speed`` [rad/s]: below it time is the independent variable."""
+
+    method: str = "dop853"
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    switch_speed: float = math.pi / 3.0  # 10 rpm
+    max_step: float = math.pi  # [rad] in crank angle
+
+
+@dataclass(frozen=True)
+class Output:
+    """Output sampling: ``samples_per_rev`` in crank angle; in time mode every ``dt`` [s]."""
+
+    samples_per_rev: int = 72
+    dt: float = 0.0  # 0: Δφ / switch_speed
+
+
+METHODS = ("dop853", "scipy-DOP853", "scipy-RK45", "scipy-Radau")
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    description: str
+    mechanism: CrankSlider
+    inertia: Inertia = field(default_factory=Inertia)
+    gas: Gas = field(default_factory=Gas)
+    load: Load = field(default_factory=Load)
+    starter: Starter = field(default_factory=Starter)
+    initial: Initial = field(default_factory=Initial)
+    run: Run = field(default_factory=Run)
+    solver: Solver = field(default_factory=Solver)
+    output: Output = field(default_factory=Output)
+
+
+# ----------------------------------------------------------------------------------------------
+# Readers, one per section
+
+
+def _read_crank_slider(s: Section) -> CrankSlider:
+    r = s.number("crank_radius", "length")
+    l = s.number("rod_length", "length")
+    strokes = s.integer("strokes", 4, choices=(2, 4))
+    n = s.integer("cylinders", 1, ge=1)
+    cycle = math.pi * strokes
+    order = s.integers("firing_order", tuple(range(1, n + 1)))
+    if sorted(order) != list(range(1, n + 1)):
+        raise SceneError(s.key("firing_order"),
+                         f"must list each cylinder 1 … {n} once, got {list(order)}")
+    even = [0.0] * n
+    for j, c in enumerate(order):
+        even[c - 1] = j * cycle / n
+    firing = s.numbers("firing", "angle", tuple(even))
+    banks = s.numbers("bank", "angle", (0.0,) * n)
+    for key, values in (("firing_deg", firing), ("bank_deg", banks)):
+        if len(values) != n:
+            raise SceneError(s.key(key), f"has {len(values)} entries; must have one per cylinder "
+                                         f"({n})")
+    rod = s.sub("rod", required=True)
+    model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
+    mech = CrankSlider(
+        crank_radius=r, rod_length=l, offset=s.number("offset", "length", 0.0),
+        bore=s.number("bore", "length"), piston_mass=s.number("piston_mass"),
+        crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
+        rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
+        rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
+        strokes=strokes, firing_angles=firing, bank_angles=banks)
+    rod.finish()
+    mech.validate()
+    return mech
+
+
+MECHANISMS = {"crank-slider": _read_crank_slider}
+
+
+def _read_gas(s: Section, base_dir: Path) -> Gas:
+    model = s.string("model", "none", choices=("none", "table", "mixed-cycle"))
+    p0 = s.number("p0", "pressure", 1.0e5, ge=0.0)
+    if model == "none":
+        return Gas(model="none", p0=p0)
+    if model == "table":
+        if s.has("file"):
+            phi, p = _read_pressure_csv(s, base_dir)
+        else:
+            phi = s.numbers("phi", "angle")
+            p = s.numbers("p", "pressure")
+        corners = s.numbers("corners", "angle", ())
+        interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
+        return Gas(model="table", p0=p0, phi=phi, p=p, corners=corners, interpolation=interp)
+    return Gas(
+        model="mixed-cycle", p0=p0,
+        compression_ratio=s.number("compression_ratio", gt=1.0),
+        p_a=s.number("p_a", "pressure", gt=0.0), n1=s.number("n1", gt=1.0),
+        p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
+        n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
+        p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+
+
+def _read_pressure_csv(s: Section, base_dir: Path):
+    """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
+    name = s.string("file")
+    path = (base_dir / name).resolve()
+    if not path.is_file():
+        raise SceneError(s.key("file"), f"no such file {str(path)!r}; give a CSV path relative "
+                                        f"to the scene")
+    angle_cols = {"phi_deg": math.pi / 180.0, "phi": 1.0}
+    p_cols = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
+    with path.open(newline="") as fh:
+        rows = list(csv.reader(line for line in fh if not line.startswith("#")))
+    header = [h.strip() for h in rows[0]] if rows else []
+    a = next((c for c in header if c in angle_cols), None)
+    b = next((c for c in header if c in p_cols), None)
+    if a is None or b is None:
+        raise SceneError(s.key("file"), f"{path.name}: needs an angle column ({', '.join(angle_cols)})"
+                                        f" and a pressure column ({', '.join(p_cols)}); "
+                                        f"header is {header}")
+    ia, ib = header.index(a), header.index(b)
+    try:
+        phi = tuple(float(r[ia]) * angle_cols[a] for r in rows[1:] if r)
+        p = tuple(float(r[ib]) * p_cols[b] for r in rows[1:] if r)
+    except (ValueError, IndexError) as exc:
+        raise SceneError(s.key("file"), f"{path.name}: a row is not numeric ({exc})") from None
+    return phi, p
+
+
+def _read_run(s: Section, mech) -> Run:
+    mode = s.string("mode", "dynamic", choices=("dynamic", "prescribed-speed"))
+    t_end = s.number("t_end", default=math.inf, gt=0.0)
+    revs = s.number("revolutions", default=math.inf, gt=0.0)
+    if math.isinf(t_end) and math.isinf(revs):
+        raise SceneError(s.key("t_end"), "the run needs an end: give t_end [s] and/or revolutions")
+    if mode == "dynamic":
+        return Run(mode=mode, t_end=t_end, revolutions=revs)
+    if s.has("speed", "speed"):
+        speed = s.number("speed", "speed", gt=0.0)
+        return Run(mode=mode, t_end=t_end, revolutions=revs, speed=speed)
+    time = s.numbers("time")
+    table = s.numbers("speed_table", "speed")
+    if len(time) != len(table) or len(time) < 2:
+        raise SceneError(s.key("speed_table"), f"needs as many entries as 'time' (≥ 2); got "
+                                               f"{len(table)} and {len(time)}")
+    if any(b <= a for a, b in zip(time, time[1:])):
+        raise SceneError(s.key("time"), "must increase strictly")
+    if min(table) <= 0:
+        raise SceneError(s.key("speed_table"), "speeds must be > 0 in a prescribed-speed run")
+    return Run(mode=mode, t_end=min(t_end, time[-1]), revolutions=revs, time=time,
+               speed_table=table)
+
+
+def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
+    """Build and validate a scene from parsed TOML. Raises :class:`SceneError`."""
+    base_dir = base_dir or Path.cwd()
+    try:
+        root = Section(data, "")
+        head = root.sub("scene")
+        name = head.string("name", Path(file).stem if file else "scene")
+        description = head.string("description", "")
+        head.finish()
+        ms = root.sub("mechanism", required=True)
+        kind = ms.string("type", choices=tuple(MECHANISMS))
+        mech = MECHANISMS[kind](ms)
+        ms.finish()
+        sections = {}
+        si = root.sub("inertia")
+        sections["inertia"] = Inertia(si.number("shaft", default=0.0, ge=0.0),
+                                      si.number("flywheel", default=0.0, ge=0.0),
+                                      si.number("load", default=0.0, ge=0.0))
+        si.finish()
+        sg = root.sub("gas")
+        sections["gas"] = _read_gas(sg, base_dir)
+        sg.finish()
+        sl = root.sub("load")
+        sections["load"] = Load(sl.number("torque", default=0.0, ge=0.0),
+                                sl.number("linear", default=0.0, ge=0.0),
+                                sl.number("fan", default=0.0, ge=0.0))
+        sl.finish()
+        ss = root.sub("starter")
+        torque = ss.number("torque", default=0.0, ge=0.0)
+        noload = ss.number("noload_speed", "speed", 1.0, gt=0.0)
+        cutout = ss.number("cutout_speed", "speed", noload, gt=0.0, le=noload)
+        sections["starter"] = Starter(torque, noload, cutout)
+        ss.finish()
+        s0 = root.sub("initial")
+        sections["initial"] = Initial(s0.number("phi", "angle", 0.0),
+                                      s0.number("omega", "speed", 0.0))
+        s0.finish()
+        sr = root.sub("run", required=True)
+        sections["run"] = _read_run(sr, mech)
+        sr.finish()
+        sv = root.sub("solver")
+        sections["solver"] = Solver(
+            method=sv.string("method", "dop853", choices=METHODS),
+            rtol=sv.number("rtol", default=1e-8, gt=0.0, lt=1.0),
+            atol=sv.number("atol", default=1e-10, gt=0.0),
+            switch_speed=sv.number("switch_speed", "speed", math.pi / 3.0, gt=0.0),
+            max_step=sv.number("max_step", "angle", math.pi, gt=0.0))
+        sv.finish()
+        so = root.sub("output")
+        sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4),
+                                    so.number("dt", default=0.0, ge=0.0))
+        so.finish()
+        root.finish()
+        scene = Scene(name=name, description=description, mechanism=mech, **sections)
+        _check_consistency(scene)
+        return scene
+    except SceneError as exc:
+        exc.file = exc.file or file
+        exc.args = (exc.line(),)
+        raise
+
+
+def _check_consistency(scene: Scene) -> None:
+    """Checks across sections, done before any integration."""
+    if scene.inertia.total + scene.mechanism.piston_mass <= 0:
+        raise SceneError("inertia", "the machine has no inertia")
+    if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
+        if scene.gas.model == "none":
+            raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
+                                              "never moves; give omega or a starter")
+    from .assemble import gas_table  # builds (and so validates) the pressure table
+    gas_table(scene)
+
+
+def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
+    """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
+    path = Path(source)
+    if text is None:
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise SceneError("(file)", f"cannot read: {exc.strerror}", file=str(path)) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError("(syntax)", f"not valid TOML: {exc}", file=str(path)) from None
+    return scene_from_dict(data, file=str(path), base_dir=path.parent)
+
+
+# ----------------------------------------------------------------------------------------------
+# Resolved scene → TOML (SI, every default filled in); load_scene reads it back to the same scene
+
+
+def to_toml(scene: Scene) -> str:
+    """The resolved scene as TOML in SI units (no suffixes), round-tripping through load_scene."""
+    lines = ["# resolved scene: SI units, every default filled in (written by transient)",
+             "[scene]", f"name = {_toml(scene.name)}", f"description = {_toml(scene.description)}"]
+    mech = scene.mechanism
+    lines += ["", "[mechanism]", 'type = "crank-slider"']
+    mech_keys = {"crank_radius": mech.crank_radius, "rod_length": mech.rod_length,
+                 "offset": mech.offset, "bore": mech.bore, "piston_mass": mech.piston_mass,
+                 "crank_mass": mech.crank_mass, "strokes": mech.strokes,
+                 "cylinders": mech.n_cylinders, "firing": list(mech.firing_angles),
+                 "bank": list(mech.bank_angles)}
+    lines += [f"{k} = {_toml(v)}" for k, v in mech_keys.items()]
+    lines += ["", "[mechanism.rod]", f"model = {_toml(mech.rod_model)}", f"mass = {_toml(mech.rod_mass)}",
+              f"cg_from_pin = {_toml(mech.rod_cg_from_pin)}"]
+    if mech.rod_model == "rigid":
+        lines.append(f"inertia_cg = {_toml(mech.rod_inertia_cg)}")
+    lines += _section("inertia", scene.inertia)
+    lines += _gas_section(scene.gas)
+    lines += _section("load", scene.load)
+    lines += _section("starter", scene.starter)
+    lines += _section("initial", scene.initial)
+    run = {"mode": scene.run.mode}
+    for k in ("t_end", "revolutions"):
+        if math.isfinite(getattr(scene.run, k)):
+            run[k] = getattr(scene.run, k)
+    if scene.run.mode == "prescribed-speed":
+        if scene.run.time:
+            run.update(time=list(scene.run.time), speed_table=list(scene.run.speed_table))
+        else:
+            run["speed"] = scene.run.speed
+    lines += ["", "[run]"] + [f"{k} = {_toml(v)}" for k, v in run.items()]
+    lines += _section("solver", scene.solver)
+    lines += _section("output", scene.output)
+    return "\n".join(lines) + "\n"
+
+
+def _gas_section(gas: Gas) -> list[str]:
+    keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation")}
+    names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
+                                 "n2", "p_intake", "p_exhaust"))
+    return ["", "[gas]"] + [f"{k} = {_toml(getattr(gas, k))}" for k in names]
+
+
+def _section(name: str, obj: Any) -> list[str]:
+    assert is_dataclass(obj)
+    return ["", f"[{name}]"] + [f"{f.name} = {_toml(getattr(obj, f.name))}" for f in fields(obj)]
+
+
+def _toml(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    raise TypeError(f"cannot write {type(value).__name__} to TOML")

@@ -1,0 +1,227 @@
+"""Drive a run: the compiled stepper chunk by chunk (or the reference path), streaming to HDF5.
+
+:func:`integrate` returns the run in memory; :func:`simulate` writes the result file and returns
+the same :class:`RunData`. Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from .assemble import build_model
+from .core import integrate as ci
+from .core.model import N_OUT_FIXED, N_STATE, OUTPUT_UNITS, OUTPUTS, inverse_dynamics
+from .errors import SimulationError
+
+BUFFER_ROWS = 8192
+EVENT_ROWS = 2048
+
+
+def output_columns(scene) -> dict[str, str]:
+    """Trajectory datasets of a run and their units (DESIGN §4)."""
+    cols = dict(zip(OUTPUTS, OUTPUT_UNITS))
+    for k in range(scene.mechanism.n_cylinders):
+        cols[f"p_{k + 1}"] = "Pa"
+    if scene.run.mode == "prescribed-speed":
+        cols["M_drive"] = "N m"
+    return cols
+
+
+@dataclass
+class RunData:
+    """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics."""
+
+    trajectory: dict[str, np.ndarray]
+    events: dict[str, np.ndarray]
+    solver: dict[str, float | int | str]
+    complete: bool = True
+    message: str = ""
+    extra: dict = field(default_factory=dict)
+
+
+def _config(scene) -> np.ndarray:
+    sv, out, run = scene.solver, scene.output, scene.run
+    cfg = np.zeros(ci.N_CFG)
+    cfg[ci.C_RTOL] = sv.rtol
+    cfg[ci.C_ATOL] = sv.atol
+    cfg[ci.C_T_END] = run.t_end
+    cfg[ci.C_PHI_END] = scene.initial.phi + 2.0 * math.pi * run.revolutions
+    cfg[ci.C_W_LO] = sv.switch_speed
+    cfg[ci.C_W_HI] = 1.5 * sv.switch_speed  # hysteresis: no chatter around the switch speed
+    cfg[ci.C_DPHI_OUT] = 2.0 * math.pi / out.samples_per_rev
+    cfg[ci.C_DT_OUT] = out.dt if out.dt > 0 else cfg[ci.C_DPHI_OUT] / cfg[ci.C_W_HI]
+    cfg[ci.C_MAX_STEP_PHI] = sv.max_step
+    cfg[ci.C_MAX_STEP_T] = sv.max_step / sv.switch_speed
+    cfg[ci.C_CHUNK_STEPS] = 20000
+    return cfg
+
+
+def _initial_state(scene):
+    y = np.zeros(N_STATE)
+    y[0] = scene.initial.phi
+    y[2] = scene.initial.omega
+    fst = np.zeros(ci.N_FST)
+    ist = np.zeros(ci.N_IST, dtype=np.int64)
+    st = scene.starter
+    ist[ci.I_STARTER_ON] = int(st.torque > 0 and scene.initial.omega < st.cutout_speed)
+    return y, fst, ist
+
+
+def _fraction_done(scene, y) -> float:
+    run = scene.run
+    f_t = y[1] / run.t_end if math.isfinite(run.t_end) else 0.0
+    f_phi = ((y[0] - scene.initial.phi) / (2 * math.pi * run.revolutions)
+             if math.isfinite(run.revolutions) else 0.0)
+    return min(1.0, max(f_t, f_phi))
+
+
+def _compile(model, cfg, bp) -> float:
+    """Compile (or load from the numba cache) the stepper; return the seconds it took."""
+    t0 = time.perf_counter()
+    warm = cfg.copy()
+    warm[ci.C_T_END] = 1e-6
+    warm[ci.C_PHI_END] = 1e-6
+    y = np.zeros(N_STATE)
+    y[2] = 1.0
+    ci.advance(model, warm, bp, y, np.zeros(ci.N_FST), np.zeros(ci.N_IST, dtype=np.int64),
+               np.empty((1024, N_OUT_FIXED + model.ncyl)), np.empty((64, 4)))
+    return time.perf_counter() - t0
+
+
+def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
+                 progress: Callable[[float], None] | None = None) -> RunData:
+    """Integrate a dynamic scene with the compiled DOP853; blocks go to ``on_block`` as they come.
+
+    A Ctrl-C between chunks ends the run with ``complete = False`` and what was computed so far.
+    """
+    model, bp, _ = build_model(scene)
+    cfg = _config(scene)
+    names = list(output_columns(scene))
+    compile_s = _compile(model, cfg, bp)
+    y, fst, ist = _initial_state(scene)
+    outbuf = np.empty((BUFFER_ROWS, N_OUT_FIXED + model.ncyl))
+    evbuf = np.empty((EVENT_ROWS, 4))
+    blocks, events = [], {name: [] for name in ci.EVENT_NAMES}
+    status, message = ci.RUNNING, ""
+    t0 = time.perf_counter()
+    try:
+        while status == ci.RUNNING:
+            status = ci.advance(model, cfg, bp, y, fst, ist, outbuf, evbuf)
+            block = {name: outbuf[: ist[ci.I_NOUT], j].copy() for j, name in enumerate(names)}
+            ev = {}
+            for code, t, phi, _ in evbuf[: ist[ci.I_NEV]]:
+                ev.setdefault(ci.EVENT_NAMES[int(code)], []).append((t, phi))
+            ist[ci.I_NOUT] = 0
+            ist[ci.I_NEV] = 0
+            blocks.append(block)
+            for k, v in ev.items():
+                events[k].extend(v)
+            if on_block:
+                on_block(block, ev)
+            if progress:
+                progress(_fraction_done(scene, y))
+    except KeyboardInterrupt:
+        message = "interrupted"
+    wall = time.perf_counter() - t0
+    last = {n: blocks[-1][n][-1] for n in ("t", "phi", "omega")} if blocks and blocks[-1]["t"].size \
+        else {"t": y[1], "phi": y[0], "omega": scene.initial.omega}
+    where = (f"t = {last['t']:.9g} s, φ = {last['phi']:.9g} rad ({math.degrees(last['phi']):.6g}°), "
+             f"ω = {last['omega']:.9g} rad/s")
+    if message:
+        message = f"interrupted; last sample at {where}"
+    if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
+        cause = ("a non-finite value in the state or its error estimate"
+                 if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")
+        message = (f"integration failed at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
+                   f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
+    solver = {"method": "dop853", "rtol": scene.solver.rtol, "atol": scene.solver.atol,
+              "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
+              "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s}
+    traj = {n: np.concatenate([b[n] for b in blocks]) for n in names}
+    return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
+                   solver, complete=status == ci.FINISHED, message=message)
+
+
+def prescribed(scene) -> RunData:
+    """Inverse dynamics at a prescribed speed: the drive torque (18) requires (textbook analysis)."""
+    model, _, _ = build_model(scene)
+    run = scene.run
+    phi0 = scene.initial.phi
+    dphi = 2.0 * math.pi / scene.output.samples_per_rev
+    if run.time:
+        spline = CubicSpline(run.time, run.speed_table)
+        angle = spline.antiderivative()
+        t_end = min(run.t_end, run.time[-1])
+        n = int(math.ceil((angle(t_end) - angle(run.time[0])) / dphi)) + 1
+        t = np.linspace(run.time[0], t_end, max(n, 2))
+        omega, eps, phi = spline(t), spline(t, 1), phi0 + angle(t) - angle(run.time[0])
+        stop = phi <= phi0 + 2 * math.pi * run.revolutions
+        t, omega, eps, phi = t[stop], omega[stop], eps[stop], phi[stop]
+    else:
+        w = run.speed
+        phi_end = phi0 + min(2 * math.pi * run.revolutions, w * run.t_end)
+        phi = np.linspace(phi0, phi_end, int(round((phi_end - phi0) / dphi)) + 1)
+        t = (phi - phi0) / w
+        omega = np.full_like(phi, w)
+        eps = np.zeros_like(phi)
+    t0 = time.perf_counter()
+    rows = np.empty((phi.size, N_OUT_FIXED + model.ncyl))
+    drive = np.empty(phi.size)
+    inverse_dynamics(model, t, phi, omega, eps, rows, drive)
+    names = list(output_columns(scene))
+    traj = {name: rows[:, j].copy() for j, name in enumerate(names[:-1])}
+    traj["M_drive"] = drive
+    solver = {"method": "prescribed", "rtol": 0.0, "atol": 0.0, "nfev": int(phi.size),
+              "nsteps": 0, "nreject": 0, "wall_s": time.perf_counter() - t0, "compile_s": 0.0}
+    return RunData(traj, {}, solver)
+
+
+def integrate(scene, on_block=None, progress=None) -> RunData:
+    """Run a scene in memory by the method it names (compiled, reference or prescribed)."""
+    if scene.run.mode == "prescribed-speed":
+        data = prescribed(scene)
+    elif scene.solver.method == "dop853":
+        data = run_compiled(scene, on_block, progress)
+    else:
+        from .reference import run_reference
+
+        data = run_reference(scene, on_block, progress)
+    return data
+
+
+def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> RunData:
+    """Run ``scene`` and write the result file ``path`` (streamed; see :mod:`transient.results`).
+
+    Raises :class:`transient.errors.SimulationError` after writing the partial result when the run
+    fails or is interrupted.
+    """
+    from .analysis.irregularity import summarize
+    from .results import ResultWriter
+    from .scene import to_toml
+
+    writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene), force)
+    data = None
+    try:
+        data = integrate(scene, on_block=lambda block, ev: writer.append(block), progress=progress)
+        if scene.run.mode == "prescribed-speed" or scene.solver.method != "dop853":
+            writer.append(data.trajectory)
+        writer.events(data.events)
+        writer.solver(data.solver)
+        summary = summarize(scene, data.trajectory)
+        for name, (value, unit) in summary.items():
+            writer.analysis(name, value, unit)
+        data.extra["summary"] = summary
+    except BaseException as exc:
+        msg = data.message if data is not None and data.message else f"{type(exc).__name__}: {exc}"
+        writer.close(False, msg)
+        raise
+    writer.close(data.complete, data.message)
+    if not data.complete:
+        raise SimulationError(f"{data.message}; partial result kept in {path} (complete = false)")
+    return data
