@@ -18,18 +18,45 @@ Choices the paper leaves open (``reference/antonyuk-swashplate-dynamics.md``, [D
 * Link 9's centre of mass is at O (it is symmetric about the plate normal), so it only rotates.
 * ``halves = 2`` adds the mirror image through the plane I–I: plate 4, link 10, cross 15, rods 8 and
   pistons 6 (opposed pistons in the same cylinders, same gas force).
+
+The mechanism interface the rest of the package uses (as :class:`~.crank_slider.CrankSlider`):
+
+* ``kind = 1`` (``core.model.SWASH_PLATE``), ``strokes = 2`` (two-stroke, one power pulse per turn),
+  ``cycle = 2π``; ``bank_angles`` are the cylinder angles ψ_Dk.
+* ``firing_angles``: the shaft angle at which cylinder k's gas table is at local angle 0 is its
+  *inner dead centre* (x_D smallest: the piston nearest the plane I–I, end of compression), found
+  exactly as a root of u_k. Cylinder k's joint B_k is lowest when φ − δ(φ) = ψ_k, δ = θ + φ the
+  Hooke joint's non-uniformity, so the dead centres are 2πk/z only where δ vanishes by symmetry:
+  at multiples of π/2 (z = 1, 2, 4 and the first cylinder always). There the paper's rule holds
+  exactly — the pulses of cylinder i start at π(i − 1)/2 for z = 4, a sequence shifted by 2π/z —
+  and the angle is snapped onto 2πk/z (the root is within 1e-15 of it). Otherwise the dead centres
+  are off the even spacing by about the largest non-uniformity δ_max = atan((1 − cos α)/(2√cos α))
+  (2.05° at α = 21.4°; the in-plane hinge gives ±1.88° for z = 3 and up to 2.13° for z = 5, the
+  rods' swing adding a little): the pistons really reach their dead centres at uneven intervals,
+  and a gas pulse timed by the even spacing would start before the piston has stopped.
+* ``volume_function(clearance)`` and ``stroke()`` describe cylinder 1 (ψ_D = 0), whose dead
+  centres are exactly at φ = 0 and π for every geometry (x_D is even about both, δ being odd), so
+  that V(π) − V(0) = halves·F_p·stroke() exactly, as the mixed cycle requires. The other cylinders'
+  strokes differ by < 1e-5 relative at the example geometry (module function :func:`stroke`).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from math import cos, degrees, pi, sin
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
 from ..core import swash_plate as core
+from ..core.model import SWASH_PLATE
 from ..errors import SceneError
+from ..units import SUFFIXES
+
+if TYPE_CHECKING:
+    from ..scene import Section
 
 #: Housing hinge of cross 13 → (phase φ_h of the Hooke relation, hinge axis a = R_x(−φ_h) e_z);
 #: see transient.core.swash_plate.
@@ -97,10 +124,41 @@ class SwashPlate:
     link_diametral_inertia: float
     cross_inertia: float
 
+    #: Model.kind of the compiled kernel (transient.core.model.SWASH_PLATE).
+    kind = core_kind = SWASH_PLATE
+    #: Two-stroke: one gas pulse per cylinder and turn.
+    strokes = 2
+    #: Cycle length in shaft angle [rad].
+    cycle = 2.0 * pi
+
     @property
     def n_cylinders(self) -> int:
         """Cylinders (gas-force points) z; with two halves each holds two pistons."""
         return self.cylinders
+
+    @property
+    def bank_angles(self) -> tuple[float, ...]:
+        """Cylinder angles ψ_Dk = 2πk/z [rad] from Oy toward Oz, eq. (5)."""
+        return tuple(2.0 * pi * k / self.cylinders for k in range(self.cylinders))
+
+    @cached_property
+    def firing_angles(self) -> tuple[float, ...]:
+        """Shaft angle [rad] in [0, 2π) at which each cylinder's gas table is at local angle 0.
+
+        The inner dead centre of each cylinder (module docstring): 2πk/z for z = 1, 2, 4, and within
+        about the Hooke joint's largest non-uniformity of it otherwise. Validates the geometry.
+        """
+        tdc, _ = dead_centres(self)
+        out = []
+        for k, a in enumerate(tdc):
+            even = 2.0 * pi * k / self.cylinders
+            off = (a - even + pi) % (2.0 * pi) - pi
+            if abs(off) < 1e-9:  # exact by symmetry; the root is within a few ulp of it
+                out.append(even)
+            else:
+                w = float(a % (2.0 * pi))
+                out.append(0.0 if w >= 2.0 * pi else w)
+        return tuple(out)
 
     @property
     def piston_area(self) -> float:
@@ -196,9 +254,56 @@ class SwashPlate:
         """See :func:`kinematics_table`."""
         return kinematics_table(self, phi)
 
-    def stroke(self) -> NDArray[np.float64]:
-        """See :func:`stroke`."""
-        return stroke(self)
+    def stroke(self) -> float:
+        """Stroke [m] of cylinder 1's piston(s), x_D(π) − x_D(0): its exact dead centres.
+
+        The one :meth:`volume_function` uses (module docstring); :func:`stroke` gives every
+        cylinder's. Validates first.
+        """
+        x = _points(self.pack(), np.array([0.0, pi]))[2][:, 0, 0]
+        return float(x[1] - x[0])
+
+    def swept_volume(self) -> float:
+        """Volume [m³] swept in cylinder 1 between its dead centres: halves·F_p·stroke()."""
+        return self.halves * self.piston_area * self.stroke()
+
+    def volume_function(self, clearance: float) -> Callable[[ArrayLike], NDArray[np.float64]]:
+        """V(x) [m³] of cylinder 1 over the local angle x [rad] (= shaft angle; vectorised).
+
+        V = clearance + halves·F_p·(x_D(x) − x_D(0)): with ``halves = 2`` the volume between the two
+        opposed pistons (each moving as far, so twice the swept volume of one piston), with one
+        half the volume above the piston, between it and a cylinder head fixed at the piston's
+        inner dead centre. ``clearance`` is that volume at the inner dead centre x = 0; x = π is
+        the outer dead centre, so V(π)/V(0) = 1 + swept_volume()/clearance exactly.
+        """
+        mp = self.pack()
+        area = self.halves * self.piston_area
+        x0 = float(_points(mp, np.zeros(1))[2][0, 0, 0])
+
+        def volume(x: ArrayLike) -> NDArray[np.float64]:
+            x = np.asarray(x, dtype=np.float64)
+            flat = np.ascontiguousarray(x.ravel())
+            xd = _points(mp, flat)[2][:, 0, 0]
+            return (clearance + area * (xd - x0)).reshape(x.shape)
+
+        return volume
+
+    def toml_lines(self) -> list[str]:
+        """The ``[mechanism]`` and ``[mechanism.rod]`` tables in SI (no unit suffixes), which
+        :func:`read_swash_plate` reads back to an equal object (the rod's ``inertia_cg`` is
+        written, and read, for the rigid model only)."""
+        keys = {"type": "swash-plate", "swash": self.swash_angle, "joint_radius": self.joint_radius,
+                "cylinder_radius": self.cylinder_radius, "rod_length": self.rod_length,
+                "bore": self.bore, "cylinders": self.cylinders, "halves": self.halves,
+                "hinge": self.hinge, "piston_mass": self.piston_mass,
+                "link_polar_inertia": self.link_polar_inertia,
+                "link_diametral_inertia": self.link_diametral_inertia,
+                "cross_inertia": self.cross_inertia}
+        rod = {"model": self.rod_model, "mass": self.rod_mass, "cg_from_pin": self.rod_cg_from_pin}
+        if self.rod_model == "rigid":
+            rod["inertia_cg"] = self.rod_inertia_cg
+        return (["[mechanism]"] + [f"{k} = {_toml(v)}" for k, v in keys.items()]
+                + ["", "[mechanism.rod]"] + [f"{k} = {_toml(v)}" for k, v in rod.items()])
 
 
 def antonyuk_example(**changes) -> SwashPlate:
@@ -310,13 +415,11 @@ def positions(geom: SwashPlate, phi: ArrayLike, mirror_x: float | None = None
     return out
 
 
-def stroke(geom: SwashPlate) -> NDArray[np.float64]:
-    """Exact stroke of each cylinder's piston (z,) [m]: x_D max − min over a turn (the opposed
-    piston of ``halves = 2`` moves as far).
+def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Shaft angles [rad] of each cylinder's inner (x_D smallest) and outer dead centre, (z,) each.
 
     The extremes of x_D are found on a grid and refined as roots of u_k = dx_D/dφ (Brent's method).
-    For ℓ → ∞ every stroke tends to 2R sin α; for finite ℓ the rod's lateral swing changes it slightly
-    and differently per cylinder.
+    Angles are not wrapped: each lies within a grid step (0.5°) of [0, 2π].
     """
     mp = geom.pack()
     z = geom.cylinders
@@ -329,13 +432,26 @@ def stroke(geom: SwashPlate) -> NDArray[np.float64]:
     grid = np.linspace(0.0, 2.0 * pi, 721)
     h = grid[1]
     x = _points(mp, grid)[2][..., 0]
-    out = np.empty(z)
+    inner, outer = np.empty(z), np.empty(z)
     for k in range(z):
-        ends = [brentq(rate, grid[j] - h, grid[j] + h, args=(k,), xtol=1e-15)
-                for j in (np.argmax(x[:, k]), np.argmin(x[:, k]))]
-        xk = _points(mp, np.array(ends))[2][:, k, 0]
-        out[k] = xk[0] - xk[1]
-    return out
+        inner[k], outer[k] = (brentq(rate, grid[j] - h, grid[j] + h, args=(k,), xtol=1e-15)
+                              for j in (np.argmin(x[:, k]), np.argmax(x[:, k])))
+    return inner, outer
+
+
+def stroke(geom: SwashPlate) -> NDArray[np.float64]:
+    """Exact stroke of each cylinder's piston (z,) [m]: x_D max − min over a turn (the opposed
+    piston of ``halves = 2`` moves as far).
+
+    For ℓ → ∞ every stroke tends to 2R sin α; for finite ℓ the rod's lateral swing changes it slightly
+    and differently per cylinder (:meth:`SwashPlate.stroke` is cylinder 1's).
+    """
+    inner, outer = dead_centres(geom)
+    mp = geom.pack()
+    z = geom.cylinders
+    lo = _points(mp, inner)[2][np.arange(z), np.arange(z), 0]
+    hi = _points(mp, outer)[2][np.arange(z), np.arange(z), 0]
+    return hi - lo
 
 
 def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.float64]]:
@@ -368,3 +484,103 @@ def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.f
     cols["J"] = JdJ[:, 0]
     cols["dJ_dphi"] = JdJ[:, 1]
     return cols
+
+
+# ------------------------------------------------------------------------------------------------
+# Scene reading and writing
+
+
+def _toml(value) -> str:
+    """One TOML value (the scalars :meth:`SwashPlate.toml_lines` writes); floats round-trip."""
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError("no booleans in a swash-plate table")
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return repr(float(value))
+
+
+def _written(s: "Section", name: str, kind: str | None = None) -> str:
+    """Dotted key of ``name`` as written (plain or with one unit suffix); call before reading it."""
+    for suffix in SUFFIXES.get(kind, {}) if kind else {}:
+        if f"{name}_{suffix}" in s.data:
+            return s.key(f"{name}_{suffix}")
+    return s.key(name)
+
+
+def read_swash_plate(s: "Section") -> SwashPlate:
+    """A :class:`SwashPlate` from the ``[mechanism]`` table (its ``type`` is read by the caller).
+
+    Keys (lengths plain in m or with ``_mm``, the angle plain in rad or with ``_deg``):
+    ``swash``, ``joint_radius``, ``cylinder_radius``, ``rod_length``, ``bore``, ``cylinders``
+    (default 1), ``halves`` (1 | 2, default 1), ``hinge`` (``"in-plane"`` default | ``"normal"``),
+    ``piston_mass`` [kg], link 9 either ``link_inertia`` (isotropic) or both ``link_polar_inertia``
+    and ``link_diametral_inertia`` [kg m²], ``cross_inertia`` [kg m²] (default 0); and the table
+    ``[mechanism.rod]``: ``model`` (``"two-mass"`` default | ``"rigid"``), ``mass`` [kg],
+    ``cg_from_pin`` (length, from the piston joint D), ``inertia_cg`` [kg m²] (rigid model only,
+    default 0). Unknown keys of the rod table are rejected here; the caller finishes ``s``.
+
+    Every error names the key as written in the file (``mechanism.swash_deg`` if the user wrote
+    ``swash_deg``, ``mechanism.swash`` if they wrote ``swash``): :meth:`SwashPlate.validate` reports
+    its canonical keys (angles as ``*_deg``, everything else by its SI name), which are mapped here.
+    """
+    # Canonical validate() key -> key as written; taken before the Section pops each key.
+    written = {f"mechanism.{n}": _written(s, n, kind) for n, kind in (
+        ("joint_radius", "length"), ("cylinder_radius", "length"), ("rod_length", "length"),
+        ("bore", "length"))}
+    written["mechanism.swash_deg"] = _written(s, "swash", "angle")
+    for n in ("cylinders", "halves", "hinge", "piston_mass", "cross_inertia"):
+        written[f"mechanism.{n}"] = s.key(n)
+
+    swash = s.number("swash", "angle")
+    R = s.number("joint_radius", "length", gt=0.0)
+    r1 = s.number("cylinder_radius", "length", gt=0.0)
+    ell = s.number("rod_length", "length", gt=0.0)
+    bore = s.number("bore", "length", gt=0.0)
+    z = s.integer("cylinders", 1, ge=1)
+    halves = s.integer("halves", 1, choices=(1, 2))
+    hinge = s.string("hinge", "in-plane", choices=tuple(HINGES))
+    piston_mass = s.number("piston_mass", ge=0.0)
+    iso = s.number("link_inertia", default=None, ge=0.0)
+    polar = s.number("link_polar_inertia", default=None, ge=0.0)
+    diametral = s.number("link_diametral_inertia", default=None, ge=0.0)
+    if iso is not None:
+        if polar is not None or diametral is not None:
+            raise SceneError(s.key("link_inertia"),
+                             "give either link_inertia (isotropic link 9) or both "
+                             "link_polar_inertia and link_diametral_inertia, not both forms")
+        polar = diametral = iso
+        written["mechanism.link_polar_inertia"] = s.key("link_inertia")
+        written["mechanism.link_diametral_inertia"] = s.key("link_inertia")
+    elif polar is None and diametral is None:
+        raise SceneError(s.key("link_inertia"),
+                         "is missing; give link_inertia [kg m²] (isotropic link 9) or both "
+                         "link_polar_inertia and link_diametral_inertia")
+    else:
+        for key, value in (("link_polar_inertia", polar), ("link_diametral_inertia", diametral)):
+            if value is None:
+                raise SceneError(s.key(key), "is missing; link_polar_inertia and "
+                                             "link_diametral_inertia go together (or give "
+                                             "link_inertia alone for an isotropic link 9)")
+            written[f"mechanism.{key}"] = s.key(key)
+    cross = s.number("cross_inertia", default=0.0, ge=0.0)
+    rod = s.sub("rod", required=True)
+    written["mechanism.rod.model"] = rod.key("model")
+    written["mechanism.rod.mass"] = rod.key("mass")
+    written["mechanism.rod.cg_from_pin"] = _written(rod, "cg_from_pin", "length")
+    written["mechanism.rod.inertia_cg"] = rod.key("inertia_cg")
+    model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
+    mech = SwashPlate(
+        swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell, bore=bore,
+        cylinders=z, halves=halves, hinge=hinge, piston_mass=piston_mass, rod_model=model,
+        rod_mass=rod.number("mass", ge=0.0),
+        rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0),
+        rod_inertia_cg=rod.number("inertia_cg", default=0.0, ge=0.0) if model == "rigid" else 0.0,
+        link_polar_inertia=polar, link_diametral_inertia=diametral, cross_inertia=cross)
+    rod.finish()
+    try:
+        mech.validate()
+    except SceneError as exc:
+        raise SceneError(written.get(exc.key, exc.key), exc.message) from None
+    return mech

@@ -1,0 +1,602 @@
+"""The ``transient`` command end to end (DESIGN §4): run, check, info, plot, kinematics.
+
+Every run is small (a few revolutions, coarse output) and goes through ``transient.cli.main``
+in-process, so the numba cache is loaded once for the whole file. One test starts
+``python -m transient`` in a subprocess.
+
+Tests marked ``xfail(strict=True)`` document bugs (see the report that came with them).
+"""
+from __future__ import annotations
+
+import datetime as dt
+import importlib
+import math
+import os
+import subprocess
+import sys
+from dataclasses import fields
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import transient
+import transient.core.integrate as ci
+from transient.cli import main
+from transient.errors import SceneError
+from transient.scene import to_toml
+
+# ``transient.simulate`` is the function re-exported by the package (it shadows the submodule as
+# an attribute), so the module is taken from the import system.
+sim = importlib.import_module("transient.simulate")
+
+REPO = Path(__file__).resolve().parents[2]
+CASES = REPO / "cases"
+
+# The Gots 3-cylinder diesel (cases/gots_diesel_spinup.toml) for 4 revolutions, coarse output.
+SPINUP = """\
+[scene]
+name = "small-spinup"
+description = "Gots diesel, 4 revolutions from 1000 rpm (CLI test)"
+
+[mechanism]
+type = "crank-slider"
+crank_radius_mm = 47
+rod_length_mm = 148
+bore_mm = 88
+piston_mass = 1.520
+crank_mass = 0.912
+strokes = 4
+cylinders = 3
+firing_order = [1, 2, 3]
+firing_deg = [360, 600, 120]
+
+[mechanism.rod]
+model = "two-mass"
+mass = 1.752
+cg_from_pin_mm = 107.3
+
+[gas]
+model = "mixed-cycle"
+p0_MPa = 0.1
+compression_ratio = 18
+p_a_MPa = 0.1436
+n1 = 1.368
+p_z_MPa = 10.5
+rho = 1.671
+n2 = 1.228
+p_intake_MPa = 0.165
+p_exhaust_MPa = 0.182
+
+[inertia]
+shaft = 0.02
+flywheel = 0.15
+
+[load]
+fan = 9.692e-4
+
+[initial]
+omega_rpm = 1000
+
+[run]
+revolutions = 4
+
+[solver]
+rtol = 1e-6
+atol = 1e-8
+
+[output]
+samples_per_rev = 24
+"""
+
+# One cylinder coasting with no forces (cases/coasting_single.toml, shorter and coarser).
+COASTING = """\
+[scene]
+name = "small-coasting"
+description = "single cylinder coasting"
+
+[mechanism]
+type = "crank-slider"
+crank_radius_mm = 47
+rod_length_mm = 148
+bore_mm = 88
+piston_mass = 1.520
+crank_mass = 0.912
+
+[mechanism.rod]
+model = "rigid"
+mass = 1.752
+cg_from_pin_mm = 107.3
+inertia_cg = 5e-3
+
+[inertia]
+shaft = 0.02
+
+[initial]
+omega_rpm = 1000
+
+[run]
+revolutions = {revolutions}
+
+[solver]
+rtol = 1e-8
+atol = 1e-10
+
+[output]
+samples_per_rev = {samples}
+"""
+
+# A measured-style indicator table with a jump and a kink, an offset V-twin, starter from rest.
+TABLE_STARTER = """\
+[scene]
+name = "table-starter"
+description = "V-twin, offset, pressure table with a jump at 360 deg, starter from rest"
+
+[mechanism]
+type = "crank-slider"
+crank_radius_mm = 40
+rod_length_mm = 140
+offset_mm = 5
+bore_mm = 80
+piston_mass = 1.1
+strokes = 4
+cylinders = 2
+firing_deg = [0, 270]
+bank_deg = [0, 90]
+
+[mechanism.rod]
+model = "rigid"
+mass = 1.3
+cg_from_pin_mm = 95
+inertia_cg = 4e-3
+
+[gas]
+model = "table"
+p0_bar = 1
+phi_deg = [0, 180, 300, 360, 360, 400, 540, 720]
+p_bar = [1, 1, 25, 60, 80, 40, 3, 1]
+corners_deg = [360, 540]
+interpolation = "linear"
+
+[inertia]
+shaft = 0.03
+
+[load]
+torque = 2
+linear = 0.01
+
+[starter]
+torque = 40
+noload_speed_rpm = 400
+cutout_speed_rpm = 300
+
+[run]
+t_end = 0.05
+revolutions = 3
+
+[output]
+samples_per_rev = 36
+dt = 1e-3
+"""
+
+PRESCRIBED_TABLE = """\
+[scene]
+name = "prescribed-ramp"
+
+[mechanism]
+type = "crank-slider"
+crank_radius_mm = 47
+rod_length_mm = 148
+bore_mm = 88
+piston_mass = 1.520
+strokes = 2
+
+[mechanism.rod]
+mass = 1.752
+cg_from_pin_mm = 107.3
+
+[run]
+mode = "prescribed-speed"
+time = [0.0, 0.02, 0.05]
+speed_table_rpm = [1000, 1500, 1600]
+revolutions = 100
+
+[output]
+samples_per_rev = 36
+"""
+
+
+def prescribed_4400() -> str:
+    """cases/gots_diesel_4400.toml shortened to 2 revolutions (one 4-stroke cycle), coarse."""
+    text = (CASES / "gots_diesel_4400.toml").read_text()
+    for old, new in (("revolutions = 4\n", "revolutions = 2\n"),
+                     ("samples_per_rev = 1440\n", "samples_per_rev = 72\n")):
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return text
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def cli(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+# ----------------------------------------------------------------------------------------------
+# run
+
+
+def test_run_writes_result_with_design_layout(tmp_path, capsys):
+    scene = write(tmp_path, "spinup", SPINUP)
+    out_dir = tmp_path / "res"
+    code, out, err = cli(capsys, "run", scene, "-o", out_dir)
+    assert (code, err) == (0, "")
+    path = out_dir / "spinup.h5"
+    assert sorted(p.name for p in out_dir.iterdir()) == ["spinup.h5"]  # no temporary left
+    lines = out.splitlines()
+    assert lines[0] == f"wrote {path}"
+    assert lines[1].startswith("  end: t = ") and "after 4 rev" in lines[1]
+    assert lines[2].startswith("  last cycle: mean ω = ")
+    assert lines[3].startswith("  steady state: ")
+    assert lines[4].startswith("  solver dop853: ") and "RHS calls" in lines[4]
+
+    with h5py.File(path, "r") as f:
+        a = f.attrs
+        assert a["creator"] == "transient"
+        assert a["version"] == transient.__version__
+        assert a["format"] == 1
+        assert dt.datetime.fromisoformat(a["created"]).tzinfo is not None
+        assert a["scene"] == "small-spinup"
+        assert bool(a["complete"]) is True
+        assert "toml" in f["scene"]
+        toml = f["scene/toml"][()]
+        toml = toml.decode() if isinstance(toml, bytes) else toml
+        assert toml == to_toml(transient.load_scene(scene))
+
+        traj = f["trajectory"]
+        units = {"t": "s", "phi": "rad", "omega": "rad/s", "epsilon": "rad/s^2", "J": "kg m^2",
+                 "dJ_dphi": "kg m^2/rad", "M_gas": "N m", "M_load": "N m",
+                 "p_1": "Pa", "p_2": "Pa", "p_3": "Pa"}
+        for name, unit in units.items():
+            assert name in traj, name
+            assert traj[name].attrs["unit"] == unit, name
+        n = traj["t"].shape[0]
+        for name, ds in traj.items():
+            assert ds.ndim == 1 and ds.shape[0] == n, name  # one shared sample axis
+            assert ds.maxshape == (None,) and ds.chunks is not None, name  # extendable, chunked
+            assert ds.compression is not None, name
+        t, phi, omega = traj["t"][()], traj["phi"][()], traj["omega"][()]
+        # 4 revolutions at 24 samples per revolution, both ends included
+        assert n == 4 * 24 + 1
+        assert t[0] == 0.0 and np.all(np.diff(t) > 0) and np.all(np.diff(phi) > 0)
+        np.testing.assert_allclose(phi[[0, -1]], [0.0, 8 * math.pi], rtol=0, atol=1e-9)
+        assert omega[0] == pytest.approx(1000 * math.pi / 30, rel=1e-12)
+        assert np.all(np.isfinite(traj["epsilon"][()]))
+
+        s = f["solver"].attrs
+        assert {"method", "rtol", "atol", "nfev", "nsteps", "nreject", "wall_s",
+                "compile_s"} <= set(s)
+        assert s["method"] == "dop853"
+        assert (s["rtol"], s["atol"]) == (1e-6, 1e-8)
+        assert s["nfev"] > s["nsteps"] > 0 and s["nreject"] >= 0
+        assert s["wall_s"] > 0 and s["compile_s"] >= 0
+        for name, ds in f["analysis"].items():
+            assert "unit" in ds.attrs, name
+
+
+def test_run_quiet_prints_nothing(tmp_path, capsys):
+    scene = write(tmp_path, "spinup", SPINUP)
+    code, out, err = cli(capsys, "run", scene, "-o", tmp_path, "-q")
+    assert (code, out, err) == (0, "", "")
+    assert transient.open_result(tmp_path / "spinup.h5").complete
+
+
+def test_run_never_overwrites_without_force(tmp_path, capsys):
+    scene = write(tmp_path, "coast", COASTING.format(revolutions=2, samples=12))
+    out_dir = tmp_path / "res"
+    path = out_dir / "coast.h5"
+    assert cli(capsys, "run", scene, "-o", out_dir)[0] == 0
+    before = path.read_bytes()
+    mtime = path.stat().st_mtime_ns
+    os.utime(path, ns=(mtime - 10**9, mtime - 10**9))  # so that any rewrite shows in the mtime
+    mtime = path.stat().st_mtime_ns
+
+    code, out, err = cli(capsys, "run", scene, "-o", out_dir)
+    assert code == 2 and out == ""
+    assert len(err.splitlines()) == 1 and str(path) in err and "--force" in err
+    assert "Traceback" not in err
+    assert path.read_bytes() == before and path.stat().st_mtime_ns == mtime
+    assert sorted(p.name for p in out_dir.iterdir()) == ["coast.h5"]
+
+    code, out, err = cli(capsys, "run", scene, "-o", out_dir, "--force")
+    assert (code, err) == (0, "")
+    assert out.startswith(f"wrote {path}\n")
+    assert path.stat().st_mtime_ns > mtime
+    assert transient.open_result(path).complete
+    assert sorted(p.name for p in out_dir.iterdir()) == ["coast.h5"]
+
+
+def test_run_default_output_folder_is_results(tmp_path, capsys, monkeypatch):
+    scene = write(tmp_path, "coast", COASTING.format(revolutions=1, samples=8))
+    monkeypatch.chdir(tmp_path)
+    assert cli(capsys, "run", "coast.toml", "-q")[0] == 0
+    assert (tmp_path / "results" / "coast.h5").is_file()
+    assert scene.is_file()
+
+
+# ----------------------------------------------------------------------------------------------
+# /scene/toml round trip
+
+
+def assert_same_scene(a, b):
+    """Dataclass equality, with the first differing field named when it fails."""
+    if a == b:
+        return
+    for section in fields(a):
+        x, y = getattr(a, section.name), getattr(b, section.name)
+        if x != y and hasattr(x, "__dataclass_fields__"):
+            for f in fields(x):
+                assert getattr(x, f.name) == getattr(y, f.name), f"{section.name}.{f.name}"
+        assert x == y, section.name
+    raise AssertionError("scenes differ")  # pragma: no cover
+
+
+@pytest.mark.parametrize("name, text", [
+    ("spinup", SPINUP),
+    ("coast", COASTING.format(revolutions=1, samples=8)),
+    ("table_starter", TABLE_STARTER),
+    ("prescribed_4400", prescribed_4400()),
+    ("prescribed_ramp", PRESCRIBED_TABLE),
+])
+def test_scene_toml_round_trips(tmp_path, capsys, name, text):
+    """``open_result(path).scene()`` rebuilds exactly the scene that ran.
+
+    The resolved TOML is SI without suffixes and writes floats with ``repr``, so values converted
+    from mm, deg, rpm or bar come back bit for bit and plain ``==`` on the dataclasses holds.
+    """
+    scene_path = write(tmp_path, name, text)
+    original = transient.load_scene(scene_path)
+    code, out, err = cli(capsys, "run", scene_path, "-o", tmp_path / "res", "-q")
+    assert (code, err) == (0, "")
+    result = transient.open_result(tmp_path / "res" / f"{name}.h5")
+    assert result.complete
+    assert_same_scene(result.scene(), original)
+
+
+@pytest.mark.parametrize("case", sorted(CASES.glob("*.toml")), ids=lambda p: p.stem)
+def test_resolved_toml_of_every_case_round_trips(case):
+    """Every committed scene survives ``to_toml`` → ``load_scene`` (no run needed).
+
+    A case whose mechanism type ``scene.py`` does not read yet (work in progress) is skipped, so
+    that it is covered as soon as its reader lands.
+    """
+    try:
+        scene = transient.load_scene(case)
+    except SceneError as exc:
+        if exc.key == "mechanism.type":
+            pytest.skip(f"{case.name}: {exc.message}")
+        raise
+    again = transient.load_scene(case.with_name("resolved.toml"), text=to_toml(scene))
+    assert_same_scene(again, scene)
+    assert to_toml(again) == to_toml(scene)
+
+
+@pytest.mark.xfail(strict=True, reason="bug: scene._toml writes control characters (a newline) "
+                                       "into a TOML basic string unescaped, so /scene/toml of a "
+                                       "scene whose description has a line break cannot be read")
+def test_scene_toml_round_trips_with_a_multiline_description(tmp_path, capsys):
+    text = COASTING.format(revolutions=1, samples=8).replace(
+        'description = "single cylinder coasting"',
+        'description = """single cylinder\ncoasting\twith a tab"""')
+    scene_path = write(tmp_path, "multiline", text)
+    original = transient.load_scene(scene_path)
+    assert "\n" in original.description
+    assert cli(capsys, "run", scene_path, "-o", tmp_path, "-q")[0] == 0
+    assert_same_scene(transient.open_result(tmp_path / "multiline.h5").scene(), original)
+
+
+# ----------------------------------------------------------------------------------------------
+# info, plot, kinematics
+
+
+def test_info_prints_the_summary(tmp_path, capsys):
+    scene = write(tmp_path, "spinup", SPINUP)
+    assert cli(capsys, "run", scene, "-o", tmp_path, "-q")[0] == 0
+    path = tmp_path / "spinup.h5"
+    code, out, err = cli(capsys, "info", path)
+    assert (code, err) == (0, "")
+    lines = out.splitlines()
+    assert lines[0].startswith(f"{path}: scene 'small-spinup', transient {transient.__version__}, "
+                               f"format 1, created ")
+    assert lines[0].endswith("complete = True")
+    assert lines[1].startswith(f"  trajectory: {4 * 24 + 1} samples; ")
+    for column in ("t [s]", "phi [rad]", "omega [rad/s]", "epsilon [rad/s^2]", "p_3 [Pa]"):
+        assert column in lines[1]
+    assert any(line.startswith("  solver dop853: rtol 1e-06, atol 1e-08, ") for line in lines)
+    for key in ("final_omega", "final_t", "revolutions", "mean_omega_last_cycle",
+                "delta_last_cycle", "steady_state_t"):
+        assert any(line.startswith(f"  {key} = ") for line in lines), key
+    assert "  revolutions = 4.0" in lines
+
+
+def test_info_rejects_a_file_that_is_not_a_result(tmp_path, capsys):
+    bogus = tmp_path / "bogus.h5"
+    bogus.write_text("not hdf5\n")
+    code, out, err = cli(capsys, "info", bogus)
+    assert code == 2 and out == ""
+    assert len(err.splitlines()) == 1 and err.startswith(f"{bogus}: ")
+    code, out, err = cli(capsys, "info", tmp_path / "missing.h5")
+    assert code == 2 and len(err.splitlines()) == 1 and "missing.h5" in err
+
+
+def test_plot_writes_png_figures(tmp_path, capsys):
+    scene = write(tmp_path, "spinup", SPINUP)
+    assert cli(capsys, "run", scene, "-o", tmp_path, "-q")[0] == 0
+    figures = tmp_path / "figures"
+    code, out, err = cli(capsys, "plot", tmp_path / "spinup.h5", "-o", figures)
+    assert (code, err) == (0, "")
+    names = ["spinup_speed.png", "spinup_torques.png", "spinup_indicator.png"]
+    assert out.splitlines() == [f"wrote {figures / n}" for n in names]
+    for n in names:
+        data = (figures / n).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 1000, n
+
+
+def test_plot_defaults_to_the_result_folder_and_skips_indicator_without_gas(tmp_path, capsys):
+    scene = write(tmp_path, "coast", COASTING.format(revolutions=2, samples=12))
+    assert cli(capsys, "run", scene, "-o", tmp_path / "res", "-q")[0] == 0
+    code, out, err = cli(capsys, "plot", tmp_path / "res" / "coast.h5")
+    assert (code, err) == (0, "")
+    assert sorted(p.name for p in (tmp_path / "res").glob("*.png")) == [
+        "coast_speed.png", "coast_torques.png"]
+
+
+def test_kinematics_writes_csv(tmp_path, capsys):
+    scene = write(tmp_path, "spinup", SPINUP)
+    csv = tmp_path / "x.csv"
+    code, out, err = cli(capsys, "kinematics", scene, "-o", csv, "--points", 49)
+    assert (code, err) == (0, "")
+    assert out == f"wrote {csv}\n"
+    header, *rows = csv.read_text().splitlines()
+    names = header.split(",")
+    for column in ("phi_deg", "J", "dJ_dphi", "s_1", "u_1", "du_1", "s_3", "u_3"):
+        assert column in names, column
+    assert len(rows) == 49
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert data.shape == (49, len(names))
+    col = {n: data[:, j] for j, n in enumerate(names)}
+    np.testing.assert_allclose(col["phi_deg"], np.linspace(0.0, 720.0, 49), atol=1e-9)
+    assert np.all(col["J"] > 0)
+    # Periodic over the cycle: the last row repeats the first.
+    np.testing.assert_allclose(data[-1, 1:], data[0, 1:], rtol=1e-9, atol=1e-12)
+
+
+def test_kinematics_to_stdout(tmp_path, capsys):
+    scene = write(tmp_path, "coast", COASTING.format(revolutions=1, samples=8))
+    code, out, err = cli(capsys, "kinematics", scene, "--points", 7)
+    assert (code, err) == (0, "")
+    lines = out.splitlines()
+    assert lines[0].split(",")[:5] == ["phi_deg", "J", "dJ_dphi", "s_1", "u_1"]
+    assert len(lines) == 1 + 7
+
+
+# ----------------------------------------------------------------------------------------------
+# prescribed speed
+
+
+def test_prescribed_speed_run_writes_drive_torque(tmp_path, capsys):
+    scene = write(tmp_path, "gots_4400", prescribed_4400())
+    code, out, err = cli(capsys, "run", scene, "-o", tmp_path)
+    assert (code, err) == (0, "")
+    assert "mean drive torque required over the last cycle: " in out
+    res = transient.open_result(tmp_path / "gots_4400.h5")
+    assert res.complete
+    assert res.units["M_drive"] == "N m"
+    tr = res.trajectory
+    n = 2 * 72 + 1
+    assert all(v.size == n for v in tr.values())
+    assert np.all(np.isfinite(tr["M_drive"]))
+    np.testing.assert_allclose(tr["omega"], 4400 * math.pi / 30, rtol=1e-12)
+    assert res.solver["method"] == "prescribed"
+    # At constant speed the inertia moment −½J′ω² has zero cycle mean, so the drive torque
+    # cancels the gas torque on average; the engine makes power, so the drive needed is < 0.
+    cycle = 4 * math.pi
+    mean_drive = np.trapezoid(tr["M_drive"], tr["phi"]) / cycle
+    mean_gas = np.trapezoid(tr["M_gas"], tr["phi"]) / cycle
+    assert mean_drive < 0
+    assert mean_drive == pytest.approx(-mean_gas, rel=1e-9)
+    assert res.analysis["mean_drive_torque_last_cycle"] == pytest.approx(mean_drive, rel=1e-9)
+
+
+# ----------------------------------------------------------------------------------------------
+# interrupted run
+
+
+def interrupt_advance(monkeypatch, on_chunk: int):
+    """Make ``advance`` raise KeyboardInterrupt on the run's ``on_chunk``-th chunk.
+
+    ``simulate._compile`` calls ``advance`` once first to warm the JIT up (with a small output
+    buffer of its own); only calls with the run's buffer of ``BUFFER_ROWS`` rows are counted.
+    Returns the list of output rows each completed chunk produced.
+    """
+    real = ci.advance
+    rows: list[int] = []
+    calls = [0]
+
+    def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
+        if outbuf.shape[0] == sim.BUFFER_ROWS:
+            calls[0] += 1
+            if calls[0] == on_chunk:
+                raise KeyboardInterrupt
+        status = real(m, cfg, bp, y, fst, ist, outbuf, evbuf)
+        if outbuf.shape[0] == sim.BUFFER_ROWS:
+            rows.append(int(ist[ci.I_NOUT]))
+        return status
+
+    monkeypatch.setattr(ci, "advance", advance)
+    return rows
+
+
+def test_interrupted_run_keeps_the_partial_result(tmp_path, capsys, monkeypatch):
+    # 20 revolutions at 1000 samples each: 20001 rows, three chunks of at most BUFFER_ROWS.
+    scene = write(tmp_path, "long", COASTING.format(revolutions=20, samples=1000))
+    rows = interrupt_advance(monkeypatch, on_chunk=2)
+    code, out, err = cli(capsys, "run", scene, "-o", tmp_path)
+    assert code == 1
+    path = tmp_path / "long.h5"
+    assert len(err.splitlines()) == 1 and "interrupted" in err and str(path) in err
+    assert "Traceback" not in err
+    assert len(rows) == 1 and 0 < rows[0] < 20001
+
+    assert sorted(p.name for p in tmp_path.glob("*.h5*")) == ["long.h5"]
+    res = transient.open_result(path)
+    assert res.complete is False
+    assert "interrupted" in res.attrs["message"]
+    tr = res.trajectory
+    assert tr["t"].size == rows[0]
+    assert all(v.size == rows[0] for v in tr.values())
+    assert np.all(np.diff(tr["phi"]) > 0)
+    step = 2 * math.pi / 1000
+    np.testing.assert_allclose(tr["phi"], step * np.arange(rows[0]), rtol=0, atol=1e-9)
+    assert tr["phi"][-1] < 20 * 2 * math.pi
+    # what was computed is the same as in an uninterrupted run
+    monkeypatch.undo()
+    assert cli(capsys, "run", scene, "-o", tmp_path / "full", "-q")[0] == 0
+    full = transient.open_result(tmp_path / "full" / "long.h5").trajectory
+    for name in ("t", "phi", "omega", "epsilon"):
+        np.testing.assert_array_equal(tr[name], full[name][: rows[0]], err_msg=name)
+    # info still works on the partial result
+    code, out, err = cli(capsys, "info", path)
+    assert code == 0 and "complete = False" in out and "message: interrupted" in out
+
+
+@pytest.mark.xfail(strict=True, raises=ValueError,
+                   reason="bug: run_compiled concatenates an empty block list when Ctrl-C comes "
+                          "during the first chunk; ValueError escapes main() as a traceback")
+def test_interrupt_during_the_first_chunk(tmp_path, capsys, monkeypatch):
+    scene = write(tmp_path, "coast", COASTING.format(revolutions=2, samples=12))
+    interrupt_advance(monkeypatch, on_chunk=1)
+    code, out, err = cli(capsys, "run", scene, "-o", tmp_path)
+    assert code == 1 and "interrupted" in err
+    assert transient.open_result(tmp_path / "coast.h5").complete is False
+
+
+# ----------------------------------------------------------------------------------------------
+# python -m transient
+
+
+def test_python_m_transient_check():
+    proc = subprocess.run([sys.executable, "-m", "transient", "check",
+                           "cases/coasting_single.toml"],
+                          cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr == ""
+    assert proc.stdout.startswith("cases/coasting_single.toml: ok (coasting-single: CrankSlider, "
+                                  "1 cylinder(s), gas none, run dynamic)")

@@ -1,0 +1,310 @@
+"""Invalid scenes reach the user as one line, ``file: key: what is wrong and what is allowed``.
+
+DESIGN §4: exit code 2 for invalid input, one line on stderr, no traceback, and ``run`` creates no
+result file. Each case starts from the valid small scene ``VALID`` and breaks one thing; it goes
+through ``transient check`` and ``transient run`` in-process. The expected key is the dotted TOML
+key that ``transient.scene`` (or the mechanism / gas-table validation it calls) reports.
+
+Cases marked ``xfail(strict=True)`` at the end document bugs: the key or message the user gets
+is misleading or the error escapes as a traceback. They flip to XPASS (and fail) once fixed, so
+that the marker is removed together with the fix.
+"""
+from __future__ import annotations
+
+import pytest
+
+from transient.cli import main
+
+VALID = """\
+[scene]
+name = "small"
+description = "a valid small scene; every case below breaks one thing"
+
+[mechanism]
+type = "crank-slider"
+crank_radius_mm = 47
+rod_length_mm = 148
+bore_mm = 88
+piston_mass = 1.520
+crank_mass = 0.912
+
+[mechanism.rod]
+model = "two-mass"
+mass = 1.752
+cg_from_pin_mm = 107.3
+
+[inertia]
+shaft = 0.02
+
+[initial]
+omega_rpm = 1000
+
+[run]
+revolutions = 2
+
+[solver]
+rtol = 1e-6
+atol = 1e-8
+
+[output]
+samples_per_rev = 12
+"""
+
+MIXED_CYCLE = """
+[gas]
+model = "mixed-cycle"
+compression_ratio = {cr}
+p_a_MPa = 0.1436
+n1 = 1.368
+p_z_MPa = 10.5
+rho = 1.671
+n2 = 1.228
+p_intake_MPa = 0.165
+p_exhaust_MPa = 0.182
+"""
+
+
+def replace(old: str, new: str) -> str:
+    """VALID with one exact line (or fragment) replaced; the fragment must be there."""
+    assert VALID.count(old) == 1, old
+    return VALID.replace(old, new)
+
+
+def add_after(anchor: str, lines: str) -> str:
+    return replace(anchor, f"{anchor}\n{lines}")
+
+
+def gas_table(phi_deg: str, p_bar: str, extra: str = "") -> str:
+    return VALID + f'\n[gas]\nmodel = "table"\nphi_deg = {phi_deg}\np_bar = {p_bar}\n{extra}'
+
+
+# (id, scene text, key reported, fragment of the message)
+CASES = [
+    ("toml-syntax", replace("bore_mm = 88", "bore_mm = = 88"),
+     "(syntax)", "not valid TOML"),
+    ("toml-unclosed-table", replace("[inertia]", "[inertia"),
+     "(syntax)", "not valid TOML"),
+    ("unknown-top-level-key", VALID + "\n[engine]\nspeed = 1\n",
+     "engine", "unknown key; allowed here: gas, inertia, initial, load, mechanism"),
+    ("unknown-top-level-scalar", "format = 2\n" + VALID,
+     "format", "unknown key"),
+    ("unknown-mechanism-key", add_after("bore_mm = 88", "stroke_mm = 94"),
+     "mechanism.stroke_mm", "unknown key; allowed here: bank, bore, crank_mass, crank_radius"),
+    ("unknown-rod-key", add_after("mass = 1.752", "length_mm = 148"),
+     "mechanism.rod.length_mm", "unknown key"),
+    ("unknown-unit-suffix", add_after("bore_mm = 88", "offset_in = 0.1"),
+     "mechanism.offset_in", "unknown unit suffix '_in'; allowed suffixes: _MPa, _bar, _deg, _mm, _rpm"),
+    ("suffix-does-not-fit", add_after("bore_mm = 88", "offset_rpm = 1"),
+     "mechanism.offset_rpm", "unit suffix '_rpm' does not fit this quantity"),
+    ("suffix-on-unitless-quantity", replace("crank_mass = 0.912", "crank_mass_mm = 912"),
+     "mechanism.crank_mass_mm", "unit suffix '_mm' does not fit this quantity; give 'crank_mass'"),
+    ("suffix-does-not-fit-speed", replace("omega_rpm = 1000", "omega_mm = 1000"),
+     "initial.omega_mm", "does not fit this quantity"),
+    ("given-twice", add_after("crank_radius_mm = 47", "crank_radius = 0.047"),
+     "mechanism.crank_radius_mm", "given twice (also as 'crank_radius'); give one of them"),
+    ("given-twice-two-suffixes", VALID + '\n[gas]\np0_bar = 1\np0_MPa = 0.1\n',
+     "gas.p0_MPa", "given twice (also as 'p0_bar')"),
+    ("missing-bore", replace("bore_mm = 88\n", ""),
+     "mechanism.bore", "is missing; give 'bore' or 'bore_mm'"),
+    ("missing-rod-table", replace("[mechanism.rod]\nmodel = \"two-mass\"\nmass = 1.752\n"
+                                  "cg_from_pin_mm = 107.3\n", ""),
+     "mechanism.rod", "is missing (a table)"),
+    ("missing-run-table", replace("[run]\nrevolutions = 2\n", ""),
+     "run", "is missing (a table)"),
+    ("wrong-type-string", replace("bore_mm = 88", 'bore_mm = "88"'),
+     "mechanism.bore_mm", "must be a number, got '88'"),
+    ("wrong-type-bool", replace("piston_mass = 1.520", "piston_mass = true"),
+     "mechanism.piston_mass", "must be a number, got True"),
+    ("wrong-type-integer", add_after("crank_mass = 0.912", "cylinders = 2.5"),
+     "mechanism.cylinders", "must be a whole number, got 2.5"),
+    ("section-not-a-table", "initial = 5\n" + replace("[initial]\nomega_rpm = 1000\n", ""),
+     "initial", "must be a table, got int"),
+    ("unknown-mechanism-type", replace('type = "crank-slider"', 'type = "wankel"'),
+     "mechanism.type", "unknown value 'wankel'; allowed: 'crank-slider'"),
+    ("strokes-not-2-or-4", add_after("crank_mass = 0.912", "strokes = 3"),
+     "mechanism.strokes", "must be one of 2, 4, got 3"),
+    ("lambda-not-below-1", replace("crank_radius_mm = 47", "crank_radius_mm = 150"),
+     "mechanism.rod_length", "λ = r/l = 1.014 must be < 1"),
+    ("lambda-equal-1", replace("crank_radius_mm = 47", "crank_radius_mm = 148"),
+     "mechanism.rod_length", "λ = r/l = 1 must be < 1"),
+    ("offset-too-large", add_after("bore_mm = 88", "offset_mm = 120"),
+     "mechanism.offset", "too large for the geometry; allowed |offset| < l − r = 101 mm"),
+    ("offset-too-large-negative", add_after("bore_mm = 88", "offset_mm = -101"),
+     "mechanism.offset", "allowed |offset| < l − r = 101 mm"),
+    ("zero-piston-mass", replace("piston_mass = 1.520", "piston_mass = 0"),
+     "mechanism.piston_mass", "must be > 0 kg, got 0"),
+    ("negative-piston-mass", replace("piston_mass = 1.520", "piston_mass = -1.5"),
+     "mechanism.piston_mass", "must be > 0 kg, got -1.5"),
+    ("negative-rod-mass", replace("mass = 1.752", "mass = -1.752"),
+     "mechanism.rod.mass", "must be > 0 kg, got -1.752"),
+    ("rod-cg-beyond-rod", replace("cg_from_pin_mm = 107.3", "cg_from_pin_mm = 160"),
+     "mechanism.rod.cg_from_pin", "160 mm is off the rod; allowed 0 … 148 mm"),
+    ("rod-cg-negative", replace("cg_from_pin_mm = 107.3", "cg_from_pin_mm = -1"),
+     "mechanism.rod.cg_from_pin", "is off the rod"),
+    ("firing-order-repeats", add_after("crank_mass = 0.912", "cylinders = 3\nfiring_order = [1, 1, 3]"),
+     "mechanism.firing_order", "must list each cylinder 1 … 3 once, got [1, 1, 3]"),
+    ("firing-order-out-of-range", add_after("crank_mass = 0.912",
+                                            "cylinders = 3\nfiring_order = [1, 2, 4]"),
+     "mechanism.firing_order", "must list each cylinder 1 … 3 once"),
+    ("firing-deg-wrong-length", add_after("crank_mass = 0.912", "cylinders = 3\nfiring_deg = [0, 240]"),
+     "mechanism.firing_deg", "has 2 entries; must have one per cylinder (3)"),
+    ("firing-deg-outside-cycle", add_after("crank_mass = 0.912",
+                                           "cylinders = 2\nfiring_deg = [0, 720]"),
+     "mechanism.firing_deg", "720° is outside the cycle; allowed 0 ≤ angle < 720°"),
+    ("gas-angles-not-increasing", gas_table("[0, 360, 180, 720]", "[1, 60, 5, 1]"),
+     "gas.phi_deg", "angles must increase, but 180° follows 360°"),
+    ("gas-angle-repeated-off-corner", gas_table("[0, 360, 360, 720]", "[1, 60, 50, 1]"),
+     "gas.phi_deg", "360° is repeated but is not in gas.corners_deg"),
+    ("gas-table-short-of-cycle", gas_table("[0, 360, 600]", "[1, 60, 1]"),
+     "gas.phi_deg", "angles run from 0° to 600°; they must start at 0° and end at 720°"),
+    ("gas-table-late-start", gas_table("[10, 360, 720]", "[1, 60, 1]"),
+     "gas.phi_deg", "they must start at 0° and end at 720°"),
+    ("gas-table-lengths-differ", gas_table("[0, 360, 720]", "[1, 60]"),
+     "gas.p", "has 2 values but gas.phi_deg has 3"),
+    ("gas-table-negative-pressure", gas_table("[0, 360, 720]", "[1, -60, 1]"),
+     "gas.p", "pressures are absolute, finite and ≥ 0"),
+    ("gas-corner-outside-cycle", gas_table("[0, 360, 720]", "[1, 60, 1]", "corners_deg = [720]\n"),
+     "gas.corners_deg", "corners must lie strictly inside the cycle"),
+    ("mixed-cycle-compression-ratio-1", VALID + MIXED_CYCLE.format(cr=1),
+     "gas.compression_ratio", "must be > 1, got 1"),
+    ("mixed-cycle-compression-ratio-below-1", VALID + MIXED_CYCLE.format(cr=0.5),
+     "gas.compression_ratio", "must be > 1, got 0.5"),
+    ("mixed-cycle-missing-key", (VALID + MIXED_CYCLE.format(cr=18)).replace("n2 = 1.228\n", ""),
+     "gas.n2", "is missing"),
+    ("unknown-gas-model", VALID + '\n[gas]\nmodel = "wiebe"\n',
+     "gas.model", "unknown value 'wiebe'; allowed: 'none', 'table', 'mixed-cycle'"),
+    ("run-without-end", replace("revolutions = 2\n", ""),
+     "run.t_end", "the run needs an end: give t_end [s] and/or revolutions"),
+    ("run-negative-t-end", add_after("revolutions = 2", "t_end = -1"),
+     "run.t_end", "must be > 0, got -1"),
+    ("unknown-run-mode", add_after("revolutions = 2", 'mode = "steady"'),
+     "run.mode", "unknown value 'steady'; allowed: 'dynamic', 'prescribed-speed'"),
+    ("starter-cutout-above-noload", VALID + "\n[starter]\ntorque = 50\nnoload_speed_rpm = 300\n"
+                                            "cutout_speed_rpm = 400\n",
+     "starter.cutout_speed_rpm", "must be ≤ 300, got 400"),
+    ("at-rest-without-starter-or-gas", replace("omega_rpm = 1000", "omega_rpm = 0"),
+     "initial.omega", "never moves; give omega or a starter"),
+    ("unknown-solver-method", add_after("rtol = 1e-6", 'method = "rk4"'),
+     "solver.method", "unknown value 'rk4'; allowed: 'dop853'"),
+    ("rtol-equal-1", replace("rtol = 1e-6", "rtol = 1"),
+     "solver.rtol", "must be < 1, got 1"),
+    ("rtol-above-1", replace("rtol = 1e-6", "rtol = 2.5"),
+     "solver.rtol", "must be < 1, got 2.5"),
+    ("rtol-zero", replace("rtol = 1e-6", "rtol = 0"),
+     "solver.rtol", "must be > 0, got 0"),
+    ("samples-per-rev-too-few", replace("samples_per_rev = 12", "samples_per_rev = 2"),
+     "output.samples_per_rev", "must be ≥ 4, got 2"),
+    ("nan-number", replace("piston_mass = 1.520", "piston_mass = nan"),
+     "mechanism.piston_mass", "must be finite"),
+]
+
+
+def run_cli(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_one_line_error(err: str, path, key: str, fragment: str) -> None:
+    lines = err.splitlines()
+    assert len(lines) == 1 and err.endswith("\n"), f"expected exactly one line, got {err!r}"
+    line = lines[0]
+    assert "Traceback" not in line
+    assert line.startswith(f"{path}: {key}: "), line
+    message = line[len(f"{path}: {key}: "):]
+    assert fragment in message, line
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+@pytest.mark.parametrize("text, key, fragment",
+                         [pytest.param(t, k, f, id=i) for i, t, k, f in CASES])
+def test_invalid_scene_is_one_line_exit_2(tmp_path, capsys, command, text, key, fragment):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text, encoding="utf-8")
+    out_dir = tmp_path / "out"
+    argv = ["check", str(scene)] if command == "check" else ["run", str(scene), "-o", str(out_dir)]
+    code, out, err = run_cli(argv, capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, key, fragment)
+    assert out == ""
+    if command == "run":
+        assert not out_dir.exists() or not any(out_dir.iterdir()), list(out_dir.iterdir())
+
+
+def test_the_cases_are_distinct_and_many():
+    ids = [c[0] for c in CASES]
+    assert len(set(ids)) == len(ids) >= 15
+    assert len({c[1] for c in CASES}) == len(CASES)  # every case is a different scene text
+
+
+def test_the_base_scene_is_valid(tmp_path, capsys):
+    """Every case differs from a scene that passes: the error comes from the one change."""
+    scene = tmp_path / "ok.toml"
+    scene.write_text(VALID, encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert (code, err) == (0, "")
+    assert out.startswith(f"{scene}: ok (small: CrankSlider, 1 cylinder(s)")
+    for extra in (MIXED_CYCLE.format(cr=18),
+                  '\n[gas]\nmodel = "table"\nphi_deg = [0, 360, 720]\np_bar = [1, 60, 1]\n',
+                  "\n[starter]\ntorque = 50\nnoload_speed_rpm = 300\ncutout_speed_rpm = 200\n"):
+        scene.write_text(VALID + extra, encoding="utf-8")
+        assert run_cli(["check", str(scene)], capsys)[0] == 0
+
+
+@pytest.mark.parametrize("command", ["check", "run", "kinematics"])
+def test_missing_scene_file(tmp_path, capsys, command):
+    scene = tmp_path / "nowhere.toml"
+    code, out, err = run_cli([command, str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, "(file)", "cannot read")
+    assert not (tmp_path / "results").exists()
+
+
+# ----------------------------------------------------------------------------------------------
+# Bugs: misleading key or message, or an error that escapes as a traceback. See the report.
+
+BUGS = [
+    pytest.param(replace("crank_radius_mm = 47", "crank_radius_in = 1.85"),
+                 "mechanism.crank_radius_in", "unknown unit suffix '_in'",
+                 id="unknown-suffix-on-required-key-reported-as-missing"),
+    pytest.param(replace("crank_radius_mm = 47", "crank_radius_rpm = 47"),
+                 "mechanism.crank_radius_rpm", "does not fit this quantity",
+                 id="misfit-suffix-on-required-key-reported-as-missing"),
+    pytest.param(add_after("bore_mm = 88", "offset_rpm = 1"),
+                 "mechanism.offset_rpm", "'offset_mm'",
+                 id="misfit-suffix-hint-omits-the-allowed-suffix"),
+    pytest.param(add_after("crank_mass = 0.912", "cylinders = 3\nfiring = [0.0, 4.0]"),
+                 "mechanism.firing", "has 2 entries",
+                 id="firing-in-radians-reported-as-firing_deg"),
+    pytest.param(VALID + '\n[gas]\nmodel = "table"\nphi = [0.0, 6.0, 3.0, 12.566370614359172]\n'
+                         'p_bar = [1, 60, 5, 1]\n',
+                 "gas.phi", "angles must increase",
+                 id="gas-phi-in-radians-reported-as-phi_deg"),
+    pytest.param(add_after("bore_mm = 88", "bore_diameter = 0.088"),
+                 "mechanism.bore_diameter", "unknown key",
+                 id="unknown-key-reported-as-unknown-unit-suffix"),
+    pytest.param("solver_method = 'dop853'\n" + VALID, "solver_method", "unknown key",
+                 id="unknown-top-level-key-reported-as-unknown-unit-suffix"),
+]
+
+
+@pytest.mark.xfail(strict=True, reason="bug: misleading key or message (see report)")
+@pytest.mark.parametrize("text, key, fragment", BUGS)
+def test_misleading_key_or_message(tmp_path, capsys, text, key, fragment):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text, encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, key, fragment)
+
+
+@pytest.mark.xfail(strict=True, raises=UnicodeDecodeError,
+                   reason="bug: load_scene catches OSError only; a non-UTF-8 file escapes as a "
+                          "UnicodeDecodeError traceback instead of exit 2")
+def test_scene_file_not_utf8(tmp_path, capsys):
+    scene = tmp_path / "latin1.toml"
+    scene.write_bytes(replace("a valid small scene", "Kolbenmotor für Prüfstand")
+                      .encode("latin-1"))
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, "(file)", "UTF-8")

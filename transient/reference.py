@@ -1,0 +1,205 @@
+"""The reference path: the same model in plain numpy, integrated by ``scipy.integrate.solve_ivp``.
+
+Slow and independent of the compiled stepper: time is always the independent variable, the state
+is (φ, ω), and (18) is written out again here from the Gots relations (exact piston velocity
+v = rω sin(φ + β)/cos β, Gots §1.2) rather than taken from the kernels. Breakpoints and the starter
+cut-out are terminal events of solve_ivp, so every segment between them is smooth.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .assemble import build_model
+from .core.integrate import next_breakpoint
+from .core.model import OUTPUTS
+
+
+class CrankSliderNumpy:
+    """J(φ), dJ/dφ and the piston transfer functions of a crank-slider, in plain numpy."""
+
+    def __init__(self, mech) -> None:
+        self.mech = mech
+        mp = mech.pack()
+        from .core import crank_slider as cs
+
+        self.r, self.l, self.e = mech.crank_radius, mech.rod_length, mech.offset
+        self.m_slide = mp[cs.M_PISTON] + mp[cs.M_PIN]
+        self.m_rot = mp[cs.M_CRANKPIN] + mp[cs.M_CRANK]
+        self.m_rod, self.f_cg, self.I_rod = mp[cs.M_ROD], mp[cs.ROD_CG] / self.l, mp[cs.I_ROD]
+        self.phases = np.asarray(mech.firing_angles)
+
+    def terms(self, phi: float):
+        """(J, dJ, u[k]) at shaft angle φ, all cylinders."""
+        a = phi - self.phases
+        r, l = self.r, self.l
+        beta = np.arcsin((r * np.sin(a) - self.e) / l)
+        cb = np.cos(beta)
+        # Gots §1.2: piston velocity over ω, and its derivative (quotient rule).
+        db = r * np.cos(a) / (l * cb)
+        u = r * np.sin(a + beta) / cb
+        du = r * (np.cos(a + beta) * (1 + db) * cb + np.sin(a + beta) * np.sin(beta) * db) / cb**2
+        ddb = (l * np.sin(beta) * db**2 - r * np.sin(a)) / (l * cb)
+        # Rod centre of mass: G = B + f (A − B); A on the crank circle, B on the cylinder axis.
+        f = self.f_cg
+        g1 = np.array([f * r * np.cos(a), -(1 - f) * u - f * r * np.sin(a)])
+        g2 = np.array([-f * r * np.sin(a), -(1 - f) * du - f * r * np.cos(a)])
+        J = np.sum(self.m_slide * u**2 + self.m_rot * r**2 + self.m_rod * np.sum(g1**2, axis=0)
+                   + self.I_rod * db**2)
+        dJ = 2 * np.sum(self.m_slide * u * du + self.m_rod * np.sum(g1 * g2, axis=0)
+                        + self.I_rod * db * ddb)
+        return J, dJ, u
+
+
+class KernelTwin:
+    """Mechanisms without a numpy twin yet run their kernel's pure-Python code (``.py_func``)."""
+
+    def __init__(self, mech, terms) -> None:
+        self.mp = mech.pack()
+        self.fn = terms.py_func
+        self.u = np.empty(mech.n_cylinders)
+        self.du = np.empty(mech.n_cylinders)
+
+    def terms(self, phi):
+        J, dJ = self.fn(self.mp, phi, self.u, self.du)
+        return J, dJ, self.u.copy()
+
+
+def _mechanism(scene):
+    mech = scene.mechanism
+    if mech.kind == 0:
+        return CrankSliderNumpy(mech)
+    from .core.swash_plate import swash_terms
+
+    return KernelTwin(mech, swash_terms)
+
+
+class ReferenceModel:
+    """Right-hand side of (18) in time, dy/dt = (ω, ε), plain numpy."""
+
+    def __init__(self, scene) -> None:
+        self.scene = scene
+        self.model, self.bp, self.table = build_model(scene)
+        self.mech = _mechanism(scene)
+        self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
+        self.pieces = None
+
+    def select(self, a: float, b: float) -> None:
+        """Table pieces for the segment of shaft angle (a, b) between two breakpoints."""
+        if self.table is None:
+            return
+        mid = 0.5 * (a + b) if math.isfinite(a) and math.isfinite(b) else (a if math.isfinite(a) else b)
+        local = np.mod(mid - self.model.gas_phase, self.model.period)
+        self.pieces = self.table.piece_of(local)
+        self.mid = mid
+
+    def moments(self, phi: float, w: float):
+        m = self.model
+        J, dJ, u = self.mech.terms(phi)
+        J += m.J0
+        M_gas = 0.0
+        p = np.zeros(m.ncyl)
+        if self.table is not None:
+            local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
+            p = self.table.evaluate(local, self.pieces)[0]
+            M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
+        M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
+        M_starter = m.starter_torque * (1 - w / m.starter_noload) if self.starter_on else 0.0
+        return J, dJ, M_gas, M_load, M_starter, p
+
+    def rhs(self, t, y):
+        phi, w = y
+        J, dJ, M_gas, M_load, M_starter, _ = self.moments(phi, w)
+        return [w, (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J]
+
+    def rows(self, t, phi, omega):
+        out = []
+        for ti, p, w in zip(t, phi, omega):
+            J, dJ, Mg, Ml, Ms, pc = self.moments(p, w)
+            eps = (Mg + Ml + Ms - 0.5 * dJ * w * w) / J
+            out.append([ti, p, w, eps, J, dJ, Mg, Ml, Ms, *pc])
+        return np.asarray(out).reshape(-1, len(OUTPUTS) + self.model.ncyl)
+
+
+def _segment(ref, phi, omega):
+    """The breakpoints enclosing φ; on a breakpoint, the segment the motion enters."""
+    period = ref.model.period
+    down = next_breakpoint(ref.bp, period, phi, False)
+    up = next_breakpoint(ref.bp, period, phi, True)
+    on = next_breakpoint(ref.bp, period, down, True)  # the breakpoint φ may sit on
+    if math.isfinite(on) and abs(on - phi) <= 1e-13 * max(1.0, abs(phi)):
+        return (on, up) if omega >= 0 else (down, on)
+    return down, up
+
+
+def run_reference(scene, on_block=None, progress=None):
+    """Integrate a dynamic scene with solve_ivp (method from ``scene.solver.method``)."""
+    from .simulate import RunData, output_columns
+
+    ref = ReferenceModel(scene)
+    method = scene.solver.method.removeprefix("scipy-")
+    sv, run = scene.solver, scene.run
+    t_end = run.t_end if math.isfinite(run.t_end) else 1e12
+    phi_end = scene.initial.phi + 2 * math.pi * run.revolutions
+    t, y = 0.0, np.array([scene.initial.phi, scene.initial.omega])
+    blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": []}, 0, 0
+    t0 = time.perf_counter()
+    max_step = sv.max_step / max(sv.switch_speed, abs(scene.initial.omega), 1e-9)
+    while True:
+        down, up = _segment(ref, y[0], y[1])
+        ref.select(down, up)
+        evs = []
+
+        def crossing(level, direction):
+            def g(t, yy):
+                return yy[0] - level
+            g.terminal, g.direction = True, direction
+            return g
+
+        if math.isfinite(up):
+            evs.append(("breakpoint", crossing(up, 1)))
+        if math.isfinite(down):
+            evs.append(("breakpoint", crossing(down, -1)))
+        if math.isfinite(phi_end):
+            evs.append(("end", crossing(phi_end, 1)))
+        if ref.starter_on:
+            def cut(t, yy):
+                return yy[1] - scene.starter.cutout_speed
+            cut.terminal, cut.direction = True, 1
+            evs.append(("starter_cutout", cut))
+        sol = solve_ivp(ref.rhs, (t, t_end), y, method=method, rtol=sv.rtol, atol=sv.atol,
+                        events=[e for _, e in evs] or None, max_step=max_step)
+        if sol.status == -1:
+            from .errors import SimulationError
+
+            raise SimulationError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
+        nfev += sol.nfev
+        nsteps += sol.t.size - 1
+        block = ref.rows(sol.t[1:] if blocks else sol.t, *(sol.y[:, 1:] if blocks else sol.y))
+        blocks.append(block)
+        t, y = sol.t[-1], sol.y[:, -1].copy()
+        if progress:
+            progress(min(1.0, max(t / t_end, (y[0] - scene.initial.phi) / (phi_end - scene.initial.phi))))
+        if sol.status == 0:
+            break
+        hit = [name for (name, _), te in zip(evs, sol.t_events) if te.size]
+        if "end" in hit:
+            break
+        if "starter_cutout" in hit:
+            ref.starter_on = False
+            events["starter_cutout"].append((t, y[0]))
+        if "breakpoint" in hit:
+            # Put φ on the breakpoint it reached (solve_ivp locates it to ~1e-12 rad), so that
+            # the next segment starts there and takes the table pieces beyond it.
+            level = up if y[1] >= 0 else down
+            y[0] = level
+            events["breakpoint"].append((t, y[0]))
+    rows = np.concatenate(blocks)
+    names = list(output_columns(scene))
+    traj = {n: rows[:, j] for j, n in enumerate(names)}
+    solver = {"method": scene.solver.method, "rtol": sv.rtol, "atol": sv.atol, "nfev": nfev,
+              "nsteps": nsteps, "nreject": -1, "wall_s": time.perf_counter() - t0, "compile_s": 0.0}
+    return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v}, solver)
