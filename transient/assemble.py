@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from .core.model import Model
 from .forces.gas import PressureTable, mixed_cycle, table_from_points
+from .forces.trapezoid import trapezoid_table
 
 
 def gas_table(scene) -> PressureTable | None:
@@ -19,14 +20,25 @@ def gas_table(scene) -> PressureTable | None:
     mech = scene.mechanism
     if gas.model == "none":
         return None
+    if gas.model == "trapezoid":  # a force per piston [N] (Antonyuk §4)
+        return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration)
     if gas.model == "table":
         return table_from_points(np.asarray(gas.phi), np.asarray(gas.p), mech.cycle,
                                  corners=gas.corners, interpolation=gas.interpolation)
-    stroke_volume = mech.piston_area * mech.stroke()
-    clearance = stroke_volume / (gas.compression_ratio - 1.0)
+    clearance = swept_volume(mech) / (gas.compression_ratio - 1.0)
     return mixed_cycle(mech.volume_function(clearance), compression_ratio=gas.compression_ratio,
                        p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
                        p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes)
+
+
+def swept_volume(mech) -> float:
+    """Swept volume of one cylinder [m³] (both pistons of an opposed-piston cylinder)."""
+    return getattr(mech, "halves", 1) * mech.piston_area * mech.stroke()
+
+
+def gas_is_force(scene) -> bool:
+    """True when the gas table holds a force per piston [N] rather than a pressure [Pa]."""
+    return scene.gas.model == "trapezoid"
 
 
 def gas_phases(scene) -> NDArray[np.float64]:
@@ -66,9 +78,10 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     else:
         knots, coef, piece_knot = table.knots, table.coef, table.piece_knot
     model = Model(
-        kind=mech.kind, mech=mech.pack(), ncyl=n, J0=scene.inertia.total,
-        has_gas=table is not None, gas_phase=phases, gas_scale=np.full(n, mech.piston_area),
-        gas_offset=scene.gas.p0, period=period, knots=knots, coef=coef,
+        kind=int(mech.kind), mech=mech.pack(), ncyl=n, J0=float(scene.inertia.total),
+        has_gas=table is not None, gas_phase=phases,
+        gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
+        gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), breakpoints=breakpoints(table, phases, period),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,

@@ -157,7 +157,7 @@ def cmd_plot(args) -> int:
     import matplotlib.pyplot as plt
 
     from . import plots
-    from .assemble import gas_table
+    from .assemble import gas_is_force, gas_table, swept_volume
 
     res = _open(args.result)
     scene = res.scene()
@@ -176,17 +176,16 @@ def cmd_plot(args) -> int:
     ax.set_title(f"{scene.name}: moments over the last cycle")
     written.append(_save(fig, out / f"{stem}_torques.png"))
     table = gas_table(scene)
-    if table is not None:
+    if table is not None and not gas_is_force(scene):
         mech = scene.mechanism
-        clearance = (mech.piston_area * mech.stroke() / (scene.gas.compression_ratio - 1.0)
-                     if scene.gas.model == "mixed-cycle" else 0.0)
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
         plots.indicator_phi(a1, table)
-        if clearance > 0:
+        if scene.gas.model == "mixed-cycle":
+            clearance = swept_volume(mech) / (scene.gas.compression_ratio - 1.0)
             plots.indicator_pv(a2, table, mech.volume_function(clearance))
-        else:
-            plots.indicator_pv(a2, table, mech.volume_function(mech.piston_area * mech.stroke() / 17))
-            a2.set_title("p(V), clearance assumed V_h/17", fontsize=9)
+        else:  # a table gives no clearance volume: plot against the swept part F_p·s
+            plots.indicator_pv(a2, table, mech.volume_function(0.0), log=False)
+            a2.set_xlabel("swept volume F_p·s [dm³]")
         a1.set_title(f"{scene.name}: indicator diagram")
         written.append(_save(fig, out / f"{stem}_indicator.png"))
     for w in written:

@@ -61,10 +61,11 @@ def indicator_phi(ax, table):
     return artists
 
 
-def indicator_pv(ax, table, volume):
-    """Indicator diagram p(V), log-log, V [dm³], p [MPa]."""
+def indicator_pv(ax, table, volume, log=True):
+    """Indicator diagram p(V), V [dm³], p [MPa]; log-log unless ``log`` is False."""
     x = np.linspace(0.0, table.period, 2881)
-    artists = ax.loglog(volume(x) * 1e3, table(x) / 1e6, lw=1.0)
+    plot = ax.loglog if log else ax.plot
+    artists = plot(volume(x) * 1e3, table(x) / 1e6, lw=1.0)
     ax.set_xlabel("V [dm³]")
     ax.set_ylabel("p [MPa]")
     ax.grid(True, which="both", alpha=0.3)

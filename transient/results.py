@@ -126,7 +126,7 @@ class Result:
         """Rebuild the scene from ``/scene/toml``."""
         from .scene import load_scene
 
-        return load_scene(self.path.with_suffix(".toml"), text=self.scene_toml)
+        return load_scene(f"{self.path}:/scene/toml", text=self.scene_toml)
 
 
 def open_result(path: str | Path) -> Result:

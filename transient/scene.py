@@ -17,7 +17,9 @@ from typing import Any
 import numpy as np
 
 from .errors import SceneError
-from .mechanisms.crank_slider import CrankSlider
+from .mechanisms.crank_slider import CrankSlider, read_crank_slider
+from .mechanisms.swash_plate import SwashPlate, read_swash_plate
+from .tomlout import toml_value
 from .units import ALL_SUFFIXES, SUFFIXES
 
 _MISSING = object()
@@ -32,6 +34,8 @@ class Section:
         self.data = dict(data)
         self.path = path
         self.known: list[str] = []
+        self.kinds: dict[str, str | None] = {}
+        self.written: dict[str, str] = {}  # base name -> the key as the user wrote it
 
     def key(self, name: str) -> str:
         return f"{self.path}.{name}" if self.path else name
@@ -39,6 +43,7 @@ class Section:
     def _take(self, name: str, kind: str | None):
         """(value, SI factor, key as written) for a quantity given plain or with one unit suffix."""
         self.known.append(name)
+        self.kinds[name] = kind
         found = []
         if name in self.data:
             found.append((name, 1.0))
@@ -49,9 +54,25 @@ class Section:
             raise SceneError(self.key(found[1][0]),
                              f"given twice (also as {found[0][0]!r}); give one of them")
         if not found:
+            self._check_suffixes(name)
             return _MISSING, 1.0, name
         written, factor = found[0]
+        self.written[name] = written
         return self.data.pop(written), factor, written
+
+    def _check_suffixes(self, name: str) -> None:
+        """A key ``name_<suffix>`` with a suffix this quantity does not take is an error here,
+        not a 'missing key' later."""
+        for key in self.data:
+            base, _, suffix = key.rpartition("_")
+            if base == name and _looks_like_unit(suffix):
+                raise SceneError(self.key(key), self._suffix_problem(name, suffix))
+
+    def _suffix_problem(self, name: str, suffix: str) -> str:
+        hint = self._unit_hint(name, self.kinds.get(name))
+        if suffix in ALL_SUFFIXES:
+            return f"unit suffix '_{suffix}' does not fit this quantity; {hint}"
+        return f"unknown unit suffix '_{suffix}'; {hint}"
 
     def number(self, name: str, kind: str | None = None, default: Any = _MISSING, *,
                gt: float | None = None, ge: float | None = None, lt: float | None = None,
@@ -148,21 +169,36 @@ class Section:
         """Every key must have been read: anything left is unknown (or has a wrong unit suffix)."""
         for key in self.data:
             base, _, suffix = key.rpartition("_")
-            if base in self.known and suffix and suffix not in {s for k in SUFFIXES.values()
-                                                                for s in k}:
-                raise SceneError(self.key(key), f"unknown unit suffix '_{suffix}'; allowed "
-                                                f"suffixes: {', '.join('_' + s for s in ALL_SUFFIXES)}"
-                                                f" (or none, for SI)")
-            if base in self.known:
-                raise SceneError(self.key(key), f"unit suffix '_{suffix}' does not fit this "
-                                                f"quantity; {self._unit_hint(base, None)}")
+            if base in self.kinds and _looks_like_unit(suffix):
+                raise SceneError(self.key(key), self._suffix_problem(base, suffix))
             raise SceneError(self.key(key), f"unknown key; allowed here: "
                                             f"{', '.join(sorted(set(self.known)))}")
+
+    def rename(self, exc: SceneError) -> SceneError:
+        """Re-key an error raised under a base name (``mechanism.firing``, or a suffixed form
+        such as ``gas.phi_deg``) to the key the user actually wrote."""
+        prefix = f"{self.path}." if self.path else ""
+        if exc.key.startswith(prefix):
+            name = exc.key[len(prefix):]
+            base = name.rpartition("_")[0] if name.rpartition("_")[2] in ALL_SUFFIXES else name
+            if base in self.written:
+                exc.key = prefix + self.written[base]
+        return exc
 
     @staticmethod
     def _unit_hint(name: str, kind: str | None) -> str:
         options = [name] + [f"{name}_{s}" for s in SUFFIXES.get(kind, {})] if kind else [name]
-        return "give " + " or ".join(repr(o) for o in options)
+        return "give " + " or ".join(repr(o) for o in options) + (" (SI without a suffix)"
+                                                                   if kind else "")
+
+
+#: Suffixes that read as a unit: an unknown one is reported as a unit suffix, not an unknown key.
+_UNIT_LIKE = {"in", "m", "cm", "km", "ft", "s", "ms", "min", "h", "rad", "rps", "hz", "pa", "kpa",
+              "psi", "atm", "kg", "g", "lb", "n", "nm", "kw", "w", "k", "c", "l"}
+
+
+def _looks_like_unit(suffix: str) -> bool:
+    return suffix in ALL_SUFFIXES or suffix.lower() in _UNIT_LIKE
 
 
 def _show(value: Any) -> str:
@@ -193,8 +229,9 @@ class Gas:
 
     ``model``: ``"none"``, ``"table"`` (indicator diagram p(φ) over one cycle, absolute pressure
     [Pa]; local angle 0 = gas-exchange TDC for 4-stroke, firing TDC for 2-stroke ... see README) or
-    ``"mixed-cycle"`` (Gots App. 2, Trinkler–Sabathé). ``p0`` is the crankcase pressure [Pa]:
-    piston force (p − p0)·F_p, Gots (33).
+    ``"mixed-cycle"`` (Gots App. 2, Trinkler–Sabathé), or ``"trapezoid"`` (the swash-plate paper's
+    force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]). ``p0`` is the
+    crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33).
     """
 
     model: str = "none"
@@ -211,6 +248,9 @@ class Gas:
     n2: float = 0.0
     p_intake: float = 0.0
     p_exhaust: float = 0.0
+    amplitude: float = 0.0
+    ramp: float = 0.0
+    duration: float = math.pi
 
 
 @dataclass(frozen=True)
@@ -282,7 +322,7 @@ METHODS = ("dop853", "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 class Scene:
     name: str
     description: str
-    mechanism: CrankSlider
+    mechanism: CrankSlider | SwashPlate
     inertia: Inertia = field(default_factory=Inertia)
     gas: Gas = field(default_factory=Gas)
     load: Load = field(default_factory=Load)
@@ -297,44 +337,15 @@ class Scene:
 # Readers, one per section
 
 
-def _read_crank_slider(s: Section) -> CrankSlider:
-    r = s.number("crank_radius", "length")
-    l = s.number("rod_length", "length")
-    strokes = s.integer("strokes", 4, choices=(2, 4))
-    n = s.integer("cylinders", 1, ge=1)
-    cycle = math.pi * strokes
-    order = s.integers("firing_order", tuple(range(1, n + 1)))
-    if sorted(order) != list(range(1, n + 1)):
-        raise SceneError(s.key("firing_order"),
-                         f"must list each cylinder 1 … {n} once, got {list(order)}")
-    even = [0.0] * n
-    for j, c in enumerate(order):
-        even[c - 1] = j * cycle / n
-    firing = s.numbers("firing", "angle", tuple(even))
-    banks = s.numbers("bank", "angle", (0.0,) * n)
-    for key, values in (("firing_deg", firing), ("bank_deg", banks)):
-        if len(values) != n:
-            raise SceneError(s.key(key), f"has {len(values)} entries; must have one per cylinder "
-                                         f"({n})")
-    rod = s.sub("rod", required=True)
-    model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
-    mech = CrankSlider(
-        crank_radius=r, rod_length=l, offset=s.number("offset", "length", 0.0),
-        bore=s.number("bore", "length"), piston_mass=s.number("piston_mass"),
-        crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
-        rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
-        rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
-        strokes=strokes, firing_angles=firing, bank_angles=banks)
-    rod.finish()
-    mech.validate()
-    return mech
-
-
-MECHANISMS = {"crank-slider": _read_crank_slider}
+MECHANISMS = {"crank-slider": read_crank_slider, "swash-plate": read_swash_plate}
 
 
 def _read_gas(s: Section, base_dir: Path) -> Gas:
-    model = s.string("model", "none", choices=("none", "table", "mixed-cycle"))
+    model = s.string("model", "none", choices=("none", "table", "mixed-cycle", "trapezoid"))
+    if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
+        return Gas(model="trapezoid", p0=0.0, amplitude=s.number("amplitude", ge=0.0),
+                   ramp=s.number("ramp", "angle", gt=0.0),
+                   duration=s.number("duration", "angle", math.pi, gt=0.0))
     p0 = s.number("p0", "pressure", 1.0e5, ge=0.0)
     if model == "none":
         return Gas(model="none", p0=p0)
@@ -462,6 +473,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
         _check_consistency(scene)
+        _check_gas_table(scene, sg)
         return scene
     except SceneError as exc:
         exc.file = exc.file or file
@@ -477,8 +489,18 @@ def _check_consistency(scene: Scene) -> None:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
                                               "never moves; give omega or a starter")
-    from .assemble import gas_table  # builds (and so validates) the pressure table
-    gas_table(scene)
+
+
+def _check_gas_table(scene: Scene, section: Section) -> None:
+    """Build (and so validate) the pressure table; report under the key the user wrote."""
+    from .assemble import gas_table
+
+    try:
+        gas_table(scene)
+    except SceneError as exc:
+        if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi"):
+            exc.key = "gas.file"
+        raise section.rename(exc) from None
 
 
 def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
@@ -486,9 +508,12 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     path = Path(source)
     if text is None:
         try:
-            text = path.read_text()
+            text = path.read_text(encoding="utf-8")
         except OSError as exc:
             raise SceneError("(file)", f"cannot read: {exc.strerror}", file=str(path)) from None
+        except UnicodeDecodeError as exc:
+            raise SceneError("(file)", f"not UTF-8 text (byte {exc.start}); save the scene as "
+                                       f"UTF-8", file=str(path)) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -503,19 +528,8 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
 def to_toml(scene: Scene) -> str:
     """The resolved scene as TOML in SI units (no suffixes), round-tripping through load_scene."""
     lines = ["# resolved scene: SI units, every default filled in (written by transient)",
-             "[scene]", f"name = {_toml(scene.name)}", f"description = {_toml(scene.description)}"]
-    mech = scene.mechanism
-    lines += ["", "[mechanism]", 'type = "crank-slider"']
-    mech_keys = {"crank_radius": mech.crank_radius, "rod_length": mech.rod_length,
-                 "offset": mech.offset, "bore": mech.bore, "piston_mass": mech.piston_mass,
-                 "crank_mass": mech.crank_mass, "strokes": mech.strokes,
-                 "cylinders": mech.n_cylinders, "firing": list(mech.firing_angles),
-                 "bank": list(mech.bank_angles)}
-    lines += [f"{k} = {_toml(v)}" for k, v in mech_keys.items()]
-    lines += ["", "[mechanism.rod]", f"model = {_toml(mech.rod_model)}", f"mass = {_toml(mech.rod_mass)}",
-              f"cg_from_pin = {_toml(mech.rod_cg_from_pin)}"]
-    if mech.rod_model == "rigid":
-        lines.append(f"inertia_cg = {_toml(mech.rod_inertia_cg)}")
+             "[scene]", f"name = {toml_value(scene.name)}", f"description = {toml_value(scene.description)}"]
+    lines += [""] + scene.mechanism.toml_lines()
     lines += _section("inertia", scene.inertia)
     lines += _gas_section(scene.gas)
     lines += _section("load", scene.load)
@@ -530,36 +544,21 @@ def to_toml(scene: Scene) -> str:
             run.update(time=list(scene.run.time), speed_table=list(scene.run.speed_table))
         else:
             run["speed"] = scene.run.speed
-    lines += ["", "[run]"] + [f"{k} = {_toml(v)}" for k, v in run.items()]
+    lines += ["", "[run]"] + [f"{k} = {toml_value(v)}" for k, v in run.items()]
     lines += _section("solver", scene.solver)
     lines += _section("output", scene.output)
     return "\n".join(lines) + "\n"
 
 
 def _gas_section(gas: Gas) -> list[str]:
-    keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation")}
+    keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation"),
+            "trapezoid": ("model", "amplitude", "ramp", "duration")}
     names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
                                  "n2", "p_intake", "p_exhaust"))
-    return ["", "[gas]"] + [f"{k} = {_toml(getattr(gas, k))}" for k in names]
+    return ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
 
 
 def _section(name: str, obj: Any) -> list[str]:
     assert is_dataclass(obj)
-    return ["", f"[{name}]"] + [f"{f.name} = {_toml(getattr(obj, f.name))}" for f in fields(obj)]
+    return ["", f"[{name}]"] + [f"{f.name} = {toml_value(getattr(obj, f.name))}" for f in fields(obj)]
 
-
-def _toml(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_toml(v) for v in value) + "]"
-    raise TypeError(f"cannot write {type(value).__name__} to TOML")

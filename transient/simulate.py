@@ -25,9 +25,12 @@ EVENT_ROWS = 2048
 
 def output_columns(scene) -> dict[str, str]:
     """Trajectory datasets of a run and their units (DESIGN §4)."""
+    from .assemble import gas_is_force
+
     cols = dict(zip(OUTPUTS, OUTPUT_UNITS))
     for k in range(scene.mechanism.n_cylinders):
-        cols[f"p_{k + 1}"] = "Pa"
+        # p_k: cylinder pressure, or the force per piston for force-pulse models
+        cols[f"p_{k + 1}"] = "N" if gas_is_force(scene) else "Pa"
     if scene.run.mode == "prescribed-speed":
         cols["M_drive"] = "N m"
     return cols
@@ -129,8 +132,10 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     except KeyboardInterrupt:
         message = "interrupted"
     wall = time.perf_counter() - t0
-    last = {n: blocks[-1][n][-1] for n in ("t", "phi", "omega")} if blocks and blocks[-1]["t"].size \
-        else {"t": y[1], "phi": y[0], "omega": scene.initial.omega}
+    filled = [b for b in blocks if b["t"].size]
+    last = ({n: filled[-1][n][-1] for n in ("t", "phi", "omega")} if filled
+            else {"t": 0.0, "phi": scene.initial.phi,
+                  "omega": scene.initial.omega})
     where = (f"t = {last['t']:.9g} s, φ = {last['phi']:.9g} rad ({math.degrees(last['phi']):.6g}°), "
              f"ω = {last['omega']:.9g} rad/s")
     if message:
@@ -143,7 +148,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     solver = {"method": "dop853", "rtol": scene.solver.rtol, "atol": scene.solver.atol,
               "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
               "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s}
-    traj = {n: np.concatenate([b[n] for b in blocks]) for n in names}
+    traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
                    solver, complete=status == ci.FINISHED, message=message)
 
@@ -170,15 +175,19 @@ def prescribed(scene) -> RunData:
         t = (phi - phi0) / w
         omega = np.full_like(phi, w)
         eps = np.zeros_like(phi)
-    t0 = time.perf_counter()
     rows = np.empty((phi.size, N_OUT_FIXED + model.ncyl))
     drive = np.empty(phi.size)
+    t0 = time.perf_counter()
+    inverse_dynamics(model, t[:1], phi[:1], omega[:1], eps[:1], rows[:1], drive[:1])  # compile
+    compile_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
     inverse_dynamics(model, t, phi, omega, eps, rows, drive)
     names = list(output_columns(scene))
     traj = {name: rows[:, j].copy() for j, name in enumerate(names[:-1])}
     traj["M_drive"] = drive
     solver = {"method": "prescribed", "rtol": 0.0, "atol": 0.0, "nfev": int(phi.size),
-              "nsteps": 0, "nreject": 0, "wall_s": time.perf_counter() - t0, "compile_s": 0.0}
+              "nsteps": 0, "nreject": 0, "wall_s": time.perf_counter() - t0,
+              "compile_s": compile_s}
     return RunData(traj, {}, solver)
 
 
@@ -213,7 +222,7 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
             writer.append(data.trajectory)
         writer.events(data.events)
         writer.solver(data.solver)
-        summary = summarize(scene, data.trajectory)
+        summary = summarize(scene, data.trajectory) if data.trajectory["t"].size else {}
         for name, (value, unit) in summary.items():
             writer.analysis(name, value, unit)
         data.extra["summary"] = summary

@@ -4,7 +4,7 @@ Every run is small (a few revolutions, coarse output) and goes through ``transie
 in-process, so the numba cache is loaded once for the whole file. One test starts
 ``python -m transient`` in a subprocess.
 
-Tests marked ``xfail(strict=True)`` document bugs (see the report that came with them).
+Some tests here were written against bugs they found (now fixed); they keep those fixed.
 """
 from __future__ import annotations
 
@@ -388,9 +388,6 @@ def test_resolved_toml_of_every_case_round_trips(case):
     assert to_toml(again) == to_toml(scene)
 
 
-@pytest.mark.xfail(strict=True, reason="bug: scene._toml writes control characters (a newline) "
-                                       "into a TOML basic string unescaped, so /scene/toml of a "
-                                       "scene whose description has a line break cannot be read")
 def test_scene_toml_round_trips_with_a_multiline_description(tmp_path, capsys):
     text = COASTING.format(revolutions=1, samples=8).replace(
         'description = "single cylinder coasting"',
@@ -577,9 +574,6 @@ def test_interrupted_run_keeps_the_partial_result(tmp_path, capsys, monkeypatch)
     assert code == 0 and "complete = False" in out and "message: interrupted" in out
 
 
-@pytest.mark.xfail(strict=True, raises=ValueError,
-                   reason="bug: run_compiled concatenates an empty block list when Ctrl-C comes "
-                          "during the first chunk; ValueError escapes main() as a traceback")
 def test_interrupt_during_the_first_chunk(tmp_path, capsys, monkeypatch):
     scene = write(tmp_path, "coast", COASTING.format(revolutions=2, samples=12))
     interrupt_advance(monkeypatch, on_chunk=1)

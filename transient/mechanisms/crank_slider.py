@@ -8,11 +8,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from math import asin, degrees, pi
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
 from ..core import crank_slider as core
 from ..errors import SceneError
+from ..tomlout import toml_value
 
 
 @dataclass(frozen=True)
@@ -93,8 +96,8 @@ class CrankSlider:
             raise SceneError("mechanism.rod_length", f"must be > 0, got {l * 1e3:g} mm")
         if r / l >= 1.0:
             raise SceneError("mechanism.rod_length",
-                             f"λ = r/l = {r / l:.4g} must be < 1 (rod longer than the crank radius "
-                             f"{r * 1e3:g} mm)")
+                             f"λ = r/l = {r / l:.4g} must be < 1: the rod ({l * 1e3:g} mm) must be "
+                             f"longer than the crank radius ({r * 1e3:g} mm)")
         if abs(e) >= l - r:
             raise SceneError("mechanism.offset",
                              f"|offset| = {abs(e) * 1e3:g} mm is too large for the geometry; "
@@ -122,7 +125,7 @@ class CrankSlider:
             raise SceneError("mechanism.cylinders", "must be ≥ 1")
         for a in self.firing_angles:
             if not 0.0 <= a < self.cycle:
-                raise SceneError("mechanism.firing_deg",
+                raise SceneError("mechanism.firing",
                                  f"{degrees(a):g}° is outside the cycle; allowed 0 ≤ angle < "
                                  f"{degrees(self.cycle):g}°")
 
@@ -145,6 +148,20 @@ class CrankSlider:
         mp[core.N_CYL] = self.n_cylinders
         mp[core.PHASE0:] = self.firing_angles
         return mp
+
+    def toml_lines(self) -> list[str]:
+        """The ``[mechanism]`` and ``[mechanism.rod]`` tables in SI, read back by
+        :func:`read_crank_slider` to an equal object."""
+        keys = {"type": "crank-slider", "crank_radius": self.crank_radius,
+                "rod_length": self.rod_length, "offset": self.offset, "bore": self.bore,
+                "piston_mass": self.piston_mass, "crank_mass": self.crank_mass,
+                "strokes": self.strokes, "cylinders": self.n_cylinders,
+                "firing": list(self.firing_angles), "bank": list(self.bank_angles)}
+        rod = {"model": self.rod_model, "mass": self.rod_mass, "cg_from_pin": self.rod_cg_from_pin}
+        if self.rod_model == "rigid":
+            rod["inertia_cg"] = self.rod_inertia_cg
+        return (["[mechanism]"] + [f"{k} = {toml_value(v)}" for k, v in keys.items()]
+                + ["", "[mechanism.rod]"] + [f"{k} = {toml_value(v)}" for k, v in rod.items()])
 
     def tdc_angle(self) -> float:
         """Local crank angle of the true top dead centre, Gots (9): sin φ₁ = e/(l + r)."""
@@ -188,3 +205,40 @@ class CrankSlider:
             return clearance + area * s
 
         return volume
+
+
+def read_crank_slider(s) -> CrankSlider:
+    """A :class:`CrankSlider` from the ``[mechanism]`` table (a ``transient.scene.Section``)."""
+    r = s.number("crank_radius", "length")
+    l = s.number("rod_length", "length")
+    strokes = s.integer("strokes", 4, choices=(2, 4))
+    n = s.integer("cylinders", 1, ge=1)
+    cycle = math.pi * strokes
+    order = s.integers("firing_order", tuple(range(1, n + 1)))
+    if sorted(order) != list(range(1, n + 1)):
+        raise SceneError(s.key("firing_order"),
+                         f"must list each cylinder 1 … {n} once, got {list(order)}")
+    even = [0.0] * n
+    for j, c in enumerate(order):
+        even[c - 1] = j * cycle / n
+    firing = s.numbers("firing", "angle", tuple(even))
+    banks = s.numbers("bank", "angle", (0.0,) * n)
+    for key, values in (("firing", firing), ("bank", banks)):
+        if len(values) != n:
+            raise s.rename(SceneError(s.key(key), f"has {len(values)} entries; must have one per "
+                                                  f"cylinder ({n})"))
+    rod = s.sub("rod", required=True)
+    model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
+    mech = CrankSlider(
+        crank_radius=r, rod_length=l, offset=s.number("offset", "length", 0.0),
+        bore=s.number("bore", "length"), piston_mass=s.number("piston_mass"),
+        crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
+        rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
+        rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
+        strokes=strokes, firing_angles=firing, bank_angles=banks)
+    rod.finish()
+    try:
+        mech.validate()
+    except SceneError as exc:
+        raise rod.rename(s.rename(exc)) from None
+    return mech

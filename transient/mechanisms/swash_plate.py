@@ -53,6 +53,7 @@ from scipy.optimize import brentq
 from ..core import swash_plate as core
 from ..core.model import SWASH_PLATE
 from ..errors import SceneError
+from ..tomlout import toml_value
 from ..units import SUFFIXES
 
 if TYPE_CHECKING:
@@ -302,8 +303,8 @@ class SwashPlate:
         rod = {"model": self.rod_model, "mass": self.rod_mass, "cg_from_pin": self.rod_cg_from_pin}
         if self.rod_model == "rigid":
             rod["inertia_cg"] = self.rod_inertia_cg
-        return (["[mechanism]"] + [f"{k} = {_toml(v)}" for k, v in keys.items()]
-                + ["", "[mechanism.rod]"] + [f"{k} = {_toml(v)}" for k, v in rod.items()])
+        return (["[mechanism]"] + [f"{k} = {toml_value(v)}" for k, v in keys.items()]
+                + ["", "[mechanism.rod]"] + [f"{k} = {toml_value(v)}" for k, v in rod.items()])
 
 
 def antonyuk_example(**changes) -> SwashPlate:
@@ -490,25 +491,6 @@ def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.f
 # Scene reading and writing
 
 
-def _toml(value) -> str:
-    """One TOML value (the scalars :meth:`SwashPlate.toml_lines` writes); floats round-trip."""
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, (bool, np.bool_)):
-        raise TypeError("no booleans in a swash-plate table")
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    return repr(float(value))
-
-
-def _written(s: "Section", name: str, kind: str | None = None) -> str:
-    """Dotted key of ``name`` as written (plain or with one unit suffix); call before reading it."""
-    for suffix in SUFFIXES.get(kind, {}) if kind else {}:
-        if f"{name}_{suffix}" in s.data:
-            return s.key(f"{name}_{suffix}")
-    return s.key(name)
-
-
 def read_swash_plate(s: "Section") -> SwashPlate:
     """A :class:`SwashPlate` from the ``[mechanism]`` table (its ``type`` is read by the caller).
 
@@ -525,14 +507,6 @@ def read_swash_plate(s: "Section") -> SwashPlate:
     ``swash_deg``, ``mechanism.swash`` if they wrote ``swash``): :meth:`SwashPlate.validate` reports
     its canonical keys (angles as ``*_deg``, everything else by its SI name), which are mapped here.
     """
-    # Canonical validate() key -> key as written; taken before the Section pops each key.
-    written = {f"mechanism.{n}": _written(s, n, kind) for n, kind in (
-        ("joint_radius", "length"), ("cylinder_radius", "length"), ("rod_length", "length"),
-        ("bore", "length"))}
-    written["mechanism.swash_deg"] = _written(s, "swash", "angle")
-    for n in ("cylinders", "halves", "hinge", "piston_mass", "cross_inertia"):
-        written[f"mechanism.{n}"] = s.key(n)
-
     swash = s.number("swash", "angle")
     R = s.number("joint_radius", "length", gt=0.0)
     r1 = s.number("cylinder_radius", "length", gt=0.0)
@@ -551,8 +525,6 @@ def read_swash_plate(s: "Section") -> SwashPlate:
                              "give either link_inertia (isotropic link 9) or both "
                              "link_polar_inertia and link_diametral_inertia, not both forms")
         polar = diametral = iso
-        written["mechanism.link_polar_inertia"] = s.key("link_inertia")
-        written["mechanism.link_diametral_inertia"] = s.key("link_inertia")
     elif polar is None and diametral is None:
         raise SceneError(s.key("link_inertia"),
                          "is missing; give link_inertia [kg m²] (isotropic link 9) or both "
@@ -563,13 +535,8 @@ def read_swash_plate(s: "Section") -> SwashPlate:
                 raise SceneError(s.key(key), "is missing; link_polar_inertia and "
                                              "link_diametral_inertia go together (or give "
                                              "link_inertia alone for an isotropic link 9)")
-            written[f"mechanism.{key}"] = s.key(key)
     cross = s.number("cross_inertia", default=0.0, ge=0.0)
     rod = s.sub("rod", required=True)
-    written["mechanism.rod.model"] = rod.key("model")
-    written["mechanism.rod.mass"] = rod.key("mass")
-    written["mechanism.rod.cg_from_pin"] = _written(rod, "cg_from_pin", "length")
-    written["mechanism.rod.inertia_cg"] = rod.key("inertia_cg")
     model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
     mech = SwashPlate(
         swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell, bore=bore,
@@ -582,5 +549,7 @@ def read_swash_plate(s: "Section") -> SwashPlate:
     try:
         mech.validate()
     except SceneError as exc:
-        raise SceneError(written.get(exc.key, exc.key), exc.message) from None
+        if iso is not None and exc.key.startswith("mechanism.link_"):
+            exc.key = s.key("link_inertia")
+        raise rod.rename(s.rename(exc)) from None
     return mech
