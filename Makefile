@@ -2,7 +2,7 @@
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
-DEFAULT_SCENE := cases/gots_diesel_spinup.toml
+DEFAULT_SCENE := cases/swash_plate_4cyl.toml
 DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
 .PHONY: run test install clean

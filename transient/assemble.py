@@ -85,5 +85,6 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         piece_knot=piece_knot.astype(np.int64), breakpoints=breakpoints(table, phases, period),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
-        starter_cutout=scene.starter.cutout_speed)
+        starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
+        gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero)
     return model, model.breakpoints, table

@@ -51,14 +51,15 @@ def _parser() -> argparse.ArgumentParser:
     i = sub.add_parser("info", help="summarise a result file")
     i.add_argument("result")
     i.set_defaults(func=cmd_info)
-    pl = sub.add_parser("plot", help="write PNG figures of a result")
-    pl.add_argument("result")
+    pl = sub.add_parser("plot", help="write PNG figures of a result, or compare several")
+    pl.add_argument("result", nargs="+", help="one result, or several to compare side by side")
     pl.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
     pl.set_defaults(func=cmd_plot)
     k = sub.add_parser("kinematics", help="tabulate positions, transfer functions, J and dJ/dφ")
     k.add_argument("scene")
     k.add_argument("-o", "--output", default=None, help="CSV file (default: standard output)")
     k.add_argument("--points", type=int, default=361, help="points over one cycle")
+    k.add_argument("--plot", default=None, help="also write a PNG of the transfer functions and J")
     k.set_defaults(func=cmd_kinematics)
     return p
 
@@ -108,6 +109,10 @@ def _print_summary(summary, solver) -> None:
     ss = v["steady_state_t"]
     print("  steady state: " + (f"reached at t = {ss:.6g} s" if math.isfinite(ss)
                                 else "not reached (cycle-mean speed still changing by ≥ 1e-4)"))
+    if "M_gas_swing_last_cycle" in v:
+        print(f"  last cycle: peak |ε| = {v['epsilon_peak_last_cycle']:.4g} rad/s², swing of the "
+              f"gas torque {v['M_gas_swing_last_cycle']:.4g} N m against the inertia torque "
+              f"½J′ω² {v['M_inertia_swing_last_cycle']:.4g} N m")
     if "mean_drive_torque_last_cycle" in v:
         print(f"  mean drive torque required over the last cycle: "
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
@@ -159,7 +164,9 @@ def cmd_plot(args) -> int:
     from . import plots
     from .assemble import gas_is_force, gas_table, swept_volume
 
-    res = _open(args.result)
+    if len(args.result) > 1:
+        return _plot_comparison(args)
+    res = _open(args.result[0])
     scene = res.scene()
     out = Path(args.output) if args.output else res.path.parent
     out.mkdir(parents=True, exist_ok=True)
@@ -193,6 +200,32 @@ def cmd_plot(args) -> int:
     return EXIT_OK
 
 
+def _plot_comparison(args) -> int:
+    """The swash-plate paper's Fig. 5 as one figure: ω(t), ε(t) and the force on piston 1 of
+    each result, one column per result, shared axes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from . import plots
+
+    results = [_open(p) for p in args.result]
+    out = Path(args.output) if args.output else results[0].path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    n = len(results)
+    fig, axes = plt.subplots(3, n, figsize=(5 * n, 8), sharex=True, sharey="row", squeeze=False)
+    for j, res in enumerate(results):
+        scene = res.scene()
+        plots.speed(axes[0, j], res.trajectory)
+        plots.acceleration(axes[1, j], res.trajectory)
+        plots.piston_force(axes[2, j], res.trajectory, scene)
+        axes[0, j].set_title(f"{scene.name}\n{scene.mechanism.n_cylinders} cylinder(s)", fontsize=9)
+    path = out / ("compare_" + "_".join(r.path.stem for r in results) + ".png")
+    print(f"wrote {_save(fig, path)}")
+    return EXIT_OK
+
+
 def _save(fig, path):
     import matplotlib.pyplot as plt
 
@@ -216,4 +249,17 @@ def cmd_kinematics(args) -> int:
         print(f"wrote {args.output}")
     else:
         np.savetxt(sys.stdout, data, delimiter=",", header=header, comments="", fmt="%.12g")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from . import plots
+
+        fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+        plots.transfer_functions(a1, table)
+        plots.reduced_inertia(a2, table)
+        a1.set_title(f"{scene.name}: transfer functions and reduced inertia")
+        print(f"wrote {_save(fig, Path(args.plot))}", file=sys.stderr if not args.output else sys.stdout)
     return EXIT_OK

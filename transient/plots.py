@@ -24,6 +24,20 @@ def acceleration(ax, traj, label=None):
     return artists
 
 
+def piston_force(ax, traj, scene, cylinder=1):
+    """Gas force on one piston of ``cylinder`` against time [kN]: the table value times the
+    governor's fuel for force models, (p − p0)·F_p·fuel for pressure models."""
+    from .assemble import gas_is_force
+
+    value = traj[f"p_{cylinder}"]
+    force = value if gas_is_force(scene) else (value - scene.gas.p0) * scene.mechanism.piston_area
+    artists = ax.plot(traj["t"], force * traj["fuel"] / 1e3, lw=0.6)
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel(f"P piston {cylinder} [kN]")
+    ax.grid(True, alpha=0.3)
+    return artists
+
+
 def last_cycle(traj, cycle):
     """Boolean mask of the samples in the last whole cycle of crank angle."""
     phi = traj["phi"]
@@ -70,3 +84,34 @@ def indicator_pv(ax, table, volume, log=True):
     ax.set_ylabel("p [MPa]")
     ax.grid(True, which="both", alpha=0.3)
     return artists
+
+
+def transfer_functions(ax, table):
+    """Transfer functions of a kinematics table against the shaft angle: u₉,₁ and u₁₃,₁ of a
+    swash plate (the paper's Fig. 4), the piston ones u_k [m/rad] on a second axis."""
+    phi = table["phi_deg"]
+    artists = [ax.plot(phi, table[k], lw=1.2, label=k)[0] for k in ("u9", "u13") if k in table]
+    pistons = [k for k in table if k.startswith("u_")]
+    other = ax.twinx() if artists else ax
+    artists += [other.plot(phi, table[k], lw=0.8, ls="--", color=f"C{j + 2}", label=k)[0]
+                for j, k in enumerate(pistons)]
+    if artists and other is not ax:
+        other.set_ylabel("piston u [m/rad]")
+    ax.set_ylabel("u₉,₁, u₁₃,₁ [1]" if other is not ax else "u [m/rad]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(handles=artists, fontsize=7, ncol=4)
+    return artists
+
+
+def reduced_inertia(ax, table):
+    """J(φ) and dJ/dφ of the moving parts from a kinematics table."""
+    phi = table["phi_deg"]
+    a = ax.plot(phi, table["J"], lw=1.2, label="J")
+    other = ax.twinx()
+    b = other.plot(phi, table["dJ_dphi"], lw=0.8, color="C3", label="dJ/dφ")
+    ax.set_xlabel("shaft angle [deg]")
+    ax.set_ylabel("J [kg m²]")
+    other.set_ylabel("dJ/dφ [kg m²/rad]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(handles=a + b, fontsize=8)
+    return a + b

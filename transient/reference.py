@@ -105,10 +105,17 @@ class ReferenceModel:
         if self.table is not None:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
             p = self.table.evaluate(local, self.pieces)[0]
-            M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
+            M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u)) * self.fuel(w)
         M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
         M_starter = m.starter_torque * (1 - w / m.starter_noload) if self.starter_on else 0.0
         return J, dJ, M_gas, M_load, M_starter, p
+
+    def fuel(self, w: float) -> float:
+        """Static droop characteristic (Antonyuk §4), 1 without a governor."""
+        g = self.scene.governor
+        if g.model == "none":
+            return 1.0
+        return float(np.clip((g.speed_zero - w) / (g.speed_zero - g.speed_full), 0.0, 1.0))
 
     def rhs(self, t, y):
         phi, w = y
@@ -120,7 +127,7 @@ class ReferenceModel:
         for ti, p, w in zip(t, phi, omega):
             J, dJ, Mg, Ml, Ms, pc = self.moments(p, w)
             eps = (Mg + Ml + Ms - 0.5 * dJ * w * w) / J
-            out.append([ti, p, w, eps, J, dJ, Mg, Ml, Ms, *pc])
+            out.append([ti, p, w, eps, J, dJ, Mg, Ml, Ms, self.fuel(w), *pc])
         return np.asarray(out).reshape(-1, len(OUTPUTS) + self.model.ncyl)
 
 
@@ -145,7 +152,8 @@ def run_reference(scene, on_block=None, progress=None):
     t_end = run.t_end if math.isfinite(run.t_end) else 1e12
     phi_end = scene.initial.phi + 2 * math.pi * run.revolutions
     t, y = 0.0, np.array([scene.initial.phi, scene.initial.omega])
-    blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": []}, 0, 0
+    blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": [],
+                                         "governor_corner": []}, 0, 0
     t0 = time.perf_counter()
     max_step = sv.max_step / max(sv.switch_speed, abs(scene.initial.omega), 1e-9)
     while True:
@@ -165,6 +173,12 @@ def run_reference(scene, on_block=None, progress=None):
             evs.append(("breakpoint", crossing(down, -1)))
         if math.isfinite(phi_end):
             evs.append(("end", crossing(phi_end, 1)))
+        if scene.governor.model == "droop":  # corners of the characteristic, both directions
+            for level in (scene.governor.speed_full, scene.governor.speed_zero):
+                def corner(t, yy, level=level):
+                    return yy[1] - level
+                corner.terminal = True
+                evs.append(("governor_corner", corner))
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -191,6 +205,8 @@ def run_reference(scene, on_block=None, progress=None):
         if "starter_cutout" in hit:
             ref.starter_on = False
             events["starter_cutout"].append((t, y[0]))
+        if "governor_corner" in hit:
+            events["governor_corner"].append((t, y[0]))
         if "breakpoint" in hit:
             # Put φ on the breakpoint it reached (solve_ivp locates it to ~1e-12 rad), so that
             # the next segment starts there and takes the table pieces beyond it.

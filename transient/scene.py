@@ -272,6 +272,17 @@ class Starter:
 
 
 @dataclass(frozen=True)
+class Governor:
+    """Speed governor. ``droop``: the static characteristic of the swash-plate paper (§4) scaling
+    every gas force by 1 below ``speed_full`` (ω_a), linearly down to 0 at ``speed_zero`` (ω_1c),
+    0 above [rad/s]."""
+
+    model: str = "none"
+    speed_full: float = 0.0
+    speed_zero: float = 0.0
+
+
+@dataclass(frozen=True)
 class Initial:
     """Initial shaft angle [rad] and speed [rad/s]."""
 
@@ -327,6 +338,7 @@ class Scene:
     gas: Gas = field(default_factory=Gas)
     load: Load = field(default_factory=Load)
     starter: Starter = field(default_factory=Starter)
+    governor: Governor = field(default_factory=Governor)
     initial: Initial = field(default_factory=Initial)
     run: Run = field(default_factory=Run)
     solver: Solver = field(default_factory=Solver)
@@ -394,6 +406,15 @@ def _read_pressure_csv(s: Section, base_dir: Path):
     return phi, p
 
 
+def _read_governor(s: Section) -> Governor:
+    model = s.string("model", "none", choices=("none", "droop"))
+    if model == "none":
+        return Governor()
+    full = s.number("speed_full", "speed", gt=0.0)
+    zero = s.number("speed_zero", "speed", gt=full)
+    return Governor(model, full, zero)
+
+
 def _read_run(s: Section, mech) -> Run:
     mode = s.string("mode", "dynamic", choices=("dynamic", "prescribed-speed"))
     t_end = s.number("t_end", default=math.inf, gt=0.0)
@@ -451,6 +472,9 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         cutout = ss.number("cutout_speed", "speed", noload, gt=0.0, le=noload)
         sections["starter"] = Starter(torque, noload, cutout)
         ss.finish()
+        sgv = root.sub("governor")
+        sections["governor"] = _read_governor(sgv)
+        sgv.finish()
         s0 = root.sub("initial")
         sections["initial"] = Initial(s0.number("phi", "angle", 0.0),
                                       s0.number("omega", "speed", 0.0))
@@ -534,6 +558,8 @@ def to_toml(scene: Scene) -> str:
     lines += _gas_section(scene.gas)
     lines += _section("load", scene.load)
     lines += _section("starter", scene.starter)
+    lines += (_section("governor", scene.governor) if scene.governor.model != "none"
+              else ["", "[governor]", 'model = "none"'])
     lines += _section("initial", scene.initial)
     run = {"mode": scene.run.mode}
     for k in ("t_end", "revolutions"):

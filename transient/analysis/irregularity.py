@@ -58,6 +58,23 @@ def fluctuation(t, phi, omega, cycle, phi0) -> float:
     return float((omega[sel].max() - omega[sel].min()) / mean)
 
 
+def last_cycle_ranges(traj, cycle) -> dict[str, tuple[float, str]]:
+    """What drives the speed fluctuation in the last cycle: peak |ε|, and the peak-to-peak swing
+    of the gas torque, of the inertia torque ½J′(φ)ω² of (18), and of the gas value of piston 1
+    (pressure or force) times the governor's fuel."""
+    phi = traj["phi"]
+    sel = phi >= phi[-1] - cycle
+    if sel.sum() < 3:
+        return {}
+    inertia = 0.5 * traj["dJ_dphi"][sel] * traj["omega"][sel] ** 2
+    gas1 = traj["p_1"][sel] * traj["fuel"][sel] if "p_1" in traj else np.zeros(1)
+    swing = lambda v: float(v.max() - v.min())  # noqa: E731
+    return {"epsilon_peak_last_cycle": (float(np.abs(traj["epsilon"][sel]).max()), "rad/s^2"),
+            "M_gas_swing_last_cycle": (swing(traj["M_gas"][sel]), "N m"),
+            "M_inertia_swing_last_cycle": (swing(inertia), "N m"),
+            "gas_1_swing_last_cycle": (swing(gas1), "Pa or N")}
+
+
 def summarize(scene, traj: dict[str, NDArray[np.float64]]) -> dict[str, tuple[float, str]]:
     """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``."""
     t, phi, omega = traj["t"], traj["phi"], traj["omega"]
@@ -72,6 +89,7 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]]) -> dict[str, tuple[fl
         "delta_last_cycle": (fluctuation(t, phi, omega, cycle, phi0), "1"),
         "steady_state_t": (steady_state_time(means, ends), "s"),
     }
+    out.update(last_cycle_ranges(traj, cycle))
     if "M_drive" in traj and means.size:
         last = (t >= ends[-1] - cycle / means[-1]) & (t <= ends[-1])
         out["mean_drive_torque_last_cycle"] = (float(np.trapezoid(traj["M_drive"][last],

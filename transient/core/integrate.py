@@ -47,9 +47,9 @@ N_IST = 10
 # advance() return codes
 RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP = 0, 1, 2, 3
 # event codes written to the event buffer as (code, t, phi, omega)
-EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END = range(6)
+EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR = range(7)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
-               "speed_reversal", "end")
+               "speed_reversal", "end", "governor_corner")
 
 
 @njit(cache=True)
@@ -379,7 +379,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
         w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
         w1 = 1.0 / K[N_STAGES, T] if angle_mode else y_new[OMEGA]
-        for e in range(5):
+        for e in range(7):
             comp = OMEGA
             level = 0.0
             hit = False
@@ -399,6 +399,11 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             elif e == 3 and not angle_mode:
                 hit = (w0 > 0.0 and w1 <= 0.0) or (w0 < 0.0 and w1 >= 0.0)
                 code = EV_REVERSAL
+            elif e >= 5 and m.gov_on:
+                # The droop characteristic has corners at ω_a and ω_1c: stop on them, both ways.
+                level = m.gov_full if e == 5 else m.gov_zero
+                hit = (w0 < level <= w1) or (w1 <= level < w0)
+                code = EV_GOVERNOR
             elif e == 4:
                 comp = T if angle_mode else PHI
                 level = cfg[C_T_END] if angle_mode else cfg[C_PHI_END]

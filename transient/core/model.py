@@ -33,8 +33,8 @@ N_STATE = len(STATE)
 CRANK_SLIDER, SWASH_PLATE = 0, 1
 
 #: Columns written for every output sample; then one gas column per cylinder.
-OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter")
-OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m")
+OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter", "fuel")
+OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m", "1")
 N_OUT_FIXED = len(OUTPUTS)
 
 Model = namedtuple(
@@ -59,6 +59,9 @@ Model = namedtuple(
         "starter_torque",  # float: starter stall torque [N m]
         "starter_noload",  # float: speed at which the starter characteristic reaches zero [rad/s]
         "starter_cutout",  # float: speed at which the starter disengages for good [rad/s]
+        "gov_on",  # bool: a static droop governor scales the gas forces
+        "gov_full",  # float: ω_a, full fuel at and below it [rad/s]
+        "gov_zero",  # float: ω_1c, no fuel at and above it [rad/s]
     ],
 )
 
@@ -100,6 +103,17 @@ def speed(J, angle_mode, y):
 
 
 @njit(cache=True)
+def fuel(m, w):
+    """Gas-force scale of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
+    to 0 at ω_1c, 0 above; 1 without a governor."""
+    if not m.gov_on or w <= m.gov_full:
+        return 1.0
+    if w >= m.gov_zero:
+        return 0.0
+    return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
+
+
+@njit(cache=True)
 def moments(m, angle_mode, y, sel, starter_on, u, du):
     """Reduced inertia, speed and moments at state ``y``.
 
@@ -113,6 +127,7 @@ def moments(m, angle_mode, y, sel, starter_on, u, du):
     if m.has_gas:
         for k in range(m.ncyl):
             M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
+        M_gas *= fuel(m, w)
     M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
     M_starter = 0.0
     if starter_on:
@@ -154,6 +169,7 @@ def output_row(m, angle_mode, y, sel, starter_on, u, du, row):
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
+    row[9] = fuel(m, w)
     for k in range(m.ncyl):
         row[N_OUT_FIXED + k] = gas_value(m, k, y[PHI], sel) if m.has_gas else 0.0
 
