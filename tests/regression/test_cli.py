@@ -245,7 +245,8 @@ def test_run_writes_result_with_design_layout(tmp_path, capsys):
     assert lines[1].startswith("  end: t = ") and "after 4 rev" in lines[1]
     assert lines[2].startswith("  last cycle: mean ω = ")
     assert lines[3].startswith("  steady state: ")
-    assert lines[4].startswith("  solver dop853: ") and "RHS calls" in lines[4]
+    assert lines[4].startswith("  last cycle: peak |ε| = ") and "½J′ω²" in lines[4]
+    assert lines[5].startswith("  solver dop853: ") and "RHS calls" in lines[5]
 
     with h5py.File(path, "r") as f:
         a = f.attrs
