@@ -84,7 +84,7 @@ CASES = [
     ("toml-unclosed-table", replace("[inertia]", "[inertia"),
      "(syntax)", "not valid TOML"),
     ("unknown-top-level-key", VALID + "\n[engine]\nspeed = 1\n",
-     "engine", "unknown key; allowed here: gas, inertia, initial, load, mechanism"),
+     "engine", "unknown key; allowed here: gas, governor, inertia, initial, load, mechanism"),
     ("unknown-top-level-scalar", "format = 2\n" + VALID,
      "format", "unknown key"),
     ("unknown-mechanism-key", add_after("bore_mm = 88", "stroke_mm = 94"),

@@ -57,8 +57,8 @@ def changed(drop=(), rod=None, **keys) -> dict:
 # The example scenes
 
 
-@pytest.mark.parametrize("name, z, fan", [("swash_plate_1cyl.toml", 1, 2.734e-3),
-                                          ("swash_plate_4cyl.toml", 4, 1.100e-2)])
+@pytest.mark.parametrize("name, z, fan", [("swash_plate_1cyl.toml", 1, 3.1976e-2),
+                                          ("swash_plate_4cyl.toml", 4, 1.2867e-1)])
 def test_example_scenes(name, z, fan):
     data = scene_file(name)
     mech = read(data["mechanism"])
@@ -76,18 +76,21 @@ def test_example_scenes(name, z, fan):
     assert data["gas"] == {"model": "trapezoid", "amplitude": 8000.0, "ramp_deg": 30,
                            "duration_deg": 180}
     assert data["load"] == {"fan": fan}
+    assert data["governor"] == {"model": "droop", "speed_full": 45.0, "speed_zero": 60.0}
     assert data["run"]["t_end"] > 0
     # The paper's pulses of cylinder i start at π(i − 1)/2 (z = 4): exactly the dead centres.
     assert mech.firing_angles == tuple(math.pi / 2 * k for k in range(z))
 
 
-def test_example_fan_constant_balances_the_mean_gas_torque_at_2000_rpm():
-    """The scenes' K_M: the mean of F·u over a turn, summed over cylinders, over ω_t²."""
+def test_example_fan_constant_balances_the_governed_gas_torque_at_50_rad_s():
+    """The scenes' K_M: the mean of F·u over a turn, summed over cylinders, times the governor's
+    fuel at the target speed (2/3 at 50 rad/s between ω_a = 45 and ω₁c = 60), over ω_t²."""
     from transient.forces.trapezoid import trapezoid_table
 
     table = trapezoid_table(8000.0, math.radians(30.0))
-    w_target = 2000.0 * math.pi / 30.0
-    for name, fan in (("swash_plate_1cyl.toml", 2.734e-3), ("swash_plate_4cyl.toml", 1.100e-2)):
+    w_target = 50.0
+    fuel = (60.0 - w_target) / (60.0 - 45.0)
+    for name, fan in (("swash_plate_1cyl.toml", 3.1976e-2), ("swash_plate_4cyl.toml", 1.2867e-1)):
         mech = read(scene_file(name)["mechanism"])
         mp = mech.pack()
         z = mech.cylinders
@@ -104,7 +107,7 @@ def test_example_fan_constant_balances_the_mean_gas_torque_at_2000_rpm():
                 force = table(p - np.asarray(mech.firing_angles))
                 work += 0.5 * (b - a) * w * float(force @ u)
         mean_torque = work / (2 * math.pi)
-        assert fan == pytest.approx(mean_torque / w_target**2, rel=5e-4)
+        assert fan == pytest.approx(fuel * mean_torque / w_target**2, rel=5e-4)
 
 
 # ------------------------------------------------------------------------------------------------
