@@ -61,7 +61,23 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--points", type=int, default=361, help="points over one cycle")
     k.add_argument("--plot", default=None, help="also write a PNG of the transfer functions and J")
     k.set_defaults(func=cmd_kinematics)
+    b = sub.add_parser("bench", help="time the compiled path against the solve_ivp reference")
+    b.add_argument("scenes", nargs="*", help="scene files (default: the spin-up benchmark scenes)")
+    b.add_argument("--revolutions", type=float, default=1000.0)
+    b.add_argument("--rtol", type=float, default=1e-8)
+    b.add_argument("--repeat", type=int, default=5)
+    b.add_argument("--no-baselines", action="store_true", help="compiled path only (quick)")
+    b.add_argument("-o", "--output", default=None, help="also write the table to this file")
+    b.set_defaults(func=cmd_bench)
     return p
+
+
+def cmd_bench(args) -> int:
+    from .bench import DEFAULT_SCENES, run_bench
+
+    run_bench(args.scenes or DEFAULT_SCENES, args.revolutions, args.rtol, args.repeat,
+              not args.no_baselines, args.output)
+    return EXIT_OK
 
 
 def cmd_check(args) -> int:
@@ -106,9 +122,10 @@ def _print_summary(summary, solver) -> None:
           f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
     print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
           f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
-    ss = v["steady_state_t"]
-    print("  steady state: " + (f"reached at t = {ss:.6g} s" if math.isfinite(ss)
-                                else "not reached (cycle-mean speed still changing by ≥ 1e-4)"))
+    ss = v.get("steady_state_t")
+    if ss is not None:
+        print("  steady state: " + (f"reached at t = {ss:.6g} s" if math.isfinite(ss) else
+                                    "not reached (cycle-mean speed still changing by ≥ 1e-4)"))
     if "M_gas_swing_last_cycle" in v:
         print(f"  last cycle: peak |ε| = {v['epsilon_peak_last_cycle']:.4g} rad/s², swing of the "
               f"gas torque {v['M_gas_swing_last_cycle']:.4g} N m against the inertia torque "
@@ -139,8 +156,9 @@ def cmd_info(args) -> int:
         print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
               f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
-    for k, v in res.analysis.items():
-        print(f"  {k} = {v}")
+    for k, (v, unit) in res.analysis.items():
+        print(f"  {k} = {v:.9g} {unit}" if np.ndim(v) == 0 and isinstance(v, (int, float, np.number))
+              else f"  {k} = {v} {unit}")
     return EXIT_OK
 
 

@@ -115,7 +115,7 @@ class Result:
     units: dict[str, str]
     events: dict[str, dict[str, np.ndarray]]
     solver: dict[str, Any]
-    analysis: dict[str, Any]
+    analysis: dict[str, tuple[Any, str]]  # name -> (value, unit)
     scene_toml: str
 
     @property
@@ -141,7 +141,8 @@ def open_result(path: str | Path) -> Result:
         analysis = {}
         for k, ds in f["analysis"].items():
             value = ds[()]
-            analysis[k] = (value.decode() if isinstance(value, bytes) else value)
+            analysis[k] = (value.decode() if isinstance(value, bytes) else value,
+                           str(ds.attrs.get("unit", "")))
         toml = f["scene"]["toml"][()]
         return Result(path=path, attrs=dict(f.attrs), trajectory=traj, units=units, events=events,
                       solver=dict(f["solver"].attrs), analysis=analysis,

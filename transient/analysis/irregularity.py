@@ -87,8 +87,9 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]]) -> dict[str, tuple[fl
         "revolutions": (float((phi[-1] - phi0) / (2 * math.pi)), "1"),
         "mean_omega_last_cycle": (float(means[-1]) if means.size else math.nan, "rad/s"),
         "delta_last_cycle": (fluctuation(t, phi, omega, cycle, phi0), "1"),
-        "steady_state_t": (steady_state_time(means, ends), "s"),
     }
+    if scene.run.mode == "dynamic":
+        out["steady_state_t"] = (steady_state_time(means, ends), "s")
     out.update(last_cycle_ranges(traj, cycle))
     if "M_drive" in traj and means.size:
         last = (t >= ends[-1] - cycle / means[-1]) & (t <= ends[-1])

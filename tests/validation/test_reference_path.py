@@ -1,0 +1,187 @@
+"""The compiled path (numba DOP853, crank angle / time) against the reference path (plain numpy model
+through ``scipy.integrate.solve_ivp``, always in time) on every dynamic scene in ``cases/``.
+
+Runs are shortened (the scenes themselves take up to 1000 revolutions or 8 s):
+
+* revolution-limited scenes: 5 revolutions (coasting) or 6 revolutions = 3 four-stroke cycles
+  (Gots spin-up: 45 table corners, every kind of breakpoint of the mixed cycle);
+* time-limited scenes (swash plate): t_end = 0.5 s, which passes the governor's full-fuel corner
+  ω_a = 45 rad/s (reached at t ≈ 0.29 s).
+
+Both at rtol = atol = 1e-10. The reference runs with max_step = 0.5° (at the start speed): its
+output rows are its step points, and they must be dense enough to be interpolated (below).
+
+Accuracy in the scipy way, e = (y − y_ref)/(atol + rtol·|y_ref|):
+
+* **final state** (t, ω; φ too when the run ends on time): e ≤ 100. Each solver keeps its local
+  error per step ≤ 1 in these units, and global errors accumulate over the ~10³ steps of a run
+  (partly cancelling): measured |e| ≤ 0.8 with the 0.5° reference (and up to 60 with scipy's own
+  step choice, which is why the reference is run with the small max_step).
+* **breakpoint events**: both paths cross the same table corners; the time at each, e ≤ 100.
+* **samples**: the reference rows interpolated onto the compiled output grid (uniform in φ, where
+  φ is monotonic) by cubic Hermite in φ, with the slopes the reference itself writes
+  (dω/dφ = ε/ω, dt/dφ = 1/ω). Every table corner is a reference row (solve_ivp segments end
+  there), so no interval spans a kink. The interpolation error (∝ Δφ⁴ with Δφ ≲ 1.3° here) adds
+  to the solvers' differences: measured max |e| ≤ 49 (ω, DOP853 rows) and ≤ 1.3 (t); bound 500.
+
+A stalled reference (solve_ivp restarted again and again at the same t) is reported as a failure
+at once rather than hanging the test run; a 60 s alarm backs that up.
+"""
+from __future__ import annotations
+
+import math
+import signal
+from contextlib import contextmanager
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.interpolate import CubicHermiteSpline
+
+import transient.reference as reference
+from transient.scene import load_scene
+from transient.simulate import integrate
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+RTOL = ATOL = 1e-10
+E_FINAL = 100.0
+E_SAMPLES = 500.0
+REF_MAX_STEP = math.radians(0.5)
+SHORT_REVS = {"coasting_single": 5.0}
+DEFAULT_REVS = 6.0
+SHORT_T_END = 0.5
+
+
+def dynamic_scenes():
+    names = []
+    for path in sorted(CASES.glob("*.toml")):
+        if load_scene(path).run.mode == "dynamic":
+            names.append(path.stem)
+    return names
+
+
+SCENES = dynamic_scenes()
+
+
+def shortened(name, method):
+    scene = load_scene(CASES / f"{name}.toml")
+    run = scene.run
+    if math.isfinite(run.revolutions):
+        run = replace(run, revolutions=SHORT_REVS.get(name, DEFAULT_REVS), t_end=math.inf)
+    else:
+        run = replace(run, t_end=SHORT_T_END)
+    solver = replace(scene.solver, method=method, rtol=RTOL, atol=ATOL)
+    if method != "dop853":
+        solver = replace(solver, max_step=REF_MAX_STEP)
+    return replace(scene, run=run, solver=solver,
+                   output=replace(scene.output, samples_per_rev=720))
+
+
+def e(y, y_ref):
+    return (np.asarray(y) - np.asarray(y_ref)) / (ATOL + RTOL * np.abs(y_ref))
+
+
+@contextmanager
+def watched_reference(monkeypatch, limit_s=60.0):
+    """Fail (not hang) if the reference path stalls: solve_ivp called 25 times in a row without
+    advancing t, or the run taking more than ``limit_s``."""
+    real = reference.solve_ivp
+    stalls = []
+
+    def solve_ivp(fun, t_span, y0, **kw):
+        sol = real(fun, t_span, y0, **kw)
+        if sol.t[-1] == t_span[0]:
+            hit = [i for i, te in enumerate(sol.t_events or []) if te.size]
+            stalls.append((t_span[0], y0[0], y0[1], hit))
+            if len(stalls) >= 25:
+                t, phi, w, ev = stalls[-1]
+                raise AssertionError(
+                    f"reference path stalled: solve_ivp restarted {len(stalls)} times at t = "
+                    f"{t!r} s (φ = {phi!r} rad, ω = {w!r} rad/s) without advancing; terminal "
+                    f"event(s) {ev} fire again at the start of every segment")
+        else:
+            stalls.clear()
+        return sol
+
+    def alarm(signum, frame):
+        raise TimeoutError(f"reference path took more than {limit_s} s")
+
+    monkeypatch.setattr(reference, "solve_ivp", solve_ivp)
+    old = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, limit_s)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, old)
+
+
+@pytest.fixture(scope="module")
+def compiled_runs():
+    return {name: integrate(shortened(name, "dop853")) for name in SCENES}
+
+
+@pytest.mark.parametrize("method", ["scipy-DOP853", "scipy-Radau"])
+@pytest.mark.parametrize("name", SCENES)
+def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch):
+    comp = compiled_runs[name]
+    scene = shortened(name, method)
+    assert comp.complete, comp.message
+    with watched_reference(monkeypatch):
+        ref = integrate(scene)
+    assert ref.solver["method"] == method
+    c, r = comp.trajectory, ref.trajectory
+    ends_on_time = math.isfinite(scene.run.t_end)
+
+    # Final state.
+    final = {"t": e(c["t"][-1], r["t"][-1]), "omega": e(c["omega"][-1], r["omega"][-1])}
+    if ends_on_time:
+        final["phi"] = e(c["phi"][-1], r["phi"][-1])
+        assert c["t"][-1] == r["t"][-1] == scene.run.t_end
+    else:
+        assert c["phi"][-1] == pytest.approx(r["phi"][-1], rel=1e-15)
+    print(f"{name} vs {method}: final e = " + ", ".join(f"{k} {v:.3g}" for k, v in final.items()))
+    for k, v in final.items():
+        assert abs(v) <= E_FINAL, (k, v)
+
+    # Breakpoint events: the same corners, at the same times.
+    bc = comp.events.get("breakpoint", np.zeros((0, 2)))
+    br = ref.events.get("breakpoint", np.zeros((0, 2)))
+    assert bc.shape == br.shape
+    if br.size:
+        np.testing.assert_allclose(bc[:, 1], br[:, 1], rtol=0, atol=1e-9)
+        e_bp = np.max(np.abs(e(bc[:, 0], br[:, 0])))
+        print(f"  {len(br)} breakpoints, max |e(t)| = {e_bp:.3g}")
+        assert e_bp <= E_FINAL
+
+    # Samples: the reference interpolated onto the compiled grid, where φ is monotonic.
+    keep = np.concatenate([[True], np.diff(r["phi"]) > 1e-12])
+    phi_r, w_r, eps_r, t_r = r["phi"][keep], r["omega"][keep], r["epsilon"][keep], r["t"][keep]
+    assert np.all(np.diff(phi_r) > 0) and np.all(w_r > 0)
+    w_of_phi = CubicHermiteSpline(phi_r, w_r, eps_r / w_r)
+    t_of_phi = CubicHermiteSpline(phi_r, t_r, 1.0 / w_r)
+    inside = (c["phi"] >= phi_r[0]) & (c["phi"] <= phi_r[-1])
+    assert np.count_nonzero(inside) >= 0.99 * c["phi"].size
+    e_w = np.max(np.abs(e(c["omega"][inside], w_of_phi(c["phi"][inside]))))
+    e_t = np.max(np.abs(e(c["t"][inside], t_of_phi(c["phi"][inside]))))
+    print(f"  {np.count_nonzero(inside)} samples: max |e(ω)| = {e_w:.3g}, max |e(t)| = {e_t:.3g}")
+    assert e_w <= E_SAMPLES and e_t <= E_SAMPLES
+
+
+@pytest.mark.parametrize("max_step_deg", [180.0, 10.0, 5.0, 2.0, 1.0])
+def test_compiled_run_reaches_its_end_for_any_max_step(max_step_deg, compiled_runs):
+    """The step-size limit is a solver setting, not the model: for every max_step the compiled run
+    must finish on φ = 6 revolutions (a table corner: 3 whole cycles) and stop on each of the 45
+    corners the reference path crosses, once each (crank angle stops on breakpoints exactly)."""
+    name = "gots_diesel_spinup"
+    scene = shortened(name, "dop853")
+    scene = replace(scene, solver=replace(scene.solver, max_step=math.radians(max_step_deg)))
+    data = integrate(scene)
+    assert data.complete, data.message
+    assert data.trajectory["phi"][-1] == pytest.approx(2 * math.pi * DEFAULT_REVS, rel=1e-15)
+    expected = compiled_runs[name].events["breakpoint"][:, 1]  # 45, = the reference's (above)
+    got = data.events.get("breakpoint", np.zeros((0, 2)))[:, 1]
+    assert expected.size == 45
+    assert got.size == expected.size, f"{got.size} breakpoint events, expected {expected.size}"
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
