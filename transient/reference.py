@@ -86,6 +86,9 @@ class ReferenceModel:
         self.mech = _mechanism(scene)
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
         self.pieces = None
+        g = scene.governor
+        w0 = scene.initial.omega
+        self.branch = 0 if w0 < g.speed_full else (2 if w0 >= g.speed_zero else 1)
 
     def select(self, a: float, b: float) -> None:
         """Table pieces for the segment of shaft angle (a, b) between two breakpoints."""
@@ -111,11 +114,13 @@ class ReferenceModel:
         return J, dJ, M_gas, M_load, M_starter, p
 
     def fuel(self, w: float) -> float:
-        """Static droop characteristic (Antonyuk §4), 1 without a governor."""
+        """Static droop characteristic (Antonyuk §4) on the segment's branch (0 full fuel, 1 the
+        droop line, 2 none), extrapolated so that solve_ivp sees a smooth function; the corners
+        are terminal events. 1 without a governor."""
         g = self.scene.governor
-        if g.model == "none":
+        if g.model == "none" or self.branch == 0:
             return 1.0
-        return float(np.clip((g.speed_zero - w) / (g.speed_zero - g.speed_full), 0.0, 1.0))
+        return 0.0 if self.branch == 2 else (g.speed_zero - w) / (g.speed_zero - g.speed_full)
 
     def rhs(self, t, y):
         phi, w = y
@@ -129,6 +134,22 @@ class ReferenceModel:
             eps = (Mg + Ml + Ms - 0.5 * dJ * w * w) / J
             out.append([ti, p, w, eps, J, dJ, Mg, Ml, Ms, self.fuel(w), *pc])
         return np.asarray(out).reshape(-1, len(OUTPUTS) + self.model.ncyl)
+
+
+def _speed_crossing(ref, t, y, level):
+    """Terminal event ω = level in the direction ω must go to reach it; starting on the level
+    (just after stopping there), the direction away from where the speed is heading now, so
+    that solve_ivp does not stop again at once."""
+    gap = y[1] - level
+    if abs(gap) <= 1e-12 * max(1.0, abs(level)):
+        direction = -np.sign(ref.rhs(t, y)[1]) or 1.0
+    else:
+        direction = -np.sign(gap)
+
+    def g(t, yy):
+        return yy[1] - level
+    g.terminal, g.direction = True, direction
+    return g
 
 
 def _segment(ref, phi, omega):
@@ -173,12 +194,9 @@ def run_reference(scene, on_block=None, progress=None):
             evs.append(("breakpoint", crossing(down, -1)))
         if math.isfinite(phi_end):
             evs.append(("end", crossing(phi_end, 1)))
-        if scene.governor.model == "droop":  # corners of the characteristic, both directions
-            for level in (scene.governor.speed_full, scene.governor.speed_zero):
-                def corner(t, yy, level=level):
-                    return yy[1] - level
-                corner.terminal = True
-                evs.append(("governor_corner", corner))
+        if scene.governor.model == "droop":  # corners of the characteristic
+            evs.append(("governor_full", _speed_crossing(ref, t, y, scene.governor.speed_full)))
+            evs.append(("governor_zero", _speed_crossing(ref, t, y, scene.governor.speed_zero)))
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -205,8 +223,12 @@ def run_reference(scene, on_block=None, progress=None):
         if "starter_cutout" in hit:
             ref.starter_on = False
             events["starter_cutout"].append((t, y[0]))
-        if "governor_corner" in hit:
-            events["governor_corner"].append((t, y[0]))
+        for name, corner, low in (("governor_full", scene.governor.speed_full, 0),
+                                  ("governor_zero", scene.governor.speed_zero, 1)):
+            if name in hit:  # cross into the branch on the other side of this corner
+                y[1] = corner
+                ref.branch = low + 1 if ref.branch == low else low
+                events["governor_corner"].append((t, y[0]))
         if "breakpoint" in hit:
             # Put φ on the breakpoint it reached (solve_ivp locates it to ~1e-12 rad), so that
             # the next segment starts there and takes the table pieces beyond it.

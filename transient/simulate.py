@@ -70,6 +70,7 @@ def _initial_state(scene):
     y[0] = scene.initial.phi
     y[2] = scene.initial.omega
     fst = np.zeros(ci.N_FST)
+    fst[ci.F_PASSED_BP] = np.nan
     ist = np.zeros(ci.N_IST, dtype=np.int64)
     st = scene.starter
     ist[ci.I_STARTER_ON] = int(st.torque > 0 and scene.initial.omega < st.cutout_speed)

@@ -16,7 +16,8 @@ import numpy as np
 from numba import njit
 
 from . import dop853_coefficients as dc
-from .model import KINETIC, N_STATE, OMEGA, PHI, T, derivative, inertia, output_row, speed
+from .model import (KINETIC, N_STATE, N_SWITCHES, OMEGA, PHI, SW_GOVERNOR, SW_STARTER, T, derivative,
+                    governor_branch, inertia, output_row, speed)
 
 _A = dc.A[: dc.N_STAGES, : dc.N_STAGES].copy()
 _B = dc.B.copy()
@@ -37,12 +38,17 @@ C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range
 C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS = range(8, 11)
 N_CFG = 11
 # fst[...] — float stepper state kept between chunks
-F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI = range(5)
-N_FST = 5
+F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL = range(7)
+N_FST = 7
+# In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
+# (a retaken step lands on it only to the accuracy of the dense output).
+BP_LANDING = 1e-7
 # ist[...] — integer stepper state kept between chunks
-(I_ANGLE_MODE, I_STARTER_ON, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
- I_NREDO) = range(10)
-N_IST = 10
+# ist[:N_SWITCHES] are the model's switches (starter, governor branch), passed on as ``sw``.
+I_STARTER_ON, I_GOV_BRANCH = SW_STARTER, SW_GOVERNOR
+(I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
+ I_NREDO) = range(N_SWITCHES, N_SWITCHES + 9)
+N_IST = N_SWITCHES + 9
 
 # advance() return codes
 RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP = 0, 1, 2, 3
@@ -83,7 +89,7 @@ def _error_norm(K, h, y, y_new, rtol, atol, ix):
 
 
 @njit(cache=True)
-def _step(m, angle_mode, x, y, f, h, sel, starter_on, K, y_new, tmp, u, du):
+def _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, u, du):
     """One DOP853 step of size h from (x, y) with f = y′; K[0] must hold f.
 
     Leaves the stages in K (K[12] = f(y_new)) and the new state in y_new.
@@ -95,7 +101,7 @@ def _step(m, angle_mode, x, y, f, h, sel, starter_on, K, y_new, tmp, u, du):
             for j in range(s):
                 acc += _A[s, j] * K[j, i]
             tmp[i] = y[i] + h * acc
-        derivative(m, angle_mode, tmp, sel, starter_on, u, du, K[s])
+        derivative(m, angle_mode, tmp, sel, sw, u, du, K[s])
     for i in range(n):
         acc = 0.0
         for j in range(N_STAGES):
@@ -103,11 +109,11 @@ def _step(m, angle_mode, x, y, f, h, sel, starter_on, K, y_new, tmp, u, du):
         y_new[i] = y[i] + h * acc
     # The independent variable advances exactly (exact stops on breakpoints).
     y_new[PHI if angle_mode else T] = x + h
-    derivative(m, angle_mode, y_new, sel, starter_on, u, du, K[N_STAGES])
+    derivative(m, angle_mode, y_new, sel, sw, u, du, K[N_STAGES])
 
 
 @njit(cache=True)
-def _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du):
+def _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du):
     """Dense-output coefficients F (7 × n) of the last step (three extra stages)."""
     n = y.shape[0]
     for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
@@ -117,7 +123,7 @@ def _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du):
             for j in range(s):
                 acc += a[j] * K[j, i]
             tmp[i] = y[i] + h * acc
-        derivative(m, angle_mode, tmp, sel, starter_on, u, du, K[s])
+        derivative(m, angle_mode, tmp, sel, sw, u, du, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]
         F[0, i] = dy
@@ -155,15 +161,18 @@ def _event_g(m, angle_mode, yv, comp, level, u, du):
 
 
 @njit(cache=True)
-def _crossing(m, angle_mode, F, y, comp, level, tmp, u, du):
+def _crossing(m, angle_mode, F, y, y_new, comp, level, tmp, u, du):
     """θ ∈ (0, 1] where the event function crosses zero on the dense output (Illinois method).
 
-    The caller has checked that it changes sign over the step.
+    The caller has checked that it changes sign between y and y_new. The bracket's right end is
+    y_new itself, not the dense output at θ = 1, which can differ from it by rounding and then
+    would not bracket a root that sits at the very end of the step.
     """
     a, b = 0.0, 1.0
     ga = _event_g(m, angle_mode, y, comp, level, u, du)
-    _dense_eval(F, y, 1.0, tmp)
-    gb = _event_g(m, angle_mode, tmp, comp, level, u, du)
+    gb = _event_g(m, angle_mode, y_new, comp, level, u, du)
+    if gb == 0.0 or (ga > 0.0) == (gb > 0.0):
+        return 1.0
     side = 0
     for _ in range(100):
         c = b - gb * (b - a) / (gb - ga)
@@ -221,8 +230,8 @@ def _emit_event(m, evbuf, ist, code, y, u, du):
 
 
 @njit(cache=True)
-def _emit_row(m, y, sel, starter_on, outbuf, ist, fst, u, du):
-    output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, starter_on, u, du, outbuf[ist[I_NOUT]])
+def _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du):
+    output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, u, du, outbuf[ist[I_NOUT]])
     ist[I_NOUT] += 1
     fst[F_LAST_T] = y[T]
     fst[F_LAST_PHI] = y[PHI]
@@ -284,11 +293,12 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
 
     if ist[I_STARTED] == 0:
         ist[I_STARTED] = 1
+        ist[I_GOV_BRANCH] = governor_branch(m, y[OMEGA], True)
         if y[OMEGA] >= cfg[C_W_HI]:
             _to_angle_mode(m, y, ist, u, du)
         fst[F_SEL] = y[PHI]
         _reset_output_grid(cfg, ist, fst, y)
-        _emit_row(m, y, fst[F_SEL], ist[I_STARTER_ON] == 1, outbuf, ist, fst, u, du)
+        _emit_row(m, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, u, du)
 
     ist[I_F_VALID] = 0  # f is local to this call: recompute it once per chunk
     steps_here = 0
@@ -298,28 +308,36 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         if steps_here >= cfg[C_CHUNK_STEPS]:
             return RUNNING
         angle_mode = ist[I_ANGLE_MODE] == 1
-        starter_on = ist[I_STARTER_ON] == 1
+        sw = ist[:N_SWITCHES]
         ix = PHI if angle_mode else T
         x = y[ix]
         if ist[I_F_VALID] == 0:
-            derivative(m, angle_mode, y, y[PHI], starter_on, u, du, f)
+            derivative(m, angle_mode, y, y[PHI], sw, u, du, f)
             ist[I_NFEV] += 1
             ist[I_F_VALID] = 1
             if fst[F_H] <= 0.0:
                 # Initial step: a fixed fraction of a revolution (angle) or of the output spacing.
                 fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
         # Where this segment ends: the next breakpoint or the end of the run.
-        up = next_breakpoint(bp, m.period, y[PHI], True)
-        down = next_breakpoint(bp, m.period, y[PHI], False)
+        here = y[PHI]
+        if not angle_mode and abs(here - fst[F_PASSED_BP]) <= BP_LANDING:
+            here = fst[F_PASSED_BP]  # just landed on it: look beyond it, both ways
+        up = next_breakpoint(bp, m.period, here, True)
+        down = next_breakpoint(bp, m.period, here, False)
         if angle_mode:
             x_end = min(up, cfg[C_PHI_END])
             h_max = min(cfg[C_MAX_STEP_PHI], 256.0 * cfg[C_DPHI_OUT])
         else:
             x_end = cfg[C_T_END]
             h_max = min(cfg[C_MAX_STEP_T], 256.0 * cfg[C_DT_OUT])
+        # A step that would end within rounding of the segment's end ends on it exactly, so that
+        # no later step of a few ulp is needed (next_breakpoint treats such a point as reached).
+        tol_end = 1e-13 * max(1.0, abs(x))
+        if x_end - x <= tol_end:
+            return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, u, du)
         h = min(fst[F_H], h_max)
         at_segment_end = False
-        if x + h >= x_end:
+        if x + h >= x_end - tol_end:
             h = x_end - x
             at_segment_end = True
         min_step = 10.0 * (np.nextafter(abs(x), np.inf) - abs(x))
@@ -331,7 +349,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             sel = y[PHI] + 0.5 * h * y[OMEGA]
         for i in range(n):
             K[0, i] = f[i]
-        _step(m, angle_mode, x, y, f, h, sel, starter_on, K, y_new, tmp, u, du)
+        _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, u, du)
         ist[I_NFEV] += N_STAGES
         err = _error_norm(K, h, y, y_new, rtol, atol, ix)
         finite = np.isfinite(err)
@@ -358,10 +376,11 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         dense_ready = False
         # In time, a step must not cross a breakpoint: retake it so that it ends there.
         if not angle_mode and (y_new[PHI] > up or y_new[PHI] < down):
-            _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du)
+            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
             ist[I_NFEV] += 3
             level = up if y_new[PHI] > up else down
-            theta = _crossing(m, angle_mode, F, y, PHI, level, tmp, u, du)
+            theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, tmp, u, du)
+            fst[F_REDO_LEVEL] = level
             if theta * h > min_step and ist[I_NREDO] < 4:
                 fst[F_H] = theta * h
                 ist[I_NREDO] += 1
@@ -369,7 +388,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
                 steps_here += 1
                 continue
             dense_ready = True
-        redo_hit_breakpoint = ist[I_NREDO] > 0
+        redo_hit_breakpoint = ist[I_NREDO] > 0 or dense_ready
         ist[I_NREDO] = 0
         # State events on this step: the earliest one truncates it.
         ev_code = -1
@@ -384,7 +403,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             level = 0.0
             hit = False
             code = -1
-            if e == 0 and starter_on:
+            if e == 0 and sw[SW_STARTER] == 1:
                 level = m.starter_cutout
                 hit = w0 < level <= w1
                 code = EV_STARTER_CUTOUT
@@ -411,23 +430,23 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
                 code = EV_END
             if hit:
                 if not dense_ready:
-                    _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du)
+                    _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
                     ist[I_NFEV] += 3
                     dense_ready = True
-                theta = _crossing(m, angle_mode, F, y, comp, level, tmp, u, du)
+                theta = _crossing(m, angle_mode, F, y, y_new, comp, level, tmp, u, du)
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
         # Output samples inside the step (dense output), then the step's end state.
         d_out = _out_spacing(cfg, angle_mode)
         if fst[F_NEXT_OUT] <= x_stop and not dense_ready:
-            _dense(m, angle_mode, y, y_new, h, sel, starter_on, K, F, tmp, u, du)
+            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
             ist[I_NFEV] += 3
             dense_ready = True
         while fst[F_NEXT_OUT] <= x_stop:
             _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
             tmp[ix] = fst[F_NEXT_OUT]
-            _emit_row(m, tmp, sel, starter_on, outbuf, ist, fst, u, du)
+            _emit_row(m, tmp, sel, sw, outbuf, ist, fst, u, du)
             fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
         ist[I_NSTEPS] += 1
         steps_here += 1
@@ -440,11 +459,12 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             if angle_mode and at_segment_end and x_end == up:
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, u, du)
             elif redo_hit_breakpoint:
+                fst[F_PASSED_BP] = fst[F_REDO_LEVEL]
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, u, du)
             if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
-                return _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du)
+                return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
             if not angle_mode and at_segment_end:
-                return _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du)
+                return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
             continue
         # Truncate the step at the event, act on it and restart from there.
         _dense_eval(F, y, ev_theta, y_evt)
@@ -461,9 +481,11 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         ist[I_F_VALID] = 0
         _emit_event(m, evbuf, ist, ev_code, y, u, du)
         if ev_code == EV_END:
-            return _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du)
+            return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
         if ev_code == EV_STARTER_CUTOUT:
             ist[I_STARTER_ON] = 0
+        elif ev_code == EV_GOVERNOR:
+            ist[I_GOV_BRANCH] = governor_branch(m, ev_level, w1 > w0)
         elif ev_code == EV_TO_TIME:
             _to_time_mode(m, y, ist, u, du)
             fst[F_H] = h_next / ev_level
@@ -491,11 +513,11 @@ def _to_time_mode(m, y, ist, u, du):
 
 
 @njit(cache=True)
-def _finish(m, y, sel, starter_on, outbuf, evbuf, ist, fst, u, du):
+def _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du):
     """Write the final state as the last sample (unless it already is one) and an end event."""
     last = outbuf[ist[I_NOUT] - 1] if ist[I_NOUT] > 0 else outbuf[0]
     if ist[I_NOUT] == 0 or last[0] != y[T] or last[1] != y[PHI]:
-        _emit_row(m, y, sel, starter_on, outbuf, ist, fst, u, du)
+        _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du)
     if ist[I_NEV] == 0 or evbuf[ist[I_NEV] - 1, 0] != EV_END:
         _emit_event(m, evbuf, ist, EV_END, y, u, du)
     return FINISHED

@@ -29,6 +29,11 @@ PHI, T, OMEGA = range(3)
 KINETIC = OMEGA
 N_STATE = len(STATE)
 
+#: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), and
+#: the governor's branch (see :func:`governor_branch`).
+SW_STARTER, SW_GOVERNOR = range(2)
+N_SWITCHES = 2
+
 #: Mechanism kinds (``Model.kind``).
 CRANK_SLIDER, SWASH_PLATE = 0, 1
 
@@ -103,18 +108,30 @@ def speed(J, angle_mode, y):
 
 
 @njit(cache=True)
-def fuel(m, w):
+def governor_branch(m, w, rising):
+    """Branch of the droop characteristic at speed w: 0 full fuel (ω ≤ ω_a), 1 the droop line,
+    2 no fuel (ω ≥ ω₁c); on a corner, the branch the motion enters (``rising``: ω increasing)."""
+    if w < m.gov_full or (w == m.gov_full and not rising):
+        return 0
+    if w > m.gov_zero or (w == m.gov_zero and rising):
+        return 2
+    return 1
+
+
+@njit(cache=True)
+def fuel(m, w, branch):
     """Gas-force scale of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
-    to 0 at ω_1c, 0 above; 1 without a governor."""
-    if not m.gov_on or w <= m.gov_full:
+    to 0 at ω_1c, 0 above; 1 without a governor. The branch is fixed for a whole step (a state
+    event stops on each corner), so that the right-hand side is smooth inside every step."""
+    if not m.gov_on or branch == 0:
         return 1.0
-    if w >= m.gov_zero:
+    if branch == 2:
         return 0.0
     return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
 
 
 @njit(cache=True)
-def moments(m, angle_mode, y, sel, starter_on, u, du):
+def moments(m, angle_mode, y, sel, sw, u, du):
     """Reduced inertia, speed and moments at state ``y``.
 
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; u, du are work arrays of length ncyl that
@@ -127,10 +144,10 @@ def moments(m, angle_mode, y, sel, starter_on, u, du):
     if m.has_gas:
         for k in range(m.ncyl):
             M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
-        M_gas *= fuel(m, w)
+        M_gas *= fuel(m, w, sw[SW_GOVERNOR])
     M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
     M_starter = 0.0
-    if starter_on:
+    if sw[SW_STARTER]:
         M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
     return J, dJ, w, M_gas, M_load, M_starter
 
@@ -142,9 +159,9 @@ def acceleration(J, dJ, M, w):
 
 
 @njit(cache=True)
-def derivative(m, angle_mode, y, sel, starter_on, u, du, out):
+def derivative(m, angle_mode, y, sel, sw, u, du, out):
     """dy/dt = (ω, 1, ε), or in crank angle dy/dφ = (1, 1/ω, M) with y[2] = K."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, starter_on, u, du)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, u, du)
     if angle_mode:
         out[PHI] = 1.0
         out[T] = 1.0 / w
@@ -157,9 +174,9 @@ def derivative(m, angle_mode, y, sel, starter_on, u, du, out):
 
 
 @njit(cache=True)
-def output_row(m, angle_mode, y, sel, starter_on, u, du, row):
+def output_row(m, angle_mode, y, sel, sw, u, du, row):
     """Fill one output sample (columns ``OUTPUTS`` then the gas value of each cylinder)."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, starter_on, u, du)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, u, du)
     row[0] = y[T]
     row[1] = y[PHI]
     row[2] = w
@@ -169,7 +186,7 @@ def output_row(m, angle_mode, y, sel, starter_on, u, du, row):
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
-    row[9] = fuel(m, w)
+    row[9] = fuel(m, w, sw[SW_GOVERNOR])
     for k in range(m.ncyl):
         row[N_OUT_FIXED + k] = gas_value(m, k, y[PHI], sel) if m.has_gas else 0.0
 
@@ -185,11 +202,13 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive):
     u = np.empty(n)
     du = np.empty(n)
     y = np.empty(N_STATE)
+    sw = np.zeros(N_SWITCHES, dtype=np.int64)
     for i in range(t.shape[0]):
         y[PHI] = phi[i]
         y[T] = t[i]
         y[OMEGA] = omega[i]
-        output_row(m, False, y, phi[i], False, u, du, rows[i])
+        sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
+        output_row(m, False, y, phi[i], sw, u, du, rows[i])
         rows[i, 3] = eps[i]
         M = rows[i, 6] + rows[i, 7]
         M_drive[i] = rows[i, 4] * eps[i] + 0.5 * rows[i, 5] * omega[i] ** 2 - M
