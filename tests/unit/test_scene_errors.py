@@ -10,6 +10,8 @@ was misleading or the error escaped as a traceback.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from transient.cli import main
@@ -303,3 +305,30 @@ def test_scene_file_not_utf8(tmp_path, capsys):
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2
     assert_one_line_error(err, scene, "(file)", "UTF-8")
+
+
+# ----------------------------------------------------------------------------------------------
+# The swash-plate mechanism (issue 3): the default scene with one thing broken.
+
+SWASH = (Path(__file__).resolve().parents[2] / "cases" / "swash_plate_4cyl.toml").read_text()
+
+SWASH_CASES = [
+    ("swash_deg = 21.4", "swash_deg = 0", "mechanism.swash_deg", "not allowed; 0° < α < 45°"),
+    ("swash_deg = 21.4", "swash_deg = 45", "mechanism.swash_deg", "not allowed; 0° < α < 45°"),
+    ("rod_length_mm = 300", "rod_length_mm = 5", "mechanism.rod_length_mm", "is too short"),
+    ("cylinder_radius_mm = 131.31", "cylinder_radius_mm = 500", "mechanism.cylinder_radius_mm", "cannot be reached by rods"),
+    ("cylinders = 4", "cylinders = 0", "mechanism.cylinders", "must be ≥ 1"),
+]
+
+
+@pytest.mark.parametrize("old, new, key, fragment", SWASH_CASES, ids=[c[1] for c in SWASH_CASES])
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_invalid_swash_plate_is_one_line_exit_2(tmp_path, capsys, command, old, new, key, fragment):
+    assert SWASH.count(old) == 1, old
+    scene = tmp_path / "bad.toml"
+    scene.write_text(SWASH.replace(old, new), encoding="utf-8")
+    argv = [command, str(scene)] + (["-o", str(tmp_path / "res")] if command == "run" else [])
+    code, out, err = run_cli(argv, capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, key, fragment)
+    assert not (tmp_path / "res").exists()
