@@ -368,6 +368,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         n_bad = 0
         if err > 1.0:
             fst[F_H] = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+            ist[I_NREDO] = 0  # a shorter step no longer ends on the breakpoint it aimed at
             ist[I_NREJECT] += 1
             steps_here += 1
             continue
@@ -382,6 +383,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, tmp, u, du)
             fst[F_REDO_LEVEL] = level
             if theta * h > min_step and ist[I_NREDO] < 4:
+                # (counted as a rejection: the step is computed again, shorter)
                 fst[F_H] = theta * h
                 ist[I_NREDO] += 1
                 ist[I_NREJECT] += 1
