@@ -73,6 +73,10 @@ class ResultWriter:
             ds[-n:] = block[name]
         self.f.flush()
 
+    def read_trajectory(self) -> dict[str, np.ndarray]:
+        """The trajectory written so far, read back."""
+        return {name: self.f["trajectory"][name][()] for name in self.columns}
+
     def events(self, events: dict[str, np.ndarray]) -> None:
         """``events[name]`` is an (n, 2) array of (t, φ)."""
         for name, rows in events.items():

@@ -99,10 +99,12 @@ def _compile(model, cfg, bp) -> float:
 
 
 def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
-                 progress: Callable[[float], None] | None = None) -> RunData:
+                 progress: Callable[[float], None] | None = None, keep: bool = True) -> RunData:
     """Integrate a dynamic scene with the compiled DOP853; blocks go to ``on_block`` as they come.
 
-    A Ctrl-C between chunks ends the run with ``complete = False`` and what was computed so far.
+    With ``keep = False`` the trajectory is not kept in memory (only its last block), so that a
+    long run streamed to a file needs bounded memory. A Ctrl-C between chunks ends the run with
+    ``complete = False`` and what was computed so far.
     """
     model, bp, _ = build_model(scene)
     cfg = _config(scene)
@@ -123,7 +125,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                 ev.setdefault(ci.EVENT_NAMES[int(code)], []).append((t, phi))
             ist[ci.I_NOUT] = 0
             ist[ci.I_NEV] = 0
-            blocks.append(block)
+            if keep or not blocks or block["t"].size:
+                blocks = (blocks if keep else []) + [block]
             for k, v in ev.items():
                 events[k].extend(v)
             if on_block:
@@ -192,12 +195,13 @@ def prescribed(scene) -> RunData:
     return RunData(traj, {}, solver)
 
 
-def integrate(scene, on_block=None, progress=None) -> RunData:
-    """Run a scene in memory by the method it names (compiled, reference or prescribed)."""
+def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
+    """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
+    for ``keep``."""
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
     elif scene.solver.method == "dop853":
-        data = run_compiled(scene, on_block, progress)
+        data = run_compiled(scene, on_block, progress, keep)
     else:
         from .reference import run_reference
 
@@ -218,11 +222,14 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
     writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene), force)
     data = None
     try:
-        data = integrate(scene, on_block=lambda block, ev: writer.append(block), progress=progress)
-        if scene.run.mode == "prescribed-speed" or scene.solver.method != "dop853":
+        streamed = scene.run.mode == "dynamic" and scene.solver.method == "dop853"
+        data = integrate(scene, on_block=lambda block, ev: writer.append(block), progress=progress,
+                         keep=False)
+        if not streamed:
             writer.append(data.trajectory)
         writer.events(data.events)
         writer.solver(data.solver)
+        data.trajectory = writer.read_trajectory()  # the summary needs the whole run
         summary = summarize(scene, data.trajectory) if data.trajectory["t"].size else {}
         for name, (value, unit) in summary.items():
             writer.analysis(name, value, unit)
