@@ -139,7 +139,6 @@ def _print_summary(summary, solver) -> None:
 
 
 def cmd_info(args) -> int:
-    from .results import open_result
 
     res = _open(args.result)
     a = res.attrs

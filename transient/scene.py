@@ -14,7 +14,6 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
 from .errors import SceneError
 from .mechanisms.crank_slider import CrankSlider, read_crank_slider

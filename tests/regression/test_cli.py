@@ -24,7 +24,6 @@ import pytest
 import transient
 import transient.core.integrate as ci
 from transient.cli import main
-from transient.errors import SceneError
 from transient.scene import to_toml
 
 # ``transient.simulate`` is the function re-exported by the package (it shadows the submodule as
@@ -373,17 +372,8 @@ def test_scene_toml_round_trips(tmp_path, capsys, name, text):
 
 @pytest.mark.parametrize("case", sorted(CASES.glob("*.toml")), ids=lambda p: p.stem)
 def test_resolved_toml_of_every_case_round_trips(case):
-    """Every committed scene survives ``to_toml`` → ``load_scene`` (no run needed).
-
-    A case whose mechanism type ``scene.py`` does not read yet (work in progress) is skipped, so
-    that it is covered as soon as its reader lands.
-    """
-    try:
-        scene = transient.load_scene(case)
-    except SceneError as exc:
-        if exc.key == "mechanism.type":
-            pytest.skip(f"{case.name}: {exc.message}")
-        raise
+    """Every committed scene survives ``to_toml`` → ``load_scene`` (no run needed)."""
+    scene = transient.load_scene(case)
     again = transient.load_scene(case.with_name("resolved.toml"), text=to_toml(scene))
     assert_same_scene(again, scene)
     assert to_toml(again) == to_toml(scene)

@@ -8,7 +8,6 @@ gas-exchange TDC and 360° the firing TDC. Run with ``-s`` to see the numbers.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -173,13 +172,8 @@ P21 = np.array("""
     480 0.4970 0.4892 1338.8    490 0.5302 0.4572 1319.2    500 0.5574 0.4162 1304.3
     510 0.5784 0.3895 1293.3    520 0.5934 0.3581 1285.8    530 0.6024 0.3064 1281.5
     540 0.6053 0.2730 1280.0""".split(), dtype=float).reshape(-1, 4)
-P21_CSV = Path("/work/shared/reference/data/gots_P2_1_indicator.csv")
-
-
-def test_p21_copy_matches_reference():
-    if not P21_CSV.exists():
-        pytest.skip(f"{P21_CSV} not available")
-    csv = np.loadtxt(P21_CSV, delimiter=",", skiprows=1)
+def test_p21_copy_matches_reference(gots_data):
+    csv = np.loadtxt(gots_data / "gots_P2_1_indicator.csv", delimiter=",", skiprows=1)
     np.testing.assert_array_equal(csv[:, [0, 2, 3, 4]], P21)
 
 

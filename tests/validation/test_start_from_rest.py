@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 from numpy.polynomial import Polynomial
 
-from transient.scene import Initial, Output, Run, Solver, Starter, load_scene
+from transient.scene import Initial, Output, Run, Starter, load_scene
 from transient.simulate import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"

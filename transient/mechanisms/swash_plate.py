@@ -54,7 +54,6 @@ from ..core import swash_plate as core
 from ..core.model import SWASH_PLATE
 from ..errors import SceneError
 from ..tomlout import toml_value
-from ..units import SUFFIXES
 
 if TYPE_CHECKING:
     from ..scene import Section
