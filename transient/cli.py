@@ -169,7 +169,7 @@ def _open(path):
     try:
         return open_result(path)
     except (OSError, ValueError) as exc:
-        raise SceneError("(file)", f"not a readable transient result: {exc}", file=str(path))
+        raise SceneError("(file)", f"not a readable transient result: {exc}", file=str(path)) from None
 
 
 def cmd_plot(args) -> int:
