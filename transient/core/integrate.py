@@ -4,8 +4,9 @@ The solver loop is compiled together with the right-hand side (``model.derivativ
 ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint, so the
 right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal) it
 integrates in time, and a step that would cross a breakpoint is retaken so that it ends on it.
-Switches between the two, starter cut-out, speed reversals and the end of the run are state events
-located on the dense output (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
+Switches between the two, starter cut-out, the governor characteristic's corners, speed reversals
+and the end of the run are state events located on the dense output (Hairer, Nørsett & Wanner,
+*Solving ODEs I*, §II.6 and §II.10).
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks.
@@ -19,14 +20,14 @@ from . import dop853_coefficients as dc
 from .model import (KINETIC, N_STATE, N_SWITCHES, OMEGA, PHI, SW_GOVERNOR, SW_STARTER, T, derivative,
                     governor_branch, inertia, output_row, speed)
 
+# The right-hand side is autonomous (t and φ are both state components), so the nodes C are not
+# needed.
 _A = dc.A[: dc.N_STAGES, : dc.N_STAGES].copy()
 _B = dc.B.copy()
-_C = dc.C[: dc.N_STAGES].copy()
 _E3 = dc.E3.copy()
 _E5 = dc.E5.copy()
 _D = dc.D.copy()
 _A_EXTRA = dc.A[dc.N_STAGES + 1 :].copy()
-_C_EXTRA = dc.C[dc.N_STAGES + 1 :].copy()
 N_STAGES = dc.N_STAGES
 N_STAGES_EXTENDED = dc.N_STAGES_EXTENDED
 
