@@ -197,6 +197,11 @@ def run_reference(scene, on_block=None, progress=None):
         if scene.governor.model == "droop":  # corners of the characteristic
             evs.append(("governor_full", _speed_crossing(ref, t, y, scene.governor.speed_full)))
             evs.append(("governor_zero", _speed_crossing(ref, t, y, scene.governor.speed_zero)))
+        if not math.isfinite(run.t_end):  # a stall would never reach the end: stop there
+            def stop(t, yy):
+                return yy[1]
+            stop.terminal, stop.direction = True, -1
+            evs.append(("stall", stop))
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -220,6 +225,12 @@ def run_reference(scene, on_block=None, progress=None):
         hit = [name for (name, _), te in zip(evs, sol.t_events) if te.size]
         if "end" in hit:
             break
+        if "stall" in hit:
+            from .errors import SimulationError
+
+            raise SimulationError(f"stalled: the speed reached zero at t = {t:.9g} s, "
+                                  f"φ = {y[0]:.9g} rad before the {run.revolutions:g} revolutions "
+                                  f"the run ends by; give run.t_end to follow the motion")
         if "starter_cutout" in hit:
             ref.starter_on = False
             events["starter_cutout"].append((t, y[0]))

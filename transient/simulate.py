@@ -144,6 +144,10 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
              f"ω = {last['omega']:.9g} rad/s")
     if message:
         message = f"interrupted; last sample at {where}"
+    if status == ci.STALLED:
+        message = (f"stalled: the speed reached zero at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
+                   f"({math.degrees(y[0]):.6g}°) before the {scene.run.revolutions:g} revolutions "
+                   f"the run ends by; give run.t_end to follow the motion after a stall")
     if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
         cause = ("a non-finite value in the state or its error estimate"
                  if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")

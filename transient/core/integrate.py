@@ -52,7 +52,7 @@ I_STARTER_ON, I_GOV_BRANCH = SW_STARTER, SW_GOVERNOR
 N_IST = N_SWITCHES + 9
 
 # advance() return codes
-RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP = 0, 1, 2, 3
+RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED = 0, 1, 2, 3, 4
 # event codes written to the event buffer as (code, t, phi, omega)
 EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR = range(7)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
@@ -276,7 +276,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
     Returns
     -------
     int
-        RUNNING, FINISHED, FAIL_NONFINITE or FAIL_STEP.
+        RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, or STALLED (the speed reached zero in a run
+        that ends only by revolutions).
     """
     n = N_STATE
     K = np.empty((N_STAGES_EXTENDED, n))
@@ -485,6 +486,11 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         _emit_event(m, evbuf, ist, ev_code, y, u, du)
         if ev_code == EV_END:
             return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
+        if ev_code == EV_REVERSAL and not np.isfinite(cfg[C_T_END]):
+            # A run that ends only by revolutions would never end once the shaft stops: report
+            # the stall (with what was computed) instead of integrating on.
+            _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du)
+            return STALLED
         if ev_code == EV_STARTER_CUTOUT:
             ist[I_STARTER_ON] = 0
         elif ev_code == EV_GOVERNOR:

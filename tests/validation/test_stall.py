@@ -1,0 +1,40 @@
+"""A shaft that stops in a run that ends only by revolutions is reported as a stall (exit 1, the
+partial result kept and marked incomplete), never integrated forever."""
+from __future__ import annotations
+
+import dataclasses as dc
+from pathlib import Path
+
+import h5py
+import pytest
+
+from transient.cli import main
+from transient.errors import SimulationError
+from transient.scene import load_scene
+from transient.simulate import integrate
+
+CASE = Path(__file__).resolve().parents[2] / "cases" / "coasting_single.toml"
+
+
+def test_stall_is_reported_with_time_angle_and_state(tmp_path, capsys):
+    text = CASE.read_text().replace("[initial]", "[load]\ntorque = 50.0\n\n[initial]")
+    scene = tmp_path / "stall.toml"
+    scene.write_text(text)
+    code = main(["run", str(scene), "-o", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "stalled: the speed reached zero at t = " in err and "φ = " in err
+    with h5py.File(tmp_path / "stall.h5") as f:
+        assert not f.attrs["complete"]
+        assert "stalled" in f.attrs["message"]
+        omega = f["trajectory/omega"][()]
+        assert omega[0] > 100 and abs(omega[-1]) < 1e-9  # computed up to the stop, kept
+        assert f["events/speed_reversal/t"].size == 1
+
+
+def test_reference_path_reports_the_stall_too(tmp_path):
+    text = CASE.read_text().replace("[initial]", "[load]\ntorque = 50.0\n\n[initial]")
+    scene = load_scene(tmp_path / "stall.toml", text=text)
+    scene = dc.replace(scene, solver=dc.replace(scene.solver, method="scipy-DOP853", rtol=1e-8))
+    with pytest.raises(SimulationError, match="stalled: the speed reached zero"):
+        integrate(scene)
