@@ -173,10 +173,7 @@ def _open(path):
 
 
 def cmd_plot(args) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
 
     from . import plots
     from .assemble import gas_is_force, gas_table, swept_volume
@@ -220,10 +217,7 @@ def cmd_plot(args) -> int:
 def _plot_comparison(args) -> int:
     """The swash-plate paper's Fig. 5 as one figure: ω(t), ε(t) and the force on piston 1 of
     each result, one column per result, shared axes."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _pyplot()
 
     from . import plots
 
@@ -243,12 +237,20 @@ def _plot_comparison(args) -> int:
     return EXIT_OK
 
 
-def _save(fig, path):
+def _pyplot():
+    """matplotlib's pyplot on the file-only Agg backend (the CLI never opens windows)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+def _save(fig, path):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _pyplot().close(fig)
     return path
 
 
@@ -267,10 +269,7 @@ def cmd_kinematics(args) -> int:
     else:
         np.savetxt(sys.stdout, data, delimiter=",", header=header, comments="", fmt="%.12g")
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = _pyplot()
 
         from . import plots
 

@@ -16,6 +16,7 @@ from scipy.integrate import solve_ivp
 from .assemble import build_model
 from .core.integrate import next_breakpoint
 from .core.model import OUTPUTS
+from .errors import SimulationError
 
 
 class CrankSliderNumpy:
@@ -210,8 +211,6 @@ def run_reference(scene, on_block=None, progress=None):
         sol = solve_ivp(ref.rhs, (t, t_end), y, method=method, rtol=sv.rtol, atol=sv.atol,
                         events=[e for _, e in evs] or None, max_step=max_step)
         if sol.status == -1:
-            from .errors import SimulationError
-
             raise SimulationError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
         nfev += sol.nfev
         nsteps += sol.t.size - 1
@@ -226,8 +225,6 @@ def run_reference(scene, on_block=None, progress=None):
         if "end" in hit:
             break
         if "stall" in hit:
-            from .errors import SimulationError
-
             raise SimulationError(f"stalled: the speed reached zero at t = {t:.9g} s, "
                                   f"φ = {y[0]:.9g} rad before the {run.revolutions:g} revolutions "
                                   f"the run ends by; give run.t_end to follow the motion")

@@ -218,6 +218,43 @@ def next_breakpoint(bp, period, phi, upward):
     return -np.inf
 
 
+N_EVENT_KINDS = 7
+
+
+@njit(cache=True)
+def _event_spec(m, cfg, e, angle_mode, sw):
+    """State event number e that applies now: (code, component, level, direction), code −1 if
+    none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
+    −1 falling, 0 either way."""
+    if e == 0 and sw[SW_STARTER] == 1:
+        return EV_STARTER_CUTOUT, OMEGA, m.starter_cutout, 1
+    if e == 1 and angle_mode:
+        return EV_TO_TIME, OMEGA, cfg[C_W_LO], -1
+    if e == 2 and not angle_mode:
+        return EV_TO_ANGLE, OMEGA, cfg[C_W_HI], 1
+    if e == 3 and not angle_mode:
+        return EV_REVERSAL, OMEGA, 0.0, 0
+    if e == 4:  # the end of the run by the variable that is not independent
+        if angle_mode:
+            return EV_END, T, cfg[C_T_END], 1
+        return EV_END, PHI, cfg[C_PHI_END], 1
+    if e >= 5 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
+        return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
+    return -1, OMEGA, 0.0, 0
+
+
+@njit(cache=True)
+def _crosses(g0, g1, direction):
+    """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
+    rising = g0 < 0.0 <= g1
+    falling = g1 <= 0.0 < g0
+    if direction > 0:
+        return rising
+    if direction < 0:
+        return falling
+    return rising or falling
+
+
 @njit(cache=True)
 def _emit_event(m, evbuf, ist, code, y, u, du):
     j = ist[I_NEV]
@@ -267,7 +304,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
     y : float64[N_STATE]
         State, updated in place.
     fst, ist : float64[N_FST], int64[N_IST]
-        Stepper state kept between calls (zeros before the first call, plus ``ist[I_STARTER_ON]``).
+        Stepper state kept between calls (zeros before the first call, except
+        ``fst[F_PASSED_BP] = nan`` and ``ist[I_STARTER_ON]``).
     outbuf : float64[nbuf, N_OUT_FIXED + ncyl]
         Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
     evbuf : float64[nev, 4]
@@ -402,37 +440,13 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
         w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
         w1 = 1.0 / K[N_STAGES, T] if angle_mode else y_new[OMEGA]
-        for e in range(7):
-            comp = OMEGA
-            level = 0.0
-            hit = False
-            code = -1
-            if e == 0 and sw[SW_STARTER] == 1:
-                level = m.starter_cutout
-                hit = w0 < level <= w1
-                code = EV_STARTER_CUTOUT
-            elif e == 1 and angle_mode:
-                level = cfg[C_W_LO]
-                hit = w1 < level <= w0
-                code = EV_TO_TIME
-            elif e == 2 and not angle_mode:
-                level = cfg[C_W_HI]
-                hit = w0 < level <= w1
-                code = EV_TO_ANGLE
-            elif e == 3 and not angle_mode:
-                hit = (w0 > 0.0 and w1 <= 0.0) or (w0 < 0.0 and w1 >= 0.0)
-                code = EV_REVERSAL
-            elif e >= 5 and m.gov_on:
-                # The droop characteristic has corners at ω_a and ω_1c: stop on them, both ways.
-                level = m.gov_full if e == 5 else m.gov_zero
-                hit = (w0 < level <= w1) or (w1 <= level < w0)
-                code = EV_GOVERNOR
-            elif e == 4:
-                comp = T if angle_mode else PHI
-                level = cfg[C_T_END] if angle_mode else cfg[C_PHI_END]
-                hit = y[comp] < level <= y_new[comp]
-                code = EV_END
-            if hit:
+        for e in range(N_EVENT_KINDS):
+            code, comp, level, direction = _event_spec(m, cfg, e, angle_mode, sw)
+            if code < 0:
+                continue
+            g0 = (w0 if comp == OMEGA else y[comp]) - level
+            g1 = (w1 if comp == OMEGA else y_new[comp]) - level
+            if _crosses(g0, g1, direction):
                 if not dense_ready:
                     _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
                     ist[I_NFEV] += 3
@@ -523,9 +537,9 @@ def _to_time_mode(m, y, ist, u, du):
 
 @njit(cache=True)
 def _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du):
-    """Write the final state as the last sample (unless it already is one) and an end event."""
-    last = outbuf[ist[I_NOUT] - 1] if ist[I_NOUT] > 0 else outbuf[0]
-    if ist[I_NOUT] == 0 or last[0] != y[T] or last[1] != y[PHI]:
+    """Write the final state as the last sample (unless it already is one, possibly in an
+    already drained buffer) and an end event."""
+    if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
         _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du)
     if ist[I_NEV] == 0 or evbuf[ist[I_NEV] - 1, 0] != EV_END:
         _emit_event(m, evbuf, ist, EV_END, y, u, du)

@@ -41,6 +41,8 @@ CRANK_SLIDER, SWASH_PLATE = 0, 1
 OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter", "fuel")
 OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m", "1")
 N_OUT_FIXED = len(OUTPUTS)
+COL_EPS, COL_J, COL_DJ = OUTPUTS.index("epsilon"), OUTPUTS.index("J"), OUTPUTS.index("dJ_dphi")
+COL_M_GAS, COL_M_LOAD = OUTPUTS.index("M_gas"), OUTPUTS.index("M_load")
 
 Model = namedtuple(
     "Model",
@@ -209,6 +211,6 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive):
         y[OMEGA] = omega[i]
         sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
         output_row(m, False, y, phi[i], sw, u, du, rows[i])
-        rows[i, 3] = eps[i]
-        M = rows[i, 6] + rows[i, 7]
-        M_drive[i] = rows[i, 4] * eps[i] + 0.5 * rows[i, 5] * omega[i] ** 2 - M
+        rows[i, COL_EPS] = eps[i]
+        M = rows[i, COL_M_GAS] + rows[i, COL_M_LOAD]
+        M_drive[i] = rows[i, COL_J] * eps[i] + 0.5 * rows[i, COL_DJ] * omega[i] ** 2 - M
