@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 
 from .errors import SceneError
 from .mechanisms.crank_slider import CrankSlider, read_crank_slider
@@ -414,7 +415,7 @@ def _read_governor(s: Section) -> Governor:
     return Governor(model, full, zero)
 
 
-def _read_run(s: Section, mech) -> Run:
+def _read_run(s: Section) -> Run:
     mode = s.string("mode", "dynamic", choices=("dynamic", "prescribed-speed"))
     t_end = s.number("t_end", default=math.inf, gt=0.0)
     revs = s.number("revolutions", default=math.inf, gt=0.0)
@@ -479,7 +480,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
                                       s0.number("omega", "speed", 0.0))
         s0.finish()
         sr = root.sub("run", required=True)
-        sections["run"] = _read_run(sr, mech)
+        sections["run"] = _read_run(sr)
         sr.finish()
         sv = root.sub("solver")
         sections["solver"] = Solver(
@@ -506,8 +507,13 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
 
 def _check_consistency(scene: Scene) -> None:
     """Checks across sections, done before any integration."""
-    if scene.inertia.total + scene.mechanism.piston_mass <= 0:
-        raise SceneError("inertia", "the machine has no inertia")
+    # (18) divides by J(φ): it must stay positive over the whole cycle, dead centres included.
+    phi = np.linspace(0.0, scene.mechanism.cycle, 721)
+    J = scene.mechanism.kinematics_table(phi)["J"] + scene.inertia.total
+    if J.min() <= 0.0:
+        at = math.degrees(phi[int(np.argmin(J))])
+        raise SceneError("inertia", f"the reduced inertia J(φ) falls to {J.min():.3g} kg m² at "
+                                    f"φ = {at:g}°; give a shaft, flywheel or load inertia > 0")
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "

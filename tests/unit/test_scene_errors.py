@@ -332,3 +332,19 @@ def test_invalid_swash_plate_is_one_line_exit_2(tmp_path, capsys, command, old, 
     assert code == 2
     assert_one_line_error(err, scene, key, fragment)
     assert not (tmp_path / "res").exists()
+
+
+def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):
+    """(18) divides by J(φ): a machine whose J vanishes at a dead centre (no crank mass, the rod's
+    mass all at the pin, no shaft inertia) is refused before any work."""
+    scene = tmp_path / "bad.toml"
+    text = VALID
+    for old, new in (("crank_mass = 0.912", "crank_mass = 0.0"), ("shaft = 0.02", "shaft = 0.0"),
+                     ("cg_from_pin_mm = 107.3", "cg_from_pin_mm = 0")):
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    scene.write_text(text, encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, "inertia", "the reduced inertia J(φ) falls to")
+
