@@ -25,15 +25,14 @@ def gas_table(scene) -> PressureTable | None:
     if gas.model == "table":
         return table_from_points(np.asarray(gas.phi), np.asarray(gas.p), mech.cycle,
                                  corners=gas.corners, interpolation=gas.interpolation)
-    clearance = swept_volume(mech) / (gas.compression_ratio - 1.0)
-    return mixed_cycle(mech.volume_function(clearance), compression_ratio=gas.compression_ratio,
+    return mixed_cycle(mech.volume_function(clearance_volume(scene)), compression_ratio=gas.compression_ratio,
                        p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
                        p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes)
 
 
-def swept_volume(mech) -> float:
-    """Swept volume of one cylinder [m³] (both pistons of an opposed-piston cylinder)."""
-    return getattr(mech, "halves", 1) * mech.piston_area * mech.stroke()
+def clearance_volume(scene) -> float:
+    """V_c = V_h/(ε − 1) of the mixed cycle's compression ratio ε [m³]."""
+    return scene.mechanism.swept_volume() / (scene.gas.compression_ratio - 1.0)
 
 
 def gas_is_force(scene) -> bool:

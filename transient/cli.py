@@ -176,7 +176,7 @@ def cmd_plot(args) -> int:
     plt = _pyplot()
 
     from . import plots
-    from .assemble import gas_is_force, gas_table, swept_volume
+    from .assemble import clearance_volume, gas_is_force, gas_table
 
     if len(args.result) > 1:
         return _plot_comparison(args)
@@ -202,8 +202,7 @@ def cmd_plot(args) -> int:
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
         plots.indicator_phi(a1, table)
         if scene.gas.model == "mixed-cycle":
-            clearance = swept_volume(mech) / (scene.gas.compression_ratio - 1.0)
-            plots.indicator_pv(a2, table, mech.volume_function(clearance))
+            plots.indicator_pv(a2, table, mech.volume_function(clearance_volume(scene)))
         else:  # a table gives no clearance volume: plot against the swept part F_p·s
             plots.indicator_pv(a2, table, mech.volume_function(0.0), log=False)
             a2.set_xlabel("swept volume F_p·s [dm³]")

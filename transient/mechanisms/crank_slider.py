@@ -172,6 +172,10 @@ class CrankSlider:
         r, l, e = self.crank_radius, self.rod_length, self.offset
         return np.sqrt((l + r) ** 2 - e**2) - np.sqrt((l - r) ** 2 - e**2)
 
+    def swept_volume(self) -> float:
+        """Swept volume of one cylinder, F_p·S [m³]."""
+        return self.piston_area * self.stroke()
+
     def kinematics_table(self, phi: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
         """Positions, transfer functions and J(φ), dJ/dφ of the moving parts over ``phi`` [rad]."""
         mp = self.pack()
