@@ -9,7 +9,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from .core.model import Model
+from .core.model import PAPER, POWER_FLOW, Model
 from .forces.gas import PressureTable, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -85,5 +85,24 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
-        gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero)
+        gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
+        **chain_fields(scene))
     return model, model.breakpoints, table
+
+
+def chain_fields(scene) -> dict:
+    """The serial chain's part of the Model: pairs, their efficiencies, the sub-chain of each link.
+
+    Pair k joins links i and i + 1; links between ideal pairs share a sub-chain, so the sub-chain
+    of link i is the number of non-ideal pairs before it.
+    """
+    mech, friction = scene.mechanism, scene.friction
+    cut_after = [mech.links.index(p.between[0]) for p in friction.pairs]
+    link_sub = np.array([sum(c < i for c in cut_after) for i in range(len(mech.links))],
+                        dtype=np.int64)
+    return dict(
+        n_pairs=len(friction.pairs),
+        eta_fwd=np.array([p.eta_forward for p in friction.pairs], dtype=np.float64),
+        eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
+        policy=PAPER if friction.policy == "paper" else POWER_FLOW,
+        link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64))

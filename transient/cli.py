@@ -1,4 +1,4 @@
-"""The ``transient`` command (DESIGN §4): run, check, info, plot, kinematics.
+"""The ``transient`` command (DESIGN §4): run, check, info, plot, kinematics, bench, efficiency.
 
 Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulation failed (the
 partial result is kept and marked incomplete).
@@ -69,7 +69,68 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--no-baselines", action="store_true", help="compiled path only (quick)")
     b.add_argument("-o", "--output", default=None, help="also write the table to this file")
     b.set_defaults(func=cmd_bench)
+    e = sub.add_parser("efficiency", help="η_mech against speed at steady speeds and loads")
+    e.add_argument("scene")
+    e.add_argument("--rpm", default="500,1000,2000,3000,4000,5000",
+                   help="speeds [rpm], comma-separated (default 500,1000,2000,3000,4000,5000)")
+    e.add_argument("--fuel", default="1", help="gas-force fractions (loads), e.g. 1,0.5 "
+                                                "(default 1, full load)")
+    e.add_argument("--policies", default=None,
+                   help="mode policies to compare, e.g. power-flow,paper (default: the scene's)")
+    e.add_argument("--samples-per-rev", type=int, default=1440)
+    e.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    e.set_defaults(func=cmd_efficiency)
     return p
+
+
+def _number_list(text: str, option: str, low: float, high: float = math.inf) -> list[float]:
+    """Comma-separated numbers in (low, high], or a one-line error (exit 2)."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise SceneError(option, f"must be comma-separated numbers, got {text!r}") from None
+    bad = [v for v in values if not (low < v <= high)]
+    if not values or bad:
+        raise SceneError(option, f"values must lie in ({low:g}, {high:g}], got {text!r}")
+    return values
+
+
+def cmd_efficiency(args) -> int:
+    from .scene import POLICIES, load_scene
+    from .study import efficiency_study, plot_study, write_csv
+
+    scene = load_scene(args.scene)
+    rpm = _number_list(args.rpm, "--rpm", 0.0)
+    fuels = _number_list(args.fuel, "--fuel", 0.0, 1.0)
+    policies = tuple(args.policies.split(",")) if args.policies else None
+    for p in policies or ():
+        if p not in POLICIES:
+            raise SceneError("--policies", f"unknown policy {p!r}; allowed: {', '.join(POLICIES)}")
+    if scene.gas.model == "none":
+        raise SceneError("gas.model", "an efficiency study needs gas forces (the input power)",
+                         file=args.scene)
+    if args.samples_per_rev < 36:
+        raise SceneError("--samples-per-rev", f"must be ≥ 36, got {args.samples_per_rev}")
+    rows = efficiency_study(scene, rpm, fuels, policies, args.samples_per_rev)
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    stem = Path(args.scene).stem
+    write_csv(rows, out / f"{stem}_efficiency.csv")
+    names = [p.name for p in scene.friction.pairs]
+    print(f"{'policy':>10} {'fuel':>5} {'rpm':>7} {'η_work':>9} {'η (30)':>9}  "
+          + "  ".join(f"loss {n} [J/cycle] (circulated)" for n in names))
+    for r in rows:
+        pairs = "  ".join(f"{r[f'W_loss_{k + 1}_per_cycle']:10.4g} ({r[f'W_circulated_{k + 1}_per_cycle']:.4g})"
+                          for k in range(len(names)))
+        print(f"{r['policy']:>10} {r['fuel']:5.3g} {r['rpm']:7.0f} {r['eta_mech_work']:9.5f} "
+              f"{r.get('eta_mech_printed', math.nan):9.5f}  {pairs}")
+    plt = _pyplot()
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    plot_study(a1, a2, rows, len(names), names)
+    a1.set_title(f"{scene.name}: mechanical efficiency at constant speed")
+    print(f"wrote {out / f'{stem}_efficiency.csv'}")
+    print(f"wrote {_save(fig, out / f'{stem}_efficiency.png')}")
+    return EXIT_OK
 
 
 def cmd_bench(args) -> int:
@@ -133,9 +194,34 @@ def _print_summary(summary, solver) -> None:
     if "mean_drive_torque_last_cycle" in v:
         print(f"  mean drive torque required over the last cycle: "
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
+    _print_efficiency(v)
     print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
           f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
           f"compile/cache load)")
+
+
+def _print_efficiency(v: dict) -> None:
+    """η_mech in both forms and each pair's budget per cycle (``analysis.efficiency``)."""
+    if "eta_mech_work" not in v:
+        return
+    print(f"  mechanical efficiency over {v['steady_cycles']:.0f} steady cycle(s): "
+          f"η = W_out/W_in = {v['eta_mech_work']:.6f} (work ratio; W_in = "
+          f"{v['W_in_per_cycle']:.6g} J/cycle; energy balance residual "
+          f"{v['energy_balance_residual']:.2e})")
+    if "eta_mech_printed" in v:
+        print(f"    (30) as printed, time average of P_out/P_in: {v['eta_mech_printed']:.6g} "
+              f"(ill-posed where P_in crosses zero; {100 * v['eta_mech_printed_excluded']:.3g} % "
+              f"of the time left out)")
+    k = 1
+    while f"W_loss_{k}_per_cycle" in v:
+        print(f"    pair {k}: loss {v[f'W_loss_{k}_per_cycle']:.6g} J/cycle "
+              f"({100 * v[f'loss_share_{k}']:.4g} % of W_in), circulated "
+              f"{v[f'W_circulated_{k}_per_cycle']:.6g} J/cycle, far side driving "
+              f"{100 * v[f'backward_share_{k}']:.3g} % of the time, mode against the power "
+              f"{100 * v[f'mode_against_power_share_{k}']:.3g} % of the time")
+        k += 1
+    if "pair_mode_switches_per_cycle" in v:
+        print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
 
 
 def cmd_info(args) -> int:
@@ -155,6 +241,7 @@ def cmd_info(args) -> int:
         print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
               f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
+    _print_efficiency({k: v for k, (v, _) in res.analysis.items()})
     for k, (v, unit) in res.analysis.items():
         print(f"  {k} = {v:.9g} {unit}" if np.ndim(v) == 0 and isinstance(v, (int, float, np.number))
               else f"  {k} = {v} {unit}")
@@ -196,6 +283,11 @@ def cmd_plot(args) -> int:
     plots.torques(ax, traj, scene.mechanism.cycle)
     ax.set_title(f"{scene.name}: moments over the last cycle")
     written.append(_save(fig, out / f"{stem}_torques.png"))
+    if scene.friction.pairs:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)
+        ax.set_title(f"{scene.name}: power through the non-ideal pairs ({scene.friction.policy})")
+        written.append(_save(fig, out / f"{stem}_pairs.png"))
     table = gas_table(scene)
     if table is not None and not gas_is_force(scene):
         mech = scene.mechanism

@@ -115,3 +115,23 @@ def reduced_inertia(ax, table):
     ax.grid(True, alpha=0.3)
     ax.legend(handles=a + b, fontsize=8)
     return a + b
+
+
+def pair_power(ax, traj, names, cycle):
+    """Power each non-ideal pair transmits, S_k ω [kW] (> 0: the shaft side drives), and the
+    power it loses, over the last cycle against the crank angle in that cycle."""
+    sel = last_cycle(traj, cycle)
+    phi = np.degrees(traj["phi"][sel] - traj["phi"][sel][0])
+    w = traj["omega"][sel]
+    artists = []
+    for k, name in enumerate(names, start=1):
+        line = ax.plot(phi, traj[f"S_{k}"][sel] * w / 1e3, lw=1.0, label=f"{name}: transmitted")[0]
+        artists.append(line)
+        artists += ax.plot(phi, traj[f"P_loss_{k}"][sel] / 1e3, lw=1.0, ls="--",
+                           color=line.get_color(), label=f"{name}: lost")
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel("power [kW]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return artists

@@ -12,10 +12,10 @@ import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from .assemble import build_model
 from .core.integrate import next_breakpoint
-from .core.model import OUTPUTS
 from .errors import SimulationError
 
 
@@ -78,8 +78,66 @@ def _mechanism(scene):
     return KernelTwin(mech, swash_terms)
 
 
+class ChainNumpy:
+    """The serial chain with power-flow modes, solved as the proof in ``transient.core.chain``
+    suggests rather than as the kernel does: the residual of the last sub-chain, F(a), strictly
+    decreases in the acceleration a, so its one root is bracketed and found by Brent's method,
+    the mode of each pair following from the sign of the power it transmits."""
+
+    def __init__(self, scene) -> None:
+        mech, pairs = scene.mechanism, scene.friction.pairs
+        self.n = len(pairs)
+        self.eta_f = np.array([p.eta_forward for p in pairs])
+        self.eta_b = np.array([p.eta_backward for p in pairs])
+        cuts = [mech.links.index(p.between[0]) for p in pairs]
+        self.sub = [sum(c < i for c in cuts) for i in range(len(mech.links))]
+        self.link_J = mech.link_inertias()
+        self.J0 = scene.inertia.total
+
+    def split(self, J, dJ, M_gas, M_shaft):
+        """(J_k, J′_k, M_k) per sub-chain: shaft link, constant middle links, the rest last."""
+        Jk, dJk, Mk = np.zeros(self.n + 1), np.zeros(self.n + 1), np.zeros(self.n + 1)
+        Jk[self.sub[0]] += self.J0
+        for i in range(1, len(self.sub) - 1):
+            Jk[self.sub[i]] += self.link_J[i]
+        Jk[self.sub[-1]] += J - self.J0 - sum(self.link_J[1:-1])
+        dJk[self.sub[-1]] += dJ
+        Mk[self.sub[0]] += M_shaft
+        Mk[self.sub[-1]] += M_gas
+        return Jk, dJk, Mk
+
+    def _sweep(self, a, Jk, R, sigma):
+        """Pair moments S_k and the last sub-chain's residual for a trial acceleration."""
+        S, arriving = np.zeros(self.n), 0.0
+        for k in range(self.n):
+            S[k] = R[k] - Jk[k] * a + arriving
+            arriving = S[k] * (self.eta_f[k] if S[k] * sigma >= 0 else 1.0 / self.eta_b[k])
+        return R[-1] - Jk[-1] * a + arriving, S
+
+    def solve(self, Jk, dJk, Mk, w, sigma):
+        """(φ̈, S_k, η*_k) for direction σ (sign of ω, or of the incipient motion at rest)."""
+        R = Mk - 0.5 * dJk * w * w
+        scale = (np.sum(np.abs(R)) + 1e-300) / np.min(Jk[Jk > 0]) / min(
+            np.min(self.eta_f), np.min(self.eta_b)) ** self.n
+        a = brentq(lambda x: self._sweep(x, Jk, R, sigma)[0], -2 * scale, 2 * scale,
+                   xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+        S = self._sweep(a, Jk, R, sigma)[1]
+        eta = np.where(S * sigma >= 0, self.eta_f, 1.0 / self.eta_b)
+        return a, S, eta
+
+    def start_direction(self, Jk, dJk, Mk):
+        """σ of the incipient motion at rest, or 0 when the pairs' friction holds the chain."""
+        if self.solve(Jk, dJk, Mk, 0.0, 1.0)[0] > 0:
+            return 1.0
+        if self.solve(Jk, dJk, Mk, 0.0, -1.0)[0] < 0:
+            return -1.0
+        return 0.0
+
+
 class ReferenceModel:
-    """Right-hand side of (18) in time, dy/dt = (ω, ε), plain numpy."""
+    """Right-hand side of (18) (or of the serial chain) in time, dy/dt = (ω, ε, powers), numpy.
+
+    The state is (φ, ω, W_gas, W_load, W_starter, W_loss per pair)."""
 
     def __init__(self, scene) -> None:
         self.scene = scene
@@ -90,6 +148,8 @@ class ReferenceModel:
         g = scene.governor
         w0 = scene.initial.omega
         self.branch = 0 if w0 < g.speed_full else (2 if w0 >= g.speed_zero else 1)
+        self.chain = ChainNumpy(scene) if scene.friction.pairs else None
+        self.sigma = 1.0 if w0 >= 0 else -1.0
 
     def select(self, a: float, b: float) -> None:
         """Table pieces for the segment of shaft angle (a, b) between two breakpoints."""
@@ -123,18 +183,29 @@ class ReferenceModel:
             return 1.0
         return 0.0 if self.branch == 2 else (g.speed_zero - w) / (g.speed_zero - g.speed_full)
 
-    def rhs(self, t, y):
-        phi, w = y
-        J, dJ, M_gas, M_load, M_starter, _ = self.moments(phi, w)
-        return [w, (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J]
+    def evaluate(self, phi, w):
+        """(moments, φ̈, S_k, η*_k) at (φ, ω)."""
+        J, dJ, Mg, Ml, Ms, pc = self.moments(phi, w)
+        if self.chain is None:
+            return (J, dJ, Mg, Ml, Ms, pc), (Mg + Ml + Ms - 0.5 * dJ * w * w) / J, (), ()
+        sigma = np.sign(w) or self.sigma
+        a, S, eta = self.chain.solve(*self.chain.split(J, dJ, Mg, Ml + Ms), w, sigma)
+        return (J, dJ, Mg, Ml, Ms, pc), a, S, eta
 
-    def rows(self, t, phi, omega):
+    def rhs(self, t, y):
+        phi, w = y[:2]
+        (J, dJ, Mg, Ml, Ms, _), a, S, eta = self.evaluate(phi, w)
+        return [w, a, Mg * w, Ml * w, Ms * w, *((1 - np.asarray(eta)) * S * w)]
+
+    def rows(self, t, y):
         out = []
-        for ti, p, w in zip(t, phi, omega):
-            J, dJ, Mg, Ml, Ms, pc = self.moments(p, w)
-            eps = (Mg + Ml + Ms - 0.5 * dJ * w * w) / J
-            out.append([ti, p, w, eps, J, dJ, Mg, Ml, Ms, self.fuel(w), *pc])
-        return np.asarray(out).reshape(-1, len(OUTPUTS) + self.model.ncyl)
+        for ti, yi in zip(t, y.T):
+            p, w = yi[:2]
+            (J, dJ, Mg, Ml, Ms, pc), a, S, eta = self.evaluate(p, w)
+            pairs = [v for k in range(len(S))
+                     for v in (S[k], eta[k], (1 - eta[k]) * S[k] * w, yi[5 + k])]
+            out.append([ti, p, w, a, J, dJ, Mg, Ml, Ms, self.fuel(w), *yi[2:5], *pc, *pairs])
+        return np.asarray(out)
 
 
 def _speed_crossing(ref, t, y, level):
@@ -173,7 +244,9 @@ def run_reference(scene, on_block=None, progress=None):
     sv, run = scene.solver, scene.run
     t_end = run.t_end if math.isfinite(run.t_end) else 1e12
     phi_end = scene.initial.phi + 2 * math.pi * run.revolutions
-    t, y = 0.0, np.array([scene.initial.phi, scene.initial.omega])
+    n_pairs = len(scene.friction.pairs)
+    t, y = 0.0, np.concatenate([[scene.initial.phi, scene.initial.omega], np.zeros(3 + n_pairs)])
+    message = ""
     blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": [],
                                          "governor_corner": []}, 0, 0
     t0 = time.perf_counter()
@@ -203,6 +276,24 @@ def run_reference(scene, on_block=None, progress=None):
                 return yy[1]
             stop.terminal, stop.direction = True, -1
             evs.append(("stall", stop))
+        if ref.chain is not None and y[1] == 0.0:  # at rest: the pairs may hold the chain
+            J, dJ, Mg, Ml, Ms, _ = ref.moments(y[0], 0.0)
+            ref.sigma = ref.chain.start_direction(*ref.chain.split(J, dJ, Mg, Ml + Ms))
+            if ref.sigma == 0.0:
+                message = (f"locked: at rest at t = {t:.9g} s, φ = {y[0]:.9g} rad the friction of "
+                           f"the non-ideal pairs holds the applied moments")
+                events.setdefault("locked", []).append((t, y[0]))
+                row = ref.rows([t], y[:, None])  # the state at rest, ω exactly 0
+                if blocks:
+                    blocks[-1][-1] = row[0]
+                else:
+                    blocks.append(row)
+                break
+        if ref.chain is not None and math.isfinite(run.t_end):
+            def rest(t, yy):  # friction turns with the motion: stop where the shaft stops
+                return yy[1]
+            rest.terminal, rest.direction = True, -np.sign(y[1]) or -ref.sigma
+            evs.append(("rest", rest))
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -214,7 +305,7 @@ def run_reference(scene, on_block=None, progress=None):
             raise SimulationError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
         nfev += sol.nfev
         nsteps += sol.t.size - 1
-        block = ref.rows(sol.t[1:] if blocks else sol.t, *(sol.y[:, 1:] if blocks else sol.y))
+        block = ref.rows(sol.t[1:] if blocks else sol.t, sol.y[:, 1:] if blocks else sol.y)
         blocks.append(block)
         t, y = sol.t[-1], sol.y[:, -1].copy()
         if progress:
@@ -228,6 +319,9 @@ def run_reference(scene, on_block=None, progress=None):
             raise SimulationError(f"stalled: the speed reached zero at t = {t:.9g} s, "
                                   f"φ = {y[0]:.9g} rad before the {run.revolutions:g} revolutions "
                                   f"the run ends by; give run.t_end to follow the motion")
+        if "rest" in hit:
+            y[1] = 0.0
+            events.setdefault("speed_reversal", []).append((t, y[0]))
         if "starter_cutout" in hit:
             ref.starter_on = False
             events["starter_cutout"].append((t, y[0]))
@@ -248,4 +342,5 @@ def run_reference(scene, on_block=None, progress=None):
     traj = {n: rows[:, j] for j, n in enumerate(names)}
     solver = {"method": scene.solver.method, "rtol": sv.rtol, "atol": sv.atol, "nfev": nfev,
               "nsteps": nsteps, "nreject": -1, "wall_s": time.perf_counter() - t0, "compile_s": 0.0}
-    return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v}, solver)
+    return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v}, solver,
+                   complete=not message, message=message)

@@ -330,6 +330,36 @@ METHODS = ("dop853", "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 
 
 @dataclass(frozen=True)
+class Pair:
+    """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).
+
+    ``between``: the link on the shaft side first (a), then the far one (b), names from the
+    mechanism's ``links``. ``eta_forward`` = η_ba, the efficiency while a (the shaft side) drives;
+    ``eta_backward`` = η_ab, while b drives; both in (0, 1] [1].
+    """
+
+    between: tuple[str, str]
+    eta_forward: float
+    eta_backward: float
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Non-ideal pairs and how their modes are chosen (``transient.core.chain``).
+
+    ``policy``: ``"power-flow"`` (each pair's mode agrees with the power it transmits) or
+    ``"paper"`` (criterion (25), the sign of the shaft-side moments' power).
+    """
+
+    policy: str = "power-flow"
+    pairs: tuple[Pair, ...] = ()
+
+
+POLICIES = ("power-flow", "paper")
+
+
+@dataclass(frozen=True)
 class Scene:
     name: str
     description: str
@@ -343,6 +373,7 @@ class Scene:
     run: Run = field(default_factory=Run)
     solver: Solver = field(default_factory=Solver)
     output: Output = field(default_factory=Output)
+    friction: Friction = field(default_factory=Friction)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -404,6 +435,48 @@ def _read_pressure_csv(s: Section, base_dir: Path):
     except (ValueError, IndexError) as exc:
         raise SceneError(s.key("file"), f"{path.name}: a row is not numeric ({exc})") from None
     return phi, p
+
+
+def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
+    """The [friction] table: a policy and an array of [[friction.pairs]] between neighbouring
+    links of the mechanism (shaft side first)."""
+    policy = s.string("policy", "power-flow", choices=POLICIES)
+    s.known.append("pairs")
+    raw = s.data.pop("pairs", [])
+    if not isinstance(raw, list):
+        raise SceneError(s.key("pairs"), "must be an array of tables ([[friction.pairs]])")
+    chain = " – ".join(links)
+    pairs, seen = [], {}
+    for i, item in enumerate(raw):
+        ps = Section(item, f"{s.key('pairs')}[{i}]")
+        ps.known.append("between")
+        between = ps.data.pop("between", None)
+        if (not isinstance(between, list) or len(between) != 2
+                or not all(isinstance(b, str) for b in between)):
+            raise SceneError(ps.key("between"), f"must be two link names, got {_show(between)}; "
+                                                f"the links are {chain}")
+        for b in between:
+            if b not in links:
+                raise SceneError(ps.key("between"), f"unknown link {b!r}; the links are {chain}")
+        ia, ib = links.index(between[0]), links.index(between[1])
+        if abs(ia - ib) != 1:
+            raise SceneError(ps.key("between"),
+                             f"{between[0]!r} and {between[1]!r} are not neighbours; a pair joins "
+                             f"two adjacent links of the chain {chain}")
+        if ib < ia:
+            raise SceneError(ps.key("between"), f"give the shaft-side link first: "
+                                                f"[{between[1]!r}, {between[0]!r}]")
+        if ia in seen:
+            raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
+        seen[ia] = i
+        pair = Pair(between=(between[0], between[1]),
+                    eta_forward=ps.number("eta_forward", gt=0.0, le=1.0),
+                    eta_backward=ps.number("eta_backward", gt=0.0, le=1.0),
+                    name=ps.string("name", f"{between[0]}-{between[1]}"))
+        ps.finish()
+        pairs.append(pair)
+    pairs.sort(key=lambda p: links.index(p.between[0]))
+    return Friction(policy, tuple(pairs))
 
 
 def _read_governor(s: Section) -> Governor:
@@ -494,6 +567,9 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4),
                                     so.number("dt", default=0.0, ge=0.0))
         so.finish()
+        sf = root.sub("friction")
+        sections["friction"] = _read_friction(sf, mech.links)
+        sf.finish()
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
         _check_consistency(scene)
@@ -514,6 +590,10 @@ def _check_consistency(scene: Scene) -> None:
         at = math.degrees(phi[int(np.argmin(J))])
         raise SceneError("inertia", f"the reduced inertia J(φ) falls to {J.min():.3g} kg m² at "
                                     f"φ = {at:g}°; give a shaft, flywheel or load inertia > 0")
+    if scene.friction.pairs and scene.friction.policy == "paper" and scene.solver.method != "dop853":
+        raise SceneError("solver.method", "the reference path (scipy-*) follows the power-flow "
+                                          "policy only; use method = \"dop853\" with policy "
+                                          "\"paper\"")
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
@@ -578,6 +658,12 @@ def to_toml(scene: Scene) -> str:
     lines += ["", "[run]"] + [f"{k} = {toml_value(v)}" for k, v in run.items()]
     lines += _section("solver", scene.solver)
     lines += _section("output", scene.output)
+    lines += ["", "[friction]", f"policy = {toml_value(scene.friction.policy)}"]
+    for pair in scene.friction.pairs:
+        lines += ["", "[[friction.pairs]]", f"name = {toml_value(pair.name)}",
+                  f"between = {toml_value(list(pair.between))}",
+                  f"eta_forward = {toml_value(pair.eta_forward)}",
+                  f"eta_backward = {toml_value(pair.eta_backward)}"]
     return "\n".join(lines) + "\n"
 
 

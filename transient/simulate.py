@@ -16,7 +16,8 @@ from scipy.interpolate import CubicSpline
 
 from .assemble import build_model
 from .core import integrate as ci
-from .core.model import N_OUT_FIXED, N_STATE, OUTPUT_UNITS, OUTPUTS, inverse_dynamics
+from .core.model import (N_OUT_FIXED, OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
+                         inverse_dynamics, n_outputs, n_state)
 from .errors import SimulationError
 
 BUFFER_ROWS = 8192
@@ -31,8 +32,12 @@ def output_columns(scene) -> dict[str, str]:
     for k in range(scene.mechanism.n_cylinders):
         # p_k: cylinder pressure, or the force per piston for force-pulse models
         cols[f"p_{k + 1}"] = "N" if gas_is_force(scene) else "Pa"
+    for k in range(len(scene.friction.pairs)):
+        for name, unit in zip(PAIR_OUTPUTS, PAIR_OUTPUT_UNITS):
+            cols[f"{name}_{k + 1}"] = unit
     if scene.run.mode == "prescribed-speed":
         cols["M_drive"] = "N m"
+        cols["W_drive"] = "J"
     return cols
 
 
@@ -65,8 +70,8 @@ def _config(scene) -> np.ndarray:
     return cfg
 
 
-def _initial_state(scene):
-    y = np.zeros(N_STATE)
+def _initial_state(scene, model):
+    y = np.zeros(n_state(model))
     y[0] = scene.initial.phi
     y[2] = scene.initial.omega
     fst = np.zeros(ci.N_FST)
@@ -91,10 +96,10 @@ def _compile(model, cfg, bp) -> float:
     warm = cfg.copy()
     warm[ci.C_T_END] = 1e-6
     warm[ci.C_PHI_END] = 1e-6
-    y = np.zeros(N_STATE)
+    y = np.zeros(n_state(model))
     y[2] = 1.0
     ci.advance(model, warm, bp, y, np.zeros(ci.N_FST), np.zeros(ci.N_IST, dtype=np.int64),
-               np.empty((1024, N_OUT_FIXED + model.ncyl)), np.empty((64, 4)))
+               np.empty((1024, n_outputs(model))), np.empty((64, 4)))
     return time.perf_counter() - t0
 
 
@@ -110,8 +115,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     cfg = _config(scene)
     names = list(output_columns(scene))
     compile_s = _compile(model, cfg, bp)
-    y, fst, ist = _initial_state(scene)
-    outbuf = np.empty((BUFFER_ROWS, N_OUT_FIXED + model.ncyl))
+    y, fst, ist = _initial_state(scene, model)
+    outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
     evbuf = np.empty((EVENT_ROWS, 4))
     blocks, events = [], {name: [] for name in ci.EVENT_NAMES}
     status, message = ci.RUNNING, ""
@@ -148,6 +153,16 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
         message = (f"stalled: the speed reached zero at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) before the {scene.run.revolutions:g} revolutions "
                    f"the run ends by; give run.t_end to follow the motion after a stall")
+    at = f"t = {y[1]:.9g} s, φ = {y[0]:.9g} rad ({math.degrees(y[0]):.6g}°)"
+    if status == ci.LOCKED:
+        message = (f"locked: at rest at {at} the friction of the non-ideal pairs holds the "
+                   f"applied moments in both directions (nothing changes them later, so the "
+                   f"machine stays there)")
+    if status == ci.CHATTERING:
+        message = (f"chattering: the pair modes switched {ci.CHATTER_COUNT} times without "
+                   f"progress at {at} (last sample {where}): the "
+                   f"{scene.friction.policy!r} criterion has no consistent mode here (a sliding "
+                   f"mode); the power-flow policy has one at every state")
     if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
         cause = ("a non-finite value in the state or its error estimate"
                  if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")
@@ -155,15 +170,18 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                    f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
     solver = {"method": "dop853", "rtol": scene.solver.rtol, "atol": scene.solver.atol,
               "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
-              "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s}
+              "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
+              "mode_switches": int(ist[ci.I_NSWITCH])}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
                    solver, complete=status == ci.FINISHED, message=message)
 
 
-def prescribed(scene) -> RunData:
-    """Inverse dynamics at a prescribed speed: the drive torque (18) requires (textbook analysis)."""
+def prescribed(scene, fuel: float = 1.0) -> RunData:
+    """Inverse dynamics at a prescribed speed: the drive torque on the shaft that the chain needs
+    (the textbook analysis at given ω). ``fuel`` scales every gas force, as the governor does."""
     model, _, _ = build_model(scene)
+    model = model._replace(gas_scale=model.gas_scale * fuel)
     run = scene.run
     phi0 = scene.initial.phi
     dphi = 2.0 * math.pi / scene.output.samples_per_rev
@@ -183,20 +201,35 @@ def prescribed(scene) -> RunData:
         t = (phi - phi0) / w
         omega = np.full_like(phi, w)
         eps = np.zeros_like(phi)
-    rows = np.empty((phi.size, N_OUT_FIXED + model.ncyl))
+    rows = np.empty((phi.size, n_outputs(model)))
     drive = np.empty(phi.size)
+    n_ok = np.empty(phi.size, dtype=np.int64)
     t0 = time.perf_counter()
-    inverse_dynamics(model, t[:1], phi[:1], omega[:1], eps[:1], rows[:1], drive[:1])  # compile
+    inverse_dynamics(model, t[:1], phi[:1], omega[:1], eps[:1], rows[:1], drive[:1], n_ok[:1])
     compile_s = time.perf_counter() - t0
     t0 = time.perf_counter()
-    inverse_dynamics(model, t, phi, omega, eps, rows, drive)
+    inverse_dynamics(model, t, phi, omega, eps, rows, drive, n_ok)
     names = list(output_columns(scene))
-    traj = {name: rows[:, j].copy() for j, name in enumerate(names[:-1])}
+    traj = {name: rows[:, j].copy() for j, name in enumerate(names) if name not in ("M_drive", "W_drive")}
     traj["M_drive"] = drive
+    _work_columns(traj, len(scene.friction.pairs))
     solver = {"method": "prescribed", "rtol": 0.0, "atol": 0.0, "nfev": int(phi.size),
               "nsteps": 0, "nreject": 0, "wall_s": time.perf_counter() - t0,
-              "compile_s": compile_s}
+              "compile_s": compile_s, "ambiguous_samples": int(np.count_nonzero(n_ok > 1)),
+              "inconsistent_samples": int(np.count_nonzero(n_ok == 0))}
     return RunData(traj, {}, solver)
+
+
+def _work_columns(traj: dict, n_pairs: int) -> None:
+    """Work integrals of a prescribed run, by the trapezoidal rule over its samples [J]
+    (a dynamic run integrates them with the motion instead)."""
+    from scipy.integrate import cumulative_trapezoid
+
+    t, w = traj["t"], traj["omega"]
+    for name, power in (("W_gas", traj["M_gas"] * w), ("W_load", traj["M_load"] * w),
+                        ("W_starter", traj["M_starter"] * w), ("W_drive", traj["M_drive"] * w),
+                        *((f"W_loss_{k + 1}", traj[f"P_loss_{k + 1}"]) for k in range(n_pairs))):
+        traj[name] = cumulative_trapezoid(power, t, initial=0.0)
 
 
 def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
@@ -234,7 +267,8 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
         writer.events(data.events)
         writer.solver(data.solver)
         data.trajectory = writer.read_trajectory()  # the summary needs the whole run
-        summary = summarize(scene, data.trajectory) if data.trajectory["t"].size else {}
+        summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
+                   else {})
         for name, (value, unit) in summary.items():
             writer.analysis(name, value, unit)
         data.extra["summary"] = summary

@@ -585,3 +585,90 @@ def test_python_m_transient_check():
     assert proc.stderr == ""
     assert proc.stdout.startswith("cases/coasting_single.toml: ok (coasting-single: CrankSlider, "
                                   "1 cylinder(s), gas none, run dynamic)")
+
+
+# ----------------------------------------------------------------------------------------------
+# non-ideal pairs (issue 4)
+
+PAIRS = """
+[friction]
+policy = "power-flow"
+
+[[friction.pairs]]
+name = "main bearings"
+between = ["shaft", "crank"]
+eta_forward = 0.985
+eta_backward = 0.98
+
+[[friction.pairs]]
+name = "crankpins"
+between = ["crank", "rod"]
+eta_forward = 0.98
+eta_backward = 0.975
+"""
+
+
+def test_run_with_pairs_writes_pair_columns_and_mode_events(tmp_path, capsys):
+    scene = write(tmp_path, "pairs", SPINUP + PAIRS)
+    code, out, err = cli(capsys, "run", scene, "-o", tmp_path)
+    assert (code, err) == (0, "")
+    res = transient.open_result(tmp_path / "pairs.h5")
+    assert res.complete
+    for k in (1, 2):
+        assert {f"S_{k}": "N m", f"eta_{k}": "1", f"P_loss_{k}": "W",
+                f"W_loss_{k}": "J"}.items() <= res.units.items()
+    assert {"W_gas": "J", "W_load": "J", "W_starter": "J"}.items() <= res.units.items()
+    tr = res.trajectory
+    assert set(np.unique(tr["eta_1"])) <= {0.985, 1 / 0.98}
+    assert res.events["pair_mode"]["t"].size > 0
+    assert res.solver["mode_switches"] == res.events["pair_mode"]["t"].size
+    assert res.scene().friction.pairs[1].name == "crankpins"
+
+
+def test_prescribed_run_with_pairs_reports_the_efficiency(tmp_path, capsys):
+    """At a prescribed constant speed every cycle is steady: run and info print η_mech in both
+    forms and each pair's budget; the values are stored under /analysis with units."""
+    scene = write(tmp_path, "gots_4400_pairs", prescribed_4400() + PAIRS)
+    code, out, err = cli(capsys, "run", scene, "-o", tmp_path)
+    assert (code, err) == (0, "")
+    assert "mechanical efficiency over 1 steady cycle(s): η = W_out/W_in = " in out
+    assert "(30) as printed, time average of P_out/P_in" in out
+    assert "pair 2: loss " in out and "circulated" in out
+    res = transient.open_result(tmp_path / "gots_4400_pairs.h5")
+    eta, unit = res.analysis["eta_mech_work"]
+    assert unit == "1" and 0.85 < eta < 0.98
+    losses = res.analysis["W_loss_1_per_cycle"][0] + res.analysis["W_loss_2_per_cycle"][0]
+    assert eta == pytest.approx(1 - losses / res.analysis["W_in_per_cycle"][0], rel=1e-9)
+    code, out, err = cli(capsys, "info", tmp_path / "gots_4400_pairs.h5")
+    assert code == 0 and "mechanical efficiency over 1 steady cycle(s)" in out
+
+
+def test_efficiency_study_writes_table_and_plot(tmp_path, capsys):
+    scene = CASES / "gots_diesel_friction.toml"
+    code, out, err = cli(capsys, "efficiency", scene, "--rpm", "1000,5000", "--fuel", "1,0.5",
+                         "--policies", "power-flow,paper", "--samples-per-rev", "360",
+                         "-o", tmp_path)
+    assert (code, err) == (0, "")
+    csv = (tmp_path / "gots_diesel_friction_efficiency.csv").read_text().splitlines()
+    header = csv[0].split(",")
+    assert header[:4] == ["policy", "fuel", "rpm", "eta_mech_work"]
+    rows = [dict(zip(header, line.split(","))) for line in csv[1:]]
+    assert len(rows) == 8
+    eta = {(r["policy"], float(r["fuel"]), float(r["rpm"])): float(r["eta_mech_work"])
+           for r in rows}
+    # The inertia power circulating through the pairs lowers η_mech at high speed.
+    assert eta[("power-flow", 1.0, 5000.0)] < eta[("power-flow", 1.0, 1000.0)] - 0.01
+    assert (tmp_path / "gots_diesel_friction_efficiency.png").stat().st_size > 10_000
+    assert "wrote" in out and "power-flow" in out
+
+
+@pytest.mark.parametrize("argv, key", [
+    (("--rpm", "-100"), "--rpm"), (("--rpm", "abc"), "--rpm"), (("--fuel", "1.5"), "--fuel"),
+    (("--fuel", "0"), "--fuel"), (("--policies", "coulomb"), "--policies"),
+    (("--samples-per-rev", "10"), "--samples-per-rev")])
+def test_efficiency_study_rejects_bad_options(tmp_path, capsys, argv, key):
+    code, out, err = cli(capsys, "efficiency", CASES / "gots_diesel_friction.toml", *argv,
+                         "-o", tmp_path)
+    assert code == 2 and out == "" and key in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.iterdir())

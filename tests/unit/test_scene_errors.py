@@ -79,6 +79,13 @@ def gas_table(phi_deg: str, p_bar: str, extra: str = "") -> str:
     return VALID + f'\n[gas]\nmodel = "table"\nphi_deg = {phi_deg}\np_bar = {p_bar}\n{extra}'
 
 
+def pair(between: str = '["shaft", "crank"]', fwd: str = "0.98", bwd: str = "0.97",
+         policy: str = "power-flow", extra: str = "") -> str:
+    """VALID with one friction pair (crank-slider links: shaft – crank – rod)."""
+    return VALID + (f'\n[friction]\npolicy = "{policy}"\n\n[[friction.pairs]]\nbetween = {between}\n'
+                    f"eta_forward = {fwd}\neta_backward = {bwd}\n{extra}")
+
+
 # (id, scene text, key reported, fragment of the message)
 CASES = [
     ("toml-syntax", replace("bore_mm = 88", "bore_mm = = 88"),
@@ -86,7 +93,7 @@ CASES = [
     ("toml-unclosed-table", replace("[inertia]", "[inertia"),
      "(syntax)", "not valid TOML"),
     ("unknown-top-level-key", VALID + "\n[engine]\nspeed = 1\n",
-     "engine", "unknown key; allowed here: gas, governor, inertia, initial, load, mechanism"),
+     "engine", "unknown key; allowed here: friction, gas, governor, inertia, initial, load, mechanism"),
     ("unknown-top-level-scalar", "format = 2\n" + VALID,
      "format", "unknown key"),
     ("unknown-mechanism-key", add_after("bore_mm = 88", "stroke_mm = 94"),
@@ -197,6 +204,35 @@ CASES = [
      "output.samples_per_rev", "must be ≥ 4, got 2"),
     ("nan-number", replace("piston_mass = 1.520", "piston_mass = nan"),
      "mechanism.piston_mass", "must be finite"),
+    # Non-ideal pairs (issue 4): non-physical efficiencies and pairs that are not in the chain.
+    ("eta-zero", pair(fwd="0"), "friction.pairs[0].eta_forward", "must be > 0, got 0"),
+    ("eta-negative", pair(bwd="-0.5"), "friction.pairs[0].eta_backward", "must be > 0, got -0.5"),
+    ("eta-above-1", pair(fwd="1.02"), "friction.pairs[0].eta_forward", "must be ≤ 1, got 1.02"),
+    ("eta-missing", pair().replace("eta_backward = 0.97\n", ""),
+     "friction.pairs[0].eta_backward", "is missing"),
+    ("pair-not-adjacent", pair(between='["shaft", "rod"]'), "friction.pairs[0].between",
+     "'shaft' and 'rod' are not neighbours; a pair joins two adjacent links of the chain "
+     "shaft – crank – rod"),
+    ("pair-unknown-link", pair(between='["shaft", "piston"]'), "friction.pairs[0].between",
+     "unknown link 'piston'; the links are shaft – crank – rod"),
+    ("pair-reversed", pair(between='["crank", "shaft"]'), "friction.pairs[0].between",
+     "give the shaft-side link first: ['shaft', 'crank']"),
+    ("pair-same-link", pair(between='["crank", "crank"]'), "friction.pairs[0].between",
+     "are not neighbours"),
+    ("pair-one-link", pair(between='["shaft"]'), "friction.pairs[0].between",
+     "must be two link names"),
+    ("pair-twice", pair(extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\n'
+                              'eta_forward = 0.9\neta_backward = 0.9\n'),
+     "friction.pairs[1].between", "the same pair as friction.pairs[0]"),
+    ("pair-unknown-key", pair(extra="efficiency = 0.9\n"), "friction.pairs[0].efficiency",
+     "unknown key; allowed here: between, eta_backward, eta_forward, name"),
+    ("pairs-not-array", VALID + '\n[friction]\npairs = 3\n', "friction.pairs",
+     "must be an array of tables"),
+    ("unknown-policy", pair(policy="coulomb"), "friction.policy",
+     "unknown value 'coulomb'; allowed: 'power-flow', 'paper'"),
+    ("paper-policy-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"') + '\n[friction]\npolicy = "paper"\n\n[[friction.pairs]]\n'
+                            'between = ["shaft", "crank"]\neta_forward = 0.9\neta_backward = 0.9\n',
+     "solver.method", "the reference path (scipy-*) follows the power-flow policy only"),
 ]
 
 

@@ -18,7 +18,7 @@ from scipy.integrate import quad
 
 from transient.analysis.irregularity import fluctuation
 from transient.assemble import build_model
-from transient.core.model import inertia
+from transient.core.model import inertia, work_array
 from transient.scene import load_scene
 from transient.simulate import integrate
 
@@ -42,9 +42,9 @@ def test_coasting_conserves_kinetic_energy_and_phase():
     assert np.ptp(tr["J"]) / tr["J"].mean() > 0.05  # J(φ) really varies
     assert np.max(np.abs(energy / energy[0] - 1.0)) <= 1e-8
     model, _, _ = build_model(scene)
-    u, du = np.empty(4), np.empty(4)
+    wk = work_array(model)
     K = energy[0]
-    turn = quad(lambda p: np.sqrt(inertia(model, p, u, du)[0] / (2 * K)), 0, 2 * np.pi,
+    turn = quad(lambda p: np.sqrt(inertia(model, p, wk)[0] / (2 * K)), 0, 2 * np.pi,
                 epsabs=1e-16, epsrel=1e-13, limit=400)[0]
     assert abs(tr["t"][-1] / (1000 * turn) - 1) <= 1e-9
 

@@ -75,8 +75,12 @@ def last_cycle_ranges(traj, cycle) -> dict[str, tuple[float, str]]:
             "gas_1_swing_last_cycle": (swing(gas1), "Pa or N")}
 
 
-def summarize(scene, traj: dict[str, NDArray[np.float64]]) -> dict[str, tuple[float, str]]:
-    """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``."""
+def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
+              ) -> dict[str, tuple[float, str]]:
+    """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``: speed, its
+    fluctuation, steady state, and the mechanical efficiency over the steady cycles."""
+    from .efficiency import mechanical_efficiency
+
     t, phi, omega = traj["t"], traj["phi"], traj["omega"]
     cycle = scene.mechanism.cycle
     phi0 = scene.initial.phi
@@ -95,4 +99,6 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]]) -> dict[str, tuple[fl
         last = (t >= ends[-1] - cycle / means[-1]) & (t <= ends[-1])
         out["mean_drive_torque_last_cycle"] = (float(np.trapezoid(traj["M_drive"][last],
                                                                   phi[last]) / cycle), "N m")
+    if scene.gas.model != "none":
+        out.update(mechanical_efficiency(scene, traj, events))
     return out

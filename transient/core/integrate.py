@@ -17,8 +17,10 @@ import numpy as np
 from numba import njit
 
 from . import dop853_coefficients as dc
-from .model import (KINETIC, N_STATE, N_SWITCHES, OMEGA, PHI, SW_GOVERNOR, SW_STARTER, T, derivative,
-                    governor_branch, inertia, output_row, speed)
+from .chain import MAX_PAIRS
+from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
+                    SW_STARTER, T, WK_G, choose_modes, derivative, governor_branch, inertia, margins_at,
+                    n_state, output_row, speed, work_array)
 
 # The right-hand side is autonomous (t and φ are both state components), so the nodes C are not
 # needed.
@@ -39,24 +41,31 @@ C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range
 C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS = range(8, 11)
 N_CFG = 11
 # fst[...] — float stepper state kept between chunks
-F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL = range(7)
-N_FST = 7
+F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH = range(8)
+N_FST = 8
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
 BP_LANDING = 1e-7
 # ist[...] — integer stepper state kept between chunks
-# ist[:N_SWITCHES] are the model's switches (starter, governor branch), passed on as ``sw``.
-I_STARTER_ON, I_GOV_BRANCH = SW_STARTER, SW_GOVERNOR
+# ist[:N_SWITCHES] are the model's switches (starter, governor branch, pair modes, direction),
+# passed on as ``sw``.
+I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
- I_NREDO) = range(N_SWITCHES, N_SWITCHES + 9)
-N_IST = N_SWITCHES + 9
+ I_NREDO, I_NCHATTER, I_NSWITCH) = range(N_SWITCHES, N_SWITCHES + 11)
+N_IST = N_SWITCHES + 11
+# Pair-mode switches closer together than this (rad in crank angle; × the output spacing in time)
+# count as no progress; this many in a row is chattering, which is reported, never looped on.
+CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
 
 # advance() return codes
-RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED = 0, 1, 2, 3, 4
+RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING = range(7)
 # event codes written to the event buffer as (code, t, phi, omega)
-EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR = range(7)
+(EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
+ EV_PAIR_MODE, EV_LOCKED) = range(9)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
-               "speed_reversal", "end", "governor_corner")
+               "speed_reversal", "end", "governor_corner", "pair_mode", "locked")
+# Event "components" at and above PAIR_COMP are the mode margins of the pairs (model.mode_margins).
+PAIR_COMP = 100
 
 
 @njit(cache=True)
@@ -71,8 +80,8 @@ def _error_norm(K, h, y, y_new, rtol, atol, ix):
     err5 = 0.0
     err3 = 0.0
     for i in range(n):
-        if i == ix:
-            continue
+        if i == ix or i >= N_DYNAMIC:
+            continue  # (work integrals do not feed back: they follow the dynamics' steps)
         if i == PHI or i == T:
             sc = atol + rtol * abs(y_new[i] - y[i])
         else:
@@ -86,11 +95,11 @@ def _error_norm(K, h, y, y_new, rtol, atol, ix):
         err3 += (e3 / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
-    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (n - 1))
+    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1))
 
 
 @njit(cache=True)
-def _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, u, du):
+def _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """One DOP853 step of size h from (x, y) with f = y′; K[0] must hold f.
 
     Leaves the stages in K (K[12] = f(y_new)) and the new state in y_new.
@@ -102,7 +111,7 @@ def _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, u, du):
             for j in range(s):
                 acc += _A[s, j] * K[j, i]
             tmp[i] = y[i] + h * acc
-        derivative(m, angle_mode, tmp, sel, sw, u, du, K[s])
+        derivative(m, angle_mode, tmp, sel, sw, wk, K[s])
     for i in range(n):
         acc = 0.0
         for j in range(N_STAGES):
@@ -110,11 +119,11 @@ def _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, u, du):
         y_new[i] = y[i] + h * acc
     # The independent variable advances exactly (exact stops on breakpoints).
     y_new[PHI if angle_mode else T] = x + h
-    derivative(m, angle_mode, y_new, sel, sw, u, du, K[N_STAGES])
+    derivative(m, angle_mode, y_new, sel, sw, wk, K[N_STAGES])
 
 
 @njit(cache=True)
-def _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du):
+def _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
     """Dense-output coefficients F (7 × n) of the last step (three extra stages)."""
     n = y.shape[0]
     for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
@@ -124,7 +133,7 @@ def _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du):
             for j in range(s):
                 acc += a[j] * K[j, i]
             tmp[i] = y[i] + h * acc
-        derivative(m, angle_mode, tmp, sel, sw, u, du, K[s])
+        derivative(m, angle_mode, tmp, sel, sw, wk, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]
         F[0, i] = dy
@@ -153,34 +162,44 @@ def _dense_eval(F, y, theta, out):
 
 
 @njit(cache=True)
-def _event_g(m, angle_mode, yv, comp, level, u, du):
-    """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), else y[comp] − level."""
+def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
+    """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
+    pair comp − PAIR_COMP, else y[comp] − level."""
+    if comp >= PAIR_COMP:
+        margins_at(m, angle_mode, yv, sel, sw, wk)
+        return wk[WK_G, comp - PAIR_COMP]
     if comp == OMEGA:
-        J, _ = inertia(m, yv[PHI], u, du)
+        J, _ = inertia(m, yv[PHI], wk)
         return speed(J, angle_mode, yv) - level
     return yv[comp] - level
 
 
 @njit(cache=True)
-def _crossing(m, angle_mode, F, y, y_new, comp, level, tmp, u, du):
-    """θ ∈ (0, 1] where the event function crosses zero on the dense output (Illinois method).
+def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
+    """θ ∈ (0, 1] where the event function crosses zero on the dense output.
 
     The caller has checked that it changes sign between y and y_new. The bracket's right end is
     y_new itself, not the dense output at θ = 1, which can differ from it by rounding and then
     would not bracket a root that sits at the very end of the step.
     """
-    a, b = 0.0, 1.0
-    ga = _event_g(m, angle_mode, y, comp, level, u, du)
-    gb = _event_g(m, angle_mode, y_new, comp, level, u, du)
+    ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
+    gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
+    return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)
+
+
+@njit(cache=True)
+def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
+    """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
+    (Illinois method); b if the bracket holds no sign change."""
     if gb == 0.0 or (ga > 0.0) == (gb > 0.0):
-        return 1.0
+        return b
     side = 0
     for _ in range(100):
         c = b - gb * (b - a) / (gb - ga)
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense_eval(F, y, c, tmp)
-        gc = _event_g(m, angle_mode, tmp, comp, level, u, du)
+        gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
         if gc == 0.0 or b - a < 1e-15:
             return c
         if (gc > 0.0) == (gb > 0.0):
@@ -194,6 +213,38 @@ def _crossing(m, angle_mode, F, y, y_new, comp, level, tmp, u, du):
                 gb *= 0.5
             side = 1
     return b
+
+
+#: A pair's mode margin can fall through zero and come back within one step, unseen at the
+#: step's ends; it is also sampled at these interior fractions of every step.
+N_MARGIN_SAMPLES = 4
+
+
+@njit(cache=True)
+def _sample_margins(m, angle_mode, F, y, y_new, x, h, sel, sw, tmp, wk, gs):
+    """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N (row j of ``gs``; row 0
+    holds the step's start already; the end is y_new itself)."""
+    ix = PHI if angle_mode else T
+    for j in range(1, N_MARGIN_SAMPLES + 1):
+        if j == N_MARGIN_SAMPLES:
+            margins_at(m, angle_mode, y_new, sel, sw, wk)
+        else:
+            theta = j / N_MARGIN_SAMPLES
+            _dense_eval(F, y, theta, tmp)
+            tmp[ix] = x + theta * h
+            margins_at(m, angle_mode, tmp, sel, sw, wk)
+        for k in range(m.n_pairs):
+            gs[j, k] = wk[WK_G, k]
+
+
+@njit(cache=True)
+def _pair_crossing(m, angle_mode, F, y, k, sel, sw, tmp, wk, gs):
+    """θ where pair k's margin first falls to zero within the step, or 2 if it does not."""
+    for j in range(N_MARGIN_SAMPLES):
+        if _crosses(gs[j, k], gs[j + 1, k], -1):
+            return _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
+                         j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
+    return 2.0
 
 
 @njit(cache=True)
@@ -218,7 +269,7 @@ def next_breakpoint(bp, period, phi, upward):
     return -np.inf
 
 
-N_EVENT_KINDS = 7
+N_EVENT_KINDS = 7 + MAX_PAIRS
 
 
 @njit(cache=True)
@@ -238,8 +289,10 @@ def _event_spec(m, cfg, e, angle_mode, sw):
         if angle_mode:
             return EV_END, T, cfg[C_T_END], 1
         return EV_END, PHI, cfg[C_PHI_END], 1
-    if e >= 5 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
+    if 5 <= e < 7 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
         return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
+    if e >= 7 and e - 7 < m.n_pairs:  # the mode margin of pair e − 7 falls to zero
+        return EV_PAIR_MODE, PAIR_COMP + e - 7, 0.0, -1
     return -1, OMEGA, 0.0, 0
 
 
@@ -256,10 +309,10 @@ def _crosses(g0, g1, direction):
 
 
 @njit(cache=True)
-def _emit_event(m, evbuf, ist, code, y, u, du):
+def _emit_event(m, evbuf, ist, code, y, wk):
     j = ist[I_NEV]
     if j < evbuf.shape[0]:
-        J, _ = inertia(m, y[PHI], u, du)
+        J, _ = inertia(m, y[PHI], wk)
         evbuf[j, 0] = code
         evbuf[j, 1] = y[T]
         evbuf[j, 2] = y[PHI]
@@ -268,8 +321,8 @@ def _emit_event(m, evbuf, ist, code, y, u, du):
 
 
 @njit(cache=True)
-def _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du):
-    output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, u, du, outbuf[ist[I_NOUT]])
+def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
+    output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
     ist[I_NOUT] += 1
     fst[F_LAST_T] = y[T]
     fst[F_LAST_PHI] = y[PHI]
@@ -301,12 +354,12 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         Settings, indices ``C_*``.
     bp : float64[:]
         Sorted breakpoints in [0, m.period).
-    y : float64[N_STATE]
+    y : float64[model.n_state(m)]
         State, updated in place.
     fst, ist : float64[N_FST], int64[N_IST]
         Stepper state kept between calls (zeros before the first call, except
         ``fst[F_PASSED_BP] = nan`` and ``ist[I_STARTER_ON]``).
-    outbuf : float64[nbuf, N_OUT_FIXED + ncyl]
+    outbuf : float64[nbuf, model.n_outputs(m)]
         Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
     evbuf : float64[nev, 4]
         Events (code, t, φ, ω); ``ist[I_NEV]`` rows filled.
@@ -314,18 +367,19 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
     Returns
     -------
     int
-        RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, or STALLED (the speed reached zero in a run
-        that ends only by revolutions).
+        RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED (the speed reached zero in a run
+        that ends only by revolutions), LOCKED (at rest, the friction of the non-ideal pairs holds
+        the applied moments) or CHATTERING (pair modes switching without progress).
     """
-    n = N_STATE
+    n = n_state(m)
     K = np.empty((N_STAGES_EXTENDED, n))
     F = np.empty((7, n))
     f = np.empty(n)
     y_new = np.empty(n)
     y_evt = np.empty(n)
     tmp = np.empty(n)
-    u = np.empty(max(m.ncyl, 1))
-    du = np.empty(max(m.ncyl, 1))
+    wk = work_array(m)
+    gs = np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1)))  # pair mode margins over a step
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
@@ -334,11 +388,14 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
     if ist[I_STARTED] == 0:
         ist[I_STARTED] = 1
         ist[I_GOV_BRANCH] = governor_branch(m, y[OMEGA], True)
+        fst[F_LAST_SWITCH] = np.nan
+        if not choose_modes(m, False, y, y[PHI], ist[:N_SWITCHES], wk):
+            return _locked(m, y, y[PHI], outbuf, evbuf, ist, fst, wk)
         if y[OMEGA] >= cfg[C_W_HI]:
-            _to_angle_mode(m, y, ist, u, du)
+            _to_angle_mode(m, y, ist, wk)
         fst[F_SEL] = y[PHI]
         _reset_output_grid(cfg, ist, fst, y)
-        _emit_row(m, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, u, du)
+        _emit_row(m, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, wk)
 
     ist[I_F_VALID] = 0  # f is local to this call: recompute it once per chunk
     steps_here = 0
@@ -352,9 +409,12 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         ix = PHI if angle_mode else T
         x = y[ix]
         if ist[I_F_VALID] == 0:
-            derivative(m, angle_mode, y, y[PHI], sw, u, du, f)
+            derivative(m, angle_mode, y, y[PHI], sw, wk, f)
             ist[I_NFEV] += 1
             ist[I_F_VALID] = 1
+            if m.n_pairs > 0:
+                margins_at(m, angle_mode, y, y[PHI], sw, wk)
+                gs[0, :] = wk[WK_G, : gs.shape[1]]
             if fst[F_H] <= 0.0:
                 # Initial step: a fixed fraction of a revolution (angle) or of the output spacing.
                 fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
@@ -374,7 +434,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         # no later step of a few ulp is needed (next_breakpoint treats such a point as reached).
         tol_end = 1e-13 * max(1.0, abs(x))
         if x_end - x <= tol_end:
-            return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, u, du)
+            return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
         h = min(fst[F_H], h_max)
         at_segment_end = False
         if x + h >= x_end - tol_end:
@@ -389,7 +449,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             sel = y[PHI] + 0.5 * h * y[OMEGA]
         for i in range(n):
             K[0, i] = f[i]
-        _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, u, du)
+        _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
         ist[I_NFEV] += N_STAGES
         err = _error_norm(K, h, y, y_new, rtol, atol, ix)
         finite = np.isfinite(err)
@@ -417,10 +477,10 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         dense_ready = False
         # In time, a step must not cross a breakpoint: retake it so that it ends there.
         if not angle_mode and (y_new[PHI] > up or y_new[PHI] < down):
-            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
+            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
             ist[I_NFEV] += 3
             level = up if y_new[PHI] > up else down
-            theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, tmp, u, du)
+            theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, sel, sw, tmp, wk)
             fst[F_REDO_LEVEL] = level
             if theta * h > min_step and ist[I_NREDO] < 4:
                 # (counted as a rejection: the step is computed again, shorter)
@@ -440,31 +500,43 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
         w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
         w1 = 1.0 / K[N_STAGES, T] if angle_mode else y_new[OMEGA]
+        if m.n_pairs > 0:
+            if not dense_ready:
+                _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+                ist[I_NFEV] += 3
+                dense_ready = True
+            _sample_margins(m, angle_mode, F, y, y_new, x, h, sel, sw, tmp, wk, gs)
+            ist[I_NFEV] += N_MARGIN_SAMPLES
         for e in range(N_EVENT_KINDS):
             code, comp, level, direction = _event_spec(m, cfg, e, angle_mode, sw)
             if code < 0:
                 continue
-            g0 = (w0 if comp == OMEGA else y[comp]) - level
-            g1 = (w1 if comp == OMEGA else y_new[comp]) - level
-            if _crosses(g0, g1, direction):
+            if comp >= PAIR_COMP:
+                theta = _pair_crossing(m, angle_mode, F, y, comp - PAIR_COMP, sel, sw, tmp, wk, gs)
+                if theta < ev_theta:
+                    ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
+                continue
+            ga = (w0 if comp == OMEGA else y[comp]) - level
+            gb = (w1 if comp == OMEGA else y_new[comp]) - level
+            if _crosses(ga, gb, direction):
                 if not dense_ready:
-                    _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
+                    _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
                     ist[I_NFEV] += 3
                     dense_ready = True
-                theta = _crossing(m, angle_mode, F, y, y_new, comp, level, tmp, u, du)
+                theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
         # Output samples inside the step (dense output), then the step's end state.
         d_out = _out_spacing(cfg, angle_mode)
         if fst[F_NEXT_OUT] <= x_stop and not dense_ready:
-            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, u, du)
+            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
             ist[I_NFEV] += 3
             dense_ready = True
         while fst[F_NEXT_OUT] <= x_stop:
             _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
             tmp[ix] = fst[F_NEXT_OUT]
-            _emit_row(m, tmp, sel, sw, outbuf, ist, fst, u, du)
+            _emit_row(m, tmp, sel, sw, outbuf, ist, fst, wk)
             fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
         ist[I_NSTEPS] += 1
         steps_here += 1
@@ -474,73 +546,99 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             for i in range(n):
                 y[i] = y_new[i]
                 f[i] = K[N_STAGES, i]
+            gs[0, :] = gs[N_MARGIN_SAMPLES, :]
             if angle_mode and at_segment_end and x_end == up:
-                _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, u, du)
+                _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
             elif redo_hit_breakpoint:
                 fst[F_PASSED_BP] = fst[F_REDO_LEVEL]
-                _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, u, du)
+                _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
             if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
-                return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
+                return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
             if not angle_mode and at_segment_end:
-                return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
+                return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
             continue
         # Truncate the step at the event, act on it and restart from there.
         _dense_eval(F, y, ev_theta, y_evt)
         y_evt[ix] = x_stop
-        if ev_comp != OMEGA:
+        if ev_comp >= PAIR_COMP:
+            pass  # the margin is zero here to the root finder's accuracy; nothing to put on a level
+        elif ev_comp != OMEGA:
             y_evt[ev_comp] = ev_level
         elif angle_mode:  # put the speed exactly on the level: K = ½ J ω²
-            J, _ = inertia(m, y_evt[PHI], u, du)
+            J, _ = inertia(m, y_evt[PHI], wk)
             y_evt[KINETIC] = 0.5 * J * ev_level * ev_level
         else:
             y_evt[OMEGA] = ev_level
         for i in range(n):
             y[i] = y_evt[i]
         ist[I_F_VALID] = 0
-        _emit_event(m, evbuf, ist, ev_code, y, u, du)
+        _emit_event(m, evbuf, ist, ev_code, y, wk)
         if ev_code == EV_END:
-            return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du)
+            return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
         if ev_code == EV_REVERSAL and not np.isfinite(cfg[C_T_END]):
             # A run that ends only by revolutions would never end once the shaft stops: report
             # the stall (with what was computed) instead of integrating on.
-            _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du)
+            _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
             return STALLED
-        if ev_code == EV_STARTER_CUTOUT:
+        if ev_code == EV_REVERSAL and m.n_pairs > 0:
+            # At rest the pairs may hold the applied moments; else the modes start afresh.
+            if not choose_modes(m, False, y, sel, sw, wk):
+                return _locked(m, y, sel, outbuf, evbuf, ist, fst, wk)
+        if ev_code == EV_PAIR_MODE:
+            ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
+            ist[I_NSWITCH] += 1
+            gap = CHATTER_GAP * (1.0 if angle_mode else cfg[C_DT_OUT])
+            ist[I_NCHATTER] = ist[I_NCHATTER] + 1 if abs(x_stop - fst[F_LAST_SWITCH]) < gap else 0
+            fst[F_LAST_SWITCH] = x_stop
+            if ist[I_NCHATTER] >= CHATTER_COUNT:
+                _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+                return CHATTERING
+        elif ev_code == EV_STARTER_CUTOUT:
             ist[I_STARTER_ON] = 0
         elif ev_code == EV_GOVERNOR:
             ist[I_GOV_BRANCH] = governor_branch(m, ev_level, w1 > w0)
         elif ev_code == EV_TO_TIME:
-            _to_time_mode(m, y, ist, u, du)
+            _to_time_mode(m, y, ist, wk)
             fst[F_H] = h_next / ev_level
             _reset_output_grid(cfg, ist, fst, y)
         elif ev_code == EV_TO_ANGLE:
-            _to_angle_mode(m, y, ist, u, du)
+            _to_angle_mode(m, y, ist, wk)
             fst[F_H] = h_next * ev_level
             _reset_output_grid(cfg, ist, fst, y)
 
 
 @njit(cache=True)
-def _to_angle_mode(m, y, ist, u, du):
+def _to_angle_mode(m, y, ist, wk):
     """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
-    J, _ = inertia(m, y[PHI], u, du)
+    J, _ = inertia(m, y[PHI], wk)
     y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
     ist[I_ANGLE_MODE] = 1
 
 
 @njit(cache=True)
-def _to_time_mode(m, y, ist, u, du):
+def _to_time_mode(m, y, ist, wk):
     """Time becomes the independent variable; the third state becomes ω."""
-    J, _ = inertia(m, y[PHI], u, du)
+    J, _ = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
     ist[I_ANGLE_MODE] = 0
 
 
 @njit(cache=True)
-def _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, u, du):
+def _locked(m, y, sel, outbuf, evbuf, ist, fst, wk):
+    """End a run at rest that the pairs' friction holds (``model.choose_modes``): φ̈ = 0 from here,
+    and nothing in the model depends on time explicitly, so the machine stays where it is."""
+    _emit_event(m, evbuf, ist, EV_LOCKED, y, wk)
+    if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI] or ist[I_NOUT] == 0:
+        _emit_row(m, y, sel, ist[:N_SWITCHES], outbuf, ist, fst, wk)
+    return LOCKED
+
+
+@njit(cache=True)
+def _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk):
     """Write the final state as the last sample (unless it already is one, possibly in an
     already drained buffer) and an end event."""
     if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
-        _emit_row(m, y, sel, sw, outbuf, ist, fst, u, du)
+        _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
     if ist[I_NEV] == 0 or evbuf[ist[I_NEV] - 1, 0] != EV_END:
-        _emit_event(m, evbuf, ist, EV_END, y, u, du)
+        _emit_event(m, evbuf, ist, EV_END, y, wk)
     return FINISHED

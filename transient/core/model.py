@@ -19,30 +19,54 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
+from .chain import chain_solve, eta_star, modes_power_flow, LOCKED
 from .crank_slider import crank_slider_terms
 from .swash_plate import swash_terms
 from .tables import find_piece, table_eval
 
-#: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode).
-STATE = ("phi", "t", "omega")
-PHI, T, OMEGA = range(3)
+#: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode). The first
+#: three are the dynamics; the rest are work integrals (quadratures that do not feed back): the work
+#: of the gas forces, of the load and of the starter [J], then the energy lost in each non-ideal
+#: pair k (``W_loss_<k+1>``). Integrated with the motion, the work–energy balance
+#: ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k holds to the solver's accuracy.
+STATE = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
+PHI, T, OMEGA, W_GAS, W_LOAD, W_STARTER = range(6)
 KINETIC = OMEGA
-N_STATE = len(STATE)
+N_DYNAMIC = 3
+N_STATE_BASE = len(STATE)
+W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 
-#: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), and
-#: the governor's branch (see :func:`governor_branch`).
-SW_STARTER, SW_GOVERNOR = range(2)
-N_SWITCHES = 2
+#: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), the
+#: governor's branch (see :func:`governor_branch`), the modes of the non-ideal pairs (bit k set:
+#: pair k backward, its far side drives) and the direction of motion σ = ±1 that the pair modes
+#: refer to (sign of ω; changed only at a speed reversal, where the modes are chosen afresh).
+SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION = range(4)
+N_SWITCHES = 4
 
 #: Mechanism kinds (``Model.kind``).
 CRANK_SLIDER, SWASH_PLATE = 0, 1
 
-#: Columns written for every output sample; then one gas column per cylinder.
-OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter", "fuel")
-OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m", "1")
+#: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
+POWER_FLOW, PAPER = 0, 1
+
+#: Columns written for every output sample; then one gas column per cylinder, then
+#: ``PAIR_OUTPUTS`` for each non-ideal pair.
+OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter", "fuel",
+           "W_gas", "W_load", "W_starter")
+OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m", "1",
+                "J", "J", "J")
 N_OUT_FIXED = len(OUTPUTS)
 COL_EPS, COL_J, COL_DJ = OUTPUTS.index("epsilon"), OUTPUTS.index("J"), OUTPUTS.index("dJ_dphi")
 COL_M_GAS, COL_M_LOAD = OUTPUTS.index("M_gas"), OUTPUTS.index("M_load")
+#: Per pair k: S_k, the moment it takes out of its shaft side (reduced to φ; the far side receives
+#: η*_k S_k), η*_k in use, the power lost (1 − η*_k) S_k ω and the energy lost so far.
+PAIR_OUTPUTS = ("S", "eta", "P_loss", "W_loss")
+PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
+
+#: Rows of the work array ``wk`` (see :func:`work_array`): transfer functions u, u′ per cylinder;
+#: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, and η*, S of a trial mode vector.
+WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_ETA_TRY, WK_S_TRY = range(10)
+N_WK = 10
 
 Model = namedtuple(
     "Model",
@@ -69,8 +93,32 @@ Model = namedtuple(
         "gov_on",  # bool: a static droop governor scales the gas forces
         "gov_full",  # float: ω_a, full fuel at and below it [rad/s]
         "gov_zero",  # float: ω_1c, no fuel at and above it [rad/s]
+        "n_pairs",  # int: number of non-ideal pairs (0: ideal constraints, equation (18))
+        "eta_fwd",  # float64[n_pairs]: efficiency of pair k when its shaft side drives
+        "eta_bwd",  # float64[n_pairs]: efficiency of pair k when its far side drives
+        "policy",  # int: POWER_FLOW or PAPER
+        "link_sub",  # int64[n_links]: sub-chain of each link (shaft first, gas-carrying link last)
+        "link_J",  # float64[n_links]: constant reduced inertia of the middle links [kg m²]
     ],
 )
+
+
+@njit(cache=True)
+def n_state(m):
+    """Length of the state vector of model ``m``."""
+    return N_STATE_BASE + m.n_pairs
+
+
+@njit(cache=True)
+def n_outputs(m):
+    """Columns of an output row of model ``m``."""
+    return N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
+
+
+@njit(cache=True)
+def work_array(m):
+    """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
+    return np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 1)))
 
 
 @njit(cache=True)
@@ -95,9 +143,9 @@ def gas_value(m, k, phi, sel):
 
 
 @njit(cache=True)
-def inertia(m, phi, u, du):
-    """Total reduced inertia J(φ) and dJ/dφ, (19) and (21); fills u, du."""
-    J, dJ = mechanism_terms(m.kind, m.mech, phi, u, du)
+def inertia(m, phi, wk):
+    """Total reduced inertia J(φ) and dJ/dφ, (19) and (21); fills the rows u, u′ of ``wk``."""
+    J, dJ = mechanism_terms(m.kind, m.mech, phi, wk[WK_U], wk[WK_DU])
     return J + m.J0, dJ
 
 
@@ -133,19 +181,19 @@ def fuel(m, w, branch):
 
 
 @njit(cache=True)
-def moments(m, angle_mode, y, sel, sw, u, du):
+def moments(m, angle_mode, y, sel, sw, wk):
     """Reduced inertia, speed and moments at state ``y``.
 
-    Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; u, du are work arrays of length ncyl that
-    are left holding the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k.
+    Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; the rows u, u′ of ``wk`` are left holding
+    the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k.
     """
     phi = y[PHI]
-    J, dJ = inertia(m, phi, u, du)
+    J, dJ = inertia(m, phi, wk)
     w = speed(J, angle_mode, y)
     M_gas = 0.0
     if m.has_gas:
         for k in range(m.ncyl):
-            M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
+            M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * wk[WK_U, k]
         M_gas *= fuel(m, w, sw[SW_GOVERNOR])
     M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
     M_starter = 0.0
@@ -155,62 +203,263 @@ def moments(m, angle_mode, y, sel, sw, u, du):
 
 
 @njit(cache=True)
-def acceleration(J, dJ, M, w):
-    """φ̈ from (18): (M − ½ J′ ω²) / J."""
-    return (M - 0.5 * dJ * w * w) / J
+def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
+    """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
+
+    Links in order: the shaft (J0 with flywheel and load; load and starter act on it), middle links
+    of constant reduced inertia ``link_J`` (the crank), and the last link with the rest of the
+    mechanism's inertia and the gas forces. Links between ideal pairs share a sub-chain.
+    """
+    for k in range(m.n_pairs + 1):
+        wk[WK_J, k] = 0.0
+        wk[WK_DJ, k] = 0.0
+        wk[WK_M, k] = 0.0
+    last = m.link_sub.shape[0] - 1
+    J_rest = J
+    for i in range(last):
+        c = m.J0 if i == 0 else m.link_J[i]
+        wk[WK_J, m.link_sub[i]] += c
+        J_rest -= c
+    wk[WK_M, m.link_sub[0]] += M_shaft
+    wk[WK_J, m.link_sub[last]] += J_rest
+    wk[WK_DJ, m.link_sub[last]] += dJ
+    wk[WK_M, m.link_sub[last]] += M_gas
 
 
 @njit(cache=True)
-def derivative(m, angle_mode, y, sel, sw, u, du, out):
-    """dy/dt = (ω, 1, ε), or in crank angle dy/dφ = (1, 1/ω, M) with y[2] = K."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, u, du)
+def pair_etas(m, modes, eta_out):
+    """η*_k of (25) for the mode bit mask ``modes`` (bit k set: pair k backward)."""
+    for k in range(m.n_pairs):
+        eta_out[k] = eta_star(m.eta_fwd[k], m.eta_bwd[k], ((modes >> k) & 1) == 0)
+
+
+@njit(cache=True)
+def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
+    """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)."""
+    if m.n_pairs == 0:
+        return (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J
+    return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+
+
+@njit(cache=True)
+def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
+    """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
+    and the pairs' η*, S in the rows of ``wk``."""
+    n = m.n_pairs
+    split_subchains(m, J, dJ, M_gas, M_shaft, wk)
+    pair_etas(m, sw[SW_MODES], wk[WK_ETA])
+    return chain_solve(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], wk[WK_ETA, :n], w,
+                       wk[WK_S, :n])
+
+
+@njit(cache=True)
+def derivative(m, angle_mode, y, sel, sw, wk, out):
+    """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
+
+    In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
+    (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
+    """
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    M = M_gas + M_load + M_starter
+    loss = 0.0  # Σ (1 − η*) S, the moment equivalent of the pairs' losses
+    q = 1.0 if angle_mode else w  # work per unit of the independent variable
+    if m.n_pairs == 0:  # equation (18); no chain to solve (a scene without pairs pays nothing)
+        a = (M - 0.5 * dJ * w * w) / J
+    else:
+        a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+        for k in range(m.n_pairs):
+            lk = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
+            out[W_LOSS0 + k] = lk * q
+            loss += lk
+    out[W_GAS] = M_gas * q
+    out[W_LOAD] = M_load * q
+    out[W_STARTER] = M_starter * q
     if angle_mode:
         out[PHI] = 1.0
         out[T] = 1.0 / w
-        out[KINETIC] = M_gas + M_load + M_starter
+        out[KINETIC] = M - loss
     else:
-        eps = acceleration(J, dJ, M_gas + M_load + M_starter, w)
         out[PHI] = w
         out[T] = 1.0
-        out[OMEGA] = eps
+        out[OMEGA] = a
 
 
 @njit(cache=True)
-def output_row(m, angle_mode, y, sel, sw, u, du, row):
-    """Fill one output sample (columns ``OUTPUTS`` then the gas value of each cylinder)."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, u, du)
+def mode_margins(m, sw, wk):
+    """How far each pair's held mode is from switching, into ``wk[WK_G]`` (after
+    :func:`acceleration`); a mode switch is due where a margin falls to zero.
+
+    ``power-flow``: the power the pair transmits must have the mode's sign, S_k σ ≥ 0 forward,
+    S_k σ < 0 backward. ``paper``: criterion (25) on the moments of everything on the shaft side,
+    (Σ_{j≤k} M_j) σ ≥ 0 forward (``transient.core.chain.modes_paper``).
+    """
+    sigma = sw[SW_DIRECTION]
+    upstream = 0.0
+    for k in range(m.n_pairs):
+        upstream += wk[WK_M, k]
+        v = wk[WK_S, k] if m.policy == POWER_FLOW else upstream
+        if (sw[SW_MODES] >> k) & 1:
+            wk[WK_G, k] = -v * sigma
+        else:
+            wk[WK_G, k] = v * sigma
+
+
+@njit(cache=True)
+def margins_at(m, angle_mode, y, sel, sw, wk):
+    """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``."""
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
+    mode_margins(m, sw, wk)
+
+
+@njit(cache=True)
+def choose_modes(m, angle_mode, y, sel, sw, wk):
+    """Choose σ and the pair modes afresh at state ``y`` (start of a run, speed reversal).
+
+    With ω ≠ 0, σ = sign ω; ``power-flow`` takes the unique consistent mode vector
+    (``chain.modes_power_flow``), ``paper`` criterion (25). At rest, the incipient motion decides:
+    σ is the direction the chain starts to move in; if the pairs' friction holds the applied
+    moments in both directions the chain is locked. Sets ``sw[SW_DIRECTION]`` and
+    ``sw[SW_MODES]``; returns False when locked.
+    """
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    n = m.n_pairs
+    if n == 0:
+        sw[SW_DIRECTION] = -1 if w < 0.0 else 1
+        sw[SW_MODES] = 0
+        return True
+    split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
+    a, status, _ = modes_power_flow(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1],
+                                    m.eta_fwd, m.eta_bwd, w, wk[WK_ETA, :n], wk[WK_S, :n])
+    if status == LOCKED:
+        return False
+    if w != 0.0:
+        sw[SW_DIRECTION] = 1 if w > 0.0 else -1
+    else:
+        sw[SW_DIRECTION] = 1 if a > 0.0 else -1
+    modes = 0
+    upstream = 0.0
+    for k in range(n):
+        upstream += wk[WK_M, k]
+        if m.policy == POWER_FLOW:
+            backward = wk[WK_ETA, k] != m.eta_fwd[k]
+        else:
+            backward = upstream * sw[SW_DIRECTION] < 0.0
+        if backward:
+            modes |= 1 << k
+    sw[SW_MODES] = modes
+    return True
+
+
+@njit(cache=True)
+def output_row(m, angle_mode, y, sel, sw, wk, row):
+    """Fill one output sample: columns ``OUTPUTS``, the gas value of each cylinder, then
+    ``PAIR_OUTPUTS`` of each pair."""
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
     row[0] = y[T]
     row[1] = y[PHI]
     row[2] = w
-    row[3] = acceleration(J, dJ, M_gas + M_load + M_starter, w)
+    row[3] = acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     row[4] = J
     row[5] = dJ
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
     row[9] = fuel(m, w, sw[SW_GOVERNOR])
+    row[10] = y[W_GAS]
+    row[11] = y[W_LOAD]
+    row[12] = y[W_STARTER]
     for k in range(m.ncyl):
         row[N_OUT_FIXED + k] = gas_value(m, k, y[PHI], sel) if m.has_gas else 0.0
+    pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
 
 
 @njit(cache=True)
-def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive):
-    """Prescribed motion: the drive torque (18) needs, M_drive = J ε + ½ J′ ω² − M [N m].
+def pair_rows(m, w, w_loss, wk, out):
+    """``PAIR_OUTPUTS`` of each pair from the rows η*, S of ``wk``; ``w_loss``: energy lost so far."""
+    np_ = len(PAIR_OUTPUTS)
+    for k in range(m.n_pairs):
+        out[np_ * k] = wk[WK_S, k]
+        out[np_ * k + 1] = wk[WK_ETA, k]
+        out[np_ * k + 2] = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k] * w
+        out[np_ * k + 3] = w_loss[k]
 
-    Fills ``rows`` (one output row per sample, ``epsilon`` being the prescribed one) and
-    ``M_drive``; the starter is off and ``sel`` is the sample angle itself.
+
+@njit(cache=True)
+def inverse_chain(m, a, w, sigma, wk):
+    """Drive torque on the shaft and pair moments for a prescribed motion (φ̈ = a, φ̇ = w).
+
+    With a known, the sub-chain equations J_k a = R_k + η*_{k−1} S_{k−1} − S_k
+    (``transient.core.chain``) are solved from the far end: η*_{n−1} S_{n−1} = J_n a − R_n, …,
+    and the drive M_drive = J_0 a − R_0 + S_0. Every mode vector is tried (bit k: pair k backward)
+    and the first consistent one kept: for ``power-flow`` S_k σ must have the mode's sign (always
+    exactly one vector, because η* > 0 keeps the sign of η* S_k), for ``paper`` the criterion (25)
+    with the drive counted among the shaft-side moments; if none is consistent, the one violating
+    least. Needs the rows J, J′, M of ``wk``; fills η*, S. Returns ``(M_drive, n_consistent)``.
     """
-    n = max(m.ncyl, 1)
-    u = np.empty(n)
-    du = np.empty(n)
-    y = np.empty(N_STATE)
+    n = m.n_pairs
+    half_w2 = 0.5 * w * w
+    eta, S = wk[WK_ETA_TRY], wk[WK_S_TRY]
+    best = np.nan
+    best_viol = np.inf
+    n_ok = 0
+    for mask in range(1 << n):
+        pair_etas(m, mask, eta)
+        for k in range(n, 0, -1):  # η*_{k−1} S_{k−1}, the moment arriving from the far side
+            carried = wk[WK_J, k] * a - (wk[WK_M, k] - wk[WK_DJ, k] * half_w2)
+            if k < n:
+                carried += S[k]
+            S[k - 1] = carried / eta[k - 1]
+        drive = wk[WK_J, 0] * a - (wk[WK_M, 0] - wk[WK_DJ, 0] * half_w2) + S[0]
+        ok = True
+        viol = 0.0
+        upstream = drive
+        for k in range(n):
+            upstream += wk[WK_M, k]
+            v = (S[k] if m.policy == POWER_FLOW else upstream) * sigma
+            if (mask >> k) & 1:
+                ok = ok and v < 0.0
+                viol += max(0.0, v)
+            else:
+                ok = ok and v >= 0.0
+                viol += max(0.0, -v)
+        if ok:
+            n_ok += 1
+        if (ok and n_ok == 1) or (n_ok == 0 and viol < best_viol):
+            best, best_viol = drive, viol
+            for k in range(n):
+                wk[WK_ETA, k] = eta[k]
+                wk[WK_S, k] = S[k]
+    return best, n_ok
+
+
+@njit(cache=True)
+def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
+    """Prescribed motion: the drive torque on the shaft that the chain needs [N m].
+
+    Without pairs M_drive = J ε + ½ J′ ω² − M, from (18); with pairs see :func:`inverse_chain`.
+    Fills ``rows`` (one output row per sample, ``epsilon`` being the prescribed one; the work
+    columns are left zero, integrated by the caller), ``M_drive`` and ``n_consistent`` (the number
+    of consistent mode vectors per sample, 1 unless a policy is ambiguous there). The starter is
+    off and ``sel`` is the sample angle itself.
+    """
+    wk = work_array(m)
+    y = np.zeros(n_state(m))
     sw = np.zeros(N_SWITCHES, dtype=np.int64)
+    n = m.n_pairs
     for i in range(t.shape[0]):
         y[PHI] = phi[i]
         y[T] = t[i]
         y[OMEGA] = omega[i]
         sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
-        output_row(m, False, y, phi[i], sw, u, du, rows[i])
+        J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, phi[i], sw, wk)
+        output_row(m, False, y, phi[i], sw, wk, rows[i])
         rows[i, COL_EPS] = eps[i]
-        M = rows[i, COL_M_GAS] + rows[i, COL_M_LOAD]
-        M_drive[i] = rows[i, COL_J] * eps[i] + 0.5 * rows[i, COL_DJ] * omega[i] ** 2 - M
+        if n == 0:
+            M_drive[i] = J * eps[i] + 0.5 * dJ * w * w - (M_gas + M_load)
+            n_consistent[i] = 1
+            continue
+        split_subchains(m, J, dJ, M_gas, M_load, wk)
+        sigma = 1.0 if w > 0.0 or (w == 0.0 and eps[i] >= 0.0) else -1.0
+        M_drive[i], n_consistent[i] = inverse_chain(m, eps[i], w, sigma, wk)
+        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, N_OUT_FIXED + m.ncyl:])

@@ -68,10 +68,18 @@ class CrankSlider:
     bank_angles: tuple[float, ...]
 
     kind = core_kind = 0
+    #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
+    #: flywheel and load, the crank, and the rods with pistons and gas forces.
+    links = ("shaft", "crank", "rod")
 
     @property
     def n_cylinders(self) -> int:
         return len(self.firing_angles)
+
+    def link_inertias(self) -> tuple[float, ...]:
+        """Constant reduced inertia of each link besides the shaft's [kg m²]: the crank throws'
+        n·m_crank·r²; the last link (rods, pistons) has the rest of J(φ), which varies."""
+        return (0.0, self.n_cylinders * self.crank_mass * self.crank_radius ** 2, 0.0)
 
     @property
     def piston_area(self) -> float:

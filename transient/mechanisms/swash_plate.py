@@ -130,6 +130,13 @@ class SwashPlate:
     strokes = 2
     #: Cycle length in shaft angle [rad].
     cycle = 2.0 * pi
+    #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with the
+    #: plates, and link 9 with cross 13, rods, pistons and gas forces (beyond plate bearing 11).
+    links = ("shaft", "link")
+
+    def link_inertias(self) -> tuple[float, ...]:
+        """Constant reduced inertia of each link besides the shaft's: none here [kg m²]."""
+        return (0.0, 0.0)
 
     @property
     def n_cylinders(self) -> int:

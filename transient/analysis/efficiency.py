@@ -1,0 +1,144 @@
+"""Mechanical efficiency over whole cycles in steady state (Antonyuk (30)) and where the power goes.
+
+Two forms are reported, and named apart (digest [!] at (30)):
+
+* ``eta_mech_work`` — the ratio of the work integrals over the same whole cycles,
+  η = W_out / W_in, W_in = ∫(M_gas + M_starter) ω dt, W_out = −∫(M_load + M_drive) ω dt. This is
+  the well-posed form: in steady state the kinetic energy returns to its value, so
+  W_in = W_out + Σ W_loss,k and η = 1 − Σ W_loss,k / W_in.
+* ``eta_mech_printed`` — (30) as printed, the time average of the instantaneous ratio
+  P_out/P_in. P_in crosses zero twice per compression stroke, so the ratio is singular there; the
+  samples with |P_in| below ``guard`` × mean |P_in| are left out and the share of the time left out
+  is stored with it (``eta_mech_printed_excluded``). Its value depends on that guard: it is kept
+  for comparison with the paper, not as a result.
+
+Per pair k, over the same cycles: the energy lost, its share of W_in, the net energy transmitted
+∫S_k ω dt and the energy *circulated*, ∫|S_k ω| dt − |∫S_k ω dt|: power that goes through the pair
+and comes back within the cycle (inertia driving part of the cycle), on which the pair loses too.
+This is why η_mech falls with speed. And how often the pair's mode runs against the power it
+transmits (negative loss): the share of the time and the number of such intervals per cycle — zero
+for the ``power-flow`` policy, the measure of disagreement for ``paper``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .irregularity import cycle_boundaries, cycle_means, steady_state_time
+
+#: |P_in| below this fraction of its mean is left out of (30) as printed.
+PRINTED_GUARD = 1e-3
+
+
+def steady_window(scene, traj, rtol: float = 1e-4, cycles: int = 3):
+    """(φ_start, φ_end, n_cycles) of the whole cycles after steady state, or None.
+
+    Steady state: the cycle-mean speed changes by less than ``rtol`` for ``cycles`` cycles in a
+    row (:func:`~transient.analysis.irregularity.steady_state_time`). A prescribed constant speed
+    is steady from the start.
+    """
+    t, phi = traj["t"], traj["phi"]
+    cycle, phi0 = scene.mechanism.cycle, scene.initial.phi
+    tb, marks = cycle_boundaries(t, phi, cycle, phi0)
+    if marks.size < 2:
+        return None
+    if scene.run.mode == "prescribed-speed" and not scene.run.time:
+        return float(marks[0]), float(marks[-1]), int(marks.size - 1)
+    means, ends = cycle_means(t, phi, cycle, phi0)
+    t_steady = steady_state_time(means, ends, rtol, cycles)
+    if math.isnan(t_steady):
+        return None
+    first = int(np.searchsorted(tb, t_steady - 1e-12 * max(1.0, abs(t_steady))))
+    if marks.size - 1 - first < 1:
+        return None
+    return float(marks[first]), float(marks[-1]), int(marks.size - 1 - first)
+
+
+def _at(traj, name: str, phi_marks) -> NDArray[np.float64]:
+    """Column ``name`` at shaft angles ``phi_marks`` (linear in φ; exact on a sample)."""
+    phi = traj["phi"]
+    keep = np.ones(phi.size, bool)
+    back = np.nonzero(np.diff(phi) <= 0)[0]
+    if back.size:  # the forward part after the last reversal
+        keep[: back[-1] + 1] = False
+    return np.interp(phi_marks, phi[keep], traj[name][keep])
+
+
+def _delta(traj, name: str, a: float, b: float) -> float:
+    if name not in traj:
+        return 0.0
+    va, vb = _at(traj, name, [a, b])
+    return float(vb - va)
+
+
+def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=None,
+                          window=None, guard: float = PRINTED_GUARD
+                          ) -> dict[str, tuple[float, str]]:
+    """η_mech in both forms and the per-pair energy budget over ``window`` (φ_a, φ_b, cycles),
+    by default the steady whole cycles (:func:`steady_window`). Empty if there is no window.
+    ``events`` (name → (n, 2) array of t, φ) adds the pair-mode switches per cycle."""
+    window = window or steady_window(scene, traj)
+    if window is None:
+        return {}
+    n_pairs = len(scene.friction.pairs)
+    a, b, n_cyc = window
+    W_in = _delta(traj, "W_gas", a, b) + _delta(traj, "W_starter", a, b)
+    W_out = -(_delta(traj, "W_load", a, b) + _delta(traj, "W_drive", a, b))
+    losses = [_delta(traj, f"W_loss_{k + 1}", a, b) for k in range(n_pairs)]
+    dK = _delta({"phi": traj["phi"], "K": 0.5 * traj["J"] * traj["omega"] ** 2}, "K", a, b)
+    out = {
+        "steady_phi_start": (a, "rad"),
+        "steady_cycles": (float(n_cyc), "1"),
+        "W_in_per_cycle": (W_in / n_cyc, "J"),
+        "W_out_per_cycle": (W_out / n_cyc, "J"),
+        "eta_mech_work": (W_out / W_in if W_in > 0 else math.nan, "1"),
+        "energy_balance_residual": ((dK - (W_in - W_out - sum(losses))) / max(abs(W_in), 1e-300),
+                                    "1"),
+    }
+    if events is not None and n_pairs:
+        switches = np.asarray(events.get("pair_mode", np.zeros((0, 2))))
+        inside = (switches[:, 1] >= a) & (switches[:, 1] < b) if switches.size else []
+        out["pair_mode_switches_per_cycle"] = (float(np.sum(inside)) / n_cyc, "1")
+    sel = (traj["phi"] >= a - 1e-12) & (traj["phi"] <= b + 1e-12)
+    out.update(_printed(traj, sel, guard))
+    t, w = traj["t"][sel], traj["omega"][sel]
+    for k in range(n_pairs):
+        P = traj[f"S_{k + 1}"][sel] * w
+        net = float(np.trapezoid(P, t))
+        gross = float(np.trapezoid(np.abs(P), t))
+        out[f"W_loss_{k + 1}_per_cycle"] = (losses[k] / n_cyc, "J")
+        out[f"loss_share_{k + 1}"] = (losses[k] / W_in if W_in > 0 else math.nan, "1")
+        out[f"W_transmitted_{k + 1}_per_cycle"] = (net / n_cyc, "J")
+        out[f"W_circulated_{k + 1}_per_cycle"] = ((gross - abs(net)) / n_cyc, "J")
+        out[f"backward_share_{k + 1}"] = (_time_share(t, traj[f"eta_{k + 1}"][sel] > 1.0), "1")
+        # A mode against the transmitted power has a negative loss (the paper's criterion can
+        # pick one when inertia drives; the power-flow policy never does).
+        loss = traj[f"P_loss_{k + 1}"][sel]
+        against = loss < -1e-9 * max(float(np.max(np.abs(loss))), 1e-300)
+        out[f"mode_against_power_share_{k + 1}"] = (_time_share(t, against), "1")
+        out[f"mode_against_power_per_cycle_{k + 1}"] = (
+            float(np.count_nonzero(against[1:] & ~against[:-1]) + against[0]) / n_cyc, "1")
+    return out
+
+
+def _time_share(t, flag) -> float:
+    """Share of the time span of ``t`` during which ``flag`` holds (sample weights dt)."""
+    dt = np.gradient(t) if t.size > 1 else np.ones(1)
+    return float(np.sum(dt[flag]) / np.sum(dt))
+
+
+def _printed(traj, sel, guard: float) -> dict[str, tuple[float, str]]:
+    """(30) as printed: the time average of P_out/P_in, leaving out |P_in| < guard·mean|P_in|."""
+    w = traj["omega"][sel]
+    drive = traj["M_drive"][sel] if "M_drive" in traj else 0.0
+    P_in = (traj["M_gas"][sel] + traj["M_starter"][sel]) * w
+    P_out = -(traj["M_load"][sel] + drive) * w
+    keep = np.abs(P_in) >= guard * np.mean(np.abs(P_in))
+    dt = np.gradient(traj["t"][sel]) if w.size > 1 else np.ones(1)
+    if not keep.any():
+        return {}
+    ratio = P_out[keep] / P_in[keep]
+    return {"eta_mech_printed": (float(np.sum(ratio * dt[keep]) / np.sum(dt[keep])), "1"),
+            "eta_mech_printed_excluded": (float(np.sum(dt[~keep]) / np.sum(dt)), "1")}
