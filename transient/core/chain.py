@@ -98,7 +98,7 @@ MAX_PAIRS = 6
 UNIQUE, AMBIGUOUS, NONE_CONSISTENT, LOCKED = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def eta_star(eta_fwd, eta_bwd, forward):
     """η* of (25): η_fwd when the shaft side drives (``forward``), else 1/η_bwd."""
     if forward:
@@ -106,7 +106,7 @@ def eta_star(eta_fwd, eta_bwd, forward):
     return 1.0 / eta_bwd
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def chain_solve(J, dJ, M, eta_s, w, S_out):
     """φ̈ of the serial chain for given modes; fills the pair moments S_k.
 

@@ -19,7 +19,7 @@ from numba import njit
 from . import dop853_coefficients as dc
 from .chain import MAX_PAIRS
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
-                    SW_STARTER, T, WK_G, choose_modes, derivative, governor_branch, inertia, margins_at,
+                    SW_STARTER, T, WK_G, WK_G_MIN, choose_modes, derivative, governor_branch, inertia, margins_at,
                     n_state, output_row, speed, work_array)
 
 # The right-hand side is autonomous (t and φ are both state components), so the nodes C are not
@@ -216,23 +216,22 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
 
 
 #: A pair's mode margin can fall through zero and come back within one step, unseen at the
-#: step's ends; it is also sampled at these interior fractions of every step.
+#: step's ends. Every stage of the step evaluates it (``model.derivative`` keeps the least value);
+#: when that dips to zero or below, the margin is sampled at these fractions of the step to find
+#: the first crossing.
 N_MARGIN_SAMPLES = 4
 
 
 @njit(cache=True)
-def _sample_margins(m, angle_mode, F, y, y_new, x, h, sel, sw, tmp, wk, gs):
-    """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N (row j of ``gs``; row 0
-    holds the step's start already; the end is y_new itself)."""
+def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
+    """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
+    holds the step's start and row N its end already)."""
     ix = PHI if angle_mode else T
-    for j in range(1, N_MARGIN_SAMPLES + 1):
-        if j == N_MARGIN_SAMPLES:
-            margins_at(m, angle_mode, y_new, sel, sw, wk)
-        else:
-            theta = j / N_MARGIN_SAMPLES
-            _dense_eval(F, y, theta, tmp)
-            tmp[ix] = x + theta * h
-            margins_at(m, angle_mode, tmp, sel, sw, wk)
+    for j in range(1, N_MARGIN_SAMPLES):
+        theta = j / N_MARGIN_SAMPLES
+        _dense_eval(F, y, theta, tmp)
+        tmp[ix] = x + theta * h
+        margins_at(m, angle_mode, tmp, sel, sw, wk)
         for k in range(m.n_pairs):
             gs[j, k] = wk[WK_G, k]
 
@@ -449,7 +448,13 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             sel = y[PHI] + 0.5 * h * y[OMEGA]
         for i in range(n):
             K[0, i] = f[i]
+        wk[WK_G_MIN, :] = np.inf
         _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        # (the step's last right-hand side is at y_new: WK_G holds the margins there)
+        dip = False
+        for k in range(m.n_pairs):
+            gs[N_MARGIN_SAMPLES, k] = wk[WK_G, k]
+            dip = dip or (gs[0, k] > 0.0 and wk[WK_G_MIN, k] <= 0.0)
         ist[I_NFEV] += N_STAGES
         err = _error_norm(K, h, y, y_new, rtol, atol, ix)
         finite = np.isfinite(err)
@@ -500,18 +505,20 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
         w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
         w1 = 1.0 / K[N_STAGES, T] if angle_mode else y_new[OMEGA]
-        if m.n_pairs > 0:
+        if dip:
             if not dense_ready:
                 _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
                 ist[I_NFEV] += 3
                 dense_ready = True
-            _sample_margins(m, angle_mode, F, y, y_new, x, h, sel, sw, tmp, wk, gs)
-            ist[I_NFEV] += N_MARGIN_SAMPLES
+            _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs)
+            ist[I_NFEV] += N_MARGIN_SAMPLES - 1
         for e in range(N_EVENT_KINDS):
             code, comp, level, direction = _event_spec(m, cfg, e, angle_mode, sw)
             if code < 0:
                 continue
             if comp >= PAIR_COMP:
+                if not dip:
+                    continue
                 theta = _pair_crossing(m, angle_mode, F, y, comp - PAIR_COMP, sel, sw, tmp, wk, gs)
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level

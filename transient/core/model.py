@@ -64,9 +64,11 @@ PAIR_OUTPUTS = ("S", "eta", "P_loss", "W_loss")
 PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 
 #: Rows of the work array ``wk`` (see :func:`work_array`): transfer functions u, u′ per cylinder;
-#: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, and η*, S of a trial mode vector.
-WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_ETA_TRY, WK_S_TRY = range(10)
-N_WK = 10
+#: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, their least value
+#: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
+#: vector.
+WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY = range(11)
+N_WK = 11
 
 Model = namedtuple(
     "Model",
@@ -188,12 +190,14 @@ def moments(m, angle_mode, y, sel, sw, wk):
     the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k.
     """
     phi = y[PHI]
-    J, dJ = inertia(m, phi, wk)
+    u = wk[WK_U]
+    J, dJ = mechanism_terms(m.kind, m.mech, phi, u, wk[WK_DU])
+    J += m.J0
     w = speed(J, angle_mode, y)
     M_gas = 0.0
     if m.has_gas:
         for k in range(m.ncyl):
-            M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * wk[WK_U, k]
+            M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
         M_gas *= fuel(m, w, sw[SW_GOVERNOR])
     M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
     M_starter = 0.0
@@ -202,7 +206,7 @@ def moments(m, angle_mode, y, sel, sw, wk):
     return J, dJ, w, M_gas, M_load, M_starter
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
     """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
 
@@ -226,7 +230,7 @@ def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
     wk[WK_M, m.link_sub[last]] += M_gas
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pair_etas(m, modes, eta_out):
     """η*_k of (25) for the mode bit mask ``modes`` (bit k set: pair k backward)."""
     for k in range(m.n_pairs):
@@ -241,7 +245,7 @@ def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
     and the pairs' η*, S in the rows of ``wk``."""
@@ -267,10 +271,12 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
         a = (M - 0.5 * dJ * w * w) / J
     else:
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+        mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
         for k in range(m.n_pairs):
             lk = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
             out[W_LOSS0 + k] = lk * q
             loss += lk
+            wk[WK_G_MIN, k] = min(wk[WK_G_MIN, k], wk[WK_G, k])
     out[W_GAS] = M_gas * q
     out[W_LOAD] = M_load * q
     out[W_STARTER] = M_starter * q
@@ -284,7 +290,7 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
         out[OMEGA] = a
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mode_margins(m, sw, wk):
     """How far each pair's held mode is from switching, into ``wk[WK_G]`` (after
     :func:`acceleration`); a mode switch is due where a margin falls to zero.
