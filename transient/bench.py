@@ -19,7 +19,8 @@ from pathlib import Path
 from .scene import load_scene
 from .simulate import integrate
 
-DEFAULT_SCENES = ("cases/gots_diesel_spinup.toml", "cases/swash_plate_4cyl.toml")
+DEFAULT_SCENES = ("cases/gots_diesel_spinup.toml", "cases/gots_diesel_friction.toml",
+                  "cases/swash_plate_4cyl.toml")
 
 
 def _with(scene, method, rtol, revolutions):

@@ -145,9 +145,12 @@ def cmd_check(args) -> int:
     from .scene import load_scene
 
     scene = load_scene(args.scene)
+    pairs = scene.friction.pairs
+    friction = (f", {len(pairs)} non-ideal pair(s) ({', '.join(p.name for p in pairs)}; "
+                f"policy {scene.friction.policy})" if pairs else "")
     print(f"{args.scene}: ok ({scene.name}: {type(scene.mechanism).__name__}, "
           f"{scene.mechanism.n_cylinders} cylinder(s), gas {scene.gas.model}, "
-          f"run {scene.run.mode})")
+          f"run {scene.run.mode}{friction})")
     return EXIT_OK
 
 

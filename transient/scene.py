@@ -469,14 +469,22 @@ def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
         if ia in seen:
             raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
         seen[ia] = i
-        pair = Pair(between=(between[0], between[1]),
-                    eta_forward=ps.number("eta_forward", gt=0.0, le=1.0),
-                    eta_backward=ps.number("eta_backward", gt=0.0, le=1.0),
+        pair = Pair(between=(between[0], between[1]), eta_forward=_efficiency(ps, "eta_forward"),
+                    eta_backward=_efficiency(ps, "eta_backward"),
                     name=ps.string("name", f"{between[0]}-{between[1]}"))
         ps.finish()
         pairs.append(pair)
     pairs.sort(key=lambda p: links.index(p.between[0]))
     return Friction(policy, tuple(pairs))
+
+
+def _efficiency(s: Section, name: str) -> float:
+    """An efficiency in (0, 1]; η ≤ 0 would be a self-locking pair, which the model excludes."""
+    eta = s.number(name, le=1.0)
+    if eta <= 0.0:
+        raise SceneError(s.key(name), f"must be > 0, got {eta:g}; an efficiency ≤ 0 is a "
+                                      f"self-locking pair (the paper's ξ regime), not modelled")
+    return eta
 
 
 def _read_governor(s: Section) -> Governor:

@@ -171,7 +171,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     solver = {"method": "dop853", "rtol": scene.solver.rtol, "atol": scene.solver.atol,
               "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
               "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
-              "mode_switches": int(ist[ci.I_NSWITCH])}
+              "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES])}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
                    solver, complete=status == ci.FINISHED, message=message)

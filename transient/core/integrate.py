@@ -17,7 +17,8 @@ import numpy as np
 from numba import njit
 
 from . import dop853_coefficients as dc
-from .chain import MAX_PAIRS
+from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
+from .chain import LOCKED as LOCKED_STATUS
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
                     SW_STARTER, T, WK_G, WK_G_MIN, choose_modes, derivative, governor_branch, inertia, margins_at,
                     n_state, output_row, speed, work_array)
@@ -51,8 +52,8 @@ BP_LANDING = 1e-7
 # passed on as ``sw``.
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
- I_NREDO, I_NCHATTER, I_NSWITCH) = range(N_SWITCHES, N_SWITCHES + 11)
-N_IST = N_SWITCHES + 11
+ I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES) = range(N_SWITCHES, N_SWITCHES + 12)
+N_IST = N_SWITCHES + 12
 # Pair-mode switches closer together than this (rad in crank angle; × the output spacing in time)
 # count as no progress; this many in a row is chattering, which is reported, never looped on.
 CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
@@ -184,24 +185,24 @@ def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
     """
     ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
     gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
-    return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)
+    return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)[0]
 
 
 @njit(cache=True)
 def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
     """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
-    (Illinois method); b if the bracket holds no sign change."""
+    (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations)."""
     if gb == 0.0 or (ga > 0.0) == (gb > 0.0):
-        return b
+        return b, 0
     side = 0
-    for _ in range(100):
+    for i in range(100):
         c = b - gb * (b - a) / (gb - ga)
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense_eval(F, y, c, tmp)
         gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
-        if gc == 0.0 or b - a < 1e-15:
-            return c
+        if gc == 0.0 or b - a < 1e-12:
+            return c, i + 1
         if (gc > 0.0) == (gb > 0.0):
             b, gb = c, gc
             if side == -1:
@@ -212,7 +213,7 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
             if side == 1:
                 gb *= 0.5
             side = 1
-    return b
+    return b, 100
 
 
 #: A pair's mode margin can fall through zero and come back within one step, unseen at the
@@ -238,12 +239,13 @@ def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
 
 @njit(cache=True)
 def _pair_crossing(m, angle_mode, F, y, k, sel, sw, tmp, wk, gs):
-    """θ where pair k's margin first falls to zero within the step, or 2 if it does not."""
+    """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
+    margin evaluations (right-hand sides) the root finding took."""
     for j in range(N_MARGIN_SAMPLES):
         if _crosses(gs[j, k], gs[j + 1, k], -1):
             return _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
                          j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
-    return 2.0
+    return 2.0, 0
 
 
 @njit(cache=True)
@@ -388,7 +390,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         ist[I_STARTED] = 1
         ist[I_GOV_BRANCH] = governor_branch(m, y[OMEGA], True)
         fst[F_LAST_SWITCH] = np.nan
-        if not choose_modes(m, False, y, y[PHI], ist[:N_SWITCHES], wk):
+        if _start_modes(m, y, y[PHI], ist, wk) == LOCKED_STATUS:
             return _locked(m, y, y[PHI], outbuf, evbuf, ist, fst, wk)
         if y[OMEGA] >= cfg[C_W_HI]:
             _to_angle_mode(m, y, ist, wk)
@@ -519,7 +521,9 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             if comp >= PAIR_COMP:
                 if not dip:
                     continue
-                theta = _pair_crossing(m, angle_mode, F, y, comp - PAIR_COMP, sel, sw, tmp, wk, gs)
+                theta, evals = _pair_crossing(m, angle_mode, F, y, comp - PAIR_COMP, sel, sw, tmp,
+                                              wk, gs)
+                ist[I_NFEV] += evals
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
                 continue
@@ -589,7 +593,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             return STALLED
         if ev_code == EV_REVERSAL and m.n_pairs > 0:
             # At rest the pairs may hold the applied moments; else the modes start afresh.
-            if not choose_modes(m, False, y, sel, sw, wk):
+            if _start_modes(m, y, sel, ist, wk) == LOCKED_STATUS:
                 return _locked(m, y, sel, outbuf, evbuf, ist, fst, wk)
         if ev_code == EV_PAIR_MODE:
             ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
@@ -628,6 +632,16 @@ def _to_time_mode(m, y, ist, wk):
     J, _ = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
     ist[I_ANGLE_MODE] = 0
+
+
+@njit(cache=True)
+def _start_modes(m, y, sel, ist, wk):
+    """Choose σ and the pair modes afresh (start, speed reversal; time domain); a rounding tie
+    that the kernel had to resolve by its rule is counted (``I_NTIES``)."""
+    status = choose_modes(m, False, y, sel, ist[:N_SWITCHES], wk)
+    if status == AMBIGUOUS or status == NONE_CONSISTENT:
+        ist[I_NTIES] += 1
+    return status
 
 
 @njit(cache=True)

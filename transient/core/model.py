@@ -19,7 +19,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from .chain import chain_solve, eta_star, modes_power_flow, LOCKED
+from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow
 from .crank_slider import crank_slider_terms
 from .swash_plate import swash_terms
 from .tables import find_piece, table_eval
@@ -326,19 +326,20 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
     (``chain.modes_power_flow``), ``paper`` criterion (25). At rest, the incipient motion decides:
     σ is the direction the chain starts to move in; if the pairs' friction holds the applied
     moments in both directions the chain is locked. Sets ``sw[SW_DIRECTION]`` and
-    ``sw[SW_MODES]``; returns False when locked.
+    ``sw[SW_MODES]``. Returns the status of ``chain.modes_power_flow``: UNIQUE, LOCKED, or (a
+    rounding tie S_k ≈ 0, resolved by its documented rule) AMBIGUOUS or NONE_CONSISTENT.
     """
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
     n = m.n_pairs
     if n == 0:
         sw[SW_DIRECTION] = -1 if w < 0.0 else 1
         sw[SW_MODES] = 0
-        return True
+        return UNIQUE
     split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
     a, status, _ = modes_power_flow(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1],
                                     m.eta_fwd, m.eta_bwd, w, wk[WK_ETA, :n], wk[WK_S, :n])
     if status == LOCKED:
-        return False
+        return status
     if w != 0.0:
         sw[SW_DIRECTION] = 1 if w > 0.0 else -1
     else:
@@ -354,7 +355,7 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
         if backward:
             modes |= 1 << k
     sw[SW_MODES] = modes
-    return True
+    return status
 
 
 @njit(cache=True)
