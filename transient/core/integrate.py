@@ -20,8 +20,8 @@ from . import dop853_coefficients as dc
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
-                    SW_STARTER, T, WK_G, WK_G_MIN, choose_modes, derivative, governor_branch, inertia, margins_at,
-                    n_state, output_row, speed, work_array)
+                    SW_STARTER, T, WK_G, WK_G_MIN, choose_modes, derivative, governor_branch, inertia,
+                    margins_at, n_state, output_row, speed, work_array)
 
 # The right-hand side is autonomous (t and φ are both state components), so the nodes C are not
 # needed.
