@@ -235,8 +235,24 @@ def _segment(ref, phi, omega):
     return down, up
 
 
-def run_reference(scene, on_block=None, progress=None):
-    """Integrate a dynamic scene with solve_ivp (method from ``scene.solver.method``)."""
+def _with_dense_tail(sol, ts, phi_from):
+    """The step points ``ts`` (states from ``sol``) plus eight dense-output samples inside every
+    step that ends beyond the angle ``phi_from``."""
+    steps = sol.t
+    inside = [np.linspace(a, b, 10)[1:-1] for a, b in zip(steps[:-1], steps[1:])
+              if sol.sol(b)[0] >= phi_from]
+    t_all = np.unique(np.concatenate([ts, *inside])) if inside else ts
+    return t_all, sol.sol(t_all) if inside else sol.y[:, -ts.size:]
+
+
+def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
+                  dense_tail: float = 0.0):
+    """Integrate a dynamic scene with solve_ivp (method from ``scene.solver.method``).
+
+    ``state_only``: keep only t, φ, ω at the steps (what a hand-written solve_ivp script keeps;
+    the benchmark times that). ``dense_tail`` > 0: over that last angle [rad] before the end, add
+    eight samples per step from solve_ivp's dense output (for error measures between steps).
+    """
     from .simulate import RunData, output_columns
 
     ref = ReferenceModel(scene)
@@ -299,14 +315,18 @@ def run_reference(scene, on_block=None, progress=None):
                 return yy[1] - scene.starter.cutout_speed
             cut.terminal, cut.direction = True, 1
             evs.append(("starter_cutout", cut))
+        dense = dense_tail > 0 and not up < phi_end - dense_tail  # may reach the tail
         sol = solve_ivp(ref.rhs, (t, t_end), y, method=method, rtol=sv.rtol, atol=sv.atol,
-                        events=[e for _, e in evs] or None, max_step=max_step)
+                        events=[e for _, e in evs] or None, max_step=max_step,
+                        dense_output=dense)
         if sol.status == -1:
             raise SimulationError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
         nfev += sol.nfev
         nsteps += sol.t.size - 1
-        block = ref.rows(sol.t[1:] if blocks else sol.t, sol.y[:, 1:] if blocks else sol.y)
-        blocks.append(block)
+        ts, ys = (sol.t[1:], sol.y[:, 1:]) if blocks else (sol.t, sol.y)
+        if dense:
+            ts, ys = _with_dense_tail(sol, ts, phi_end - dense_tail)
+        blocks.append(np.column_stack([ts, ys[0], ys[1]]) if state_only else ref.rows(ts, ys))
         t, y = sol.t[-1], sol.y[:, -1].copy()
         if progress:
             progress(min(1.0, max(t / t_end, (y[0] - scene.initial.phi) / (phi_end - scene.initial.phi))))
@@ -338,7 +358,7 @@ def run_reference(scene, on_block=None, progress=None):
             y[0] = level
             events["breakpoint"].append((t, y[0]))
     rows = np.concatenate(blocks)
-    names = list(output_columns(scene))
+    names = ["t", "phi", "omega"] if state_only else list(output_columns(scene))
     traj = {n: rows[:, j] for j, n in enumerate(names)}
     solver = {"method": scene.solver.method, "rtol": sv.rtol, "atol": sv.atol, "nfev": nfev,
               "nsteps": nsteps, "nreject": -1, "wall_s": time.perf_counter() - t0, "compile_s": 0.0}

@@ -159,10 +159,12 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                    f"applied moments in both directions (nothing changes them later, so the "
                    f"machine stays there)")
     if status == ci.CHATTERING:
-        message = (f"chattering: the pair modes switched {ci.CHATTER_COUNT} times without "
-                   f"progress at {at} (last sample {where}): the "
-                   f"{scene.friction.policy!r} criterion has no consistent mode here (a sliding "
-                   f"mode); the power-flow policy has one at every state")
+        event = ci.EVENT_NAMES[int(ist[ci.I_CHATTER_CODE])]
+        message = (f"chattering: {ci.CHATTER_COUNT} state events in a row ({event}) without "
+                   f"progress at {at} (last sample {where})"
+                   + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
+                      f"sliding mode), the power-flow policy has one at every state"
+                      if event == "pair_mode" else ""))
     if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
         cause = ("a non-finite value in the state or its error estimate"
                  if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")

@@ -52,11 +52,15 @@ BP_LANDING = 1e-7
 # passed on as ``sw``.
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
- I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES) = range(N_SWITCHES, N_SWITCHES + 12)
-N_IST = N_SWITCHES + 12
-# Pair-mode switches closer together than this (rad in crank angle; × the output spacing in time)
-# count as no progress; this many in a row is chattering, which is reported, never looped on.
+ I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE) = range(
+    N_SWITCHES, N_SWITCHES + 14)
+N_IST = N_SWITCHES + 14
+# State events closer together than this (rad in crank angle; × the output spacing in time) count
+# as no progress; this many in a row is chattering, which is reported, never looped on.
 CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
+# A step that starts within this (relative) of an event's level starts on it: an event has just
+# put it there, and rounding must not make it cross the level again at once.
+ON_LEVEL = 1e-12
 
 # advance() return codes
 RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING = range(7)
@@ -416,6 +420,9 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             if m.n_pairs > 0:
                 margins_at(m, angle_mode, y, y[PHI], sw, wk)
                 gs[0, :] = wk[WK_G, : gs.shape[1]]
+                if ist[I_FLIPPED] > 0:  # that pair's mode has just switched here: on its level
+                    gs[0, ist[I_FLIPPED] - 1] = 0.0
+                    ist[I_FLIPPED] = 0
             if fst[F_H] <= 0.0:
                 # Initial step: a fixed fraction of a revolution (angle) or of the output spacing.
                 fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
@@ -529,6 +536,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
                 continue
             ga = (w0 if comp == OMEGA else y[comp]) - level
             gb = (w1 if comp == OMEGA else y_new[comp]) - level
+            if abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
+                ga = 0.0
             if _crosses(ga, gb, direction):
                 if not dense_ready:
                     _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
@@ -595,15 +604,17 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             # At rest the pairs may hold the applied moments; else the modes start afresh.
             if _start_modes(m, y, sel, ist, wk) == LOCKED_STATUS:
                 return _locked(m, y, sel, outbuf, evbuf, ist, fst, wk)
+        gap = CHATTER_GAP * (1.0 if angle_mode else cfg[C_DT_OUT])
+        ist[I_NCHATTER] = ist[I_NCHATTER] + 1 if abs(x_stop - fst[F_LAST_SWITCH]) < gap else 0
+        fst[F_LAST_SWITCH] = x_stop
+        if ist[I_NCHATTER] >= CHATTER_COUNT:
+            ist[I_CHATTER_CODE] = ev_code
+            _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+            return CHATTERING
         if ev_code == EV_PAIR_MODE:
             ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
             ist[I_NSWITCH] += 1
-            gap = CHATTER_GAP * (1.0 if angle_mode else cfg[C_DT_OUT])
-            ist[I_NCHATTER] = ist[I_NCHATTER] + 1 if abs(x_stop - fst[F_LAST_SWITCH]) < gap else 0
-            fst[F_LAST_SWITCH] = x_stop
-            if ist[I_NCHATTER] >= CHATTER_COUNT:
-                _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
-                return CHATTERING
+            ist[I_FLIPPED] = ev_comp - PAIR_COMP + 1
         elif ev_code == EV_STARTER_CUTOUT:
             ist[I_STARTER_ON] = 0
         elif ev_code == EV_GOVERNOR:
