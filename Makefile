@@ -5,7 +5,7 @@ STAMP := $(VENV)/.installed
 DEFAULT_SCENE := cases/swash_plate_4cyl.toml
 DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
-.PHONY: run test install clean
+.PHONY: run test bench install clean
 
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
@@ -22,6 +22,12 @@ run: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q
+
+# The work-precision record in results/benchmarks/ (issue 5; about half an hour). CyRK, the
+# compiled peer, comes with the optional `bench` extra.
+bench: $(STAMP)
+	$(PY) -m pip install -q -e '.[test,bench]'
+	$(VENV)/bin/transient bench -o results/benchmarks
 
 clean:
 	rm -rf $(VENV) results/*.h5 results/*.png

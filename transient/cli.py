@@ -61,13 +61,17 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--points", type=int, default=361, help="points over one cycle")
     k.add_argument("--plot", default=None, help="also write a PNG of the transfer functions and J")
     k.set_defaults(func=cmd_kinematics)
-    b = sub.add_parser("bench", help="time the compiled path against the solve_ivp reference")
-    b.add_argument("scenes", nargs="*", help="scene files (default: the spin-up benchmark scenes)")
+    b = sub.add_parser("bench", help="work-precision record: error against run time, transient "
+                                     "against solve_ivp (and CyRK if installed)")
+    b.add_argument("scenes", nargs="*", help="scene files (default: the three benchmark scenes)")
     b.add_argument("--revolutions", type=float, default=1000.0)
-    b.add_argument("--rtol", type=float, default=1e-8)
-    b.add_argument("--repeat", type=int, default=5)
-    b.add_argument("--no-baselines", action="store_true", help="compiled path only (quick)")
-    b.add_argument("-o", "--output", default=None, help="also write the table to this file")
+    b.add_argument("--repeat", type=int, default=5, help="timed runs per point (median)")
+    b.add_argument("--no-baselines", action="store_true", help="transient's paths only")
+    b.add_argument("--baseline-budget", type=float, default=60.0,
+                   help="stop tightening a baseline's tolerance once a run takes longer [s]")
+    b.add_argument("--quick", action="store_true",
+                   help="a smoke test of the harness: 10 revolutions, 3 tolerances, one run each")
+    b.add_argument("-o", "--output", default="results/benchmarks", help="folder of the record")
     b.set_defaults(func=cmd_bench)
     e = sub.add_parser("efficiency", help="η_mech against speed at steady speeds and loads")
     e.add_argument("scene")
@@ -134,10 +138,21 @@ def cmd_efficiency(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from .bench import DEFAULT_SCENES, run_bench
+    from .bench import BENCH_SCENES, run_bench
+    from .scene import load_scene
 
-    run_bench(args.scenes or DEFAULT_SCENES, args.revolutions, args.rtol, args.repeat,
-              not args.no_baselines, args.output)
+    scenes = {Path(p).stem: p for p in args.scenes} if args.scenes else BENCH_SCENES
+    for path in scenes.values():
+        load_scene(path)  # an invalid scene fails here, before any work (exit 2)
+    if args.quick:
+        run_bench(scenes, revolutions=10.0, tolerances=(1e-4, 1e-6, 1e-8), repeat=1,
+                  baselines=not args.no_baselines, out=args.output, baseline_budget=5.0,
+                  baseline_tolerances=(1e-4,))
+    else:
+        run_bench(scenes, args.revolutions, repeat=args.repeat, baselines=not args.no_baselines,
+                  out=args.output, baseline_budget=args.baseline_budget,
+                  baseline_tolerances=tuple(10.0 ** -k for k in range(3, 11)))
+    print(f"wrote {Path(args.output) / 'work_precision.csv'}, work_precision.md and figures")
     return EXIT_OK
 
 

@@ -73,20 +73,34 @@ class ResultWriter:
             ds[-n:] = block[name]
         self.f.flush()
 
-    def read_trajectory(self) -> dict[str, np.ndarray]:
-        """The trajectory written so far, read back."""
-        return {name: self.f["trajectory"][name][()] for name in self.columns}
+    def read_trajectory(self, last: int | None = None) -> dict[str, np.ndarray]:
+        """The trajectory written so far (its ``last`` samples only, if given), read back."""
+        n = self.f["trajectory"]["t"].shape[0]
+        start = 0 if last is None else max(0, n - last)
+        return {name: self.f["trajectory"][name][start:] for name in self.columns}
 
     def events(self, events: dict[str, np.ndarray]) -> None:
-        """``events[name]`` is an (n, 2) array of (t, φ)."""
+        """Append events: ``events[name]`` is an (n, 2) array (or list of pairs) of (t, φ).
+        Extendable datasets, so that a long run streams its events too."""
         for name, rows in events.items():
+            rows = np.asarray(rows, dtype=float).reshape(-1, 2)
             g = self.f["events"].require_group(name)
-            for j, col in enumerate(("t", "phi")):
-                if col in g:
-                    del g[col]
-                g.create_dataset(col, data=np.asarray(rows, dtype=float).reshape(-1, 2)[:, j])
-            g["t"].attrs["unit"] = "s"
-            g["phi"].attrs["unit"] = "rad"
+            for j, (col, unit) in enumerate((("t", "s"), ("phi", "rad"))):
+                if col not in g:
+                    g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
+                                     chunks=(1024,)).attrs["unit"] = unit
+                ds = g[col]
+                ds.resize(ds.shape[0] + rows.shape[0], axis=0)
+                ds[ds.shape[0] - rows.shape[0]:] = rows[:, j]
+
+    def read_events(self, phi_from: float = -np.inf) -> dict[str, np.ndarray]:
+        """Events written so far at φ ≥ ``phi_from``, name → (n, 2) array of (t, φ)."""
+        out = {}
+        for name, g in self.f["events"].items():
+            t, phi = g["t"][()], g["phi"][()]
+            keep = phi >= phi_from
+            out[name] = np.column_stack([t[keep], phi[keep]])
+        return out
 
     def solver(self, attrs: dict[str, Any]) -> None:
         for k, v in attrs.items():

@@ -309,13 +309,16 @@ class Run:
 
 @dataclass(frozen=True)
 class Solver:
-    """Integration settings. ``switch_speed`` [rad/s]: below it time is the independent variable."""
+    """Integration settings. ``switch_speed`` [rad/s]: below it time is the independent variable;
+    ``domain``: ``"auto"`` (crank angle above the switch speed) or ``"time"`` (time throughout,
+    for comparison; the maximum step is then bounded by the output spacing only)."""
 
     method: str = "dop853"
     rtol: float = 1e-8
     atol: float = 1e-10
     switch_speed: float = math.pi / 3.0  # 10 rpm
     max_step: float = math.pi  # [rad] in crank angle
+    domain: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -569,7 +572,8 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
             rtol=sv.number("rtol", default=1e-8, gt=0.0, lt=1.0),
             atol=sv.number("atol", default=1e-10, gt=0.0),
             switch_speed=sv.number("switch_speed", "speed", math.pi / 3.0, gt=0.0),
-            max_step=sv.number("max_step", "angle", math.pi, gt=0.0))
+            max_step=sv.number("max_step", "angle", math.pi, gt=0.0),
+            domain=sv.string("domain", "auto", choices=("auto", "time")))
         sv.finish()
         so = root.sub("output")
         sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4),

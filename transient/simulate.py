@@ -22,6 +22,8 @@ from .errors import SimulationError
 
 BUFFER_ROWS = 8192
 EVENT_ROWS = 2048
+#: The end-of-run summary reads back at most this many samples (the end of the run).
+SUMMARY_SAMPLES = 500_000
 
 
 def output_columns(scene) -> dict[str, str]:
@@ -66,6 +68,9 @@ def _config(scene) -> np.ndarray:
     cfg[ci.C_DT_OUT] = out.dt if out.dt > 0 else cfg[ci.C_DPHI_OUT] / cfg[ci.C_W_HI]
     cfg[ci.C_MAX_STEP_PHI] = sv.max_step
     cfg[ci.C_MAX_STEP_T] = sv.max_step / sv.switch_speed
+    if sv.domain == "time":  # never to crank angle; steps bounded by the output spacing only
+        cfg[ci.C_W_LO] = cfg[ci.C_W_HI] = math.inf
+        cfg[ci.C_MAX_STEP_T] = math.inf
     cfg[ci.C_CHUNK_STEPS] = 20000
     return cfg
 
@@ -118,7 +123,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     y, fst, ist = _initial_state(scene, model)
     outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
     evbuf = np.empty((EVENT_ROWS, 4))
-    blocks, events = [], {name: [] for name in ci.EVENT_NAMES}
+    blocks, events = [], {name: [] for name in ci.EVENT_NAMES}  # events kept only with keep
     status, message = ci.RUNNING, ""
     t0 = time.perf_counter()
     try:
@@ -132,8 +137,9 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
             ist[ci.I_NEV] = 0
             if keep or not blocks or block["t"].size:
                 blocks = (blocks if keep else []) + [block]
-            for k, v in ev.items():
-                events[k].extend(v)
+            if keep:
+                for k, v in ev.items():
+                    events[k].extend(v)
             if on_block:
                 on_block(block, ev)
             if progress:
@@ -262,13 +268,21 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
     data = None
     try:
         streamed = scene.run.mode == "dynamic" and scene.solver.method == "dop853"
-        data = integrate(scene, on_block=lambda block, ev: writer.append(block), progress=progress,
-                         keep=False)
+
+        def on_block(block, ev):
+            writer.append(block)
+            writer.events(ev)
+
+        data = integrate(scene, on_block=on_block, progress=progress, keep=False)
         if not streamed:
             writer.append(data.trajectory)
-        writer.events(data.events)
+            writer.events(data.events)
         writer.solver(data.solver)
-        data.trajectory = writer.read_trajectory()  # the summary needs the whole run
+        # The summary looks at the end of the run: its last SUMMARY_SAMPLES samples, so that
+        # memory stays bounded however long the run (steady state, efficiency are found there).
+        data.trajectory = writer.read_trajectory(last=SUMMARY_SAMPLES)
+        data.events = writer.read_events(phi_from=data.trajectory["phi"][0]
+                                         if data.trajectory["t"].size else -math.inf)
         summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
                    else {})
         for name, (value, unit) in summary.items():

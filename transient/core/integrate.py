@@ -20,7 +20,7 @@ from . import dop853_coefficients as dc
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
-                    SW_STARTER, T, WK_G, WK_G_MIN, choose_modes, derivative, governor_branch, inertia,
+                    SW_STARTER, T, WK_G, WK_G_MIN, WK_SPEED, choose_modes, derivative, governor_branch, inertia,
                     margins_at, n_state, output_row, speed, work_array)
 
 # The right-hand side is autonomous (t and φ are both state components), so the nodes C are not
@@ -52,14 +52,14 @@ BP_LANDING = 1e-7
 # passed on as ``sw``.
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
- I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE) = range(
-    N_SWITCHES, N_SWITCHES + 14)
-N_IST = N_SWITCHES + 14
+ I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT) = range(
+    N_SWITCHES, N_SWITCHES + 15)
+N_IST = N_SWITCHES + 15
 # State events closer together than this (rad in crank angle; × the output spacing in time) count
 # as no progress; this many in a row is chattering, which is reported, never looped on.
 CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
-# A step that starts within this (relative) of an event's level starts on it: an event has just
-# put it there, and rounding must not make it cross the level again at once.
+# A step that starts within this (relative) of the level of the event just handled starts on it:
+# the event has put it there, and rounding must not make it cross the level again at once.
 ON_LEVEL = 1e-12
 
 # advance() return codes
@@ -242,9 +242,35 @@ def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
 
 
 @njit(cache=True)
+def _speed_crossing_inside(m, angle_mode, F, y, x, h, level, direction, ga, sel, sw, tmp, wk):
+    """θ where the speed first crosses ``level`` (in ``direction``) inside a step whose ends are
+    on the same side of it, sampled at θ = j/N_MARGIN_SAMPLES on the dense output; 2 if the
+    samples see no crossing (it was only in a stage)."""
+    ix = PHI if angle_mode else T
+    g_prev = ga
+    for j in range(1, N_MARGIN_SAMPLES + 1):
+        theta = j / N_MARGIN_SAMPLES
+        _dense_eval(F, y, theta, tmp)
+        tmp[ix] = x + theta * h
+        g = _event_g(m, angle_mode, tmp, OMEGA, level, sel, sw, wk)
+        if _crosses(g_prev, g, direction):
+            return _root(m, angle_mode, F, y, OMEGA, level, sel, sw, tmp, wk,
+                         (j - 1) / N_MARGIN_SAMPLES, theta, g_prev, g)[0]
+        g_prev = g
+    return 2.0
+
+
+@njit(cache=True)
 def _pair_crossing(m, angle_mode, F, y, k, sel, sw, tmp, wk, gs):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
-    margin evaluations (right-hand sides) the root finding took."""
+    margin evaluations (right-hand sides) the root finding took.
+
+    A margin that starts at 0 (an event has just switched this pair's mode) and falls below it
+    at once means the power only touched zero there and turns back: the switch is undone at the
+    step's start (θ = 0).
+    """
+    if gs[0, k] == 0.0 and gs[1, k] < 0.0:
+        return 0.0, 0
     for j in range(N_MARGIN_SAMPLES):
         if _crosses(gs[j, k], gs[j + 1, k], -1):
             return _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
@@ -414,15 +440,12 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         ix = PHI if angle_mode else T
         x = y[ix]
         if ist[I_F_VALID] == 0:
+            if m.n_pairs > 0:
+                _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf)
+                ist[I_NFEV] += 1
             derivative(m, angle_mode, y, y[PHI], sw, wk, f)
             ist[I_NFEV] += 1
             ist[I_F_VALID] = 1
-            if m.n_pairs > 0:
-                margins_at(m, angle_mode, y, y[PHI], sw, wk)
-                gs[0, :] = wk[WK_G, : gs.shape[1]]
-                if ist[I_FLIPPED] > 0:  # that pair's mode has just switched here: on its level
-                    gs[0, ist[I_FLIPPED] - 1] = 0.0
-                    ist[I_FLIPPED] = 0
             if fst[F_H] <= 0.0:
                 # Initial step: a fixed fraction of a revolution (angle) or of the output spacing.
                 fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
@@ -458,12 +481,17 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         for i in range(n):
             K[0, i] = f[i]
         wk[WK_G_MIN, :] = np.inf
+        wk[WK_SPEED, 0] = np.inf
+        wk[WK_SPEED, 1] = -np.inf
         _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        w_lo, w_hi = wk[WK_SPEED, 0], wk[WK_SPEED, 1]
         # (the step's last right-hand side is at y_new: WK_G holds the margins there)
         dip = False
         for k in range(m.n_pairs):
             gs[N_MARGIN_SAMPLES, k] = wk[WK_G, k]
-            dip = dip or (gs[0, k] > 0.0 and wk[WK_G_MIN, k] <= 0.0)
+            # a margin that starts at or above zero and dips below, or above and reaches it
+            g_min = wk[WK_G_MIN, k]
+            dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
         ist[I_NFEV] += N_STAGES
         err = _error_norm(K, h, y, y_new, rtol, atol, ix)
         finite = np.isfinite(err)
@@ -536,14 +564,22 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
                 continue
             ga = (w0 if comp == OMEGA else y[comp]) - level
             gb = (w1 if comp == OMEGA else y_new[comp]) - level
-            if abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
+            if code == ist[I_AT_EVENT] - 1 and abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
                 ga = 0.0
-            if _crosses(ga, gb, direction):
+            ends = _crosses(ga, gb, direction)
+            # The speed can pass a level and come back within one step (its fluctuation within a
+            # cycle about a governor corner): the stages' range shows it.
+            inside = comp == OMEGA and not ends and w_lo < level < w_hi
+            if ends or inside:
                 if not dense_ready:
                     _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
                     ist[I_NFEV] += 3
                     dense_ready = True
-                theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
+                if ends:
+                    theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
+                else:
+                    theta = _speed_crossing_inside(m, angle_mode, F, y, x, h, level, direction,
+                                                   ga, sel, sw, tmp, wk)
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
@@ -563,6 +599,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         fst[F_H] = h_next
         fst[F_SEL] = sel
         if ev_code < 0:
+            ist[I_AT_EVENT] = 0
             for i in range(n):
                 y[i] = y_new[i]
                 f[i] = K[N_STAGES, i]
@@ -611,6 +648,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             ist[I_CHATTER_CODE] = ev_code
             _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
             return CHATTERING
+        ist[I_AT_EVENT] = ev_code + 1
         if ev_code == EV_PAIR_MODE:
             ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
             ist[I_NSWITCH] += 1
@@ -643,6 +681,29 @@ def _to_time_mode(m, y, ist, wk):
     J, _ = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
     ist[I_ANGLE_MODE] = 0
+
+
+@njit(cache=True)
+def _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf):
+    """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
+    just switched sits on its level (margin 0). Any other pair already past its level here (two
+    pairs switching within the event location's accuracy) is switched now, so that no step starts
+    with a mode against its criterion: the stepper watches a margin only while it is positive."""
+    margins_at(m, angle_mode, y, y[PHI], sw, wk)
+    flipped = ist[I_FLIPPED] - 1
+    ist[I_FLIPPED] = 0
+    changed = False
+    for k in range(m.n_pairs):
+        if k != flipped and wk[WK_G, k] < 0.0:
+            sw[SW_MODES] ^= 1 << k
+            ist[I_NSWITCH] += 1
+            changed = True
+            _emit_event(m, evbuf, ist, EV_PAIR_MODE, y, wk)
+    if changed:
+        margins_at(m, angle_mode, y, y[PHI], sw, wk)
+        ist[I_NFEV] += 1
+    for k in range(m.n_pairs):
+        gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]
 
 
 @njit(cache=True)

@@ -66,9 +66,10 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: Rows of the work array ``wk`` (see :func:`work_array`): transfer functions u, u′ per cylinder;
 #: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, their least value
 #: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
-#: vector.
-WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY = range(11)
-N_WK = 11
+#: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED).
+(WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
+ WK_SPEED) = range(12)
+N_WK = 12
 
 Model = namedtuple(
     "Model",
@@ -120,7 +121,7 @@ def n_outputs(m):
 @njit(cache=True)
 def work_array(m):
     """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
-    return np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 1)))
+    return np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
 
 
 @njit(cache=True)
@@ -264,6 +265,9 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
     """
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    # the speed's range over a step's stages: a speed event inside the step shows here
+    wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w)
+    wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w)
     M = M_gas + M_load + M_starter
     loss = 0.0  # Σ (1 − η*) S, the moment equivalent of the pairs' losses
     q = 1.0 if angle_mode else w  # work per unit of the independent variable

@@ -1,0 +1,60 @@
+"""Stepper overhead: wall time of a run against (RHS evaluations × cost of one compiled RHS
+call), for the benchmark scenes at rtol 1e-8 over 1000 revolutions (issue 5's target: ≤ 30 %).
+The cost of one call is timed in a compiled loop over 2000 states taken from the run itself (in
+crank angle, as the run integrates), median of 5 loops. Rerun:
+``.venv/bin/python scripts/stepper_overhead.py`` (about 20 s).
+"""
+import dataclasses as dc
+import statistics
+import time
+
+import numpy as np
+from numba import njit
+
+from transient.assemble import build_model
+from transient.bench import BENCH_SCENES
+from transient.core import model as cm
+from transient.scene import load_scene
+from transient.simulate import integrate
+
+
+@njit(cache=True)
+def rhs_loop(m, states, out):
+    """Evaluate the crank-angle RHS at every state (rows: φ, t, K, works); return a checksum."""
+    wk = cm.work_array(m)
+    sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
+    sw[cm.SW_DIRECTION] = 1
+    acc = 0.0
+    for i in range(states.shape[0]):
+        cm.derivative(m, True, states[i], states[i, cm.PHI], sw, wk, out)
+        acc += out[cm.KINETIC]
+    return acc
+
+
+for name, path in BENCH_SCENES.items():
+    base = load_scene(path)
+    scene = dc.replace(base, run=dc.replace(base.run, revolutions=1000.0, t_end=np.inf),
+                       solver=dc.replace(base.solver, rtol=1e-8, atol=1e-11))
+    integrate(scene, keep=False)
+    walls = []
+    for _ in range(5):
+        data = integrate(scene, keep=False)
+        walls.append(data.solver["wall_s"])
+    wall, nfev = statistics.median(walls), data.solver["nfev"]
+    model, _, _ = build_model(scene)
+    tr = integrate(dc.replace(scene, run=dc.replace(scene.run, revolutions=50.0))).trajectory
+    pick = np.linspace(0, tr["t"].size - 1, 2000).astype(int)
+    states = np.zeros((pick.size, cm.n_state(model)))
+    states[:, cm.PHI], states[:, cm.T] = tr["phi"][pick], tr["t"][pick]
+    states[:, cm.KINETIC] = 0.5 * tr["J"][pick] * tr["omega"][pick] ** 2
+    out = np.empty(cm.n_state(model))
+    rhs_loop(model, states, out)
+    loops = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(50):
+            rhs_loop(model, states, out)
+        loops.append((time.perf_counter() - t0) / (50 * pick.size))
+    per_call = statistics.median(loops)
+    print(f"{name}: {nfev} RHS evaluations, {wall:.4g} s, one call {per_call * 1e6:.3f} µs → "
+          f"RHS {nfev * per_call:.4g} s, stepper overhead {wall / (nfev * per_call) - 1:+.0%}")
