@@ -1,5 +1,6 @@
 """Stepper overhead: wall time of a run against (RHS evaluations × cost of one compiled RHS
-call), for the benchmark scenes at rtol 1e-8 over 1000 revolutions (issue 5's target: ≤ 30 %).
+call), for the benchmark scenes and the Gots spin-up with and without friction pairs, at rtol 1e-8
+over 1000 revolutions (issue 5's target: ≤ 30 %).
 The cost of one call is timed in a compiled loop over 2000 states taken from the run itself (in
 crank angle, as the run integrates), median of 5 loops. Rerun:
 ``.venv/bin/python scripts/stepper_overhead.py`` (about 20 s).
@@ -7,6 +8,7 @@ crank angle, as the run integrates), median of 5 loops. Rerun:
 import dataclasses as dc
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -16,6 +18,8 @@ from transient.bench import BENCH_SCENES
 from transient.core import model as cm
 from transient.scene import load_scene
 from transient.simulate import integrate
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
 
 
 @njit(cache=True)
@@ -31,7 +35,9 @@ def rhs_loop(m, states, out):
     return acc
 
 
-for name, path in BENCH_SCENES.items():
+SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
+              gots_friction=CASES / "gots_diesel_friction.toml")
+for name, path in SCENES.items():
     base = load_scene(path)
     scene = dc.replace(base, run=dc.replace(base.run, revolutions=1000.0, t_end=np.inf),
                        solver=dc.replace(base.solver, rtol=1e-8, atol=1e-11))

@@ -11,8 +11,8 @@ For each benchmark scene (:data:`BENCH_SCENES`), over ``revolutions`` (1000):
   after a warm-up, the compile (or cache load) apart, integration loop only (``/solver wall_s``);
 * baselines in the same run: ``scipy.integrate.solve_ivp`` RK45 and DOP853 with the plain-numpy
   right-hand side of :mod:`transient.reference` (breakpoints as terminal events, only the state
-  kept), one run each (they take seconds to minutes), from loose to tight until a run exceeds
-  ``baseline_budget`` seconds; and, when the optional ``bench`` extra (CyRK) is installed, CyRK's
+  kept), one run each (they take seconds to minutes), from loose to tight until a run is stopped
+  at ``baseline_budget`` seconds; and, when the optional ``bench`` extra (CyRK) is installed, CyRK's
   compiled DOP853 (``nbsolve2_ivp``) with transient's own numba right-hand side as a C callback
   (governor branch and pair modes chosen inside each call, as a generic solver needs), timed like
   the compiled paths.
@@ -26,7 +26,9 @@ from __future__ import annotations
 
 import csv
 import dataclasses as dc
+import json
 import math
+import signal
 import statistics
 import time
 from pathlib import Path
@@ -34,15 +36,16 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from .errors import SimulationError
 from .scene import load_scene
 from .simulate import integrate
 
 #: Benchmark scenes: the single-cylinder crank (equation (18) alone), the Gots diesel with
 #: friction pairs and a governor, the 4-cylinder swash-plate engine.
 _CASES = Path(__file__).resolve().parents[1] / "cases"
-BENCH_SCENES = {"single_cylinder": _CASES / "coasting_single.toml",
-                "gots_governed_friction": _CASES / "gots_diesel_governed.toml",
-                "swash_plate_4cyl": _CASES / "swash_plate_4cyl.toml"}
+BENCH_SCENES = {path.stem: path for path in (_CASES / "coasting_single.toml",
+                                             _CASES / "gots_diesel_governed.toml",
+                                             _CASES / "swash_plate_4cyl.toml")}
 TOLERANCES = tuple(10.0 ** -k for k in range(3, 13))
 #: atol of the sweep, for every method, relative to rtol. With atol = rtol the stepper's control
 #: of the accumulating time (or angle) — scaled by its increment per step, ~1e-4 s — is set by
@@ -140,11 +143,32 @@ def _compiled(name, base, ref, rtol, revolutions, repeat, time_domain):
                 data.solver, (phase, w_err, l2))
 
 
-def _solve_ivp(name, base, ref, rtol, revolutions, method):
+class OverBudget(Exception):
+    """A baseline run took longer than its budget and was stopped."""
+
+
+def _solve_ivp(name, base, ref, rtol, revolutions, method, budget):
+    """One solve_ivp run, or None if it was stopped after ``budget`` seconds (checked after every
+    segment between breakpoints)."""
     from .reference import run_reference
 
     scene = _scene(base, f"scipy-{method}", rtol, revolutions)
-    data = run_reference(scene, state_only=True, dense_tail=base.mechanism.cycle + 0.5)
+
+    def stop(signum, frame):
+        raise OverBudget
+
+    # A timer signal, not a check between segments: one segment can take arbitrarily long.
+    previous = signal.signal(signal.SIGALRM, stop)
+    signal.setitimer(signal.ITIMER_REAL, budget)
+    try:
+        data = run_reference(scene, state_only=True, dense_tail=base.mechanism.cycle + 0.5)
+    except OverBudget:
+        return None
+    except (ValueError, FloatingPointError, SimulationError) as exc:  # e.g. a stage overflowed
+        return f"failed: {exc}"
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
     tr = data.trajectory
     return _row(name, f"solve_ivp {method} (numpy RHS)", rtol, data.solver["wall_s"], 0.0, 1,
                 data.solver, _errors(ref, tr["t"][-1], tr["omega"][-1], tr["phi"], tr["omega"]))
@@ -206,7 +230,7 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
 
 
 def run_bench(scenes=None, revolutions=1000.0, tolerances=TOLERANCES, repeat=5,
-              baselines=True, out="results/benchmarks", baseline_budget=60.0,
+              baselines=True, out="results/benchmarks", baseline_budget=30.0,
               baseline_tolerances=None, progress=print) -> list[dict]:
     """Measure every (scene, method, rtol); write ``work_precision.csv``, one figure per scene
     and ``work_precision.md`` into ``out``; return the rows."""
@@ -222,21 +246,25 @@ def run_bench(scenes=None, revolutions=1000.0, tolerances=TOLERANCES, repeat=5,
             for rtol in tolerances:
                 rows.append(_compiled(name, base, ref, rtol, revolutions, repeat, time_domain))
                 progress(_line(rows[-1]))
-        if not baselines:
-            continue
-        if cyrk_available():
+        if baselines and cyrk_available():
             for rtol in tolerances:
                 row = _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache)
                 if row:
                     rows.append(row)
                     progress(_line(rows[-1]))
-        for method in ("RK45", "DOP853"):
+        for method in ("RK45", "DOP853") if baselines else ():
             for rtol in baseline_tolerances or tolerances:
-                rows.append(_solve_ivp(name, base, ref, rtol, revolutions, method))
-                progress(_line(rows[-1]))
-                if rows[-1]["wall_s"] > baseline_budget:
+                row = _solve_ivp(name, base, ref, rtol, revolutions, method, baseline_budget)
+                if row is None:
+                    progress(f"  {name} | solve_ivp {method} | rtol {rtol:.0e} | stopped after "
+                             f"{baseline_budget:g} s (budget)")
                     break
-    write_record(rows, refs, Path(out), revolutions)
+                if isinstance(row, str):  # a failed run: try the next, tighter tolerance
+                    progress(f"  {name} | solve_ivp {method} | rtol {rtol:.0e} | {row}")
+                    continue
+                rows.append(row)
+                progress(_line(rows[-1]))
+        write_record(rows, refs, Path(out), revolutions)  # after every scene: nothing is lost
     return rows
 
 
@@ -258,6 +286,8 @@ def at_target(rows, scene, method, target=TARGET_PHASE):
     if len(good) < 2 or good[0]["phase_err_rad"] >= good[1]["phase_err_rad"]:
         return math.nan, "not reached"
     (e1, w1), (e2, w2) = ((r["phase_err_rad"], r["wall_s"]) for r in good[:2])
+    if not w1 > w2:  # the more accurate run was not the slower one: no trend to follow
+        return math.nan, f"not reached (best {e1:.1e} rad)"
     slope = math.log(w1 / w2) / math.log(e1 / e2)
     return w1 * (target / e1) ** slope, f"extrapolated from {e1:.1e} rad"
 
@@ -273,8 +303,28 @@ def order_slope(rows, scene, method, floor):
     return float(np.polyfit(x, y, 1)[0])
 
 
+def _merge_earlier(rows, refs, out: Path):
+    """Rows and references of scenes measured by an earlier run into ``out`` and not by this one
+    (``transient bench SCENE…`` updates the record scene by scene)."""
+    csv_path, ref_path = out / "work_precision.csv", out / "work_precision_references.json"
+    if not (csv_path.is_file() and ref_path.is_file()):
+        return rows, refs
+    earlier = json.loads(ref_path.read_text())
+    keep = {name: Reference(phi_grid=np.zeros(0), omega_grid=np.zeros(0), **r)
+            for name, r in earlier.items() if name not in refs}
+    with open(csv_path, newline="") as fh:
+        old = [{k: (v if k in ("scene", "method") else float(v)) for k, v in r.items()}
+               for r in csv.DictReader(fh) if r["scene"] in keep]
+    return old + rows, {**keep, **refs}
+
+
 def write_record(rows, refs, out: Path, revolutions) -> None:
     out.mkdir(parents=True, exist_ok=True)
+    rows, refs = _merge_earlier(rows, refs, out)
+    (out / "work_precision_references.json").write_text(json.dumps(
+        {name: {k: getattr(r, k) for k in ("t_end", "omega_end", "phi_end", "confirm_phase",
+                                            "confirm_omega")} for name, r in refs.items()},
+        indent=1) + "\n")
     with open(out / "work_precision.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=COLUMNS)
         w.writeheader()

@@ -67,8 +67,8 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--revolutions", type=float, default=1000.0)
     b.add_argument("--repeat", type=int, default=5, help="timed runs per point (median)")
     b.add_argument("--no-baselines", action="store_true", help="transient's paths only")
-    b.add_argument("--baseline-budget", type=float, default=60.0,
-                   help="stop tightening a baseline's tolerance once a run takes longer [s]")
+    b.add_argument("--baseline-budget", type=float, default=30.0,
+                   help="stop a baseline run after this long, and its tighter tolerances [s]")
     b.add_argument("--quick", action="store_true",
                    help="a smoke test of the harness: 10 revolutions, 3 tolerances, one run each")
     b.add_argument("-o", "--output", default="results/benchmarks", help="folder of the record")

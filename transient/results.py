@@ -93,13 +93,21 @@ class ResultWriter:
                 ds.resize(ds.shape[0] + rows.shape[0], axis=0)
                 ds[ds.shape[0] - rows.shape[0]:] = rows[:, j]
 
-    def read_events(self, phi_from: float = -np.inf) -> dict[str, np.ndarray]:
-        """Events written so far at φ ≥ ``phi_from``, name → (n, 2) array of (t, φ)."""
+    def read_events(self, t_from: float = -np.inf) -> dict[str, np.ndarray]:
+        """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ). Events are
+        written in time order, so the first one is found by bisection in the file and only the
+        tail is read (a long run has millions of breakpoint events)."""
         out = {}
         for name, g in self.f["events"].items():
-            t, phi = g["t"][()], g["phi"][()]
-            keep = phi >= phi_from
-            out[name] = np.column_stack([t[keep], phi[keep]])
+            t = g["t"]
+            lo, hi = 0, t.shape[0]
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if t[mid] < t_from:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            out[name] = np.column_stack([t[lo:], g["phi"][lo:]])
         return out
 
     def solver(self, attrs: dict[str, Any]) -> None:

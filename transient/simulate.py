@@ -281,7 +281,7 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
         # The summary looks at the end of the run: its last SUMMARY_SAMPLES samples, so that
         # memory stays bounded however long the run (steady state, efficiency are found there).
         data.trajectory = writer.read_trajectory(last=SUMMARY_SAMPLES)
-        data.events = writer.read_events(phi_from=data.trajectory["phi"][0]
+        data.events = writer.read_events(t_from=data.trajectory["t"][0]
                                          if data.trajectory["t"].size else -math.inf)
         summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
                    else {})
