@@ -81,16 +81,23 @@ class Reference:
     confirm_omega: float = math.nan
 
 
-def _errors(ref: Reference, t_end, omega_end, phi, omega):
-    """(phase [rad], relative final ω, relative L2 of ω(φ) over the last cycle)."""
-    phase = abs(ref.omega_end * (t_end - ref.t_end))
-    w_err = abs(omega_end / ref.omega_end - 1.0)
+def _end_errors(ref: Reference, t_end, omega_end):
+    """(phase [rad], relative final ω) of a run that ends at the reference's final angle."""
+    return abs(ref.omega_end * (t_end - ref.t_end)), abs(omega_end / ref.omega_end - 1.0)
+
+
+def _l2_error(ref: Reference, phi, omega) -> float:
+    """Relative L2 error of ω(φ) over the last cycle, on the reference's samples."""
     window = phi >= ref.phi_grid[0] - 0.5
     p, w = phi[window], omega[window]
     keep = np.concatenate([[True], np.diff(p) > 0])
     w_run = CubicSpline(p[keep], w[keep])(ref.phi_grid) if keep.sum() >= 4 else np.nan
-    l2 = float(np.sqrt(np.mean((w_run - ref.omega_grid) ** 2)) / np.mean(ref.omega_grid))
-    return phase, w_err, l2
+    return float(np.sqrt(np.mean((w_run - ref.omega_grid) ** 2)) / np.mean(ref.omega_grid))
+
+
+def _errors(ref: Reference, t_end, omega_end, phi, omega):
+    """(phase [rad], relative final ω, relative L2 of ω(φ) over the last cycle)."""
+    return (*_end_errors(ref, t_end, omega_end), _l2_error(ref, phi, omega))
 
 
 def _tail(traj, cycle):
@@ -136,8 +143,8 @@ def _compiled(name, base, ref, rtol, revolutions, repeat, time_domain):
     end = data.trajectory
     full = integrate(dc.replace(scene, output=dc.replace(scene.output, dt=scene.output.dt / 8)))
     tr = full.trajectory
-    phase, w_err, _ = _errors(ref, end["t"][-1], end["omega"][-1], tr["phi"], tr["omega"])
-    l2 = _errors(ref, tr["t"][-1], tr["omega"][-1], tr["phi"], tr["omega"])[2]
+    phase, w_err = _end_errors(ref, end["t"][-1], end["omega"][-1])
+    l2 = _l2_error(ref, tr["phi"], tr["omega"])
     method = "transient DOP853 (time)" if time_domain else "transient DOP853 (crank angle)"
     return _row(name, method, rtol, statistics.median(walls), first.solver["compile_s"], repeat,
                 data.solver, (phase, w_err, l2))
@@ -223,7 +230,8 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     tail = sol.call_vectorize(t_tail)
     sol.free()
     phase = abs(y_end[cm.PHI] - ref.phi_end)
-    _, w_err, l2 = _errors(ref, ref.t_end, y_end[cm.OMEGA], tail[cm.PHI], tail[cm.OMEGA])
+    w_err = _end_errors(ref, ref.t_end, y_end[cm.OMEGA])[1]
+    l2 = _l2_error(ref, tail[cm.PHI], tail[cm.OMEGA])
     return _row(name, "CyRK DOP853 (transient's compiled RHS)", rtol, statistics.median(walls),
                 compile_s, repeat, {"nfev": -1, "nsteps": steps, "nreject": -1},
                 (phase, w_err, l2))
