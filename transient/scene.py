@@ -311,7 +311,10 @@ class Run:
 class Solver:
     """Integration settings. ``switch_speed`` [rad/s]: below it time is the independent variable;
     ``domain``: ``"auto"`` (crank angle above the switch speed) or ``"time"`` (time throughout,
-    for comparison; the maximum step is then bounded by the output spacing only)."""
+    for comparison; the maximum step is then bounded by the output spacing only).
+    ``fixed_step`` [rad]: 0 for adaptive steps; > 0 for steps of that crank angle (compiled
+    methods; the last step before a breakpoint ends on it), with no error control, for periodic
+    steady runs. Time-domain stretches (below the switch speed) stay adaptive."""
 
     method: str = "dop853"
     rtol: float = 1e-8
@@ -319,6 +322,7 @@ class Solver:
     switch_speed: float = math.pi / 3.0  # 10 rpm
     max_step: float = math.pi  # [rad] in crank angle
     domain: str = "auto"
+    fixed_step: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -329,7 +333,9 @@ class Output:
     dt: float = 0.0  # 0: Δφ / switch_speed
 
 
-METHODS = ("dop853", "scipy-DOP853", "scipy-RK45", "scipy-Radau")
+#: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
+COMPILED_METHODS = ("dop853", "dopri5")
+METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 
 
 @dataclass(frozen=True)
@@ -573,7 +579,8 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
             atol=sv.number("atol", default=1e-10, gt=0.0),
             switch_speed=sv.number("switch_speed", "speed", math.pi / 3.0, gt=0.0),
             max_step=sv.number("max_step", "angle", math.pi, gt=0.0),
-            domain=sv.string("domain", "auto", choices=("auto", "time")))
+            domain=sv.string("domain", "auto", choices=("auto", "time")),
+            fixed_step=sv.number("fixed_step", "angle", 0.0, ge=0.0))
         sv.finish()
         so = root.sub("output")
         sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4),
@@ -602,10 +609,18 @@ def _check_consistency(scene: Scene) -> None:
         at = math.degrees(phi[int(np.argmin(J))])
         raise SceneError("inertia", f"the reduced inertia J(φ) falls to {J.min():.3g} kg m² at "
                                     f"φ = {at:g}°; give a shaft, flywheel or load inertia > 0")
-    if scene.friction.pairs and scene.friction.policy == "paper" and scene.solver.method != "dop853":
+    sv = scene.solver
+    compiled = sv.method in COMPILED_METHODS
+    if scene.friction.pairs and scene.friction.policy == "paper" and not compiled:
         raise SceneError("solver.method", "the reference path (scipy-*) follows the power-flow "
-                                          "policy only; use method = \"dop853\" with policy "
-                                          "\"paper\"")
+                                          "policy only; use method = \"dop853\" or \"dopri5\" "
+                                          "with policy \"paper\"")
+    if sv.fixed_step > 0.0 and not compiled:
+        raise SceneError("solver.fixed_step", f"fixed steps need a compiled method "
+                                              f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")
+    if sv.fixed_step > 0.0 and sv.domain == "time":
+        raise SceneError("solver.fixed_step", "fixed steps are crank-angle steps; use "
+                                              "domain = \"auto\" or fixed_step = 0")
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "

@@ -16,9 +16,11 @@ from scipy.interpolate import CubicSpline
 
 from .assemble import build_model
 from .core import integrate as ci
+from .core.tableaus import TABLEAUS
 from .core.model import (N_OUT_FIXED, OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
                          inverse_dynamics, n_outputs, n_state)
 from .errors import SimulationError
+from .scene import COMPILED_METHODS
 
 BUFFER_ROWS = 8192
 EVENT_ROWS = 2048
@@ -72,6 +74,7 @@ def _config(scene) -> np.ndarray:
         cfg[ci.C_W_LO] = cfg[ci.C_W_HI] = math.inf
         cfg[ci.C_MAX_STEP_T] = math.inf
     cfg[ci.C_CHUNK_STEPS] = 20000
+    cfg[ci.C_FIXED_STEP] = sv.fixed_step
     return cfg
 
 
@@ -95,7 +98,7 @@ def _fraction_done(scene, y) -> float:
     return min(1.0, max(f_t, f_phi))
 
 
-def _compile(model, cfg, bp) -> float:
+def _compile(model, tab, cfg, bp) -> float:
     """Compile (or load from the numba cache) the stepper; return the seconds it took."""
     t0 = time.perf_counter()
     warm = cfg.copy()
@@ -103,14 +106,15 @@ def _compile(model, cfg, bp) -> float:
     warm[ci.C_PHI_END] = 1e-6
     y = np.zeros(n_state(model))
     y[2] = 1.0
-    ci.advance(model, warm, bp, y, np.zeros(ci.N_FST), np.zeros(ci.N_IST, dtype=np.int64),
+    ci.advance(model, tab, warm, bp, y, np.zeros(ci.N_FST), np.zeros(ci.N_IST, dtype=np.int64),
                np.empty((1024, n_outputs(model))), np.empty((64, 4)))
     return time.perf_counter() - t0
 
 
 def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                  progress: Callable[[float], None] | None = None, keep: bool = True) -> RunData:
-    """Integrate a dynamic scene with the compiled DOP853; blocks go to ``on_block`` as they come.
+    """Integrate a dynamic scene with the compiled stepper (``scene.solver.method``: DOP853 or
+    DOPRI5, adaptive or fixed-step); blocks go to ``on_block`` as they come.
 
     With ``keep = False`` the trajectory is not kept in memory (only its last block), so that a
     long run streamed to a file needs bounded memory. A Ctrl-C between chunks ends the run with
@@ -119,7 +123,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     model, bp, _ = build_model(scene)
     cfg = _config(scene)
     names = list(output_columns(scene))
-    compile_s = _compile(model, cfg, bp)
+    tab = TABLEAUS[scene.solver.method]
+    compile_s = _compile(model, tab, cfg, bp)
     y, fst, ist = _initial_state(scene, model)
     outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
     evbuf = np.empty((EVENT_ROWS, 4))
@@ -128,7 +133,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     t0 = time.perf_counter()
     try:
         while status == ci.RUNNING:
-            status = ci.advance(model, cfg, bp, y, fst, ist, outbuf, evbuf)
+            status = ci.advance(model, tab, cfg, bp, y, fst, ist, outbuf, evbuf)
             block = {name: outbuf[: ist[ci.I_NOUT], j].copy() for j, name in enumerate(names)}
             ev = {}
             for code, t, phi, _ in evbuf[: ist[ci.I_NEV]]:
@@ -176,7 +181,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                  if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")
         message = (f"integration failed at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
-    solver = {"method": "dop853", "rtol": scene.solver.rtol, "atol": scene.solver.atol,
+    solver = {"method": scene.solver.method, "fixed_step": scene.solver.fixed_step,
+              "rtol": scene.solver.rtol, "atol": scene.solver.atol,
               "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
               "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
               "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES])}
@@ -245,7 +251,7 @@ def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
     for ``keep``."""
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
-    elif scene.solver.method == "dop853":
+    elif scene.solver.method in COMPILED_METHODS:
         data = run_compiled(scene, on_block, progress, keep)
     else:
         from .reference import run_reference
@@ -267,7 +273,7 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
     writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene), force)
     data = None
     try:
-        streamed = scene.run.mode == "dynamic" and scene.solver.method == "dop853"
+        streamed = scene.run.mode == "dynamic" and scene.solver.method in COMPILED_METHODS
 
         def on_block(block, ev):
             writer.append(block)

@@ -1,4 +1,7 @@
-"""Compiled adaptive DOP853 with dense output, driven segment by segment (DESIGN §2).
+"""Compiled embedded Runge–Kutta stepper with dense output, driven segment by segment (DESIGN §2).
+
+One loop for every pair in :mod:`.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
+fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).
 
 The solver loop is compiled together with the right-hand side (``model.derivative``). While
 ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint, so the
@@ -16,31 +19,19 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from . import dop853_coefficients as dc
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
                     SW_STARTER, T, WK_G, WK_G_MIN, WK_SPEED, choose_modes, derivative, governor_branch, inertia,
                     margins_at, n_state, output_row, speed, work_array)
 
-# The right-hand side is autonomous (t and φ are both state components), so the nodes C are not
-# needed.
-_A = dc.A[: dc.N_STAGES, : dc.N_STAGES].copy()
-_B = dc.B.copy()
-_E3 = dc.E3.copy()
-_E5 = dc.E5.copy()
-_D = dc.D.copy()
-_A_EXTRA = dc.A[dc.N_STAGES + 1 :].copy()
-N_STAGES = dc.N_STAGES
-N_STAGES_EXTENDED = dc.N_STAGES_EXTENDED
-
-# Step-size control as in SciPy's DOP853 (error exponent −1/8).
+# Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
 # cfg[...] — settings (float64 array, filled by transient.simulate)
 C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range(8)
-C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS = range(8, 11)
-N_CFG = 11
+C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS, C_FIXED_STEP = range(8, 12)
+N_CFG = 12
 # fst[...] — float stepper state kept between chunks
 F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH = range(8)
 N_FST = 8
@@ -74,8 +65,9 @@ PAIR_COMP = 100
 
 
 @njit(cache=True)
-def _error_norm(K, h, y, y_new, rtol, atol, ix):
-    """DOP853 error norm with the 5th- and 3rd-order estimators (Hairer's blend).
+def _error_norm(tab, K, h, y, y_new, rtol, atol, ix):
+    """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
+    the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5).
 
     The accumulating components (t in crank angle, φ in time) are scaled by their increment over
     the step, not by their size: relative to |t| the allowed error would grow with the run's length
@@ -93,9 +85,9 @@ def _error_norm(K, h, y, y_new, rtol, atol, ix):
             sc = atol + rtol * max(abs(y[i]), abs(y_new[i]))
         e5 = 0.0
         e3 = 0.0
-        for s in range(N_STAGES + 1):
-            e5 += K[s, i] * _E5[s]
-            e3 += K[s, i] * _E3[s]
+        for s in range(tab.n_stages + 1):
+            e5 += K[s, i] * tab.E5[s]
+            e3 += K[s, i] * tab.E3[s]
         err5 += (e5 / sc) ** 2
         err3 += (e3 / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
@@ -104,35 +96,38 @@ def _error_norm(K, h, y, y_new, rtol, atol, ix):
 
 
 @njit(cache=True)
-def _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
-    """One DOP853 step of size h from (x, y) with f = y′; K[0] must hold f.
+def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
+    """One Runge–Kutta step of size h from (x, y) with f = y′; K[0] must hold f.
 
-    Leaves the stages in K (K[12] = f(y_new)) and the new state in y_new.
+    Leaves the stages in K (K[tab.n_stages] = f(y_new)) and the new state in y_new.
     """
     n = y.shape[0]
-    for s in range(1, N_STAGES):
+    ns = tab.n_stages
+    for s in range(1, ns):
         for i in range(n):
             acc = 0.0
             for j in range(s):
-                acc += _A[s, j] * K[j, i]
+                acc += tab.A[s, j] * K[j, i]
             tmp[i] = y[i] + h * acc
         derivative(m, angle_mode, tmp, sel, sw, wk, K[s])
     for i in range(n):
         acc = 0.0
-        for j in range(N_STAGES):
-            acc += _B[j] * K[j, i]
+        for j in range(ns):
+            acc += tab.B[j] * K[j, i]
         y_new[i] = y[i] + h * acc
     # The independent variable advances exactly (exact stops on breakpoints).
     y_new[PHI if angle_mode else T] = x + h
-    derivative(m, angle_mode, y_new, sel, sw, wk, K[N_STAGES])
+    derivative(m, angle_mode, y_new, sel, sw, wk, K[ns])
 
 
 @njit(cache=True)
-def _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
-    """Dense-output coefficients F (7 × n) of the last step (three extra stages)."""
+def _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
+    """Dense-output coefficients F (3 + tab.D rows × n) of the last step, after the extra stages
+    (three for DOP853, none for DOPRI5; layout in :mod:`.tableaus`)."""
     n = y.shape[0]
-    for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
-        a = _A_EXTRA[s - N_STAGES - 1]
+    ns = tab.n_stages
+    for s in range(ns + 1, tab.n_ext):
+        a = tab.A[s]
         for i in range(n):
             acc = 0.0
             for j in range(s):
@@ -143,11 +138,11 @@ def _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
         dy = y_new[i] - y[i]
         F[0, i] = dy
         F[1, i] = h * K[0, i] - dy
-        F[2, i] = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
-        for r in range(_D.shape[0]):
+        F[2, i] = 2.0 * dy - h * (K[ns, i] + K[0, i])
+        for r in range(tab.D.shape[0]):
             acc = 0.0
-            for j in range(N_STAGES_EXTENDED):
-                acc += _D[r, j] * K[j, i]
+            for j in range(tab.n_ext):
+                acc += tab.D[r, j] * K[j, i]
             F[3 + r, i] = h * acc
 
 
@@ -159,7 +154,7 @@ def _dense_eval(F, y, theta, out):
         acc = 0.0
         for r in range(F.shape[0] - 1, -1, -1):
             acc += F[r, i]
-            if (F.shape[0] - 1 - r) % 2 == 0:
+            if r % 2 == 0:
                 acc *= theta
             else:
                 acc *= 1.0 - theta
@@ -375,12 +370,14 @@ def _reset_output_grid(cfg, ist, fst, y):
 
 
 @njit(cache=True)
-def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
+def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 
     Parameters
     ----------
     m : Model
+    tab : tableaus.Tableau
+        The Runge–Kutta pair (DOP853, DOPRI5).
     cfg : float64[N_CFG]
         Settings, indices ``C_*``.
     bp : float64[:]
@@ -403,8 +400,9 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         the applied moments) or CHATTERING (pair modes switching without progress).
     """
     n = n_state(m)
-    K = np.empty((N_STAGES_EXTENDED, n))
-    F = np.empty((7, n))
+    K = np.empty((tab.n_ext, n))
+    F = np.empty((3 + tab.D.shape[0], n))
+    n_extra = tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
     f = np.empty(n)
     y_new = np.empty(n)
     y_evt = np.empty(n)
@@ -466,7 +464,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         tol_end = 1e-13 * max(1.0, abs(x))
         if x_end - x <= tol_end:
             return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
-        h = min(fst[F_H], h_max)
+        fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
+        h = cfg[C_FIXED_STEP] if fixed else min(fst[F_H], h_max)
         at_segment_end = False
         if x + h >= x_end - tol_end:
             h = x_end - x
@@ -483,7 +482,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         wk[WK_G_MIN, :] = np.inf
         wk[WK_SPEED, 0] = np.inf
         wk[WK_SPEED, 1] = -np.inf
-        _step(m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
         w_lo, w_hi = wk[WK_SPEED, 0], wk[WK_SPEED, 1]
         # (the step's last right-hand side is at y_new: WK_G holds the margins there)
         dip = False
@@ -492,8 +491,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             # a margin that starts at or above zero and dips below, or above and reaches it
             g_min = wk[WK_G_MIN, k]
             dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
-        ist[I_NFEV] += N_STAGES
-        err = _error_norm(K, h, y, y_new, rtol, atol, ix)
+        ist[I_NFEV] += tab.n_stages
+        err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix)
         finite = np.isfinite(err)
         for i in range(n):
             finite = finite and np.isfinite(y_new[i])
@@ -508,6 +507,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             steps_here += 1
             continue
         n_bad = 0
+        if fixed:
+            err = 0.0  # every step is accepted; the step size alone sets the accuracy
         if err > 1.0:
             fst[F_H] = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0))
             ist[I_NREDO] = 0  # a shorter step no longer ends on the breakpoint it aimed at
@@ -519,8 +520,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         dense_ready = False
         # In time, a step must not cross a breakpoint: retake it so that it ends there.
         if not angle_mode and (y_new[PHI] > up or y_new[PHI] < down):
-            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
-            ist[I_NFEV] += 3
+            _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+            ist[I_NFEV] += n_extra
             level = up if y_new[PHI] > up else down
             theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, sel, sw, tmp, wk)
             fst[F_REDO_LEVEL] = level
@@ -541,11 +542,11 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         ev_level = 0.0
         # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
         w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
-        w1 = 1.0 / K[N_STAGES, T] if angle_mode else y_new[OMEGA]
+        w1 = 1.0 / K[tab.n_stages, T] if angle_mode else y_new[OMEGA]
         if dip:
             if not dense_ready:
-                _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
-                ist[I_NFEV] += 3
+                _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+                ist[I_NFEV] += n_extra
                 dense_ready = True
             _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs)
             ist[I_NFEV] += N_MARGIN_SAMPLES - 1
@@ -572,8 +573,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             inside = comp == OMEGA and not ends and w_lo < level < w_hi
             if ends or inside:
                 if not dense_ready:
-                    _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
-                    ist[I_NFEV] += 3
+                    _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+                    ist[I_NFEV] += n_extra
                     dense_ready = True
                 if ends:
                     theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
@@ -586,8 +587,8 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
         # Output samples inside the step (dense output), then the step's end state.
         d_out = _out_spacing(cfg, angle_mode)
         if fst[F_NEXT_OUT] <= x_stop and not dense_ready:
-            _dense(m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
-            ist[I_NFEV] += 3
+            _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+            ist[I_NFEV] += n_extra
             dense_ready = True
         while fst[F_NEXT_OUT] <= x_stop:
             _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
@@ -602,7 +603,7 @@ def advance(m, cfg, bp, y, fst, ist, outbuf, evbuf):
             ist[I_AT_EVENT] = 0
             for i in range(n):
                 y[i] = y_new[i]
-                f[i] = K[N_STAGES, i]
+                f[i] = K[tab.n_stages, i]
             gs[0, :] = gs[N_MARGIN_SAMPLES, :]
             if angle_mode and at_segment_end and x_end == up:
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)

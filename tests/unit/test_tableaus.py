@@ -1,0 +1,87 @@
+"""The Runge–Kutta pairs of :mod:`transient.core.tableaus` and the dense-output layout of
+:mod:`transient.core.integrate`, against SciPy's independent implementations (``RK45`` with its
+own interpolant matrix P, ``DOP853``): one step of the same size on a nonlinear system must give
+the same new state, the same error estimate's size and the same dense output.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import DOP853, RK45
+
+from transient.core.integrate import _dense_eval
+from transient.core.tableaus import TABLEAUS
+
+SCIPY = {"dopri5": RK45, "dop853": DOP853}
+
+
+def pendulum(t, y):
+    """A nonlinear autonomous system (a damped pendulum), y′ = f(y)."""
+    return np.array([y[1], -np.sin(y[0]) - 0.3 * y[1]])
+
+
+def one_step(tab, y0, h):
+    """Stages, new state and dense-output rows F of one step, following the layout documented in
+    :mod:`transient.core.tableaus` (written here in numpy, independently of the compiled loop)."""
+    K = np.zeros((tab.n_ext, y0.size))
+    K[0] = pendulum(0.0, y0)
+    for s in range(1, tab.n_ext):
+        K[s] = pendulum(0.0, y0 + h * tab.A[s, :s] @ K[:s])
+    y1 = y0 + h * tab.B @ K[: tab.n_stages]
+    K[tab.n_stages] = pendulum(0.0, y1)  # FSAL, also row n_stages of A for these pairs
+    dy = y1 - y0
+    F = np.vstack([dy, h * K[0] - dy, 2 * dy - h * (K[0] + K[tab.n_stages]), h * tab.D @ K])
+    return K, y1, F
+
+
+@pytest.mark.parametrize("name", list(TABLEAUS))
+def test_consistency_conditions(name):
+    """Row sums of A are the nodes c (0 ≤ c ≤ 1), the weights sum to 1, the error estimators
+    annihilate constants (sum 0)."""
+    tab = TABLEAUS[name]
+    c = tab.A.sum(axis=1)
+    assert c[0] == 0.0 and np.all((c >= 0) & (c <= 1 + 1e-14))
+    assert tab.B.sum() == pytest.approx(1.0, abs=1e-14)
+    assert tab.E5.sum() == pytest.approx(0.0, abs=1e-14)
+    assert tab.E3.sum() == pytest.approx(0.0, abs=1e-14)
+    assert np.allclose(tab.A[tab.n_stages, : tab.n_stages], tab.B, rtol=0, atol=1e-16)
+
+
+@pytest.mark.parametrize("name", list(TABLEAUS))
+def test_step_and_dense_output_match_scipy(name):
+    tab = TABLEAUS[name]
+    y0, h = np.array([1.2, 0.4]), 0.37
+    solver = SCIPY[name](pendulum, 0.0, y0, 10.0, first_step=h, max_step=h, rtol=1.0, atol=1.0)
+    solver.step()
+    assert solver.t == pytest.approx(h, rel=1e-15)
+    _, y1, F = one_step(tab, y0, h)
+    np.testing.assert_allclose(y1, solver.y, rtol=1e-14, atol=1e-15)
+    sol = solver.dense_output()
+    out = np.empty(2)
+    for theta in (0.0, 0.13, 0.5, 0.77, 1.0):
+        _dense_eval(F, y0, theta, out)
+        np.testing.assert_allclose(out, sol(theta * h), rtol=1e-13, atol=1e-15,
+                                   err_msg=f"{name} at θ = {theta}")
+
+
+@pytest.mark.parametrize("name", list(TABLEAUS))
+def test_dense_output_order(name):
+    """Halving h reduces the interpolant's midpoint error against a tight reference by 2^(q+1)
+    with q = 7 (DOP853) or 4 (DOPRI5): checks the D rows beyond agreeing with SciPy at one h."""
+    from scipy.integrate import solve_ivp
+
+    tab = TABLEAUS[name]
+    q = {"dop853": 7, "dopri5": 4}[name]
+    y0 = np.array([1.2, 0.4])
+    errs = []
+    for h in (0.4, 0.2):
+        _, _, F = one_step(tab, y0, h)
+        ref = solve_ivp(pendulum, (0.0, 0.5 * h), y0, method="DOP853", rtol=1e-13,
+                        atol=1e-15).y[:, -1]
+        out = np.empty(2)
+        _dense_eval(F, y0, 0.5, out)
+        errs.append(np.max(np.abs(out - ref)))
+    order = np.log2(errs[0] / errs[1])
+    print(f"{name}: midpoint errors {errs}, order {order:.2f}")
+    assert errs[1] > 1e-14  # above round-off, so the slope means something
+    assert q + 1 - 0.5 <= order <= q + 1 + 1.5, (errs, order)
