@@ -5,11 +5,12 @@ One place where the scene's dataclasses meet the unit-free arrays of :mod:`trans
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .core.model import PAPER, POWER_FLOW, Model
+from .core.model import PAPER, POWER_FLOW, TABULATED, Model
 from .forces.gas import PressureTable, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -76,8 +77,12 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         knots, coef, piece_knot = np.array([0.0, period]), np.zeros((1, 4)), np.array([0, 1])
     else:
         knots, coef, piece_knot = table.knots, table.coef, table.piece_knot
+    kin = kinematics_table(scene)
+    tabulated = kin is not None and kin.coef is not None
     model = Model(
-        kind=int(mech.kind), mech=mech.pack(), ncyl=n, J0=float(scene.inertia.total),
+        kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
+        kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
+        J0=float(scene.inertia.total),
         has_gas=table is not None, gas_phase=phases,
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
@@ -88,6 +93,20 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
         **chain_fields(scene))
     return model, model.breakpoints, table
+
+
+@lru_cache(maxsize=8)
+def kinematics_table(scene):
+    """The tables of a ``kinematics = "tabulated"`` scene (:mod:`transient.tabulate`; ``coef`` None
+    if none reaches the tolerance), else None. Cached: a scene is frozen."""
+    from .tabulate import FRACTION_OF_RTOL, build_table
+
+    sv = scene.solver
+    if sv.kinematics != "tabulated":
+        return None
+    mech = scene.mechanism
+    target = sv.table_tolerance or FRACTION_OF_RTOL * sv.rtol
+    return build_table(int(mech.kind), mech.pack(), mech.n_cylinders, target)
 
 
 def chain_fields(scene) -> dict:

@@ -314,7 +314,11 @@ class Solver:
     for comparison; the maximum step is then bounded by the output spacing only).
     ``fixed_step`` [rad]: 0 for adaptive steps; > 0 for steps of that crank angle (compiled
     methods; the last step before a breakpoint ends on it), with no error control, for periodic
-    steady runs. Time-domain stretches (below the switch speed) stay adaptive."""
+    steady runs. Time-domain stretches (below the switch speed) stay adaptive.
+    ``kinematics``: ``"exact"`` (the mechanism kernel at every evaluation) or ``"tabulated"``
+    (periodic quintic splines of J(φ) and u_k(φ), :mod:`transient.tabulate`), whose relative error
+    is kept ≤ ``table_tolerance`` (0: 0.01·rtol); if no table reaches it the run uses the exact
+    kernel and says so."""
 
     method: str = "dop853"
     rtol: float = 1e-8
@@ -323,6 +327,8 @@ class Solver:
     max_step: float = math.pi  # [rad] in crank angle
     domain: str = "auto"
     fixed_step: float = 0.0
+    kinematics: str = "exact"
+    table_tolerance: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -580,7 +586,9 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
             switch_speed=sv.number("switch_speed", "speed", math.pi / 3.0, gt=0.0),
             max_step=sv.number("max_step", "angle", math.pi, gt=0.0),
             domain=sv.string("domain", "auto", choices=("auto", "time")),
-            fixed_step=sv.number("fixed_step", "angle", 0.0, ge=0.0))
+            fixed_step=sv.number("fixed_step", "angle", 0.0, ge=0.0),
+            kinematics=sv.string("kinematics", "exact", choices=("exact", "tabulated")),
+            table_tolerance=sv.number("table_tolerance", default=0.0, ge=0.0, lt=1.0))
         sv.finish()
         so = root.sub("output")
         sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4),
@@ -618,6 +626,10 @@ def _check_consistency(scene: Scene) -> None:
     if sv.fixed_step > 0.0 and not compiled:
         raise SceneError("solver.fixed_step", f"fixed steps need a compiled method "
                                               f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")
+    if sv.kinematics == "tabulated" and not compiled:
+        raise SceneError("solver.kinematics", f"tables are for the compiled methods "
+                                              f"({', '.join(COMPILED_METHODS)}); the reference path "
+                                              f"{sv.method!r} is exact by design")
     if sv.fixed_step > 0.0 and sv.domain == "time":
         raise SceneError("solver.fixed_step", "fixed steps are crank-angle steps; use "
                                               "domain = \"auto\" or fixed_step = 0")

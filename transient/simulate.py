@@ -185,10 +185,27 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
               "rtol": scene.solver.rtol, "atol": scene.solver.atol,
               "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
               "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
-              "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES])}
+              "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES]),
+              **_kinematics_attrs(scene)}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
                    solver, complete=status == ci.FINISHED, message=message)
+
+
+def _kinematics_attrs(scene) -> dict:
+    """How J(φ) and u_k(φ) were evaluated: ``kinematics`` exact or tabulated, and for tables
+    their size, estimated relative error and the tolerance they had to meet."""
+    from .assemble import kinematics_table
+
+    kin = kinematics_table(scene)
+    if kin is None:
+        return {"kinematics": "exact"}
+    if kin.coef is None:
+        return {"kinematics": "exact (no table reached the tolerance)",
+                "table_tolerance": kin.target, "table_error": kin.error,
+                "table_intervals": kin.intervals}
+    return {"kinematics": "tabulated", "table_tolerance": kin.target, "table_error": kin.error,
+            "table_intervals": kin.intervals}
 
 
 def prescribed(scene, fuel: float = 1.0) -> RunData:

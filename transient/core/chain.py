@@ -91,6 +91,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .jit import kernel
+
 #: Largest number of pairs :func:`modes_power_flow` enumerates (2ⁿ candidates).
 MAX_PAIRS = 6
 
@@ -98,7 +100,7 @@ MAX_PAIRS = 6
 UNIQUE, AMBIGUOUS, NONE_CONSISTENT, LOCKED = 0, 1, 2, 3
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def eta_star(eta_fwd, eta_bwd, forward):
     """η* of (25): η_fwd when the shaft side drives (``forward``), else 1/η_bwd."""
     if forward:
@@ -106,7 +108,7 @@ def eta_star(eta_fwd, eta_bwd, forward):
     return 1.0 / eta_bwd
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def chain_solve(J, dJ, M, eta_s, w, S_out):
     """φ̈ of the serial chain for given modes; fills the pair moments S_k.
 
@@ -145,14 +147,14 @@ def chain_solve(J, dJ, M, eta_s, w, S_out):
     return a
 
 
-@njit(cache=True)
+@kernel
 def pair_losses(eta_s, S, w, out):
     """Power lost in each pair, (1 − η*_k) S_k ω [W]; fills ``out`` (float64[n])."""
     for k in range(eta_s.shape[0]):
         out[k] = (1.0 - eta_s[k]) * S[k] * w
 
 
-@njit(cache=True)
+@kernel
 def modes_paper(M, eta_fwd, eta_bwd, w, eta_out):
     """η* of every pair by criterion (25) generalized to a chain (module docstring).
 
@@ -165,7 +167,14 @@ def modes_paper(M, eta_fwd, eta_bwd, w, eta_out):
         eta_out[k] = eta_star(eta_fwd[k], eta_bwd[k], upstream * w >= 0.0)
 
 
-@njit(cache=True)
+@kernel(inline="always")
+def _copy(dst, src):
+    """dst[:] = src, as a loop (an array assignment needs reference counting, ``core.jit``)."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@kernel
 def _best_candidate(J, dJ, M, eta_fwd, eta_bwd, w, sigma, eta_out, S_out, eta_try, S_try):
     """Enumerate the 2ⁿ modes against direction ``sigma``; keep the chosen one in eta_out/S_out.
 
@@ -194,18 +203,26 @@ def _best_candidate(J, dJ, M, eta_fwd, eta_bwd, w, sigma, eta_out, S_out, eta_tr
             if n_ok == 1:
                 best_viol = -1.0  # a consistent candidate beats every inconsistent one
                 a_best = a
-                eta_out[:] = eta_try
-                S_out[:] = S_try
+                _copy(eta_out, eta_try)
+                _copy(S_out, S_try)
         elif n_ok == 0 and viol < best_viol:
             best_viol = viol
             a_best = a
-            eta_out[:] = eta_try
-            S_out[:] = S_try
+            _copy(eta_out, eta_try)
+            _copy(S_out, S_try)
     return a_best, n_ok
 
 
 @njit(cache=True)
 def modes_power_flow(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out):
+    """:func:`modes_power_flow_into` with scratch space of its own (for callers outside the
+    compiled loop)."""
+    return modes_power_flow_into(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out,
+                                 np.empty((4, eta_fwd.shape[0])))
+
+
+@kernel
+def modes_power_flow_into(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out, scratch):
     """φ̈ with every pair in the mode consistent with the power it transmits.
 
     Parameters
@@ -218,6 +235,8 @@ def modes_power_flow(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out):
         Shaft speed φ̇.
     eta_out, S_out : float64[n]
         Filled with the chosen η*_k and S_k (S_out[1:] NaN when locked with n ≥ 2).
+    scratch : float64[4, n]
+        Work space (a kernel allocates nothing, ``transient.core.jit``).
 
     Returns
     -------
@@ -230,8 +249,7 @@ def modes_power_flow(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out):
         Number of consistent candidates (for ω = 0, in the direction that moves; 0 if locked).
     """
     n = eta_fwd.shape[0]
-    eta_try = np.empty(n)
-    S_try = np.empty(n)
+    eta_try, S_try, eta_b, S_b = scratch[0], scratch[1], scratch[2], scratch[3]
     if w != 0.0:
         sigma = 1.0 if w > 0.0 else -1.0
         a, n_ok = _best_candidate(J, dJ, M, eta_fwd, eta_bwd, w, sigma, eta_out, S_out,
@@ -240,13 +258,11 @@ def modes_power_flow(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out):
         a, n_ok = _best_candidate(J, dJ, M, eta_fwd, eta_bwd, w, 1.0, eta_out, S_out,
                                   eta_try, S_try)
         if not a > 0.0:
-            eta_b = np.empty(n)
-            S_b = np.empty(n)
             a, n_ok = _best_candidate(J, dJ, M, eta_fwd, eta_bwd, w, -1.0, eta_b, S_b,
                                       eta_try, S_try)
             if a < 0.0:
-                eta_out[:] = eta_b
-                S_out[:] = S_b
+                _copy(eta_out, eta_b)
+                _copy(S_out, S_b)
             else:
                 # Neither direction of incipient motion is consistent: static friction holds.
                 for k in range(n):
@@ -262,7 +278,7 @@ def modes_power_flow(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out):
     return a, NONE_CONSISTENT, n_ok
 
 
-@njit(cache=True)
+@kernel
 def one_pair_reactions(I_a, u_ba, eta_s, S0):
     """(M_ba, M_ab) of (26) in the paper's coordinates from S_0 (sign conventions above).
 
@@ -272,7 +288,7 @@ def one_pair_reactions(I_a, u_ba, eta_s, S0):
     return -S0, eta_s * S0 / u_ba
 
 
-@njit(cache=True)
+@kernel
 def two_pair_reactions(u_ba, u_dc, eta_ba, eta_dc, S0, S1):
     """(M_ba, M_ab, M_dc, M_cd) of (29) re-derived, from S_0 and S_1.
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from math import asin, cos, sin, sqrt
 
-from numba import njit
+from .jit import kernel
 
 #: Layout of the parameter array ``mp`` of :func:`crank_slider_terms` (filled by
 #: ``transient.mechanisms.crank_slider.CrankSlider.pack``).
@@ -20,7 +20,7 @@ R, L, E, M_PISTON, M_PIN, M_CRANKPIN, M_ROD, ROD_CG, I_ROD, M_CRANK, N_CYL = ran
 PHASE0 = 11  # mp[PHASE0 + k]: shaft angle at which cylinder k has local angle 0
 
 
-@njit(cache=True)
+@kernel
 def slider(alpha, r, l, e):
     """Exact crank-slider kinematics at local crank angle ``alpha`` [rad].
 
@@ -46,7 +46,7 @@ def slider(alpha, r, l, e):
     return y_tdc - y_pin, -dy_pin, -ddy_pin, asin(sb), db, ddb
 
 
-@njit(cache=True)
+@kernel
 def cylinder_terms(alpha, mp):
     """Reduced inertia of one cylinder's moving parts (piston, rod, crank throw) and its derivative.
 
@@ -75,7 +75,7 @@ def cylinder_terms(alpha, mp):
     return J, dJ, ds, dds
 
 
-@njit(cache=True)
+@kernel
 def crank_slider_terms(mp, phi, u, du):
     """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
 

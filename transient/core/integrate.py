@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .jit import kernel
+
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
@@ -64,7 +66,7 @@ EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutou
 PAIR_COMP = 100
 
 
-@njit(cache=True)
+@kernel
 def _error_norm(tab, K, h, y, y_new, rtol, atol, ix):
     """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
     the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5).
@@ -95,7 +97,7 @@ def _error_norm(tab, K, h, y, y_new, rtol, atol, ix):
     return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1))
 
 
-@njit(cache=True)
+@kernel
 def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """One Runge–Kutta step of size h from (x, y) with f = y′; K[0] must hold f.
 
@@ -120,7 +122,7 @@ def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     derivative(m, angle_mode, y_new, sel, sw, wk, K[ns])
 
 
-@njit(cache=True)
+@kernel
 def _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
     """Dense-output coefficients F (3 + tab.D rows × n) of the last step, after the extra stages
     (three for DOP853, none for DOPRI5; layout in :mod:`.tableaus`)."""
@@ -146,7 +148,7 @@ def _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
             F[3 + r, i] = h * acc
 
 
-@njit(cache=True)
+@kernel
 def _dense_eval(F, y, theta, out):
     """State at fraction θ ∈ [0, 1] of the last step."""
     n = y.shape[0]
@@ -161,7 +163,7 @@ def _dense_eval(F, y, theta, out):
         out[i] = y[i] + acc
 
 
-@njit(cache=True)
+@kernel
 def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
     """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
     pair comp − PAIR_COMP, else y[comp] − level."""
@@ -174,7 +176,7 @@ def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
     return yv[comp] - level
 
 
-@njit(cache=True)
+@kernel
 def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
     """θ ∈ (0, 1] where the event function crosses zero on the dense output.
 
@@ -187,7 +189,7 @@ def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
     return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)[0]
 
 
-@njit(cache=True)
+@kernel
 def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
     """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
     (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations)."""
@@ -222,7 +224,7 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
 N_MARGIN_SAMPLES = 4
 
 
-@njit(cache=True)
+@kernel
 def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
     """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
     holds the step's start and row N its end already)."""
@@ -236,7 +238,7 @@ def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
             gs[j, k] = wk[WK_G, k]
 
 
-@njit(cache=True)
+@kernel
 def _speed_crossing_inside(m, angle_mode, F, y, x, h, level, direction, ga, sel, sw, tmp, wk):
     """θ where the speed first crosses ``level`` (in ``direction``) inside a step whose ends are
     on the same side of it, sampled at θ = j/N_MARGIN_SAMPLES on the dense output; 2 if the
@@ -255,7 +257,7 @@ def _speed_crossing_inside(m, angle_mode, F, y, x, h, level, direction, ga, sel,
     return 2.0
 
 
-@njit(cache=True)
+@kernel
 def _pair_crossing(m, angle_mode, F, y, k, sel, sw, tmp, wk, gs):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
     margin evaluations (right-hand sides) the root finding took.
@@ -273,7 +275,7 @@ def _pair_crossing(m, angle_mode, F, y, k, sel, sw, tmp, wk, gs):
     return 2.0, 0
 
 
-@njit(cache=True)
+@kernel
 def next_breakpoint(bp, period, phi, upward):
     """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle."""
     tol = 1e-13 * max(1.0, abs(phi))
@@ -298,7 +300,7 @@ def next_breakpoint(bp, period, phi, upward):
 N_EVENT_KINDS = 7 + MAX_PAIRS
 
 
-@njit(cache=True)
+@kernel
 def _event_spec(m, cfg, e, angle_mode, sw):
     """State event number e that applies now: (code, component, level, direction), code −1 if
     none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
@@ -322,7 +324,7 @@ def _event_spec(m, cfg, e, angle_mode, sw):
     return -1, OMEGA, 0.0, 0
 
 
-@njit(cache=True)
+@kernel
 def _crosses(g0, g1, direction):
     """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
     rising = g0 < 0.0 <= g1
@@ -334,7 +336,7 @@ def _crosses(g0, g1, direction):
     return rising or falling
 
 
-@njit(cache=True)
+@kernel
 def _emit_event(m, evbuf, ist, code, y, wk):
     j = ist[I_NEV]
     if j < evbuf.shape[0]:
@@ -346,7 +348,7 @@ def _emit_event(m, evbuf, ist, code, y, wk):
         ist[I_NEV] = j + 1
 
 
-@njit(cache=True)
+@kernel
 def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
     output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
     ist[I_NOUT] += 1
@@ -354,12 +356,12 @@ def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
     fst[F_LAST_PHI] = y[PHI]
 
 
-@njit(cache=True)
+@kernel
 def _out_spacing(cfg, angle_mode):
     return cfg[C_DPHI_OUT] if angle_mode else cfg[C_DT_OUT]
 
 
-@njit(cache=True)
+@kernel
 def _reset_output_grid(cfg, ist, fst, y):
     """Next output sample: the first grid point of the current mode's grid beyond the state."""
     angle_mode = ist[I_ANGLE_MODE] == 1
@@ -668,7 +670,7 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
             _reset_output_grid(cfg, ist, fst, y)
 
 
-@njit(cache=True)
+@kernel
 def _to_angle_mode(m, y, ist, wk):
     """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
     J, _ = inertia(m, y[PHI], wk)
@@ -676,7 +678,7 @@ def _to_angle_mode(m, y, ist, wk):
     ist[I_ANGLE_MODE] = 1
 
 
-@njit(cache=True)
+@kernel
 def _to_time_mode(m, y, ist, wk):
     """Time becomes the independent variable; the third state becomes ω."""
     J, _ = inertia(m, y[PHI], wk)
@@ -684,7 +686,7 @@ def _to_time_mode(m, y, ist, wk):
     ist[I_ANGLE_MODE] = 0
 
 
-@njit(cache=True)
+@kernel
 def _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf):
     """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
     just switched sits on its level (margin 0). Any other pair already past its level here (two
@@ -707,7 +709,7 @@ def _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf):
         gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]
 
 
-@njit(cache=True)
+@kernel
 def _start_modes(m, y, sel, ist, wk):
     """Choose σ and the pair modes afresh (start, speed reversal; time domain); a rounding tie
     that the kernel had to resolve by its rule is counted (``I_NTIES``)."""
@@ -717,7 +719,7 @@ def _start_modes(m, y, sel, ist, wk):
     return status
 
 
-@njit(cache=True)
+@kernel
 def _locked(m, y, sel, outbuf, evbuf, ist, fst, wk):
     """End a run at rest that the pairs' friction holds (``model.choose_modes``): φ̈ = 0 from here,
     and nothing in the model depends on time explicitly, so the machine stays where it is."""
@@ -727,7 +729,7 @@ def _locked(m, y, sel, outbuf, evbuf, ist, fst, wk):
     return LOCKED
 
 
-@njit(cache=True)
+@kernel
 def _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk):
     """Write the final state as the last sample (unless it already is one, possibly in an
     already drained buffer) and an end event."""

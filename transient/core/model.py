@@ -19,9 +19,12 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow
+from .jit import kernel
+
+from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from .crank_slider import crank_slider_terms
 from .swash_plate import swash_terms
+from .tabulated import tabulated_terms
 from .tables import find_piece, table_eval
 
 #: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode). The first
@@ -43,8 +46,8 @@ W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION = range(4)
 N_SWITCHES = 4
 
-#: Mechanism kinds (``Model.kind``).
-CRANK_SLIDER, SWASH_PLATE = 0, 1
+#: Mechanism kinds (``Model.kind``); TABULATED: either, from its tables (``Model.kin_coef``).
+CRANK_SLIDER, SWASH_PLATE, TABULATED = 0, 1, 2
 
 #: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
 POWER_FLOW, PAPER = 0, 1
@@ -68,14 +71,15 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
 #: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
- WK_SPEED) = range(12)
-N_WK = 12
+ WK_SPEED, WK_SCRATCH) = range(13)
+N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
 
 Model = namedtuple(
     "Model",
     [
-        "kind",  # int: CRANK_SLIDER or SWASH_PLATE
+        "kind",  # int: CRANK_SLIDER, SWASH_PLATE or TABULATED
         "mech",  # float64[:]: the mechanism's packed parameters
+        "kin_coef",  # float64[1 + ncyl, n, 6]: the TABULATED kind's splines (transient.core.tabulated)
         "ncyl",  # int: number of cylinders (gas force points)
         "J0",  # float: constant inertia of shaft, flywheel and load [kg m²]
         "has_gas",  # bool
@@ -106,13 +110,13 @@ Model = namedtuple(
 )
 
 
-@njit(cache=True)
+@kernel
 def n_state(m):
     """Length of the state vector of model ``m``."""
     return N_STATE_BASE + m.n_pairs
 
 
-@njit(cache=True)
+@kernel
 def n_outputs(m):
     """Columns of an output row of model ``m``."""
     return N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
@@ -124,15 +128,17 @@ def work_array(m):
     return np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
 
 
-@njit(cache=True)
-def mechanism_terms(kind, mech, phi, u, du):
+@kernel(inline="always")
+def mechanism_terms(kind, mech, kin_coef, phi, u, du):
     """J(φ) and dJ/dφ of the mechanism's moving parts; fills ``u[k]``, ``du[k]`` per cylinder."""
+    if kind == TABULATED:
+        return tabulated_terms(kin_coef, phi, u, du)
     if kind == CRANK_SLIDER:
         return crank_slider_terms(mech, phi, u, du)
     return swash_terms(mech, phi, u, du)
 
 
-@njit(cache=True)
+@kernel(inline="always")
 def gas_value(m, k, phi, sel):
     """Table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
@@ -145,14 +151,14 @@ def gas_value(m, k, phi, sel):
     return value
 
 
-@njit(cache=True)
+@kernel(inline="always")
 def inertia(m, phi, wk):
     """Total reduced inertia J(φ) and dJ/dφ, (19) and (21); fills the rows u, u′ of ``wk``."""
-    J, dJ = mechanism_terms(m.kind, m.mech, phi, wk[WK_U], wk[WK_DU])
+    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, wk[WK_U], wk[WK_DU])
     return J + m.J0, dJ
 
 
-@njit(cache=True)
+@kernel(inline="always")
 def speed(J, angle_mode, y):
     """ω from the state: y[2] itself in time mode, √(2K/J) in crank-angle mode (ω > 0 there)."""
     if angle_mode:
@@ -160,7 +166,7 @@ def speed(J, angle_mode, y):
     return y[OMEGA]
 
 
-@njit(cache=True)
+@kernel
 def governor_branch(m, w, rising):
     """Branch of the droop characteristic at speed w: 0 full fuel (ω ≤ ω_a), 1 the droop line,
     2 no fuel (ω ≥ ω₁c); on a corner, the branch the motion enters (``rising``: ω increasing)."""
@@ -171,7 +177,7 @@ def governor_branch(m, w, rising):
     return 1
 
 
-@njit(cache=True)
+@kernel(inline="always")
 def fuel(m, w, branch):
     """Gas-force scale of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
     to 0 at ω_1c, 0 above; 1 without a governor. The branch is fixed for a whole step (a state
@@ -183,7 +189,7 @@ def fuel(m, w, branch):
     return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
 
 
-@njit(cache=True)
+@kernel(inline="always")
 def moments(m, angle_mode, y, sel, sw, wk):
     """Reduced inertia, speed and moments at state ``y``.
 
@@ -192,7 +198,7 @@ def moments(m, angle_mode, y, sel, sw, wk):
     """
     phi = y[PHI]
     u = wk[WK_U]
-    J, dJ = mechanism_terms(m.kind, m.mech, phi, u, wk[WK_DU])
+    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, u, wk[WK_DU])
     J += m.J0
     w = speed(J, angle_mode, y)
     M_gas = 0.0
@@ -207,7 +213,7 @@ def moments(m, angle_mode, y, sel, sw, wk):
     return J, dJ, w, M_gas, M_load, M_starter
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
     """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
 
@@ -231,14 +237,14 @@ def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
     wk[WK_M, m.link_sub[last]] += M_gas
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def pair_etas(m, modes, eta_out):
     """η*_k of (25) for the mode bit mask ``modes`` (bit k set: pair k backward)."""
     for k in range(m.n_pairs):
         eta_out[k] = eta_star(m.eta_fwd[k], m.eta_bwd[k], ((modes >> k) & 1) == 0)
 
 
-@njit(cache=True)
+@kernel
 def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)."""
     if m.n_pairs == 0:
@@ -246,7 +252,7 @@ def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
     and the pairs' η*, S in the rows of ``wk``."""
@@ -257,7 +263,7 @@ def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
                        wk[WK_S, :n])
 
 
-@njit(cache=True)
+@kernel
 def derivative(m, angle_mode, y, sel, sw, wk, out):
     """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
 
@@ -294,7 +300,7 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
         out[OMEGA] = a
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def mode_margins(m, sw, wk):
     """How far each pair's held mode is from switching, into ``wk[WK_G]`` (after
     :func:`acceleration`); a mode switch is due where a margin falls to zero.
@@ -314,7 +320,7 @@ def mode_margins(m, sw, wk):
             wk[WK_G, k] = v * sigma
 
 
-@njit(cache=True)
+@kernel
 def margins_at(m, angle_mode, y, sel, sw, wk):
     """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
@@ -322,7 +328,7 @@ def margins_at(m, angle_mode, y, sel, sw, wk):
     mode_margins(m, sw, wk)
 
 
-@njit(cache=True)
+@kernel
 def choose_modes(m, angle_mode, y, sel, sw, wk):
     """Choose σ and the pair modes afresh at state ``y`` (start of a run, speed reversal).
 
@@ -340,8 +346,10 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
         sw[SW_MODES] = 0
         return UNIQUE
     split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
-    a, status, _ = modes_power_flow(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1],
-                                    m.eta_fwd, m.eta_bwd, w, wk[WK_ETA, :n], wk[WK_S, :n])
+    a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
+                                         wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,
+                                         wk[WK_ETA, :n], wk[WK_S, :n],
+                                         wk[WK_SCRATCH: WK_SCRATCH + 4, :n])
     if status == LOCKED:
         return status
     if w != 0.0:
@@ -362,7 +370,7 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
     return status
 
 
-@njit(cache=True)
+@kernel
 def output_row(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value of each cylinder, then
     ``PAIR_OUTPUTS`` of each pair."""
@@ -385,7 +393,7 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
 
 
-@njit(cache=True)
+@kernel
 def pair_rows(m, w, w_loss, wk, out):
     """``PAIR_OUTPUTS`` of each pair from the rows η*, S of ``wk``; ``w_loss``: energy lost so far."""
     np_ = len(PAIR_OUTPUTS)
@@ -396,7 +404,7 @@ def pair_rows(m, w, w_loss, wk, out):
         out[np_ * k + 3] = w_loss[k]
 
 
-@njit(cache=True)
+@kernel
 def inverse_chain(m, a, w, sigma, wk):
     """Drive torque on the shaft and pair moments for a prescribed motion (φ̈ = a, φ̇ = w).
 

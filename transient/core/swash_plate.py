@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from math import atan2, cos, sin, sqrt
 
-from numba import njit
+from .jit import kernel
 
 #: Layout of the parameter array ``mp``, filled by
 #: ``transient.mechanisms.swash_plate.SwashPlate.pack``:
@@ -49,7 +49,7 @@ Y_D, Z_D, COS_PSI, SIN_PSI = range(4)
 CYL_STRIDE = 4
 
 
-@njit(cache=True)
+@kernel
 def hooke(mp, phi):
     """Link 9 and cross 13 at shaft angle φ [rad], from the Hooke constraint a ⊥ c.
 
@@ -75,7 +75,7 @@ def hooke(mp, phi):
     return theta, d1, d2, d1 * sa * s, sa * (d2 * s + d1 * c)
 
 
-@njit(cache=True)
+@kernel
 def joint_b(mp, k, c_phi, s_phi, c_theta, s_theta):
     """Centre (x, y, z) [m] of joint B_k on link 9, given cos/sin of the shaft angle φ and of θ."""
     r = mp[JOINT_R]
@@ -89,7 +89,7 @@ def joint_b(mp, k, c_phi, s_phi, c_theta, s_theta):
     return -r * cb * mp[SIN_A], c_phi * py - s_phi * pz, s_phi * py + c_phi * pz
 
 
-@njit(cache=True)
+@kernel
 def swash_points(mp, phi, theta, pts):
     """Positions of the joints of half 1 at the shaft angles ``phi``.
 
@@ -121,12 +121,12 @@ def swash_points(mp, phi, theta, pts):
             pts[j, k, 5] = zd
 
 
-@njit(cache=True)
+@kernel
 def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(cache=True)
+@kernel
 def swash_terms(mp, phi, u, du):
     """Reduced inertia of the moving parts except shaft and plates, eqs. (19), (21).
 

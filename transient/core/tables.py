@@ -22,10 +22,10 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from .jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def find_piece(knots, piece_knot, x):
     """Index of the piece that contains the angle `x`.
 
@@ -58,7 +58,7 @@ def find_piece(knots, piece_knot, x):
     return lo
 
 
-@njit(cache=True)
+@kernel
 def table_eval(knots, coef, piece_knot, piece, x):
     """Value and slope of the table at `x`, using the polynomials of `piece` only.
 
@@ -108,7 +108,7 @@ def table_eval(knots, coef, piece_knot, piece, x):
     return value, slope
 
 
-@njit(cache=True)
+@kernel
 def wrap_angle(x, period):
     """`x` reduced into ``[0, period)``.
 
@@ -133,7 +133,7 @@ def wrap_angle(x, period):
     return y
 
 
-@njit(cache=True)
+@kernel
 def table_value(knots, coef, piece_knot, x):
     """Table value at any angle `x`: wrap into the cycle, find the piece, evaluate.
 
