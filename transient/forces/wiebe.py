@@ -29,21 +29,25 @@ What is not modelled
 """
 from __future__ import annotations
 
+import inspect
+import itertools
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
+from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
 from transient.errors import SceneError
-from transient.forces.gas import PressureTable, table_from_function
+from transient.forces.gas import PressureTable
 
 __all__ = [
     "DEFAULT_A",
     "DEFAULT_M",
+    "DEFAULT_TOLERANCE",
     "WIEBE_STEP",
     "ClosedPart",
     "WiebeCycle",
@@ -57,18 +61,32 @@ __all__ = [
 #: the combustion duration (Vibe's usual choice).
 DEFAULT_A = 6.908
 
-#: Wiebe shape exponent. 0.5 is in the range quoted for single-Wiebe fits of direct-injection
-#: diesels (about 0.2–1; spark-ignition engines use about 2).
+#: Wiebe shape exponent: a typical single-Wiebe diesel value (fits of direct-injection diesels
+#: are usually quoted below 1, spark ignition near 2); set it from a measured heat release.
 DEFAULT_M = 0.5
 
-#: Default knot spacing of the tables [rad] (0.125°, as
-#: :data:`~transient.forces.gas.DEFAULT_STEP`). Measured on the Gots geometry with 0.05 g of
-#: fuel, a 50° combustion from 358° and m = 0.5 (``tests/validation/test_wiebe_cycle.py``):
-#: midpoint estimate 1.6e-10 of p_max; the motored cycle 4.8e-11.
+#: Default largest knot spacing of the tables [rad] (0.125°, as
+#: :data:`~transient.forces.gas.DEFAULT_STEP`), refined where needed to meet the tolerance.
+#: Measured on the Gots geometry (``tests/validation/test_wiebe_cycle.py``): with 0.05 g of
+#: fuel, a 50° combustion from 358° and m = 0.5 the uniform 0.125° grid errs by 2.6e-5 of p_max
+#: in its first interval after the combustion start (``p ∝ y**1.5`` there); refining to 1e-10
+#: takes 3110 knots instead of 2887. The motored cycle: 6.4e-10 uniform (at the TDC), 1e-10
+#: with 4 more knots.
 WIEBE_STEP = math.radians(0.125)
 
 #: Default relative tolerance of the closed-part integration (DOP853).
 DEFAULT_RTOL = 1e-12
+
+#: Default target of the tabulation error, relative to the cycle's largest pressure: intervals
+#: whose midpoint error exceeds it are halved (see :func:`_tabulate`). For m < 0 the pressure
+#: rises like ``y**(m + 1)`` with an infinite slope at the combustion start and the target is
+#: not met there (m = -0.5: 1.9e-5 with intervals down to 1e-9 rad);
+#: :attr:`WiebeCycle.interpolation_error` reports what was reached.
+DEFAULT_TOLERANCE = 1e-10
+
+# Knot intervals are not halved below this [rad]; at most this many halving rounds per piece.
+_MIN_SPACING = 1e-9
+_MAX_REFINE = 60
 
 # Angles read from degrees miss a corner by a few ulp; closer than this they are snapped onto it
 # (the same tolerance as transient.forces.gas).
@@ -319,8 +337,10 @@ class WiebeCycle(PressureTable):
     strokes : int
         2 or 4.
     interpolation_error : float
-        Relative tabulation error estimate of :func:`~transient.forces.gas.table_from_function`
-        (midpoint error over the largest pressure), against the dense ODE solution.
+        Tabulation error estimate: the largest ``|table - p|`` at the knot-interval midpoints
+        against the dense ODE solution, over the largest pressure (as
+        :func:`~transient.forces.gas.table_from_function` estimates it). A 4-points-per-interval
+        scan finds up to about 20 % more (end intervals of the not-a-knot splines).
     closed : ClosedPart
         The dense ODE solution (pressure and cumulative work), for checks.
     """
@@ -375,6 +395,7 @@ class _Setup:
     period: float
     ivc: float           # intake closing, table angle
     evo: float           # exhaust opening, unwrapped (> 2π for a 2-stroke)
+    evo_table: float     # exhaust opening, table angle (as given)
     start: float         # combustion start, unwrapped, in [ivc, evo)
     duration: float
     a: float
@@ -419,6 +440,13 @@ def _setup(*, strokes, p_a, start, duration, a, m, lhv, efficiency, gamma, gamma
     gamma_t_ref = _check_positive("gas.wiebe.gamma_t_ref", gamma_t_ref,
                                   "the reference temperature of γ(T) [K]")
     t_a = _check_positive("gas.wiebe.t_a", t_a, "the temperature at intake closing [K]")
+    # dT/dx ∝ γ(T) - 1 in this model, so a temperature where γ = 1 is never crossed: γ > 1 at
+    # intake closing keeps it > 1 over the whole cycle.
+    g_a = gamma + gamma_slope * (t_a - gamma_t_ref)
+    if not g_a > 1.0:
+        raise SceneError("gas.wiebe.gamma_slope",
+                         f"γ(T) = {gamma:g} + {gamma_slope:g}·(T - {gamma_t_ref:g} K) is {g_a:.4g} "
+                         f"at intake closing (T_a = {t_a:g} K); it must be > 1 there")
     if not (np.isfinite(step) and step > 0.0):
         raise SceneError("gas.wiebe.step_deg", f"knot spacing {step!r} rad; it must be > 0")
     if not (np.isfinite(rtol) and 1e-14 <= rtol <= 1e-6):
@@ -453,6 +481,8 @@ def _setup(*, strokes, p_a, start, duration, a, m, lhv, efficiency, gamma, gamma
                              f"after the port closing at {_deg(ivc)}")
         if abs(evo - ivc) <= tol:
             evo = ivc
+    evo_table = evo
+    if strokes == 2:
         evo += period  # the closed part runs through the firing TDC at 2π ≡ 0
 
     # Combustion start: moved by whole periods into [ivc, ivc + period) (a 2-stroke start of
@@ -477,7 +507,7 @@ def _setup(*, strokes, p_a, start, duration, a, m, lhv, efficiency, gamma, gamma
                          f"combustion from {_deg(s % period)} for {_deg(duration)} ends at "
                          f"{_deg(end % period)}, after the exhaust opening at "
                          f"{_deg(evo % period)}; it must end inside the closed part")
-    return _Setup(strokes=strokes, period=period, ivc=ivc, evo=evo, start=s,
+    return _Setup(strokes=strokes, period=period, ivc=ivc, evo=evo, evo_table=evo_table, start=s,
                   duration=end - s, a=a, m=m, lhv=lhv, efficiency=float(efficiency),
                   gamma=float(gamma), gamma_slope=float(gamma_slope), gamma_t_ref=gamma_t_ref,
                   t_a=t_a, p_a=p_a, p_intake=p_intake, p_exhaust=p_exhaust, step=float(step),
@@ -511,7 +541,7 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction,
     segments = []
     y0 = np.array([st.p_a, 0.0])
     atol = np.array([1e-3 * st.rtol * st.p_a, 1e-3 * st.rtol * st.p_a * v_a])
-    for lo, hi in zip(breaks[:-1], breaks[1:]):
+    for lo, hi in itertools.pairwise(breaks):
         burning = q_total > 0.0 and lo >= st.start and hi <= end
         power = st.m + 1.0 if burning and st.m < 0.0 else None
 
@@ -576,43 +606,34 @@ def _peak(closed: ClosedPart, volume: VolumeFunction, period: float
     return best_p, best_x, t_max
 
 
-def _check_gamma(st: _Setup, closed: ClosedPart, volume: VolumeFunction) -> None:
-    """γ(T) must stay > 1 over the temperatures the cycle reaches."""
-    if st.gamma_slope == 0.0:
-        return
-    t_lo, t_hi = math.inf, 0.0
-    for seg in closed.segments:
-        x = np.linspace(seg.lo, seg.hi, 2001)
-        xv = np.where(x > st.period, x - st.period, x)
-        t = closed.temperature(seg(x)[0], np.asarray(volume(xv)))
-        t_lo, t_hi = min(t_lo, float(t.min())), max(t_hi, float(t.max()))
-    for t in (t_lo, t_hi):
-        g = st.gamma + st.gamma_slope * (t - st.gamma_t_ref)
-        if not g > 1.0:
-            raise SceneError("gas.wiebe.gamma_slope",
-                             f"γ(T) = {st.gamma:g} + {st.gamma_slope:g}·(T - {st.gamma_t_ref:g} K) "
-                             f"falls to {g:.4g} at T = {t:.0f} K in this cycle; γ must stay > 1 "
-                             "between the lowest and highest temperature")
+@dataclass(frozen=True, eq=False)
+class _Solved:
+    """One integrated cycle before tabulation: its pieces and scalars."""
+
+    pieces: list            # (a, b, callable or float) in table angles, in order
+    scale: float            # largest pressure of the cycle [Pa]
+    fields: dict            # WiebeCycle fields other than the table's
 
 
-def _cycle(st: _Setup, fuel_mass: float, volume: VolumeFunction,
-           dvolume: VolumeFunction) -> WiebeCycle:
+def _solve(st: _Setup, fuel_mass: float, volume: VolumeFunction,
+           dvolume: VolumeFunction) -> _Solved:
+    """Integrate the closed part and describe the table pieces (not yet tabulated)."""
     period = st.period
     closed = _integrate(st, fuel_mass, volume, dvolume)
-    _check_gamma(st, closed, volume)
 
     def wrap(x: float) -> float:
-        return x - period if x > period else x
+        # Table angle of an unwrapped one; the exhaust opening exactly as given.
+        return st.evo_table if x == st.evo else (x - period if x > period else x)
 
-    # Table pieces (a, b, f) in table angles, each with a shift to the unwrapped closed angle.
+    # Table pieces (a, b, f) in table angles; a closed piece evaluates the dense solution at
+    # the unwrapped angle x + shift.
     pieces: list[tuple[float, float, object]] = []
 
-    def closed_piece(lo: float, hi: float, shift: float):
-        seg_index = int(np.clip(np.searchsorted(closed.breaks, lo + shift, side="right") - 1,
-                                0, len(closed.segments) - 1))
-        seg = closed.segments[seg_index]
+    def closed_piece(lo: float, hi: float, shift: float) -> None:
+        k = int(np.clip(np.searchsorted(closed.breaks, 0.5 * (lo + hi) + shift, side="right") - 1,
+                        0, len(closed.segments) - 1))
 
-        def f(x, seg=seg, shift=shift):
+        def f(x, seg=closed.segments[k], shift=shift):
             return seg(np.asarray(x, dtype=np.float64) + shift)[0]
         pieces.append((lo, hi, f))
 
@@ -624,24 +645,18 @@ def _cycle(st: _Setup, fuel_mass: float, volume: VolumeFunction,
     else:
         # Split the closed part at the period end 2π ≡ 0 (the firing TDC).
         cuts = sorted(set(closed.breaks.tolist()) | {period})
-        after, before = [], []
-        for lo, hi in zip(cuts[:-1], cuts[1:]):
+        spans = list(itertools.pairwise(cuts))
+        for lo, hi in spans:                               # 0 → exhaust opening
+            if hi > period:
+                closed_piece(lo - period, wrap(hi), period)
+        if st.evo_table < st.ivc:                          # scavenging at p_a
+            pieces.append((st.evo_table, st.ivc, st.p_a))
+        for lo, hi in spans:                               # intake closing → 2π
             if hi <= period:
-                before.append((lo, hi))
-            else:
-                after.append((lo, hi))
-        for lo, hi in after:                               # 0 → exhaust opening
-            closed_piece(lo - period, hi - period, period)
-        if st.evo - period < st.ivc:                       # scavenging at p_a
-            pieces.append((st.evo - period, st.ivc, st.p_a))
-        for lo, hi in before:                              # intake closing → 2π
-            closed_piece(lo, hi, 0.0)
-    corners = [a for a, _, _ in pieces[1:]]
-    table, err = table_from_function([f for _, _, f in pieces], period, corners, st.step)
+                closed_piece(lo, hi, 0.0)
 
     p_w_end = closed(np.array([st.evo]))
     closed_work = float(p_w_end[1][0])
-    p_end = float(p_w_end[0][0])
     v_a = closed.v_a
     v_b = _scalar(volume, wrap(st.evo))
     if st.strokes == 4:
@@ -653,22 +668,109 @@ def _cycle(st: _Setup, fuel_mass: float, volume: VolumeFunction,
         v_c = _scalar(volume, 0.0)
     p_max, x_max, t_max = _peak(closed, volume, period)
     end = st.start + st.duration
-    xb = float(_fraction_y(np.array((st.evo - st.start) / st.duration), st.a, st.m))
     if st.evo >= end:
         xb = float(-np.expm1(-st.a))
-    cycle = WiebeCycle(knots=table.knots, coef=table.coef, piece_knot=table.piece_knot,
-                       period=period, work=work, closed_work=closed_work, p_max=p_max,
-                       angle_max=wrap(x_max) % period, t_max=t_max, burned_fraction=xb,
-                       heat_released=fuel_mass * st.lhv * st.efficiency * xb, p_end=p_end,
-                       v_a=v_a, v_b=v_b, v_c=v_c, v_h=_scalar(volume, math.pi) - v_c,
-                       intake_closing=st.ivc,
-                       exhaust_opening=wrap(st.evo) % period,
-                       combustion_start=wrap(st.start) % period,
-                       combustion_end=wrap(end) % period, fuel_mass=fuel_mass,
-                       strokes=st.strokes, interpolation_error=err, closed=closed)
-    return cycle
+    else:
+        xb = float(_fraction_y(np.array((st.evo - st.start) / st.duration), st.a, st.m))
+    fields = {"work": work, "closed_work": closed_work, "p_max": p_max,
+              "angle_max": wrap(x_max) % period, "t_max": t_max, "burned_fraction": xb,
+              "heat_released": fuel_mass * st.lhv * st.efficiency * xb,
+              "p_end": float(p_w_end[0][0]), "v_a": v_a, "v_b": v_b, "v_c": v_c,
+              "v_h": _scalar(volume, math.pi) - v_c, "intake_closing": st.ivc,
+              "exhaust_opening": st.evo_table, "combustion_start": wrap(st.start) % period,
+              "combustion_end": wrap(end) % period, "fuel_mass": fuel_mass,
+              "strokes": st.strokes, "closed": closed}
+    scale = max(p_max, st.p_a, *(v for v in (st.p_intake, st.p_exhaust) if np.isfinite(v)))
+    return _Solved(pieces=pieces, scale=scale, fields=fields)
 
 
+def _spline_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Ascending local cubic coefficients (n, 4) of the spline through (x, y).
+
+    Not-a-knot, as :func:`~transient.forces.gas.table_from_function` (natural with 2 points,
+    i.e. the straight line).
+    """
+    spline = CubicSpline(x, y, bc_type="not-a-knot" if x.size > 2 else "natural")
+    return np.ascontiguousarray(spline.c[::-1].T, dtype=np.float64)
+
+
+def _tabulate(solved: Sequence[_Solved], period: float, step: float, tolerance: float
+              ) -> list[tuple[PressureTable, float]]:
+    """Tables of several cycles on common knots, refined until the midpoint error is small.
+
+    Every piece starts with the fewest equal intervals not longer than `step`. Then every
+    interval whose midpoint error ``|spline - f|`` exceeds `tolerance` times the cycle's largest
+    pressure, for any of the cycles, is halved, until none does or the interval is shorter than
+    :data:`_MIN_SPACING` (the heat-release rate ``∝ y**m`` makes ``p ∝ y**(m + 1)`` near the
+    combustion start, which a uniform cubic cannot follow for non-integer m).
+
+    Returns
+    -------
+    list of (table, rel_error)
+        rel_error: the largest midpoint error over the cycle's largest pressure.
+    """
+    n_cycles = len(solved)
+    knots: list[NDArray[np.float64]] = []
+    coefs: list[list[NDArray[np.float64]]] = [[] for _ in range(n_cycles)]
+    errors = np.zeros(n_cycles)
+    n_pieces = len(solved[0].pieces)
+    for j in range(n_pieces):
+        a, b, _ = solved[0].pieces[j]
+        funcs = [s.pieces[j][2] for s in solved]
+        if not callable(funcs[0]):
+            knots.append(np.array([a, b]))
+            for i, f in enumerate(funcs):
+                coefs[i].append(np.array([[float(f), 0.0, 0.0, 0.0]]))
+            continue
+        n = max(1, math.ceil((b - a) / step * (1.0 - 1e-12)))
+        x = np.linspace(a, b, n + 1)
+        for _ in range(_MAX_REFINE):
+            h = np.diff(x)
+            xm = x[:-1] + 0.5 * h
+            piece_coef, piece_err = [], []
+            bad = np.zeros(h.size, dtype=bool)
+            for s, f in zip(solved, funcs):
+                c = _spline_coef(x, f(x))
+                hm = 0.5 * h
+                tm = c[:, 0] + hm * (c[:, 1] + hm * (c[:, 2] + hm * c[:, 3]))
+                e = np.abs(tm - f(xm)) / s.scale
+                piece_coef.append(c)
+                piece_err.append(e)
+                bad |= e > tolerance
+            bad &= h > 2.0 * _MIN_SPACING
+            if not np.any(bad):
+                break
+            x = np.sort(np.concatenate([x, xm[bad]]))
+        knots.append(x)
+        for i in range(n_cycles):
+            coefs[i].append(piece_coef[i])
+            errors[i] = max(errors[i], float(np.max(piece_err[i])))
+    all_knots = np.concatenate([knots[0]] + [k[1:] for k in knots[1:]])
+    piece_knot = np.concatenate([[0], np.cumsum([k.size - 1 for k in knots])]).astype(np.int64)
+    return [(PressureTable(knots=all_knots, coef=np.vstack(coefs[i]), piece_knot=piece_knot,
+                           period=period), float(errors[i])) for i in range(n_cycles)]
+
+
+def _cycles(volume: VolumeFunction, fuel_levels: Sequence[float], *, p_a, start, duration, a,
+            m, lhv, efficiency, gamma, gamma_slope, gamma_t_ref, t_a, p_intake, p_exhaust,
+            strokes, intake_closing, exhaust_opening, dvolume, step, tolerance,
+            rtol) -> tuple[WiebeCycle, ...]:
+    """Validate, integrate and tabulate the cycles of `fuel_levels` on common knots."""
+    st = _setup(strokes=strokes, p_a=p_a, start=start, duration=duration, a=a, m=m, lhv=lhv,
+                efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
+                gamma_t_ref=gamma_t_ref, t_a=t_a, p_intake=p_intake, p_exhaust=p_exhaust,
+                intake_closing=intake_closing, exhaust_opening=exhaust_opening, step=step,
+                rtol=rtol)
+    if not (np.isfinite(tolerance) and 1e-13 <= tolerance <= 1e-3):
+        raise SceneError("gas.wiebe.tolerance", f"{tolerance!r}; the relative tabulation "
+                                                "tolerance must be in [1e-13, 1e-3]")
+    _check_volume(st, volume)
+    dvolume = dvolume or _volume_derivative(volume)
+    solved = [_solve(st, float(q), volume, dvolume) for q in fuel_levels]
+    tables = _tabulate(solved, st.period, st.step, float(tolerance))
+    return tuple(WiebeCycle(knots=t.knots, coef=t.coef, piece_knot=t.piece_knot,
+                            period=st.period, interpolation_error=err, **s.fields)
+                 for s, (t, err) in zip(solved, tables))
 
 
 def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: float,
@@ -679,7 +781,8 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
                 strokes: int = 4, intake_closing: float | None = None,
                 exhaust_opening: float | None = None,
                 dvolume: VolumeFunction | None = None, step: float = WIEBE_STEP,
-                rtol: float = DEFAULT_RTOL) -> WiebeCycle:
+                tolerance: float = DEFAULT_TOLERANCE, rtol: float = DEFAULT_RTOL
+                ) -> WiebeCycle:
     """Single-zone Wiebe cycle tabulated against the local crank angle.
 
     From intake closing to exhaust opening the pressure solves
@@ -726,7 +829,10 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
         Heat capacity ratio γ > 1; with `gamma_slope` it is γ at `gamma_t_ref`.
     gamma_slope : float
         dγ/dT [1/K]: ``γ(T) = gamma + gamma_slope·(T - gamma_t_ref)``. 0 (default) for a
-        constant γ; air-like mixtures fall about 1e-4 per K. γ(T) must stay > 1 over the cycle.
+        constant γ; air-like mixtures fall about 1e-4 per K. γ(T_a) must be > 1; then γ stays
+        > 1, because ``dT/dx ∝ γ(T) - 1`` makes a temperature with γ = 1 unreachable (it is
+        approached with an ever larger c_v: choose a line that stays well above 1 up to the
+        peak temperature, :attr:`WiebeCycle.t_max`).
     gamma_t_ref : float
         Reference temperature of γ(T) [K].
     t_a : float
@@ -747,7 +853,12 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
         π for a 2-stroke). 4-stroke: in (2π, 4π); 2-stroke: in (0, intake_closing]; between the
         two a 2-stroke is at `p_a`.
     step : float
-        Knot spacing of the table [rad], see :func:`~transient.forces.gas.table_from_function`.
+        Largest knot spacing of the table [rad]: each piece starts with the fewest equal
+        intervals not longer than it (as :func:`~transient.forces.gas.table_from_function`).
+    tolerance : float
+        Target tabulation error relative to the largest pressure: an interval whose midpoint
+        error against the dense ODE solution exceeds it is halved, down to 1e-9 rad. Needed
+        near the combustion start for non-integer m, where ``p - p_smooth ∝ y**(m + 1)``.
     rtol : float
         Relative tolerance of the DOP853 integration (absolute tolerances 1e-3·rtol of the
         intake-closing pressure and of ``p_a V_a``).
@@ -765,21 +876,21 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
         ``gas.wiebe.fuel_mass``, ``gas.wiebe.start_deg`` (combustion starting outside the
         closed part), ``gas.wiebe.duration_deg`` (≤ 0, or ending after exhaust opening),
         ``gas.wiebe.a``, ``gas.wiebe.m``, ``gas.wiebe.lhv``, ``gas.wiebe.efficiency``,
-        ``gas.wiebe.gamma``, ``gas.wiebe.gamma_slope`` (also when γ(T) reaches 1 in the cycle),
+        ``gas.wiebe.gamma``, ``gas.wiebe.gamma_slope`` (also when γ(T_a) ≤ 1),
         ``gas.wiebe.gamma_t_ref``, ``gas.wiebe.t_a``, ``gas.wiebe.intake_closing_deg``,
-        ``gas.wiebe.exhaust_opening_deg``, ``gas.wiebe.step_deg``; ``gas.compression_ratio``
+        ``gas.wiebe.exhaust_opening_deg``, ``gas.wiebe.step_deg``, ``gas.wiebe.tolerance``;
+        ``gas.compression_ratio``
         if the volume is not positive over the closed part.
     """
-    st = _setup(strokes=strokes, p_a=p_a, start=start, duration=duration, a=a, m=m, lhv=lhv,
-                efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
-                gamma_t_ref=gamma_t_ref, t_a=t_a, p_intake=p_intake, p_exhaust=p_exhaust,
-                intake_closing=intake_closing, exhaust_opening=exhaust_opening, step=step,
-                rtol=rtol)
     if fuel_mass is None or not (np.isfinite(fuel_mass) and fuel_mass >= 0.0):
         raise SceneError("gas.wiebe.fuel_mass",
                          f"{fuel_mass!r} kg; the fuel mass per cycle must be finite and ≥ 0")
-    _check_volume(st, volume)
-    return _cycle(st, float(fuel_mass), volume, dvolume or _volume_derivative(volume))
+    return _cycles(volume, [float(fuel_mass)], p_a=p_a, start=start, duration=duration, a=a,
+                   m=m, lhv=lhv, efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
+                   gamma_t_ref=gamma_t_ref, t_a=t_a, p_intake=p_intake, p_exhaust=p_exhaust,
+                   strokes=strokes, intake_closing=intake_closing,
+                   exhaust_opening=exhaust_opening, dvolume=dvolume, step=step,
+                   tolerance=tolerance, rtol=rtol)[0]
 
 
 def wiebe_tables(volume: VolumeFunction, fuel_levels: Sequence[float], **cycle
@@ -825,7 +936,12 @@ def wiebe_tables(volume: VolumeFunction, fuel_levels: Sequence[float], **cycle
         k = back[0]
         raise SceneError("gas.wiebe.fuel_levels", f"{levels[k + 1]!r} kg follows {levels[k]!r} kg;"
                                                    " fuel levels must increase strictly")
-    return tuple(wiebe_cycle(volume, fuel_mass=float(q), **cycle) for q in levels)
+    # The defaults live in wiebe_cycle's signature only.
+    args = inspect.signature(wiebe_cycle).bind(volume, fuel_mass=0.0, **cycle)
+    args.apply_defaults()
+    kwargs = dict(args.arguments)
+    del kwargs["volume"], kwargs["fuel_mass"]
+    return _cycles(volume, levels.tolist(), **kwargs)
 
 
 def _check_volume(st: _Setup, volume: VolumeFunction) -> None:
