@@ -7,8 +7,10 @@ For each benchmark scene (:data:`BENCH_SCENES`), over ``revolutions`` (1000):
   the compiled DOP853 in time at the same tolerance (a different independent variable, state and
   error control); their difference is reported and bounds what the errors below can resolve;
 * a sweep of rtol 1e-3 … 1e-12 (atol = rtol/1000, :data:`ATOL_PER_RTOL`) for transient's compiled
-  DOP853 in crank angle (the default) and in time, each timed as the median of ``repeat`` runs
-  after a warm-up, the compile (or cache load) apart, integration loop only (``/solver wall_s``);
+  paths (:data:`ADAPTIVE`: DOP853 and DOPRI5 in crank angle and in time, DOP853 with the tabulated
+  reduced model), and a sweep of the step for the fixed-step DOP853 with tables (:data:`FIXED`,
+  :data:`STEPS_PER_REV`), each timed as the median of ``repeat`` runs after a warm-up, the compile
+  (or cache load) apart, integration loop only (``/solver wall_s``);
 * baselines in the same run: ``scipy.integrate.solve_ivp`` RK45 and DOP853 with the plain-numpy
   right-hand side of :mod:`transient.reference` (breakpoints as terminal events, only the state
   kept), one run each (they take seconds to minutes), from loose to tight until a run is stopped
@@ -57,14 +59,31 @@ REF_RTOL = 1e-13
 TARGET_PHASE = 1e-6
 SAMPLES_PER_REV = 72
 
-COLUMNS = ("scene", "method", "rtol", "wall_s", "compile_s", "repeats", "nfev", "nsteps",
-           "nreject", "phase_err_rad", "omega_rel_err", "omega_l2_rel_err")
+#: transient's compiled paths in the sweep: label → solver settings. Adaptive ones sweep rtol.
+ADAPTIVE = {
+    "transient DOP853 (crank angle)": {"method": "dop853"},
+    "transient DOP853 (time)": {"method": "dop853", "domain": "time"},
+    "transient DOPRI5 (crank angle)": {"method": "dopri5"},
+    "transient DOPRI5 (time)": {"method": "dopri5", "domain": "time"},
+    "transient DOP853 tabulated (crank angle)": {"method": "dop853", "kinematics": "tabulated"},
+}
+#: The fixed-step path sweeps the step instead: 2π/N for these N (steps per revolution); its
+#: tables are made to 1e-12 (``table_tolerance``), near the splines' floor.
+FIXED = {"transient DOP853 fixed step, tabulated (crank angle)":
+         {"method": "dop853", "kinematics": "tabulated", "table_tolerance": 1e-12}}
+STEPS_PER_REV = (16, 32, 64, 128, 256, 512, 1024)
+#: The label of the default path, against which the others' speed is stated.
+DEFAULT = "transient DOP853 (crank angle)"
+
+COLUMNS = ("scene", "method", "rtol", "step_rad", "wall_s", "compile_s", "repeats", "nfev",
+           "nsteps", "nreject", "phase_err_rad", "omega_rel_err", "omega_l2_rel_err")
 
 
-def _scene(base, method, rtol, revolutions, time_domain=False, dt=0.0):
-    solver = dc.replace(base.solver, method=method, rtol=rtol, atol=rtol * ATOL_PER_RTOL)
-    if time_domain:
-        solver = dc.replace(solver, domain="time")
+def _scene(base, method, rtol, revolutions, dt=0.0, **solver):
+    """``base`` over ``revolutions`` with a method, rtol (atol = rtol·ATOL_PER_RTOL) and any other
+    solver settings; output at SAMPLES_PER_REV per turn (or every ``dt`` in time)."""
+    solver = dc.replace(base.solver, method=method, rtol=rtol, atol=rtol * ATOL_PER_RTOL,
+                        **solver)
     return dc.replace(base, run=dc.replace(base.run, revolutions=revolutions, t_end=math.inf),
                       solver=solver, output=dc.replace(base.output,
                                                        samples_per_rev=SAMPLES_PER_REV, dt=dt))
@@ -113,8 +132,8 @@ def reference(base, revolutions) -> Reference:
     tr = data.trajectory
     phi, w = _tail(tr, cycle)
     ref = Reference(tr["t"][-1], tr["omega"][-1], tr["phi"][-1], phi, w)
-    check = integrate(_scene(base, "dop853", REF_RTOL, revolutions, time_domain=True,
-                             dt=_dt(base, ref)), keep=False).trajectory
+    check = integrate(_scene(base, "dop853", REF_RTOL, revolutions, dt=_dt(base, ref),
+                             domain="time"), keep=False).trajectory
     ref.confirm_phase = abs(ref.omega_end * (check["t"][-1] - ref.t_end))
     ref.confirm_omega = abs(check["omega"][-1] / ref.omega_end - 1.0)
     return ref
@@ -125,13 +144,18 @@ def _dt(base, ref: Reference) -> float:
     return 2.0 * math.pi / (SAMPLES_PER_REV * abs(ref.omega_end))
 
 
-def _row(name, method, rtol, wall, compile_s, repeats, solver, errors):
-    return dict(zip(COLUMNS, (name, method, rtol, wall, compile_s, repeats, solver.get("nfev", 0),
-                              solver.get("nsteps", 0), solver.get("nreject", 0), *errors)))
+def _row(name, method, rtol, wall, compile_s, repeats, solver, errors, step=0.0):
+    return dict(zip(COLUMNS, (name, method, rtol, step, wall, compile_s, repeats,
+                              solver.get("nfev", 0), solver.get("nsteps", 0),
+                              solver.get("nreject", 0), *errors)))
 
 
-def _compiled(name, base, ref, rtol, revolutions, repeat, time_domain):
-    scene = _scene(base, "dop853", rtol, revolutions, time_domain, _dt(base, ref))
+def _compiled(name, base, ref, label, settings, rtol, revolutions, repeat, step=0.0):
+    """One compiled path (``settings``: solver fields) at one rtol or fixed step [rad]."""
+    time_domain = settings.get("domain") == "time"
+    settings = dict(settings, fixed_step=step)
+    scene = _scene(base, settings.pop("method"), rtol, revolutions,
+                   _dt(base, ref) if time_domain else 0.0, **settings)
     first = integrate(scene, keep=False)
     walls, data = [], None
     for _ in range(repeat):
@@ -141,13 +165,13 @@ def _compiled(name, base, ref, rtol, revolutions, repeat, time_domain):
     # with 8× denser output, so that the spline through them adds nothing measurable; its step
     # bound follows the output spacing, so its steps may differ slightly).
     end = data.trajectory
-    full = integrate(dc.replace(scene, output=dc.replace(scene.output, dt=scene.output.dt / 8)))
+    full = integrate(dc.replace(scene, output=dc.replace(scene.output, dt=scene.output.dt / 8))
+                     if time_domain else scene)
     tr = full.trajectory
     phase, w_err = _end_errors(ref, end["t"][-1], end["omega"][-1])
     l2 = _l2_error(ref, tr["phi"], tr["omega"])
-    method = "transient DOP853 (time)" if time_domain else "transient DOP853 (crank angle)"
-    return _row(name, method, rtol, statistics.median(walls), first.solver["compile_s"], repeat,
-                data.solver, (phase, w_err, l2))
+    return _row(name, label, 0.0 if step else rtol, statistics.median(walls),
+                first.solver["compile_s"], repeat, data.solver, (phase, w_err, l2), step)
 
 
 class OverBudget(Exception):
@@ -239,7 +263,8 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
 
 def run_bench(scenes=None, revolutions=1000.0, tolerances=TOLERANCES, repeat=5,
               baselines=True, out="results/benchmarks", baseline_budget=30.0,
-              baseline_tolerances=None, progress=print) -> list[dict]:
+              baseline_tolerances=None, progress=print, steps_per_rev=STEPS_PER_REV
+              ) -> list[dict]:
     """Measure every (scene, method, rtol); write ``work_precision.csv``, one figure per scene
     and ``work_precision.md`` into ``out``; return the rows."""
     scenes = scenes or BENCH_SCENES
@@ -250,9 +275,15 @@ def run_bench(scenes=None, revolutions=1000.0, tolerances=TOLERANCES, repeat=5,
         refs[name] = ref = reference(base, revolutions)
         progress(f"{name}: reference in {time.perf_counter() - t0:.1f} s (time-domain check: "
                  f"phase {ref.confirm_phase:.1e} rad, ω {ref.confirm_omega:.1e})")
-        for time_domain in (False, True):
+        for label, settings in ADAPTIVE.items():
             for rtol in tolerances:
-                rows.append(_compiled(name, base, ref, rtol, revolutions, repeat, time_domain))
+                rows.append(_compiled(name, base, ref, label, settings, rtol, revolutions,
+                                      repeat))
+                progress(_line(rows[-1]))
+        for label, settings in FIXED.items():
+            for n in steps_per_rev:
+                rows.append(_compiled(name, base, ref, label, settings, base.solver.rtol,
+                                      revolutions, repeat, step=2.0 * math.pi / n))
                 progress(_line(rows[-1]))
         if baselines and cyrk_available():
             for rtol in tolerances:
@@ -277,7 +308,9 @@ def run_bench(scenes=None, revolutions=1000.0, tolerances=TOLERANCES, repeat=5,
 
 
 def _line(r) -> str:
-    return (f"  {r['scene']} | {r['method']} | rtol {r['rtol']:.0e} | {r['wall_s']:.4g} s | "
+    how = (f"step {math.degrees(r['step_rad']):.3g}°" if r["step_rad"] else
+           f"rtol {r['rtol']:.0e}")
+    return (f"  {r['scene']} | {r['method']} | {how} | {r['wall_s']:.4g} s | "
             f"phase {r['phase_err_rad']:.2e} rad | ω {r['omega_rel_err']:.2e} | "
             f"L2 {r['omega_l2_rel_err']:.2e}")
 
@@ -301,9 +334,10 @@ def at_target(rows, scene, method, target=TARGET_PHASE):
 
 
 def order_slope(rows, scene, method, floor):
-    """Least-squares slope of log(phase error) against log(rtol) over the runs whose error is
-    above 100× ``floor`` (the reference's own uncertainty)."""
-    pts = [(math.log10(r["rtol"]), math.log10(r["phase_err_rad"])) for r in rows
+    """Least-squares slope of log(phase error) against log(rtol) — or against log(step) for a
+    fixed-step path — over the runs whose error is above 100× ``floor`` (the reference's own
+    uncertainty)."""
+    pts = [(math.log10(r["step_rad"] or r["rtol"]), math.log10(r["phase_err_rad"])) for r in rows
            if r["scene"] == scene and r["method"] == method and r["phase_err_rad"] > 100 * floor]
     if len(pts) < 3:
         return math.nan
@@ -321,8 +355,8 @@ def _merge_earlier(rows, refs, out: Path):
     keep = {name: Reference(phi_grid=np.zeros(0), omega_grid=np.zeros(0), **r)
             for name, r in earlier.items() if name not in refs}
     with open(csv_path, newline="") as fh:
-        old = [{k: (v if k in ("scene", "method") else float(v)) for k, v in r.items()}
-               for r in csv.DictReader(fh) if r["scene"] in keep]
+        old = [{k: (r.get(k, "0") if k in ("scene", "method") else float(r.get(k) or 0.0))
+                for k in COLUMNS} for r in csv.DictReader(fh) if r["scene"] in keep]
     return old + rows, {**keep, **refs}
 
 
@@ -348,9 +382,10 @@ def write_record(rows, refs, out: Path, revolutions) -> None:
                   f"time differs by {ref.confirm_phase:.1e} rad in phase and "
                   f"{ref.confirm_omega:.1e} in final ω.", "",
                   "| method | wall at ≤ 1e-6 rad [s] | how | × transient (crank angle) | "
-                  "slope of log(error) against log(rtol) |", "|---|---|---|---|---|"]
+                  "slope of log(error) against log(rtol), fixed step: log(step) |",
+                  "|---|---|---|---|---|"]
         methods = sorted({r["method"] for r in rows if r["scene"] == scene})
-        base_wall, _ = at_target(rows, scene, "transient DOP853 (crank angle)")
+        base_wall, _ = at_target(rows, scene, DEFAULT)
         for m in methods:
             wall, how = at_target(rows, scene, m)
             lines.append(f"| {m} | {wall:.4g} | {how} | {wall / base_wall:.3g} | "
@@ -369,7 +404,7 @@ def _figures(rows, out: Path) -> None:
         fig, axes = plt.subplots(1, 2, figsize=(12, 5))
         for m in sorted({r["method"] for r in rows if r["scene"] == scene}):
             sel = sorted((r for r in rows if r["scene"] == scene and r["method"] == m),
-                         key=lambda r: -r["rtol"])
+                         key=lambda r: -(r["step_rad"] or r["rtol"]))
             for ax, key in zip(axes, ("phase_err_rad", "omega_l2_rel_err")):
                 ax.loglog([r["wall_s"] for r in sel], [max(r[key], 1e-17) for r in sel], "o-",
                           label=m, ms=4)

@@ -147,7 +147,7 @@ def cmd_bench(args) -> int:
     if args.quick:
         run_bench(scenes, revolutions=10.0, tolerances=(1e-4, 1e-6, 1e-8), repeat=1,
                   baselines=not args.no_baselines, out=args.output, baseline_budget=5.0,
-                  baseline_tolerances=(1e-4,))
+                  baseline_tolerances=(1e-4,), steps_per_rev=(32, 128))
     else:
         run_bench(scenes, args.revolutions, repeat=args.repeat, baselines=not args.no_baselines,
                   out=args.output, baseline_budget=args.baseline_budget,

@@ -700,20 +700,25 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     """The harness end to end on 3 revolutions (CI's smoke test: outputs and error measures,
     never timings): every scene and method has rows, errors are finite, the compiled paths'
     phase error falls as the tolerance tightens, and the record's files are written."""
-    from transient.bench import BENCH_SCENES, COLUMNS, run_bench
+    from transient.bench import ADAPTIVE, BENCH_SCENES, COLUMNS, FIXED, run_bench
 
     rows = run_bench(BENCH_SCENES, revolutions=3.0, tolerances=(1e-4, 1e-8), repeat=1,
                      out=tmp_path, baseline_budget=5.0, baseline_tolerances=(1e-4,),
-                     progress=lambda line: None)
+                     progress=lambda line: None, steps_per_rev=(16, 256))
     for scene in BENCH_SCENES:
         methods = {r["method"] for r in rows if r["scene"] == scene}
-        assert {"transient DOP853 (crank angle)", "transient DOP853 (time)",
-                "solve_ivp RK45 (numpy RHS)", "solve_ivp DOP853 (numpy RHS)"} <= methods
-        for m in ("transient DOP853 (crank angle)", "transient DOP853 (time)"):
+        assert {*ADAPTIVE, *FIXED, "solve_ivp RK45 (numpy RHS)",
+                "solve_ivp DOP853 (numpy RHS)"} <= methods
+        for m in ADAPTIVE:
             err = {r["rtol"]: r["phase_err_rad"] for r in rows
                    if r["scene"] == scene and r["method"] == m}
             # (over 3 revolutions a smooth scene may be resolved to ~1e-9 rad at both)
             assert err[1e-8] < err[1e-4] or max(err.values()) < 1e-7, (scene, m, err)
+        for m in FIXED:
+            err = {r["step_rad"]: r["phase_err_rad"] for r in rows
+                   if r["scene"] == scene and r["method"] == m}
+            assert sorted(err) == pytest.approx([2 * np.pi / 256, 2 * np.pi / 16])
+            assert min(err, key=err.get) == min(err) or max(err.values()) < 1e-7, (scene, err)
     for r in rows:
         assert set(r) == set(COLUMNS)
         assert all(np.isfinite(r[k]) and r[k] >= 0 for k in ("phase_err_rad", "omega_rel_err",

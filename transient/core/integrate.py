@@ -29,6 +29,7 @@ from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW
 
 # Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+PI_BETA = 0.04
 
 # cfg[...] — settings (float64 array, filled by transient.simulate)
 C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range(8)
@@ -36,7 +37,8 @@ C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS, C_FIXED_STEP = range(8, 12)
 N_CFG = 12
 # fst[...] — float stepper state kept between chunks
 F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH = range(8)
-N_FST = 8
+F_ERR_OLD = 8  # the last accepted step's error norm (≥ 1e-4), for the PI step-size control
+N_FST = 9
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
 BP_LANDING = 1e-7
@@ -105,21 +107,20 @@ def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """
     n = y.shape[0]
     ns = tab.n_stages
-    for s in range(1, ns):
+    # Stage ns is the derivative at the new state (FSAL: row ns of A holds B). One call site, as
+    # ``model.derivative`` is inlined wherever it is called.
+    for s in range(1, ns + 1):
         for i in range(n):
             acc = 0.0
             for j in range(s):
                 acc += tab.A[s, j] * K[j, i]
             tmp[i] = y[i] + h * acc
+        if s == ns:
+            # The independent variable advances exactly (exact stops on breakpoints).
+            tmp[PHI if angle_mode else T] = x + h
+            for i in range(n):
+                y_new[i] = tmp[i]
         derivative(m, angle_mode, tmp, sel, sw, wk, K[s])
-    for i in range(n):
-        acc = 0.0
-        for j in range(ns):
-            acc += tab.B[j] * K[j, i]
-        y_new[i] = y[i] + h * acc
-    # The independent variable advances exactly (exact stops on breakpoints).
-    y_new[PHI if angle_mode else T] = x + h
-    derivative(m, angle_mode, y_new, sel, sw, wk, K[ns])
 
 
 @kernel
@@ -300,7 +301,7 @@ def next_breakpoint(bp, period, phi, upward):
 N_EVENT_KINDS = 7 + MAX_PAIRS
 
 
-@kernel
+@kernel(inline="always")
 def _event_spec(m, cfg, e, angle_mode, sw):
     """State event number e that applies now: (code, component, level, direction), code −1 if
     none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
@@ -324,7 +325,7 @@ def _event_spec(m, cfg, e, angle_mode, sw):
     return -1, OMEGA, 0.0, 0
 
 
-@kernel
+@kernel(inline="always")
 def _crosses(g0, g1, direction):
     """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
     rising = g0 < 0.0 <= g1
@@ -356,7 +357,7 @@ def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
     fst[F_LAST_PHI] = y[PHI]
 
 
-@kernel
+@kernel(inline="always")
 def _out_spacing(cfg, angle_mode):
     return cfg[C_DPHI_OUT] if angle_mode else cfg[C_DT_OUT]
 
@@ -404,20 +405,26 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     n = n_state(m)
     K = np.empty((tab.n_ext, n))
     F = np.empty((3 + tab.D.shape[0], n))
-    n_extra = tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
-    f = np.empty(n)
-    y_new = np.empty(n)
-    y_evt = np.empty(n)
-    tmp = np.empty(n)
-    wk = work_array(m)
     gs = np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1)))  # pair mode margins over a step
+    return _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, np.empty(n), np.empty(n),
+                    np.empty(n), np.empty(n), work_array(m), gs)
+
+
+@kernel
+def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk, gs):
+    """:func:`advance` in buffers allocated by it, compiled as a kernel (no reference counting,
+    :mod:`.jit`): the stepper loop passes arrays to its helpers at every step."""
+    n = y.shape[0]
+    n_extra = tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
     n_bad = 0  # consecutive non-finite step attempts
+    rejected = False  # the last attempt was rejected by the error test
 
     if ist[I_STARTED] == 0:
         ist[I_STARTED] = 1
+        fst[F_ERR_OLD] = 1e-4
         ist[I_GOV_BRANCH] = governor_branch(m, y[OMEGA], True)
         fst[F_LAST_SWITCH] = np.nan
         if _start_modes(m, y, y[PHI], ist, wk) == LOCKED_STATUS:
@@ -468,6 +475,7 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
             return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
         fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
         h = cfg[C_FIXED_STEP] if fixed else min(fst[F_H], h_max)
+        h_planned = h  # before a cut to the segment's end
         at_segment_end = False
         if x + h >= x_end - tol_end:
             h = x_end - x
@@ -512,13 +520,27 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
         if fixed:
             err = 0.0  # every step is accepted; the step size alone sets the accuracy
         if err > 1.0:
-            fst[F_H] = h * max(MIN_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+            fst[F_H] = h * max(MIN_FACTOR, SAFETY * err ** -tab.exponent)
             ist[I_NREDO] = 0  # a shorter step no longer ends on the breakpoint it aimed at
             ist[I_NREJECT] += 1
             steps_here += 1
+            rejected = True
             continue
-        factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** (-1.0 / 8.0))
+        # PI control (Gustafsson; Hairer's DOPRI5 with β): the last accepted error damps the
+        # step size's response to an estimate that happens to be small.
+        e = max(err, 1e-12)
+        factor = min(MAX_FACTOR, SAFETY * e ** -(tab.exponent - 0.75 * PI_BETA)
+                     * fst[F_ERR_OLD] ** PI_BETA)
+        fst[F_ERR_OLD] = max(err, 1e-4)
+        if rejected:
+            # No growth right after a rejection (Hairer's DOPRI codes, SciPy): else the step
+            # size oscillates between growing past what the error allows and being cut back.
+            factor = min(factor, 1.0)
+            rejected = False
         h_next = h * factor
+        if at_segment_end and not rejected:
+            # a step cut short to end on a breakpoint says nothing against the step planned
+            h_next = max(h_next, min(h_planned, h_planned * factor))
         dense_ready = False
         # In time, a step must not cross a breakpoint: retake it so that it ends there.
         if not angle_mode and (y_new[PHI] > up or y_new[PHI] < down):
@@ -606,7 +628,8 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
             for i in range(n):
                 y[i] = y_new[i]
                 f[i] = K[tab.n_stages, i]
-            gs[0, :] = gs[N_MARGIN_SAMPLES, :]
+            for k in range(gs.shape[1]):
+                gs[0, k] = gs[N_MARGIN_SAMPLES, k]
             if angle_mode and at_segment_end and x_end == up:
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
             elif redo_hit_breakpoint:
