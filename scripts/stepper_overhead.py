@@ -11,23 +11,21 @@ import time
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
 from transient.assemble import build_model
 from transient.bench import BENCH_SCENES
 from transient.core import model as cm
+from transient.core.jit import kernel
 from transient.scene import load_scene
 from transient.simulate import integrate
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 
 
-@njit(cache=True)
-def rhs_loop(m, states, out):
-    """Evaluate the crank-angle RHS at every state (rows: φ, t, K, works); return a checksum."""
-    wk = cm.work_array(m)
-    sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-    sw[cm.SW_DIRECTION] = 1
+@kernel
+def rhs_loop(m, states, out, sw, wk):
+    """Evaluate the crank-angle RHS at every state (rows: φ, t, K, works); return a checksum.
+    A kernel with its buffers from outside, as the stepper calls the RHS (core.jit)."""
     acc = 0.0
     for i in range(states.shape[0]):
         cm.derivative(m, True, states[i], states[i, cm.PHI], sw, wk, out)
@@ -54,12 +52,15 @@ for name, path in SCENES.items():
     states[:, cm.PHI], states[:, cm.T] = tr["phi"][pick], tr["t"][pick]
     states[:, cm.KINETIC] = 0.5 * tr["J"][pick] * tr["omega"][pick] ** 2
     out = np.empty(cm.n_state(model))
-    rhs_loop(model, states, out)
+    sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
+    sw[cm.SW_DIRECTION] = 1
+    wk = cm.work_array(model)
+    rhs_loop(model, states, out, sw, wk)
     loops = []
     for _ in range(5):
         t0 = time.perf_counter()
         for _ in range(50):
-            rhs_loop(model, states, out)
+            rhs_loop(model, states, out, sw, wk)
         loops.append((time.perf_counter() - t0) / (50 * pick.size))
     per_call = statistics.median(loops)
     print(f"{name}: {nfev} RHS evaluations, {wall:.4g} s, one call {per_call * 1e6:.3f} µs → "
