@@ -99,11 +99,10 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
 def kinematics_table(scene):
     """The tables of a ``kinematics = "tabulated"`` scene (:mod:`transient.tabulate`; ``coef`` None
     if none reaches the tolerance), else None. Cached: a scene is frozen."""
-    from .tabulate import FRACTION_OF_RTOL, build_table
-
     sv = scene.solver
     if sv.kinematics != "tabulated":
         return None
+    from .tabulate import FRACTION_OF_RTOL, build_table
     mech = scene.mechanism
     target = sv.table_tolerance or FRACTION_OF_RTOL * sv.rtol
     return build_table(int(mech.kind), mech.pack(), mech.n_cylinders, target)

@@ -54,7 +54,7 @@ class ResultWriter:
         self.columns = columns
         for name, unit in columns.items():
             ds = traj.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
-                                     chunks=(4096,), compression="gzip", compression_opts=4,
+                                     chunks=(4096,), compression="gzip", compression_opts=1,
                                      shuffle=True)
             ds.attrs["unit"] = unit
         self.f.create_group("events")

@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .assemble import build_model
 from .core import integrate as ci
@@ -217,6 +216,8 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     phi0 = scene.initial.phi
     dphi = 2.0 * math.pi / scene.output.samples_per_rev
     if run.time:
+        from scipy.interpolate import CubicSpline
+
         spline = CubicSpline(run.time, run.speed_table)
         angle = spline.antiderivative()
         t_end = min(run.t_end, run.time[-1])

@@ -22,8 +22,6 @@ from typing import Callable, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import CubicSpline, PchipInterpolator
-from scipy.optimize import brentq
 
 from transient.errors import SceneError
 
@@ -224,10 +222,14 @@ def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: flo
         coef[:, 0] = y[:-1]
         coef[:, 1] = np.diff(y) / np.diff(x)
     elif interpolation == "pchip":
+        from scipy.interpolate import PchipInterpolator  # (lazily: start-up time)
+
         coef = _ppoly_coef(PchipInterpolator(x, y))
     else:
         # not-a-knot needs 4 points for a true cubic; with 3 scipy gives the parabola through
         # them, and with 2 the natural spline is the straight line.
+        from scipy.interpolate import CubicSpline  # (lazily: start-up time)
+
         coef = _ppoly_coef(CubicSpline(x, y, bc_type="not-a-knot" if x.size > 2 else "natural"))
     knots = x.copy()
     if x[0] > a:
@@ -624,6 +626,8 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
     if rho > 1.0:
         # V rises monotonically from TDC to BDC on a crank slider; brentq finds the crossing to
         # about machine precision, so the expansion starts at p_z to ~1e-15 relative.
+        from scipy.optimize import brentq  # (lazily: start-up time)
+
         angle_z = brentq(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc,
                          xtol=1e-15, rtol=4.0 * np.finfo(float).eps, maxiter=200)
     # A ρ within rounding of 1 leaves no isobar worth a piece (and no zero-length interval).

@@ -48,7 +48,6 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
 from ..core import swash_plate as core
 from ..core.model import SWASH_PLATE
@@ -435,6 +434,8 @@ def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.floa
     def rate(p: float, k: int) -> float:
         core.swash_terms(mp, p, u, du)
         return u[k]
+
+    from scipy.optimize import brentq  # (here: scipy.optimize costs 0.2 s of start-up)
 
     grid = np.linspace(0.0, 2.0 * pi, 721)
     h = grid[1]
