@@ -1,4 +1,5 @@
-"""Scene → compiled model: packs the mechanism, builds the pressure table and the breakpoints.
+"""Scene → compiled model: packs the mechanism, builds the pressure table, the breakpoints and the
+load schedule.
 
 One place where the scene's dataclasses meet the unit-free arrays of :mod:`transient.core`.
 """
@@ -10,7 +11,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from .core.model import PAPER, POWER_FLOW, TABULATED, Model
+from .core.model import PAPER, PHI, POWER_FLOW, TABULATED, T, Model
 from .forces.gas import PressureTable, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -66,6 +67,22 @@ def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period
     return angles
 
 
+def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
+    """The load schedule as the model holds it: ``(x, s, component)``.
+
+    ``x`` are the corners as values of the state component they are levels of: times [s] (T), or
+    shaft angles φ₀ + 2π·revolutions [rad] (PHI), counted from the initial angle; ``s`` the scale
+    at each. Empty arrays without a schedule (s ≡ 1).
+    """
+    load = scene.load
+    s = np.asarray(load.schedule_scale, dtype=np.float64)
+    if load.schedule_revolutions:
+        x = scene.initial.phi + 2.0 * math.pi * np.asarray(load.schedule_revolutions,
+                                                           dtype=np.float64)
+        return x, s, PHI
+    return np.asarray(load.schedule_time, dtype=np.float64), s, T
+
+
 def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None]:
     """The compiled model, its breakpoints and the pressure table of a scene."""
     mech = scene.mechanism
@@ -79,6 +96,7 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         knots, coef, piece_knot = table.knots, table.coef, table.piece_knot
     kin = kinematics_table(scene)
     tabulated = kin is not None and kin.coef is not None
+    load_x, load_s, load_comp = load_schedule(scene)
     model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -88,6 +106,8 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), breakpoints=breakpoints(table, phases, period),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
+        load_x=load_x, load_s=load_s, load_comp=load_comp,
+        gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,

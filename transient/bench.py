@@ -333,6 +333,38 @@ def at_target(rows, scene, method, target=TARGET_PHASE):
     return w1 * (target / e1) ** slope, f"extrapolated from {e1:.1e} rad"
 
 
+def fastest_as_accurate(rows, scene, method, error):
+    """(wall, run) of the fastest run of ``method`` whose phase error is ≤ ``error`` (measured
+    runs only, no interpolation); (NaN, None) if none is."""
+    ok = [r for r in rows if r["scene"] == scene and r["method"] == method
+          and r["phase_err_rad"] <= error]
+    if not ok:
+        return math.nan, None
+    best = min(ok, key=lambda r: r["wall_s"])
+    return best["wall_s"], best
+
+
+def equal_error_lines(rows, scene) -> list[str]:
+    """Markdown rows: each baseline's most accurate run against the fastest run of each transient
+    path at least as accurate (speed at equal error where the baseline cannot reach 1e-6 rad)."""
+    lines = []
+    transient = sorted({r["method"] for r in rows if r["scene"] == scene
+                        and r["method"].startswith("transient")})
+    for base in sorted({r["method"] for r in rows if r["scene"] == scene
+                        and not r["method"].startswith("transient")}):
+        runs = [r for r in rows if r["scene"] == scene and r["method"] == base
+                and math.isfinite(r["phase_err_rad"])]
+        if not runs:
+            continue
+        b = min(runs, key=lambda r: r["phase_err_rad"])
+        for m in transient:
+            wall, r = fastest_as_accurate(rows, scene, m, b["phase_err_rad"])
+            if r is not None:
+                lines.append(f"| {base} | {b['phase_err_rad']:.2g} | {b['wall_s']:.4g} | {m} | "
+                             f"{r['phase_err_rad']:.2g} | {wall:.4g} | {b['wall_s'] / wall:.3g} |")
+    return lines
+
+
 def order_slope(rows, scene, method, floor):
     """Least-squares slope of log(phase error) against log(rtol) — or against log(step) for a
     fixed-step path — over the runs whose error is above 100× ``floor`` (the reference's own
@@ -390,8 +422,19 @@ def write_record(rows, refs, out: Path, revolutions) -> None:
             wall, how = at_target(rows, scene, m)
             lines.append(f"| {m} | {wall:.4g} | {how} | {wall / base_wall:.3g} | "
                          f"{order_slope(rows, scene, m, ref.confirm_phase):.2f} |")
-        lines.append("")
+        lines += ["", "At equal error: each baseline's most accurate run against the fastest run "
+                      "of each transient path that is at least as accurate.", "",
+                  "| baseline | its phase error [rad] | its wall [s] | transient path | "
+                  "phase error [rad] | wall [s] | baseline / transient |",
+                  "|---|---|---|---|---|---|---|", *equal_error_lines(rows, scene), ""]
     (out / "work_precision.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def rewrite_report(out: Path, revolutions: float = 1000.0) -> None:
+    """Rewrite ``work_precision.md`` and the figures from the record's CSV and references (after
+    a change to the report, without measuring again)."""
+    rows, refs = _merge_earlier([], {}, Path(out))
+    write_record(rows, refs, Path(out), revolutions)
 
 
 def _figures(rows, out: Path) -> None:

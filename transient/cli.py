@@ -71,6 +71,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="stop a baseline run after this long, and its tighter tolerances [s]")
     b.add_argument("--quick", action="store_true",
                    help="a smoke test of the harness: 10 revolutions, 3 tolerances, one run each")
+    b.add_argument("--report", action="store_true",
+                   help="only rewrite work_precision.md and the figures from the record's CSV")
     b.add_argument("-o", "--output", default="results/benchmarks", help="folder of the record")
     b.set_defaults(func=cmd_bench)
     e = sub.add_parser("efficiency", help="η_mech against speed at steady speeds and loads")
@@ -138,8 +140,16 @@ def cmd_efficiency(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from .bench import BENCH_SCENES, run_bench
+    from .bench import BENCH_SCENES, rewrite_report, run_bench
     from .scene import load_scene
+
+    if args.report:
+        if not (Path(args.output) / "work_precision.csv").is_file():
+            raise SceneError("bench --report", f"no work_precision.csv in {args.output}; run "
+                                               f"transient bench first")
+        rewrite_report(Path(args.output), args.revolutions)
+        print(f"rewrote {Path(args.output) / 'work_precision.md'} and figures")
+        return EXIT_OK
 
     scenes = {Path(p).stem: p for p in args.scenes} if args.scenes else BENCH_SCENES
     for path in scenes.values():

@@ -16,6 +16,7 @@ from scipy.optimize import brentq
 
 from .assemble import build_model
 from .core.integrate import next_breakpoint
+from .core.model import T, generator_branch, load_segment
 from .errors import SimulationError
 
 
@@ -150,6 +151,24 @@ class ReferenceModel:
         self.branch = 0 if w0 < g.speed_full else (2 if w0 >= g.speed_zero else 1)
         self.chain = ChainNumpy(scene) if scene.friction.pairs else None
         self.sigma = 1.0 if w0 >= 0 else -1.0
+        m = self.model
+        # the load schedule's segment and the generator's branch, switched at terminal events
+        x0 = 0.0 if m.load_comp == T else scene.initial.phi
+        self.seg = int(load_segment(m, x0, True))
+        self.gen_low = bool(generator_branch(m, w0, True))
+        self.t = 0.0  # time of the state being evaluated (the schedule may be in time)
+
+    def load_scale(self, phi: float) -> float:
+        """The schedule's scale s on the current segment (``model.load_scale``, in numpy)."""
+        m = self.model
+        n, j = m.load_x.size, self.seg
+        if n == 0:
+            return 1.0
+        if j <= 0 or j >= n:
+            return float(m.load_s[0 if j <= 0 else n - 1])
+        x = self.t if m.load_comp == T else phi
+        x0, s0 = m.load_x[j - 1], m.load_s[j - 1]
+        return float(s0 + (m.load_s[j] - s0) * (x - x0) / (m.load_x[j] - x0))
 
     def select(self, a: float, b: float) -> None:
         """Table pieces for the segment of shaft angle (a, b) between two breakpoints."""
@@ -170,7 +189,10 @@ class ReferenceModel:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
             p = self.table.evaluate(local, self.pieces)[0]
             M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u)) * self.fuel(w)
-        M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
+        resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
+        if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min
+            resist += m.gen_power / (m.gen_min if self.gen_low else w)
+        M_load = -self.load_scale(phi) * resist
         M_starter = m.starter_torque * (1 - w / m.starter_noload) if self.starter_on else 0.0
         return J, dJ, M_gas, M_load, M_starter, p
 
@@ -193,6 +215,7 @@ class ReferenceModel:
         return (J, dJ, Mg, Ml, Ms, pc), a, S, eta
 
     def rhs(self, t, y):
+        self.t = t
         phi, w = y[:2]
         (J, dJ, Mg, Ml, Ms, _), a, S, eta = self.evaluate(phi, w)
         return [w, a, Mg * w, Ml * w, Ms * w, *((1 - np.asarray(eta)) * S * w)]
@@ -200,6 +223,7 @@ class ReferenceModel:
     def rows(self, t, y):
         out = []
         for ti, yi in zip(t, y.T):
+            self.t = ti
             p, w = yi[:2]
             (J, dJ, Mg, Ml, Ms, pc), a, S, eta = self.evaluate(p, w)
             pairs = [v for k in range(len(S))
@@ -220,6 +244,14 @@ def _speed_crossing(ref, t, y, level):
 
     def g(t, yy):
         return yy[1] - level
+    g.terminal, g.direction = True, direction
+    return g
+
+
+def _level_crossing(in_time: bool, level: float, direction: int):
+    """Terminal event: t (``in_time``) or φ reaching ``level`` in ``direction``."""
+    def g(t, yy):
+        return (t if in_time else yy[0]) - level
     g.terminal, g.direction = True, direction
     return g
 
@@ -310,6 +342,13 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
                 return yy[1]
             rest.terminal, rest.direction = True, -np.sign(y[1]) or -ref.sigma
             evs.append(("rest", rest))
+        m = ref.model
+        if ref.seg < m.load_x.size:  # the next corner of the load schedule, and the one behind
+            evs.append(("load_up", _level_crossing(m.load_comp == T, m.load_x[ref.seg], 1)))
+        if ref.seg > 0 and m.load_comp != T:  # (time never turns back)
+            evs.append(("load_down", _level_crossing(False, m.load_x[ref.seg - 1], -1)))
+        if m.gen_power != 0.0:
+            evs.append(("generator", _speed_crossing(ref, t, y, m.gen_min)))
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -351,6 +390,17 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
                 y[1] = corner
                 ref.branch = low + 1 if ref.branch == low else low
                 events["governor_corner"].append((t, y[0]))
+        if "load_up" in hit or "load_down" in hit:
+            rising = "load_up" in hit
+            x = m.load_x[ref.seg if rising else ref.seg - 1]
+            if m.load_comp != T:
+                y[0] = x
+            ref.seg = int(load_segment(m, x, rising))
+            events.setdefault("load_schedule", []).append((t, y[0]))
+        if "generator" in hit:
+            y[1] = m.gen_min
+            ref.gen_low = not ref.gen_low
+            events.setdefault("generator_min_speed", []).append((t, y[0]))
         if "breakpoint" in hit:
             # Put φ on the breakpoint it reached (solve_ivp locates it to ~1e-12 rad), so that
             # the next segment starts there and takes the table pieces beyond it.

@@ -255,11 +255,29 @@ class Gas:
 
 @dataclass(frozen=True)
 class Load:
-    """Resisting moments: −torque − linear·ω − fan·ω|ω| [N m] (signs as Gots §1: + with rotation)."""
+    """Resisting moment M_load = −s·(torque + linear·ω + fan·ω|ω| + P/max(ω, ω_min)) [N m]
+    (signs as Gots §1: + with rotation).
+
+    ``torque`` [N m], ``linear`` [N m s], ``fan`` [N m s²]. ``generator_power`` P [W]: an
+    electrical load, M·ω = −s·P; below ``generator_min_speed`` ω_min [rad/s] its torque is held
+    at −s·P/ω_min, so that it stays finite at a start from rest (like ``torque``, it does not
+    change sign with ω). ω_min must be > 0 when P > 0.
+
+    The scale s [1] (1 without a schedule) is piecewise linear in time (``schedule_time`` [s])
+    or in shaft revolutions from the initial angle (``schedule_revolutions`` [1]) through the
+    points (abscissa, ``schedule_scale``), constant before the first and after the last. The
+    abscissae do not decrease; two equal ones are a step (value before, value after). The
+    corners are state events (``load_schedule``): a step changes s exactly there.
+    """
 
     torque: float = 0.0
     linear: float = 0.0
     fan: float = 0.0
+    generator_power: float = 0.0
+    generator_min_speed: float = 0.0
+    schedule_time: tuple[float, ...] = ()
+    schedule_revolutions: tuple[float, ...] = ()
+    schedule_scale: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -502,6 +520,65 @@ def _efficiency(s: Section, name: str) -> float:
     return eta
 
 
+#: Distinct abscissae of a load schedule closer than this (relative to max(1, |x|)) are
+#: refused: a ramp that short is a step to the solver, and the event search could not tell its
+#: two corners apart (``transient.core.integrate.ON_LEVEL`` is 1e-12).
+SCHEDULE_MIN_GAP = 1e-9
+
+
+def _read_load(s: Section) -> Load:
+    """The [load] table: resisting torques, a generator and the schedule of their scale."""
+    torque = s.number("torque", default=0.0, ge=0.0)
+    linear = s.number("linear", default=0.0, ge=0.0)
+    fan = s.number("fan", default=0.0, ge=0.0)
+    power = s.number("generator_power", default=0.0, ge=0.0)
+    given = s.has("generator_min_speed", "speed")
+    w_min = s.number("generator_min_speed", "speed", 0.0, ge=0.0)
+    if power > 0.0 and w_min <= 0.0:
+        key = s.key(s.written.get("generator_min_speed", "generator_min_speed"))
+        what = "must be > 0" if given else "is missing"
+        raise SceneError(key, f"{what} with a generator_power: below it the torque −P/ω is held "
+                              f"at −P/ω_min (finite at rest); give 'generator_min_speed' or "
+                              f"'generator_min_speed_rpm' > 0")
+    times = s.numbers("schedule_time", default=())
+    revs = s.numbers("schedule_revolutions", default=())
+    scale = s.numbers("schedule_scale", default=())
+    if times and revs:
+        raise SceneError(s.key("schedule_revolutions"),
+                         "given together with 'schedule_time'; a schedule runs against time or "
+                         "against revolutions: give one of them")
+    name, x = ("schedule_time", times) if times else ("schedule_revolutions", revs)
+    if scale and not x:
+        raise SceneError(s.key("schedule_scale"), "has no abscissae; give 'schedule_time' [s] or "
+                                                  "'schedule_revolutions' with one entry per "
+                                                  "value")
+    if x and not scale:
+        raise SceneError(s.key(name), "has no values; give 'schedule_scale', the load's scale "
+                                      "at each entry")
+    if len(x) != len(scale):
+        raise SceneError(s.key("schedule_scale"), f"needs as many entries as {name!r}; got "
+                                                  f"{len(scale)} and {len(x)}")
+    for i in range(1, len(x)):
+        a, b = x[i - 1], x[i]
+        if b < a:
+            raise SceneError(s.key(name), f"must not decrease, but {b:g} follows {a:g} (entry "
+                                          f"{i + 1}); a step is two equal entries, a ramp two "
+                                          f"increasing ones")
+        if i >= 2 and x[i - 2] == a == b:
+            raise SceneError(s.key(name), f"{b:g} appears three times in a row (entries {i - 1} "
+                                          f"to {i + 1}); a step is two equal entries: the value "
+                                          f"before and the value after")
+        if 0.0 < b - a < SCHEDULE_MIN_GAP * max(1.0, abs(a), abs(b)):
+            raise SceneError(s.key(name), f"{a!r} and {b!r} (entries {i} and {i + 1}) are closer "
+                                          f"than {SCHEDULE_MIN_GAP:g} (relative); give equal "
+                                          f"entries for a step, or a longer ramp")
+    for i, v in enumerate(scale):
+        if v < 0.0:
+            raise SceneError(s.key("schedule_scale"), f"must be ≥ 0, got {v:g} (entry {i + 1}); "
+                                                      f"the scale multiplies a resisting load")
+    return Load(torque, linear, fan, power, w_min, times, revs, scale)
+
+
 def _read_governor(s: Section) -> Governor:
     model = s.string("model", "none", choices=("none", "droop"))
     if model == "none":
@@ -558,9 +635,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["gas"] = _read_gas(sg, base_dir)
         sg.finish()
         sl = root.sub("load")
-        sections["load"] = Load(sl.number("torque", default=0.0, ge=0.0),
-                                sl.number("linear", default=0.0, ge=0.0),
-                                sl.number("fan", default=0.0, ge=0.0))
+        sections["load"] = _read_load(sl)
         sl.finish()
         ss = root.sub("starter")
         torque = ss.number("torque", default=0.0, ge=0.0)
@@ -680,7 +755,7 @@ def to_toml(scene: Scene) -> str:
     lines += [""] + scene.mechanism.toml_lines()
     lines += _section("inertia", scene.inertia)
     lines += _gas_section(scene.gas)
-    lines += _section("load", scene.load)
+    lines += _load_section(scene.load)
     lines += _section("starter", scene.starter)
     lines += (_section("governor", scene.governor) if scene.governor.model != "none"
               else ["", "[governor]", 'model = "none"'])
@@ -712,6 +787,15 @@ def _gas_section(gas: Gas) -> list[str]:
     names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
                                  "n2", "p_intake", "p_exhaust"))
     return ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
+
+
+def _load_section(load: Load) -> list[str]:
+    """[load] with the schedule's keys only when there is one (and only its abscissa)."""
+    names = ["torque", "linear", "fan", "generator_power", "generator_min_speed"]
+    if load.schedule_scale:
+        names += ["schedule_revolutions" if load.schedule_revolutions else "schedule_time",
+                  "schedule_scale"]
+    return ["", "[load]"] + [f"{k} = {toml_value(getattr(load, k))}" for k in names]
 
 
 def _section(name: str, obj: Any) -> list[str]:

@@ -7,8 +7,9 @@ The solver loop is compiled together with the right-hand side (``model.derivativ
 ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint, so the
 right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal) it
 integrates in time, and a step that would cross a breakpoint is retaken so that it ends on it.
-Switches between the two, starter cut-out, the governor characteristic's corners, speed reversals
-and the end of the run are state events located on the dense output (Hairer, Nørsett & Wanner,
+Switches between the two, starter cut-out, the governor characteristic's corners, the corners of
+the load schedule and the generator's minimum speed, speed reversals and the end of the run are
+state events located on the dense output (Hairer, Nørsett & Wanner,
 *Solving ODEs I*, §II.6 and §II.10).
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
@@ -23,9 +24,10 @@ from .jit import kernel
 
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
-from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, SW_MODES,
-                    SW_STARTER, T, WK_G, WK_G_MIN, WK_SPEED, choose_modes, derivative, governor_branch, inertia,
-                    margins_at, n_state, output_row, speed, work_array)
+from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GENERATOR,
+                    SW_GOVERNOR, SW_LOAD, SW_MODES, SW_STARTER, T, WK_G, WK_G_MIN, WK_SPEED,
+                    choose_modes, derivative, generator_branch, governor_branch, inertia,
+                    load_segment, margins_at, n_state, output_row, speed, work_array)
 
 # Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -43,9 +45,10 @@ N_FST = 9
 # (a retaken step lands on it only to the accuracy of the dense output).
 BP_LANDING = 1e-7
 # ist[...] — integer stepper state kept between chunks
-# ist[:N_SWITCHES] are the model's switches (starter, governor branch, pair modes, direction),
-# passed on as ``sw``.
+# ist[:N_SWITCHES] are the model's switches (starter, governor branch, pair modes, direction,
+# load-schedule segment, generator branch), passed on as ``sw``.
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
+I_LOAD_SEG, I_GEN_LOW = SW_LOAD, SW_GENERATOR
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
  I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT) = range(
     N_SWITCHES, N_SWITCHES + 15)
@@ -61,9 +64,10 @@ ON_LEVEL = 1e-12
 RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING = range(7)
 # event codes written to the event buffer as (code, t, phi, omega)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
- EV_PAIR_MODE, EV_LOCKED) = range(9)
+ EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR) = range(11)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
-               "speed_reversal", "end", "governor_corner", "pair_mode", "locked")
+               "speed_reversal", "end", "governor_corner", "pair_mode", "locked", "load_schedule",
+               "generator_min_speed")
 # Event "components" at and above PAIR_COMP are the mode margins of the pairs (model.mode_margins).
 PAIR_COMP = 100
 
@@ -298,14 +302,30 @@ def next_breakpoint(bp, period, phi, upward):
     return -np.inf
 
 
-N_EVENT_KINDS = 7 + MAX_PAIRS
+FIRST_PAIR_EVENT = 10
+N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
+
+
+@kernel(inline="always")
+def _load_corner(m, ix, sw):
+    """The load schedule's next corner on the independent variable ``ix`` (``inf`` if the
+    schedule runs against the other variable, or has no corner ahead)."""
+    seg = sw[SW_LOAD]
+    if m.load_comp != ix or seg >= m.load_x.shape[0]:
+        return np.inf
+    return m.load_x[seg]
 
 
 @kernel(inline="always")
 def _event_spec(m, cfg, e, angle_mode, sw):
     """State event number e that applies now: (code, component, level, direction), code −1 if
     none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
-    −1 falling, 0 either way."""
+    −1 falling, 0 either way.
+
+    The load schedule's corners are levels of t or φ, watched one segment at a time: the corner
+    above and, for corners in φ (the shaft may turn back in time mode), the one below. On the
+    independent variable the segment also ends on the corner (see ``_advance``), so the event is
+    found at the step's end exactly, as a breakpoint is in crank angle."""
     if e == 0 and sw[SW_STARTER] == 1:
         return EV_STARTER_CUTOUT, OMEGA, m.starter_cutout, 1
     if e == 1 and angle_mode:
@@ -320,8 +340,15 @@ def _event_spec(m, cfg, e, angle_mode, sw):
         return EV_END, PHI, cfg[C_PHI_END], 1
     if 5 <= e < 7 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
         return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
-    if e >= 7 and e - 7 < m.n_pairs:  # the mode margin of pair e − 7 falls to zero
-        return EV_PAIR_MODE, PAIR_COMP + e - 7, 0.0, -1
+    if e == 7 and sw[SW_LOAD] < m.load_x.shape[0]:  # the schedule's corner ahead
+        return EV_LOAD, m.load_comp, m.load_x[sw[SW_LOAD]], 1
+    if e == 8 and m.load_comp == PHI and sw[SW_LOAD] > 0:  # behind, reached turning back
+        return EV_LOAD, PHI, m.load_x[sw[SW_LOAD] - 1], -1
+    if e == 9 and m.gen_power != 0.0:  # the generator's minimum speed
+        return EV_GENERATOR, OMEGA, m.gen_min, 0
+    if e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
+        # the mode margin of pair e − FIRST_PAIR_EVENT falls to zero
+        return EV_PAIR_MODE, PAIR_COMP + e - FIRST_PAIR_EVENT, 0.0, -1
     return -1, OMEGA, 0.0, 0
 
 
@@ -426,6 +453,9 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         ist[I_STARTED] = 1
         fst[F_ERR_OLD] = 1e-4
         ist[I_GOV_BRANCH] = governor_branch(m, y[OMEGA], True)
+        # (time only increases; the shaft angle as ω's sign says, forward from rest)
+        ist[I_LOAD_SEG] = load_segment(m, y[m.load_comp], m.load_comp == T or y[OMEGA] >= 0.0)
+        ist[I_GEN_LOW] = generator_branch(m, y[OMEGA], True)
         fst[F_LAST_SWITCH] = np.nan
         if _start_modes(m, y, y[PHI], ist, wk) == LOCKED_STATUS:
             return _locked(m, y, y[PHI], outbuf, evbuf, ist, fst, wk)
@@ -473,6 +503,12 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         tol_end = 1e-13 * max(1.0, abs(x))
         if x_end - x <= tol_end:
             return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
+        # A load-schedule corner on the independent variable (t in time, φ in crank angle) ends
+        # the segment too: the step lands on it and its event is found there (θ = 1). One closer
+        # than tol_end is left to the event search, which finds it at once in the next step.
+        corner = _load_corner(m, ix, sw)
+        if tol_end < corner - x and corner < x_end:
+            x_end = corner
         fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
         h = cfg[C_FIXED_STEP] if fixed else min(fst[F_H], h_max)
         h_planned = h  # before a cut to the segment's end
@@ -493,6 +529,8 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         wk[WK_SPEED, 0] = np.inf
         wk[WK_SPEED, 1] = -np.inf
         _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        if at_segment_end and x_end == corner:
+            y_new[ix] = corner  # x + (corner − x) can miss it by an ulp: the event needs g = 0
         w_lo, w_hi = wk[WK_SPEED, 0], wk[WK_SPEED, 1]
         # (the step's last right-hand side is at y_new: WK_G holds the margins there)
         dip = False
@@ -564,6 +602,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         ev_theta = 2.0
         ev_comp = 0
         ev_level = 0.0
+        ev_rising = True
         # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
         w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
         w1 = 1.0 / K[tab.n_stages, T] if angle_mode else y_new[OMEGA]
@@ -607,6 +646,9 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                                                    ga, sel, sw, tmp, wk)
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
+                    # the crossing's direction: from below (an 'inside' crossing is the first
+                    # one away from the step's start, so this holds for it too)
+                    ev_rising = ga < 0.0 or (ga == 0.0 and gb > 0.0)
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
         # Output samples inside the step (dense output), then the step's end state.
         d_out = _out_spacing(cfg, angle_mode)
@@ -637,11 +679,17 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
             if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
                 return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
-            if not angle_mode and at_segment_end:
+            if not angle_mode and at_segment_end and x_end == cfg[C_T_END]:
                 return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
             continue
         # Truncate the step at the event, act on it and restart from there.
         _dense_eval(F, y, ev_theta, y_evt)
+        # An event within rounding of the breakpoint the step ends on (a pair whose power changes
+        # sign at a pressure corner, a load corner there) is on it: the state goes exactly there
+        # and both are recorded (else the next step would take the breakpoint as passed, unseen).
+        on_breakpoint = angle_mode and at_segment_end and x_end == up and x_end - x_stop <= tol_end
+        if on_breakpoint:
+            x_stop = x_end
         y_evt[ix] = x_stop
         if ev_comp >= PAIR_COMP:
             pass  # the margin is zero here to the root finder's accuracy; nothing to put on a level
@@ -655,6 +703,8 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         for i in range(n):
             y[i] = y_evt[i]
         ist[I_F_VALID] = 0
+        if on_breakpoint:
+            _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
         _emit_event(m, evbuf, ist, ev_code, y, wk)
         if ev_code == EV_END:
             return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
@@ -683,6 +733,11 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             ist[I_STARTER_ON] = 0
         elif ev_code == EV_GOVERNOR:
             ist[I_GOV_BRANCH] = governor_branch(m, ev_level, w1 > w0)
+        elif ev_code == EV_LOAD:
+            # past the corner (and past its twin, for a step) in the direction of motion
+            ist[I_LOAD_SEG] = load_segment(m, ev_level, ev_rising)
+        elif ev_code == EV_GENERATOR:
+            ist[I_GEN_LOW] = generator_branch(m, ev_level, ev_rising)
         elif ev_code == EV_TO_TIME:
             _to_time_mode(m, y, ist, wk)
             fst[F_H] = h_next / ev_level

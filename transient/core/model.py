@@ -41,10 +41,12 @@ W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 
 #: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), the
 #: governor's branch (see :func:`governor_branch`), the modes of the non-ideal pairs (bit k set:
-#: pair k backward, its far side drives) and the direction of motion σ = ±1 that the pair modes
-#: refer to (sign of ω; changed only at a speed reversal, where the modes are chosen afresh).
-SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION = range(4)
-N_SWITCHES = 4
+#: pair k backward, its far side drives), the direction of motion σ = ±1 that the pair modes
+#: refer to (sign of ω; changed only at a speed reversal, where the modes are chosen afresh), the
+#: segment of the load schedule (:func:`load_segment`) and the generator's low-speed branch
+#: (:func:`generator_branch`).
+SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR = range(6)
+N_SWITCHES = 6
 
 #: Mechanism kinds (``Model.kind``); TABULATED: either, from its tables (``Model.kin_coef``).
 CRANK_SLIDER, SWASH_PLATE, TABULATED = 0, 1, 2
@@ -94,6 +96,11 @@ Model = namedtuple(
         "load_const",  # float: constant resisting torque [N m]
         "load_linear",  # float: c in −c·ω [N m s]
         "load_fan",  # float: K in −K·ω|ω| [N m s²]
+        "load_x",  # float64[:]: corners of the load schedule, non-decreasing (empty: s ≡ 1)
+        "load_s",  # float64[:]: the load's scale s at each corner (piecewise linear between)
+        "load_comp",  # int: state component the corners are values of, T [s] or PHI [rad]
+        "gen_power",  # float: generator power P in −s·P/max(ω, ω_min) [W] (0: none)
+        "gen_min",  # float: ω_min, below it the generator's torque is held at −s·P/ω_min [rad/s]
         "starter_torque",  # float: starter stall torque [N m]
         "starter_noload",  # float: speed at which the starter characteristic reaches zero [rad/s]
         "starter_cutout",  # float: speed at which the starter disengages for good [rad/s]
@@ -189,12 +196,59 @@ def fuel(m, w, branch):
     return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
 
 
+@kernel
+def load_segment(m, x, rising):
+    """Segment of the load schedule at abscissa ``x`` (a time or a shaft angle, as ``m.load_comp``).
+
+    Segment j lies between corners j − 1 and j (segment 0 before the first, n after the last,
+    n corners): the number of corners below x, and on a corner the segment the motion enters
+    (``rising``: x increasing), so that a step (two equal corners) takes its value after the
+    step in the direction of motion. A step's empty segment is never the result.
+    """
+    j = 0
+    n = m.load_x.shape[0]
+    while j < n and (m.load_x[j] < x or (m.load_x[j] == x and rising)):
+        j += 1
+    return j
+
+
+@kernel(inline="always")
+def load_scale(m, y, seg):
+    """Scale s of the load at state ``y`` in schedule segment ``seg``: 1 without a schedule, the
+    first (last) value before (after) the corners, linear between two of them.
+
+    The segment is held for a whole step (a state event stops on each corner and moves it on),
+    so that the right-hand side is smooth inside every step and a step changes s exactly at its
+    event; inside a step the segment's line is extrapolated, as the governor's branch is.
+    """
+    n = m.load_x.shape[0]
+    if n == 0:
+        return 1.0
+    if seg <= 0:
+        return m.load_s[0]
+    if seg >= n:
+        return m.load_s[n - 1]
+    x0 = m.load_x[seg - 1]
+    s0 = m.load_s[seg - 1]
+    return s0 + (m.load_s[seg] - s0) * (y[m.load_comp] - x0) / (m.load_x[seg] - x0)
+
+
+@kernel
+def generator_branch(m, w, rising):
+    """1 while the generator's torque is held at −s·P/ω_min (ω < ω_min, or on it falling), else 0."""
+    if w < m.gen_min or (w == m.gen_min and not rising):
+        return 1
+    return 0
+
+
 @kernel(inline="always")
 def moments(m, angle_mode, y, sel, sw, wk):
     """Reduced inertia, speed and moments at state ``y``.
 
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; the rows u, u′ of ``wk`` are left holding
-    the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k.
+    the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The load is
+    M_load = −s·(torque + linear·ω + fan·ω|ω| + P/max(ω, ω_min)), s from the schedule's segment
+    ``sw[SW_LOAD]`` and the max from the generator's branch ``sw[SW_GENERATOR]``.
     """
     phi = y[PHI]
     u = wk[WK_U]
@@ -206,7 +260,15 @@ def moments(m, angle_mode, y, sel, sw, wk):
         for k in range(m.ncyl):
             M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
         M_gas *= fuel(m, w, sw[SW_GOVERNOR])
-    M_load = -(m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
+    # (with s = 1 exactly the formula without a schedule, to the last bit)
+    s = load_scale(m, y, sw[SW_LOAD])
+    M_load = -s * (m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
+    if m.gen_power != 0.0:
+        # An electrical load of power s·P: M ω = −s·P. Below ω_min (a start from rest) the
+        # torque is held at its value there, so that it stays finite; a state event switches
+        # the branch at ω_min, as at the governor's corners, keeping each step smooth.
+        w_gen = m.gen_min if sw[SW_GENERATOR] else w
+        M_load -= s * m.gen_power / w_gen
     M_starter = 0.0
     if sw[SW_STARTER]:
         M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
@@ -463,7 +525,7 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
     Fills ``rows`` (one output row per sample, ``epsilon`` being the prescribed one; the work
     columns are left zero, integrated by the caller), ``M_drive`` and ``n_consistent`` (the number
     of consistent mode vectors per sample, 1 unless a policy is ambiguous there). The starter is
-    off and ``sel`` is the sample angle itself.
+    off, ``sel`` is the sample angle itself and a load-schedule corner takes its value after.
     """
     wk = work_array(m)
     y = np.zeros(n_state(m))
@@ -474,6 +536,8 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
         y[T] = t[i]
         y[OMEGA] = omega[i]
         sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
+        sw[SW_LOAD] = load_segment(m, y[m.load_comp], True)  # t and φ increase here (ω > 0)
+        sw[SW_GENERATOR] = generator_branch(m, omega[i], eps[i] >= 0.0)
         J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, phi[i], sw, wk)
         output_row(m, False, y, phi[i], sw, wk, rows[i])
         rows[i, COL_EPS] = eps[i]
