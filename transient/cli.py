@@ -222,10 +222,31 @@ def _print_summary(summary, solver) -> None:
     if "mean_drive_torque_last_cycle" in v:
         print(f"  mean drive torque required over the last cycle: "
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
+    _print_response(v)
     _print_efficiency(v)
     print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
           f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
           f"compile/cache load)")
+
+
+def _print_response(v: dict) -> None:
+    """ISO 8528-5 measures of each load step and of a spin-up (``analysis.transient_response``)."""
+    rpm = 30.0 / math.pi
+    k = 1
+    while f"load_change_{k}_t_s" in v:
+        p = f"load_change_{k}_"
+        rec = (f"recovered into ±{v[p + 'band_pct']:.3g} % after {v[p + 'recovery_s']:.4g} s"
+               if v[p + "recovered"] else "not recovered by the end of its segment")
+        print(f"  load step {k} at t = {v[p + 't_s']:.6g} s: cycle-mean speed "
+              f"{v[p + 'omega_before_rad_s'] * rpm:.6g} → {v[p + 'omega_after_rad_s'] * rpm:.6g} "
+              f"rpm, transient deviation {v[p + 'dev_max_pct']:+.4g} %, {rec}, steady change "
+              f"(droop) {v[p + 'droop_pct']:+.4g} %"
+              + ("" if v[p + "settled"] else " (not settled: segment too short)"))
+        k += 1
+    if "spin_up_t90_s" in v:
+        print(f"  spin-up: 90 % of the final {v['spin_up_omega_final_rad_s'] * rpm:.6g} rpm after "
+              f"{v['spin_up_t90_s']:.4g} s, in ±1 % after {v['spin_up_settling_s']:.4g} s, "
+              f"overshoot {v['spin_up_overshoot_pct']:.3g} %")
 
 
 def _print_efficiency(v: dict) -> None:
@@ -311,6 +332,11 @@ def cmd_plot(args) -> int:
     plots.torques(ax, traj, scene.mechanism.cycle)
     ax.set_title(f"{scene.name}: moments over the last cycle")
     written.append(_save(fig, out / f"{stem}_torques.png"))
+    if "load_change_1_t_s" in res.analysis:
+        fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+        plots.load_response(axes, traj, scene.mechanism.cycle, res.analysis)
+        axes[0].set_title(f"{scene.name}: load steps (ISO 8528-5 band around the new speed)")
+        written.append(_save(fig, out / f"{stem}_response.png"))
     if scene.friction.pairs:
         fig, ax = plt.subplots(figsize=(8, 4.5))
         plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)

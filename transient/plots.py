@@ -135,3 +135,41 @@ def pair_power(ax, traj, names, cycle):
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     return artists
+
+
+def load_response(axes, traj, cycle, analysis):
+    """Speed (as run, and its one-cycle mean), fuel command and load torque against time, with
+    each load step's ±band around its new steady speed (``analysis``: the run's ``/analysis``
+    entries, name → (value, unit)). ``axes``: three axes sharing t. Returns the artists."""
+    from .analysis.transient_response import cycle_mean_speed
+
+    rpm = 30.0 / math.pi
+    a_w, a_f, a_m = axes
+    t = traj["t"]
+    artists = a_w.plot(t, traj["omega"] * rpm, lw=0.5, color="0.6", label="ω")
+    tm, wm = cycle_mean_speed(t, traj["phi"], cycle, traj["omega"])
+    artists += a_w.plot(tm, wm * rpm, lw=1.2, color="C0", label="cycle mean")
+    k = 1
+    while f"load_change_{k}_t_s" in analysis:
+        p = f"load_change_{k}_"
+        t0, t1 = analysis[p + "t_s"][0], analysis[p + "t_end_s"][0]
+        w_ss, band = analysis[p + "omega_after_rad_s"][0], analysis[p + "band_pct"][0] / 100.0
+        w_ref = analysis[p + "omega_rated_rad_s"][0]
+        artists.append(a_w.fill_between([t0, t1], (w_ss - band * w_ref) * rpm,
+                                        (w_ss + band * w_ref) * rpm, color="C2", alpha=0.25,
+                                        label="±band" if k == 1 else None))
+        for ax in axes:
+            artists.append(ax.axvline(t0, color="k", lw=0.6, ls=":"))
+        if analysis[p + "recovered"][0]:
+            artists.append(a_w.axvline(t0 + analysis[p + "recovery_s"][0], color="C2", lw=0.8))
+        k += 1
+    a_w.set_ylabel("ω [rpm]")
+    a_w.legend(fontsize=8, loc="best")
+    artists += a_f.plot(t, traj["fuel"], lw=1.0, color="C1")
+    a_f.set_ylabel("fuel command [1]")
+    artists += a_m.plot(t, -traj["M_load"], lw=1.0, color="C3")
+    a_m.set_ylabel("load torque [N m]")
+    a_m.set_xlabel("t [s]")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    return artists

@@ -728,3 +728,32 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert {f"work_precision_{s}.png" for s in BENCH_SCENES} <= names
     text = (tmp_path / "work_precision.md").read_text()
     assert all(f"## {s}" in text for s in BENCH_SCENES)
+
+
+# ----------------------------------------------------------------------------------------------
+# load steps: ISO 8528-5 measures in the summary, a response plot (issue 6)
+
+
+def test_load_steps_are_measured_printed_and_plotted(tmp_path, capsys):
+    """cases/gots_diesel_load_steps.toml: the summary finds the schedule's two steps (at 1 s and
+    2 s, from the load_schedule events), the acceptance dips and the rejection rises, the speed
+    returns to where it started (static droop: the two steady changes cancel), both recover into
+    ±1 %, ``run`` prints them and ``plot`` writes the response figure."""
+    scene = CASES / "gots_diesel_load_steps.toml"
+    code = main(["run", str(scene), "-o", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "load step 1 at t = 1 s" in out and "load step 2 at t = 2 s" in out
+    with h5py.File(tmp_path / "gots_diesel_load_steps.h5") as f:
+        a = {k: f["analysis"][k][()] for k in f["analysis"]}
+        assert f["analysis"]["load_change_1_recovery_s"].attrs["unit"] == "s"
+    assert (a["load_change_1_t_s"], a["load_change_2_t_s"]) == (1.0, 2.0)
+    assert a["load_change_1_dev_max_pct"] < -1.0 < 1.0 < a["load_change_2_dev_max_pct"]
+    assert a["load_change_1_recovered"] == a["load_change_2_recovered"] == 1.0
+    assert 0.0 < a["load_change_1_recovery_s"] < 1.0 and 0.0 < a["load_change_2_recovery_s"] < 1.0
+    w0, w1 = a["load_change_1_omega_before_rad_s"], a["load_change_2_omega_after_rad_s"]
+    assert w1 == pytest.approx(w0, rel=1e-5)
+    assert a["load_change_1_omega_after_rad_s"] == pytest.approx(
+        a["load_change_2_omega_before_rad_s"], rel=1e-5)  # (different windows)
+    assert main(["plot", str(tmp_path / "gots_diesel_load_steps.h5"), "-o", str(tmp_path)]) == 0
+    assert (tmp_path / "gots_diesel_load_steps_response.png").stat().st_size > 10_000

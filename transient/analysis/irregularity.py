@@ -78,9 +78,18 @@ def last_cycle_ranges(traj, cycle) -> dict[str, tuple[float, str]]:
 def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
               ) -> dict[str, tuple[float, str]]:
     """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``: speed, its
-    fluctuation, steady state, and the mechanical efficiency over the steady cycles."""
+    fluctuation, steady state, the mechanical efficiency over the steady cycles, and the
+    ISO 8528-5 measures of each load step and of a spin-up (``transient_response``). With load
+    steps, the steady state and the efficiency are looked for after the last one."""
     from .efficiency import mechanical_efficiency
+    from .transient_response import load_step_times, run_response
 
+    response = run_response(scene, traj, events) if scene.run.mode == "dynamic" else {}
+    steps = load_step_times(scene, events) if scene.run.mode == "dynamic" else []
+    if steps and steps[-1] < traj["t"][-1]:
+        after = traj["t"] >= steps[-1]
+        traj = {k: v[after] for k, v in traj.items()}
+        events = {k: v[v[:, 0] >= steps[-1]] for k, v in (events or {}).items()}
     t, phi, omega = traj["t"], traj["phi"], traj["omega"]
     cycle = scene.mechanism.cycle
     phi0 = scene.initial.phi
@@ -94,6 +103,7 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
     }
     if scene.run.mode == "dynamic":
         out["steady_state_t"] = (steady_state_time(means, ends), "s")
+        out.update(response)
     out.update(last_cycle_ranges(traj, cycle))
     if "M_drive" in traj and means.size:
         last = (t >= ends[-1] - cycle / means[-1]) & (t <= ends[-1])

@@ -579,3 +579,55 @@ def metrics_table(t: NDArray[np.float64], phi: NDArray[np.float64],
         m = load_change_metrics(t, phi, omega, tc, cycle, band, rated_speed, settle_window, te)
         out.update(to_table(m, f"load_change_{k}"))
     return out
+
+
+# --- a run's summary ------------------------------------------------------------------------------
+
+#: Tolerance band of the summary's recovery times, a fraction of the reference speed (±1 %).
+SUMMARY_BAND = 0.01
+
+
+def load_step_times(scene, events) -> list[float]:
+    """Times of the run's sudden load changes: the steps of its load schedule (two equal
+    abscissae), from the ``load_schedule`` events (a step in revolutions happens at a time the run
+    finds). Ramps are not load changes in the ISO 8528-5 sense and are left out."""
+    load = scene.load
+    x = np.asarray(load.schedule_time or load.schedule_revolutions, dtype=float)
+    steps = x[1:][np.diff(x) == 0.0]
+    rows = np.asarray(events.get("load_schedule", np.zeros((0, 2))) if events else np.zeros((0, 2)))
+    if steps.size == 0 or rows.size == 0:
+        return []
+    if load.schedule_time:
+        at = rows[:, 0]
+        return [float(t) for t in rows[:, 0] if np.any(np.abs(steps - t) <= 1e-9 * max(1.0, t))
+                ] if at.size else []
+    angles = scene.initial.phi + 2.0 * np.pi * steps
+    return [float(t) for t, p in rows if np.any(np.abs(angles - p) <= 1e-9 * max(1.0, abs(p)))]
+
+
+def run_response(scene, traj, events) -> dict[str, tuple[float, str]]:
+    """ISO 8528-5 measures of a dynamic run for ``/analysis`` (:func:`metrics_table`): one set per
+    load step of the schedule (each change is its own reference: the cycle-mean speed before it),
+    and for a run from (near) rest the spin-up, referred to the speed the run ends at (a scene
+    names no rated speed). Entries that cannot be measured (a change too close to the start or
+    the end, too short a run) are left out, never guessed."""
+    t, phi, omega = traj["t"], traj["phi"], traj["omega"]
+    cycle = scene.mechanism.cycle
+    out: dict[str, tuple[float, str]] = {}
+    changes = [tc for tc in load_step_times(scene, events) if t[0] < tc < t[-1]]
+    for k, tc in enumerate(changes, start=1):
+        end = changes[k] if k < len(changes) else float(t[-1])
+        try:
+            m = load_change_metrics(t, phi, omega, tc, cycle, SUMMARY_BAND, t_end=end)
+        except ValueError:
+            continue  # (e.g. less than a cycle before the change, or a settle window too short)
+        out.update(to_table(m, f"load_change_{k}"))
+    final = float(np.mean(omega[-max(2, omega.size // 50):]))
+    if scene.initial.omega < 0.1 * final and final > 0:
+        try:
+            sm = spin_up_metrics(t, phi, omega, final, cycle, SUMMARY_BAND,
+                                 t_end=changes[0] if changes else None)
+            out.update(to_table(sm, "spin_up"))
+        except ValueError:
+            pass  # too short a run to measure
+    return out
