@@ -1,0 +1,646 @@
+"""Order analysis: signals on a uniform crank-angle grid, per-cycle spectra in engine orders, the
+piston acceleration with a variable shaft speed, and the odd-harmonic report.
+
+**Engine order.** A component of order ν varies as cos(ν φ + θ): ν harmonics per revolution of the
+shaft. Over an engine cycle of angle Φ (2π for a 2-stroke, 4π for a 4-stroke engine) the DFT of
+``N`` samples per cycle gives the orders ν_k = 2πk/Φ, k = 0 … N/2, i.e. whole orders for Φ = 2π and
+half orders for Φ = 4π.
+
+**Why odd orders.** At constant ω the piston acceleration is W = ω² s″(φ). For a central
+crank-slider (e = 0), s(φ) = r(1 − cos φ) + l(1 − √(1 − λ² sin²φ)) (Gots (1)–(2)): the root
+depends on sin²φ only, so it has period π and only even orders; r cos φ is the only odd term.
+Hence W holds orders 1, 2, 4, 6 … and no odd order ≥ 3 (Semenov §2.5, (14), (19)), while the rod
+angle β = arcsin(λ sin φ) holds odd orders only (Semenov (33)). When ω varies,
+
+    W = ω² s″(φ) + ε s′(φ),     ε = dω/dt = ω dω/dφ                     (Semenov §4)
+
+and a speed ripple of order q multiplies the kinematic orders 1, 2, 4 … into q ± 1, q ± 2, q ± 4 …:
+odd orders ≥ 3 (and, in a 4-stroke engine, half orders) appear that the constant-speed analysis
+does not have (Semenov p. 22: "the acceleration will also contain odd harmonics"). Sizes, relative
+to the first order, for ω = ω₀(1 + 0.02 cos qφ) and the Gots geometry (λ = 0.3176): q = 3 gives
+order 5 = q + 2 at 1.1e-2, 7 = q + 4 at 1.6e-4, 3 = |q − 6| at 3.9e-6; q = 2 gives order 3 = q + 1
+at 4.0e-2; q = 1.5 gives orders 0.5, 2.5, 3.5 at 0.9e-2, 3.5e-2, 0.9e-2.
+
+**Offset mechanism.** With e = k·r ≠ 0 (Gots §1.4), sin β = λ(sin φ − k) and the root is no
+longer even in sin φ: odd orders appear even at constant ω. To leading order the −⅛λ⁴(sin φ − k)⁴
+term of cos β = √(1 − λ²(sin φ − k)²) holds +½kλ⁴ sin³φ ⊃ −⅛kλ⁴ sin 3φ, so
+s = y_TDC − r cos φ − l cos β ⊃ ⅛ l k λ⁴ sin 3φ, and the third order of W = ω²s″ relative to the
+first is ≈ (9/8)·k·λ³. For λ = 0.3176: exact 3rd/1st = 8.03e-3 and 5th/1st = 4.5e-4 at k = 0.2
+(series 7.21e-3), 3.99e-3 and 2.2e-4 at k = 0.1 (series 3.60e-3) (tests/unit/test_orders.py).
+
+Functions
+---------
+:func:`resample_angle`, :func:`to_angle_grid`
+    Resample trajectory columns onto a uniform crank-angle grid of whole cycles.
+:func:`order_spectrum`
+    Per-cycle amplitude and phase per order (:class:`OrderSpectrum`).
+:func:`slider_arrays`, :func:`piston_acceleration`, :func:`piston_inertia_force`,
+:func:`rod_angular_acceleration`
+    Exact kinematics (:func:`transient.core.crank_slider.slider`) on arrays, with ω and ε.
+:func:`odd_harmonic_report`, :func:`report_for_scene`
+    Orders of the piston acceleration of a run against the same engine at its mean speed
+    (:class:`OddHarmonicReport`).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..core.crank_slider import slider
+
+#: Orders closer than this to a whole number are whole orders (the grid gives ν = 2πk/Φ exactly
+#: up to rounding).
+_ORDER_TOL = 1e-9
+
+
+# ------------------------------------------------------------------------------------------------
+# Resampling onto a crank-angle grid
+
+
+def _pieces(x: NDArray[np.float64], cuts: NDArray[np.float64]) -> list[tuple[int, int, float]]:
+    """Split the non-decreasing abscissae ``x`` into runs that are interpolated on their own.
+
+    A run ends at a repeated abscissa (a sample written on both sides of a jump: the left run
+    takes the first, the right run the second) and at a cut (a corner of the signal): a cut
+    between two samples ends one run there and starts the next after it; a cut on a sample makes
+    that sample the last of one run and the first of the next. Returns (start, stop, left
+    boundary) per run; a grid point belongs to the last run whose left boundary is ≤ it.
+    """
+    breaks = [(float(x[i + 1]), i + 1, i + 1) for i in np.nonzero(np.diff(x) == 0.0)[0]]
+    for c in cuts:
+        k = int(np.searchsorted(x, c, side="left"))  # first sample ≥ c
+        if 0 < k < x.size - 1 and x[k] == c and x[k + 1] > c and x[k - 1] < c:
+            breaks.append((float(c), k + 1, k))  # on a sample: shared by both runs
+        elif 0 < k < x.size and x[k] > c:
+            breaks.append((float(c), k, k))
+    breaks.sort()
+    out, start, left = [], 0, -math.inf
+    for bound, stop, nxt in breaks:
+        if stop > start:
+            out.append((start, stop, left))
+        start = max(start, nxt)
+        left = bound
+    out.append((start, x.size, left))
+    return out
+
+
+def _hermite(x, v, d, g):
+    """Piecewise cubic Hermite interpolant of (x, v, dv/dx) at g (extrapolated past the ends)."""
+    if x.size == 1:
+        return v[0] + d[0] * (g - x[0])
+    i = np.clip(np.searchsorted(x, g, side="right") - 1, 0, x.size - 2)
+    h = x[i + 1] - x[i]
+    t = (g - x[i]) / h
+    s = 1.0 - t
+    return ((1.0 + 2.0 * t) * s * s * v[i] + t * s * s * h * d[i]
+            + t * t * (3.0 - 2.0 * t) * v[i + 1] - t * t * s * h * d[i + 1])
+
+
+def _spline(x, v, g):
+    """Not-a-knot cubic spline (C²) of (x, v) at g; fewer than 4 samples: lower degree."""
+    if x.size == 1:
+        return np.full(g.shape, v[0])
+    from scipy.interpolate import CubicSpline
+
+    return CubicSpline(x, v, bc_type="not-a-knot", extrapolate=True)(g)
+
+
+def resample_angle(phi: ArrayLike, values: ArrayLike, grid: ArrayLike,
+                   dvalues: ArrayLike | None = None, cuts: ArrayLike = ()) -> NDArray[np.float64]:
+    """Values of a trajectory column at the crank angles ``grid``.
+
+    Parameters
+    ----------
+    phi : (n,) array
+        Sample angles [rad], non-decreasing. A repeated angle (a sample written on both sides of
+        a jump) splits the interpolation there: each side uses its own samples.
+    values : (n,) array
+        The column at those samples.
+    grid : (m,) array
+        Angles [rad] wanted, within [phi[0], phi[-1]] (outside, the end pieces are extrapolated).
+    dvalues : (n,) array, optional
+        dv/dφ at the samples (for ω: ε/ω; for t: 1/ω; in general (dv/dt)/ω). With it the
+        interpolant is the piecewise cubic Hermite one; without it a not-a-knot cubic spline (C²).
+    cuts : array, optional
+        Angles [rad] at which the signal has a corner or a jump (the run's breakpoints, e.g.
+        ``data.events["breakpoint"][:, 1]``). No interval is interpolated across a cut: grid points
+        between the last sample before it and the cut are extrapolated from the samples before,
+        those after from the samples after. A cut on a sample ends one piece and starts the next
+        there (the spline sides are then independent; the Hermite interpolant has only the one
+        derivative that sample holds, so a corner exactly on a sample keeps an O(h·jump) error
+        on one side).
+
+    Returns
+    -------
+    (m,) array
+
+    Notes
+    -----
+    When every grid angle coincides with a sample (a run integrated in crank angle whose output
+    spacing divides the grid's, from the same origin; coincidence within 1e-9 of the sample
+    spacing, which leaves an error ≤ 1e-9·h·|dv/dφ|) the samples are returned: no interpolation.
+
+    Accuracy otherwise, h the largest sample spacing near the grid point, v⁽⁴⁾ = d⁴v/dφ⁴:
+
+    * Hermite, exact derivatives: |error| ≤ h⁴/384 · max|v⁽⁴⁾| (the remainder
+      v⁽⁴⁾(ξ)(φ − φ_i)²(φ − φ_{i+1})²/4!); an error δd in the derivatives adds ≤ (4/27)·h·|δd|.
+      A solver's ε is its right-hand side at the output state, consistent with ω to its tolerance.
+    * Spline: ≈ (5/384)·h⁴·max|v⁽⁴⁾| in the interior (Hall & Meyer's bound for the complete
+      spline; measured ≤ 0.33 of it on random ±40 % meshes); the not-a-knot end conditions
+      make it larger within about three intervals of each end of a piece (measured ≤ 1.7× the
+      bound; tests/unit/test_orders.py asserts 2×).
+    * Extrapolation next to a cut, over at most one interval: ≤ h⁴/6 · max|v⁽⁴⁾| (Hermite).
+    * Across a corner that is not given as a cut (a jump J in dv/dφ inside an interval) both
+      fall to O(h·J) locally, and the spline spreads it, decaying ~4× per interval.
+
+    A time-domain run sampled every Δt has h ≈ ω Δt: for Δt = 2e-5 s at 400 rad/s, h = 0.008 rad
+    and h⁴/384 = 1.1e-11 (rad⁴).
+    """
+    phi = np.asarray(phi, dtype=float)
+    values = np.asarray(values, dtype=float)
+    grid = np.asarray(grid, dtype=float)
+    if phi.ndim != 1 or phi.shape != values.shape:
+        raise ValueError(f"phi and values must be 1-D of one length, got {phi.shape} and "
+                         f"{values.shape}")
+    if phi.size == 0:
+        raise ValueError("no samples to resample")
+    step = np.diff(phi)
+    if np.any(step < 0):
+        raise ValueError("phi must be non-decreasing (take the part after a reversal)")
+    d = None if dvalues is None else np.asarray(dvalues, dtype=float)
+    if d is not None and d.shape != phi.shape:
+        raise ValueError(f"dvalues must have the shape of phi {phi.shape}, got {d.shape}")
+
+    # Coinciding grids: take the samples themselves.
+    k = np.clip(np.searchsorted(phi, grid), 0, phi.size - 1)
+    k_left = np.clip(k - 1, 0, phi.size - 1)
+    near = np.where(np.abs(phi[k_left] - grid) < np.abs(phi[k] - grid), k_left, k)
+    h = step[step > 0].min() if np.any(step > 0) else 1.0
+    if np.all(np.abs(phi[near] - grid) <= 1e-9 * h):
+        # at a repeated angle take the later sample (the right-hand limit), as the interpolants do
+        last = np.searchsorted(phi, phi[near], side="right") - 1
+        return values[last].copy()
+
+    out = np.empty(grid.shape)
+    pieces = _pieces(phi, np.sort(np.asarray(cuts, dtype=float).ravel()))
+    lefts = np.array([p[2] for p in pieces])
+    which = np.searchsorted(lefts, grid, side="right") - 1
+    for j, (a, b, _) in enumerate(pieces):
+        sel = which == j
+        if not np.any(sel):
+            continue
+        x, v = phi[a:b], values[a:b]
+        out[sel] = _spline(x, v, grid[sel]) if d is None else _hermite(x, v, d[a:b], grid[sel])
+    return out
+
+
+def _increasing_part(traj: Mapping[str, NDArray[np.float64]]) -> slice:
+    """The samples after the last backward motion (or stop) of φ, where ω > 0."""
+    phi = np.asarray(traj["phi"])
+    bad = np.diff(phi) < 0
+    if "omega" in traj:
+        w = np.asarray(traj["omega"])
+        bad = bad | (w[1:] <= 0.0)
+    back = np.nonzero(bad)[0]
+    return slice(back[-1] + 1 if back.size else 0, phi.size)
+
+
+def cycle_marks(phi: NDArray[np.float64], cycle: float, phi0: float = 0.0
+                ) -> NDArray[np.float64]:
+    """Angles phi0 + j·cycle of the whole cycles inside [phi[0], phi[-1]] (start and end marks)."""
+    if phi.size < 2:
+        return np.zeros(0)
+    k0 = math.ceil((phi[0] - phi0) / cycle - 1e-12)
+    k1 = math.floor((phi[-1] - phi0) / cycle + 1e-12)
+    return phi0 + cycle * np.arange(k0, k1 + 1)
+
+
+def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
+                  samples_per_cycle: int, cycle: float, *, phi0: float = 0.0,
+                  cycles: int | None = None, cuts: ArrayLike = (),
+                  derivatives: Mapping[str, NDArray[np.float64]] | None = None,
+                  ) -> tuple[NDArray[np.float64], dict[str, NDArray[np.float64]]]:
+    """Trajectory columns on a uniform crank-angle grid of whole cycles.
+
+    Parameters
+    ----------
+    traj : mapping
+        Trajectory columns (``RunData.trajectory``): needs ``phi``; ``omega`` and ``epsilon`` for
+        the Hermite derivatives below.
+    names : sequence of str
+        Columns wanted.
+    samples_per_cycle : int
+        N, grid points per cycle.
+    cycle : float
+        Cycle angle Φ [rad] (``scene.mechanism.cycle``).
+    phi0 : float
+        Cycles start at phi0 + j·Φ (``scene.initial.phi``, as :mod:`.irregularity` counts them).
+    cycles : int, optional
+        Keep only the last ``cycles`` whole cycles (default: all).
+    cuts : array, optional
+        Corner angles, see :func:`resample_angle`.
+    derivatives : mapping, optional
+        dv/dφ per column name, on the trajectory's samples, for columns other than these known
+        ones: ``t`` (1/ω), ``omega`` (ε/ω), ``phi`` (the grid itself). Other columns use the
+        not-a-knot spline.
+
+    Returns
+    -------
+    grid : (n_cycles·N,) array
+        phi0 + Φ(j0 + i/N), i = 0 … n_cycles·N − 1: each cycle's start, not its end (the end is
+        the next cycle's start), as the DFT of :func:`order_spectrum` wants.
+    values : dict
+        name → (n_cycles·N,) array.
+
+    Only the part of the run after its last backward motion (φ decreasing, or ω ≤ 0) is used.
+    """
+    part = _increasing_part(traj)
+    phi = np.asarray(traj["phi"], dtype=float)[part]
+    marks = cycle_marks(phi, cycle, phi0)
+    n_cyc = marks.size - 1
+    if n_cyc < 1:
+        raise ValueError(f"the run holds no whole cycle of {math.degrees(cycle):g}° from "
+                         f"φ0 = {phi0:g} rad (φ from {phi[0] if phi.size else math.nan:.6g} to "
+                         f"{phi[-1] if phi.size else math.nan:.6g} rad)")
+    if cycles is not None:
+        n_cyc = min(n_cyc, int(cycles))
+        marks = marks[-n_cyc - 1:]
+    n = int(samples_per_cycle)
+    j0 = round((marks[0] - phi0) / cycle)
+    grid = phi0 + (cycle / n) * np.arange(j0 * n, (j0 + n_cyc) * n)
+    derivatives = dict(derivatives or {})
+    out = {}
+    for name in names:
+        if name == "phi":
+            out[name] = grid.copy()
+            continue
+        v = np.asarray(traj[name], dtype=float)[part]
+        if name in derivatives:
+            d = np.asarray(derivatives[name], dtype=float)[part]
+        elif name == "t" and "omega" in traj:
+            d = 1.0 / np.asarray(traj["omega"], dtype=float)[part]
+        elif name == "omega" and "epsilon" in traj:
+            d = np.asarray(traj["epsilon"], dtype=float)[part] / v
+        else:
+            d = None
+        out[name] = resample_angle(phi, v, grid, d, cuts)
+    return grid, out
+
+
+# ------------------------------------------------------------------------------------------------
+# Spectra in engine orders
+
+
+@dataclass(frozen=True)
+class OrderSpectrum:
+    """Per-cycle spectrum of a signal in engine orders.
+
+    Each cycle c is written v(φ) = Σ_k Re[coef[c, k] · exp(i ν_k (φ − φ_c))], φ_c its first grid
+    angle: amplitude |coef| and phase arg(coef) of A_k cos(ν_k (φ − φ_c) + θ_k); coef[:, 0] is the
+    cycle mean (real). At the Nyquist order (N even, k = N/2) only A cos θ is measurable: coef is
+    that real number.
+
+    Attributes
+    ----------
+    orders : (n_orders,) array
+        ν_k = 2πk/Φ [1/rev], k = 0 … N//2.
+    coef : (n_cycles, n_orders) complex array
+        In the unit of the signal.
+    window : str
+        ``"none"`` or ``"hann"``.
+    drift : (n_cycles,) array
+        v(next cycle's start) − v(this cycle's start); NaN for the last cycle. For a periodic
+        signal it is 0. A drift D (a spin-up) is a ramp across the cycle, which the unwindowed DFT
+        sees as a sawtooth: it leaks D/(π k) into the amplitude of every harmonic k of the cycle.
+    """
+
+    orders: NDArray[np.float64]
+    coef: NDArray[np.complex128]
+    window: str
+    drift: NDArray[np.float64]
+
+    @property
+    def amplitude(self) -> NDArray[np.float64]:
+        return np.abs(self.coef)
+
+    @property
+    def phase(self) -> NDArray[np.float64]:
+        """[rad], in (−π, π]."""
+        return np.angle(self.coef)
+
+    @property
+    def mean(self) -> NDArray[np.float64]:
+        return self.coef[:, 0].real
+
+    def at(self, order: float) -> NDArray[np.complex128]:
+        """coef[:, k] of the order nearest to ``order`` (which must be on the grid of orders)."""
+        k = int(round(order / self.orders[1]))
+        if not 0 <= k < self.orders.size or abs(self.orders[k] - order) > _ORDER_TOL:
+            raise ValueError(f"order {order:g} is not among the orders k·{self.orders[1]:g}, "
+                             f"k = 0 … {self.orders.size - 1}")
+        return self.coef[:, k]
+
+
+def order_spectrum(values_on_grid: ArrayLike, samples_per_cycle: int, cycle: float,
+                   window: str = "none") -> OrderSpectrum:
+    """Amplitude and phase per engine order of each whole cycle, by the DFT over the cycle.
+
+    Parameters
+    ----------
+    values_on_grid : (n_cycles·N,) or (n_cycles, N) array
+        Samples uniform in crank angle, N per cycle, each cycle's end left out
+        (:func:`to_angle_grid`).
+    samples_per_cycle : int
+        N.
+    cycle : float
+        Cycle angle Φ [rad]; orders are k·2π/Φ.
+    window : ``"none"`` or ``"hann"``
+        ``"none"`` (default): a periodic signal (steady state) sampled over whole cycles has no
+        leakage, and order k·2π/Φ is exact up to aliasing of the orders above N/2 (choose N so
+        that they are negligible). ``"hann"``: the periodic Hann window w_i = ½(1 − cos 2πi/N),
+        amplitudes divided by its mean ½ (exact for a line on an order). For a signal that is
+        not periodic over the cycle (see ``drift``) it lowers the leakage of the ends from
+        ~1/k to ~1/k³, at the price of spreading each line over its neighbours k ± 1 (at half-order
+        spacing a half order and the whole orders beside it mix) and of a biased mean.
+
+    Returns
+    -------
+    OrderSpectrum
+    """
+    v = np.asarray(values_on_grid, dtype=float)
+    n = int(samples_per_cycle)
+    if v.ndim == 1:
+        if v.size % n or v.size == 0:
+            raise ValueError(f"{v.size} samples are not whole cycles of {n}")
+        v = v.reshape(-1, n)
+    elif v.ndim != 2 or v.shape[1] != n:
+        raise ValueError(f"values must be (n_cycles·{n},) or (n_cycles, {n}), got {v.shape}")
+    if window == "none":
+        w = np.ones(n)
+    elif window == "hann":
+        w = 0.5 * (1.0 - np.cos(2.0 * np.pi * np.arange(n) / n))
+    else:
+        raise ValueError(f"window {window!r}: allowed 'none', 'hann'")
+    X = np.fft.rfft(v * w, axis=1) / w.sum()
+    X[:, 1:] *= 2.0
+    if n % 2 == 0:
+        X[:, -1] = X[:, -1].real / 2.0  # Nyquist: A cos θ, once
+    X[:, 0] = X[:, 0].real
+    drift = np.full(v.shape[0], np.nan)
+    drift[:-1] = v[1:, 0] - v[:-1, 0]
+    orders = np.arange(X.shape[1]) * (2.0 * np.pi / cycle)
+    return OrderSpectrum(orders, X, window, drift)
+
+
+# ------------------------------------------------------------------------------------------------
+# Piston kinematics with a variable shaft speed
+
+
+def slider_arrays(alpha: ArrayLike, r: float, l: float, e: float = 0.0
+                  ) -> tuple[NDArray[np.float64], ...]:
+    """:func:`transient.core.crank_slider.slider` on an array of local crank angles.
+
+    Returns s, s′, s″ [m, m/rad, m/rad²] (from the true TDC, positive toward the crank) and β,
+    β′, β″ [rad, 1, 1/rad], each of the shape of ``alpha``.
+    """
+    a = np.asarray(alpha, dtype=float)
+    out = np.array([slider(x, r, l, e) for x in a.ravel()], dtype=float).reshape(a.size, 6)
+    return tuple(out[:, j].reshape(a.shape) for j in range(6))
+
+
+def piston_acceleration(phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLike, r: float,
+                        l: float, e: float = 0.0, phase: float = 0.0) -> NDArray[np.float64]:
+    """Piston acceleration W = ω² s″(α) + ε s′(α), α = φ − phase [m/s²] (Semenov §4).
+
+    Exact kinematics (no truncated series); positive toward the crank axis (Gots §1: at TDC and
+    constant ω, W = rω²(1 + λ) > 0). ``phase``: the shaft angle at which the cylinder's local
+    angle is 0 (``mechanism.firing_angles[k]``). ω [rad/s] and ε [rad/s²] broadcast with φ.
+    """
+    phi = np.asarray(phi, dtype=float)
+    _, ds, dds, _, _, _ = slider_arrays(phi - phase, r, l, e)
+    return np.asarray(omega) ** 2 * dds + np.asarray(epsilon) * ds
+
+
+def piston_inertia_force(phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLike, r: float,
+                         l: float, e: float, m_j: float, phase: float = 0.0
+                         ) -> NDArray[np.float64]:
+    """Inertia force of the reciprocating mass m_j [kg], P_j = −m_j W [N] (Gots §2.3), positive
+    toward the crank axis."""
+    return -m_j * piston_acceleration(phi, omega, epsilon, r, l, e, phase)
+
+
+def rod_angular_acceleration(phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLike, r: float,
+                             l: float, e: float = 0.0, phase: float = 0.0
+                             ) -> NDArray[np.float64]:
+    """Rod angular acceleration ε_ш = ω² β″ + ε β′ [rad/s²] (Semenov §4); odd orders only at
+    constant ω for e = 0 (Semenov (35))."""
+    phi = np.asarray(phi, dtype=float)
+    _, _, _, _, db, ddb = slider_arrays(phi - phase, r, l, e)
+    return np.asarray(omega) ** 2 * ddb + np.asarray(epsilon) * db
+
+
+# ------------------------------------------------------------------------------------------------
+# The odd-harmonic report
+
+
+def _is_odd(orders):
+    whole = np.abs(orders - np.round(orders)) <= _ORDER_TOL
+    return whole & (np.round(orders) % 2 == 1) & (np.round(orders) >= 3)
+
+
+def _is_fractional(orders):
+    return np.abs(orders - np.round(orders)) > _ORDER_TOL
+
+
+@dataclass(frozen=True)
+class OddHarmonicReport:
+    """Orders of the piston acceleration of a run, cycle by cycle, against the same engine turning
+    at the cycle's mean speed.
+
+    Attributes
+    ----------
+    orders : (n_orders,) array
+        Engine orders k·2π/Φ.
+    cycle_start : (n_cycles,) array
+        Angle [rad] at which each cycle starts (the phase reference of the coefficients).
+    omega_mean : (n_cycles,) array
+        Cycle-mean speed Φ / (cycle time) [rad/s] (as :mod:`.irregularity`).
+    delta : (n_cycles,) array
+        δ = (ω_max − ω_min)/ω_mean over the cycle, its two ends included.
+    coef : (n_cycles, n_orders) complex array
+        W with the run's ω(φ), ε(φ) [m/s²] (:class:`OrderSpectrum` convention).
+    coef_constant : (n_cycles, n_orders) complex array
+        W at constant ω = omega_mean: ω̄² s″(φ).
+    drift : (n_cycles,) array
+        W(next start) − W(start) [m/s²] (see :class:`OrderSpectrum`).
+
+    The speed fluctuation *adds* coef − coef_constant = spectrum of (ω² − ω̄²)s″ + εs′.
+    """
+
+    orders: NDArray[np.float64]
+    cycle_start: NDArray[np.float64]
+    omega_mean: NDArray[np.float64]
+    delta: NDArray[np.float64]
+    coef: NDArray[np.complex128]
+    coef_constant: NDArray[np.complex128]
+    drift: NDArray[np.float64]
+
+    @property
+    def amplitude(self):
+        return np.abs(self.coef)
+
+    @property
+    def amplitude_constant(self):
+        return np.abs(self.coef_constant)
+
+    @property
+    def first(self) -> NDArray[np.float64]:
+        """First-order amplitude of W per cycle [m/s²]."""
+        return self.amplitude[:, self._k(1.0)]
+
+    @property
+    def relative(self):
+        """Amplitudes of W relative to its first order."""
+        return self.amplitude / self.first[:, None]
+
+    @property
+    def relative_constant(self):
+        """Amplitudes of W at constant ω̄ relative to the first order of W at ω̄."""
+        return self.amplitude_constant / self.amplitude_constant[:, self._k(1.0), None]
+
+    @property
+    def relative_added(self):
+        """|coef − coef_constant| relative to the first order of W."""
+        return np.abs(self.coef - self.coef_constant) / self.first[:, None]
+
+    @property
+    def odd(self) -> NDArray[np.bool_]:
+        """Mask of the odd whole orders ≥ 3."""
+        return _is_odd(self.orders)
+
+    @property
+    def fractional(self) -> NDArray[np.bool_]:
+        """Mask of the non-whole orders (half orders of a 4-stroke cycle): absent at constant ω
+        for any crank-slider, since s(φ) has period 2π."""
+        return _is_fractional(self.orders)
+
+    def _k(self, order: float) -> int:
+        return int(round(order / self.orders[1]))
+
+    def table(self, cycle: int = -1, max_order: float = 12.0) -> list[dict]:
+        """Rows (order, |W|, |W| at ω̄, relative, relative at ω̄, added relative, kind) of one
+        cycle up to ``max_order``; kind is "odd ≥ 3", "fractional" or "kinematic"."""
+        rows = []
+        for k, nu in enumerate(self.orders):
+            if nu == 0.0 or nu > max_order + _ORDER_TOL:
+                continue
+            kind = ("odd>=3" if self.odd[k] else "fractional" if self.fractional[k]
+                    else "kinematic")
+            rows.append({"order": float(nu), "amplitude": float(self.amplitude[cycle, k]),
+                         "amplitude_constant": float(self.amplitude_constant[cycle, k]),
+                         "relative": float(self.relative[cycle, k]),
+                         "relative_constant": float(self.relative_constant[cycle, k]),
+                         "relative_added": float(self.relative_added[cycle, k]), "kind": kind})
+        return rows
+
+    def summary(self, cycle: int = -1, max_order: float = 9.0) -> dict[str, tuple[float, str]]:
+        """Flat (value, unit) pairs of one cycle (default the last), for ``/analysis``: δ, ω̄, the
+        first-order amplitude, each odd order ≥ 3 up to ``max_order`` relative to the first (run
+        and constant ω̄), the largest odd and fractional ones."""
+        k1 = self._k(1.0)
+        out = {"orders_delta": (float(self.delta[cycle]), "1"),
+               "orders_omega_mean": (float(self.omega_mean[cycle]), "rad/s"),
+               "orders_W_first": (float(self.amplitude[cycle, k1]), "m/s^2"),
+               "orders_W_first_constant": (float(self.amplitude_constant[cycle, k1]), "m/s^2")}
+        for k in np.nonzero(self.odd & (self.orders <= max_order + _ORDER_TOL))[0]:
+            o = int(round(self.orders[k]))
+            out[f"orders_W_odd{o}_rel"] = (float(self.relative[cycle, k]), "1")
+            out[f"orders_W_odd{o}_rel_constant"] = (float(self.relative_constant[cycle, k]), "1")
+        rel = self.relative[cycle]
+        out["orders_W_odd_max_rel"] = (float(rel[self.odd].max(initial=0.0)), "1")
+        out["orders_W_odd_max_rel_constant"] = (
+            float(self.relative_constant[cycle][self.odd].max(initial=0.0)), "1")
+        out["orders_W_fractional_max_rel"] = (float(rel[self.fractional].max(initial=0.0)), "1")
+        return out
+
+
+def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float, l: float,
+                        e: float = 0.0, *, cycle: float = 4.0 * math.pi, phi0: float = 0.0,
+                        phase: float = 0.0, samples_per_cycle: int = 1440,
+                        cycles: int | None = None, cuts: ArrayLike = ()) -> OddHarmonicReport:
+    """Orders of the piston acceleration of a run against the same engine at constant mean speed.
+
+    Parameters
+    ----------
+    traj : mapping
+        Trajectory with ``t``, ``phi``, ``omega``, ``epsilon``.
+    r, l, e : float
+        Crank radius, rod length and offset [m] of the cylinder.
+    cycle, phi0 : float
+        Cycle angle Φ [rad] and the angle cycles are counted from (``scene.initial.phi``).
+    phase : float
+        Shaft angle at which the cylinder's local angle is 0 (its firing angle).
+    samples_per_cycle : int
+        Grid size N per cycle (orders up to N/2 · 2π/Φ; higher ones alias).
+    cycles : int, optional
+        Only the last ``cycles`` whole cycles.
+    cuts : array, optional
+        Corner angles of the run (breakpoints), see :func:`resample_angle`.
+
+    Notes
+    -----
+    The comparison is meant for steady state (periodic cycles). In a transient (a spin-up) the
+    trend of ω across a cycle enters δ (the 20-revolution Gots spin-up: a rise of 2.6 % of ω̄ over
+    its last cycle, δ = 4.7 %) and leaks into every order of the cycle as a sawtooth, ≈
+    drift/(πk) at harmonic k of the cycle (see ``drift``): there the "added" orders mix the
+    ripple's products with that leakage.
+
+    ω, t are resampled by Hermite interpolation with dω/dφ = ε/ω, dt/dφ = 1/ω; ε by the spline
+    (exact when the run's samples lie on the grid). W = ω²s″ + εs′ is then evaluated on the grid
+    with the exact kinematics, and at ω̄ as ω̄²s″.
+    """
+    grid, cols = to_angle_grid(traj, ("t", "omega", "epsilon"), samples_per_cycle, cycle,
+                               phi0=phi0, cycles=cycles, cuts=cuts)
+    n = int(samples_per_cycle)
+    n_cyc = grid.size // n
+    # The cycle ends: t for the mean speed, ω to close the cycle for δ.
+    part = _increasing_part(traj)
+    phi, w = np.asarray(traj["phi"], float)[part], np.asarray(traj["omega"], float)[part]
+    eps = np.asarray(traj["epsilon"], float)[part]
+    ends = grid[::n] + cycle
+    t_end = resample_angle(phi, np.asarray(traj["t"], float)[part], ends, 1.0 / w, cuts)
+    w_end = resample_angle(phi, w, ends, eps / w, cuts)
+    t_start = cols["t"][::n]
+    omega_mean = cycle / (t_end - t_start)
+    wc = cols["omega"].reshape(n_cyc, n)
+    delta = (np.maximum(wc.max(axis=1), w_end) - np.minimum(wc.min(axis=1), w_end)) / omega_mean
+
+    _, ds, dds, _, _, _ = slider_arrays(grid - phase, r, l, e)
+    W = cols["omega"] ** 2 * dds + cols["epsilon"] * ds
+    W_const = np.repeat(omega_mean, n) ** 2 * dds
+    spec = order_spectrum(W, n, cycle)
+    spec_c = order_spectrum(W_const, n, cycle)
+    # the last cycle's drift from its own end (the next cycle's start is not on the grid)
+    drift = spec.drift.copy()
+    eps_end = resample_angle(phi, eps, ends[-1:], None, cuts)
+    _, ds_e, dds_e, _, _, _ = slider_arrays(ends[-1:] - phase, r, l, e)
+    drift[-1] = float(w_end[-1] ** 2 * dds_e[0] + eps_end[0] * ds_e[0] - W[-n])
+    return OddHarmonicReport(spec.orders, grid[::n].copy(), omega_mean, delta, spec.coef,
+                             spec_c.coef, drift)
+
+
+def report_for_scene(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int = 1,
+                     **options) -> OddHarmonicReport:
+    """:func:`odd_harmonic_report` for cylinder ``cylinder`` (1-based) of a crank-slider scene:
+    r, l, e, Φ, φ0 and the cylinder's firing angle taken from the scene; ``options`` as there."""
+    m = scene.mechanism
+    if not hasattr(m, "crank_radius"):
+        raise ValueError(f"the odd-harmonic report needs a crank-slider mechanism, "
+                         f"not {type(m).__name__}")
+    return odd_harmonic_report(traj, m.crank_radius, m.rod_length, m.offset, cycle=m.cycle,
+                               phi0=scene.initial.phi, phase=m.firing_angles[cylinder - 1],
+                               **options)
