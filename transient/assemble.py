@@ -12,28 +12,69 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .core.model import PAPER, PHI, POWER_FLOW, TABULATED, T, Model
-from .forces.gas import PressureTable, mixed_cycle, table_from_points
+from .forces.gas import PressureTable, _shift_cubic, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
 
 def gas_table(scene) -> PressureTable | None:
-    """The cylinder pressure table of the scene (absolute pressure [Pa] over the local angle)."""
+    """The cylinder pressure table of the scene (absolute pressure [Pa] over the local angle) at
+    full load (governor fuel 1); see :func:`gas_tables` for the motored one."""
+    return gas_tables(scene)[0]
+
+
+def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
+    """``(full, motored)``: the full-load table and the motored one, between which the governor's
+    fuel f interpolates, p = p_mot + f·(p_full − p_mot) (:class:`transient.scene.Gas`).
+
+    ``motored`` is None when the motored curve is the constant crankcase pressure p0 (table,
+    mixed cycle; a force model's zero), so that such a scene's model holds one table only. For
+    ``"wiebe"`` it is the cycle without fuel, on the same knots as the full-load one (both from one
+    :func:`~transient.forces.wiebe.wiebe_tables`); with ``fuel_mass = 0`` both are that cycle.
+    """
     gas = scene.gas
     mech = scene.mechanism
     if gas.model == "none":
-        return None
+        return None, None
     if gas.model == "trapezoid":  # a force per piston [N] (Antonyuk §4)
-        return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration)
+        return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration), None
     if gas.model == "table":
         return table_from_points(np.asarray(gas.phi), np.asarray(gas.p), mech.cycle,
-                                 corners=gas.corners, interpolation=gas.interpolation)
+                                 corners=gas.corners, interpolation=gas.interpolation), None
+    if gas.model == "wiebe":
+        tables = wiebe_levels(mech, gas)
+        return tables[-1], tables[0]
     return mixed_cycle(mech.volume_function(clearance_volume(scene)), compression_ratio=gas.compression_ratio,
                        p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
-                       p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes)
+                       p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes), None
+
+
+@lru_cache(maxsize=8)
+def wiebe_levels(mech, gas) -> tuple:
+    """The Wiebe cycles of ``gas`` (``model = "wiebe"``) on the mechanism's cylinder volume:
+    ``(motored, full load)``, or ``(motored,)`` with no fuel
+    (:class:`~transient.forces.wiebe.WiebeCycle`).
+
+    Cached (the mechanism and the gas model are frozen): ``load_scene`` builds them to validate
+    the scene, and every run of a scene with the same engine and cycle uses them again (~0.2 s).
+    """
+    # (lazily: scipy's integrators, start-up time)
+    from .forces.wiebe import wiebe_tables
+
+    w = gas.wiebe
+    clearance = mech.swept_volume() / (gas.compression_ratio - 1.0)
+    levels = [0.0, w.fuel_mass] if w.fuel_mass > 0.0 else [0.0]
+    return wiebe_tables(
+        mech.volume_function(clearance), levels, p_a=gas.p_a, start=w.start,
+        duration=w.duration, a=w.a, m=w.m, lhv=w.lhv, efficiency=w.efficiency, gamma=w.gamma,
+        gamma_slope=w.gamma_slope, gamma_t_ref=w.gamma_t_ref, t_a=w.t_a,
+        p_intake=gas.p_intake if mech.strokes == 4 else None,
+        p_exhaust=gas.p_exhaust if mech.strokes == 4 else None, strokes=mech.strokes,
+        intake_closing=w.intake_closing, exhaust_opening=w.exhaust_opening, step=w.step,
+        tolerance=w.tolerance)
 
 
 def clearance_volume(scene) -> float:
-    """V_c = V_h/(ε − 1) of the mixed cycle's compression ratio ε [m³]."""
+    """V_c = V_h/(ε − 1) of the cycle's compression ratio ε (mixed cycle, Wiebe) [m³]."""
     return scene.mechanism.swept_volume() / (scene.gas.compression_ratio - 1.0)
 
 
@@ -53,18 +94,56 @@ def gas_phases(scene) -> NDArray[np.float64]:
     return np.mod(np.asarray(mech.firing_angles) - shift, mech.cycle)
 
 
-def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float
-                ) -> NDArray[np.float64]:
-    """Sorted shaft angles in [0, period) where any cylinder's table has a corner."""
+def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
+                motored: PressureTable | None = None) -> NDArray[np.float64]:
+    """Sorted shaft angles in [0, period) where any cylinder's table (full-load or motored) has a
+    corner."""
     if table is None:
         return np.zeros(0)
     corners = table.corners[:-1]  # the period's end is the next cycle's 0
+    if motored is not None:
+        corners = np.union1d(corners, motored.corners[:-1])
     angles = np.sort(np.mod(np.add.outer(phases, corners).ravel(), period))
     keep = np.concatenate(([True], np.diff(angles) > 1e-12 * period))
     angles = angles[keep]
     if angles.size > 1 and period - angles[-1] < 1e-12 * period:
         angles = angles[:-1]
     return angles
+
+
+def paired_table(full: PressureTable, motored: PressureTable
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Both curves on common knots, as the model holds them (``transient.core.tables``, paired):
+    ``(knots, coef, piece_knot)`` with ``coef`` float64[n, 8], the full-load cubic in columns
+    0–3 and the motored one in 4–7, so that the right-hand side finds the interval once.
+
+    Tables on the same knots and corners (the Wiebe levels) are stacked as they are. Otherwise
+    the knots and the corners are the unions of both (points closer than 1e-12 of the period
+    taken as one), and each curve's cubic is re-expanded about the new knots: exact, as a
+    cubic restricted to part of its interval is the same cubic.
+    """
+    if (full.knots.shape == motored.knots.shape and np.array_equal(full.knots, motored.knots)
+            and np.array_equal(full.piece_knot, motored.piece_knot)):
+        return full.knots, np.hstack([full.coef, motored.coef]), full.piece_knot
+    period = full.period
+    tol = 1e-12 * period
+
+    def union(a, b):
+        x = np.union1d(a, b)
+        return x[np.concatenate(([True], np.diff(x) > tol))]
+
+    knots = union(full.knots, motored.knots)
+    knots[-1] = period
+    corners = union(full.corners, motored.corners)
+    piece_knot = np.searchsorted(knots, corners - tol)
+    mid = 0.5 * (knots[:-1] + knots[1:])
+    coefs = []
+    for table in (full, motored):
+        piece = table.piece_of(mid)
+        i = np.clip(np.searchsorted(table.knots, mid, side="right") - 1,
+                    table.piece_knot[piece], table.piece_knot[piece + 1] - 1)
+        coefs.append(_shift_cubic(table.coef[i].T, knots[:-1] - table.knots[i]).T)
+    return knots, np.ascontiguousarray(np.hstack(coefs)), piece_knot.astype(np.int64)
 
 
 def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
@@ -84,16 +163,18 @@ def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]
 
 
 def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None]:
-    """The compiled model, its breakpoints and the pressure table of a scene."""
+    """The compiled model, its breakpoints and the (full-load) pressure table of a scene."""
     mech = scene.mechanism
-    table = gas_table(scene)
+    table, motored = gas_tables(scene)
     phases = gas_phases(scene)
     period = mech.cycle
     n = mech.n_cylinders
-    if table is None:
+    if table is None:  # one interval, zero (the kernels never read it)
         knots, coef, piece_knot = np.array([0.0, period]), np.zeros((1, 4)), np.array([0, 1])
-    else:
+    elif motored is None:
         knots, coef, piece_knot = table.knots, table.coef, table.piece_knot
+    else:
+        knots, coef, piece_knot = paired_table(table, motored)
     kin = kinematics_table(scene)
     tabulated = kin is not None and kin.coef is not None
     load_x, load_s, load_comp = load_schedule(scene)
@@ -104,7 +185,8 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         has_gas=table is not None, gas_phase=phases,
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
-        piece_knot=piece_knot.astype(np.int64), breakpoints=breakpoints(table, phases, period),
+        piece_knot=piece_knot.astype(np.int64), has_motored=motored is not None,
+        breakpoints=breakpoints(table, phases, period, motored),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
         gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,

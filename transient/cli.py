@@ -347,7 +347,7 @@ def cmd_plot(args) -> int:
         mech = scene.mechanism
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
         plots.indicator_phi(a1, table)
-        if scene.gas.model == "mixed-cycle":
+        if scene.gas.model in ("mixed-cycle", "wiebe"):
             plots.indicator_pv(a2, table, mech.volume_function(clearance_volume(scene)))
         else:  # a table gives no clearance volume: plot against the swept part F_p·s
             plots.indicator_pv(a2, table, mech.volume_function(0.0), log=False)

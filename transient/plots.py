@@ -26,12 +26,13 @@ def acceleration(ax, traj, label=None):
 
 def piston_force(ax, traj, scene, cylinder=1):
     """Gas force on one piston of ``cylinder`` against time [kN]: the table value times the
-    governor's fuel for force models, (p − p0)·F_p·fuel for pressure models."""
+    pressure applied (the governor's fuel included) for force models, (p − p0)·F_p for pressure
+    models."""
     from .assemble import gas_is_force
 
     value = traj[f"p_{cylinder}"]
     force = value if gas_is_force(scene) else (value - scene.gas.p0) * scene.mechanism.piston_area
-    artists = ax.plot(traj["t"], force * traj["fuel"] / 1e3, lw=0.6)
+    artists = ax.plot(traj["t"], force / 1e3, lw=0.6)
     ax.set_xlabel("t [s]")
     ax.set_ylabel(f"P piston {cylinder} [kN]")
     ax.grid(True, alpha=0.3)

@@ -14,7 +14,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from .assemble import build_model
+from .assemble import build_model, gas_tables
 from .core.integrate import next_breakpoint
 from .core.model import T, generator_branch, load_segment
 from .errors import SimulationError
@@ -143,6 +143,9 @@ class ReferenceModel:
     def __init__(self, scene) -> None:
         self.scene = scene
         self.model, self.bp, self.table = build_model(scene)
+        # The motored curve (None: the constant p0) between which and the table the fuel
+        # interpolates, as PressureTable objects rather than the model's arrays.
+        self.motored = gas_tables(scene)[1]
         self.mech = _mechanism(scene)
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
         self.pieces = None
@@ -177,6 +180,8 @@ class ReferenceModel:
         mid = 0.5 * (a + b) if math.isfinite(a) and math.isfinite(b) else (a if math.isfinite(a) else b)
         local = np.mod(mid - self.model.gas_phase, self.model.period)
         self.pieces = self.table.piece_of(local)
+        if self.motored is not None:
+            self.motored_pieces = self.motored.piece_of(local)
         self.mid = mid
 
     def moments(self, phi: float, w: float):
@@ -187,8 +192,13 @@ class ReferenceModel:
         p = np.zeros(m.ncyl)
         if self.table is not None:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
-            p = self.table.evaluate(local, self.pieces)[0]
-            M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u)) * self.fuel(w)
+            f = self.fuel(w)
+            p_full = self.table.evaluate(local, self.pieces)[0]
+            # p = p_mot + f·(p_full − p_mot); the motored curve is p0 without a motored table
+            p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
+                     if self.motored is not None else m.gas_offset)
+            p = p_mot + f * (p_full - p_mot)
+            M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
         resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
         if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min
             resist += m.gen_power / (m.gen_min if self.gen_low else w)

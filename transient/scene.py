@@ -36,6 +36,7 @@ class Section:
         self.known: list[str] = []
         self.kinds: dict[str, str | None] = {}
         self.written: dict[str, str] = {}  # base name -> the key as the user wrote it
+        self.subs: dict[str, Section] = {}  # sub-tables read so far, for rename()
 
     def key(self, name: str) -> str:
         return f"{self.path}.{name}" if self.path else name
@@ -158,8 +159,11 @@ class Section:
         if name not in self.data:
             if required:
                 raise SceneError(self.key(name), "is missing (a table)")
-            return Section({}, self.key(name))
-        return Section(self.data.pop(name), self.key(name))
+            child = Section({}, self.key(name))
+        else:
+            child = Section(self.data.pop(name), self.key(name))
+        self.subs[name] = child
+        return child
 
     def has(self, name: str, kind: str | None = None) -> bool:
         names = [name] + [f"{name}_{s}" for s in SUFFIXES.get(kind, {})] if kind else [name]
@@ -180,6 +184,9 @@ class Section:
         prefix = f"{self.path}." if self.path else ""
         if exc.key.startswith(prefix):
             name = exc.key[len(prefix):]
+            head, dot, _ = name.partition(".")
+            if dot and head in self.subs:  # a key of a sub-table (gas.wiebe.start_deg)
+                return self.subs[head].rename(exc)
             base = name.rpartition("_")[0] if name.rpartition("_")[2] in ALL_SUFFIXES else name
             if base in self.written:
                 exc.key = prefix + self.written[base]
@@ -224,14 +231,63 @@ class Inertia:
 
 
 @dataclass(frozen=True)
+class Wiebe:
+    """Single-zone Wiebe combustion, the ``[gas.wiebe]`` table of ``model = "wiebe"``
+    (:func:`transient.forces.wiebe.wiebe_cycle`, whose parameters these are, in SI).
+
+    ``start`` [rad] (``start_deg``) and ``duration`` [rad] of the combustion, local angles as the
+    other gas models (4-stroke: 0 gas-exchange TDC, 2π firing TDC). ``fuel_mass`` [kg]: fuel
+    burned per cycle and cylinder at full load (governor fuel 1); 0 runs the engine motored.
+    ``a``, ``m`` [1]: Wiebe efficiency parameter and shape exponent. ``lhv`` [J/kg]: lower heating
+    value; ``efficiency`` [1]: combustion efficiency η_c, the share of m_f·LHV released.
+    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K].
+    ``t_a`` [K]: gas temperature at intake closing. ``intake_closing``, ``exhaust_opening`` [rad]:
+    ends of the closed part (None: the BDCs around the firing TDC). ``step`` [rad] and
+    ``tolerance`` [1]: largest knot spacing and target relative error of the tables.
+    """
+
+    start: float = 0.0
+    duration: float = 0.0
+    fuel_mass: float = 0.0
+    a: float = 6.908
+    m: float = 0.5
+    lhv: float = 42.5e6
+    efficiency: float = 1.0
+    gamma: float = 1.35
+    gamma_slope: float = 0.0
+    gamma_t_ref: float = 300.0
+    t_a: float = 330.0
+    intake_closing: float | None = None
+    exhaust_opening: float | None = None
+    step: float = math.radians(0.125)
+    tolerance: float = 1e-10
+
+
+@dataclass(frozen=True)
 class Gas:
     """Cylinder pressure model (angle-only in this version).
 
     ``model``: ``"none"``, ``"table"`` (indicator diagram p(φ) over one cycle, absolute pressure
-    [Pa]; local angle 0 = gas-exchange TDC for 4-stroke, firing TDC for 2-stroke ... see README) or
-    ``"mixed-cycle"`` (Gots App. 2, Trinkler–Sabathé), or ``"trapezoid"`` (the swash-plate paper's
-    force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]). ``p0`` is the
+    [Pa]; local angle 0 = gas-exchange TDC for 4-stroke, firing TDC for 2-stroke ... see README),
+    ``"mixed-cycle"`` (Gots App. 2, Trinkler–Sabathé), ``"trapezoid"`` (the swash-plate paper's
+    force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]) or
+    ``"wiebe"`` (single-zone Wiebe combustion, :class:`Wiebe`; with ``compression_ratio``, ``p_a``
+    [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]). ``p0`` is the
     crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33).
+
+    **Fuel command.** The governor's fuel f ∈ [0, 1] (1 without a governor) sets the cylinder
+    pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot). For
+    ``"table"`` and ``"mixed-cycle"`` the motored curve is the constant p0, so the gas force is
+    f·(p − p0)·F_p (for ``"trapezoid"``, f times the force). For ``"wiebe"`` it is the cycle with
+    no fuel and p_full the cycle with ``fuel_mass``: with a constant γ the single-zone pressure is
+    linear in the fuel mass, so this is exactly the cycle burning f·fuel_mass. With
+    ``gamma_slope`` ≠ 0 (γ(T)) it is not, and the pressure at part load is only approximately
+    that cycle's: the author of :mod:`transient.forces.wiebe` reports up to about 2.5 % of p_max
+    for fuel levels 0.02 g apart; ``tests/validation/test_wiebe_runs.py`` measures, on the Gots
+    engine of ``cases/gots_diesel_wiebe.toml`` with γ = 1.38 − 1e-4·(T − 300 K), 1.1 % of the
+    full-load p_max between 0 and 0.02 g and 2.1 % between 0 and 0.031 g (at f = 0.5; the
+    indicated work at f = 0.25 is then 7.6 % low). Use a constant γ where part load matters.
+    The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"``).
     """
 
     model: str = "none"
@@ -251,6 +307,7 @@ class Gas:
     amplitude: float = 0.0
     ramp: float = 0.0
     duration: float = math.pi
+    wiebe: Wiebe | None = None
 
 
 @dataclass(frozen=True)
@@ -416,8 +473,9 @@ class Scene:
 MECHANISMS = {"crank-slider": read_crank_slider, "swash-plate": read_swash_plate}
 
 
-def _read_gas(s: Section, base_dir: Path) -> Gas:
-    model = s.string("model", "none", choices=("none", "table", "mixed-cycle", "trapezoid"))
+def _read_gas(s: Section, base_dir: Path, strokes: int) -> Gas:
+    model = s.string("model", "none",
+                     choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe"))
     if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
         return Gas(model="trapezoid", p0=0.0, amplitude=s.number("amplitude", ge=0.0),
                    ramp=s.number("ramp", "angle", gt=0.0),
@@ -434,6 +492,8 @@ def _read_gas(s: Section, base_dir: Path) -> Gas:
         corners = s.numbers("corners", "angle", ())
         interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
         return Gas(model="table", p0=p0, phi=phi, p=p, corners=corners, interpolation=interp)
+    if model == "wiebe":
+        return _read_wiebe(s, p0, strokes)
     return Gas(
         model="mixed-cycle", p0=p0,
         compression_ratio=s.number("compression_ratio", gt=1.0),
@@ -441,6 +501,39 @@ def _read_gas(s: Section, base_dir: Path) -> Gas:
         p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
         n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
         p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+
+
+def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
+    """``model = "wiebe"``: the cycle's pressures in [gas], the combustion in [gas.wiebe].
+
+    Ranges of single keys are checked here; what needs several of them (the combustion inside
+    the closed part, γ(T) > 1 at intake closing) by :mod:`transient.forces.wiebe` when the table
+    is built, still inside :func:`load_scene` (``_check_gas_table``).
+    """
+    d = Wiebe()
+    ratio = s.number("compression_ratio", gt=1.0)
+    p_a = s.number("p_a", "pressure", gt=0.0)
+    # A 2-stroke is scavenged to p_a: it has no intake or exhaust stroke.
+    need = _MISSING if strokes == 4 else 0.0
+    p_in = s.number("p_intake", "pressure", need, ge=0.0)
+    p_ex = s.number("p_exhaust", "pressure", need, ge=0.0)
+    w = s.sub("wiebe", required=True)
+    wiebe = Wiebe(
+        start=w.number("start", "angle"), duration=w.number("duration", "angle", gt=0.0),
+        fuel_mass=w.number("fuel_mass", ge=0.0), a=w.number("a", default=d.a, gt=0.0),
+        m=w.number("m", default=d.m, gt=-1.0), lhv=w.number("lhv", default=d.lhv, gt=0.0),
+        efficiency=w.number("efficiency", default=d.efficiency, gt=0.0, le=1.0),
+        gamma=w.number("gamma", default=d.gamma, gt=1.0),
+        gamma_slope=w.number("gamma_slope", default=d.gamma_slope),
+        gamma_t_ref=w.number("gamma_t_ref", default=d.gamma_t_ref, gt=0.0),
+        t_a=w.number("t_a", default=d.t_a, gt=0.0),
+        intake_closing=w.number("intake_closing", "angle", None),
+        exhaust_opening=w.number("exhaust_opening", "angle", None),
+        step=w.number("step", "angle", d.step, gt=0.0),
+        tolerance=w.number("tolerance", default=d.tolerance, gt=0.0))
+    w.finish()
+    return Gas(model="wiebe", p0=p0, compression_ratio=ratio, p_a=p_a, p_intake=p_in,
+               p_exhaust=p_ex, wiebe=wiebe)
 
 
 def _read_pressure_csv(s: Section, base_dir: Path):
@@ -632,7 +725,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
                                       si.number("load", default=0.0, ge=0.0))
         si.finish()
         sg = root.sub("gas")
-        sections["gas"] = _read_gas(sg, base_dir)
+        sections["gas"] = _read_gas(sg, base_dir, mech.strokes)
         sg.finish()
         sl = root.sub("load")
         sections["load"] = _read_load(sl)
@@ -783,10 +876,16 @@ def to_toml(scene: Scene) -> str:
 
 def _gas_section(gas: Gas) -> list[str]:
     keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation"),
-            "trapezoid": ("model", "amplitude", "ramp", "duration")}
+            "trapezoid": ("model", "amplitude", "ramp", "duration"),
+            "wiebe": ("model", "p0", "compression_ratio", "p_a", "p_intake", "p_exhaust")}
     names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
                                  "n2", "p_intake", "p_exhaust"))
-    return ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
+    lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
+    if gas.model == "wiebe":  # unset optional angles (None) are left out: they read back as None
+        lines += ["", "[gas.wiebe]"] + [f"{f.name} = {toml_value(getattr(gas.wiebe, f.name))}"
+                                        for f in fields(gas.wiebe)
+                                        if getattr(gas.wiebe, f.name) is not None]
+    return lines
 
 
 def _load_section(load: Load) -> list[str]:

@@ -209,9 +209,18 @@ def _kinematics_attrs(scene) -> dict:
 
 def prescribed(scene, fuel: float = 1.0) -> RunData:
     """Inverse dynamics at a prescribed speed: the drive torque on the shaft that the chain needs
-    (the textbook analysis at given ω). ``fuel`` scales every gas force, as the governor does."""
+    (the textbook analysis at given ω). ``fuel`` sets the pressure between the motored and the
+    full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot the
+    crankcase pressure p0, or zero force, for the models without a motored curve): the tables'
+    cubics are blended, so the ``p_<k>`` columns hold the pressure applied."""
     model, _, _ = build_model(scene)
-    model = model._replace(gas_scale=model.gas_scale * fuel)
+    coef = model.coef.copy()
+    if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.model.Model)
+        coef[:, :4] = coef[:, 4:] + fuel * (coef[:, :4] - coef[:, 4:])
+    else:
+        coef *= fuel
+        coef[:, 0] += (1.0 - fuel) * model.gas_offset
+    model = model._replace(coef=coef)
     run = scene.run
     phi0 = scene.initial.phi
     dphi = 2.0 * math.pi / scene.output.samples_per_rev

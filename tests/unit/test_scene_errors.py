@@ -179,8 +179,9 @@ CASES = [
      "gas.compression_ratio", "must be > 1, got 0.5"),
     ("mixed-cycle-missing-key", (VALID + MIXED_CYCLE.format(cr=18)).replace("n2 = 1.228\n", ""),
      "gas.n2", "is missing"),
-    ("unknown-gas-model", VALID + '\n[gas]\nmodel = "wiebe"\n',
-     "gas.model", "unknown value 'wiebe'; allowed: 'none', 'table', 'mixed-cycle'"),
+    ("unknown-gas-model", VALID + '\n[gas]\nmodel = "woschni"\n',
+     "gas.model", "unknown value 'woschni'; allowed: 'none', 'table', 'mixed-cycle', 'trapezoid', "
+                  "'wiebe'"),
     ("run-without-end", replace("revolutions = 2\n", ""),
      "run.t_end", "the run needs an end: give t_end [s] and/or revolutions"),
     ("run-negative-t-end", add_after("revolutions = 2", "t_end = -1"),

@@ -22,7 +22,9 @@ Accuracy in the scipy way, e = (y − y_ref)/(atol + rtol·|y_ref|):
   φ is monotonic) by cubic Hermite in φ, with the slopes the reference itself writes
   (dω/dφ = ε/ω, dt/dφ = 1/ω). Every table corner is a reference row (solve_ivp segments end
   there), so no interval spans a kink. The interpolation error (∝ Δφ⁴ with Δφ ≲ 1.3° here) adds
-  to the solvers' differences: measured max |e| ≤ 49 (ω, DOP853 rows) and ≤ 1.3 (t); bound 500.
+  to the solvers' differences: measured max |e| ≤ 49 (ω, DOP853 rows) and ≤ 1.3 (t), except
+  the Wiebe scene: 268 (ω), 0.5° after the combustion start, where the pressure rises like
+  (x − start)^1.5 and the Hermite interpolation between reference rows is poorest; bound 500.
 
 A stalled reference (solve_ivp restarted again and again at the same t) is reported as a failure
 at once rather than hanging the test run; a 60 s alarm backs that up.

@@ -61,13 +61,13 @@ def fluctuation(t, phi, omega, cycle, phi0) -> float:
 def last_cycle_ranges(traj, cycle) -> dict[str, tuple[float, str]]:
     """What drives the speed fluctuation in the last cycle: peak |ε|, and the peak-to-peak swing
     of the gas torque, of the inertia torque ½J′(φ)ω² of (18), and of the gas value of piston 1
-    (pressure or force) times the governor's fuel."""
+    (pressure or force, as applied: the governor's fuel included)."""
     phi = traj["phi"]
     sel = phi >= phi[-1] - cycle
     if sel.sum() < 3:
         return {}
     inertia = 0.5 * traj["dJ_dphi"][sel] * traj["omega"][sel] ** 2
-    gas1 = traj["p_1"][sel] * traj["fuel"][sel] if "p_1" in traj else np.zeros(1)
+    gas1 = traj["p_1"][sel] if "p_1" in traj else np.zeros(1)  # (the fuel is applied in p_1)
     swing = lambda v: float(v.max() - v.min())  # noqa: E731
     return {"epsilon_peak_last_cycle": (float(np.abs(traj["epsilon"][sel]).max()), "rad/s^2"),
             "M_gas_swing_last_cycle": (swing(traj["M_gas"][sel]), "N m"),

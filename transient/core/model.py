@@ -25,7 +25,7 @@ from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from .crank_slider import crank_slider_terms
 from .swash_plate import swash_terms
 from .tabulated import tabulated_terms
-from .tables import find_piece, table_eval
+from .tables import find_piece, table_eval, table_eval_pair
 
 #: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode). The first
 #: three are the dynamics; the rest are work integrals (quadratures that do not feed back): the work
@@ -90,8 +90,9 @@ Model = namedtuple(
         "gas_offset",  # float: table value of zero force (crankcase pressure p0 [Pa], or 0)
         "period",  # float: cycle length in local angle [rad] (4π four-stroke, 2π two-stroke)
         "knots",  # float64[:], piecewise-cubic table (transient.core.tables)
-        "coef",  # float64[:, 4]
+        "coef",  # float64[:, 4], or [:, 8] with has_motored (full-load, then motored cubic)
         "piece_knot",  # int64[:]
+        "has_motored",  # bool: coef pairs a motored curve; else it is the constant gas_offset
         "breakpoints",  # float64[:]: sorted shaft angles in [0, period) where a table has a corner
         "load_const",  # float: constant resisting torque [N m]
         "load_linear",  # float: c in −c·ω [N m s]
@@ -147,7 +148,7 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du):
 
 @kernel(inline="always")
 def gas_value(m, k, phi, sel):
-    """Table value (pressure or force) of cylinder k at shaft angle ``phi``.
+    """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
     ends exactly on a corner keeps using the piece it integrates over (DESIGN §2, breakpoints).
@@ -156,6 +157,31 @@ def gas_value(m, k, phi, sel):
     piece = find_piece(m.knots, m.piece_knot, local_sel)
     value, _ = table_eval(m.knots, m.coef, m.piece_knot, piece, local_sel + (phi - sel))
     return value
+
+
+@kernel(inline="always")
+def gas_pair(m, k, phi, sel):
+    """Full-load and motored table values of cylinder k at shaft angle ``phi`` (``m.has_motored``
+    only: ``m.coef`` pairs the two curves on common knots); ``sel`` as in :func:`gas_value`."""
+    local_sel = (sel - m.gas_phase[k]) % m.period
+    piece = find_piece(m.knots, m.piece_knot, local_sel)
+    return table_eval_pair(m.knots, m.coef, m.piece_knot, piece, local_sel + (phi - sel))
+
+
+@kernel(inline="always")
+def applied_value(m, k, phi, sel, f):
+    """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot).
+
+    Without a motored table the motored curve is the constant ``gas_offset`` (p0), and at f = 1
+    the value is the table's to the last bit.
+    """
+    if m.has_motored:
+        p, p_mot = gas_pair(m, k, phi, sel)
+        return p_mot + f * (p - p_mot)
+    p = gas_value(m, k, phi, sel)
+    if f == 1.0:
+        return p
+    return m.gas_offset + f * (p - m.gas_offset)
 
 
 @kernel(inline="always")
@@ -186,9 +212,11 @@ def governor_branch(m, w, rising):
 
 @kernel(inline="always")
 def fuel(m, w, branch):
-    """Gas-force scale of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
-    to 0 at ω_1c, 0 above; 1 without a governor. The branch is fixed for a whole step (a state
-    event stops on each corner), so that the right-hand side is smooth inside every step."""
+    """Fuel command f of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
+    to 0 at ω_1c, 0 above; 1 without a governor. The cylinder pressure is p_mot + f·(p_full −
+    p_mot) (:func:`applied_value`), i.e. f scales the gas force (p − p0)·F_p when the motored curve
+    is p0. The branch is fixed for a whole step (a state event stops on each corner), so that the
+    right-hand side is smooth inside every step."""
     if not m.gov_on or branch == 0:
         return 1.0
     if branch == 2:
@@ -246,9 +274,11 @@ def moments(m, angle_mode, y, sel, sw, wk):
     """Reduced inertia, speed and moments at state ``y``.
 
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; the rows u, u′ of ``wk`` are left holding
-    the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The load is
-    M_load = −s·(torque + linear·ω + fan·ω|ω| + P/max(ω, ω_min)), s from the schedule's segment
-    ``sw[SW_LOAD]`` and the max from the generator's branch ``sw[SW_GENERATOR]``.
+    the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force
+    of cylinder k is (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel
+    f (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
+    P/max(ω, ω_min)), s from the schedule's segment ``sw[SW_LOAD]`` and the max from the
+    generator's branch ``sw[SW_GENERATOR]``.
     """
     phi = y[PHI]
     u = wk[WK_U]
@@ -257,9 +287,14 @@ def moments(m, angle_mode, y, sel, sw, wk):
     w = speed(J, angle_mode, y)
     M_gas = 0.0
     if m.has_gas:
-        for k in range(m.ncyl):
-            M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
-        M_gas *= fuel(m, w, sw[SW_GOVERNOR])
+        f = fuel(m, w, sw[SW_GOVERNOR])
+        if m.has_motored:  # p = p_mot + f·(p_full − p_mot), per cylinder
+            for k in range(m.ncyl):
+                M_gas += m.gas_scale[k] * (applied_value(m, k, phi, sel, f) - m.gas_offset) * u[k]
+        else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
+            for k in range(m.ncyl):
+                M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
+            M_gas *= f
     # (with s = 1 exactly the formula without a schedule, to the last bit)
     s = load_scale(m, y, sw[SW_LOAD])
     M_load = -s * (m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
@@ -306,7 +341,7 @@ def pair_etas(m, modes, eta_out):
         eta_out[k] = eta_star(m.eta_fwd[k], m.eta_bwd[k], ((modes >> k) & 1) == 0)
 
 
-@kernel
+@kernel(inline="always")
 def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)."""
     if m.n_pairs == 0:
@@ -437,8 +472,8 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
 
 @kernel
 def output_row(m, angle_mode, y, sel, sw, wk, row):
-    """Fill one output sample: columns ``OUTPUTS``, the gas value of each cylinder, then
-    ``PAIR_OUTPUTS`` of each pair."""
+    """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
+    (p_mot + f·(p_full − p_mot), see :func:`applied_value`), then ``PAIR_OUTPUTS`` of each pair."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
     row[0] = y[T]
     row[1] = y[PHI]
@@ -449,16 +484,17 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
-    row[9] = fuel(m, w, sw[SW_GOVERNOR])
+    f = fuel(m, w, sw[SW_GOVERNOR])
+    row[9] = f
     row[10] = y[W_GAS]
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
-    for k in range(m.ncyl):
-        row[N_OUT_FIXED + k] = gas_value(m, k, y[PHI], sel) if m.has_gas else 0.0
+    for k in range(m.ncyl):  # the pressure (force) applied, at the governor's fuel
+        row[N_OUT_FIXED + k] = applied_value(m, k, y[PHI], sel, f) if m.has_gas else 0.0
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
 
 
-@kernel
+@kernel(inline="always")
 def pair_rows(m, w, w_loss, wk, out):
     """``PAIR_OUTPUTS`` of each pair from the rows η*, S of ``wk``; ``w_loss``: energy lost so far."""
     np_ = len(PAIR_OUTPUTS)

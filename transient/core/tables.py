@@ -17,6 +17,11 @@ smooth parts. The layout, shared by the right-hand side and by :mod:`transient.f
 
 The corners in angle are ``knots[piece_knot]``. Angles are in radians, values in SI (Pa).
 The plain-numpy twin is :meth:`transient.forces.gas.PressureTable.evaluate`.
+
+A **paired** table holds two curves on the same knots and corners (the full-load and the motored
+cylinder pressure, ``transient.assemble.paired_table``): ``coef`` is float64[n, 8], columns 0–3
+the first curve's cubic and 4–7 the second's. :func:`table_eval` reads the first curve of it,
+:func:`table_eval_pair` both, with one interval search.
 """
 from __future__ import annotations
 
@@ -106,6 +111,30 @@ def table_eval(knots, coef, piece_knot, piece, x):
     value = c0 + d * (c1 + d * (c2 + d * c3))
     slope = c1 + d * (2.0 * c2 + 3.0 * d * c3)
     return value, slope
+
+
+@kernel
+def table_eval_pair(knots, coef, piece_knot, piece, x):
+    """Values of both curves of a paired table (``coef`` float64[n, 8]) at `x`, using the
+    polynomials of `piece` only, as :func:`table_eval` (which this is, twice on one interval).
+
+    Returns
+    -------
+    first, second : float
+        The curves of columns 0–3 and 4–7 (full-load and motored pressure) [Pa].
+    """
+    lo = piece_knot[piece]
+    hi = piece_knot[piece + 1] - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if knots[mid] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    d = x - knots[lo]
+    first = coef[lo, 0] + d * (coef[lo, 1] + d * (coef[lo, 2] + d * coef[lo, 3]))
+    second = coef[lo, 4] + d * (coef[lo, 5] + d * (coef[lo, 6] + d * coef[lo, 7]))
+    return first, second
 
 
 @kernel
