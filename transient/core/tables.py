@@ -63,6 +63,22 @@ def find_piece(knots, piece_knot, x):
     return lo
 
 
+@kernel(inline="always")
+def _interval(knots, piece_knot, piece, x):
+    """The knot interval of ``piece`` that holds x (bisection). Only the piece's own intervals
+    are searched: the same result as a global search clamped into the piece, and fewer
+    comparisons."""
+    lo = piece_knot[piece]
+    hi = piece_knot[piece + 1] - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if knots[mid] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
 @kernel
 def table_eval(knots, coef, piece_knot, piece, x):
     """Value and slope of the table at `x`, using the polynomials of `piece` only.
@@ -93,16 +109,7 @@ def table_eval(knots, coef, piece_knot, piece, x):
     slope : float
         Derivative with respect to the angle (Pa/rad).
     """
-    # Search only the piece's own intervals: the same result as a global search clamped into
-    # the piece, and fewer comparisons.
-    lo = piece_knot[piece]
-    hi = piece_knot[piece + 1] - 1
-    while lo < hi:
-        mid = (lo + hi + 1) // 2
-        if knots[mid] <= x:
-            lo = mid
-        else:
-            hi = mid - 1
+    lo = _interval(knots, piece_knot, piece, x)
     d = x - knots[lo]
     c0 = coef[lo, 0]
     c1 = coef[lo, 1]
@@ -123,14 +130,7 @@ def table_eval_pair(knots, coef, piece_knot, piece, x):
     first, second : float
         The curves of columns 0–3 and 4–7 (full-load and motored pressure) [Pa].
     """
-    lo = piece_knot[piece]
-    hi = piece_knot[piece + 1] - 1
-    while lo < hi:
-        mid = (lo + hi + 1) // 2
-        if knots[mid] <= x:
-            lo = mid
-        else:
-            hi = mid - 1
+    lo = _interval(knots, piece_knot, piece, x)
     d = x - knots[lo]
     first = coef[lo, 0] + d * (coef[lo, 1] + d * (coef[lo, 2] + d * coef[lo, 3]))
     second = coef[lo, 4] + d * (coef[lo, 5] + d * (coef[lo, 6] + d * coef[lo, 7]))
