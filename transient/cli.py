@@ -86,6 +86,36 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--samples-per-rev", type=int, default=1440)
     e.add_argument("-o", "--output", default="results", help="output folder (default results/)")
     e.set_defaults(func=cmd_efficiency)
+    lo = sub.add_parser(
+        "loads", help="crankpin, main-journal loads and running torques along a crank-slider "
+                      "result (PNG + CSV files; the result file is not changed)",
+        description="Loads along the stored trajectory (transient.analysis.loads): polar "
+                    "diagrams of the crankpin and of the most loaded main journal, |R| over the "
+                    "last cycle, the wear diagram (Gots §2.6, ±60° rule), running torques; peak "
+                    "values on standard output; the last cycle's loads as CSV. Results are "
+                    "written as files into DIR, never into the HDF5 result (read only here).")
+    lo.add_argument("result")
+    lo.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    lo.add_argument("--cylinder", type=int, default=1,
+                    help="cylinder (1-based, from the nose) whose crankpin is drawn (default 1)")
+    lo.set_defaults(func=cmd_loads)
+    od = sub.add_parser(
+        "orders", help="order spectra of ω, M_gas and the piston acceleration (PNG + CSV "
+                       "files; the result file is not changed)",
+        description="Order spectra over the last whole cycle (transient.analysis.orders): ω, "
+                    "the gas torque M_gas and, for a crank-slider, the piston acceleration of "
+                    "cylinder 1 against the same engine at constant mean speed (odd-harmonic "
+                    "report); δ of the last cycle; with two or more whole cycles, a run-up "
+                    "waterfall and order tracks of ω against the cycle-mean speed. Results are "
+                    "written as files into DIR, never into the HDF5 result (read only here).")
+    od.add_argument("result")
+    od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    od.add_argument("--samples-per-cycle", type=int, default=720,
+                    help="crank-angle grid points per engine cycle (default 720); orders up to "
+                         "half of it per cycle")
+    od.add_argument("--max-order", type=float, default=12.0,
+                    help="highest order in the tables and figures (default 12)")
+    od.set_defaults(func=cmd_orders)
     return p
 
 
@@ -423,4 +453,345 @@ def cmd_kinematics(args) -> int:
         plots.reduced_inertia(a2, table)
         a1.set_title(f"{scene.name}: transfer functions and reduced inertia")
         print(f"wrote {_save(fig, Path(args.plot))}", file=sys.stderr if not args.output else sys.stdout)
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------------------------------
+# transient loads / transient orders: analyses of a stored result, written as CSV and PNG files
+# (the result file stays as it is).
+
+#: Half-width of the arc each load vector "wears" in the conventional wear diagram (Gots §2.6,
+#: reference/gots-crank-dynamics.md §7: wear ∝ force, each force acting over ±60° of arc).
+WEAR_HALF_ARC_DEG = 60.0
+
+
+def _crank_slider_scene(res):
+    """The result's scene, or a one-line error (exit 2) if its mechanism is not a crank-slider."""
+    from .mechanisms.crank_slider import CrankSlider
+
+    scene = res.scene()
+    if not isinstance(scene.mechanism, CrankSlider):
+        raise SceneError("mechanism.type", f"loads are computed for crank-slider engines only, "
+                                           f"not {type(scene.mechanism).__name__}",
+                         file=str(res.path))
+    return scene
+
+
+def _last_cycle_window(scene, traj, path):
+    """Mask of the samples of the last whole cycle counted from ``scene.initial.phi`` (as
+    ``analysis.irregularity`` counts cycles), its end marks included, and its start angle."""
+    from .analysis.irregularity import cycle_boundaries
+
+    cycle = scene.mechanism.cycle
+    _, marks = cycle_boundaries(traj["t"], traj["phi"], cycle, scene.initial.phi)
+    if marks.size < 2:
+        raise SceneError("(trajectory)", f"the run holds no whole cycle of "
+                                         f"{math.degrees(cycle):g}°", file=str(path))
+    a, b = marks[-2], marks[-1]
+    tol = 1e-9 * cycle
+    phi = traj["phi"]
+    # after the last backward motion only (a run that reversed passes these angles twice)
+    back = np.nonzero(np.diff(phi) < 0)[0]
+    start = back[-1] + 1 if back.size else 0
+    mask = (phi >= a - tol) & (phi <= b + tol)
+    mask[:start] = False
+    return mask, a
+
+
+def wear_rays(direction: np.ndarray, magnitude: np.ndarray, weight: np.ndarray,
+              n_rays: int = 36, half_arc_deg: float = WEAR_HALF_ARC_DEG
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """The conventional wear diagram's ray sums (Gots §2.6, Table 14;
+    reference/gots-crank-dynamics.md §7): for each of ``n_rays`` equally spaced directions, the
+    sum of the magnitudes of the load vectors whose direction lies within ±``half_arc_deg`` of
+    it. Gots draws 12 (or 18) rays over samples at equal crank-angle steps; here each sample
+    counts with ``weight`` (the crank angle it stands for over the mean step: 1 for equal
+    steps), so that extra samples at breakpoints do not count twice.
+
+    Returns (ray angles [deg], sums [unit of ``magnitude``]).
+    """
+    rays = np.arange(n_rays) * (360.0 / n_rays)
+    d = np.degrees(direction)[None, :] - rays[:, None]
+    d = (d + 180.0) % 360.0 - 180.0
+    inside = np.abs(d) <= half_arc_deg + 1e-9
+    return rays, (inside * (magnitude * weight)[None, :]).sum(axis=1)
+
+
+def _angle_weights(phi: np.ndarray) -> np.ndarray:
+    """Crank angle each sample stands for (half the intervals on either side) over the mean."""
+    if phi.size < 2:
+        return np.ones_like(phi)
+    gaps = np.diff(phi)
+    w = np.zeros_like(phi)
+    w[:-1] += 0.5 * gaps
+    w[1:] += 0.5 * gaps
+    return w / (w.sum() / (phi.size - 1))
+
+
+def cmd_loads(args) -> int:
+    from .analysis.loads import (
+        engine_torque,
+        loads_from_trajectory,
+        main_journal_loads,
+        running_torques,
+    )
+
+    res = _open(args.result)
+    scene = _crank_slider_scene(res)
+    mech = scene.mechanism
+    n_cyl = mech.n_cylinders
+    if not 1 <= args.cylinder <= n_cyl:
+        raise SceneError("--cylinder", f"must be 1 … {n_cyl}, got {args.cylinder}")
+    traj = res.trajectory
+    mask, start = _last_cycle_window(scene, traj, res.path)
+    win = {k: v[mask] for k, v in traj.items()}
+    loads = loads_from_trajectory(scene, win)
+    k = args.cylinder - 1
+    deg = np.degrees(win["phi"] - start)
+    inline = n_cyl == 1 or np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12
+    journals = crankpins = mj = None
+    if inline:
+        journals, crankpins = running_torques(mech, loads)
+        mj = main_journal_loads(mech, loads, win["omega"], win["epsilon"])
+
+    out = Path(args.output) if args.output else res.path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    stem = res.path.stem
+    plt = _pyplot()
+
+    from . import plots
+
+    written = []
+    # Frame of the pictures: crank k pointing up (+y, outward along ĉ), +x the direction of
+    # rotation at the crankpin (t̂); the load on the crankpin is R_T t̂ − R_K ĉ.
+    px, py = loads.R_T[k], -loads.R_K[k]
+    best = None
+    ncols = 2 if inline else 1
+    fig, axes = plt.subplots(1, ncols, figsize=(6 * ncols, 5.5), squeeze=False)
+    plots.polar_load(axes[0, 0], px, py)
+    axes[0, 0].set_xlabel("R_T = T + T_rш [kN] (direction of rotation)")
+    axes[0, 0].set_ylabel("−R_K = −(K + K_rш) [kN] (crank outward)")
+    axes[0, 0].set_title(f"crankpin {args.cylinder}, crank frame", fontsize=9)
+    if inline:
+        best = int(np.argmax(mj.magnitude.max(axis=1)))
+        plots.polar_load(axes[0, 1], mj.x[best], -mj.y[best])
+        axes[0, 1].set_xlabel("R_x [kN] (along T₁, direction of rotation)")
+        axes[0, 1].set_ylabel("−R_y [kN] (crank 1 outward)")
+        axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
+                             f"(split beam, (58))", fontsize=9)
+    fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle")
+    written.append(_save(fig, out / f"{stem}_loads_polar.png"))
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for j in range(n_cyl):
+        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin {j + 1}")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
+    written.append(_save(fig, out / f"{stem}_loads_crankpin.png"))
+
+    weight = _angle_weights(win["phi"])
+    rays, sums = wear_rays(np.arctan2(py, px), loads.R[k], weight)
+    fig, axes = plt.subplots(1, ncols, figsize=(5.5 * ncols, 5.5), squeeze=False)
+    plots.wear_diagram(axes[0, 0], rays, sums)
+    axes[0, 0].set_title(f"crankpin {args.cylinder} (frame of its polar diagram)", fontsize=9)
+    if inline:
+        rays_j, sums_j = wear_rays(np.arctan2(-mj.y[best], mj.x[best]), mj.magnitude[best],
+                                   weight)
+        plots.wear_diagram(axes[0, 1], rays_j, sums_j)
+        axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
+    fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6: each load wears ±60° around its "
+                 f"direction)", fontsize=10)
+    written.append(_save(fig, out / f"{stem}_loads_wear.png"))
+
+    if inline:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        plots.running_torque_curves(ax, deg, journals, crankpins)
+        ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
+        written.append(_save(fig, out / f"{stem}_loads_running_torques.png"))
+
+    # CSV of the last cycle: every cylinder's forces, the engine torque, running torques and
+    # main-journal loads.
+    cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
+            "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
+    for j in range(n_cyl):
+        for name in ("P_g", "P_j", "P", "N", "S", "K", "T", "R_K", "R_T", "R"):
+            cols[f"{name}_{j + 1}_N"] = getattr(loads, name)[j]
+        cols[f"M_{j + 1}_Nm"] = loads.torque[j]
+    cols["M_engine_Nm"] = engine_torque(loads)
+    if inline:
+        for j in range(journals.shape[0]):
+            cols[f"M_journal_{j + 1}_Nm"] = journals[j]
+        for j in range(crankpins.shape[0]):
+            cols[f"M_crankpin_{j + 1}_Nm"] = crankpins[j]
+        for j in range(mj.x.shape[0]):
+            cols[f"R_main_{j + 1}_N"] = mj.magnitude[j]
+    csv = out / f"{stem}_loads.csv"
+    np.savetxt(csv, np.column_stack(list(cols.values())), delimiter=",",
+               header=",".join(cols), comments="", fmt="%.12g")
+    written.append(csv)
+
+    area = loads.area
+    print(f"{res.path}: loads over the last cycle (φ = {start:.6g} … "
+          f"{start + mech.cycle:.6g} rad, {int(mask.sum())} samples)")
+    for j in range(n_cyl):
+        i = int(np.argmax(loads.R[j]))
+        print(f"  crankpin {j + 1}: |R| max {loads.R[j][i] / 1e3:.6g} kN "
+              f"({loads.R[j][i] / area / 1e6:.4g} MPa on the piston area) at "
+              f"{deg[i]:.4g}° of the cycle, mean {np.mean(loads.R[j]) / 1e3:.6g} kN, "
+              f"min {loads.R[j].min() / 1e3:.6g} kN")
+    s, n = loads.S[k], loads.N[k]
+    print(f"  cylinder {args.cylinder}: rod force S from {s.min() / 1e3:.6g} to "
+          f"{s.max() / 1e3:.6g} kN (compression > 0), side force |N| max "
+          f"{np.abs(n).max() / 1e3:.6g} kN, T from {loads.T[k].min() / 1e3:.6g} to "
+          f"{loads.T[k].max() / 1e3:.6g} kN")
+    m = engine_torque(loads)
+    print(f"  engine torque Σ T r: mean {np.mean(m):.6g} N m (sample mean), from "
+          f"{m.min():.6g} to {m.max():.6g} N m")
+    if inline:
+        for j in range(mj.x.shape[0]):
+            print(f"  main journal {j + 1}: |R| max {mj.magnitude[j].max() / 1e3:.6g} kN")
+        for j in range(1, journals.shape[0]):
+            print(f"  running torque journal {j + 1}: max |M| {np.abs(journals[j]).max():.6g} "
+                  f"N m")
+        for j in range(crankpins.shape[0]):
+            print(f"  running torque crankpin {j + 1}: max |M| "
+                  f"{np.abs(crankpins[j]).max():.6g} N m")
+    else:
+        print("  main journals and running torques: in-line engines only (skipped)")
+    print(f"  wear diagram of crankpin {args.cylinder}: least loaded ray at "
+          f"{rays[np.argmin(sums)]:g}° (counter-clockwise from the direction of rotation, "
+          f"crank up)")
+    for w in written:
+        print(f"wrote {w}")
+    return EXIT_OK
+
+
+def cmd_orders(args) -> int:
+    from .analysis.irregularity import cycle_means, fluctuation
+    from .analysis.orders import order_spectrum, report_for_scene, to_angle_grid
+    from .mechanisms.crank_slider import CrankSlider
+
+    res = _open(args.result)
+    scene = res.scene()
+    mech = scene.mechanism
+    n = args.samples_per_cycle
+    if n < 16:
+        raise SceneError("--samples-per-cycle", f"must be ≥ 16, got {n}")
+    if not args.max_order > 0:
+        raise SceneError("--max-order", f"must be > 0, got {args.max_order:g}")
+    traj = res.trajectory
+    cycle, phi0 = mech.cycle, scene.initial.phi
+    cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
+    try:
+        grid, cols = to_angle_grid(traj, ("omega",), n, cycle, phi0=phi0, cuts=cuts)
+    except ValueError as exc:
+        raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
+    n_cyc = grid.size // n
+    spec_w = order_spectrum(cols["omega"], n, cycle)
+    spec_m = None
+    if "M_gas" in traj and scene.gas.model != "none":
+        _, cm = to_angle_grid(traj, ("M_gas",), n, cycle, phi0=phi0, cycles=1, cuts=cuts)
+        spec_m = order_spectrum(cm["M_gas"], n, cycle)
+    rep = None
+    if isinstance(mech, CrankSlider):
+        rep = report_for_scene(scene, traj, 1, samples_per_cycle=n, cycles=1, cuts=cuts)
+    t, phi, omega = traj["t"], traj["phi"], traj["omega"]
+    delta = fluctuation(t, phi, omega, cycle, phi0)
+    means, _ = cycle_means(t, phi, cycle, phi0)
+    means = means[-n_cyc:]
+    rpm = 30.0 / math.pi
+    orders = spec_w.orders
+    top = args.max_order
+    shown = (orders > 0.0) & (orders <= top + 1e-9)
+
+    out = Path(args.output) if args.output else res.path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    stem = res.path.stem
+    written = []
+    cols_csv = {"order": orders, "omega_amplitude_rad_s": spec_w.amplitude[-1],
+                "omega_phase_rad": spec_w.phase[-1]}
+    if spec_m is not None:
+        cols_csv["M_gas_amplitude_Nm"] = spec_m.amplitude[-1]
+        cols_csv["M_gas_phase_rad"] = spec_m.phase[-1]
+    if rep is not None:
+        cols_csv["W_amplitude_m_s2"] = rep.amplitude[-1]
+        cols_csv["W_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
+        cols_csv["W_relative"] = rep.relative[-1]
+        cols_csv["W_relative_constant"] = rep.relative_constant[-1]
+        cols_csv["W_relative_added"] = rep.relative_added[-1]
+    csv = out / f"{stem}_orders.csv"
+    np.savetxt(csv, np.column_stack(list(cols_csv.values())), delimiter=",",
+               header=",".join(cols_csv), comments="", fmt="%.12g")
+    written.append(csv)
+
+    plt = _pyplot()
+
+    from . import plots
+
+    rows = 1 + (spec_m is not None) + (rep is not None)
+    fig, axes = plt.subplots(rows, 1, figsize=(9, 3.2 * rows), squeeze=False)
+    axes = axes[:, 0]
+    plots.order_bars(axes[0], orders, spec_w.amplitude[-1], "ω amplitude [rad/s]", top)
+    axes[0].set_title(f"{scene.name}: orders over the last cycle (mean ω "
+                      f"{spec_w.mean[-1] * rpm:.5g} rpm, δ = {delta:.4g})", fontsize=10)
+    i = 1
+    if spec_m is not None:
+        plots.order_bars(axes[i], orders, spec_m.amplitude[-1], "M_gas amplitude [N m]", top)
+        i += 1
+    if rep is not None:
+        plots.order_bars(axes[i], orders, rep.relative[-1], "W / W₁ (cylinder 1)", top,
+                         width=0.2, offset=-0.1, label="run", log=True)
+        plots.order_bars(axes[i], orders, rep.relative_constant[-1], "W / W₁ (cylinder 1)", top,
+                         width=0.2, offset=0.1, label="constant ω̄", log=True)
+        axes[i].legend(fontsize=8)
+    written.append(_save(fig, out / f"{stem}_orders.png"))
+
+    if n_cyc >= 2:
+        amp = spec_w.amplitude
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5))
+        pick = np.unique(np.linspace(0, n_cyc - 1, min(n_cyc, 60)).round().astype(int))
+        plots.order_waterfall(a1, means[pick] * rpm, orders, amp[pick], top)
+        a1.set_title(f"ω spectrum per cycle ({pick.size} of {n_cyc} cycles)", fontsize=9)
+        # the strongest orders of the last cycle, and the firing-frequency ones
+        strongest = np.argsort(amp[-1][shown])[::-1][:6]
+        ks = np.nonzero(shown)[0][strongest]
+        tracks = {f"order {orders[j]:g}": amp[:, j] for j in sorted(ks)}
+        plots.order_tracks(a2, means * rpm, tracks, "ω amplitude [rad/s]")
+        a2.set_title("order tracks of ω against the cycle-mean speed", fontsize=9)
+        fig.suptitle(f"{scene.name}: run-up orders of ω")
+        written.append(_save(fig, out / f"{stem}_orders_runup.png"))
+        sel = np.nonzero(shown)[0]
+        run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": grid[::n],
+               "omega_mean_rad_s": means}
+        run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j] for j in sel})
+        csv = out / f"{stem}_orders_runup.csv"
+        np.savetxt(csv, np.column_stack(list(run.values())), delimiter=",",
+                   header=",".join(run), comments="", fmt="%.12g")
+        written.append(csv)
+
+    print(f"{res.path}: orders over the last whole cycle (φ = {grid[-n]:.6g} … "
+          f"{grid[-n] + cycle:.6g} rad, {n} points; {n_cyc} whole cycle(s))")
+    print(f"  δ = {delta:.12g} (last cycle, (ω_max − ω_min)/ω_mean), cycle-mean ω = "
+          f"{means[-1]:.6g} rad/s ({means[-1] * rpm:.6g} rpm)")
+    strongest = np.nonzero(shown)[0][np.argsort(spec_w.amplitude[-1][shown])[::-1][:6]]
+    print("  ω, strongest orders: " + ", ".join(
+        f"{orders[j]:g}: {spec_w.amplitude[-1][j]:.4g} rad/s" for j in strongest))
+    if spec_m is not None:
+        strongest = np.nonzero(shown)[0][np.argsort(spec_m.amplitude[-1][shown])[::-1][:6]]
+        print(f"  M_gas (mean {spec_m.mean[-1]:.6g} N m), strongest orders: " + ", ".join(
+            f"{orders[j]:g}: {spec_m.amplitude[-1][j]:.4g} N m" for j in strongest))
+    if rep is not None:
+        print(f"  piston acceleration W of cylinder 1, relative to its first order "
+              f"(|W₁| = {rep.first[-1]:.6g} m/s²), against the same engine at constant "
+              f"ω̄ = {rep.omega_mean[-1]:.6g} rad/s:")
+        print(f"  {'order':>6} {'|W| [m/s²]':>12} {'rel. run':>10} {'rel. ω̄':>10} "
+              f"{'added':>10}  kind")
+        for r in rep.table(-1, max_order=top):
+            print(f"  {r['order']:6g} {r['amplitude']:12.5g} {r['relative']:10.3e} "
+                  f"{r['relative_constant']:10.3e} {r['relative_added']:10.3e}  {r['kind']}")
+        if rep.drift[-1] and abs(rep.drift[-1]) > 1e-6 * rep.first[-1]:
+            print(f"  (the cycle is not periodic: W drifts by {rep.drift[-1]:.3g} m/s² across "
+                  f"it, which leaks into every order)")
+    for w in written:
+        print(f"wrote {w}")
     return EXIT_OK

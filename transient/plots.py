@@ -174,3 +174,126 @@ def load_response(axes, traj, cycle, analysis):
     for ax in axes:
         ax.grid(True, alpha=0.3)
     return artists
+
+
+def polar_load(ax, x, y, label=None, scale=1e-3):
+    """Polar load diagram: the end points of a load vector (x, y) [N] drawn from the pole, in kN
+    by default (``scale``). The caller picks the frame; the largest vector is drawn as an arrow.
+    Returns the artists."""
+    x = np.asarray(x) * scale
+    y = np.asarray(y) * scale
+    artists = ax.plot(x, y, lw=1.0, label=label)
+    k = int(np.argmax(np.hypot(x, y)))
+    artists.append(ax.annotate("", xy=(x[k], y[k]), xytext=(0.0, 0.0),
+                               arrowprops={"arrowstyle": "->", "color": artists[0].get_color(),
+                                           "lw": 0.8}))
+    artists += ax.plot([0.0], [0.0], "k+", ms=8)
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    ax.axvline(0.0, color="0.7", lw=0.5)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    return artists
+
+
+def load_against_angle(ax, angle_deg, values, label=None, ylabel="|R| [kN]", scale=1e-3):
+    """A load [N] (plotted in kN by default) against the crank angle [deg], with its mean as a
+    dashed line. Returns the artists."""
+    v = np.asarray(values) * scale
+    artists = ax.plot(angle_deg, v, lw=1.0, label=label)
+    artists.append(ax.axhline(float(np.mean(v)), color=artists[0].get_color(), lw=0.8, ls="--"))
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    return artists
+
+
+def wear_diagram(ax, ray_deg, sums, label=None):
+    """Conventional wear diagram: the journal as a unit circle and each ray's load sum plotted
+    inward from it (Gots §2.6), scaled so that the largest sum reaches half the radius. ``ray_deg``
+    are the ray directions in the frame of the matching polar diagram (counter-clockwise from its
+    +x axis). Returns the artists."""
+    th = np.radians(np.append(ray_deg, ray_deg[0]))
+    s = np.append(sums, sums[0])
+    top = float(np.max(s)) if np.max(s) > 0 else 1.0
+    inner = 1.0 - 0.5 * s / top
+    c = np.linspace(0.0, 2.0 * math.pi, 361)
+    artists = ax.plot(np.cos(c), np.sin(c), color="k", lw=0.8)
+    artists += ax.plot(inner * np.cos(th), inner * np.sin(th), lw=1.2, label=label)
+    artists.append(ax.fill(np.concatenate([np.cos(th), inner[::-1] * np.cos(th[::-1])]),
+                           np.concatenate([np.sin(th), inner[::-1] * np.sin(th[::-1])]),
+                           alpha=0.3, lw=0, color=artists[-1].get_color())[0])
+    for a in th[:-1]:
+        ax.plot([0.0, math.cos(a)], [0.0, math.sin(a)], color="0.85", lw=0.4)
+    k = int(np.argmin(sums))
+    artists += ax.plot([math.cos(th[k])], [math.sin(th[k])], "v", color="C3",
+                       label="least loaded ray")
+    ax.set_aspect("equal")
+    ax.set_xlim(-1.1, 1.1)
+    ax.set_ylim(-1.1, 1.1)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    return artists
+
+
+def running_torque_curves(ax, angle_deg, journals, crankpins):
+    """Running torques [N m] against the crank angle [deg]: each main journal after the first
+    (solid; the last carries the engine torque) and each crankpin (dashed). Returns the artists."""
+    artists = []
+    for j in range(1, journals.shape[0]):
+        artists += ax.plot(angle_deg, journals[j], lw=1.0, label=f"journal {j + 1}")
+    for k in range(crankpins.shape[0]):
+        artists += ax.plot(angle_deg, crankpins[k], lw=0.8, ls="--", label=f"crankpin {k + 1}")
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel("running torque [N m]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return artists
+
+
+def order_bars(ax, orders, amplitude, ylabel, max_order=12.0, width=0.35, offset=0.0,
+               label=None, log=False):
+    """Amplitude per engine order (order 0, the mean, left out) up to ``max_order`` as bars.
+    Returns the artists."""
+    orders = np.asarray(orders)
+    sel = (orders > 0.0) & (orders <= max_order + 1e-9)
+    artists = list(ax.bar(orders[sel] + offset, np.asarray(amplitude)[sel], width=width,
+                          label=label, log=log))
+    ax.set_xlabel("engine order [1/rev]")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3, axis="y")
+    return artists
+
+
+def order_waterfall(ax, omega_mean_rpm, orders, amplitude, max_order=12.0):
+    """Run-up waterfall: each cycle's order spectrum [unit of the signal] as one line, raised by
+    its cycle-mean speed (the y axis reads speed at each line's base). ``amplitude``: (n_cycles,
+    n_orders). Returns the artists."""
+    orders = np.asarray(orders)
+    sel = (orders > 0.0) & (orders <= max_order + 1e-9)
+    amp = np.asarray(amplitude)[:, sel]
+    w = np.asarray(omega_mean_rpm)
+    step = np.ptp(w) / max(len(w) - 1, 1) if len(w) > 1 else 1.0
+    top = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
+    scale = 3.0 * (step if step > 0 else 1.0) / top
+    artists = []
+    for c in range(amp.shape[0]):
+        artists += ax.plot(orders[sel], w[c] + scale * amp[c], lw=0.6,
+                           color=f"C{c % 10}" if amp.shape[0] <= 10 else "C0")
+    ax.set_xlabel("engine order [1/rev]")
+    ax.set_ylabel("cycle-mean speed [rpm] (+ amplitude)")
+    ax.grid(True, alpha=0.3)
+    return artists
+
+
+def order_tracks(ax, omega_mean_rpm, tracks, ylabel):
+    """Campbell-style order tracks: the amplitude of each order in ``tracks`` (label → per-cycle
+    amplitude) against the cycle-mean speed [rpm]. Returns the artists."""
+    artists = [ax.plot(omega_mean_rpm, v, lw=1.0, marker=".", ms=3, label=k)[0]
+               for k, v in tracks.items()]
+    ax.set_xlabel("cycle-mean speed [rpm]")
+    ax.set_ylabel(ylabel)
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return artists

@@ -1,0 +1,141 @@
+"""``transient loads`` and ``transient orders`` end to end (issue 7): a short Gots spin-up is run
+through ``transient.cli.main`` and both analyses are checked against independent calls of the
+analysis functions; a swash-plate result is refused by ``loads`` (exit 2)."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from transient.analysis.irregularity import cycle_boundaries, fluctuation
+from transient.analysis.loads import loads_from_trajectory
+from transient.cli import main
+from transient.results import open_result
+
+REPO = Path(__file__).resolve().parents[2]
+CASES = REPO / "cases"
+
+
+def _scene_text(name: str, old: str, new: str) -> str:
+    text = (CASES / name).read_text()
+    assert old in text, f"{name}: {old!r} not found"
+    return text.replace(old, new)
+
+
+@pytest.fixture(scope="module")
+def spinup(tmp_path_factory):
+    """The Gots spin-up (cases/gots_diesel_spinup.toml) for 8 revolutions: 4 whole cycles."""
+    tmp = tmp_path_factory.mktemp("spinup")
+    scene = tmp / "short_spinup.toml"
+    scene.write_text(_scene_text("gots_diesel_spinup.toml", "revolutions = 1000",
+                                 "revolutions = 8"))
+    assert main(["run", str(scene), "-o", str(tmp), "-q"]) == 0
+    path = tmp / "short_spinup.h5"
+    assert path.is_file()
+    return path
+
+
+def _last_cycle_mask(res):
+    scene = res.scene()
+    traj = res.trajectory
+    _, marks = cycle_boundaries(traj["t"], traj["phi"], scene.mechanism.cycle,
+                                scene.initial.phi)
+    tol = 1e-9 * scene.mechanism.cycle
+    return (traj["phi"] >= marks[-2] - tol) & (traj["phi"] <= marks[-1] + tol)
+
+
+def _nontrivial_png(path: Path) -> None:
+    assert path.is_file(), path
+    assert path.stat().st_size > 10_000, path
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def _read_csv(path: Path) -> dict[str, np.ndarray]:
+    header = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    assert data.shape[1] == len(header)
+    return {name: data[:, j] for j, name in enumerate(header)}
+
+
+def test_loads_files_and_peak(spinup, tmp_path, capsys):
+    with h5py.File(spinup, "r") as f:
+        before = sorted(f["analysis"])
+    out = tmp_path / "loads"
+    assert main(["loads", str(spinup), "-o", str(out), "--cylinder", "2"]) == 0
+    printed = capsys.readouterr().out
+    stem = spinup.stem
+    for name in ("polar", "crankpin", "wear", "running_torques"):
+        _nontrivial_png(out / f"{stem}_loads_{name}.png")
+    csv = _read_csv(out / f"{stem}_loads.csv")
+
+    # Independent recomputation over the same window: the last whole cycle from φ0.
+    res = open_result(spinup)
+    scene = res.scene()
+    loads = loads_from_trajectory(scene, res.trajectory)
+    mask = _last_cycle_mask(res)
+    assert csv["phi_rad"].size == mask.sum() > 100
+    np.testing.assert_allclose(csv["phi_rad"], res.trajectory["phi"][mask], rtol=1e-11)
+    for k in range(scene.mechanism.n_cylinders):
+        peak = loads.R[k][mask].max()
+        assert csv[f"R_{k + 1}_N"].max() == pytest.approx(peak, rel=1e-10)
+        assert f"crankpin {k + 1}: |R| max {peak / 1e3:.6g} kN" in printed
+    assert 3e4 < loads.R[1][mask].max() < 1e5  # tens of kN: the Gots diesel at full fuel
+    # the engine torque column is Σ T r over the cylinders
+    total = sum(csv[f"M_{k + 1}_Nm"] for k in range(scene.mechanism.n_cylinders))
+    np.testing.assert_allclose(csv["M_engine_Nm"], total, rtol=1e-9, atol=1e-6)
+    assert "main journal 2: |R| max" in printed and "kN" in printed and "N m" in printed
+    # the result file is read only: nothing was added under /analysis
+    with h5py.File(spinup, "r") as f:
+        assert sorted(f["analysis"]) == before
+
+
+def test_loads_bad_cylinder(spinup, tmp_path, capsys):
+    assert main(["loads", str(spinup), "-o", str(tmp_path), "--cylinder", "4"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--cylinder" in err and len(err.splitlines()) == 1
+
+
+def test_orders_files_and_delta(spinup, tmp_path, capsys):
+    out = tmp_path / "orders"
+    assert main(["orders", str(spinup), "-o", str(out), "--samples-per-cycle", "720"]) == 0
+    printed = capsys.readouterr().out
+    stem = spinup.stem
+    _nontrivial_png(out / f"{stem}_orders.png")
+    _nontrivial_png(out / f"{stem}_orders_runup.png")
+    csv = _read_csv(out / f"{stem}_orders.csv")
+    assert csv["order"].size == 361  # N/2 + 1 orders, half orders of a 4-stroke cycle
+    assert csv["order"][1] == pytest.approx(0.5)
+    assert csv["omega_amplitude_rad_s"][1:].max() > 0.0
+    assert csv["M_gas_amplitude_Nm"][1:].max() > 0.0
+    # the odd-harmonic table: first-order W relative to itself is 1
+    k1 = int(np.argmin(np.abs(csv["order"] - 1.0)))
+    assert csv["W_relative"][k1] == pytest.approx(1.0)
+    assert "odd>=3" in printed and "fractional" in printed
+    runup = _read_csv(out / f"{stem}_orders_runup.csv")
+    assert runup["cycle"].size == 4
+    assert np.all(np.diff(runup["omega_mean_rad_s"]) > 0)  # spinning up
+
+    res = open_result(spinup)
+    scene = res.scene()
+    traj = res.trajectory
+    delta = fluctuation(traj["t"], traj["phi"], traj["omega"], scene.mechanism.cycle,
+                        scene.initial.phi)
+    m = re.search(r"δ = ([0-9.eE+-]+)", printed)
+    assert m, printed
+    assert float(m.group(1)) == pytest.approx(delta, rel=1e-10)
+    assert delta == pytest.approx(res.analysis["delta_last_cycle"][0], rel=1e-12)
+
+
+def test_loads_refuses_swash_plate(tmp_path, capsys):
+    scene = tmp_path / "short_swash.toml"
+    scene.write_text(_scene_text("swash_plate_1cyl.toml", "t_end = 8.0", "t_end = 0.3"))
+    assert main(["run", str(scene), "-o", str(tmp_path), "-q"]) == 0
+    result = tmp_path / "short_swash.h5"
+    capsys.readouterr()
+    assert main(["loads", str(result), "-o", str(tmp_path / "loads")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "crank-slider" in err
+    assert not (tmp_path / "loads").exists()
