@@ -608,8 +608,8 @@ def load_step_times(scene, events) -> list[float]:
 def run_response(scene, traj, events) -> dict[str, tuple[float, str]]:
     """ISO 8528-5 measures of a dynamic run for ``/analysis`` (:func:`metrics_table`): one set per
     load step of the schedule (each change is its own reference: the cycle-mean speed before it),
-    and for a run from (near) rest the spin-up, referred to the speed the run ends at (a scene
-    names no rated speed). Entries that cannot be measured (a change too close to the start or
+    and for a run that starts below 90 % of the speed it ends at, the spin-up, referred to that
+    final speed (a scene names no rated speed). Entries that cannot be measured (a change too close to the start or
     the end, too short a run) are left out, never guessed."""
     t, phi, omega = traj["t"], traj["phi"], traj["omega"]
     cycle = scene.mechanism.cycle
@@ -623,7 +623,7 @@ def run_response(scene, traj, events) -> dict[str, tuple[float, str]]:
             continue  # (e.g. less than a cycle before the change, or a settle window too short)
         out.update(to_table(m, f"load_change_{k}"))
     final = float(np.mean(omega[-max(2, omega.size // 50):]))
-    if scene.initial.omega < 0.1 * final and final > 0:
+    if final > 0 and scene.initial.omega < 0.9 * final:  # (else there is no 90 % to reach)
         try:
             sm = spin_up_metrics(t, phi, omega, final, cycle, SUMMARY_BAND,
                                  t_end=changes[0] if changes else None)
