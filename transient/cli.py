@@ -320,7 +320,9 @@ def cmd_info(args) -> int:
         print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
               f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
-    _print_efficiency({k: v for k, (v, _) in res.analysis.items()})
+    values = {k: v for k, (v, _) in res.analysis.items()}
+    _print_response(values)
+    _print_efficiency(values)
     for k, (v, unit) in res.analysis.items():
         print(f"  {k} = {v:.9g} {unit}" if np.ndim(v) == 0 and isinstance(v, (int, float, np.number))
               else f"  {k} = {v} {unit}")

@@ -755,6 +755,8 @@ def test_load_steps_are_measured_printed_and_plotted(tmp_path, capsys):
     assert w1 == pytest.approx(w0, rel=1e-5)
     assert a["load_change_1_omega_after_rad_s"] == pytest.approx(
         a["load_change_2_omega_before_rad_s"], rel=1e-5)  # (different windows)
+    assert main(["info", str(tmp_path / "gots_diesel_load_steps.h5")]) == 0
+    assert "load step 2 at t = 2 s" in capsys.readouterr().out
     assert main(["plot", str(tmp_path / "gots_diesel_load_steps.h5"), "-o", str(tmp_path)]) == 0
     assert (tmp_path / "gots_diesel_load_steps_response.png").stat().st_size > 10_000
 
