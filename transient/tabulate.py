@@ -89,7 +89,8 @@ def build_table(kind: int, mech: NDArray[np.float64], ncyl: int, target: float) 
     if np.max(np.abs(probe[:, -1] - probe[:, 0])) > 1e-12 * np.max(np.abs(probe)):
         raise ValueError("the mechanism's kinematics is not 2π-periodic")
     # Relative to each function's largest magnitude (a function that vanishes: absolute).
-    scale = np.maximum(np.max(np.abs(probe), axis=1), 1e-300)[:, None][:, 0]
+    peak = np.max(np.abs(probe), axis=1)
+    scale = np.where(peak > 0.0, peak, 1.0)
     target = max(target, ERROR_FLOOR)
     n, best, best_n = MIN_INTERVALS, math.inf, 0
     while n <= MAX_INTERVALS:

@@ -570,13 +570,14 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         factor = min(MAX_FACTOR, SAFETY * e ** -(tab.exponent - 0.75 * PI_BETA)
                      * fst[F_ERR_OLD] ** PI_BETA)
         fst[F_ERR_OLD] = max(err, 1e-4)
-        if rejected:
+        after_rejection = rejected
+        rejected = False
+        if after_rejection:
             # No growth right after a rejection (Hairer's DOPRI codes, SciPy): else the step
             # size oscillates between growing past what the error allows and being cut back.
             factor = min(factor, 1.0)
-            rejected = False
         h_next = h * factor
-        if at_segment_end and not rejected:
+        if at_segment_end and not after_rejection:
             # a step cut short to end on a breakpoint says nothing against the step planned
             h_next = max(h_next, min(h_planned, h_planned * factor))
         dense_ready = False
@@ -732,7 +733,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         elif ev_code == EV_STARTER_CUTOUT:
             ist[I_STARTER_ON] = 0
         elif ev_code == EV_GOVERNOR:
-            ist[I_GOV_BRANCH] = governor_branch(m, ev_level, w1 > w0)
+            ist[I_GOV_BRANCH] = governor_branch(m, ev_level, ev_rising)
         elif ev_code == EV_LOAD:
             # past the corner (and past its twin, for a step) in the direction of motion
             ist[I_LOAD_SEG] = load_segment(m, ev_level, ev_rising)
