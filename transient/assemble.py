@@ -11,7 +11,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from .core.model import PAPER, PHI, POWER_FLOW, TABULATED, T, Model
+from .core import governor as gv
+from .core.model import PAPER, PHI, POWER_FLOW, TABULATED, T, Model, fuel, governor_branch
 from .forces.gas import PressureTable, _shift_cubic, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -95,20 +96,46 @@ def gas_phases(scene) -> NDArray[np.float64]:
 
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
-                motored: PressureTable | None = None) -> NDArray[np.float64]:
+                motored: PressureTable | None = None,
+                injection: float | None = None) -> NDArray[np.float64]:
     """Sorted shaft angles in [0, period) where any cylinder's table (full-load or motored) has a
-    corner."""
+    corner, or (fuel latching) a cylinder starts its injection."""
     if table is None:
         return np.zeros(0)
     corners = table.corners[:-1]  # the period's end is the next cycle's 0
     if motored is not None:
         corners = np.union1d(corners, motored.corners[:-1])
+    if injection is not None:
+        corners = np.union1d(corners, [injection])
     angles = np.sort(np.mod(np.add.outer(phases, corners).ravel(), period))
     keep = np.concatenate(([True], np.diff(angles) > 1e-12 * period))
     angles = angles[keep]
     if angles.size > 1 and period - angles[-1] < 1e-12 * period:
         angles = angles[:-1]
     return angles
+
+
+def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64],
+                     period: float) -> NDArray[np.bool_]:
+    """For each breakpoint, whether a cylinder's pressure (any of ``tables``) jumps there: the
+    stepper's first stage beyond it must then be evaluated afresh, not carried over from the
+    step that ended on it (which used the table piece before the corner)."""
+    out = np.zeros(bp.size, dtype=np.bool_)
+    tol = 1e-12 * period
+    for table in (t for t in tables if t is not None):
+        scale = 1e-12 * max(np.abs(table.coef[:, 0]).max(), 1.0)
+        corners = table.corners[:-1]
+        for j, angle in enumerate(bp):
+            local = np.mod(angle - phases, period)
+            for c in local:
+                near = np.flatnonzero(np.minimum(np.abs(corners - c), period - np.abs(corners - c))
+                                      <= tol)
+                for i in near:
+                    right = table.evaluate(corners[i], i)[0]
+                    left_piece = (i - 1) % table.n_pieces
+                    left = table.evaluate(corners[i] if i > 0 else period, left_piece)[0]
+                    out[j] |= bool(abs(right - left) > scale)
+    return out
 
 
 def paired_table(full: PressureTable, motored: PressureTable
@@ -178,6 +205,7 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     kin = kinematics_table(scene)
     tabulated = kin is not None and kin.coef is not None
     load_x, load_s, load_comp = load_schedule(scene)
+    bp = breakpoints(table, phases, period, motored, scene.gas.injection)
     model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -186,15 +214,76 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), has_motored=motored is not None,
-        breakpoints=breakpoints(table, phases, period, motored),
+        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), phases, period),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
         gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **chain_fields(scene))
+        **governor_fields(scene), **chain_fields(scene))
     return model, model.breakpoints, table
+
+
+def governor_kind(governor) -> int:
+    """The dynamic governor (``transient.core.governor``) of a scene's governor: none for the
+    static droop; PID only with a derivative gain (else the filter state would be integrated for
+    nothing)."""
+    if governor.model == "pi":
+        return gv.PID if governor.gain_d > 0.0 else gv.PI
+    return gv.FLYWEIGHT if governor.model == "flyweight" else gv.NONE
+
+
+def governor_fields(scene) -> dict:
+    """The dynamic governor's and the fuel latching's part of the Model (``transient.core.governor``
+    for the parameters' meaning)."""
+    g = scene.governor
+    latch = dict(latch=scene.gas.injection is not None,
+                 inj_angle=float(scene.gas.injection or 0.0))
+    if g.model == "pi":
+        par = np.zeros(10)
+        tracking = g.tracking_time or (g.gain_p / g.gain_i if g.gain_i > 0.0 else math.inf)
+        par[[gv.P_REF, gv.P_KP, gv.P_KI, gv.P_KD, gv.P_TAU_D, gv.P_TAU_A, gv.P_FMIN, gv.P_FMAX]] = (
+            g.speed, g.gain_p, g.gain_i, g.gain_d, g.derivative_time, g.actuator_time,
+            g.fuel_min, g.fuel_max)
+        par[gv.P_RATE] = g.rate_limit or math.inf
+        # (a P-only governor with anti-windup tracks with T_t = ∞: it has no integrator to wind)
+        par[gv.P_INV_TT] = 1.0 / tracking if g.anti_windup else 0.0
+        return dict(gov_dyn=governor_kind(g), gov_par=par, **latch)
+    if g.model == "flyweight":
+        par = np.zeros(12)
+        arm = g.arm_ratio
+        cent = g.weights * g.weight_mass * arm * g.gear_ratio ** 2
+        par[[gv.F_CENT, gv.F_RHO0, gv.F_ARM, gv.F_PRELOAD, gv.F_SPRING, gv.F_DAMP, gv.F_MASS,
+             gv.F_TRAVEL, gv.F_FMAX, gv.F_FMIN]] = (
+            cent, g.radius, arm, g.spring_preload, g.spring_rate, g.damping,
+            g.sleeve_mass + g.weights * g.weight_mass * arm ** 2, g.travel, g.fuel_max,
+            g.fuel_min)
+        par[gv.F_W_LIFT], par[gv.F_W_TOP] = gv.lift_speeds(cent, g.radius, arm, g.spring_preload,
+                                                           g.spring_rate, g.travel)
+        return dict(gov_dyn=gv.FLYWEIGHT, gov_par=par, **latch)
+    return dict(gov_dyn=gv.NONE, gov_par=np.zeros(1), **latch)
+
+
+def initial_governor(scene, model: Model) -> tuple[NDArray[np.float64], int]:
+    """Initial values of the governor's states and the latched fuels (the state after the pairs'
+    work integrals) and the sleeve's switch: the PI(D) rack and integrator at ``fuel_initial``,
+    its filter at the initial speed; the flyweight sleeve at rest in its static balance at the
+    initial speed (on a stop if that lies beyond one); each cylinder latched at the command."""
+    g, w0 = scene.governor, scene.initial.omega
+    sleeve = gv.FREE
+    if model.gov_dyn in (gv.PI, gv.PID):
+        states = [g.fuel_initial, g.fuel_initial, w0][:gv.n_states(model.gov_dyn)]
+        f0 = g.fuel_initial
+    elif model.gov_dyn == gv.FLYWEIGHT:
+        z, sleeve = gv.sleeve_equilibrium(model.gov_par, w0)
+        states = [z, 0.0]
+        f0 = gv.rack_of_lift(model.gov_par, z)
+    else:
+        states = []
+        f0 = fuel(model, w0, governor_branch(model, w0, True))
+    latched = [f0] * model.ncyl if model.latch else []
+    return np.array(states + latched, dtype=np.float64), sleeve
 
 
 @lru_cache(maxsize=8)

@@ -115,7 +115,46 @@ def _parser() -> argparse.ArgumentParser:
                          "half of it per cycle")
     od.add_argument("--max-order", type=float, default=12.0,
                     help="highest order in the tables and figures (default 12)")
+    od.add_argument("--detrend", choices=("auto", "ramp", "none"), default="auto",
+                    help="remove each cycle's ramp from ω before its DFT (default auto: for a "
+                         "spin-up, a run starting below 90 %% of its final speed)")
     od.set_defaults(func=cmd_orders)
+    st = sub.add_parser(
+        "stress", help="run the catalogue of hostile scenes → DIR/stress.md (issue 9)",
+        description="Each case runs in a child process with a hard time bound and is checked "
+                    "against the work–energy balance or its expected diagnosis "
+                    "(transient.stress); result files go to DIR/stress/. Exit 1 if a case "
+                    "fails (known failures are reported, not counted).")
+    st.add_argument("--quick", action="store_true",
+                    help="the CI subset with shorter runs (no 10⁶-revolution runs)")
+    st.add_argument("--case", action="append", default=None,
+                    help="run only this case (repeatable)")
+    st.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    st.set_defaults(func=cmd_stress)
+    sw = sub.add_parser(
+        "sweep", help="run a parameter sweep on Dask → DIR/<stem>.h5 and <stem>_summary.csv",
+        description="A base scene, parameter axes and quantities to collect (transient.sweep; "
+                    "README, Sweeps). Every scene is validated before any work; an interrupted "
+                    "sweep resumes where it stopped when the same command is run again.")
+    sw.add_argument("sweep")
+    sw.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    sw.add_argument("--scheduler", default=None,
+                    help="tcp://host:port of a running Dask scheduler (default: a local cluster "
+                         "of one process per core); 'serial' runs in this process without Dask")
+    sw.add_argument("--workers", type=int, default=None,
+                    help="processes of the local cluster (default: one per core)")
+    sw.add_argument("--force", action="store_true",
+                    help="replace an existing sweep file instead of resuming it")
+    sw.add_argument("--retry-failed", action="store_true", help="run the failed runs again")
+    sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    sw.set_defaults(func=cmd_sweep)
+    sp = sub.add_parser("sweep-plot", help="plot a sweep's summary: lines (one axis), heat maps "
+                                           "(two-axis grid), scatter (otherwise)")
+    sp.add_argument("result", help="a sweep file (DIR/<stem>.h5)")
+    sp.add_argument("-o", "--output", default=None, help="folder (default: beside the file)")
+    sp.add_argument("--quantity", action="append", default=None,
+                    help="a collected quantity to plot (repeatable; default: all)")
+    sp.set_defaults(func=cmd_sweep_plot)
     return p
 
 
@@ -167,6 +206,22 @@ def cmd_efficiency(args) -> int:
     print(f"wrote {out / f'{stem}_efficiency.csv'}")
     print(f"wrote {_save(fig, out / f'{stem}_efficiency.png')}")
     return EXIT_OK
+
+
+def cmd_stress(args) -> int:
+    from .results import check_writable
+    from .stress import catalogue, run_stress
+
+    names = [c.name for c in catalogue()]
+    for name in args.case or ():
+        if name not in names:
+            raise SceneError("--case", f"unknown case {name!r}; allowed: {', '.join(names)}")
+    out = Path(args.output)
+    check_writable(out / "stress.md", force=True)  # before any work (exit 2)
+    rows, path = run_stress(args.quick, out, only=args.case)
+    failed = [case.name for case, o in rows if o.outcome == "FAIL"]
+    print(f"wrote {path}" + (f"; FAILED: {', '.join(failed)}" if failed else ""))
+    return EXIT_FAILED if failed else EXIT_OK
 
 
 def cmd_bench(args) -> int:
@@ -254,6 +309,10 @@ def _print_summary(summary, solver) -> None:
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
     _print_response(v)
     _print_efficiency(v)
+    asked = [k for k, val in v.items() if np.ndim(val) > 0]
+    if asked:
+        print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
+              f"`transient info`)")
     print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
           f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
           f"compile/cache load)")
@@ -323,9 +382,16 @@ def cmd_info(args) -> int:
     values = {k: v for k, (v, _) in res.analysis.items()}
     _print_response(values)
     _print_efficiency(values)
+    arrays = []
     for k, (v, unit) in res.analysis.items():
-        print(f"  {k} = {v:.9g} {unit}" if np.ndim(v) == 0 and isinstance(v, (int, float, np.number))
-              else f"  {k} = {v} {unit}")
+        if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped
+            arrays.append(f"{k} {'×'.join(map(str, np.shape(v)))} [{unit}]")
+        else:
+            print(f"  {k} = {v:.9g} {unit}" if isinstance(v, (int, float, np.number))
+                  else f"  {k} = {v} {unit}")
+    if arrays:
+        print(f"  analyses asked for by the scene ([analysis]; {len(arrays)} arrays): "
+              + ", ".join(arrays))
     return EXIT_OK
 
 
@@ -670,7 +736,8 @@ def cmd_loads(args) -> int:
 
 def cmd_orders(args) -> int:
     from .analysis.irregularity import cycle_means, fluctuation
-    from .analysis.orders import order_spectrum, report_for_scene, to_angle_grid
+    from .analysis.orders import (cycle_spectra, order_spectrum, report_for_scene,
+                                  resolve_detrend, to_angle_grid)
     from .mechanisms.crank_slider import CrankSlider
 
     res = _open(args.result)
@@ -684,12 +751,14 @@ def cmd_orders(args) -> int:
     traj = res.trajectory
     cycle, phi0 = mech.cycle, scene.initial.phi
     cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
+    # a spin-up's trend would leak into every order of each cycle: detrended by default
+    detrend = resolve_detrend(args.detrend, scene.initial.omega, float(traj["omega"][-1]))
     try:
-        grid, cols = to_angle_grid(traj, ("omega",), n, cycle, phi0=phi0, cuts=cuts)
+        starts, spec_w = cycle_spectra(traj, "omega", n, cycle, phi0=phi0, cuts=cuts,
+                                       detrend=detrend)
     except ValueError as exc:
         raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
-    n_cyc = grid.size // n
-    spec_w = order_spectrum(cols["omega"], n, cycle)
+    n_cyc = starts.size
     spec_m = None
     if "M_gas" in traj and scene.gas.model != "none":
         _, cm = to_angle_grid(traj, ("M_gas",), n, cycle, phi0=phi0, cycles=1, cuts=cuts)
@@ -735,7 +804,8 @@ def cmd_orders(args) -> int:
     axes = axes[:, 0]
     plots.order_bars(axes[0], orders, spec_w.amplitude[-1], "ω amplitude [rad/s]", top)
     axes[0].set_title(f"{scene.name}: orders over the last cycle (mean ω "
-                      f"{spec_w.mean[-1] * rpm:.5g} rpm, δ = {delta:.4g})", fontsize=10)
+                      f"{means[-1] * rpm:.5g} rpm, δ = {delta:.4g}"
+                      f"{', detrended' if detrend == 'ramp' else ''})", fontsize=10)
     i = 1
     if spec_m is not None:
         plots.order_bars(axes[i], orders, spec_m.amplitude[-1], "M_gas amplitude [N m]", top)
@@ -763,7 +833,7 @@ def cmd_orders(args) -> int:
         fig.suptitle(f"{scene.name}: run-up orders of ω")
         written.append(_save(fig, out / f"{stem}_orders_runup.png"))
         sel = np.nonzero(shown)[0]
-        run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": grid[::n],
+        run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": starts,
                "omega_mean_rad_s": means}
         run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j] for j in sel})
         csv = out / f"{stem}_orders_runup.csv"
@@ -771,8 +841,9 @@ def cmd_orders(args) -> int:
                    header=",".join(run), comments="", fmt="%.12g")
         written.append(csv)
 
-    print(f"{res.path}: orders over the last whole cycle (φ = {grid[-n]:.6g} … "
-          f"{grid[-n] + cycle:.6g} rad, {n} points; {n_cyc} whole cycle(s))")
+    print(f"{res.path}: orders over the last whole cycle (φ = {starts[-1]:.6g} … "
+          f"{starts[-1] + cycle:.6g} rad, {n} points; {n_cyc} whole cycle(s); ω spectra "
+          f"{'detrended (ramp)' if detrend == 'ramp' else 'not detrended'})")
     print(f"  δ = {delta:.12g} (last cycle, (ω_max − ω_min)/ω_mean), cycle-mean ω = "
           f"{means[-1]:.6g} rad/s ({means[-1] * rpm:.6g} rpm)")
     strongest = np.nonzero(shown)[0][np.argsort(spec_w.amplitude[-1][shown])[::-1][:6]]
@@ -797,3 +868,107 @@ def cmd_orders(args) -> int:
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
+
+
+# ------------------------------------------------------------------------------------------------
+# transient sweep / sweep-plot (transient.sweep): parameter sweeps on Dask and their summaries
+
+
+def cmd_sweep(args) -> int:
+    from .sweep import load_sweep, run_sweep
+
+    sweep = load_sweep(args.sweep)  # every scene validated here, before any work (exit 2)
+    s = args.scheduler
+    if s is not None and s != "serial" and "://" not in s:
+        raise SceneError("--scheduler", f"{s!r} is not an address; give tcp://host:port of a "
+                                        f"running Dask scheduler, or 'serial'")
+    if args.workers is not None and (args.workers < 1 or s is not None):
+        raise SceneError("--workers", "must be ≥ 1, and only for the local cluster (no "
+                                      "--scheduler)")
+    bar = None
+    if not args.quiet and sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(sweep.runs), desc=sweep.name, unit="run", file=sys.stderr)
+
+    def on_result(spec, res, done, total):
+        if bar is not None:
+            bar.n = done
+            bar.set_postfix_str(f"run {spec.index}: {res['status']}", refresh=True)
+
+    try:
+        out = run_sweep(sweep, args.output, args.scheduler, args.workers, args.force,
+                        args.retry_failed, on_result)
+    except KeyboardInterrupt:
+        print(f"transient: interrupted; the finished runs are kept in {args.output}/."
+              f"{sweep.path.stem}.h5.part: run the same command again to resume",
+              file=sys.stderr)
+        return EXIT_FAILED
+    finally:
+        if bar is not None:
+            bar.close()
+    if not args.quiet:
+        print(f"wrote {out.path} and {out.csv}: {len(out.computed)} run(s) computed, "
+              f"{len(out.skipped)} found finished, {len(out.failed)} failed")
+        for r in out.failed:
+            print(f"  run {r['run']} failed: {r['message']}")
+    if out.failed:
+        print(f"transient: {len(out.failed)} of {len(sweep.runs)} runs failed (recorded in "
+              f"{out.path}; --retry-failed runs them again)", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def cmd_sweep_plot(args) -> int:
+    from . import plots
+    from .sweep import read_summary
+
+    if not Path(args.result).is_file():
+        raise FileNotFoundError(f"{args.result}: no such sweep file")
+    try:
+        tab = read_summary(args.result)
+    except (OSError, ValueError, KeyError) as exc:
+        raise SceneError("(file)", f"not a readable transient sweep file: {exc}",
+                         file=str(args.result)) from None
+    quantities = args.quantity or tab.collect
+    for q in quantities:
+        if q not in tab.columns or q in ("run", "status", "message"):
+            raise SceneError("--quantity", f"{q!r} is not in the summary; allowed: "
+                                           f"{', '.join(tab.collect)}", file=str(args.result))
+    out = Path(args.output) if args.output else tab.path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    plt = _pyplot()
+    dims = []  # one coordinate per grid dimension: the first axis of each group
+    for a in tab.axes:
+        if all(d["group"] != a["group"] for d in dims):
+            dims.append(a)
+    failed = tab.columns["status"] != "ok"
+    written = []
+    for q in quantities:
+        label = f"{q} [{tab.units.get(q, '')}]"
+        fig, ax = plt.subplots(figsize=(7, 5))
+        if tab.method == "grid" and len(dims) == 2:
+            x, y = dims[1]["values"], dims[0]["values"]  # runs are in row-major order
+            plots.sweep_heatmap(ax, x, y, tab.columns[q].reshape(len(y), len(x)),
+                                _axis_label(dims[1], tab), _axis_label(dims[0], tab), label)
+        elif len(tab.axes) == 1 or (tab.method == "grid" and len(dims) == 1):
+            key = dims[0]["key"]
+            plots.sweep_line(ax, tab.columns[key], tab.columns[q], failed,
+                             _axis_label(dims[0], tab), label)
+        else:
+            a, b = tab.axes[0], tab.axes[1]
+            plots.sweep_scatter(ax, tab.columns[a["key"]], tab.columns[b["key"]], tab.columns[q],
+                                _axis_label(a, tab), _axis_label(b, tab), label)
+        ax.set_title(f"{tab.name}: {q}", fontsize=10)
+        written.append(_save(fig, out / f"{tab.path.stem.lstrip('.')}_{q}.png"))
+    for w in written:
+        print(f"wrote {w}")
+    return EXIT_OK
+
+
+def _axis_label(axis: dict, tab) -> str:
+    """An axis key and the other keys of its group (they move together)."""
+    others = [a["key"] for a in tab.axes if a["group"] == axis["group"] and a is not axis]
+    if len(others) > 1:  # (a long label would not fit beside the plot)
+        return f"{axis['key']} (+ {len(others)} keys of its group)"
+    return axis["key"] + (f" (with {others[0]})" if others else "")

@@ -297,3 +297,52 @@ def order_tracks(ax, omega_mean_rpm, tracks, ylabel):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
     return artists
+
+
+def sweep_line(ax, x, y, failed, xlabel, ylabel):
+    """A quantity of a one-axis sweep against the axis; failed runs as crosses on the axis
+    line (they have no value). Returns the artists."""
+    x, y, failed = np.asarray(x, float), np.asarray(y, float), np.asarray(failed, bool)
+    order = np.argsort(x)
+    artists = ax.plot(x[order], y[order], marker="o", ms=4, lw=1.0)
+    if failed.any():
+        artists += ax.plot(x[failed], np.full(failed.sum(), np.nanmin(y) if np.isfinite(y).any()
+                                              else 0.0), "rx", ms=8, label="failed run")
+        ax.legend(fontsize=8)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    return artists
+
+
+def sweep_heatmap(ax, x, y, z, xlabel, ylabel, zlabel):
+    """A quantity of a two-axis grid sweep as a heat map: ``z`` of shape (len(y), len(x)), NaN
+    (failed or not measured) left blank; each cell is labelled with its value. Returns the
+    mesh."""
+    z = np.ma.masked_invalid(np.asarray(z, float))
+    mesh = ax.pcolormesh(np.arange(len(x) + 1), np.arange(len(y) + 1), z, cmap="viridis",
+                         shading="flat")
+    ax.figure.colorbar(mesh, ax=ax, label=zlabel)
+    ax.set_xticks(np.arange(len(x)) + 0.5, [f"{v:.4g}" for v in x], rotation=45)
+    ax.set_yticks(np.arange(len(y)) + 0.5, [f"{v:.4g}" for v in y])
+    if z.size <= 100:
+        for (i, j), v in np.ndenumerate(z.filled(np.nan)):
+            ax.text(j + 0.5, i + 0.5, "–" if np.isnan(v) else f"{v:.4g}", ha="center",
+                    va="center", fontsize=7)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    return mesh
+
+
+def sweep_scatter(ax, x, y, c, xlabel, ylabel, clabel=None):
+    """Runs as points (x, y), coloured by ``c`` if given (random or list sweeps). Returns the
+    artists."""
+    if c is None:
+        artists = ax.plot(x, y, "o", ms=4)
+    else:
+        artists = ax.scatter(x, y, c=c, s=20, cmap="viridis")
+        ax.figure.colorbar(artists, ax=ax, label=clabel)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    return artists

@@ -14,7 +14,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from .assemble import build_model, gas_tables
+from .assemble import build_model, gas_tables, initial_governor
 from .core.integrate import next_breakpoint
 from .core.model import T, generator_branch, load_segment
 from .errors import SimulationError
@@ -74,6 +74,10 @@ def _mechanism(scene):
     mech = scene.mechanism
     if mech.kind == 0:
         return CrankSliderNumpy(mech)
+    if mech.kind == 3:  # articulated
+        from .core.articulated import articulated_terms
+
+        return KernelTwin(mech, articulated_terms)
     from .core.swash_plate import swash_terms
 
     return KernelTwin(mech, swash_terms)
@@ -135,10 +139,65 @@ class ChainNumpy:
         return 0.0
 
 
+class GovernorNumpy:
+    """The dynamic governors of ``transient.core.governor``, written out again from the equations
+    in its docstring (not from its kernels): the state is ``y[g:]`` of the reference state."""
+
+    def __init__(self, scene, g: int) -> None:
+        self.gov, self.g = scene.governor, g
+        gov = self.gov
+        if gov.model == "pi":
+            self.tracking = gov.tracking_time or (gov.gain_p / gov.gain_i if gov.gain_i else math.inf)
+        if gov.model == "flyweight":
+            self.arm = gov.arm_ratio
+            self.cent = gov.weights * gov.weight_mass * gov.arm_ratio * gov.gear_ratio ** 2
+            self.mass = gov.sleeve_mass + gov.weights * gov.weight_mass * gov.arm_ratio ** 2
+        self.sleeve = 0  # 0 moving, 1 on the low stop, 2 on the high stop
+
+    def force(self, w, z, v):
+        """Net force on the flyweight sleeve: centrifugal, less spring and damper [N]."""
+        gov = self.gov
+        return (self.cent * w * w * (gov.radius + self.arm * z)
+                - gov.spring_preload - gov.spring_rate * z - gov.damping * v)
+
+    def pi_demand(self, w, y):
+        gov = self.gov
+        e = 1.0 - w / gov.speed
+        u = gov.gain_p * e + y[self.g]
+        if gov.gain_d:
+            u -= gov.gain_d * (w - y[self.g + 2]) / (gov.derivative_time * gov.speed)
+        return e, u, float(np.clip(u, gov.fuel_min, gov.fuel_max))
+
+    def rates(self, w, y):
+        gov, g = self.gov, self.g
+        if gov.model == "pi":
+            e, u, u_s = self.pi_demand(w, y)
+            back = (u_s - u) / self.tracking if gov.anti_windup else 0.0
+            rack = (u_s - y[g + 1]) / gov.actuator_time
+            if gov.rate_limit:
+                rack = float(np.clip(rack, -gov.rate_limit, gov.rate_limit))
+            rates = [gov.gain_i * e + back, rack]
+            return rates + ([(w - y[g + 2]) / gov.derivative_time] if gov.gain_d else [])
+        if gov.model == "flyweight":
+            if self.sleeve:
+                return [0.0, 0.0]
+            return [y[g + 1], self.force(w, y[g], y[g + 1]) / self.mass]
+        return []
+
+    def command(self, w, y, droop):
+        gov = self.gov
+        if gov.model == "pi":
+            return y[self.g + 1]
+        if gov.model == "flyweight":
+            return gov.fuel_max + (gov.fuel_min - gov.fuel_max) * y[self.g] / gov.travel
+        return droop(w)
+
+
 class ReferenceModel:
     """Right-hand side of (18) (or of the serial chain) in time, dy/dt = (ω, ε, powers), numpy.
 
-    The state is (φ, ω, W_gas, W_load, W_starter, W_loss per pair)."""
+    The state is (φ, ω, W_gas, W_load, W_starter, W_loss per pair, the governor's states); the
+    fuel each cylinder latched (``latched``) changes only at terminal events."""
 
     def __init__(self, scene) -> None:
         self.scene = scene
@@ -160,6 +219,8 @@ class ReferenceModel:
         self.seg = int(load_segment(m, x0, True))
         self.gen_low = bool(generator_branch(m, w0, True))
         self.t = 0.0  # time of the state being evaluated (the schedule may be in time)
+        self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
+        self.latched = None  # fuel per cylinder, with latching (set by run_reference)
 
     def load_scale(self, phi: float) -> float:
         """The schedule's scale s on the current segment (``model.load_scale``, in numpy)."""
@@ -184,7 +245,7 @@ class ReferenceModel:
             self.motored_pieces = self.motored.piece_of(local)
         self.mid = mid
 
-    def moments(self, phi: float, w: float):
+    def moments(self, phi: float, w: float, y):
         m = self.model
         J, dJ, u = self.mech.terms(phi)
         J += m.J0
@@ -192,7 +253,7 @@ class ReferenceModel:
         p = np.zeros(m.ncyl)
         if self.table is not None:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
-            f = self.fuel(w)
+            f = self.latched if self.latched is not None else self.command(w, y)
             p_full = self.table.evaluate(local, self.pieces)[0]
             # p = p_mot + f·(p_full − p_mot); the motored curve is p0 without a motored table
             p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
@@ -206,6 +267,10 @@ class ReferenceModel:
         M_starter = m.starter_torque * (1 - w / m.starter_noload) if self.starter_on else 0.0
         return J, dJ, M_gas, M_load, M_starter, p
 
+    def command(self, w: float, y) -> float:
+        """The governor's fuel command at state y."""
+        return self.governor.command(w, y, self.fuel)
+
     def fuel(self, w: float) -> float:
         """Static droop characteristic (Antonyuk §4) on the segment's branch (0 full fuel, 1 the
         droop line, 2 none), extrapolated so that solve_ivp sees a smooth function; the corners
@@ -215,9 +280,9 @@ class ReferenceModel:
             return 1.0
         return 0.0 if self.branch == 2 else (g.speed_zero - w) / (g.speed_zero - g.speed_full)
 
-    def evaluate(self, phi, w):
-        """(moments, φ̈, S_k, η*_k) at (φ, ω)."""
-        J, dJ, Mg, Ml, Ms, pc = self.moments(phi, w)
+    def evaluate(self, phi, w, y):
+        """(moments, φ̈, S_k, η*_k) at state y (φ, ω and the governor's states)."""
+        J, dJ, Mg, Ml, Ms, pc = self.moments(phi, w, y)
         if self.chain is None:
             return (J, dJ, Mg, Ml, Ms, pc), (Mg + Ml + Ms - 0.5 * dJ * w * w) / J, (), ()
         sigma = np.sign(w) or self.sigma
@@ -227,18 +292,21 @@ class ReferenceModel:
     def rhs(self, t, y):
         self.t = t
         phi, w = y[:2]
-        (J, dJ, Mg, Ml, Ms, _), a, S, eta = self.evaluate(phi, w)
-        return [w, a, Mg * w, Ml * w, Ms * w, *((1 - np.asarray(eta)) * S * w)]
+        (J, dJ, Mg, Ml, Ms, _), a, S, eta = self.evaluate(phi, w, y)
+        return [w, a, Mg * w, Ml * w, Ms * w, *((1 - np.asarray(eta)) * S * w),
+                *self.governor.rates(w, y)]
 
     def rows(self, t, y):
         out = []
         for ti, yi in zip(t, y.T):
             self.t = ti
             p, w = yi[:2]
-            (J, dJ, Mg, Ml, Ms, pc), a, S, eta = self.evaluate(p, w)
+            (J, dJ, Mg, Ml, Ms, pc), a, S, eta = self.evaluate(p, w, yi)
             pairs = [v for k in range(len(S))
                      for v in (S[k], eta[k], (1 - eta[k]) * S[k] * w, yi[5 + k])]
-            out.append([ti, p, w, a, J, dJ, Mg, Ml, Ms, self.fuel(w), *yi[2:5], *pc, *pairs])
+            latched = [] if self.latched is None else list(self.latched)
+            out.append([ti, p, w, a, J, dJ, Mg, Ml, Ms, self.command(w, yi), *yi[2:5], *pc, *pairs,
+                        *yi[self.governor.g:], *latched])
         return np.asarray(out)
 
 
@@ -277,6 +345,29 @@ def _segment(ref, phi, omega):
     return down, up
 
 
+def _sleeve_events(gov: GovernorNumpy, y) -> list:
+    """Terminal events of the flyweight governor: a moving sleeve reaching a stop; on a stop, the
+    net force turning away from it (the balance of centrifugal force and spring, ω free)."""
+    if gov.gov.model != "flyweight":
+        return []
+    g, travel = gov.g, gov.gov.travel
+    if gov.sleeve == 0:
+        def low(t, yy):
+            return yy[g]
+
+        def high(t, yy):
+            return yy[g] - travel
+        low.terminal, low.direction = True, -1
+        high.terminal, high.direction = True, 1
+        return [("sleeve_stop", low), ("sleeve_stop", high)]
+    z = 0.0 if gov.sleeve == 1 else travel
+
+    def away(t, yy):
+        return gov.force(yy[1], z, 0.0)
+    away.terminal, away.direction = True, 1 if gov.sleeve == 1 else -1
+    return [("sleeve_free", away)]
+
+
 def _with_dense_tail(sol, ts, phi_from):
     """The step points ``ts`` (states from ``sol``) plus eight dense-output samples inside every
     step that ends beyond the angle ``phi_from``."""
@@ -303,7 +394,12 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
     t_end = run.t_end if math.isfinite(run.t_end) else 1e12
     phi_end = scene.initial.phi + 2 * math.pi * run.revolutions
     n_pairs = len(scene.friction.pairs)
-    t, y = 0.0, np.concatenate([[scene.initial.phi, scene.initial.omega], np.zeros(3 + n_pairs)])
+    start, ref.governor.sleeve = initial_governor(scene, ref.model)
+    n_gov = start.size - (ref.model.ncyl if ref.model.latch else 0)
+    if ref.model.latch:
+        ref.latched = start[n_gov:].copy()
+    t, y = 0.0, np.concatenate([[scene.initial.phi, scene.initial.omega], np.zeros(3 + n_pairs),
+                                start[:n_gov]])
     message = ""
     blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": [],
                                          "governor_corner": []}, 0, 0
@@ -335,7 +431,7 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             stop.terminal, stop.direction = True, -1
             evs.append(("stall", stop))
         if ref.chain is not None and y[1] == 0.0:  # at rest: the pairs may hold the chain
-            J, dJ, Mg, Ml, Ms, _ = ref.moments(y[0], 0.0)
+            J, dJ, Mg, Ml, Ms, _ = ref.moments(y[0], 0.0, y)
             ref.sigma = ref.chain.start_direction(*ref.chain.split(J, dJ, Mg, Ml + Ms))
             if ref.sigma == 0.0:
                 message = (f"locked: at rest at t = {t:.9g} s, φ = {y[0]:.9g} rad the friction of "
@@ -359,6 +455,7 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             evs.append(("load_down", _level_crossing(False, m.load_x[ref.seg - 1], -1)))
         if m.gen_power != 0.0:
             evs.append(("generator", _speed_crossing(ref, t, y, m.gen_min)))
+        evs += _sleeve_events(ref.governor, y)
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -411,12 +508,29 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             y[1] = m.gen_min
             ref.gen_low = not ref.gen_low
             events.setdefault("generator_min_speed", []).append((t, y[0]))
+        if "sleeve_stop" in hit:
+            z, w = y[ref.governor.g], y[1]
+            y[ref.governor.g + 1] = 0.0
+            low = z < 0.5 * scene.governor.travel
+            y[ref.governor.g] = 0.0 if low else scene.governor.travel
+            force = ref.governor.force(w, y[ref.governor.g], 0.0)
+            ref.governor.sleeve = (1 if force <= 0 else 0) if low else (2 if force >= 0 else 0)
+            events.setdefault("sleeve_stop", []).append((t, y[0]))
+        if "sleeve_free" in hit:
+            ref.governor.sleeve = 0
+            events.setdefault("sleeve_free", []).append((t, y[0]))
         if "breakpoint" in hit:
             # Put φ on the breakpoint it reached (solve_ivp locates it to ~1e-12 rad), so that
             # the next segment starts there and takes the table pieces beyond it.
             level = up if y[1] >= 0 else down
             y[0] = level
             events["breakpoint"].append((t, y[0]))
+            if ref.latched is not None and y[1] > 0:  # a cylinder's start of injection
+                m = ref.model
+                local = np.mod(y[0] - m.gas_phase - m.inj_angle, m.period)
+                for k in np.flatnonzero(np.minimum(local, m.period - local) < 1e-9):
+                    ref.latched[k] = ref.command(y[1], y)
+                    events.setdefault("injection", []).append((t, y[0]))
     rows = np.concatenate(blocks)
     names = ["t", "phi", "omega"] if state_only else list(output_columns(scene))
     traj = {n: rows[:, j] for j, n in enumerate(names)}

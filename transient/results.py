@@ -16,6 +16,7 @@ import h5py
 import numpy as np
 
 from . import __version__
+from .errors import SimulationError
 
 FORMAT = 1
 
@@ -24,13 +25,40 @@ class ResultExists(FileExistsError):
     """The result file is there already and ``force`` was not given."""
 
 
+class NotWritable(PermissionError):
+    """The result cannot be written: its folder cannot be made or written, or the disk is full
+    (the CLI prints the one-line message and exits 2 when this happens before integrating)."""
+
+
 def check_writable(path: Path, force: bool) -> None:
     """Fail before any work if the result exists (without force) or its folder is not writable."""
     if path.exists() and not force:
         raise ResultExists(f"{path}: exists; use --force to overwrite it")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # a file in the way, a read-only or missing file system, …
+        raise NotWritable(f"{path.parent}: cannot create the output folder "
+                          f"({exc.strerror or exc}); give a writable folder") from None
     if not os.access(path.parent, os.W_OK):
-        raise PermissionError(f"{path.parent}: folder is not writable")
+        raise NotWritable(f"{path.parent}: folder is not writable")
+    # A probe of PROBE_BYTES with plain file I/O: a full disk (or a read-only file system, which
+    # os.access does not see for root) fails here, before any work and before HDF5, whose
+    # objects cannot be closed cleanly once its writes fail.
+    probe = path.with_name(f".{path.name}.probe")
+    try:
+        with open(probe, "wb") as fh:
+            fh.write(bytes(PROBE_BYTES))
+            fh.flush()
+            os.fsync(fh.fileno())
+    except OSError as exc:
+        raise NotWritable(f"{path.parent}: cannot write the result there ({exc.strerror or exc});"
+                          f" is the disk full?") from None
+    finally:
+        probe.unlink(missing_ok=True)
+
+
+#: Size of the write probe of :func:`check_writable` [bytes]: a result's header and first blocks.
+PROBE_BYTES = 1 << 16
 
 
 class ResultWriter:
@@ -41,7 +69,24 @@ class ResultWriter:
         self.path = Path(path)
         check_writable(self.path, force)
         self.tmp = self.path.with_name(f".{self.path.name}.part")
-        self.f = h5py.File(self.tmp, "w")
+        try:
+            self.f = h5py.File(self.tmp, "w")
+            self._start(scene_name, scene_toml, columns)
+        except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
+            self._abandon()
+            raise NotWritable(f"{self.tmp}: cannot write the result file "
+                              f"({str(exc).splitlines()[0]}); is the disk full?") from None
+
+    def _abandon(self) -> None:
+        """Close what can be closed of a file whose writes failed, and remove it."""
+        try:
+            self.f.close()
+        except Exception:  # noqa: BLE001 — the file is broken already
+            pass
+        self.tmp.unlink(missing_ok=True)
+
+    def _start(self, scene_name: str, scene_toml: str, columns: dict[str, str]) -> None:
+        self.broken = ""  # why a write failed, if one did
         a = self.f.attrs
         a["creator"] = "transient"
         a["version"] = __version__
@@ -67,11 +112,15 @@ class ResultWriter:
         n = len(next(iter(block.values())))
         if n == 0:
             return
-        for name in self.columns:
-            ds = self.f["trajectory"][name]
-            ds.resize(ds.shape[0] + n, axis=0)
-            ds[-n:] = block[name]
-        self.f.flush()
+        try:
+            for name in self.columns:
+                ds = self.f["trajectory"][name]
+                ds.resize(ds.shape[0] + n, axis=0)
+                ds[-n:] = block[name]
+            self.f.flush()
+        except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
+            self.broken = f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); is the disk full?"
+            raise SimulationError(self.broken) from None
 
     def read_trajectory(self, last: int | None = None) -> dict[str, np.ndarray]:
         """The trajectory written so far (its ``last`` samples only, if given), read back."""
@@ -122,7 +171,15 @@ class ResultWriter:
         ds.attrs["unit"] = unit
 
     def close(self, complete: bool, message: str = "") -> Path:
-        """Mark the file complete or not, close it and move it to its final name."""
+        """Mark the file complete or not, close it and move it to its final name. After a failed
+        write the file is left as it is under its temporary name (it says complete = false if
+        its header reached the disk) and :class:`SimulationError` says so."""
+        if self.broken:
+            try:
+                self.f.close()
+            except Exception:  # noqa: BLE001 — the file is broken already
+                pass
+            raise SimulationError(f"{self.broken}; the partial file {self.tmp} may be unreadable")
         self.f.attrs["complete"] = bool(complete)
         if message:
             self.f.attrs["message"] = message

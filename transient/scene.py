@@ -10,13 +10,14 @@ from __future__ import annotations
 import csv
 import math
 import tomllib
-from dataclasses import dataclass, field, fields, is_dataclass
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .errors import SceneError
+from .mechanisms.articulated import Articulated, read_articulated
 from .mechanisms.crank_slider import CrankSlider, read_crank_slider
 from .mechanisms.swash_plate import SwashPlate, read_swash_plate
 from .tomlout import toml_value
@@ -99,7 +100,7 @@ class Section:
                                  f"must be {word} {bound / factor:g}, got {value:g}")
 
     def integer(self, name: str, default: Any = _MISSING, *, ge: int | None = None,
-                choices: tuple[int, ...] | None = None) -> int:
+                choices: tuple[int, ...] | None = None, le: int | None = None) -> int:
         value, _, written = self._take(name, None)
         if value is _MISSING:
             if default is _MISSING:
@@ -109,10 +110,30 @@ class Section:
             raise SceneError(self.key(written), f"must be a whole number, got {_show(value)}")
         if ge is not None and value < ge:
             raise SceneError(self.key(written), f"must be ≥ {ge}, got {value}")
+        if le is not None and value > le:
+            raise SceneError(self.key(written), f"must be ≤ {le}, got {value}")
         if choices is not None and value not in choices:
             raise SceneError(self.key(written),
                              f"must be one of {', '.join(map(str, choices))}, got {value}")
         return value
+
+    def flag(self, name: str, default: bool) -> bool:
+        value, _, written = self._take(name, None)
+        if value is _MISSING:
+            return default
+        if not isinstance(value, bool):
+            raise SceneError(self.key(written), f"must be true or false, got {_show(value)}")
+        return value
+
+    def strings(self, name: str, default: Any = _MISSING) -> tuple:
+        value, _, written = self._take(name, None)
+        if value is _MISSING:
+            if default is _MISSING:
+                raise SceneError(self.key(name), "is missing; give a list of strings")
+            return default
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise SceneError(self.key(written), f"must be a list of strings, got {_show(value)}")
+        return tuple(value)
 
     def string(self, name: str, default: Any = _MISSING, *,
                choices: tuple[str, ...] | None = None) -> str:
@@ -288,6 +309,11 @@ class Gas:
     full-load p_max between 0 and 0.02 g and 2.1 % between 0 and 0.031 g (at f = 0.5; the
     indicated work at f = 0.25 is then 7.6 % low). Use a constant γ where part load matters.
     The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"``).
+
+    **Fuel latching.** With ``injection`` [rad] (a local angle, as the tables'), each cylinder
+    takes the governor's command at its start of injection and burns that fuel until its next
+    one, so that the governor acts with the real per-cylinder delay (event ``injection``);
+    without it every cylinder follows the command at once.
     """
 
     model: str = "none"
@@ -308,6 +334,7 @@ class Gas:
     ramp: float = 0.0
     duration: float = math.pi
     wiebe: Wiebe | None = None
+    injection: float | None = None
 
 
 @dataclass(frozen=True)
@@ -348,13 +375,63 @@ class Starter:
 
 @dataclass(frozen=True)
 class Governor:
-    """Speed governor. ``droop``: the static characteristic of the swash-plate paper (§4) scaling
-    every gas force by 1 below ``speed_full`` (ω_a), linearly down to 0 at ``speed_zero`` (ω_1c),
-    0 above [rad/s]."""
+    """Speed governor, setting the fuel command f (see :class:`Gas`); equations in
+    :mod:`transient.core.governor`.
+
+    ``droop``: the static characteristic of the swash-plate paper (§4): f = 1 below
+    ``speed_full`` (ω_a), linearly down to 0 at ``speed_zero`` (ω_1c), 0 above [rad/s].
+
+    ``pi``: isochronous PI(D) at ``speed`` ω_ref [rad/s]: ``gain_p`` K_p [1] and ``gain_i`` K_i
+    [1/s] per unit relative speed error, ``gain_d`` K_d [s] with its filter ``derivative_time``
+    τ_D [s]; the rack follows the clipped demand with the lag ``actuator_time`` τ_A [s], at most
+    ``rate_limit`` [1/s] (0: none), between ``fuel_min`` and ``fuel_max``; ``anti_windup`` back-calculation
+    with ``tracking_time`` T_t [s] (0: K_p/K_i); the rack and the integrator start at
+    ``fuel_initial``.
+
+    ``flyweight``: a centrifugal governor: ``weights`` n_w of ``weight_mass`` m_w [kg] at
+    ``radius`` ρ₀ [m] with the sleeve on its low stop, bell cranks of ``arm_ratio`` a/b [1],
+    turning at ``gear_ratio`` i_g times the shaft; ``sleeve_mass`` [kg], ``spring_rate`` k [N/m],
+    ``spring_preload`` F₀ [N], ``damping`` c [N s/m], sleeve ``travel`` z_max [m]; the rack gives
+    ``fuel_max`` on the low stop, ``fuel_min`` on the high one, linear between.
+    """
 
     model: str = "none"
     speed_full: float = 0.0
     speed_zero: float = 0.0
+    speed: float = 0.0
+    gain_p: float = 0.0
+    gain_i: float = 0.0
+    gain_d: float = 0.0
+    derivative_time: float = 0.01
+    actuator_time: float = 0.02
+    rate_limit: float = 0.0
+    fuel_min: float = 0.0
+    fuel_max: float = 1.0
+    anti_windup: bool = True
+    tracking_time: float = 0.0
+    fuel_initial: float = 1.0
+    weights: int = 2
+    weight_mass: float = 0.0
+    radius: float = 0.0
+    arm_ratio: float = 1.0
+    gear_ratio: float = 1.0
+    sleeve_mass: float = 0.0
+    spring_rate: float = 0.0
+    spring_preload: float = 0.0
+    damping: float = 0.0
+    travel: float = 0.0
+
+
+#: The keys of each governor model (the resolved scene writes these).
+GOVERNOR_KEYS = {
+    "none": ("model",),
+    "droop": ("model", "speed_full", "speed_zero"),
+    "pi": ("model", "speed", "gain_p", "gain_i", "gain_d", "derivative_time", "actuator_time",
+           "rate_limit", "fuel_min", "fuel_max", "anti_windup", "tracking_time", "fuel_initial"),
+    "flyweight": ("model", "weights", "weight_mass", "radius", "arm_ratio", "gear_ratio",
+                  "sleeve_mass", "spring_rate", "spring_preload", "damping", "travel", "fuel_min",
+                  "fuel_max"),
+}
 
 
 @dataclass(frozen=True)
@@ -414,6 +491,9 @@ class Output:
     dt: float = 0.0  # 0: Δφ / switch_speed
 
 
+#: Output samples per revolution at most (0.00036° apart).
+MAX_SAMPLES_PER_REV = 1_000_000
+
 #: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
 COMPILED_METHODS = ("dop853", "dopri5")
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
@@ -450,10 +530,39 @@ POLICIES = ("power-flow", "paper")
 
 
 @dataclass(frozen=True)
+class Analysis:
+    """Derived results computed after the run and stored under ``/analysis`` only when asked
+    (:mod:`transient.analysis.requested` lists the names and units).
+
+    ``loads``: forces, crankpin and main-journal loads, running torques over the last cycle
+    (crank-slider). ``orders``: signals whose order spectrum is stored per whole cycle —
+    trajectory columns (``omega``, ``M_gas``, ``p_1`` …) or ``W_<k>``, the piston acceleration of
+    cylinder k. ``irregularity``: δ and the mean speed of every cycle. ``max_order`` [1/rev]:
+    orders stored up to it. ``samples_per_cycle``: crank-angle grid per engine cycle.
+    ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
+    (:func:`transient.analysis.orders.order_spectrum`).
+    """
+
+    loads: bool = False
+    orders: tuple[str, ...] = ()
+    irregularity: bool = False
+    max_order: float = 12.0
+    samples_per_cycle: int = 720
+    detrend: str = "auto"
+
+    @property
+    def requested(self) -> bool:
+        return self.loads or bool(self.orders) or self.irregularity
+
+
+DETREND = ("auto", "ramp", "none")
+
+
+@dataclass(frozen=True)
 class Scene:
     name: str
     description: str
-    mechanism: CrankSlider | SwashPlate
+    mechanism: CrankSlider | SwashPlate | Articulated
     inertia: Inertia = field(default_factory=Inertia)
     gas: Gas = field(default_factory=Gas)
     load: Load = field(default_factory=Load)
@@ -464,16 +573,26 @@ class Scene:
     solver: Solver = field(default_factory=Solver)
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
+    analysis: Analysis = field(default_factory=Analysis)
 
 
 # ----------------------------------------------------------------------------------------------
 # Readers, one per section
 
 
-MECHANISMS = {"crank-slider": read_crank_slider, "swash-plate": read_swash_plate}
+MECHANISMS = {"crank-slider": read_crank_slider, "swash-plate": read_swash_plate,
+              "articulated": read_articulated}
 
 
 def _read_gas(s: Section, base_dir: Path, strokes: int) -> Gas:
+    gas = _read_gas_model(s, base_dir, strokes)
+    if gas.model == "none":
+        return gas
+    cycle = 2.0 * math.pi * strokes / 2
+    return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle))
+
+
+def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
     model = s.string("model", "none",
                      choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe"))
     if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
@@ -545,8 +664,12 @@ def _read_pressure_csv(s: Section, base_dir: Path):
                                         f"to the scene")
     angle_cols = {"phi_deg": math.pi / 180.0, "phi": 1.0}
     p_cols = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
-    with path.open(newline="") as fh:
-        rows = list(csv.reader(line for line in fh if not line.startswith("#")))
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:
+            rows = list(csv.reader(line for line in fh if not line.startswith("#")))
+    except UnicodeDecodeError as exc:
+        raise SceneError(s.key("file"), f"{path.name}: not UTF-8 text (byte {exc.start}); "
+                                        f"save the table as UTF-8 CSV") from None
     header = [h.strip() for h in rows[0]] if rows else []
     a = next((c for c in header if c in angle_cols), None)
     b = next((c for c in header if c in p_cols), None)
@@ -599,6 +722,11 @@ def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
                     eta_backward=_efficiency(ps, "eta_backward"),
                     name=ps.string("name", f"{between[0]}-{between[1]}"))
         ps.finish()
+        twin = next((j for j, q in enumerate(pairs) if q.name == pair.name), None)
+        if twin is not None:
+            raise SceneError(ps.key("name"), f"{pair.name!r} names {s.key('pairs')}[{twin}] "
+                                             f"too; give each pair its own name (it labels the "
+                                             f"pair's result columns and reports)")
         pairs.append(pair)
     pairs.sort(key=lambda p: links.index(p.between[0]))
     return Friction(policy, tuple(pairs))
@@ -673,12 +801,40 @@ def _read_load(s: Section) -> Load:
 
 
 def _read_governor(s: Section) -> Governor:
-    model = s.string("model", "none", choices=("none", "droop"))
+    model = s.string("model", "none", choices=tuple(GOVERNOR_KEYS))
     if model == "none":
         return Governor()
-    full = s.number("speed_full", "speed", gt=0.0)
-    zero = s.number("speed_zero", "speed", gt=full)
-    return Governor(model, full, zero)
+    if model == "droop":
+        full = s.number("speed_full", "speed", gt=0.0)
+        zero = s.number("speed_zero", "speed", gt=full)
+        return Governor(model, full, zero)
+    d = Governor()
+    f_min = s.number("fuel_min", default=d.fuel_min, ge=0.0)
+    f_max = s.number("fuel_max", default=d.fuel_max, gt=f_min)
+    if model == "flyweight":
+        return Governor(
+            model, fuel_min=f_min, fuel_max=f_max, weights=s.integer("weights", d.weights, ge=1),
+            weight_mass=s.number("weight_mass", gt=0.0), radius=s.number("radius", "length", gt=0.0),
+            arm_ratio=s.number("arm_ratio", default=d.arm_ratio, gt=0.0),
+            gear_ratio=s.number("gear_ratio", default=d.gear_ratio, gt=0.0),
+            sleeve_mass=s.number("sleeve_mass", default=0.0, ge=0.0),
+            spring_rate=s.number("spring_rate", ge=0.0),
+            spring_preload=s.number("spring_preload", gt=0.0),
+            damping=s.number("damping", ge=0.0), travel=s.number("travel", "length", gt=0.0))
+    gain_p = s.number("gain_p", ge=0.0)
+    gain_i = s.number("gain_i", ge=0.0)
+    if gain_p == 0.0 and gain_i == 0.0:
+        raise SceneError(s.key("gain_i"), "gain_p and gain_i are both 0: the governor would never "
+                                          "move the rack; give gain_i > 0 (isochronous)")
+    return Governor(
+        model, speed=s.number("speed", "speed", gt=0.0), gain_p=gain_p, gain_i=gain_i,
+        gain_d=s.number("gain_d", default=0.0, ge=0.0),
+        derivative_time=s.number("derivative_time", default=d.derivative_time, gt=0.0),
+        actuator_time=s.number("actuator_time", default=d.actuator_time, gt=0.0),
+        rate_limit=s.number("rate_limit", default=0.0, ge=0.0),
+        fuel_min=f_min, fuel_max=f_max, anti_windup=s.flag("anti_windup", True),
+        tracking_time=s.number("tracking_time", default=0.0, ge=0.0),
+        fuel_initial=s.number("fuel_initial", default=f_max, ge=f_min, le=f_max))
 
 
 def _read_run(s: Section) -> Run:
@@ -692,6 +848,9 @@ def _read_run(s: Section) -> Run:
     if s.has("speed", "speed"):
         speed = s.number("speed", "speed", gt=0.0)
         return Run(mode=mode, t_end=t_end, revolutions=revs, speed=speed)
+    if not s.has("time") and not s.has("speed_table", "speed"):
+        raise SceneError(s.key("speed"), "is missing; a prescribed-speed run needs 'speed' (or "
+                                         "'speed_rpm'), or a table 'time' [s] with 'speed_table'")
     time = s.numbers("time")
     table = s.numbers("speed_table", "speed")
     if len(time) != len(table) or len(time) < 2:
@@ -712,6 +871,10 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         root = Section(data, "")
         head = root.sub("scene")
         name = head.string("name", Path(file).stem if file else "scene")
+        if not name.strip():
+            raise SceneError(head.key(head.written.get("name", "name")),
+                             "must not be empty; it names the result (leave it out to use the "
+                             "file's name)")
         description = head.string("description", "")
         head.finish()
         ms = root.sub("mechanism", required=True)
@@ -759,16 +922,24 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
             table_tolerance=sv.number("table_tolerance", default=0.0, ge=0.0, lt=1.0))
         sv.finish()
         so = root.sub("output")
-        sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4),
+        spr = so.integer("samples_per_rev", 72, ge=4)
+        if spr > MAX_SAMPLES_PER_REV:  # (every sample is written: a run must stay finite)
+            raise SceneError(so.key("samples_per_rev"), f"must be ≤ {MAX_SAMPLES_PER_REV}, got "
+                                                        f"{spr}")
+        sections["output"] = Output(spr,
                                     so.number("dt", default=0.0, ge=0.0))
         so.finish()
         sf = root.sub("friction")
         sections["friction"] = _read_friction(sf, mech.links)
         sf.finish()
+        sa = root.sub("analysis")
+        sections["analysis"] = _read_analysis(sa)
+        sa.finish()
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
         _check_consistency(scene)
         _check_gas_table(scene, sg)
+        _check_analysis(scene)
         return scene
     except SceneError as exc:
         exc.file = exc.file or file
@@ -780,7 +951,18 @@ def _check_consistency(scene: Scene) -> None:
     """Checks across sections, done before any integration."""
     # (18) divides by J(φ): it must stay positive over the whole cycle, dead centres included.
     phi = np.linspace(0.0, scene.mechanism.cycle, 721)
-    J = scene.mechanism.kinematics_table(phi)["J"] + scene.inertia.total
+    with np.errstate(over="ignore", invalid="ignore"):
+        J = scene.mechanism.kinematics_table(phi)["J"] + scene.inertia.total
+    if not np.all(np.isfinite(J)):
+        raise SceneError("mechanism", "the reduced inertia J(φ) overflows (is not finite); "
+                                      "check the masses and lengths and their units")
+    try:
+        area = scene.mechanism.piston_area
+    except OverflowError:
+        area = math.inf
+    if not math.isfinite(area):
+        raise SceneError("mechanism.bore", f"the piston area overflows; check the bore and its "
+                                           f"unit (mm: 'bore_mm')")
     if J.min() <= 0.0:
         at = math.degrees(phi[int(np.argmin(J))])
         raise SceneError("inertia", f"the reduced inertia J(φ) falls to {J.min():.3g} kg m² at "
@@ -801,10 +983,47 @@ def _check_consistency(scene: Scene) -> None:
     if sv.fixed_step > 0.0 and sv.domain == "time":
         raise SceneError("solver.fixed_step", "fixed steps are crank-angle steps; use "
                                               "domain = \"auto\" or fixed_step = 0")
+    if scene.run.mode == "prescribed-speed" and scene.governor.model in ("pi", "flyweight"):
+        raise SceneError("governor.model", f"a prescribed-speed run integrates no governor state; "
+                                           f"use model = \"none\" or \"droop\", not "
+                                           f"{scene.governor.model!r}")
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
                                               "never moves; give omega or a starter")
+
+
+def _read_analysis(s: Section) -> Analysis:
+    return Analysis(loads=s.flag("loads", False), orders=s.strings("orders", ()),
+                    irregularity=s.flag("irregularity", False),
+                    max_order=s.number("max_order", default=12.0, gt=0.0),
+                    samples_per_cycle=s.integer("samples_per_cycle", 720, ge=16),
+                    detrend=s.string("detrend", "auto", choices=DETREND))
+
+
+def _check_analysis(scene: Scene) -> None:
+    """The [analysis] signals exist in this scene's trajectory and the orders fit the grid."""
+    from .simulate import output_columns
+
+    a, mech = scene.analysis, scene.mechanism
+    crank_slider = isinstance(mech, CrankSlider)
+    if a.loads and not crank_slider:
+        raise SceneError("analysis.loads", f"loads are computed for crank-slider engines only, "
+                                           f"not {type(mech).__name__}; allowed here: false")
+    columns = list(output_columns(scene))
+    derived = [f"W_{k + 1}" for k in range(mech.n_cylinders)] if crank_slider else []
+    for name in a.orders:
+        if name not in columns + derived:
+            raise SceneError("analysis.orders", f"unknown signal {name!r}; allowed: "
+                                                f"{', '.join(columns + derived)}")
+    if len(set(a.orders)) != len(a.orders):
+        raise SceneError("analysis.orders", "a signal is named twice; name each once")
+    nyquist = (a.samples_per_cycle // 2) * 2.0 * math.pi / mech.cycle
+    if a.orders and a.max_order > nyquist:
+        raise SceneError("analysis.max_order", f"must be ≤ {nyquist:g} (the Nyquist order of "
+                                               f"samples_per_cycle = {a.samples_per_cycle} over "
+                                               f"a {math.degrees(mech.cycle):g}° cycle), got "
+                                               f"{a.max_order:g}")
 
 
 def _check_gas_table(scene: Scene, section: Section) -> None:
@@ -824,7 +1043,7 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     path = Path(source)
     if text is None:
         try:
-            text = path.read_text(encoding="utf-8")
+            text = path.read_text(encoding="utf-8-sig")  # (a byte-order mark is not TOML)
         except OSError as exc:
             raise SceneError("(file)", f"cannot read: {exc.strerror}", file=str(path)) from None
         except UnicodeDecodeError as exc:
@@ -850,8 +1069,8 @@ def to_toml(scene: Scene) -> str:
     lines += _gas_section(scene.gas)
     lines += _load_section(scene.load)
     lines += _section("starter", scene.starter)
-    lines += (_section("governor", scene.governor) if scene.governor.model != "none"
-              else ["", "[governor]", 'model = "none"'])
+    lines += ["", "[governor]"] + [f"{k} = {toml_value(getattr(scene.governor, k))}"
+                                   for k in GOVERNOR_KEYS[scene.governor.model]]
     lines += _section("initial", scene.initial)
     run = {"mode": scene.run.mode}
     for k in ("t_end", "revolutions"):
@@ -865,6 +1084,8 @@ def to_toml(scene: Scene) -> str:
     lines += ["", "[run]"] + [f"{k} = {toml_value(v)}" for k, v in run.items()]
     lines += _section("solver", scene.solver)
     lines += _section("output", scene.output)
+    if scene.analysis.requested:  # (a scene that asks for nothing reads back the same without)
+        lines += _section("analysis", scene.analysis)
     lines += ["", "[friction]", f"policy = {toml_value(scene.friction.policy)}"]
     for pair in scene.friction.pairs:
         lines += ["", "[[friction.pairs]]", f"name = {toml_value(pair.name)}",
@@ -880,6 +1101,8 @@ def _gas_section(gas: Gas) -> list[str]:
             "wiebe": ("model", "p0", "compression_ratio", "p_a", "p_intake", "p_exhaust")}
     names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
                                  "n2", "p_intake", "p_exhaust"))
+    if gas.injection is not None:
+        names = (*names, "injection")
     lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
     if gas.model == "wiebe":  # unset optional angles (None) are left out: they read back as None
         lines += ["", "[gas.wiebe]"] + [f"{f.name} = {toml_value(getattr(gas.wiebe, f.name))}"

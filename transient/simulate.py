@@ -13,7 +13,8 @@ from typing import Callable
 
 import numpy as np
 
-from .assemble import build_model
+from .assemble import build_model, governor_kind, initial_governor
+from .core import governor as gv
 from .core import integrate as ci
 from .core.tableaus import TABLEAUS
 from .core.model import (N_OUT_FIXED, OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
@@ -38,6 +39,10 @@ def output_columns(scene) -> dict[str, str]:
     for k in range(len(scene.friction.pairs)):
         for name, unit in zip(PAIR_OUTPUTS, PAIR_OUTPUT_UNITS):
             cols[f"{name}_{k + 1}"] = unit
+    kind = governor_kind(scene.governor)
+    cols.update(zip(gv.STATE_NAMES[kind], gv.STATE_UNITS[kind]))
+    if scene.gas.injection is not None:  # the fuel each cylinder latched at its last injection
+        cols.update({f"fuel_{k + 1}": "1" for k in range(scene.mechanism.n_cylinders)})
     if scene.run.mode == "prescribed-speed":
         cols["M_drive"] = "N m"
         cols["W_drive"] = "J"
@@ -81,11 +86,14 @@ def _initial_state(scene, model):
     y = np.zeros(n_state(model))
     y[0] = scene.initial.phi
     y[2] = scene.initial.omega
+    governor, sleeve = initial_governor(scene, model)
+    y[y.size - governor.size:] = governor
     fst = np.zeros(ci.N_FST)
     fst[ci.F_PASSED_BP] = np.nan
     ist = np.zeros(ci.N_IST, dtype=np.int64)
     st = scene.starter
     ist[ci.I_STARTER_ON] = int(st.torque > 0 and scene.initial.omega < st.cutout_speed)
+    ist[ci.I_SLEEVE] = sleeve
     return y, fst, ist
 
 

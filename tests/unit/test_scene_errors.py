@@ -16,6 +16,8 @@ import pytest
 
 from transient.cli import main
 
+CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
+
 VALID = """\
 [scene]
 name = "small"
@@ -93,7 +95,8 @@ CASES = [
     ("toml-unclosed-table", replace("[inertia]", "[inertia"),
      "(syntax)", "not valid TOML"),
     ("unknown-top-level-key", VALID + "\n[engine]\nspeed = 1\n",
-     "engine", "unknown key; allowed here: friction, gas, governor, inertia, initial, load, mechanism"),
+     "engine", "unknown key; allowed here: analysis, friction, gas, governor, inertia, initial, "
+               "load, mechanism"),
     ("unknown-top-level-scalar", "format = 2\n" + VALID,
      "format", "unknown key"),
     ("unknown-mechanism-key", add_after("bore_mm = 88", "stroke_mm = 94"),
@@ -234,6 +237,34 @@ CASES = [
     ("paper-policy-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"') + '\n[friction]\npolicy = "paper"\n\n[[friction.pairs]]\n'
                             'between = ["shaft", "crank"]\neta_forward = 0.9\neta_backward = 0.9\n',
      "solver.method", "the reference path (scipy-*) follows the power-flow policy only"),
+    # [analysis] (issue 7): what to store under /analysis after the run.
+    ("analysis-loads-not-bool", VALID + "\n[analysis]\nloads = 1\n", "analysis.loads",
+     "must be true or false, got 1"),
+    ("analysis-orders-not-list", VALID + '\n[analysis]\norders = "omega"\n', "analysis.orders",
+     "must be a list of strings"),
+    ("analysis-unknown-signal", VALID + '\n[analysis]\norders = ["omega", "torque"]\n',
+     "analysis.orders", "unknown signal 'torque'; allowed: t, phi, omega, epsilon"),
+    ("analysis-piston-of-missing-cylinder", VALID + '\n[analysis]\norders = ["W_2"]\n',
+     "analysis.orders", "unknown signal 'W_2'; allowed:"),
+    ("analysis-signal-twice", VALID + '\n[analysis]\norders = ["omega", "omega"]\n',
+     "analysis.orders", "a signal is named twice"),
+    ("analysis-max-order-zero", VALID + "\n[analysis]\norders = [\"omega\"]\nmax_order = 0\n",
+     "analysis.max_order", "must be > 0, got 0"),
+    ("analysis-max-order-above-nyquist",
+     VALID + '\n[analysis]\norders = ["omega"]\nsamples_per_cycle = 16\nmax_order = 9\n',
+     "analysis.max_order",
+     "must be ≤ 4 (the Nyquist order of samples_per_cycle = 16 over a 720° cycle), got 9"),
+    ("analysis-few-samples", VALID + "\n[analysis]\nirregularity = true\nsamples_per_cycle = 8\n",
+     "analysis.samples_per_cycle", "must be ≥ 16, got 8"),
+    ("analysis-unknown-detrend", VALID + '\n[analysis]\ndetrend = "linear"\n', "analysis.detrend",
+     "unknown value 'linear'; allowed: 'auto', 'ramp', 'none'"),
+    ("analysis-unknown-key", VALID + "\n[analysis]\nspectra = true\n", "analysis.spectra",
+     "unknown key; allowed here: detrend, irregularity, loads, max_order, orders, "
+     "samples_per_cycle"),
+    ("analysis-loads-swash-plate",
+     (CASES_DIR / "swash_plate_1cyl.toml").read_text() + "\n[analysis]\nloads = true\n",
+     "analysis.loads",
+     "loads are computed for crank-slider engines only, not SwashPlate; allowed here: false"),
 ]
 
 
@@ -385,3 +416,45 @@ def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):
     assert code == 2
     assert_one_line_error(err, scene, "inertia", "the reduced inertia J(φ) falls to")
 
+
+
+# Dynamic governors and fuel latching (issue 6): limits, gains, what a prescribed run cannot do.
+PI = '\n[governor]\nmodel = "pi"\nspeed_rpm = 1000\ngain_p = 10\ngain_i = 30\n'
+FLYWEIGHT = ('\n[governor]\nmodel = "flyweight"\nweight_mass = 0.1\nradius_mm = 30\n'
+             'spring_rate = 2e4\nspring_preload = 200\ndamping = 50\ntravel_mm = 8\n')
+GOVERNOR_CASES = [
+    ("pi-negative-fuel", VALID + PI + "fuel_min = -0.1\n", "governor.fuel_min",
+     "must be ≥ 0, got -0.1"),
+    ("pi-limits-reversed", VALID + PI + "fuel_min = 0.5\nfuel_max = 0.4\n", "governor.fuel_max",
+     "must be > 0.5, got 0.4"),
+    ("pi-initial-fuel-outside", VALID + PI + "fuel_initial = 1.5\n", "governor.fuel_initial",
+     "must be ≤ 1, got 1.5"),
+    ("pi-no-gain", VALID + PI.replace("gain_p = 10", "gain_p = 0").replace("gain_i = 30", "gain_i = 0"),
+     "governor.gain_i", "gain_p and gain_i are both 0"),
+    ("pi-actuator-lag-zero", VALID + PI + "actuator_time = 0\n", "governor.actuator_time",
+     "must be > 0, got 0"),
+    ("pi-anti-windup-not-bool", VALID + PI + "anti_windup = 1\n", "governor.anti_windup",
+     "must be true or false, got 1"),
+    ("pi-speed-missing", VALID + PI.replace("speed_rpm = 1000\n", ""), "governor.speed",
+     "is missing"),
+    ("pi-prescribed-speed", replace("revolutions = 2", 'mode = "prescribed-speed"\nspeed = 100\n'
+                                    'revolutions = 2') + PI,
+     "governor.model", "a prescribed-speed run integrates no governor state"),
+    ("flyweight-travel-zero", VALID + FLYWEIGHT.replace("travel_mm = 8", "travel_mm = 0"),
+     "governor.travel_mm", "must be > 0, got 0"),
+    ("flyweight-no-weights", VALID + FLYWEIGHT + "weights = 0\n", "governor.weights",
+     "must be ≥ 1, got 0"),
+    ("flyweight-pi-key", VALID + FLYWEIGHT + "gain_p = 3\n", "governor.gain_p", "unknown key"),
+    ("injection-beyond-cycle", VALID + MIXED_CYCLE.format(cr=18) + "injection_deg = 720\n",
+     "gas.injection_deg", "must be < 720, got 720"),
+]
+
+
+@pytest.mark.parametrize("text, key, fragment",
+                         [pytest.param(t, k, f, id=i) for i, t, k, f in GOVERNOR_CASES])
+def test_invalid_governor_is_one_line_exit_2(tmp_path, capsys, text, key, fragment):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text, encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, key, fragment)

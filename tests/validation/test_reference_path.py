@@ -5,8 +5,9 @@ Runs are shortened (the scenes themselves take up to 1000 revolutions or 8 s):
 
 * revolution-limited scenes: 5 revolutions (coasting) or 6 revolutions = 3 four-stroke cycles
   (Gots spin-up: 45 table corners, every kind of breakpoint of the mixed cycle);
-* time-limited scenes (swash plate): t_end = 0.5 s, which passes the governor's full-fuel corner
-  ω_a = 45 rad/s (reached at t ≈ 0.29 s).
+* time-limited scenes: t_end = 0.5 s (swash plate: past the governor's full-fuel corner
+  ω_a = 45 rad/s, reached at t ≈ 0.29 s), or 6 revolutions at the initial speed if shorter (the
+  generator sets at 4000 rpm: 0.09 s), or 0.25 s for a start from rest.
 
 Both at rtol = atol = 1e-10. The reference runs with max_step = 0.5° (at the start speed): its
 output rows are its step points, and they must be dense enough to be interpolated (below).
@@ -25,6 +26,9 @@ Accuracy in the scipy way, e = (y − y_ref)/(atol + rtol·|y_ref|):
   to the solvers' differences: measured max |e| ≤ 49 (ω, DOP853 rows) and ≤ 1.3 (t), except
   the Wiebe scene: 268 (ω), 0.5° after the combustion start, where the pressure rises like
   (x − start)^1.5 and the Hermite interpolation between reference rows is poorest; bound 500.
+  Samples in the reference interval just past each corner are left out: where the torque jumps
+  there (a radial's slave, whose pressure jumps away from its dead centre; a cylinder's latched
+  fuel) the reference's row on the corner carries ε from before it, the wrong slope after.
 
 A stalled reference (solve_ivp restarted again and again at the same t) is reported as a failure
 at once rather than hanging the test run; a 60 s alarm backs that up.
@@ -53,6 +57,7 @@ REF_MAX_STEP = math.radians(0.5)
 SHORT_REVS = {"coasting_single": 5.0}
 DEFAULT_REVS = 6.0
 SHORT_T_END = 0.5
+START_T_END = 0.25
 
 
 def dynamic_scenes():
@@ -71,8 +76,11 @@ def shortened(name, method):
     run = scene.run
     if math.isfinite(run.revolutions):
         run = replace(run, revolutions=SHORT_REVS.get(name, DEFAULT_REVS), t_end=math.inf)
+    elif scene.initial.omega > 0.0:
+        w0 = scene.initial.omega
+        run = replace(run, t_end=min(SHORT_T_END, 2.0 * math.pi * DEFAULT_REVS / w0))
     else:
-        run = replace(run, t_end=SHORT_T_END)
+        run = replace(run, t_end=START_T_END)
     solver = replace(scene.solver, method=method, rtol=RTOL, atol=ATOL)
     if method != "dop853":
         solver = replace(solver, max_step=REF_MAX_STEP)
@@ -158,6 +166,10 @@ def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch
         assert e_bp <= E_FINAL
 
     # Samples: the reference interpolated onto the compiled grid, where φ is monotonic.
+    if scene.initial.omega == 0.0:
+        # A start from rest: its reference steps, bounded by the switch speed's max_step, are too
+        # long to interpolate once the engine runs; test_start_from_rest.py compares its samples.
+        return
     keep = np.concatenate([[True], np.diff(r["phi"]) > 1e-12])
     phi_r, w_r, eps_r, t_r = r["phi"][keep], r["omega"][keep], r["epsilon"][keep], r["t"][keep]
     assert np.all(np.diff(phi_r) > 0) and np.all(w_r > 0)
@@ -165,6 +177,14 @@ def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch
     t_of_phi = CubicHermiteSpline(phi_r, t_r, 1.0 / w_r)
     inside = (c["phi"] >= phi_r[0]) & (c["phi"] <= phi_r[-1])
     assert np.count_nonzero(inside) >= 0.99 * c["phi"].size
+    # (leave out the reference interval just past each corner: ε may jump there)
+    left = np.clip(np.searchsorted(phi_r, c["phi"], side="right") - 1, 0, phi_r.size - 1)
+    on_corner = np.zeros(phi_r.size, dtype=bool)
+    if br.size:
+        for j in np.searchsorted(phi_r, br[:, 1]) + np.array([[-1], [0]]):  # both neighbours
+            j = np.clip(j, 0, phi_r.size - 1)
+            on_corner[j[np.abs(phi_r[j] - br[:, 1]) < 1e-9]] = True
+    inside &= ~on_corner[left]
     e_w = np.max(np.abs(e(c["omega"][inside], w_of_phi(c["phi"][inside]))))
     e_t = np.max(np.abs(e(c["t"][inside], t_of_phi(c["phi"][inside]))))
     print(f"  {np.count_nonzero(inside)} samples: max |e(ω)| = {e_w:.3g}, max |e(t)| = {e_t:.3g}")

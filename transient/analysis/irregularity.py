@@ -79,11 +79,15 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
               ) -> dict[str, tuple[float, str]]:
     """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``: speed, its
     fluctuation, steady state, the mechanical efficiency over the steady cycles, and the
-    ISO 8528-5 measures of each load step and of a spin-up (``transient_response``). With load
-    steps, the steady state and the efficiency are looked for after the last one."""
+    ISO 8528-5 measures of each load step and of a spin-up (``transient_response``), and what
+    the scene's ``[analysis]`` table asks for (:mod:`.requested`). With load steps, the steady
+    state and the efficiency are looked for after the last one."""
     from .efficiency import mechanical_efficiency
+    from .requested import requested_analyses
     from .transient_response import load_step_times, run_response
 
+    # what the scene's [analysis] table asks for, over the whole stored run (before the cut below)
+    requested = requested_analyses(scene, traj, events) if scene.analysis.requested else {}
     response = run_response(scene, traj, events) if scene.run.mode == "dynamic" else {}
     steps = load_step_times(scene, events) if scene.run.mode == "dynamic" else []
     if steps and steps[-1] < traj["t"][-1]:
@@ -111,4 +115,7 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
                                                                   phi[last]) / cycle), "N m")
     if scene.gas.model != "none":
         out.update(mechanical_efficiency(scene, traj, events))
+    out.update(requested)
+    # the mechanism's own figures (articulated rods: slave harmonics against Semenov's series)
+    out.update(getattr(scene.mechanism, "analysis_summary", dict)())
     return out

@@ -223,6 +223,7 @@ def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
                   samples_per_cycle: int, cycle: float, *, phi0: float = 0.0,
                   cycles: int | None = None, cuts: ArrayLike = (),
                   derivatives: Mapping[str, NDArray[np.float64]] | None = None,
+                  closed: bool = False,
                   ) -> tuple[NDArray[np.float64], dict[str, NDArray[np.float64]]]:
     """Trajectory columns on a uniform crank-angle grid of whole cycles.
 
@@ -247,10 +248,13 @@ def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
         dv/dφ per column name, on the trajectory's samples, for columns other than these known
         ones: ``t`` (1/ω), ``omega`` (ε/ω), ``phi`` (the grid itself). Other columns use the
         not-a-knot spline.
+    closed : bool
+        Add one point, the end of the last cycle (for the ramp of :func:`order_spectrum`'s
+        ``detrend``: its ``end``).
 
     Returns
     -------
-    grid : (n_cycles·N,) array
+    grid : (n_cycles·N,) array (one more with ``closed``)
         phi0 + Φ(j0 + i/N), i = 0 … n_cycles·N − 1: each cycle's start, not its end (the end is
         the next cycle's start), as the DFT of :func:`order_spectrum` wants.
     values : dict
@@ -271,7 +275,7 @@ def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
         marks = marks[-n_cyc - 1:]
     n = int(samples_per_cycle)
     j0 = round((marks[0] - phi0) / cycle)
-    grid = phi0 + (cycle / n) * np.arange(j0 * n, (j0 + n_cyc) * n)
+    grid = phi0 + (cycle / n) * np.arange(j0 * n, (j0 + n_cyc) * n + int(closed))
     derivatives = dict(derivatives or {})
     out = {}
     for name in names:
@@ -313,7 +317,8 @@ class OrderSpectrum:
     window : str
         ``"none"`` or ``"hann"``.
     drift : (n_cycles,) array
-        v(next cycle's start) − v(this cycle's start); NaN for the last cycle. For a periodic
+        v(next cycle's start) − v(this cycle's start); for the last cycle v(its end) − v(start)
+        when ``end`` was given, else NaN. For a periodic
         signal it is 0. A drift D (a spin-up) is a ramp across the cycle, which the unwindowed DFT
         sees as a sawtooth: it leaks D/(π k) into the amplitude of every harmonic k of the cycle.
     """
@@ -322,6 +327,7 @@ class OrderSpectrum:
     coef: NDArray[np.complex128]
     window: str
     drift: NDArray[np.float64]
+    detrend: str = "none"
 
     @property
     def amplitude(self) -> NDArray[np.float64]:
@@ -346,7 +352,8 @@ class OrderSpectrum:
 
 
 def order_spectrum(values_on_grid: ArrayLike, samples_per_cycle: int, cycle: float,
-                   window: str = "none") -> OrderSpectrum:
+                   window: str = "none", detrend: str = "none", end: float | None = None
+                   ) -> OrderSpectrum:
     """Amplitude and phase per engine order of each whole cycle, by the DFT over the cycle.
 
     Parameters
@@ -366,6 +373,16 @@ def order_spectrum(values_on_grid: ArrayLike, samples_per_cycle: int, cycle: flo
         not periodic over the cycle (see ``drift``) it lowers the leakage of the ends from
         ~1/k to ~1/k³, at the price of spreading each line over its neighbours k ± 1 (at half-order
         spacing a half order and the whole orders beside it mix) and of a biased mean.
+    detrend : ``"none"`` or ``"ramp"``
+        ``"ramp"``: before the DFT, subtract from each cycle the ramp D·i/N that carries its start
+        value to its end value (D: the cycle's ``drift``), so that a run-up trend does not leak
+        into the orders as a sawtooth (D/(πk) at harmonic k). A linear trend plus any signal
+        periodic over the cycle is separated exactly; the mean loses D/2 (the trend's share)
+        and the signal's own value at the cycle ends is kept. (A least-squares line would not
+        do: it takes a share of every sine harmonic, −3A/(kπ²) of slope for A sin kφ.)
+    end : float, optional
+        The signal's value at the end of the last cycle (``to_angle_grid(..., closed=True)``);
+        needed by ``detrend="ramp"``, whose other cycles end at the next cycle's start.
 
     Returns
     -------
@@ -379,6 +396,16 @@ def order_spectrum(values_on_grid: ArrayLike, samples_per_cycle: int, cycle: flo
         v = v.reshape(-1, n)
     elif v.ndim != 2 or v.shape[1] != n:
         raise ValueError(f"values must be (n_cycles·{n},) or (n_cycles, {n}), got {v.shape}")
+    drift = np.full(v.shape[0], np.nan)
+    drift[:-1] = v[1:, 0] - v[:-1, 0]
+    if end is not None:
+        drift[-1] = float(end) - v[-1, 0]
+    if detrend == "ramp":
+        if end is None:
+            raise ValueError("detrend='ramp' needs the value at the end of the last cycle (end)")
+        v = v - drift[:, None] * (np.arange(n) / n)[None, :]
+    elif detrend != "none":
+        raise ValueError(f"detrend {detrend!r}: allowed 'none', 'ramp'")
     if window == "none":
         w = np.ones(n)
     elif window == "hann":
@@ -390,10 +417,34 @@ def order_spectrum(values_on_grid: ArrayLike, samples_per_cycle: int, cycle: flo
     if n % 2 == 0:
         X[:, -1] = X[:, -1].real / 2.0  # Nyquist: A cos θ, once
     X[:, 0] = X[:, 0].real
-    drift = np.full(v.shape[0], np.nan)
-    drift[:-1] = v[1:, 0] - v[:-1, 0]
     orders = np.arange(X.shape[1]) * (2.0 * np.pi / cycle)
-    return OrderSpectrum(orders, X, window, drift)
+    return OrderSpectrum(orders, X, window, drift, detrend)
+
+
+def resolve_detrend(mode: str, initial_omega: float, final_omega: float) -> str:
+    """``"auto"`` → ``"ramp"`` for a spin-up
+    (:func:`transient.analysis.transient_response.is_spin_up`), else ``"none"``; other modes
+    as given."""
+    from .transient_response import is_spin_up
+
+    if mode != "auto":
+        return mode
+    return "ramp" if is_spin_up(initial_omega, final_omega) else "none"
+
+
+def cycle_spectra(traj: Mapping[str, NDArray[np.float64]], name: str, samples_per_cycle: int,
+                  cycle: float, *, phi0: float = 0.0, cuts: ArrayLike = (),
+                  detrend: str = "none") -> tuple[NDArray[np.float64], OrderSpectrum]:
+    """Order spectrum of every whole cycle of one trajectory column (the run-up waterfall's rows).
+
+    The column is resampled with :func:`to_angle_grid` (closed: the last cycle's end too, which
+    ``detrend="ramp"`` of :func:`order_spectrum` needs). Returns (each cycle's start angle
+    [rad], spectrum).
+    """
+    n = int(samples_per_cycle)
+    grid, cols = to_angle_grid(traj, (name,), n, cycle, phi0=phi0, cuts=cuts, closed=True)
+    v = cols[name]
+    return grid[:-1:n], order_spectrum(v[:-1], n, cycle, detrend=detrend, end=v[-1])
 
 
 # ------------------------------------------------------------------------------------------------

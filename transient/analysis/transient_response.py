@@ -605,27 +605,44 @@ def load_step_times(scene, events) -> list[float]:
     return [float(t) for t, p in rows if np.any(np.abs(angles - p) <= 1e-9 * max(1.0, abs(p)))]
 
 
+def is_spin_up(initial_omega: float, final_omega: float) -> bool:
+    """A run that starts below 90 % of the speed it ends at (so it has a 90 % to reach): its
+    spin-up is measured (:func:`run_response`) and its order spectra are detrended
+    (:func:`transient.analysis.orders.order_spectrum`)."""
+    return final_omega > 0 and initial_omega < SPIN_UP_FRACTION * final_omega
+
+
+def rated_speed(scene) -> float | None:
+    """The scene's rated speed [rad/s]: the isochronous (PI) governor's set speed; None for the
+    others (a droop governor's speed moves with the load), whose measures refer each load step
+    to the speed before it and a spin-up to the speed it ends at."""
+    return scene.governor.speed if scene.governor.model == "pi" else None
+
+
 def run_response(scene, traj, events) -> dict[str, tuple[float, str]]:
     """ISO 8528-5 measures of a dynamic run for ``/analysis`` (:func:`metrics_table`): one set per
-    load step of the schedule (each change is its own reference: the cycle-mean speed before it),
-    and for a run that starts below 90 % of the speed it ends at, the spin-up, referred to that
-    final speed (a scene names no rated speed). Entries that cannot be measured (a change too close to the start or
-    the end, too short a run) are left out, never guessed."""
+    load step of the schedule, and for a run that starts below 90 % of the rated speed the
+    spin-up. The reference of the percentages is the rated speed (:func:`rated_speed`) where the
+    scene has one, else the speed before each step and the speed the spin-up ends at. Entries that
+    cannot be measured (a change too close to the start or the end, too short a run) are left
+    out, never guessed."""
     t, phi, omega = traj["t"], traj["phi"], traj["omega"]
     cycle = scene.mechanism.cycle
+    rated = rated_speed(scene)
     out: dict[str, tuple[float, str]] = {}
     changes = [tc for tc in load_step_times(scene, events) if t[0] < tc < t[-1]]
     for k, tc in enumerate(changes, start=1):
         end = changes[k] if k < len(changes) else float(t[-1])
         try:
-            m = load_change_metrics(t, phi, omega, tc, cycle, SUMMARY_BAND, t_end=end)
+            m = load_change_metrics(t, phi, omega, tc, cycle, SUMMARY_BAND, rated_speed=rated,
+                                    t_end=end)
         except ValueError:
             continue  # (e.g. less than a cycle before the change, or a settle window too short)
         out.update(to_table(m, f"load_change_{k}"))
     final = float(np.mean(omega[-max(2, omega.size // 50):]))
-    if final > 0 and scene.initial.omega < 0.9 * final:  # (else there is no 90 % to reach)
+    if is_spin_up(scene.initial.omega, rated or final):
         try:
-            sm = spin_up_metrics(t, phi, omega, final, cycle, SUMMARY_BAND,
+            sm = spin_up_metrics(t, phi, omega, rated or final, cycle, SUMMARY_BAND,
                                  t_end=changes[0] if changes else None)
             out.update(to_table(sm, "spin_up"))
         except ValueError:

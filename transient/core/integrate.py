@@ -7,9 +7,12 @@ The solver loop is compiled together with the right-hand side (``model.derivativ
 ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint, so the
 right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal) it
 integrates in time, and a step that would cross a breakpoint is retaken so that it ends on it.
-Switches between the two, starter cut-out, the governor characteristic's corners, the corners of
-the load schedule and the generator's minimum speed, speed reversals and the end of the run are
-state events located on the dense output (Hairer, Nørsett & Wanner,
+On a breakpoint, cylinders starting their injection latch the governor's fuel command, and where
+a pressure jumps the first stage of the next step is evaluated afresh (not carried over).
+Switches between the two, starter cut-out, the governor characteristic's corners, the PI
+governor's limits, the flyweight governor's stops, the corners of the load schedule and the
+generator's minimum speed, speed reversals and the end of the run are state events located on
+the dense output (Hairer, Nørsett & Wanner,
 *Solving ODEs I*, §II.6 and §II.10).
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
@@ -24,10 +27,12 @@ from .jit import kernel
 
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
+from . import governor as gv
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GENERATOR,
-                    SW_GOVERNOR, SW_LOAD, SW_MODES, SW_STARTER, T, WK_G, WK_G_MIN, WK_SPEED,
-                    choose_modes, derivative, generator_branch, governor_branch, inertia,
-                    load_segment, margins_at, n_state, output_row, speed, work_array)
+                    SW_GOVERNOR, SW_LOAD, SW_MODES, SW_SLEEVE, SW_STARTER, T, WK_DEMAND, WK_G,
+                    WK_G_MIN, WK_SPEED, choose_modes, command, demand, derivative, generator_branch,
+                    gov_index, governor_branch, inertia, is_pi, latch_index, load_segment,
+                    margins_at, n_state, output_row, speed, start_branch, work_array)
 
 # Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -46,9 +51,9 @@ N_FST = 9
 BP_LANDING = 1e-7
 # ist[...] — integer stepper state kept between chunks
 # ist[:N_SWITCHES] are the model's switches (starter, governor branch, pair modes, direction,
-# load-schedule segment, generator branch), passed on as ``sw``.
+# load-schedule segment, generator branch, sleeve on a stop), passed on as ``sw``.
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
-I_LOAD_SEG, I_GEN_LOW = SW_LOAD, SW_GENERATOR
+I_LOAD_SEG, I_GEN_LOW, I_SLEEVE = SW_LOAD, SW_GENERATOR, SW_SLEEVE
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
  I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT) = range(
     N_SWITCHES, N_SWITCHES + 15)
@@ -64,28 +69,32 @@ ON_LEVEL = 1e-12
 RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING = range(7)
 # event codes written to the event buffer as (code, t, phi, omega)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
- EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR) = range(11)
+ EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR, EV_SLEEVE_STOP, EV_SLEEVE_FREE,
+ EV_INJECTION) = range(14)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
                "speed_reversal", "end", "governor_corner", "pair_mode", "locked", "load_schedule",
-               "generator_min_speed")
-# Event "components" at and above PAIR_COMP are the mode margins of the pairs (model.mode_margins).
+               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection")
+# Event "components" at and above PAIR_COMP are the mode margins of the pairs (model.mode_margins);
+# DEMAND_COMP is the PI governor's demand u (model.demand).
 PAIR_COMP = 100
+DEMAND_COMP = -1
 
 
 @kernel
-def _error_norm(tab, K, h, y, y_new, rtol, atol, ix):
+def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1):
     """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
-    the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5).
+    the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5), over the dynamics'
+    components and the governor's states y[g0:g1].
 
     The accumulating components (t in crank angle, φ in time) are scaled by their increment over
     the step, not by their size: relative to |t| the allowed error would grow with the run's length
     and a long run would lose phase for nothing. The independent variable ``ix`` has no error.
     """
-    n = y.shape[0]
+    n = g1
     err5 = 0.0
     err3 = 0.0
     for i in range(n):
-        if i == ix or i >= N_DYNAMIC:
+        if i == ix or N_DYNAMIC <= i < g0:
             continue  # (work integrals do not feed back: they follow the dynamics' steps)
         if i == PHI or i == T:
             sc = atol + rtol * abs(y_new[i] - y[i])
@@ -100,7 +109,7 @@ def _error_norm(tab, K, h, y, y_new, rtol, atol, ix):
         err3 += (e3 / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
-    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1))
+    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1 + g1 - g0))
 
 
 @kernel
@@ -171,13 +180,14 @@ def _dense_eval(F, y, theta, out):
 @kernel
 def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
     """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
-    pair comp − PAIR_COMP, else y[comp] − level."""
+    pair comp − PAIR_COMP, the PI demand u − level, else y[comp] − level."""
     if comp >= PAIR_COMP:
         margins_at(m, angle_mode, yv, sel, sw, wk)
         return wk[WK_G, comp - PAIR_COMP]
-    if comp == OMEGA:
+    if comp == OMEGA or comp == DEMAND_COMP:
         J, _ = inertia(m, yv[PHI], wk)
-        return speed(J, angle_mode, yv) - level
+        w = speed(J, angle_mode, yv)
+        return (w if comp == OMEGA else demand(m, w, yv)) - level
     return yv[comp] - level
 
 
@@ -244,19 +254,19 @@ def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
 
 
 @kernel
-def _speed_crossing_inside(m, angle_mode, F, y, x, h, level, direction, ga, sel, sw, tmp, wk):
-    """θ where the speed first crosses ``level`` (in ``direction``) inside a step whose ends are
-    on the same side of it, sampled at θ = j/N_MARGIN_SAMPLES on the dense output; 2 if the
-    samples see no crossing (it was only in a stage)."""
+def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp, wk):
+    """θ where the speed (or the PI demand, ``comp``) first crosses ``level`` (in ``direction``)
+    inside a step whose ends are on the same side of it, sampled at θ = j/N_MARGIN_SAMPLES on the
+    dense output; 2 if the samples see no crossing (it was only in a stage)."""
     ix = PHI if angle_mode else T
     g_prev = ga
     for j in range(1, N_MARGIN_SAMPLES + 1):
         theta = j / N_MARGIN_SAMPLES
         _dense_eval(F, y, theta, tmp)
         tmp[ix] = x + theta * h
-        g = _event_g(m, angle_mode, tmp, OMEGA, level, sel, sw, wk)
+        g = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
         if _crosses(g_prev, g, direction):
-            return _root(m, angle_mode, F, y, OMEGA, level, sel, sw, tmp, wk,
+            return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
                          (j - 1) / N_MARGIN_SAMPLES, theta, g_prev, g)[0]
         g_prev = g
     return 2.0
@@ -302,7 +312,7 @@ def next_breakpoint(bp, period, phi, upward):
     return -np.inf
 
 
-FIRST_PAIR_EVENT = 10
+FIRST_PAIR_EVENT = 14
 N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
 
 
@@ -340,16 +350,86 @@ def _event_spec(m, cfg, e, angle_mode, sw):
         return EV_END, PHI, cfg[C_PHI_END], 1
     if 5 <= e < 7 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
         return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
+    if 5 <= e < 7 and is_pi(m):  # the PI demand reaching its upper or lower limit
+        return EV_GOVERNOR, DEMAND_COMP, m.gov_par[gv.P_FMAX if e == 5 else gv.P_FMIN], 0
     if e == 7 and sw[SW_LOAD] < m.load_x.shape[0]:  # the schedule's corner ahead
         return EV_LOAD, m.load_comp, m.load_x[sw[SW_LOAD]], 1
     if e == 8 and m.load_comp == PHI and sw[SW_LOAD] > 0:  # behind, reached turning back
         return EV_LOAD, PHI, m.load_x[sw[SW_LOAD] - 1], -1
     if e == 9 and m.gen_power != 0.0:  # the generator's minimum speed
         return EV_GENERATOR, OMEGA, m.gen_min, 0
+    if 10 <= e < 14 and m.gov_dyn == gv.FLYWEIGHT:
+        return _sleeve_event(m, e, sw)
     if e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
         # the mode margin of pair e − FIRST_PAIR_EVENT falls to zero
         return EV_PAIR_MODE, PAIR_COMP + e - FIRST_PAIR_EVENT, 0.0, -1
     return -1, OMEGA, 0.0, 0
+
+
+@kernel(inline="always")
+def _sleeve_event(m, e, sw):
+    """The flyweight governor's events (``_event_spec``, e = 10 … 13): a moving sleeve reaching
+    its low or high stop; on a stop, the speed at which the net force turns away from it."""
+    par = m.gov_par
+    z = gov_index(m) + gv.FW_LIFT
+    sleeve = sw[SW_SLEEVE]
+    if e == 10 and sleeve == gv.FREE:
+        return EV_SLEEVE_STOP, z, 0.0, -1
+    if e == 11 and sleeve == gv.FREE:
+        return EV_SLEEVE_STOP, z, par[gv.F_TRAVEL], 1
+    if e == 12 and sleeve == gv.ON_LOW_STOP:
+        return EV_SLEEVE_FREE, OMEGA, par[gv.F_W_LIFT], 1
+    if e == 13 and sleeve == gv.ON_HIGH_STOP:
+        return EV_SLEEVE_FREE, OMEGA, par[gv.F_W_TOP], -1
+    return -1, OMEGA, 0.0, 0
+
+
+@kernel
+def _sleeve_stops(m, y, level, w):
+    """The sleeve has reached a stop (lift ``level``): it stops there (ż = 0) unless the net force
+    already pulls it away, so that it stays free (returns the new switch)."""
+    g = gov_index(m)
+    y[g + gv.FW_RATE] = 0.0
+    low = level == 0.0
+    force = gv.sleeve_force(m.gov_par, w, level, 0.0)
+    if low and force <= 0.0:
+        return gv.ON_LOW_STOP
+    if not low and force >= 0.0:
+        return gv.ON_HIGH_STOP
+    return gv.FREE
+
+
+@kernel
+def _jumps_at(m, bp, phi):
+    """Whether a pressure jumps at the breakpoint the shaft is on (``Model.bp_jump``): the
+    derivative carried over from the step that ended there (FSAL) used the piece before it."""
+    local = phi % m.period
+    for j in range(bp.shape[0]):
+        d = abs(bp[j] - local)
+        if min(d, m.period - d) <= BP_LANDING:
+            return m.bp_jump[j]
+    return False
+
+
+@kernel
+def _inject(m, y, sw, evbuf, ist, wk):
+    """At a breakpoint, moving forward: each cylinder whose start of injection this is latches the
+    governor's command (``m.latch``). Returns whether any did (the derivative at y changes)."""
+    if not m.latch:
+        return False
+    J, _ = inertia(m, y[PHI], wk)
+    w = speed(J, ist[I_ANGLE_MODE] == 1, y)
+    if w <= 0.0:
+        return False
+    c = latch_index(m)
+    hit = False
+    for k in range(m.ncyl):
+        local = (y[PHI] - m.gas_phase[k] - m.inj_angle) % m.period
+        if min(local, m.period - local) <= BP_LANDING:
+            y[c + k] = command(m, w, y, sw)
+            hit = True
+            _emit_event(m, evbuf, ist, EV_INJECTION, y, wk)
+    return hit
 
 
 @kernel(inline="always")
@@ -448,11 +528,13 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
     n_bad = 0  # consecutive non-finite step attempts
     rejected = False  # the last attempt was rejected by the error test
+    g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics
+    g1 = g0 + gv.n_states(m.gov_dyn)
 
     if ist[I_STARTED] == 0:
         ist[I_STARTED] = 1
         fst[F_ERR_OLD] = 1e-4
-        ist[I_GOV_BRANCH] = governor_branch(m, y[OMEGA], True)
+        ist[I_GOV_BRANCH] = start_branch(m, y[OMEGA], y)
         # (time only increases; the shaft angle as ω's sign says, forward from rest)
         ist[I_LOAD_SEG] = load_segment(m, y[m.load_comp], m.load_comp == T or y[OMEGA] >= 0.0)
         ist[I_GEN_LOW] = generator_branch(m, y[OMEGA], True)
@@ -477,10 +559,13 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         ix = PHI if angle_mode else T
         x = y[ix]
         if ist[I_F_VALID] == 0:
+            # (the table piece just ahead in the direction of motion: on a breakpoint, rounding
+            # of the shaft angle must not pick the piece behind it)
+            ahead = y[PHI] + (1e-9 if angle_mode or y[OMEGA] >= 0.0 else -1e-9)
             if m.n_pairs > 0:
-                _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf)
+                _settle_modes(m, angle_mode, y, ahead, sw, wk, gs, ist, evbuf)
                 ist[I_NFEV] += 1
-            derivative(m, angle_mode, y, y[PHI], sw, wk, f)
+            derivative(m, angle_mode, y, ahead, sw, wk, f)
             ist[I_NFEV] += 1
             ist[I_F_VALID] = 1
             if fst[F_H] <= 0.0:
@@ -528,6 +613,8 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         wk[WK_G_MIN, :] = np.inf
         wk[WK_SPEED, 0] = np.inf
         wk[WK_SPEED, 1] = -np.inf
+        wk[WK_DEMAND, 0] = np.inf
+        wk[WK_DEMAND, 1] = -np.inf
         _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
         if at_segment_end and x_end == corner:
             y_new[ix] = corner  # x + (corner − x) can miss it by an ulp: the event needs g = 0
@@ -540,7 +627,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             g_min = wk[WK_G_MIN, k]
             dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
         ist[I_NFEV] += tab.n_stages
-        err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix)
+        err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1)
         finite = np.isfinite(err)
         for i in range(n):
             finite = finite and np.isfinite(y_new[i])
@@ -627,14 +714,19 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
                 continue
-            ga = (w0 if comp == OMEGA else y[comp]) - level
-            gb = (w1 if comp == OMEGA else y_new[comp]) - level
+            if comp == DEMAND_COMP:
+                ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
+                gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
+            else:
+                ga = (w0 if comp == OMEGA else y[comp]) - level
+                gb = (w1 if comp == OMEGA else y_new[comp]) - level
             if code == ist[I_AT_EVENT] - 1 and abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
                 ga = 0.0
             ends = _crosses(ga, gb, direction)
-            # The speed can pass a level and come back within one step (its fluctuation within a
-            # cycle about a governor corner): the stages' range shows it.
-            inside = comp == OMEGA and not ends and w_lo < level < w_hi
+            # The speed (the PI demand) can pass a level and come back within one step (its
+            # fluctuation within a cycle about a governor corner): the stages' range shows it.
+            inside = not ends and ((comp == OMEGA and w_lo < level < w_hi) or (
+                comp == DEMAND_COMP and wk[WK_DEMAND, 0] < level < wk[WK_DEMAND, 1]))
             if ends or inside:
                 if not dense_ready:
                     _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
@@ -643,8 +735,8 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 if ends:
                     theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
                 else:
-                    theta = _speed_crossing_inside(m, angle_mode, F, y, x, h, level, direction,
-                                                   ga, sel, sw, tmp, wk)
+                    theta = _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction,
+                                             ga, sel, sw, tmp, wk)
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
                     # the crossing's direction: from below (an 'inside' crossing is the first
@@ -675,9 +767,13 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 gs[0, k] = gs[N_MARGIN_SAMPLES, k]
             if angle_mode and at_segment_end and x_end == up:
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
+                if _inject(m, y, sw, evbuf, ist, wk) or _jumps_at(m, bp, y[PHI]):
+                    ist[I_F_VALID] = 0
             elif redo_hit_breakpoint:
                 fst[F_PASSED_BP] = fst[F_REDO_LEVEL]
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
+                if _inject(m, y, sw, evbuf, ist, wk) or _jumps_at(m, bp, y[PHI]):
+                    ist[I_F_VALID] = 0
             if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
                 return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
             if not angle_mode and at_segment_end and x_end == cfg[C_T_END]:
@@ -694,6 +790,11 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         y_evt[ix] = x_stop
         if ev_comp >= PAIR_COMP:
             pass  # the margin is zero here to the root finder's accuracy; nothing to put on a level
+        elif ev_comp == DEMAND_COMP:
+            # the demand onto the limit exactly, by its integrator (a shift of the root finder's
+            # accuracy), so that the next step starts on the level and does not cross it again
+            y_evt[gov_index(m) + gv.PI_INTEGRAL] -= _event_g(m, angle_mode, y_evt, ev_comp,
+                                                             ev_level, sel, sw, wk)
         elif ev_comp != OMEGA:
             y_evt[ev_comp] = ev_level
         elif angle_mode:  # put the speed exactly on the level: K = ½ J ω²
@@ -706,6 +807,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         ist[I_F_VALID] = 0
         if on_breakpoint:
             _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
+            _inject(m, y, sw, evbuf, ist, wk)
         _emit_event(m, evbuf, ist, ev_code, y, wk)
         if ev_code == EV_END:
             return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
@@ -732,6 +834,8 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             ist[I_FLIPPED] = ev_comp - PAIR_COMP + 1
         elif ev_code == EV_STARTER_CUTOUT:
             ist[I_STARTER_ON] = 0
+        elif ev_code == EV_GOVERNOR and ev_comp == DEMAND_COMP:
+            ist[I_GOV_BRANCH] = gv.demand_branch(m.gov_par, ev_level, ev_rising)
         elif ev_code == EV_GOVERNOR:
             ist[I_GOV_BRANCH] = governor_branch(m, ev_level, ev_rising)
         elif ev_code == EV_LOAD:
@@ -739,6 +843,11 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             ist[I_LOAD_SEG] = load_segment(m, ev_level, ev_rising)
         elif ev_code == EV_GENERATOR:
             ist[I_GEN_LOW] = generator_branch(m, ev_level, ev_rising)
+        elif ev_code == EV_SLEEVE_STOP:
+            J, _ = inertia(m, y[PHI], wk)
+            ist[I_SLEEVE] = _sleeve_stops(m, y, ev_level, speed(J, angle_mode, y))
+        elif ev_code == EV_SLEEVE_FREE:
+            ist[I_SLEEVE] = gv.FREE
         elif ev_code == EV_TO_TIME:
             _to_time_mode(m, y, ist, wk)
             fst[F_H] = h_next / ev_level
@@ -766,12 +875,12 @@ def _to_time_mode(m, y, ist, wk):
 
 
 @kernel
-def _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf):
+def _settle_modes(m, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
     just switched sits on its level (margin 0). Any other pair already past its level here (two
     pairs switching within the event location's accuracy) is switched now, so that no step starts
     with a mode against its criterion: the stepper watches a margin only while it is positive."""
-    margins_at(m, angle_mode, y, y[PHI], sw, wk)
+    margins_at(m, angle_mode, y, sel, sw, wk)
     flipped = ist[I_FLIPPED] - 1
     ist[I_FLIPPED] = 0
     changed = False
@@ -782,7 +891,7 @@ def _settle_modes(m, angle_mode, y, sw, wk, gs, ist, evbuf):
             changed = True
             _emit_event(m, evbuf, ist, EV_PAIR_MODE, y, wk)
     if changed:
-        margins_at(m, angle_mode, y, y[PHI], sw, wk)
+        margins_at(m, angle_mode, y, sel, sw, wk)
         ist[I_NFEV] += 1
     for k in range(m.n_pairs):
         gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]

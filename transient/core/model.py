@@ -22,16 +22,21 @@ from numba import njit
 from .jit import kernel
 
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
+from . import governor as gv
+from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
 from .swash_plate import swash_terms
 from .tabulated import tabulated_terms
 from .tables import find_piece, table_eval, table_eval_pair
 
 #: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode). The first
-#: three are the dynamics; the rest are work integrals (quadratures that do not feed back): the work
+#: three are the dynamics; then work integrals (quadratures that do not feed back): the work
 #: of the gas forces, of the load and of the starter [J], then the energy lost in each non-ideal
 #: pair k (``W_loss_<k+1>``). Integrated with the motion, the work–energy balance
 #: ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k holds to the solver's accuracy.
+#: After them the dynamic governor's states (:mod:`.governor`, from :func:`gov_index`), then, with
+#: fuel latching, the fuel each cylinder took at its last injection (:func:`latch_index`; held
+#: constant between injections: their derivative is zero and the stepper sets them).
 STATE = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
 PHI, T, OMEGA, W_GAS, W_LOAD, W_STARTER = range(6)
 KINETIC = OMEGA
@@ -44,18 +49,20 @@ W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 #: pair k backward, its far side drives), the direction of motion σ = ±1 that the pair modes
 #: refer to (sign of ω; changed only at a speed reversal, where the modes are chosen afresh), the
 #: segment of the load schedule (:func:`load_segment`) and the generator's low-speed branch
-#: (:func:`generator_branch`).
-SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR = range(6)
-N_SWITCHES = 6
+#: (:func:`generator_branch`), and the flyweight governor's sleeve, moving or on a stop
+#: (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``).
+SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE = range(7)
+N_SWITCHES = 7
 
-#: Mechanism kinds (``Model.kind``); TABULATED: either, from its tables (``Model.kin_coef``).
-CRANK_SLIDER, SWASH_PLATE, TABULATED = 0, 1, 2
+#: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
+CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
 
 #: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
 POWER_FLOW, PAPER = 0, 1
 
 #: Columns written for every output sample; then one gas column per cylinder, then
-#: ``PAIR_OUTPUTS`` for each non-ideal pair.
+#: ``PAIR_OUTPUTS`` for each non-ideal pair, then the dynamic governor's states
+#: (``governor.STATE_NAMES``) and, with fuel latching, the fuel latched by each cylinder.
 OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter", "fuel",
            "W_gas", "W_load", "W_starter")
 OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m", "1",
@@ -71,15 +78,16 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: Rows of the work array ``wk`` (see :func:`work_array`): transfer functions u, u′ per cylinder;
 #: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, their least value
 #: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
-#: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED).
+#: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
+#: of the PI governor's demand u (WK_DEMAND).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
- WK_SPEED, WK_SCRATCH) = range(13)
+ WK_SPEED, WK_DEMAND, WK_SCRATCH) = range(14)
 N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
 
 Model = namedtuple(
     "Model",
     [
-        "kind",  # int: CRANK_SLIDER, SWASH_PLATE or TABULATED
+        "kind",  # int: CRANK_SLIDER, SWASH_PLATE, ARTICULATED or TABULATED
         "mech",  # float64[:]: the mechanism's packed parameters
         "kin_coef",  # float64[1 + ncyl, n, 6]: the TABULATED kind's splines (transient.core.tabulated)
         "ncyl",  # int: number of cylinders (gas force points)
@@ -94,6 +102,7 @@ Model = namedtuple(
         "piece_knot",  # int64[:]
         "has_motored",  # bool: coef pairs a motored curve; else it is the constant gas_offset
         "breakpoints",  # float64[:]: sorted shaft angles in [0, period) where a table has a corner
+        "bp_jump",  # bool[:]: whether a cylinder's pressure jumps at each breakpoint
         "load_const",  # float: constant resisting torque [N m]
         "load_linear",  # float: c in −c·ω [N m s]
         "load_fan",  # float: K in −K·ω|ω| [N m s²]
@@ -108,6 +117,10 @@ Model = namedtuple(
         "gov_on",  # bool: a static droop governor scales the gas forces
         "gov_full",  # float: ω_a, full fuel at and below it [rad/s]
         "gov_zero",  # float: ω_1c, no fuel at and above it [rad/s]
+        "gov_dyn",  # int: governor with states (transient.core.governor: NONE, PI, PID, FLYWEIGHT)
+        "gov_par",  # float64[:]: its parameters (governor.P_* or governor.F_*)
+        "latch",  # bool: each cylinder's fuel is latched at its start of injection
+        "inj_angle",  # float: local angle of the start of injection [rad] (with latch)
         "n_pairs",  # int: number of non-ideal pairs (0: ideal constraints, equation (18))
         "eta_fwd",  # float64[n_pairs]: efficiency of pair k when its shaft side drives
         "eta_bwd",  # float64[n_pairs]: efficiency of pair k when its far side drives
@@ -118,16 +131,29 @@ Model = namedtuple(
 )
 
 
+@kernel(inline="always")
+def gov_index(m):
+    """Index of the dynamic governor's first state."""
+    return N_STATE_BASE + m.n_pairs
+
+
+@kernel(inline="always")
+def latch_index(m):
+    """Index of cylinder 0's latched fuel (with ``m.latch``)."""
+    return N_STATE_BASE + m.n_pairs + gv.n_states(m.gov_dyn)
+
+
 @kernel
 def n_state(m):
     """Length of the state vector of model ``m``."""
-    return N_STATE_BASE + m.n_pairs
+    return latch_index(m) + (m.ncyl if m.latch else 0)
 
 
 @kernel
 def n_outputs(m):
     """Columns of an output row of model ``m``."""
-    return N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
+    return (N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs + gv.n_states(m.gov_dyn)
+            + (m.ncyl if m.latch else 0))
 
 
 @njit(cache=True)
@@ -143,6 +169,8 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du):
         return tabulated_terms(kin_coef, phi, u, du)
     if kind == CRANK_SLIDER:
         return crank_slider_terms(mech, phi, u, du)
+    if kind == ARTICULATED:
+        return articulated_terms(mech, phi, u, du)
     return swash_terms(mech, phi, u, du)
 
 
@@ -224,6 +252,55 @@ def fuel(m, w, branch):
     return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
 
 
+@kernel(inline="always")
+def command(m, w, y, sw):
+    """The governor's fuel command at state ``y``: the rack of a dynamic governor (PI(D): its
+    position state; flyweight: linked to the sleeve), else the droop characteristic (:func:`fuel`)."""
+    if is_pi(m):
+        return y[gov_index(m) + gv.PI_RACK]
+    if m.gov_dyn == gv.FLYWEIGHT:
+        return gv.rack_of_lift(m.gov_par, y[gov_index(m) + gv.FW_LIFT])
+    return fuel(m, w, sw[SW_GOVERNOR])
+
+
+@kernel(inline="always")
+def is_pi(m):
+    """Whether the governor is a PI(D) one (its demand's clipping is a switch, ``SW_GOVERNOR``)."""
+    return m.gov_dyn == gv.PI or m.gov_dyn == gv.PID
+
+
+@kernel(inline="always")
+def demand(m, w, y):
+    """The PI(D) governor's demand u at state y (before clipping)."""
+    return gv.pi_demand(m.gov_dyn, m.gov_par, w, y, gov_index(m))[1]
+
+
+@kernel
+def start_branch(m, w, y):
+    """``SW_GOVERNOR`` at the start of a run: the PI demand's clipping branch, or the droop
+    characteristic's branch (:func:`governor_branch`)."""
+    if is_pi(m):
+        return gv.demand_branch(m.gov_par, demand(m, w, y), True)
+    return governor_branch(m, w, True)
+
+
+@kernel(inline="always")
+def governor_rates(m, w, y, scale, sw, wk, out):
+    """Derivatives of the dynamic governor's states (× ``scale``: 1/ω in crank angle) and zero
+    for the latched fuels, into ``out``; the PI demand's range over a step into ``wk``."""
+    g = gov_index(m)
+    if is_pi(m):
+        u = gv.pi_rates(m.gov_dyn, m.gov_par, w, y, g, sw[SW_GOVERNOR], scale, out)
+        wk[WK_DEMAND, 0] = min(wk[WK_DEMAND, 0], u)
+        wk[WK_DEMAND, 1] = max(wk[WK_DEMAND, 1], u)
+    elif m.gov_dyn == gv.FLYWEIGHT:
+        gv.flyweight_rates(m.gov_par, w, y, g, sw[SW_SLEEVE], scale, out)
+    if m.latch:
+        c = latch_index(m)
+        for k in range(m.ncyl):
+            out[c + k] = 0.0
+
+
 @kernel
 def load_segment(m, x, rising):
     """Segment of the load schedule at abscissa ``x`` (a time or a shaft angle, as ``m.load_comp``).
@@ -278,7 +355,8 @@ def moments(m, angle_mode, y, sel, sw, wk):
     of cylinder k is (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel
     f (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
     P/max(ω, ω_min)), s from the schedule's segment ``sw[SW_LOAD]`` and the max from the
-    generator's branch ``sw[SW_GENERATOR]``.
+    generator's branch ``sw[SW_GENERATOR]``. With fuel latching cylinder k burns the fuel it
+    took at its last injection, else every cylinder the governor's command (:func:`command`).
     """
     phi = y[PHI]
     u = wk[WK_U]
@@ -287,10 +365,12 @@ def moments(m, angle_mode, y, sel, sw, wk):
     w = speed(J, angle_mode, y)
     M_gas = 0.0
     if m.has_gas:
-        f = fuel(m, w, sw[SW_GOVERNOR])
-        if m.has_motored:  # p = p_mot + f·(p_full − p_mot), per cylinder
+        f = command(m, w, y, sw)
+        if m.latch or m.has_motored:  # p = p_mot + f_k·(p_full − p_mot), per cylinder
+            c = latch_index(m)
             for k in range(m.ncyl):
-                M_gas += m.gas_scale[k] * (applied_value(m, k, phi, sel, f) - m.gas_offset) * u[k]
+                f_k = y[c + k] if m.latch else f
+                M_gas += m.gas_scale[k] * (applied_value(m, k, phi, sel, f_k) - m.gas_offset) * u[k]
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
                 M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
@@ -390,6 +470,8 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     out[W_GAS] = M_gas * q
     out[W_LOAD] = M_load * q
     out[W_STARTER] = M_starter * q
+    if m.gov_dyn != gv.NONE or m.latch:
+        governor_rates(m, w, y, 1.0 / w if angle_mode else 1.0, sw, wk, out)
     if angle_mode:
         out[PHI] = 1.0
         out[T] = 1.0 / w
@@ -473,7 +555,8 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
 @kernel
 def output_row(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
-    (p_mot + f·(p_full − p_mot), see :func:`applied_value`), then ``PAIR_OUTPUTS`` of each pair."""
+    (p_mot + f·(p_full − p_mot), see :func:`applied_value`), ``PAIR_OUTPUTS`` of each pair, the
+    dynamic governor's states and the latched fuels."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
     row[0] = y[T]
     row[1] = y[PHI]
@@ -484,14 +567,20 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
-    f = fuel(m, w, sw[SW_GOVERNOR])
+    f = command(m, w, y, sw)
     row[9] = f
     row[10] = y[W_GAS]
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
-    for k in range(m.ncyl):  # the pressure (force) applied, at the governor's fuel
-        row[N_OUT_FIXED + k] = applied_value(m, k, y[PHI], sel, f) if m.has_gas else 0.0
+    c = latch_index(m)
+    for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
+        f_k = y[c + k] if m.latch else f
+        row[N_OUT_FIXED + k] = applied_value(m, k, y[PHI], sel, f_k) if m.has_gas else 0.0
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
+    j = N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
+    for i in range(gov_index(m), n_state(m)):  # governor states, latched fuels
+        row[j] = y[i]
+        j += 1
 
 
 @kernel(inline="always")
@@ -574,6 +663,9 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
         sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
         sw[SW_LOAD] = load_segment(m, y[m.load_comp], True)  # t and φ increase here (ω > 0)
         sw[SW_GENERATOR] = generator_branch(m, omega[i], eps[i] >= 0.0)
+        if m.latch:  # (a static governor only) at a prescribed speed each cylinder latches it
+            for k in range(m.ncyl):
+                y[latch_index(m) + k] = fuel(m, omega[i], sw[SW_GOVERNOR])
         J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, phi[i], sw, wk)
         output_row(m, False, y, phi[i], sw, wk, rows[i])
         rows[i, COL_EPS] = eps[i]

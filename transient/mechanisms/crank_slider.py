@@ -219,12 +219,16 @@ class CrankSlider:
         return volume
 
 
+#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
+MAX_CYLINDERS = 64
+
+
 def read_crank_slider(s) -> CrankSlider:
     """A :class:`CrankSlider` from the ``[mechanism]`` table (a ``transient.scene.Section``)."""
     r = s.number("crank_radius", "length")
     l = s.number("rod_length", "length")
     strokes = s.integer("strokes", 4, choices=(2, 4))
-    n = s.integer("cylinders", 1, ge=1)
+    n = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
     cycle = math.pi * strokes
     order = s.integers("firing_order", tuple(range(1, n + 1)))
     if sorted(order) != list(range(1, n + 1)):

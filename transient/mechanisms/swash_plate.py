@@ -498,6 +498,10 @@ def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.f
 # Scene reading and writing
 
 
+#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
+MAX_CYLINDERS = 64
+
+
 def read_swash_plate(s: "Section") -> SwashPlate:
     """A :class:`SwashPlate` from the ``[mechanism]`` table (its ``type`` is read by the caller).
 
@@ -519,7 +523,7 @@ def read_swash_plate(s: "Section") -> SwashPlate:
     r1 = s.number("cylinder_radius", "length", gt=0.0)
     ell = s.number("rod_length", "length", gt=0.0)
     bore = s.number("bore", "length", gt=0.0)
-    z = s.integer("cylinders", 1, ge=1)
+    z = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
     halves = s.integer("halves", 1, choices=(1, 2))
     hinge = s.string("hinge", "in-plane", choices=tuple(HINGES))
     piston_mass = s.number("piston_mass", ge=0.0)

@@ -1,0 +1,150 @@
+"""The analyses a scene asks for in its ``[analysis]`` table (:class:`transient.scene.Analysis`),
+computed at the end of a run and stored under ``/analysis/<name>`` with a unit each (DESIGN §4).
+
+Nothing here runs unless the scene asks. :func:`requested_analyses` returns name → (value, unit)
+like the end-of-run summary (:func:`transient.analysis.irregularity.summarize`, which calls it);
+values are scalars, strings or arrays. A part that cannot be computed (the run holds no whole
+cycle) is left out and ``<part>_skipped`` says why: never guessed.
+
+Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders 0 … max_order)
+
+* ``irregularity = true``: ``irregularity_cycle_end_t`` [s], ``irregularity_cycle_omega_mean``
+  [rad/s] (cycle angle over cycle time), ``irregularity_cycle_delta`` [1]
+  (δ = (ω_max − ω_min)/ω_mean over each cycle's samples, Gots §2.8), each (C,).
+* ``orders = [...]``: ``orders_order`` (K,) [1/rev]; ``orders_cycle_start`` (C,) [rad],
+  ``orders_cycle_omega_mean`` (C,) [rad/s]; ``orders_detrend`` ("ramp" or "none"); per signal s
+  ``orders_<s>_amplitude`` (C, K) [unit of s] and ``orders_<s>_phase`` (C, K) [rad]
+  (:class:`transient.analysis.orders.OrderSpectrum`; order 0 is the mean of the detrended cycle).
+  A signal is a trajectory column or ``W_<k>``, the piston acceleration of cylinder k,
+  W = ω²s″ + εs′ [m/s²] (crank-slider).
+* ``loads = true`` (crank-slider), over the last whole cycle on a uniform grid of N angles
+  (:mod:`transient.analysis.loads`): ``loads_phi`` (N,) [rad]; ``loads_P``, ``loads_N``,
+  ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load ``loads_R_K``,
+  ``loads_R_T``, ``loads_R`` ((40)/(41) as vectors), each (n, N) [N]; ``loads_torque`` (n, N)
+  and ``loads_engine_torque`` (N,) [N m]; ``loads_crankpin_R_max`` (n,) [N]; in-line engines
+  also the running torques ``loads_journal_torque`` (n+1, N), ``loads_crankpin_torque`` (n, N)
+  [N m] (§2.8) and the main journals by (58), ``loads_main_x``, ``loads_main_y`` (n+1, N) and
+  ``loads_main_R_max`` (n+1,) [N] (frame of crank 1).
+"""
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import numpy as np
+
+from .irregularity import cycle_boundaries
+from .orders import order_spectrum, resolve_detrend, to_angle_grid
+
+#: A derived signal of ``orders``: the piston acceleration of cylinder k.
+PISTON_ACCELERATION = re.compile(r"W_([1-9][0-9]*)$")
+
+
+def requested_analyses(scene, traj: dict[str, np.ndarray], events=None
+                       ) -> dict[str, tuple[Any, str]]:
+    """Every analysis ``scene.analysis`` asks for, as name → (value, unit); {} if none."""
+    req = scene.analysis
+    cuts = np.asarray((events or {}).get("breakpoint", np.zeros((0, 2))))[:, 1]
+    out: dict[str, tuple[Any, str]] = {}
+    parts = (("irregularity", req.irregularity, lambda: cycle_irregularity(scene, traj)),
+             ("orders", bool(req.orders), lambda: stored_orders(scene, traj, cuts)),
+             ("loads", req.loads, lambda: stored_loads(scene, traj, cuts)))
+    for name, asked, compute in parts:
+        if not asked:
+            continue
+        try:
+            out.update(compute())
+        except ValueError as exc:  # e.g. no whole cycle in the run
+            out[f"{name}_skipped"] = (str(exc), "")
+    return out
+
+
+def cycle_irregularity(scene, traj) -> dict[str, tuple[Any, str]]:
+    """δ and the mean speed of every whole cycle (cycles counted from ``scene.initial.phi``)."""
+    t, phi, omega = traj["t"], traj["phi"], traj["omega"]
+    cycle = scene.mechanism.cycle
+    tb, _ = cycle_boundaries(t, phi, cycle, scene.initial.phi)
+    if tb.size < 2:
+        raise ValueError("the run holds no whole cycle")
+    means = cycle / np.diff(tb)
+    lo = np.searchsorted(t, tb[:-1], side="left")
+    hi = np.searchsorted(t, tb[1:], side="right")
+    delta = np.array([np.ptp(omega[a:b]) if b > a else np.nan for a, b in zip(lo, hi)]) / means
+    return {"irregularity_cycle_end_t": (tb[1:], "s"),
+            "irregularity_cycle_omega_mean": (means, "rad/s"),
+            "irregularity_cycle_delta": (delta, "1")}
+
+
+def _column_units(scene) -> dict[str, str]:
+    from ..simulate import output_columns
+
+    return output_columns(scene)
+
+
+def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
+    """Per-cycle order spectra of the signals ``scene.analysis.orders`` up to ``max_order``."""
+    req = scene.analysis
+    mech = scene.mechanism
+    n, cycle = req.samples_per_cycle, mech.cycle
+    units = _column_units(scene)
+    derived = {s: int(m.group(1)) for s in req.orders if (m := PISTON_ACCELERATION.match(s))}
+    columns = [s for s in req.orders if s not in derived]
+    if derived:
+        columns += ["omega", "epsilon"]
+    names = tuple(dict.fromkeys(["t", *columns]))
+    grid, cols = to_angle_grid(traj, names, n, cycle, phi0=scene.initial.phi, cuts=cuts,
+                               closed=True)
+    for s, k in derived.items():
+        cols[s] = _piston_acceleration(mech, grid, cols["omega"], cols["epsilon"], k)
+        units[s] = "m/s^2"
+    mode = resolve_detrend(req.detrend, scene.initial.omega, float(traj["omega"][-1]))
+    t_marks = cols["t"][::n]  # every cycle's start and the last one's end (closed grid)
+    out: dict[str, tuple[Any, str]] = {"orders_cycle_start": (grid[:-1:n], "rad"),
+                                       "orders_cycle_omega_mean": (cycle / np.diff(t_marks),
+                                                                   "rad/s"),
+                                       "orders_detrend": (mode, "")}
+    for s in req.orders:
+        v = cols[s]
+        spec = order_spectrum(v[:-1], n, cycle, detrend=mode, end=v[-1])
+        keep = spec.orders <= req.max_order + 1e-9
+        out["orders_order"] = (spec.orders[keep], "1/rev")
+        out[f"orders_{s}_amplitude"] = (spec.amplitude[:, keep], units[s])
+        out[f"orders_{s}_phase"] = (spec.phase[:, keep], "rad")
+    return out
+
+
+def _piston_acceleration(mech, phi, omega, epsilon, k: int) -> np.ndarray:
+    """W = ω²s″ + εs′ of cylinder k (1-based) [m/s²] (Semenov §4), exact kinematics."""
+    from .loads import slider_arrays
+
+    alpha = phi - mech.firing_angles[k - 1]
+    _, ds, dds, _, _, _ = slider_arrays(alpha, mech.crank_radius, mech.rod_length, mech.offset)
+    return omega ** 2 * dds + epsilon * ds
+
+
+def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
+    """Forces, crankpin and main-journal loads and running torques over the last whole cycle."""
+    from .loads import engine_torque, loads_from_trajectory, main_journal_loads, running_torques
+
+    mech = scene.mechanism
+    n = scene.analysis.samples_per_cycle
+    names = [c for c in ("t", "omega", "epsilon", "fuel") if c in traj]
+    names += [f"p_{k + 1}" for k in range(mech.n_cylinders) if f"p_{k + 1}" in traj]
+    grid, cols = to_angle_grid(traj, names, n, mech.cycle, phi0=scene.initial.phi, cycles=1,
+                               cuts=cuts)
+    ld = loads_from_trajectory(scene, {"phi": grid, **cols})
+    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
+    for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R"):
+        out[f"loads_{name}"] = (getattr(ld, name), "N")
+    out["loads_torque"] = (ld.torque, "N m")
+    out["loads_engine_torque"] = (engine_torque(ld), "N m")
+    out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
+    if np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12:  # in-line: (58), §2.8
+        journals, pins = running_torques(mech, ld)
+        mj = main_journal_loads(mech, ld, cols["omega"], cols["epsilon"])
+        out["loads_journal_torque"] = (journals, "N m")
+        out["loads_crankpin_torque"] = (pins, "N m")
+        out["loads_main_x"] = (mj.x, "N")
+        out["loads_main_y"] = (mj.y, "N")
+        out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
+    return out
