@@ -208,9 +208,8 @@ class ReferenceModel:
         self.mech = _mechanism(scene)
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
         self.pieces = None
-        g = scene.governor
         w0 = scene.initial.omega
-        self.branch = 0 if w0 < g.speed_full else (2 if w0 >= g.speed_zero else 1)
+        self.branch = self.droop_branch(w0)
         self.chain = ChainNumpy(scene) if scene.friction.pairs else None
         self.sigma = 1.0 if w0 >= 0 else -1.0
         m = self.model
@@ -266,6 +265,11 @@ class ReferenceModel:
         M_load = -self.load_scale(phi) * resist
         M_starter = m.starter_torque * (1 - w / m.starter_noload) if self.starter_on else 0.0
         return J, dJ, M_gas, M_load, M_starter, p
+
+    def droop_branch(self, w: float) -> int:
+        """Branch of the droop characteristic at speed w (0 full fuel, 1 the line, 2 none)."""
+        g = self.scene.governor
+        return 0 if w < g.speed_full else (2 if w >= g.speed_zero else 1)
 
     def command(self, w: float, y) -> float:
         """The governor's fuel command at state y."""
@@ -456,6 +460,8 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
         if m.gen_power != 0.0:
             evs.append(("generator", _speed_crossing(ref, t, y, m.gen_min)))
         evs += _sleeve_events(ref.governor, y)
+        if scene.load.inertia > 0.0 and t < scene.load.inertia_time < t_end:
+            evs.append(("inertia_switch", _level_crossing(True, scene.load.inertia_time, 1)))
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
@@ -508,6 +514,19 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             y[1] = m.gen_min
             ref.gen_low = not ref.gen_low
             events.setdefault("generator_min_speed", []).append((t, y[0]))
+        if "inertia_switch" in hit:  # a clutch couples J_x at rest: J(φ)ω is conserved
+            t = scene.load.inertia_time
+            J = ref.mech.terms(y[0])[0] + ref.model.J0
+            extra = scene.load.inertia
+            w_new = J * y[1] / (J + extra)
+            y[3] -= 0.5 * J * y[1] ** 2 - 0.5 * (J + extra) * w_new ** 2  # W_load
+            y[1] = w_new
+            ref.model = ref.model._replace(J0=ref.model.J0 + extra)
+            ref.branch = ref.droop_branch(w_new)  # (ω jumped: its switches afresh)
+            ref.gen_low = bool(generator_branch(ref.model, w_new, True))
+            if ref.chain is not None:
+                ref.chain.J0 += extra
+            events.setdefault("inertia_switch", []).append((t, y[0]))
         if "sleeve_stop" in hit:
             z, w = y[ref.governor.g], y[1]
             y[ref.governor.g + 1] = 0.0

@@ -352,6 +352,11 @@ class Load:
     points (abscissa, ``schedule_scale``), constant before the first and after the last. The
     abscissae do not decrease; two equal ones are a step (value before, value after). The
     corners are state events (``load_schedule``): a step changes s exactly there.
+
+    ``inertia`` J_x [kg m²] switched in at ``inertia_time`` [s]: a load's inertia, at rest, that
+    a clutch couples to the shaft at that instant (an inelastic engagement: the angular momentum
+    J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the kinetic energy lost, ½Jω₋²·J_x/(J + J_x), is
+    counted in ``W_load``; event ``inertia_switch``).
     """
 
     torque: float = 0.0
@@ -362,6 +367,8 @@ class Load:
     schedule_time: tuple[float, ...] = ()
     schedule_revolutions: tuple[float, ...] = ()
     schedule_scale: tuple[float, ...] = ()
+    inertia: float = 0.0
+    inertia_time: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -797,7 +804,9 @@ def _read_load(s: Section) -> Load:
         if v < 0.0:
             raise SceneError(s.key("schedule_scale"), f"must be ≥ 0, got {v:g} (entry {i + 1}); "
                                                       f"the scale multiplies a resisting load")
-    return Load(torque, linear, fan, power, w_min, times, revs, scale)
+    extra = s.number("inertia", default=0.0, ge=0.0)
+    at = s.number("inertia_time", default=_MISSING if extra > 0.0 else 0.0, gt=0.0)
+    return Load(torque, linear, fan, power, w_min, times, revs, scale, extra, at)
 
 
 def _read_governor(s: Section) -> Governor:
@@ -983,6 +992,9 @@ def _check_consistency(scene: Scene) -> None:
     if sv.fixed_step > 0.0 and sv.domain == "time":
         raise SceneError("solver.fixed_step", "fixed steps are crank-angle steps; use "
                                               "domain = \"auto\" or fixed_step = 0")
+    if scene.run.mode == "prescribed-speed" and scene.load.inertia > 0.0:
+        raise SceneError("load.inertia", "a prescribed-speed run has no momentum to conserve when "
+                                         "an inertia is switched in; leave it out (0)")
     if scene.run.mode == "prescribed-speed" and scene.governor.model in ("pi", "flyweight"):
         raise SceneError("governor.model", f"a prescribed-speed run integrates no governor state; "
                                            f"use model = \"none\" or \"droop\", not "
@@ -1114,6 +1126,8 @@ def _gas_section(gas: Gas) -> list[str]:
 def _load_section(load: Load) -> list[str]:
     """[load] with the schedule's keys only when there is one (and only its abscissa)."""
     names = ["torque", "linear", "fan", "generator_power", "generator_min_speed"]
+    if load.inertia > 0.0:
+        names += ["inertia", "inertia_time"]
     if load.schedule_scale:
         names += ["schedule_revolutions" if load.schedule_revolutions else "schedule_time",
                   "schedule_scale"]

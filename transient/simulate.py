@@ -16,6 +16,7 @@ import numpy as np
 from .assemble import build_model, governor_kind, initial_governor
 from .core import governor as gv
 from .core import integrate as ci
+from .core import model as cm
 from .core.tableaus import TABLEAUS
 from .core.model import (N_OUT_FIXED, OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
                          inverse_dynamics, n_outputs, n_state)
@@ -137,21 +138,33 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     evbuf = np.empty((EVENT_ROWS, 4))
     blocks, events = [], {name: [] for name in ci.EVENT_NAMES}  # events kept only with keep
     status, message = ci.RUNNING, ""
+    # An inertia switched in: the run stops at that time (as at its end), the shaft's inertia and
+    # speed jump (switch_inertia), and the run goes on.
+    switch_at = scene.load.inertia_time if 0.0 < scene.load.inertia and (
+        scene.load.inertia_time < scene.run.t_end) else math.inf
+    run_cfg = cfg.copy()
+    run_cfg[ci.C_T_END] = min(cfg[ci.C_T_END], switch_at)
     t0 = time.perf_counter()
     try:
         while status == ci.RUNNING:
-            status = ci.advance(model, tab, cfg, bp, y, fst, ist, outbuf, evbuf)
+            status = ci.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf)
+            switching = status == ci.FINISHED and y[cm.T] == switch_at
             block = {name: outbuf[: ist[ci.I_NOUT], j].copy() for j, name in enumerate(names)}
             ev = {}
             for code, t, phi, _ in evbuf[: ist[ci.I_NEV]]:
-                ev.setdefault(ci.EVENT_NAMES[int(code)], []).append((t, phi))
+                name = ci.EVENT_NAMES[int(code)]
+                ev.setdefault("inertia_switch" if switching and name == "end" else name,
+                              []).append((t, phi))
             ist[ci.I_NOUT] = 0
             ist[ci.I_NEV] = 0
+            if switching:
+                model = switch_inertia(model, scene.load.inertia, y, ist)
+                run_cfg, switch_at, status = cfg, math.inf, ci.RUNNING
             if keep or not blocks or block["t"].size:
                 blocks = (blocks if keep else []) + [block]
             if keep:
                 for k, v in ev.items():
-                    events[k].extend(v)
+                    events.setdefault(k, []).extend(v)
             if on_block:
                 on_block(block, ev)
             if progress:
@@ -197,6 +210,27 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
                    solver, complete=status == ci.FINISHED, message=message)
+
+
+def switch_inertia(model, extra: float, y, ist):
+    """Couple the inertia ``extra`` [kg m²], at rest, to the shaft (an inelastic engagement):
+    J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the energy lost, ½Jω₋² − ½(J + J_x)ω₊², is taken
+    from ``W_load``, so that the work–energy balance still closes. Updates the state ``y`` and
+    the switches that depend on the speed, which jumped across their levels without an event
+    (the governor's branch, the generator's); returns the model with the extra inertia on the
+    shaft (``J0``)."""
+    angle_mode = ist[ci.I_ANGLE_MODE] == 1
+    J, _ = cm.inertia(model, y[cm.PHI], cm.work_array(model))
+    w = cm.speed(J, angle_mode, y)
+    w_new = J * w / (J + extra)
+    y[cm.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new
+    if angle_mode:
+        y[cm.KINETIC] = 0.5 * (J + extra) * w_new * w_new
+    else:
+        y[cm.OMEGA] = w_new
+    ist[ci.I_GOV_BRANCH] = cm.start_branch(model, w_new, y)
+    ist[ci.I_GEN_LOW] = cm.generator_branch(model, w_new, True)
+    return model._replace(J0=model.J0 + extra)
 
 
 def _kinematics_attrs(scene) -> dict:

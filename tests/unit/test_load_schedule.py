@@ -154,8 +154,8 @@ ERRORS = [
     ("min-speed-negative", "generator_min_speed = -1", "load.generator_min_speed",
      "must be ≥ 0, got -1"),
     ("unknown-key", "schedule = [0, 1]", "load.schedule",
-     ("unknown key; allowed here: fan, generator_min_speed, generator_power, linear, "
-      "schedule_revolutions, schedule_scale, schedule_time, torque")),
+     ("unknown key; allowed here: fan, generator_min_speed, generator_power, inertia, "
+      "inertia_time, linear, schedule_revolutions, schedule_scale, schedule_time, torque")),
 ]
 
 

@@ -447,6 +447,14 @@ GOVERNOR_CASES = [
     ("flyweight-pi-key", VALID + FLYWEIGHT + "gain_p = 3\n", "governor.gain_p", "unknown key"),
     ("injection-beyond-cycle", VALID + MIXED_CYCLE.format(cr=18) + "injection_deg = 720\n",
      "gas.injection_deg", "must be < 720, got 720"),
+    ("inertia-switch-without-time", VALID + "\n[load]\ninertia = 0.1\n", "load.inertia_time",
+     "is missing"),
+    ("inertia-switch-negative", VALID + "\n[load]\ninertia = -0.1\ninertia_time = 1\n",
+     "load.inertia", "must be ≥ 0, got -0.1"),
+    ("inertia-switch-prescribed", replace("revolutions = 2", 'mode = "prescribed-speed"\n'
+                                          'speed = 100\nrevolutions = 2')
+     + "\n[load]\ninertia = 0.1\ninertia_time = 1\n",
+     "load.inertia", "a prescribed-speed run has no momentum to conserve"),
 ]
 
 
