@@ -12,7 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .core import governor as gv
-from .core.model import PAPER, PHI, POWER_FLOW, TABULATED, T, Model, fuel, governor_branch
+from .core.model import (PAPER, PHI, POWER_FLOW, TABULATED, T, Model, fuel, governor_branch,
+                         mechanism_terms)
 from .forces.gas import PressureTable, _shift_cubic, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -116,25 +117,28 @@ def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period
 
 
 def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64],
-                     period: float) -> NDArray[np.bool_]:
-    """For each breakpoint, whether a cylinder's pressure (any of ``tables``) jumps there: the
-    stepper's first stage beyond it must then be evaluated afresh, not carried over from the
-    step that ended on it (which used the table piece before the corner)."""
+                     period: float, mech) -> NDArray[np.bool_]:
+    """For each breakpoint, whether a cylinder's gas torque jumps there: its pressure (any of
+    ``tables``) jumps while its piston moves (u_k ≠ 0; a jump at a dead centre, as all of the
+    crank-slider cycles' are, leaves the torque continuous). The stepper's first stage beyond such
+    a breakpoint must be evaluated afresh, not carried over from the step that ended on it (which
+    used the table piece before the corner)."""
     out = np.zeros(bp.size, dtype=np.bool_)
     tol = 1e-12 * period
-    for table in (t for t in tables if t is not None):
-        scale = 1e-12 * max(np.abs(table.coef[:, 0]).max(), 1.0)
-        corners = table.corners[:-1]
-        for j, angle in enumerate(bp):
-            local = np.mod(angle - phases, period)
-            for c in local:
-                near = np.flatnonzero(np.minimum(np.abs(corners - c), period - np.abs(corners - c))
-                                      <= tol)
-                for i in near:
+    u, du = np.empty(mech.n_cylinders), np.empty(mech.n_cylinders)
+    for j, angle in enumerate(bp):
+        mechanism_terms(int(mech.kind), mech.pack(), np.zeros((1, 1, 6)), angle, u, du)
+        reach = 1e-9 * np.abs(u).max()  # u_k below it: a dead centre, to rounding
+        for table in (t for t in tables if t is not None):
+            corners = table.corners[:-1]
+            step = 1e-9 * np.abs(table.coef[:, 0]).max()  # a jump, not the rounding at a kink
+            for k, c in enumerate(np.mod(angle - phases, period)):
+                gap = np.abs(corners - c)
+                for i in np.flatnonzero(np.minimum(gap, period - gap) <= tol):
                     right = table.evaluate(corners[i], i)[0]
-                    left_piece = (i - 1) % table.n_pieces
-                    left = table.evaluate(corners[i] if i > 0 else period, left_piece)[0]
-                    out[j] |= bool(abs(right - left) > scale)
+                    left = table.evaluate(corners[i] if i > 0 else period,
+                                          (i - 1) % table.n_pieces)[0]
+                    out[j] |= bool(abs(right - left) > step and abs(u[k]) > reach)
     return out
 
 
@@ -214,7 +218,7 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), has_motored=motored is not None,
-        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), phases, period),
+        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), phases, period, mech),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
         gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,

@@ -281,21 +281,21 @@ def test_governed_mixed_cycle_unchanged():
     2.4.6 on the development machine: if another platform differs in the last bits only, compare
     the compiled path with the reference path instead (test_reference_path.py does).
 
-    Re-recorded after commit 705e2d5, when the stepper began to evaluate the first stage after a
-    breakpoint where a pressure jumps afresh and to take the table piece ahead on a breakpoint
-    (issue 8's radial engines): the Gots cycle's jumps lie at dead centres, where the piston's
-    transfer function vanishes, so the change is rounding only — t by 9e-15 s (4e-15), ω by
-    8e-13 rad/s, W_gas by 1.3e-9 J, fuel by 1.2e-13 (values before: 2.413504852030478,
-    429.0454495403209, 182400.97323543674, 0.838196256124024)."""
+    Re-recorded after commit 047fd38, when the stepper began to take the table piece ahead of a
+    breakpoint when it evaluates the first stage of a step starting on one (issue 8's radial
+    engines, whose slaves' pressures jump away from their dead centres): for this engine a
+    change of rounding only — t by 5e-15 s, ω by 1.3e-12 rad/s, W_gas by 1.7e-9 J, fuel by
+    2e-13 (values before: 2.413504852030478, 429.0454495403209, 182400.97323543674,
+    0.838196256124024)."""
     scene = load_scene(CASES / "gots_diesel_governed.toml")
     scene = replace(scene, run=replace(scene.run, revolutions=150.0))
     assert not build_model(scene)[0].has_motored
     tr = integrate(scene).trajectory
-    assert tr["t"][-1] == 2.413504852030487
+    assert tr["t"][-1] == 2.413504852030473
     assert tr["phi"][-1] == 942.4777960769379
-    assert tr["omega"][-1] == 429.04544954031326
-    assert tr["W_gas"][-1] == 182400.97323543546
-    assert tr["fuel"][-1] == 0.8381962561241453
+    assert tr["omega"][-1] == 429.04544954030837
+    assert tr["W_gas"][-1] == 182400.973235435
+    assert tr["fuel"][-1] == 0.8381962561242231
     # The p_k columns are now the pressure applied: p0 + f·(p − p0) (the table itself at f = 1).
     table = gas_tables(scene)[0]
     model = build_model(scene)[0]
