@@ -1,0 +1,250 @@
+"""Property-based tests over random valid scenes of every mechanism (issue 9, item 2).
+
+For each random scene (crank-slider: 1–4 cylinders, 2/4 strokes, λ 0.2–0.6, offset up to half
+its limit, rigid or two-mass rod, no gas / trapezoid pulses / a table, a load, up to two
+non-ideal pairs, either domain; swash plate: 1–6 cylinders, swash angle 8–40°, trapezoid pulses,
+a droop governor or none, plate bearing non-ideal or not):
+
+* the compiled run raises nothing and stores no non-finite value; it completes, or stops with a
+  diagnosis naming time and angle (a random load may stall the machine, a random pair set lock it);
+* the work–energy balance closes to ``transient.stress.balance_tolerance(rtol)`` (C·rtol);
+* the reference path (``solver.method = "scipy-DOP853"``) agrees with the compiled one at the end
+  of the run: same status, and the end time and speed within e = (y − y_ref)/(atol + rtol·|y_ref|)
+  ≤ E_AGREE.
+
+Profiles: CI runs ``EXAMPLES_CI`` examples per mechanism; ``TRANSIENT_STRESS_FULL=1`` runs
+``EXAMPLES_FULL`` (≥ 500) per mechanism, no deadline — the full suite's command is
+``TRANSIENT_STRESS_FULL=1 .venv/bin/python -m pytest tests/stress/test_properties.py``.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import signal
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import strategies as st
+
+from transient.stress import balance_residual, balance_tolerance, base, nonfinite, put, scene_of
+from transient.simulate import integrate
+
+FULL = os.environ.get("TRANSIENT_STRESS_FULL", "") not in ("", "0")
+EXAMPLES_CI, EXAMPLES_FULL = 30, 500
+settings.register_profile("stress-ci", max_examples=EXAMPLES_CI, deadline=None, derandomize=True,
+                          suppress_health_check=[HealthCheck.too_slow],
+                          phases=[Phase.explicit, Phase.reuse, Phase.generate])  # no shrinking
+settings.register_profile("stress-full", max_examples=EXAMPLES_FULL, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+PROFILE = "stress-full" if FULL else "stress-ci"
+
+#: Compiled against reference at the end of the run, in units of atol + rtol·|y|: each path's
+#: global error is at most the sum of its local errors (≤ 1 per step in these units) when errors
+#: do not grow, so the bound is E_AGREE + the steps of both runs (tests/validation measured ≤ 4
+#: over 10³ steps; a random scene that reverses and spins up backwards for 2 s at rtol 1e-6
+#: measured e = 1010 over ~10⁴ steps).
+E_AGREE = 200.0
+
+#: CI profile: the reference path (solve_ivp, ~40 fevals per step with pairs at ~50 µs each) is
+#: run only for scenes of at most this many compiled steps; the full profile runs it always.
+REF_STEPS_CI = 300
+
+rtols = st.sampled_from([1e-6, 1e-7, 1e-8, 1e-9])
+
+
+@st.composite
+def crank_slider_scenes(draw):
+    d = base("gots_diesel_spinup")
+    r = draw(st.floats(30.0, 80.0))
+    lam = draw(st.floats(0.2, 0.6))
+    ell = r / lam
+    n = draw(st.integers(1, 4))
+    strokes = draw(st.sampled_from([2, 4]))
+    cycle = 180.0 * strokes
+    d["mechanism"] = {
+        "type": "crank-slider", "crank_radius_mm": r, "rod_length_mm": ell,
+        "bore_mm": draw(st.floats(50.0, 120.0)), "piston_mass": draw(st.floats(0.3, 3.0)),
+        "crank_mass": draw(st.floats(0.0, 2.0)), "strokes": strokes, "cylinders": n,
+        "offset_mm": draw(st.floats(-0.5, 0.5)) * (ell - r),
+        "firing_deg": [k * cycle / n for k in range(n)],
+        "rod": {"model": draw(st.sampled_from(["two-mass", "rigid"])),
+                "mass": draw(st.floats(0.5, 3.0)),
+                "cg_from_pin_mm": draw(st.floats(0.2, 0.8)) * ell},
+    }
+    if d["mechanism"]["rod"]["model"] == "rigid":
+        d["mechanism"]["rod"]["inertia_cg"] = draw(st.floats(0.0, 1e-2))
+    d["inertia"] = {"shaft": draw(st.floats(0.01, 0.5))}
+    gas = draw(st.sampled_from(["none", "trapezoid", "table"]))
+    if gas == "trapezoid":
+        d["gas"] = {"model": "trapezoid", "amplitude": draw(st.floats(0.0, 2e4)),
+                    "ramp_deg": draw(st.floats(5.0, 60.0)), "duration_deg": 180.0}
+    elif gas == "table":
+        x = math.pi * strokes
+        rise = draw(st.floats(1e-3, 0.5))
+        phi = [0.0, x / 2, x / 2 + rise, x / 2 + 0.6 + rise, 0.75 * x, x]
+        d["gas"] = {"model": "table", "p0_MPa": 0.1, "phi": phi, "corners": phi[1:-1],
+                    "p_bar": [1.0, 1.0, draw(st.floats(5.0, 150.0)), 30.0, 1.0, 1.0],
+                    "interpolation": "linear"}
+    else:
+        d["gas"] = {"model": "none"}
+    d["load"] = {"torque": draw(st.floats(0.0, 50.0)), "linear": draw(st.floats(0.0, 0.1)),
+                 "fan": draw(st.floats(0.0, 1e-3))}
+    n_pairs = draw(st.integers(0, 2))
+    links = [("shaft", "crank"), ("crank", "rod")]
+    if n_pairs:
+        d["friction"] = {"pairs": [{"between": list(links[k]),
+                                    "eta_forward": draw(st.floats(0.5, 1.0)),
+                                    "eta_backward": draw(st.floats(0.5, 1.0))}
+                                   for k in range(n_pairs)]}
+    common(draw, d)
+    return d
+
+
+@st.composite
+def swash_plate_scenes(draw):
+    d = base("swash_plate_4cyl")
+    n = draw(st.integers(1, 6))
+    put(d, "mechanism", swash_deg=draw(st.floats(8.0, 40.0)), cylinders=n,
+        bore_mm=min(100.0, 0.9 * 2.0 * 131.31 * math.sin(math.pi / max(n, 2))),
+        piston_mass=draw(st.floats(0.5, 8.0)), link_inertia=draw(st.floats(0.0, 0.5)),
+        cross_inertia=draw(st.floats(0.0, 0.5)))
+    put(d, "mechanism.rod", mass=draw(st.floats(0.2, 2.0)))
+    put(d, "gas", amplitude=draw(st.floats(0.0, 12000.0)), ramp_deg=draw(st.floats(5.0, 60.0)))
+    if draw(st.booleans()):
+        del d["governor"]
+    if draw(st.booleans()):
+        d["friction"] = {"pairs": [{"between": ["shaft", "link"],
+                                    "eta_forward": draw(st.floats(0.5, 1.0)),
+                                    "eta_backward": draw(st.floats(0.5, 1.0))}]}
+    put(d, "inertia", shaft=draw(st.floats(0.2, 2.0)))
+    common(draw, d, omega=(5.0, 80.0))
+    return d
+
+
+def common(draw, d, omega=(30.0, 400.0)):
+    """Initial state, a short run, the solver and the output sampling."""
+    d["initial"] = {"phi": draw(st.floats(0.0, 2 * math.pi)),
+                    "omega": draw(st.floats(*omega))}
+    d["run"] = {"revolutions": draw(st.floats(0.5, 2.0)), "t_end": 0.3}
+    rtol = draw(rtols)
+    d["solver"] = {"rtol": rtol, "atol": rtol * 1e-2,
+                   "domain": draw(st.sampled_from(["auto", "auto", "time"]))}
+    d["output"] = {"samples_per_rev": 72, "dt": 2e-4}
+
+
+#: Hang guard of one reference run [s] (typically 0.01–0.3 s in the CI profile).
+REF_GUARD_S = 30.0
+
+
+class HangGuard(Exception):
+    pass
+
+
+@contextlib.contextmanager
+def hang_guard(seconds):
+    """Raise HangGuard in this (main) thread after ``seconds`` (SIGALRM): the reference path is
+    plain Python, so the signal interrupts it."""
+    def fire(*_):
+        raise HangGuard
+    old = signal.signal(signal.SIGALRM, fire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def check(d):
+    scene = scene_of(d, "random")
+    data = integrate(scene)
+    tr = data.trajectory
+    assert not nonfinite(tr), (nonfinite(tr), d)
+    if not data.complete:
+        word = data.message.split(":")[0]
+        assert word in ("stalled", "locked"), (data.message, d)
+        assert "t = " in data.message and "φ = " in data.message, data.message
+    err = balance_residual(tr, len(scene.friction.pairs))
+    assert err <= balance_tolerance(scene.solver.rtol), (err, d)
+
+    if not FULL and data.solver["nsteps"] > REF_STEPS_CI:
+        return  # (the reference path would take seconds; the full profile always compares)
+    if d.get("governor", {}).get("model") == "droop" and not os.environ.get(
+            "TRANSIENT_STRESS_GOVERNOR"):
+        return  # known disagreement at the droop governor's corners: test_governor_corner_*
+    ref_d = dict(d, solver=dict(d["solver"], method="scipy-DOP853"))
+    ref_d["solver"].pop("domain", None)
+    try:
+        with hang_guard(REF_GUARD_S):
+            ref = integrate(scene_of(ref_d, "random-reference"))
+        ref_complete, ref_message, rtr = ref.complete, ref.message, ref.trajectory
+    except HangGuard:
+        raise AssertionError(f"the reference path did not finish within {REF_GUARD_S:g} s "
+                             f"(the compiled run took {data.solver['nsteps']} steps): {d}") from None
+    except Exception as exc:  # the reference path raises where the compiled one stops
+        from transient.errors import SimulationError
+
+        assert isinstance(exc, SimulationError), exc
+        ref_complete, ref_message, rtr = False, str(exc), None
+    assert ref_complete == data.complete, (data.message, ref_message, d)
+    if data.complete:
+        sv = scene.solver
+        for name in ("t", "omega", "phi"):
+            y, y_ref = tr[name][-1], rtr[name][-1]
+            e = (y - y_ref) / (sv.atol + sv.rtol * abs(y_ref))
+            bound = E_AGREE + data.solver["nsteps"] + ref.solver["nsteps"]
+            assert abs(e) <= bound, (name, y, y_ref, e, bound, d)
+
+
+@settings.get_profile(PROFILE)
+@given(crank_slider_scenes())
+def test_random_crank_slider_scenes(d):
+    check(d)
+
+
+@settings.get_profile(PROFILE)
+@given(swash_plate_scenes())
+def test_random_swash_plate_scenes(d):
+    check(d)
+
+
+# A failure found by the swash-plate property test (compiled against reference with the droop
+# governor): the two paths disagree once the speed crosses the governor's corner ω_a = 45 rad/s
+# late in the run — end time 0.175420 s against 0.174500 s, ω 45.645 against 47.009 rad/s at
+# rtol 1e-8, in either domain; without the governor, or from φ₀ = 0, they agree to ~1e-8. The
+# numerical core is being reworked for a dynamic governor (not edited here): strict xfail, so that
+# the fix shows. The random test leaves governed scenes out of the comparison until then
+# (TRANSIENT_STRESS_GOVERNOR=1 puts them back).
+GOVERNOR_CORNER = {
+    "mechanism": {"type": "swash-plate", "joint_radius_mm": 136, "cylinder_radius_mm": 131.31,
+                  "rod_length_mm": 300, "halves": 1, "hinge": "in-plane",
+                  "rod": {"model": "two-mass", "cg_from_pin_mm": 150, "mass": 0.6241109587160757},
+                  "swash_deg": 14.589393716378078, "cylinders": 4, "bore_mm": 100.0,
+                  "piston_mass": 3.6703099433111976, "link_inertia": 0.1767415789040179,
+                  "cross_inertia": 0.19130770751266596},
+    "inertia": {"shaft": 0.47766253643826434},
+    "gas": {"model": "trapezoid", "duration_deg": 180, "amplitude": 6746.8834796012225,
+            "ramp_deg": 6.0365950903610095},
+    "load": {"fan": 0.12867},
+    "governor": {"model": "droop", "speed_full": 45.0, "speed_zero": 60.0},
+    "initial": {"phi": 0.8952575408357096, "omega": 23.412899904126956},
+    "run": {"revolutions": 1.1418190367532555, "t_end": 0.3},
+    "solver": {"rtol": 1e-08, "atol": 1e-10, "domain": "time"},
+    "output": {"samples_per_rev": 72, "dt": 0.0002},
+}
+
+
+@pytest.mark.xfail(strict=True, reason="compiled and reference paths disagree after a droop-"
+                                       "governor corner (issue 9 report; numerical core)")
+def test_governor_corner_compiled_against_reference():
+    import copy
+
+    import transient.stress  # noqa: F401
+
+    os.environ["TRANSIENT_STRESS_GOVERNOR"] = "1"
+    try:
+        check(copy.deepcopy(GOVERNOR_CORNER))
+    finally:
+        del os.environ["TRANSIENT_STRESS_GOVERNOR"]
