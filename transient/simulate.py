@@ -181,7 +181,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     if message:
         message = f"interrupted; last sample at {where}"
     if status == ci.STALLED:
-        message = (f"stalled: the speed reached zero at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
+        how = "the shaft turned backwards" if y[2] < 0.0 else "the speed reached zero"
+        message = (f"stalled: {how} at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) before the {scene.run.revolutions:g} revolutions "
                    f"the run ends by; give run.t_end to follow the motion after a stall")
     at = f"t = {y[1]:.9g} s, φ = {y[0]:.9g} rad ({math.degrees(y[0]):.6g}°)"

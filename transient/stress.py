@@ -722,11 +722,7 @@ def catalogue() -> list[Case]:
                                           "run ending by revolutions only: the shaft turns "
                                           "backwards and can never reach them",
              single(backward_from_rest, "stalled|locked", name="backward-revolutions-only"),
-             time_limit=10.0,
-             known="the run never ends (no stall is detected: ω starts at 0 and only grows "
-                   "negative) and its result file grows without bound until killed; the same "
-                   "with initial.omega < 0 — numerical core (run end / stall condition), left "
-                   "to the lead"),
+             time_limit=10.0),
         Case("million-revolutions-coasting", "10⁶ revolutions coasting: energy drift, phase "
                                              "drift, memory", million_revolutions(False),
              quick=False, time_limit=900.0),

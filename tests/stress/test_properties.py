@@ -171,11 +171,13 @@ def check(d):
 
     if not FULL and data.solver["nsteps"] > REF_STEPS_CI:
         return  # (the reference path would take seconds; the full profile always compares)
-    if d.get("governor", {}).get("model") == "droop" and not os.environ.get(
-            "TRANSIENT_STRESS_GOVERNOR"):
-        return  # known disagreement at the droop governor's corners: test_governor_corner_*
-    ref_d = dict(d, solver=dict(d["solver"], method="scipy-DOP853"))
+    # The reference with short steps (0.5°, as tests/validation/test_reference_path.py): solve_ivp
+    # sees an event only where its function changes sign between step ends, and the speed can
+    # cross a governor corner and come back within one of its own long steps
+    # (test_governor_corner_compiled_against_reference).
+    ref_d = dict(d, solver=dict(d["solver"], method="scipy-DOP853", max_step_deg=0.5))
     ref_d["solver"].pop("domain", None)
+    ref_d["solver"].pop("max_step", None)
     try:
         with hang_guard(REF_GUARD_S):
             ref = integrate(scene_of(ref_d, "random-reference"))
@@ -211,12 +213,13 @@ def test_random_swash_plate_scenes(d):
 
 
 # A failure found by the swash-plate property test (compiled against reference with the droop
-# governor): the two paths disagree once the speed crosses the governor's corner ω_a = 45 rad/s
+# governor): the two paths disagreed once the speed crossed the governor's corner ω_a = 45 rad/s
 # late in the run — end time 0.175420 s against 0.174500 s, ω 45.645 against 47.009 rad/s at
-# rtol 1e-8, in either domain; without the governor, or from φ₀ = 0, they agree to ~1e-8. The
-# numerical core is being reworked for a dynamic governor (not edited here): strict xfail, so that
-# the fix shows. The random test leaves governed scenes out of the comparison until then
-# (TRANSIENT_STRESS_GOVERNOR=1 puts them back).
+# rtol 1e-8. The reference path was wrong: with its own step choice (up to 0.13 s here) the speed
+# crossed the corner and came back inside one solve_ivp step, which sees events only as sign
+# changes between step ends, so it missed two of the three corner events; the compiled stepper
+# watches the speed's range over its stages. With 0.5° steps the reference finds all three, at the
+# compiled path's times (0.091277, 0.10415, 0.109782 s), and the end agrees to ~4e-12 s.
 GOVERNOR_CORNER = {
     "mechanism": {"type": "swash-plate", "joint_radius_mm": 136, "cylinder_radius_mm": 131.31,
                   "rod_length_mm": 300, "halves": 1, "hinge": "in-plane",
@@ -236,15 +239,7 @@ GOVERNOR_CORNER = {
 }
 
 
-@pytest.mark.xfail(strict=True, reason="compiled and reference paths disagree after a droop-"
-                                       "governor corner (issue 9 report; numerical core)")
 def test_governor_corner_compiled_against_reference():
     import copy
 
-    import transient.stress  # noqa: F401
-
-    os.environ["TRANSIENT_STRESS_GOVERNOR"] = "1"
-    try:
-        check(copy.deepcopy(GOVERNOR_CORNER))
-    finally:
-        del os.environ["TRANSIENT_STRESS_GOVERNOR"]
+    check(copy.deepcopy(GOVERNOR_CORNER))

@@ -38,3 +38,20 @@ def test_reference_path_reports_the_stall_too(tmp_path):
     scene = dc.replace(scene, solver=dc.replace(scene.solver, method="scipy-DOP853", rtol=1e-8))
     with pytest.raises(SimulationError, match="stalled: the speed reached zero"):
         integrate(scene)
+
+
+@pytest.mark.parametrize("start", ["backwards", "from rest"])
+def test_backward_motion_in_a_revolutions_run_is_a_stall(tmp_path, start):
+    """A shaft that turns backwards never reaches its revolutions: given a negative speed, or
+    started from rest by a starter weaker than the load (found by the stress suite: the run
+    integrated on without end, its file growing). Reported as a stall, the partial run kept."""
+    text = CASE.read_text().replace("[initial]", "[load]\ntorque = 10.0\n\n[initial]")
+    text = text.replace("omega_rpm = 1000", "omega_rpm = -100" if start == "backwards" else
+                        "omega_rpm = 0")
+    if start == "from rest":
+        text += "\n[starter]\ntorque = 5.0\nnoload_speed_rpm = 300\ncutout_speed_rpm = 200\n"
+    scene = load_scene(tmp_path / "back.toml", text=text)
+    data = integrate(scene)
+    assert not data.complete
+    assert data.message.startswith("stalled: the shaft turned backwards at t = ")
+    assert data.trajectory["omega"][-1] < 0.0 and data.trajectory["t"].size >= 1

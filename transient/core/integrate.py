@@ -558,6 +558,12 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         sw = ist[:N_SWITCHES]
         ix = PHI if angle_mode else T
         x = y[ix]
+        if not angle_mode and y[OMEGA] < 0.0 and not np.isfinite(cfg[C_T_END]):
+            # A run that ends only by revolutions, turning backwards (from rest, or given a
+            # negative speed), would never reach them: report it as a stall, with what was
+            # computed, instead of integrating on.
+            _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+            return STALLED
         if ist[I_F_VALID] == 0:
             # (the table piece just ahead in the direction of motion: on a breakpoint, rounding
             # of the shaft angle must not pick the piece behind it)
