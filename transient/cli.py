@@ -316,6 +316,8 @@ def _print_summary(summary, solver) -> None:
     print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
           f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
           f"compile/cache load)")
+    if solver.get("stiff_rerun"):
+        print(f"  {solver['stiff_rerun']}")
 
 
 def _print_response(v: dict) -> None:
@@ -379,6 +381,8 @@ def cmd_info(args) -> int:
         print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
               f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
+        if s.get("stiff_rerun"):
+            print(f"  {s['stiff_rerun']}")
     values = {k: v for k, (v, _) in res.analysis.items()}
     _print_response(values)
     _print_efficiency(values)

@@ -122,6 +122,15 @@ class ResultWriter:
             self.broken = f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); is the disk full?"
             raise SimulationError(self.broken) from None
 
+    def restart(self) -> None:
+        """Drop the trajectory and events written so far (a run started again from the
+        beginning, e.g. a stiff scene by an implicit method)."""
+        for ds in self.f["trajectory"].values():
+            ds.resize(0, axis=0)
+        del self.f["events"]
+        self.f.create_group("events")
+        self.f.flush()
+
     def read_trajectory(self, last: int | None = None) -> dict[str, np.ndarray]:
         """The trajectory written so far (its ``last`` samples only, if given), read back."""
         n = self.f["trajectory"]["t"].shape[0]

@@ -197,6 +197,11 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                    + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
                       f"sliding mode), the power-flow policy has one at every state"
                       if event == "pair_mode" else ""))
+    if status == ci.STIFF:
+        message = (f"stiff at {at}: in {ci.STIFF_COUNT} steps the estimate h·λ of the dominant "
+                   f"eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
+                   f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
+                   f"the step (a governor or actuator far faster than the engine?)")
     if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
         cause = ("a non-finite value in the state or its error estimate"
                  if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")
@@ -323,10 +328,30 @@ def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
         data = run_compiled(scene, on_block, progress, keep)
+        if data.message.startswith("stiff"):
+            data = _implicit_rerun(scene, data, on_block, progress)
     else:
         from .reference import run_reference
 
         data = run_reference(scene, on_block, progress)
+    return data
+
+
+def _implicit_rerun(scene, stiff: RunData, on_block, progress) -> RunData:
+    """A stiff scene again from the start by the reference path's implicit Radau method
+    (solve_ivp), which stability does not bound; the result says so (``solver.stiff_rerun``)."""
+    import dataclasses
+
+    from .reference import run_reference
+
+    note = f"{stiff.message}; rerun from the start with the implicit scipy-Radau"
+    radau = dataclasses.replace(scene, solver=dataclasses.replace(scene.solver,
+                                                                  method="scipy-Radau"))
+    if on_block:  # (what the explicit run streamed is superseded: start the file afresh)
+        on_block(None, None)
+    data = run_reference(radau, None, progress)
+    data.solver["stiff_rerun"] = note
+    data.solver["explicit_nsteps"] = stiff.solver["nsteps"]
     return data
 
 
@@ -346,11 +371,14 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
         streamed = scene.run.mode == "dynamic" and scene.solver.method in COMPILED_METHODS
 
         def on_block(block, ev):
+            if block is None:  # the run starts again (a stiff scene, by an implicit method)
+                writer.restart()
+                return
             writer.append(block)
             writer.events(ev)
 
         data = integrate(scene, on_block=on_block, progress=progress, keep=False)
-        if not streamed:
+        if not streamed or "stiff_rerun" in data.solver:
             writer.append(data.trajectory)
             writer.events(data.events)
         writer.solver(data.solver)

@@ -55,9 +55,13 @@ BP_LANDING = 1e-7
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
 I_LOAD_SEG, I_GEN_LOW, I_SLEEVE = SW_LOAD, SW_GENERATOR, SW_SLEEVE
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
- I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT) = range(
-    N_SWITCHES, N_SWITCHES + 15)
-N_IST = N_SWITCHES + 15
+ I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT, I_STIFF,
+ I_NONSTIFF) = range(N_SWITCHES, N_SWITCHES + 17)
+N_IST = N_SWITCHES + 17
+# Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
+# tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
+# not accuracy, sets the step: the problem is stiff for an explicit method.
+STIFF_COUNT, NONSTIFF_RESET = 15, 6
 # State events closer together than this (rad in crank angle; × the output spacing in time) count
 # as no progress; this many in a row is chattering, which is reported, never looped on.
 CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
@@ -66,7 +70,7 @@ CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
 ON_LEVEL = 1e-12
 
 # advance() return codes
-RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING = range(7)
+RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING, STIFF = range(8)
 # event codes written to the event buffer as (code, t, phi, omega)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
  EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR, EV_SLEEVE_STOP, EV_SLEEVE_FREE,
@@ -110,6 +114,44 @@ def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1):
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
     return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1 + g1 - g0))
+
+
+@kernel
+def _stiffness(tab, K, h, y, ix, g0, g1, rtol, atol):
+    """Estimate of h·λ over the step (Hairer, *Solving ODEs II*, §IV.2): the last main stage and
+    the FSAL stage both sit at the step's end, and ‖f(y₁) − f(y_s)‖/‖y₁ − y_s‖ estimates the
+    dominant eigenvalue's modulus; y₁ − y_s = h Σ_j (A[ns, j] − A[ns−1, j]) K_j. Over the
+    dynamics' components and the governor's states, each scaled as in the error norm (the
+    state mixes joules with fuel fractions: unscaled, a stiff governor state would be hidden
+    behind the kinetic energy)."""
+    ns = tab.n_stages
+    num = 0.0
+    den = 0.0
+    for i in range(g1):
+        if i == ix or N_DYNAMIC <= i < g0:
+            continue
+        sc = atol + rtol * abs(y[i])
+        dy = 0.0
+        for j in range(ns):
+            dy += (tab.A[ns, j] - tab.A[ns - 1, j]) * K[j, i]
+        num += ((K[ns, i] - K[ns - 1, i]) / sc) ** 2
+        den += (h * dy / sc) ** 2
+    if den == 0.0:
+        return 0.0
+    return abs(h) * np.sqrt(num / den)
+
+
+@kernel
+def _stiff(tab, K, h, y, ix, g0, g1, rtol, atol, ist):
+    """Count an accepted step in Hairer's stiffness test (``STIFF_COUNT``); True when stiff."""
+    if _stiffness(tab, K, h, y, ix, g0, g1, rtol, atol) > tab.stiff_bound:
+        ist[I_NONSTIFF] = 0
+        ist[I_STIFF] += 1
+        return ist[I_STIFF] >= STIFF_COUNT
+    ist[I_NONSTIFF] += 1
+    if ist[I_NONSTIFF] >= NONSTIFF_RESET:
+        ist[I_STIFF] = 0
+    return False
 
 
 @kernel
@@ -670,6 +712,11 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             # size oscillates between growing past what the error allows and being cut back.
             factor = min(factor, 1.0)
         h_next = h * factor
+        if not fixed and _stiff(tab, K, h, y, ix, g0, g1, rtol, atol, ist):
+            # the run so far is kept; the state is the accepted step's start
+            if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
+                _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+            return STIFF
         if at_segment_end and not after_rejection:
             # a step cut short to end on a breakpoint says nothing against the step planned
             h_next = max(h_next, min(h_planned, h_planned * factor))
