@@ -126,8 +126,9 @@ def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64
     out = np.zeros(bp.size, dtype=np.bool_)
     tol = 1e-12 * period
     u, du = np.empty(mech.n_cylinders), np.empty(mech.n_cylinders)
+    packed, no_table = mech.pack(), np.zeros((1, 1, 6))
     for j, angle in enumerate(bp):
-        mechanism_terms(int(mech.kind), mech.pack(), np.zeros((1, 1, 6)), angle, u, du)
+        mechanism_terms(int(mech.kind), packed, no_table, angle, u, du)
         reach = 1e-9 * np.abs(u).max()  # u_k below it: a dead centre, to rounding
         for table in (t for t in tables if t is not None):
             corners = table.corners[:-1]

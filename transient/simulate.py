@@ -18,7 +18,7 @@ from .core import governor as gv
 from .core import integrate as ci
 from .core import model as cm
 from .core.tableaus import TABLEAUS
-from .core.model import (N_OUT_FIXED, OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
+from .core.model import (OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
                          inverse_dynamics, n_outputs, n_state)
 from .errors import SimulationError
 from .scene import COMPILED_METHODS

@@ -88,6 +88,46 @@ def pair(between: str = '["shaft", "crank"]', fwd: str = "0.98", bwd: str = "0.9
                     f"eta_forward = {fwd}\neta_backward = {bwd}\n{extra}")
 
 
+# Dynamic governors and fuel latching (issue 6): limits, gains, what a prescribed run cannot do.
+PI = '\n[governor]\nmodel = "pi"\nspeed_rpm = 1000\ngain_p = 10\ngain_i = 30\n'
+FLYWEIGHT = ('\n[governor]\nmodel = "flyweight"\nweight_mass = 0.1\nradius_mm = 30\n'
+             'spring_rate = 2e4\nspring_preload = 200\ndamping = 50\ntravel_mm = 8\n')
+GOVERNOR_CASES = [  # (id, scene text, key, fragment), part of CASES below
+    ("pi-negative-fuel", VALID + PI + "fuel_min = -0.1\n", "governor.fuel_min",
+     "must be ≥ 0, got -0.1"),
+    ("pi-limits-reversed", VALID + PI + "fuel_min = 0.5\nfuel_max = 0.4\n", "governor.fuel_max",
+     "must be > 0.5, got 0.4"),
+    ("pi-initial-fuel-outside", VALID + PI + "fuel_initial = 1.5\n", "governor.fuel_initial",
+     "must be ≤ 1, got 1.5"),
+    ("pi-no-gain", VALID + PI.replace("gain_p = 10", "gain_p = 0").replace("gain_i = 30", "gain_i = 0"),
+     "governor.gain_i", "gain_p and gain_i are both 0"),
+    ("pi-actuator-lag-zero", VALID + PI + "actuator_time = 0\n", "governor.actuator_time",
+     "must be > 0, got 0"),
+    ("pi-anti-windup-not-bool", VALID + PI + "anti_windup = 1\n", "governor.anti_windup",
+     "must be true or false, got 1"),
+    ("pi-speed-missing", VALID + PI.replace("speed_rpm = 1000\n", ""), "governor.speed",
+     "is missing"),
+    ("pi-prescribed-speed", replace("revolutions = 2", 'mode = "prescribed-speed"\nspeed = 100\n'
+                                    'revolutions = 2') + PI,
+     "governor.model", "a prescribed-speed run integrates no governor state"),
+    ("flyweight-travel-zero", VALID + FLYWEIGHT.replace("travel_mm = 8", "travel_mm = 0"),
+     "governor.travel_mm", "must be > 0, got 0"),
+    ("flyweight-no-weights", VALID + FLYWEIGHT + "weights = 0\n", "governor.weights",
+     "must be ≥ 1, got 0"),
+    ("flyweight-pi-key", VALID + FLYWEIGHT + "gain_p = 3\n", "governor.gain_p", "unknown key"),
+    ("injection-beyond-cycle", VALID + MIXED_CYCLE.format(cr=18) + "injection_deg = 720\n",
+     "gas.injection_deg", "must be < 720, got 720"),
+    ("inertia-switch-without-time", VALID + "\n[load]\ninertia = 0.1\n", "load.inertia_time",
+     "is missing"),
+    ("inertia-switch-negative", VALID + "\n[load]\ninertia = -0.1\ninertia_time = 1\n",
+     "load.inertia", "must be ≥ 0, got -0.1"),
+    ("inertia-switch-prescribed", replace("revolutions = 2", 'mode = "prescribed-speed"\n'
+                                          'speed = 100\nrevolutions = 2')
+     + "\n[load]\ninertia = 0.1\ninertia_time = 1\n",
+     "load.inertia", "a prescribed-speed run has no momentum to conserve"),
+]
+
+
 # (id, scene text, key reported, fragment of the message)
 CASES = [
     ("toml-syntax", replace("bore_mm = 88", "bore_mm = = 88"),
@@ -265,6 +305,7 @@ CASES = [
      (CASES_DIR / "swash_plate_1cyl.toml").read_text() + "\n[analysis]\nloads = true\n",
      "analysis.loads",
      "loads are computed for crank-slider engines only, not SwashPlate; allowed here: false"),
+    *GOVERNOR_CASES,
 ]
 
 
@@ -415,54 +456,3 @@ def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2
     assert_one_line_error(err, scene, "inertia", "the reduced inertia J(φ) falls to")
-
-
-
-# Dynamic governors and fuel latching (issue 6): limits, gains, what a prescribed run cannot do.
-PI = '\n[governor]\nmodel = "pi"\nspeed_rpm = 1000\ngain_p = 10\ngain_i = 30\n'
-FLYWEIGHT = ('\n[governor]\nmodel = "flyweight"\nweight_mass = 0.1\nradius_mm = 30\n'
-             'spring_rate = 2e4\nspring_preload = 200\ndamping = 50\ntravel_mm = 8\n')
-GOVERNOR_CASES = [
-    ("pi-negative-fuel", VALID + PI + "fuel_min = -0.1\n", "governor.fuel_min",
-     "must be ≥ 0, got -0.1"),
-    ("pi-limits-reversed", VALID + PI + "fuel_min = 0.5\nfuel_max = 0.4\n", "governor.fuel_max",
-     "must be > 0.5, got 0.4"),
-    ("pi-initial-fuel-outside", VALID + PI + "fuel_initial = 1.5\n", "governor.fuel_initial",
-     "must be ≤ 1, got 1.5"),
-    ("pi-no-gain", VALID + PI.replace("gain_p = 10", "gain_p = 0").replace("gain_i = 30", "gain_i = 0"),
-     "governor.gain_i", "gain_p and gain_i are both 0"),
-    ("pi-actuator-lag-zero", VALID + PI + "actuator_time = 0\n", "governor.actuator_time",
-     "must be > 0, got 0"),
-    ("pi-anti-windup-not-bool", VALID + PI + "anti_windup = 1\n", "governor.anti_windup",
-     "must be true or false, got 1"),
-    ("pi-speed-missing", VALID + PI.replace("speed_rpm = 1000\n", ""), "governor.speed",
-     "is missing"),
-    ("pi-prescribed-speed", replace("revolutions = 2", 'mode = "prescribed-speed"\nspeed = 100\n'
-                                    'revolutions = 2') + PI,
-     "governor.model", "a prescribed-speed run integrates no governor state"),
-    ("flyweight-travel-zero", VALID + FLYWEIGHT.replace("travel_mm = 8", "travel_mm = 0"),
-     "governor.travel_mm", "must be > 0, got 0"),
-    ("flyweight-no-weights", VALID + FLYWEIGHT + "weights = 0\n", "governor.weights",
-     "must be ≥ 1, got 0"),
-    ("flyweight-pi-key", VALID + FLYWEIGHT + "gain_p = 3\n", "governor.gain_p", "unknown key"),
-    ("injection-beyond-cycle", VALID + MIXED_CYCLE.format(cr=18) + "injection_deg = 720\n",
-     "gas.injection_deg", "must be < 720, got 720"),
-    ("inertia-switch-without-time", VALID + "\n[load]\ninertia = 0.1\n", "load.inertia_time",
-     "is missing"),
-    ("inertia-switch-negative", VALID + "\n[load]\ninertia = -0.1\ninertia_time = 1\n",
-     "load.inertia", "must be ≥ 0, got -0.1"),
-    ("inertia-switch-prescribed", replace("revolutions = 2", 'mode = "prescribed-speed"\n'
-                                          'speed = 100\nrevolutions = 2')
-     + "\n[load]\ninertia = 0.1\ninertia_time = 1\n",
-     "load.inertia", "a prescribed-speed run has no momentum to conserve"),
-]
-
-
-@pytest.mark.parametrize("text, key, fragment",
-                         [pytest.param(t, k, f, id=i) for i, t, k, f in GOVERNOR_CASES])
-def test_invalid_governor_is_one_line_exit_2(tmp_path, capsys, text, key, fragment):
-    scene = tmp_path / "bad.toml"
-    scene.write_text(text, encoding="utf-8")
-    code, out, err = run_cli(["check", str(scene)], capsys)
-    assert code == 2
-    assert_one_line_error(err, scene, key, fragment)

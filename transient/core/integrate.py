@@ -441,14 +441,19 @@ def _sleeve_stops(m, y, level, w):
     return gv.FREE
 
 
+@kernel(inline="always")
+def _on_angle(phi, angle, period):
+    """Whether the shaft angle phi is on ``angle`` of the cycle (to BP_LANDING)."""
+    d = (phi - angle) % period
+    return min(d, period - d) <= BP_LANDING
+
+
 @kernel
 def _jumps_at(m, bp, phi):
     """Whether a pressure jumps at the breakpoint the shaft is on (``Model.bp_jump``): the
     derivative carried over from the step that ended there (FSAL) used the piece before it."""
-    local = phi % m.period
     for j in range(bp.shape[0]):
-        d = abs(bp[j] - local)
-        if min(d, m.period - d) <= BP_LANDING:
+        if _on_angle(phi, bp[j], m.period):
             return m.bp_jump[j]
     return False
 
@@ -466,8 +471,7 @@ def _inject(m, y, sw, evbuf, ist, wk):
     c = latch_index(m)
     hit = False
     for k in range(m.ncyl):
-        local = (y[PHI] - m.gas_phase[k] - m.inj_angle) % m.period
-        if min(local, m.period - local) <= BP_LANDING:
+        if _on_angle(y[PHI], m.gas_phase[k] + m.inj_angle, m.period):
             y[c + k] = command(m, w, y, sw)
             hit = True
             _emit_event(m, evbuf, ist, EV_INJECTION, y, wk)
