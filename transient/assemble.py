@@ -11,9 +11,10 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
+from .core import cylinder as cyl
 from .core import governor as gv
-from .core.model import (PAPER, PHI, POWER_FLOW, TABULATED, T, Model, fuel, governor_branch,
-                         mechanism_terms)
+from .core.model import (PAPER, PHI, POWER_FLOW, TABULATED, T, Model, applied_value, fuel,
+                         governor_branch, mechanism_terms)
 from .forces.gas import PressureTable, _shift_cubic, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -226,8 +227,48 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **governor_fields(scene), **chain_fields(scene))
+        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene))
+    if model.woschni:
+        model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
     return model, model.breakpoints, table
+
+
+def cylinder_fields(scene) -> dict:
+    """The cylinder-pressure states' part of the Model: with ``[gas.woschni]`` the closed part's
+    parameters of :mod:`transient.core.cylinder` (from the full-load Wiebe cycle, whose closed
+    part it integrates again, now with wall heat)."""
+    gas = scene.gas
+    par = np.zeros(cyl.N_PAR)
+    if gas.woschni is None:
+        return dict(woschni=False, cyl_par=par)
+    mech, w, h = scene.mechanism, gas.wiebe, gas.woschni
+    cycle = wiebe_levels(mech, gas)[-1]
+    closed = cycle.closed
+    area = mech.piston_area
+    par[[cyl.IVC, cyl.CLOSED, cyl.START, cyl.DURATION, cyl.WA, cyl.WM]] = (
+        closed.start, closed.end - closed.start, (cycle.combustion_start - closed.start) % mech.cycle,
+        w.duration, w.a, w.m)
+    par[[cyl.Q_FULL, cyl.GAMMA, cyl.GAMMA_SLOPE, cyl.GAMMA_TREF, cyl.T_A, cyl.P_A, cyl.V_A]] = (
+        w.fuel_mass * w.lhv * w.efficiency, w.gamma, w.gamma_slope, w.gamma_t_ref, w.t_a,
+        gas.p_a, cycle.v_a)
+    par[[cyl.V_C, cyl.AREA, cyl.BORE, cyl.STROKE, cyl.V_H]] = (
+        clearance_volume(scene), area, mech.bore, cycle.v_h / area, cycle.v_h)
+    par[[cyl.C1, cyl.C2, cyl.T_WALL]] = h.c1, h.c2, h.wall_temperature
+    par[cyl.GAMMA_A] = w.gamma + w.gamma_slope * (w.t_a - w.gamma_t_ref)
+    return dict(woschni=True, cyl_par=par)
+
+
+def _on_closed_part_corner(bp: NDArray[np.float64], phases: NDArray[np.float64], model
+                           ) -> NDArray[np.bool_]:
+    """Breakpoints where a cylinder-pressure state's derivative jumps: its intake closing and
+    exhaust opening, and its combustion's start and end (the heat release and Woschni's
+    combustion term switch there), so that the stepper evaluates the first stage beyond them
+    afresh instead of carrying it over from the step that ended there (FSAL)."""
+    par = model.cyl_par
+    corners = par[cyl.IVC] + np.array([0.0, par[cyl.CLOSED], par[cyl.START],
+                                       par[cyl.START] + par[cyl.DURATION]])
+    d = np.mod(np.subtract.outer(bp, np.add.outer(phases, corners).ravel()), model.period)
+    return np.any(np.minimum(d, model.period - d) <= 1e-9, axis=1)
 
 
 def governor_kind(governor) -> int:
@@ -288,7 +329,24 @@ def initial_governor(scene, model: Model) -> tuple[NDArray[np.float64], int]:
         states = []
         f0 = fuel(model, w0, governor_branch(model, w0, True))
     latched = [f0] * model.ncyl if model.latch else []
-    return np.array(states + latched, dtype=np.float64), sleeve
+    return np.array(states + latched + initial_cylinders(scene, model, f0), dtype=np.float64), sleeve
+
+
+def initial_cylinders(scene, model: Model, f0: float) -> list[float]:
+    """Initial cylinder pressures (``model.woschni``): in its closed part at the start, a
+    cylinder's pressure is the Wiebe cycle's at fuel f0, without wall heat (the run's first
+    cycle of that cylinder carries this approximation); elsewhere p_a, unused until its intake
+    closes and the stepper sets it there."""
+    if not model.woschni:
+        return []
+    phi0 = scene.initial.phi
+    out = []
+    for k in range(model.ncyl):
+        local = (phi0 - model.gas_phase[k]) % model.period
+        closed = cyl.closed_angle(model.cyl_par, local, model.period) >= 0.0
+        out.append(applied_value(model, k, phi0, phi0 + 1e-9, f0) if closed
+                   else model.cyl_par[cyl.P_A])
+    return out
 
 
 @lru_cache(maxsize=8)

@@ -7,14 +7,31 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from .errors import SceneError, SimulationError
+from .errors import SceneError, SimulationError, WriteFailed
 
 EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
+
+
+# The error of a result file whose writes failed: HDF5's deallocators must never run on it.
+_BROKEN_WRITE: WriteFailed | None = None
+
+
+def entry() -> None:
+    """The ``transient`` command: :func:`main`, then exit with its code. After a failed write
+    (:class:`~transient.errors.WriteFailed`) the process leaves by ``os._exit``, skipping the
+    interpreter's teardown, in which HDF5 would retry the writes of the broken file and crash."""
+    code = main()
+    if _BROKEN_WRITE is not None:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -30,6 +47,10 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_INVALID
     except SimulationError as exc:
         print(f"transient: {exc}", file=sys.stderr)
+        if isinstance(exc, WriteFailed):
+            # (its traceback holds the broken file's objects: keep them from being freed)
+            global _BROKEN_WRITE
+            _BROKEN_WRITE = exc
         return EXIT_FAILED
     except KeyboardInterrupt:
         print("transient: interrupted", file=sys.stderr)

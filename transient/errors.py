@@ -28,3 +28,9 @@ class SceneError(ValueError):
 
 class SimulationError(RuntimeError):
     """The integration failed; carries where (time, angle, state)."""
+
+
+class WriteFailed(SimulationError):
+    """A write to the result file failed mid-run (a full disk). HDF5 cannot close the handles of
+    a file whose writes failed: at interpreter exit its deallocators retry the writes and crash
+    (SIGSEGV), so the command line leaves by ``os._exit`` after printing (``cli.entry``)."""

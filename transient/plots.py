@@ -195,6 +195,17 @@ def polar_load(ax, x, y, label=None, scale=1e-3):
     return artists
 
 
+def crankpin_polar(ax, R_K, R_T, label=None):
+    """Polar diagram of a crankpin load [N] in the crank frame, in kN: the crank pointing up (+y,
+    outward), +x the direction of rotation, so the load R_T t̂ − R_K ĉ is drawn as (R_T, −R_K) —
+    the frame of ``transient loads``. Takes a crank-slider's ``CylinderLoads`` rows or a radial
+    row's master crankpin (``ArticulatedLoads.R_K[j]``, ``R_T[j]``). Returns the artists."""
+    artists = polar_load(ax, R_T, -np.asarray(R_K), label=label)
+    ax.set_xlabel("R_T [kN] (direction of rotation)")
+    ax.set_ylabel("−R_K [kN] (crank outward)")
+    return artists
+
+
 def load_against_angle(ax, angle_deg, values, label=None, ylabel="|R| [kN]", scale=1e-3):
     """A load [N] (plotted in kN by default) against the crank angle [deg], with its mean as a
     dashed line. Returns the artists."""

@@ -16,6 +16,7 @@ from scipy.optimize import brentq
 
 from .assemble import build_model, gas_tables, initial_governor
 from .core.integrate import next_breakpoint
+from .core import governor as gv
 from .core.model import T, generator_branch, load_segment
 from .errors import SimulationError
 
@@ -122,8 +123,11 @@ class ChainNumpy:
     def solve(self, Jk, dJk, Mk, w, sigma):
         """(φ̈, S_k, η*_k) for direction σ (sign of ω, or of the incipient motion at rest)."""
         R = Mk - 0.5 * dJk * w * w
-        scale = (np.sum(np.abs(R)) + 1e-300) / np.min(Jk[Jk > 0]) / min(
-            np.min(self.eta_f), np.min(self.eta_b)) ** self.n
+        # The residual is Σ c_k (R_k − J_k a) with weights c_k, products of n factors η_f or
+        # 1/η_b, so its root a = Σ c_k R_k / Σ c_k J_k is within Σ|R| / ΣJ · η_min^(−2n). (ΣJ is
+        # J(φ) > 0; a bound on the least J_k overflows when a link's inertia is denormal.)
+        eta_min = min(np.min(self.eta_f), np.min(self.eta_b))
+        scale = (np.sum(np.abs(R)) + 1e-300) / np.sum(Jk) / eta_min ** (2 * self.n)
         a = brentq(lambda x: self._sweep(x, Jk, R, sigma)[0], -2 * scale, 2 * scale,
                    xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
         S = self._sweep(a, Jk, R, sigma)[1]
@@ -137,6 +141,72 @@ class ChainNumpy:
         if self.solve(Jk, dJk, Mk, 0.0, -1.0)[0] < 0:
             return -1.0
         return 0.0
+
+
+class CylindersNumpy:
+    """The cylinder pressures of the closed part with wall heat transfer (``[gas.woschni]``),
+    from :mod:`transient.forces.woschni`'s scalar functions (not from the kernels of
+    ``transient.core.cylinder``): the state is ``y[c:]`` of the reference state, in time,
+    dp/dt = (γ − 1)/V·(ω dQ_b/dx − Q̇_w) − γ p/V·dV/dt, dV/dt = F_p·u_k·ω. The combustion and
+    Woschni's combustion term are switched by the segment between breakpoints, as in the
+    closed-cycle integration there."""
+
+    def __init__(self, scene, phases: np.ndarray, period: float, c: int) -> None:
+        from .assemble import clearance_volume, wiebe_levels
+        from .forces import woschni
+
+        gas, mech = scene.gas, scene.mechanism
+        self.fn, self.w, self.c, self.period, self.phases = woschni, gas.wiebe, c, period, phases
+        self.heat = woschni.WoschniParameters.of_mechanism(
+            mech, c1=gas.woschni.c1, c2=gas.woschni.c2,
+            wall_temperature=gas.woschni.wall_temperature)
+        cycle = wiebe_levels(mech, gas)[-1]
+        self.ivc, self.v_a, self.p_a = cycle.intake_closing, cycle.v_a, gas.p_a
+        self.closed = (cycle.exhaust_opening - self.ivc) % period or period
+        self.start = (cycle.combustion_start - self.ivc) % period
+        self.volume = mech.volume_function(clearance_volume(scene))
+        self.area = mech.piston_area
+        w = self.w
+        self.gamma_a = w.gamma + w.gamma_slope * (w.t_a - w.gamma_t_ref)
+
+    def past_intake(self, local):
+        """Angles past intake closing, NaN outside the closed part."""
+        x = np.mod(local - self.ivc, self.period)
+        return np.where(x < self.closed, x, np.nan)
+
+    def pressures(self, p_table, local_mid, y):
+        """The applied pressures: the states in the closed part, else the table's."""
+        closed = np.isfinite(self.past_intake(local_mid))
+        return np.where(closed, y[self.c:self.c + p_table.size], p_table)
+
+    def rates(self, local_mid, phi_shift, u, w, fuel, y):
+        w_ = self.w
+        out = []
+        for k, x_mid in enumerate(self.past_intake(local_mid)):
+            if not np.isfinite(x_mid):
+                out.append(0.0)
+                continue
+            x, p = x_mid + phi_shift, y[self.c + k]
+            v = float(self.volume(np.array([local_mid[k] + phi_shift]))[0])
+            burnt = x_mid >= self.start
+            burning = burnt and x_mid < self.start + w_.duration
+            q = fuel[k] * w_.fuel_mass * w_.lhv * w_.efficiency
+            dq_b = (q * self.fn._rate_scalar(min(max((x - self.start) / w_.duration, 0.0), 1.0),
+                                             w_.a, w_.m) / w_.duration if burning else 0.0)
+            h = self.heat
+            q_w = self.fn.wall_heat_flow(p, v, w, w_.t_a, self.p_a, self.v_a, self.gamma_a, h.c1,
+                                         h.c2 if burnt else 0.0, h.wall_temperature, h.bore,
+                                         h.stroke)
+            g = w_.gamma + w_.gamma_slope * (w_.t_a * p * v / (self.p_a * self.v_a)
+                                             - w_.gamma_t_ref)
+            out.append(self.fn.first_law_rate(p, v, self.area * u[k] * w, dq_b * w, q_w, g))
+        return out
+
+    def close_intakes(self, phi, y) -> None:
+        """At a breakpoint: the cylinders whose intake closes here start at p_a."""
+        local = np.mod(phi - self.phases - self.ivc, self.period)
+        for k in np.flatnonzero(np.minimum(local, self.period - local) < 1e-9):
+            y[self.c + k] = self.p_a
 
 
 class GovernorNumpy:
@@ -219,7 +289,10 @@ class ReferenceModel:
         self.gen_low = bool(generator_branch(m, w0, True))
         self.t = 0.0  # time of the state being evaluated (the schedule may be in time)
         self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
+        self.n_gov = gv.n_states(m.gov_dyn)
         self.latched = None  # fuel per cylinder, with latching (set by run_reference)
+        self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov)
+                          if m.woschni else None)
 
     def load_scale(self, phi: float) -> float:
         """The schedule's scale s on the current segment (``model.load_scale``, in numpy)."""
@@ -258,6 +331,8 @@ class ReferenceModel:
             p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
                      if self.motored is not None else m.gas_offset)
             p = p_mot + f * (p_full - p_mot)
+            if self.cylinders is not None:
+                p = self.cylinders.pressures(p, np.mod(self.mid - m.gas_phase, m.period), y)
             M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
         resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
         if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min
@@ -298,7 +373,18 @@ class ReferenceModel:
         phi, w = y[:2]
         (J, dJ, Mg, Ml, Ms, _), a, S, eta = self.evaluate(phi, w, y)
         return [w, a, Mg * w, Ml * w, Ms * w, *((1 - np.asarray(eta)) * S * w),
-                *self.governor.rates(w, y)]
+                *self.governor.rates(w, y), *self.cylinder_rates(phi, w, y)]
+
+    def cylinder_rates(self, phi, w, y):
+        """dp_k/dt of the cylinder pressure states (wall heat transfer), else nothing."""
+        if self.cylinders is None:
+            return []
+        m = self.model
+        u = self.mech.terms(phi)[2]
+        fuel = (self.latched if self.latched is not None
+                else np.full(m.ncyl, self.command(w, y)))
+        return self.cylinders.rates(np.mod(self.mid - m.gas_phase, m.period), phi - self.mid, u,
+                                    w, fuel, y)
 
     def rows(self, t, y):
         out = []
@@ -309,8 +395,9 @@ class ReferenceModel:
             pairs = [v for k in range(len(S))
                      for v in (S[k], eta[k], (1 - eta[k]) * S[k] * w, yi[5 + k])]
             latched = [] if self.latched is None else list(self.latched)
+            g = self.governor.g
             out.append([ti, p, w, a, J, dJ, Mg, Ml, Ms, self.command(w, yi), *yi[2:5], *pc, *pairs,
-                        *yi[self.governor.g:], *latched])
+                        *yi[g:g + self.n_gov], *latched])
         return np.asarray(out)
 
 
@@ -399,11 +486,12 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
     phi_end = scene.initial.phi + 2 * math.pi * run.revolutions
     n_pairs = len(scene.friction.pairs)
     start, ref.governor.sleeve = initial_governor(scene, ref.model)
-    n_gov = start.size - (ref.model.ncyl if ref.model.latch else 0)
+    n_gov, n_cyl = ref.n_gov, ref.model.ncyl
     if ref.model.latch:
-        ref.latched = start[n_gov:].copy()
+        ref.latched = start[n_gov:n_gov + n_cyl].copy()
+    cylinders = start[start.size - n_cyl:] if ref.cylinders is not None else []
     t, y = 0.0, np.concatenate([[scene.initial.phi, scene.initial.omega], np.zeros(3 + n_pairs),
-                                start[:n_gov]])
+                                start[:n_gov], cylinders])
     message = ""
     blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": [],
                                          "governor_corner": []}, 0, 0
@@ -544,6 +632,8 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             level = up if y[1] >= 0 else down
             y[0] = level
             events["breakpoint"].append((t, y[0]))
+            if ref.cylinders is not None:
+                ref.cylinders.close_intakes(y[0], y)
             if ref.latched is not None and y[1] > 0:  # a cylinder's start of injection
                 m = ref.model
                 local = np.mod(y[0] - m.gas_phase - m.inj_angle, m.period)

@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 
 from . import __version__
-from .errors import SimulationError
+from .errors import SimulationError, WriteFailed
 
 FORMAT = 1
 
@@ -97,8 +97,11 @@ class ResultWriter:
         self.f.create_group("scene").create_dataset("toml", data=scene_toml)
         traj = self.f.create_group("trajectory")
         self.columns = columns
+        # The columns' datasets stay open for the file's life: a dataset object freed after a
+        # failed write would make HDF5 retry it (and print its failure) on closing.
+        self.datasets = {}
         for name, unit in columns.items():
-            ds = traj.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
+            ds = self.datasets[name] = traj.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
                                      chunks=(4096,), compression="gzip", compression_opts=1,
                                      shuffle=True)
             ds.attrs["unit"] = unit
@@ -113,14 +116,13 @@ class ResultWriter:
         if n == 0:
             return
         try:
-            for name in self.columns:
-                ds = self.f["trajectory"][name]
+            for name, ds in self.datasets.items():
                 ds.resize(ds.shape[0] + n, axis=0)
                 ds[-n:] = block[name]
             self.f.flush()
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
             self.broken = f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); is the disk full?"
-            raise SimulationError(self.broken) from None
+            raise WriteFailed(self.broken) from None
 
     def restart(self) -> None:
         """Drop the trajectory and events written so far (a run started again from the
@@ -184,11 +186,9 @@ class ResultWriter:
         write the file is left as it is under its temporary name (it says complete = false if
         its header reached the disk) and :class:`SimulationError` says so."""
         if self.broken:
-            try:
-                self.f.close()
-            except Exception:  # noqa: BLE001 — the file is broken already
-                pass
-            raise SimulationError(f"{self.broken}; the partial file {self.tmp} may be unreadable")
+            # (not closed: HDF5 would retry the failed writes, print and crash; cli.entry exits
+            # without freeing it)
+            raise WriteFailed(f"{self.broken}; the partial file {self.tmp} may be unreadable")
         self.f.attrs["complete"] = bool(complete)
         if message:
             self.f.attrs["message"] = message

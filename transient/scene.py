@@ -285,6 +285,23 @@ class Wiebe:
 
 
 @dataclass(frozen=True)
+class Woschni:
+    """Wall heat transfer of the closed part, Woschni's correlation: the ``[gas.woschni]`` table
+    of ``model = "wiebe"`` (equations in :mod:`transient.forces.woschni`). With it the cylinder
+    pressure depends on the shaft speed and on its own history, so the closed part of each
+    cylinder is a state of the ODE instead of a table (``transient.core.cylinder``).
+
+    ``c1`` [1] multiplies the mean piston speed, ``c2`` [m/(s K)] the pressure rise combustion
+    causes (from the combustion start on; Woschni's direct-injection value by default);
+    ``wall_temperature`` [K]: the mean temperature of head, piston crown and liner.
+    """
+
+    c1: float = 2.28
+    c2: float = 3.24e-3
+    wall_temperature: float = 450.0
+
+
+@dataclass(frozen=True)
 class Gas:
     """Cylinder pressure model (angle-only in this version).
 
@@ -335,6 +352,7 @@ class Gas:
     duration: float = math.pi
     wiebe: Wiebe | None = None
     injection: float | None = None
+    woschni: Woschni | None = None
 
 
 @dataclass(frozen=True)
@@ -501,6 +519,10 @@ class Output:
 #: Output samples per revolution at most (0.00036° apart).
 MAX_SAMPLES_PER_REV = 1_000_000
 
+#: Smallest time-mode output spacing [s]: 10⁸ samples per second of engine time, already
+#: 0.8 GB per column and second before compression.
+MIN_OUTPUT_DT = 1e-8
+
 #: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
 COMPILED_METHODS = ("dop853", "dopri5")
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
@@ -658,8 +680,16 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
         step=w.number("step", "angle", d.step, gt=0.0),
         tolerance=w.number("tolerance", default=d.tolerance, gt=0.0))
     w.finish()
+    woschni = None
+    if s.has("woschni"):
+        h, dh = s.sub("woschni"), Woschni()
+        woschni = Woschni(c1=h.number("c1", default=dh.c1, ge=0.0),
+                          c2=h.number("c2", default=dh.c2, ge=0.0),
+                          wall_temperature=h.number("wall_temperature", default=dh.wall_temperature,
+                                                    gt=0.0))
+        h.finish()
     return Gas(model="wiebe", p0=p0, compression_ratio=ratio, p_a=p_a, p_intake=p_in,
-               p_exhaust=p_ex, wiebe=wiebe)
+               p_exhaust=p_ex, wiebe=wiebe, woschni=woschni)
 
 
 def _read_pressure_csv(s: Section, base_dir: Path):
@@ -935,8 +965,11 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         if spr > MAX_SAMPLES_PER_REV:  # (every sample is written: a run must stay finite)
             raise SceneError(so.key("samples_per_rev"), f"must be ≤ {MAX_SAMPLES_PER_REV}, got "
                                                         f"{spr}")
-        sections["output"] = Output(spr,
-                                    so.number("dt", default=0.0, ge=0.0))
+        dt = so.number("dt", default=0.0, ge=0.0)
+        if 0.0 < dt < MIN_OUTPUT_DT:  # (every sample is written: a run must stay finite)
+            raise SceneError(so.key("dt"), f"must be 0 (the default spacing) or ≥ "
+                                           f"{MIN_OUTPUT_DT:g} s, got {dt:g}")
+        sections["output"] = Output(spr, dt)
         so.finish()
         sf = root.sub("friction")
         sections["friction"] = _read_friction(sf, mech.links)
@@ -954,6 +987,28 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         exc.file = exc.file or file
         exc.args = (exc.line(),)
         raise
+
+
+def _check_woschni(scene: Scene) -> None:
+    """Wall heat transfer makes each cylinder's pressure a state of the ODE (built for the
+    crank-slider's exact cylinder volume, integrated by the compiled and the reference paths)."""
+    if not isinstance(scene.mechanism, CrankSlider):
+        kind = {SwashPlate: "swash-plate", Articulated: "articulated"}[type(scene.mechanism)]
+        raise SceneError("gas.woschni", f"wall heat transfer is built for crank-slider engines "
+                                        f"(their cylinder volume enters the ODE), not for the "
+                                        f"{kind!r} mechanism; leave [gas.woschni] out")
+    if scene.run.mode == "prescribed-speed":
+        raise SceneError("gas.woschni", "with wall heat transfer the cylinder pressures are "
+                                        "states of the ODE, which a prescribed-speed run does not "
+                                        "integrate; run it dynamic (a large flywheel holds the "
+                                        "speed) or leave [gas.woschni] out")
+    if scene.gas.wiebe.m < 0.0:
+        raise SceneError("gas.wiebe.m", f"m = {scene.gas.wiebe.m:g}: with wall heat transfer the "
+                                        f"heat-release rate enters the ODE, and for m < 0 it is "
+                                        f"infinite at the combustion start; give m ≥ 0")
+    if scene.solver.kinematics == "tabulated":
+        raise SceneError("solver.kinematics", "the cylinder volumes of wall heat transfer use the "
+                                              "exact kinematics; use kinematics = \"exact\"")
 
 
 def _check_consistency(scene: Scene) -> None:
@@ -995,6 +1050,8 @@ def _check_consistency(scene: Scene) -> None:
     if scene.run.mode == "prescribed-speed" and scene.load.inertia > 0.0:
         raise SceneError("load.inertia", "a prescribed-speed run has no momentum to conserve when "
                                          "an inertia is switched in; leave it out (0)")
+    if scene.gas.woschni is not None:
+        _check_woschni(scene)
     if scene.run.mode == "prescribed-speed" and scene.governor.model in ("pi", "flyweight"):
         raise SceneError("governor.model", f"a prescribed-speed run integrates no governor state; "
                                            f"use model = \"none\" or \"droop\", not "
@@ -1019,9 +1076,6 @@ def _check_analysis(scene: Scene) -> None:
 
     a, mech = scene.analysis, scene.mechanism
     crank_slider = isinstance(mech, CrankSlider)
-    if a.loads and not crank_slider:
-        raise SceneError("analysis.loads", f"loads are computed for crank-slider engines only, "
-                                           f"not {type(mech).__name__}; allowed here: false")
     columns = list(output_columns(scene))
     derived = [f"W_{k + 1}" for k in range(mech.n_cylinders)] if crank_slider else []
     for name in a.orders:
@@ -1120,6 +1174,9 @@ def _gas_section(gas: Gas) -> list[str]:
         lines += ["", "[gas.wiebe]"] + [f"{f.name} = {toml_value(getattr(gas.wiebe, f.name))}"
                                         for f in fields(gas.wiebe)
                                         if getattr(gas.wiebe, f.name) is not None]
+    if gas.woschni is not None:
+        lines += ["", "[gas.woschni]"] + [f"{f.name} = {toml_value(getattr(gas.woschni, f.name))}"
+                                          for f in fields(gas.woschni)]
     return lines
 
 

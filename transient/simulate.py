@@ -196,7 +196,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                    f"progress at {at} (last sample {where})"
                    + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
                       f"sliding mode), the power-flow policy has one at every state"
-                      if event == "pair_mode" else ""))
+                      if event == "pair_mode" and scene.friction.policy != "power-flow" else ""))
     if status == ci.STIFF:
         message = (f"stiff at {at}: in {ci.STIFF_COUNT} steps the estimate h·λ of the dominant "
                    f"eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "

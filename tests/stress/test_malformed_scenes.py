@@ -20,6 +20,7 @@ import h5py
 import pytest
 
 from transient.cli import main
+from transient.results import PROBE_BYTES
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -171,6 +172,8 @@ CASES = [
      "governor.speed_zero_rpm: must be > 3000, got 2000"),
     ("range-output-dt-negative", add("samples_per_rev = 12", "dt = -1e-4"),
      "output.dt: must be ≥ 0, got -0.0001"),
+    ("range-output-dt-tiny", add("samples_per_rev = 12", "dt = 1e-12"),
+     "output.dt: must be 0 (the default spacing) or ≥ 1e-08 s, got 1e-12"),
     ("range-max-step-zero", add("atol = 1e-8", "max_step = 0"), "solver.max_step: must be > 0, got 0"),
     ("range-table-tolerance-1", add("atol = 1e-8", "table_tolerance = 1"),
      "solver.table_tolerance: must be < 1, got 1"),
@@ -428,3 +431,28 @@ def test_full_disk_fails_before_integrating(tmp_path):
     assert r.returncode == 2, r.stderr
     assert r.stderr == f"{out}: cannot write the result there (File too large); is the disk full?\n"
     assert list(out.iterdir()) == []
+
+
+def test_full_disk_mid_run_fails_with_one_line(tmp_path):
+    """The disk fills up while the trajectory streams: one line, exit 1, the partial file left
+    under its temporary name (was a bug: HDF5's deallocators retried the failed writes, printed
+    their tracebacks and crashed the process with SIGSEGV at exit)."""
+    scene = tmp_path / "long.toml"
+    scene.write_text(VALID.replace("revolutions = 2", "revolutions = 1000"), encoding="utf-8")
+    warm = subprocess.run([sys.executable, "-m", "transient", "run", str(scene), "-o",
+                           str(tmp_path / "warm"), "-q"], cwd=REPO, capture_output=True, timeout=600)
+    assert warm.returncode == 0, warm.stderr
+    size = (tmp_path / "warm" / "long.h5").stat().st_size
+    limit = size // 2  # past the probe and the header, short of the whole trajectory
+    assert limit > PROBE_BYTES
+    out = tmp_path / "out"
+    out.mkdir()
+    r = subprocess.run([sys.executable, "-m", "transient", "run", str(scene), "-o", str(out), "-q"],
+                       cwd=REPO, capture_output=True, text=True, timeout=300,
+                       preexec_fn=full_disk(limit))
+    part = out / ".long.h5.part"
+    assert r.returncode == 1, r.stderr
+    assert r.stderr.count("\n") == 1, r.stderr
+    assert r.stderr.startswith(f"transient: writing {part} failed (")
+    assert r.stderr.endswith(f"is the disk full?; the partial file {part} may be unreadable\n")
+    assert list(out.iterdir()) == [part]

@@ -129,6 +129,45 @@ GOVERNOR_CASES = [  # (id, scene text, key, fragment), part of CASES below
 
 
 # (id, scene text, key reported, fragment of the message)
+# Wall heat transfer (issue 6): [gas.woschni] of a Wiebe cycle; cylinder pressures in the ODE.
+WIEBE = """
+[gas]
+model = "wiebe"
+compression_ratio = 18
+p_a_MPa = 0.1436
+p_intake_MPa = 0.165
+p_exhaust_MPa = 0.182
+
+[gas.wiebe]
+start_deg = 358
+duration_deg = 50
+fuel_mass = 0.031e-3
+"""
+WOSCHNI = "\n[gas.woschni]\n"
+WOSCHNI_CASES = [  # (id, scene text, key, fragment), part of CASES below
+    ("woschni-negative-c1", VALID + WIEBE + WOSCHNI + "c1 = -1\n", "gas.woschni.c1",
+     "must be ≥ 0, got -1"),
+    ("woschni-wall-temperature-zero", VALID + WIEBE + WOSCHNI + "wall_temperature = 0\n",
+     "gas.woschni.wall_temperature", "must be > 0, got 0"),
+    ("woschni-unknown-key", VALID + WIEBE + WOSCHNI + "c3 = 1\n", "gas.woschni.c3",
+     "unknown key; allowed here: c1, c2, wall_temperature"),
+    ("woschni-wiebe-m-negative", VALID + WIEBE + "m = -0.2\n" + WOSCHNI, "gas.wiebe.m",
+     "with wall heat transfer the heat-release rate enters the ODE"),
+    ("woschni-prescribed-speed", replace("revolutions = 2", 'mode = "prescribed-speed"\n'
+                                         'speed = 100\nrevolutions = 2') + WIEBE + WOSCHNI,
+     "gas.woschni", "which a prescribed-speed run does not integrate"),
+    ("woschni-tabulated-kinematics", replace("atol = 1e-8", 'atol = 1e-8\nkinematics = "tabulated"')
+     + WIEBE + WOSCHNI, "solver.kinematics", "use the exact kinematics"),
+    ("woschni-mixed-cycle", VALID + MIXED_CYCLE.format(cr=18) + WOSCHNI, "gas.woschni",
+     "unknown key; allowed here:"),
+    ("woschni-swash-plate", (CASES_DIR / "swash_plate_1cyl.toml").read_text()
+     .replace('model = "trapezoid"\namplitude = 8000.0   # N, force per piston\nramp_deg = 30\n'
+              'duration_deg = 180', 'model = "wiebe"\ncompression_ratio = 12\np_a_MPa = 0.1')
+     + "\n[gas.wiebe]\nstart_deg = -5\nduration_deg = 40\nfuel_mass = 1e-5\n" + WOSCHNI,
+     "gas.woschni", "wall heat transfer is built for crank-slider engines"),
+]
+
+
 CASES = [
     ("toml-syntax", replace("bore_mm = 88", "bore_mm = = 88"),
      "(syntax)", "not valid TOML"),
@@ -301,11 +340,8 @@ CASES = [
     ("analysis-unknown-key", VALID + "\n[analysis]\nspectra = true\n", "analysis.spectra",
      "unknown key; allowed here: detrend, irregularity, loads, max_order, orders, "
      "samples_per_cycle"),
-    ("analysis-loads-swash-plate",
-     (CASES_DIR / "swash_plate_1cyl.toml").read_text() + "\n[analysis]\nloads = true\n",
-     "analysis.loads",
-     "loads are computed for crank-slider engines only, not SwashPlate; allowed here: false"),
     *GOVERNOR_CASES,
+    *WOSCHNI_CASES,
 ]
 
 

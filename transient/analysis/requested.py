@@ -25,6 +25,17 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   also the running torques ``loads_journal_torque`` (n+1, N), ``loads_crankpin_torque`` (n, N)
   [N m] (§2.8) and the main journals by (58), ``loads_main_x``, ``loads_main_y`` (n+1, N) and
   ``loads_main_R_max`` (n+1,) [N] (frame of crank 1).
+* ``loads = true``, articulated (radial, V; :mod:`transient.analysis.loads_radial`), the same grid
+  and ``loads_phi``: per cylinder ``loads_P``, ``loads_N``, ``loads_S`` (n, N) [N] and
+  ``loads_torque`` = P u (n, N) [N m]; per row (its crankpin, ρ rows) ``loads_K``, ``loads_T``,
+  ``loads_R_K``, ``loads_R_T``, ``loads_R`` (ρ, N) and ``loads_crankpin_R_max`` (ρ,) [N]; per link
+  pin (ρ·z′ slaves) its load in the row frame ``loads_link_x``, ``loads_link_y`` (ρ·z′, N) and
+  ``loads_link_R_max`` (ρ·z′,) [N]; ``loads_engine_torque`` Σ T r (N,) [N m]. No main journals
+  or running torques.
+* ``loads = true``, swash plate (:mod:`transient.analysis.loads_swash`): per cylinder (one piston;
+  torques count both halves) ``loads_P``, ``loads_S``, ``loads_N_radial``, ``loads_N_tangential``
+  (z, N) [N], ``loads_torque`` (z, N) [N m]; ``loads_engine_torque`` (Σ torque) and
+  ``loads_shaft_torque`` (with the rods' and link 9's inertia) (N,) [N m]. No crankpin.
 """
 from __future__ import annotations
 
@@ -33,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import SceneError
 from .irregularity import cycle_boundaries
 from .orders import order_spectrum, resolve_detrend, to_angle_grid
 
@@ -132,6 +144,8 @@ def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     names += [f"p_{k + 1}" for k in range(mech.n_cylinders) if f"p_{k + 1}" in traj]
     grid, cols = to_angle_grid(traj, names, n, mech.cycle, phi0=scene.initial.phi, cycles=1,
                                cuts=cuts)
+    if store := _other_loads(mech):  # articulated, swash plate
+        return store(scene, grid, {"phi": grid, **cols})
     ld = loads_from_trajectory(scene, {"phi": grid, **cols})
     out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
     for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R"):
@@ -147,4 +161,52 @@ def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
         out["loads_main_x"] = (mj.x, "N")
         out["loads_main_y"] = (mj.y, "N")
         out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
+    return out
+
+
+def _other_loads(mech):
+    """The storer of a mechanism other than the crank-slider, None for a crank-slider; a one-line
+    :class:`~transient.errors.SceneError` for a mechanism without loads."""
+    from ..mechanisms.articulated import Articulated
+    from ..mechanisms.crank_slider import CrankSlider
+    from ..mechanisms.swash_plate import SwashPlate
+
+    if isinstance(mech, CrankSlider):
+        return None
+    if isinstance(mech, Articulated):
+        return _stored_articulated_loads
+    if isinstance(mech, SwashPlate):
+        return _stored_swash_loads
+    raise SceneError("analysis.loads", f"loads are not computed for {type(mech).__name__}; "
+                                       f"allowed here: false")
+
+
+def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
+    """Radial/V rows (:mod:`transient.analysis.loads_radial`): per cylinder, link pin and
+    crankpin; no main journals or running torques (one crankpin carries a whole row)."""
+    from .loads_radial import articulated_loads_from_trajectory
+
+    ld = articulated_loads_from_trajectory(scene, traj)
+    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
+    for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R", "link_x", "link_y"):
+        out[f"loads_{name}"] = (getattr(ld, name), "N")
+    out["loads_torque"] = (ld.torque, "N m")
+    out["loads_engine_torque"] = (ld.engine_torque, "N m")
+    out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
+    out["loads_link_R_max"] = (ld.link_R.max(axis=1), "N")
+    return out
+
+
+def _stored_swash_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
+    """Swash plate (:mod:`transient.analysis.loads_swash`): per cylinder and the shaft torque;
+    no crankpin, journals or running torques."""
+    from .loads_swash import swash_loads_from_trajectory
+
+    ld = swash_loads_from_trajectory(scene, traj)
+    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
+    for name in ("P", "S", "N_radial", "N_tangential"):
+        out[f"loads_{name}"] = (getattr(ld, name), "N")
+    out["loads_torque"] = (ld.torque, "N m")
+    out["loads_engine_torque"] = (ld.engine_torque, "N m")
+    out["loads_shaft_torque"] = (ld.shaft_torque, "N m")
     return out

@@ -27,11 +27,12 @@ from .jit import kernel
 
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
+from . import cylinder as cyl
 from . import governor as gv
 from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GENERATOR,
                     SW_GOVERNOR, SW_LOAD, SW_MODES, SW_SLEEVE, SW_STARTER, T, WK_DEMAND, WK_G,
                     WK_G_MIN, WK_SPEED, choose_modes, command, demand, derivative, generator_branch,
-                    gov_index, governor_branch, inertia, is_pi, latch_index, load_segment,
+                    cyl_index, gov_index, governor_branch, inertia, is_pi, latch_index, load_segment,
                     margins_at, n_state, output_row, speed, start_branch, work_array)
 
 # Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
@@ -84,22 +85,31 @@ PAIR_COMP = 100
 DEMAND_COMP = -1
 
 
+@kernel(inline="always")
+def _controlled(i, ix, g0, g1, c0):
+    """Whether state component i is error-controlled: the dynamics' (but the independent
+    variable ``ix``), the governor's y[g0:g1] and the cylinder pressures y[c0:]. The work
+    integrals do not feed back (they follow the dynamics' steps) and the latched fuels are
+    constant."""
+    return i != ix and (i < N_DYNAMIC or g0 <= i < g1 or i >= c0)
+
+
 @kernel
-def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1):
+def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0):
     """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
-    the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5), over the dynamics'
-    components and the governor's states y[g0:g1].
+    the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5), over the components
+    :func:`_controlled` names.
 
     The accumulating components (t in crank angle, φ in time) are scaled by their increment over
     the step, not by their size: relative to |t| the allowed error would grow with the run's length
     and a long run would lose phase for nothing. The independent variable ``ix`` has no error.
     """
-    n = g1
+    n = y.shape[0]
     err5 = 0.0
     err3 = 0.0
     for i in range(n):
-        if i == ix or N_DYNAMIC <= i < g0:
-            continue  # (work integrals do not feed back: they follow the dynamics' steps)
+        if not _controlled(i, ix, g0, g1, c0):
+            continue
         if i == PHI or i == T:
             sc = atol + rtol * abs(y_new[i] - y[i])
         else:
@@ -113,11 +123,11 @@ def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1):
         err3 += (e3 / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
-    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1 + g1 - g0))
+    return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1 + g1 - g0 + n - c0))
 
 
 @kernel
-def _stiffness(tab, K, h, y, ix, g0, g1, rtol, atol):
+def _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol):
     """Estimate of h·λ over the step (Hairer, *Solving ODEs II*, §IV.2): the last main stage and
     the FSAL stage both sit at the step's end, and ‖f(y₁) − f(y_s)‖/‖y₁ − y_s‖ estimates the
     dominant eigenvalue's modulus; y₁ − y_s = h Σ_j (A[ns, j] − A[ns−1, j]) K_j. Over the
@@ -127,8 +137,8 @@ def _stiffness(tab, K, h, y, ix, g0, g1, rtol, atol):
     ns = tab.n_stages
     num = 0.0
     den = 0.0
-    for i in range(g1):
-        if i == ix or N_DYNAMIC <= i < g0:
+    for i in range(y.shape[0]):
+        if not _controlled(i, ix, g0, g1, c0):
             continue
         sc = atol + rtol * abs(y[i])
         dy = 0.0
@@ -142,9 +152,9 @@ def _stiffness(tab, K, h, y, ix, g0, g1, rtol, atol):
 
 
 @kernel
-def _stiff(tab, K, h, y, ix, g0, g1, rtol, atol, ist):
+def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
     """Count an accepted step in Hairer's stiffness test (``STIFF_COUNT``); True when stiff."""
-    if _stiffness(tab, K, h, y, ix, g0, g1, rtol, atol) > tab.stiff_bound:
+    if _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol) > tab.stiff_bound:
         ist[I_NONSTIFF] = 0
         ist[I_STIFF] += 1
         return ist[I_STIFF] >= STIFF_COUNT
@@ -249,17 +259,24 @@ def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
 @kernel
 def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
     """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
-    (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations)."""
+    (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations).
+
+    The θ returned is on the far side of the crossing (g there has gb's sign, or is 0): the
+    state at the event has crossed. Two pairs whose margins fall through zero at the same angle
+    (a massless link between them) then both see their crossing there, and a switch is never
+    undone because rounding left the event a hair before its own root."""
     if gb == 0.0 or (ga > 0.0) == (gb > 0.0):
         return b, 0
     side = 0
     for i in range(100):
+        if b - a < 1e-12:
+            return b, i
         c = b - gb * (b - a) / (gb - ga)
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense_eval(F, y, c, tmp)
         gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
-        if gc == 0.0 or b - a < 1e-12:
+        if gc == 0.0:
             return c, i + 1
         if (gc > 0.0) == (gb > 0.0):
             b, gb = c, gc
@@ -478,6 +495,31 @@ def _inject(m, y, sw, evbuf, ist, wk):
     return hit
 
 
+@kernel
+def _close_intake(m, y):
+    """At a breakpoint: each cylinder whose intake closes here starts its closed part at p_a
+    (``m.woschni``, :mod:`.cylinder`). Returns whether any did (the derivative at y changes)."""
+    if not m.woschni:
+        return False
+    c = cyl_index(m)
+    hit = False
+    for k in range(m.ncyl):
+        if _on_angle(y[PHI], m.gas_phase[k] + m.cyl_par[cyl.IVC], m.period):
+            y[c + k] = m.cyl_par[cyl.P_A]
+            hit = True
+    return hit
+
+
+@kernel
+def _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+    """What a breakpoint does to the state (injections, intake closings); returns whether the
+    derivative carried over from the last step (FSAL) is stale: the state changed, or a pressure
+    jumps here."""
+    injected = _inject(m, y, sw, evbuf, ist, wk)
+    closed = _close_intake(m, y)
+    return injected or closed or _jumps_at(m, bp, y[PHI])
+
+
 @kernel(inline="always")
 def _crosses(g0, g1, direction):
     """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
@@ -574,8 +616,9 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
     n_bad = 0  # consecutive non-finite step attempts
     rejected = False  # the last attempt was rejected by the error test
-    g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics
+    g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics,
     g1 = g0 + gv.n_states(m.gov_dyn)
+    c0 = cyl_index(m)  # and so are the cylinder pressures y[c0:]
 
     if ist[I_STARTED] == 0:
         ist[I_STARTED] = 1
@@ -679,7 +722,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             g_min = wk[WK_G_MIN, k]
             dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
         ist[I_NFEV] += tab.n_stages
-        err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1)
+        err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0)
         finite = np.isfinite(err)
         for i in range(n):
             finite = finite and np.isfinite(y_new[i])
@@ -716,7 +759,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             # size oscillates between growing past what the error allows and being cut back.
             factor = min(factor, 1.0)
         h_next = h * factor
-        if not fixed and _stiff(tab, K, h, y, ix, g0, g1, rtol, atol, ist):
+        if not fixed and _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
@@ -740,6 +783,18 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 steps_here += 1
                 continue
             dense_ready = True
+        elif not angle_mode and 0 < ist[I_NREDO] < 4:
+            # A retaken step lands on the breakpoint only to the accuracy of the dense output
+            # it was aimed with (at loose tolerances, up to ~1e-3 rad short): lengthen it by the
+            # time the rest of the angle takes at the speed reached (a secant step), rather than
+            # leaving a sliver that the next step would cross and retake again.
+            rest = (fst[F_REDO_LEVEL] - y_new[PHI]) / y_new[OMEGA]
+            if abs(fst[F_REDO_LEVEL] - y_new[PHI]) > BP_LANDING and rest > 0.0:
+                fst[F_H] = h + rest
+                ist[I_NREDO] += 1
+                ist[I_NREJECT] += 1
+                steps_here += 1
+                continue
         redo_hit_breakpoint = ist[I_NREDO] > 0 or dense_ready
         ist[I_NREDO] = 0
         # State events on this step: the earliest one truncates it.
@@ -824,12 +879,12 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 gs[0, k] = gs[N_MARGIN_SAMPLES, k]
             if angle_mode and at_segment_end and x_end == up:
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
-                if _inject(m, y, sw, evbuf, ist, wk) or _jumps_at(m, bp, y[PHI]):
+                if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
                     ist[I_F_VALID] = 0
             elif redo_hit_breakpoint:
                 fst[F_PASSED_BP] = fst[F_REDO_LEVEL]
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
-                if _inject(m, y, sw, evbuf, ist, wk) or _jumps_at(m, bp, y[PHI]):
+                if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
                     ist[I_F_VALID] = 0
             if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
                 return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
@@ -864,7 +919,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         ist[I_F_VALID] = 0
         if on_breakpoint:
             _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
-            _inject(m, y, sw, evbuf, ist, wk)
+            _at_breakpoint(m, bp, y, sw, evbuf, ist, wk)
         _emit_event(m, evbuf, ist, ev_code, y, wk)
         if ev_code == EV_END:
             return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)

@@ -22,6 +22,7 @@ from numba import njit
 from .jit import kernel
 
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
+from . import cylinder as cyl
 from . import governor as gv
 from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
@@ -121,6 +122,8 @@ Model = namedtuple(
         "gov_par",  # float64[:]: its parameters (governor.P_* or governor.F_*)
         "latch",  # bool: each cylinder's fuel is latched at its start of injection
         "inj_angle",  # float: local angle of the start of injection [rad] (with latch)
+        "woschni",  # bool: the closed part's pressures are states (wall heat transfer, .cylinder)
+        "cyl_par",  # float64[cylinder.N_PAR]: their parameters (transient.core.cylinder)
         "n_pairs",  # int: number of non-ideal pairs (0: ideal constraints, equation (18))
         "eta_fwd",  # float64[n_pairs]: efficiency of pair k when its shaft side drives
         "eta_bwd",  # float64[n_pairs]: efficiency of pair k when its far side drives
@@ -143,10 +146,16 @@ def latch_index(m):
     return N_STATE_BASE + m.n_pairs + gv.n_states(m.gov_dyn)
 
 
+@kernel(inline="always")
+def cyl_index(m):
+    """Index of cylinder 0's pressure state (with ``m.woschni``), after the latched fuels."""
+    return latch_index(m) + (m.ncyl if m.latch else 0)
+
+
 @kernel
 def n_state(m):
     """Length of the state vector of model ``m``."""
-    return latch_index(m) + (m.ncyl if m.latch else 0)
+    return cyl_index(m) + (m.ncyl if m.woschni else 0)
 
 
 @kernel
@@ -210,6 +219,37 @@ def applied_value(m, k, phi, sel, f):
     if f == 1.0:
         return p
     return m.gas_offset + f * (p - m.gas_offset)
+
+
+@kernel(inline="always")
+def cylinder_value(m, k, y, sel, f):
+    """The pressure on piston k: its state in the closed part with wall heat transfer
+    (``m.woschni``, :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
+    if m.woschni:
+        local_sel = (sel - m.gas_phase[k]) % m.period
+        if cyl.closed_angle(m.cyl_par, local_sel, m.period) >= 0.0:
+            return y[cyl_index(m) + k]
+    return applied_value(m, k, y[PHI], sel, f)
+
+
+@kernel(inline="always")
+def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
+    """dp_k/dφ (crank angle) or dp_k/dt (time) of the cylinder pressure states (``m.woschni``):
+    the first law with Wiebe's heat release and Woschni's wall heat (:mod:`.cylinder`); zero
+    outside the closed part. dV/dφ = F_p·u_k from the row u of ``wk`` (left by :func:`moments`)."""
+    c = cyl_index(m)
+    lc = latch_index(m)
+    for k in range(m.ncyl):
+        local_sel = (sel - m.gas_phase[k]) % m.period
+        x_sel = cyl.closed_angle(m.cyl_par, local_sel, m.period)
+        if x_sel < 0.0:
+            out[c + k] = 0.0
+            continue
+        shift = y[PHI] - sel  # the angles at y, continued from the step's piece
+        f_k = y[lc + k] if m.latch else f
+        A, B = cyl.pressure_rate(m.mech, m.cyl_par, x_sel + shift, x_sel, local_sel + shift,
+                                 y[c + k], m.gas_scale[k] * wk[WK_U, k], w, f_k)
+        out[c + k] = A - B / w if angle_mode else w * A - B
 
 
 @kernel(inline="always")
@@ -370,7 +410,7 @@ def moments(m, angle_mode, y, sel, sw, wk):
             c = latch_index(m)
             for k in range(m.ncyl):
                 f_k = y[c + k] if m.latch else f
-                M_gas += m.gas_scale[k] * (applied_value(m, k, phi, sel, f_k) - m.gas_offset) * u[k]
+                M_gas += m.gas_scale[k] * (cylinder_value(m, k, y, sel, f_k) - m.gas_offset) * u[k]
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
                 M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
@@ -472,6 +512,8 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     out[W_STARTER] = M_starter * q
     if m.gov_dyn != gv.NONE or m.latch:
         governor_rates(m, w, y, 1.0 / w if angle_mode else 1.0, sw, wk, out)
+    if m.woschni:
+        cylinder_rates(m, angle_mode, y, sel, w, command(m, w, y, sw), wk, out)
     if angle_mode:
         out[PHI] = 1.0
         out[T] = 1.0 / w
@@ -575,10 +617,10 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     c = latch_index(m)
     for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
         f_k = y[c + k] if m.latch else f
-        row[N_OUT_FIXED + k] = applied_value(m, k, y[PHI], sel, f_k) if m.has_gas else 0.0
+        row[N_OUT_FIXED + k] = cylinder_value(m, k, y, sel, f_k) if m.has_gas else 0.0
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
     j = N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
-    for i in range(gov_index(m), n_state(m)):  # governor states, latched fuels
+    for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels
         row[j] = y[i]
         j += 1
 
