@@ -109,7 +109,8 @@ def _parser() -> argparse.ArgumentParser:
     e.set_defaults(func=cmd_efficiency)
     lo = sub.add_parser(
         "loads", help="crankpin, main-journal loads and running torques along a crank-slider "
-                      "result (PNG + CSV files; the result file is not changed)",
+                      "result, crankpin and link-pin loads along an articulated one (PNG + CSV "
+                      "files; the result file is not changed)",
         description="Loads along the stored trajectory (transient.analysis.loads): polar "
                     "diagrams of the crankpin and of the most loaded main journal, |R| over the "
                     "last cycle, the wear diagram (Gots §2.6, ±60° rule), running torques; peak "
@@ -559,15 +560,86 @@ WEAR_HALF_ARC_DEG = 60.0
 
 
 def _crank_slider_scene(res):
-    """The result's scene, or a one-line error (exit 2) if its mechanism is not a crank-slider."""
+    """The result's scene, or a one-line error (exit 2) if its mechanism is not a crank-slider
+    (nor, for ``loads``, articulated: those go to :func:`_radial_loads`)."""
     from .mechanisms.crank_slider import CrankSlider
 
     scene = res.scene()
     if not isinstance(scene.mechanism, CrankSlider):
-        raise SceneError("mechanism.type", f"loads are computed for crank-slider engines only, "
-                                           f"not {type(scene.mechanism).__name__}",
+        raise SceneError("mechanism.type", f"load diagrams are drawn for crank-slider and "
+                                           f"articulated engines, not "
+                                           f"{type(scene.mechanism).__name__} (its forces are "
+                                           f"stored by [analysis] loads = true)",
                          file=str(res.path))
     return scene
+
+
+def _is_articulated(scene) -> bool:
+    from .mechanisms.articulated import Articulated
+
+    return isinstance(scene.mechanism, Articulated)
+
+
+def _radial_loads(args, res, scene) -> int:
+    """``transient loads`` of an articulated engine: each row's master crankpin in its crank
+    frame (polar), the crankpin and link-pin loads over the last cycle, and a CSV
+    (``transient.analysis.loads_radial``; main journals and running torques do not apply)."""
+    from . import plots
+    from .analysis.loads_radial import articulated_loads_from_trajectory
+
+    mech = scene.mechanism
+    traj = res.trajectory
+    mask, start = _last_cycle_window(scene, traj, res.path)
+    win = {k: v[mask] for k, v in traj.items()}
+    loads = articulated_loads_from_trajectory(scene, win)
+    deg = np.degrees(win["phi"] - start)
+    rows, n_links = loads.R.shape[0], loads.link_x.shape[0]
+    out = Path(args.output) if args.output else res.path.parent
+    out.mkdir(parents=True, exist_ok=True)
+    stem = res.path.stem
+    plt = _pyplot()
+    written = []
+    fig, axes = plt.subplots(1, rows, figsize=(6 * rows, 5.5), squeeze=False)
+    for j in range(rows):
+        plots.crankpin_polar(axes[0, j], loads.R_K[j], loads.R_T[j])
+        axes[0, j].set_title(f"master crankpin of row {j + 1}, crank frame", fontsize=9)
+    fig.suptitle(f"{scene.name}: polar load diagram over the last cycle")
+    written.append(_save(fig, out / f"{stem}_loads_polar.png"))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for j in range(rows):
+        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin, row {j + 1}")
+    for i in range(n_links):
+        plots.load_against_angle(ax, deg, np.hypot(loads.link_x[i], loads.link_y[i]),
+                                 label=f"link pin {i + 1}")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{scene.name}: crankpin and link-pin loads over the last cycle (dashed: mean)")
+    written.append(_save(fig, out / f"{stem}_loads_crankpin.png"))
+    cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
+            "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
+    for k in range(loads.P.shape[0]):
+        for name in ("P_g", "P_j", "P", "N", "S", "torque"):
+            cols[f"{name}_{k + 1}_{'Nm' if name == 'torque' else 'N'}"] = getattr(loads, name)[k]
+    for i in range(n_links):
+        cols[f"link_x_{i + 1}_N"], cols[f"link_y_{i + 1}_N"] = loads.link_x[i], loads.link_y[i]
+    for j in range(rows):
+        for name in ("K", "T", "R_K", "R_T", "R"):
+            cols[f"{name}_row{j + 1}_N"] = getattr(loads, name)[j]
+    csv = out / f"{stem}_loads.csv"
+    np.savetxt(csv, np.column_stack(list(cols.values())), delimiter=",",
+               header=",".join(cols), comments="", fmt="%.12g")
+    written.append(csv)
+    print(f"{res.path}: loads over the last cycle (φ = {start:.6g} … "
+          f"{start + mech.cycle:.6g} rad, {int(mask.sum())} samples)")
+    for j in range(rows):
+        i = int(np.argmax(loads.R[j]))
+        print(f"  master crankpin, row {j + 1}: |R| max {loads.R[j][i] / 1e3:.6g} kN at "
+              f"{deg[i]:.4g}° of the cycle, mean {np.mean(loads.R[j]) / 1e3:.6g} kN")
+    for i in range(n_links):
+        print(f"  link pin {i + 1}: |F| max "
+              f"{np.hypot(loads.link_x[i], loads.link_y[i]).max() / 1e3:.6g} kN")
+    for path in written:
+        print(f"  wrote {path}")
+    return EXIT_OK
 
 
 def _last_cycle_window(scene, traj, path):
@@ -630,6 +702,8 @@ def cmd_loads(args) -> int:
     )
 
     res = _open(args.result)
+    if _is_articulated(res.scene()):
+        return _radial_loads(args, res, res.scene())
     scene = _crank_slider_scene(res)
     mech = scene.mechanism
     n_cyl = mech.n_cylinders

@@ -733,8 +733,10 @@ def catalogue() -> list[Case]:
                                  "ω along the run falls monotonically", tolerance_ladder,
              time_limit=120.0,
              known="full suite, time domain: the error at rtol 1e-5 is not below the one at "
-                   "1e-4 (6.3e-5 against 6.2e-5, 40 revolutions); below 1e-5 it falls "
-                   "monotonically — numerical core, left to the lead"),
+                   "1e-4 (6.4e-5 against 4.3e-5, 40 revolutions); below 1e-5 it falls "
+                   "monotonically. A phase drift whose increments fall at the same angles "
+                   "every cycle (7–15° before each firing TDC): local errors of one sign add up "
+                   "unless the step pattern there cancels them (README, Stress suite)"),
         Case("stiff-governor", "a PI governor whose actuator (2 µs) is ~10⁴× faster than the "
                                "engine: detected by the stiffness test, rerun by Radau",
              single(stiff_governor, extra=_stiff_extra, name="stiff-governor"), time_limit=120.0),

@@ -139,3 +139,32 @@ def test_loads_refuses_swash_plate(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "crank-slider" in err
     assert not (tmp_path / "loads").exists()
+
+
+def test_loads_of_a_radial_engine(tmp_path, capsys):
+    """An articulated result: the polar diagram of the master crankpin, the load curves and a
+    CSV whose crankpin load is the analysis function's on the stored samples of the last cycle."""
+    from transient.analysis.loads_radial import articulated_loads_from_trajectory
+
+    scene = tmp_path / "short_radial.toml"
+    scene.write_text(_scene_text("radial_5cyl.toml", "revolutions = 300", "revolutions = 6"))
+    assert main(["run", str(scene), "-o", str(tmp_path), "-q"]) == 0
+    result = tmp_path / "short_radial.h5"
+    capsys.readouterr()
+    out = tmp_path / "loads"
+    assert main(["loads", str(result), "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    for name in ("polar", "crankpin"):
+        _nontrivial_png(out / f"short_radial_loads_{name}.png")
+    csv = _read_csv(out / "short_radial_loads.csv")
+    res = open_result(result)
+    mask = _last_cycle_mask(res)
+    win = {k: v[mask] for k, v in res.trajectory.items()}
+    loads = articulated_loads_from_trajectory(res.scene(), win)
+    # (the CSV holds 12 significant digits)
+    np.testing.assert_allclose(csv["phi_rad"], win["phi"], rtol=1e-11)
+    np.testing.assert_allclose(csv["R_row1_N"], loads.R[0], rtol=1e-10)
+    np.testing.assert_allclose(csv["link_x_4_N"], loads.link_x[3], rtol=1e-10,
+                               atol=1e-10 * np.abs(loads.link_x[3]).max())
+    peak = re.search(r"row 1: \|R\| max ([0-9.eE+-]+) kN", printed)
+    assert peak and float(peak.group(1)) == pytest.approx(loads.R[0].max() / 1e3, rel=1e-6)

@@ -92,13 +92,7 @@ def crank_slider_scenes(draw):
         d["gas"] = {"model": "none"}
     d["load"] = {"torque": draw(st.floats(0.0, 50.0)), "linear": draw(st.floats(0.0, 0.1)),
                  "fan": draw(st.floats(0.0, 1e-3))}
-    n_pairs = draw(st.integers(0, 2))
-    links = [("shaft", "crank"), ("crank", "rod")]
-    if n_pairs:
-        d["friction"] = {"pairs": [{"between": list(links[k]),
-                                    "eta_forward": draw(st.floats(0.5, 1.0)),
-                                    "eta_backward": draw(st.floats(0.5, 1.0))}
-                                   for k in range(n_pairs)]}
+    crank_pairs(draw, d)
     common(draw, d)
     return d
 
@@ -152,6 +146,13 @@ def articulated_scenes(draw):
         put(d, "gas", p_z_MPa=draw(st.floats(1.0, 6.0)))
     put(d, "inertia", flywheel=draw(st.floats(0.5, 8.0)))
     put(d, "load", fan=draw(st.floats(0.0, 0.05)))
+    crank_pairs(draw, d)
+    common(draw, d, omega=(20.0, 250.0))
+    return d
+
+
+def crank_pairs(draw, d):
+    """Up to two non-ideal pairs on a crank mechanism's links (shaft – crank – rod)."""
     n_pairs = draw(st.integers(0, 2))
     links = [("shaft", "crank"), ("crank", "rod")]
     if n_pairs:
@@ -159,8 +160,6 @@ def articulated_scenes(draw):
                                     "eta_forward": draw(st.floats(0.5, 1.0)),
                                     "eta_backward": draw(st.floats(0.5, 1.0))}
                                    for k in range(n_pairs)]}
-    common(draw, d, omega=(20.0, 250.0))
-    return d
 
 
 def common(draw, d, omega=(30.0, 400.0)):

@@ -788,8 +788,9 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             # it was aimed with (at loose tolerances, up to ~1e-3 rad short): lengthen it by the
             # time the rest of the angle takes at the speed reached (a secant step), rather than
             # leaving a sliver that the next step would cross and retake again.
-            rest = (fst[F_REDO_LEVEL] - y_new[PHI]) / y_new[OMEGA]
-            if abs(fst[F_REDO_LEVEL] - y_new[PHI]) > BP_LANDING and rest > 0.0:
+            short = fst[F_REDO_LEVEL] - y_new[PHI]
+            rest = short / y_new[OMEGA] if y_new[OMEGA] != 0.0 else -1.0
+            if abs(short) > BP_LANDING and 0.0 < rest < h:
                 fst[F_H] = h + rest
                 ist[I_NREDO] += 1
                 ist[I_NREJECT] += 1
