@@ -330,3 +330,41 @@ def test_simultaneous_pair_switches_and_a_denormal_link(crank_mass):
     data = integrate(scene_of(copy.deepcopy(d), "massless-crank"))
     assert data.complete, data.message  # coasting with ideal pairs: nothing stops it
     check(d)
+
+
+# A failure found by the full profile (crank-slider): a single 2-stroke cylinder with one pair of
+# η = 0.5 coasting into its gas pulse. The pair's power reverses at the TDC (φ = 2π, a breakpoint)
+# for 0.087 rad only. The step from 2π saw the margin below zero in its stages but not at its four
+# samples, and took no event: the compiled end speed was 3.5e-5 off (3534 tolerance units
+# against a bound of 1058). Found by the fine search (64 samples) now; the switch it makes at
+# 2π then met the rule that undid a switch whose margin is below zero a quarter step on, which
+# took the short rise for a touch and chattered; the rule now looks for the rise first
+# (transient.core.integrate._fall_after_rise).
+SHORT_REVERSAL = {
+    "mechanism": {"type": "crank-slider", "crank_radius_mm": 35.252687217558076,
+                  "rod_length_mm": 144.42229924612502, "bore_mm": 50.0,
+                  "piston_mass": 1.749101213621759, "crank_mass": 0.0, "strokes": 2,
+                  "cylinders": 1, "offset_mm": 0.0, "firing_deg": [0.0],
+                  "rod": {"model": "two-mass", "mass": 1.0134365765152848,
+                          "cg_from_pin_mm": 72.21114962306251}},
+    "gas": {"model": "trapezoid", "amplitude": 16616.349000214166, "ramp_deg": 27.5871915001266,
+            "duration_deg": 180.0},
+    "inertia": {"shaft": 0.21123566695891272},
+    "load": {"torque": 0.0, "linear": 0.0, "fan": 0.0},
+    "initial": {"phi": 0.0, "omega": 160.59392711007897},
+    "run": {"revolutions": 1.236750721702853, "t_end": 0.3},
+    "solver": {"rtol": 1e-08, "atol": 1e-10, "domain": "auto"},
+    "output": {"samples_per_rev": 72, "dt": 0.0002},
+    "friction": {"pairs": [{"between": ["shaft", "crank"], "eta_forward": 0.5,
+                            "eta_backward": 0.5}]},
+}
+
+
+def test_short_power_reversal_inside_a_step():
+    import copy
+
+    data = integrate(scene_of(copy.deepcopy(SHORT_REVERSAL), "short-reversal"))
+    switches = data.events["pair_mode"][:, 1]
+    assert np.any(np.abs(switches - 2 * math.pi) < 1e-9)  # into the reversal at the TDC …
+    assert np.any(np.abs(switches - 6.37005) < 1e-4)  # … and out of it 0.087 rad later
+    check(copy.deepcopy(SHORT_REVERSAL))

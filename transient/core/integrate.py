@@ -312,41 +312,77 @@ def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
             gs[j, k] = wk[WK_G, k]
 
 
+#: Samples of the fine search for a crossing that a step's stages show and its coarse samples
+#: miss (a pair's power reversing for a few degrees inside a long step); a crossing that these
+#: miss too makes the step be retaken shorter, at most MAX_UNSEEN times in a row.
+N_FINE_SAMPLES, MAX_UNSEEN = 64, 3
+
+
 @kernel
-def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp, wk):
-    """θ where the speed (or the PI demand, ``comp``) first crosses ``level`` (in ``direction``)
-    inside a step whose ends are on the same side of it, sampled at θ = j/N_MARGIN_SAMPLES on the
-    dense output; 2 if the samples see no crossing (it was only in a stage)."""
+def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp, wk,
+                     n_samples):
+    """θ where the speed, the PI demand or a pair's margin (``comp``) first crosses ``level``
+    (in ``direction``) inside a step whose ends are on the same side of it, sampled at
+    θ = j/n_samples on the dense output; 2 if the samples see no crossing (it was only in a
+    stage, or between samples). Returns (θ, evaluations)."""
     ix = PHI if angle_mode else T
     g_prev = ga
-    for j in range(1, N_MARGIN_SAMPLES + 1):
-        theta = j / N_MARGIN_SAMPLES
+    for j in range(1, n_samples + 1):
+        theta = j / n_samples
         _dense_eval(F, y, theta, tmp)
         tmp[ix] = x + theta * h
         g = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
         if _crosses(g_prev, g, direction):
-            return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
-                         (j - 1) / N_MARGIN_SAMPLES, theta, g_prev, g)[0]
+            root, evals = _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
+                                (j - 1) / n_samples, theta, g_prev, g)
+            return root, j + evals
         g_prev = g
-    return 2.0
+    return 2.0, n_samples
 
 
 @kernel
-def _pair_crossing(m, angle_mode, F, y, k, sel, sw, tmp, wk, gs):
+def _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
     margin evaluations (right-hand sides) the root finding took.
 
-    A margin that starts at 0 (an event has just switched this pair's mode) and falls below it
-    at once means the power only touched zero there and turns back: the switch is undone at the
-    step's start (θ = 0).
+    A margin that starts at 0 (an event has just switched this pair's mode) and is below it a
+    sample on either fell at once — the power only touched zero there and turns back, and the
+    switch is undone at the step's start (θ = 0) — or first rose for less than a sample's span
+    (the power reversed for a few degrees): :func:`_fall_after_rise` tells which.
     """
     if gs[0, k] == 0.0 and gs[1, k] < 0.0:
-        return 0.0, 0
+        return _fall_after_rise(m, angle_mode, F, y, x, h, k, 1.0 / N_MARGIN_SAMPLES, sel, sw,
+                                tmp, wk)
     for j in range(N_MARGIN_SAMPLES):
         if _crosses(gs[j, k], gs[j + 1, k], -1):
             return _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
                          j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
     return 2.0, 0
+
+
+@kernel
+def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
+    """For a margin that starts at 0 and is below it at ``theta_end``: θ where it falls to zero
+    after rising above it (sampled at N_FINE_SAMPLES points up to ``theta_end``), or 0 if no
+    sample rises above zero (it fell at once). Returns (θ, evaluations)."""
+    ix = PHI if angle_mode else T
+    rose = False
+    g_prev = 0.0
+    th_prev = 0.0
+    for j in range(1, N_FINE_SAMPLES + 1):
+        theta = theta_end * j / N_FINE_SAMPLES
+        _dense_eval(F, y, theta, tmp)
+        tmp[ix] = x + theta * h
+        margins_at(m, angle_mode, tmp, sel, sw, wk)
+        g = wk[WK_G, k]
+        if rose and g <= 0.0:
+            root, evals = _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
+                                th_prev, theta, g_prev, g)
+            return root, j + evals
+        rose = rose or g > 0.0
+        g_prev = g
+        th_prev = theta
+    return 0.0, N_FINE_SAMPLES
 
 
 @kernel
@@ -615,6 +651,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
     atol = cfg[C_ATOL]
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
     n_bad = 0  # consecutive non-finite step attempts
+    n_unseen = 0  # consecutive attempts retaken for a crossing no sample found
     rejected = False  # the last attempt was rejected by the error test
     g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics,
     g1 = g0 + gv.n_states(m.gov_dyn)
@@ -801,6 +838,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         # State events on this step: the earliest one truncates it.
         ev_code = -1
         ev_theta = 2.0
+        unseen = False  # a pair's margin dipped below zero in the stages only
         ev_comp = 0
         ev_level = 0.0
         ev_rising = True
@@ -821,9 +859,15 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             if comp >= PAIR_COMP:
                 if not dip:
                     continue
-                theta, evals = _pair_crossing(m, angle_mode, F, y, comp - PAIR_COMP, sel, sw, tmp,
-                                              wk, gs)
+                k = comp - PAIR_COMP
+                theta, evals = _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs)
                 ist[I_NFEV] += evals
+                if theta > 1.0 and wk[WK_G_MIN, k] < 0.0 <= gs[0, k]:
+                    # the stages saw the margin fall below zero, the samples did not
+                    theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, 0.0, -1,
+                                                    gs[0, k], sel, sw, tmp, wk, N_FINE_SAMPLES)
+                    ist[I_NFEV] += evals
+                    unseen = unseen or theta > 1.0
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
                 continue
@@ -848,13 +892,26 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 if ends:
                     theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
                 else:
-                    theta = _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction,
-                                             ga, sel, sw, tmp, wk)
+                    theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, level,
+                                                    direction, ga, sel, sw, tmp, wk,
+                                                    N_MARGIN_SAMPLES)
+                    if theta > 1.0:
+                        theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, level,
+                                                        direction, ga, sel, sw, tmp, wk,
+                                                        N_FINE_SAMPLES)
+                    ist[I_NFEV] += evals
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
                     # the crossing's direction: from below (an 'inside' crossing is the first
                     # one away from the step's start, so this holds for it too)
                     ev_rising = ga < 0.0 or (ga == 0.0 and gb > 0.0)
+        if unseen and ev_code < 0 and n_unseen < MAX_UNSEEN:
+            fst[F_H] = 0.5 * h  # (counted as a rejection: the step is computed again, shorter)
+            n_unseen += 1
+            ist[I_NREJECT] += 1
+            steps_here += 1
+            continue
+        n_unseen = 0
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
         # Output samples inside the step (dense output), then the step's end state.
         d_out = _out_spacing(cfg, angle_mode)
@@ -878,6 +935,11 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 f[i] = K[tab.n_stages, i]
             for k in range(gs.shape[1]):
                 gs[0, k] = gs[N_MARGIN_SAMPLES, k]
+                if gs[0, k] < 0.0:
+                    # A margin that the step's end leaves below zero (a root on the step's end,
+                    # by rounding on its far side) would never be seen falling: the next step
+                    # settles the modes first (_settle_modes).
+                    ist[I_F_VALID] = 0
             if angle_mode and at_segment_end and x_end == up:
                 _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
                 if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
