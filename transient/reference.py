@@ -127,7 +127,14 @@ class ChainNumpy:
         # 1/η_b, so its root a = Σ c_k R_k / Σ c_k J_k is within Σ|R| / ΣJ · η_min^(−2n). (ΣJ is
         # J(φ) > 0; a bound on the least J_k overflows when a link's inertia is denormal.)
         eta_min = min(np.min(self.eta_f), np.min(self.eta_b))
-        scale = (np.sum(np.abs(R)) + 1e-300) / np.sum(Jk) / eta_min ** (2 * self.n)
+        with np.errstate(over="ignore", invalid="ignore"):
+            scale = (np.sum(np.abs(R)) + 1e-300) / np.sum(Jk) / eta_min ** (2 * self.n)
+        if not np.isfinite(scale):
+            # A trial stage of a loose tolerance has left the physical range: a non-finite
+            # derivative makes solve_ivp reject the step and shorten it (as the compiled stepper
+            # does), where Brent's method would raise.
+            nan = np.full(self.n, np.nan)
+            return np.nan, nan, nan
         a = brentq(lambda x: self._sweep(x, Jk, R, sigma)[0], -2 * scale, 2 * scale,
                    xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
         S = self._sweep(a, Jk, R, sigma)[1]

@@ -207,3 +207,20 @@ def test_compiled_run_reaches_its_end_for_any_max_step(max_step_deg, compiled_ru
     assert expected.size == 45
     assert got.size == expected.size, f"{got.size} breakpoint events, expected {expected.size}"
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+
+
+def test_chain_of_a_nonfinite_trial_stage_is_not_a_number():
+    """A trial stage of solve_ivp at a loose tolerance can leave the physical range (the bench's
+    governed diesel at rtol 1e-3: a moment overflowed). The chain then gives a non-finite
+    acceleration, which solve_ivp rejects and retakes shorter, where Brent's method raised a
+    ValueError (was a bug: `transient bench` recorded the reference as failed; on 1000
+    revolutions the run now completes)."""
+    scene = load_scene(CASES / "gots_diesel_governed.toml")
+    chain = reference.ChainNumpy(scene)
+    n = chain.n
+    Jk, dJk = np.full(n + 1, 0.1), np.zeros(n + 1)
+    a, S, eta = chain.solve(Jk, dJk, np.full(n + 1, 10.0), 100.0, 1.0)
+    assert np.isfinite(a) and np.all(np.isfinite(S))  # (a finite state: a number)
+    for Mk in (np.array([np.inf] + [0.0] * n), np.array([1e308] * (n + 1))):
+        a, S, eta = chain.solve(Jk, dJk, Mk, 100.0, 1.0)
+        assert np.isnan(a) and np.all(np.isnan(S)) and np.all(np.isnan(eta))

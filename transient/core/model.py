@@ -37,7 +37,9 @@ from .tables import find_piece, table_eval, table_eval_pair
 #: ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k holds to the solver's accuracy.
 #: After them the dynamic governor's states (:mod:`.governor`, from :func:`gov_index`), then, with
 #: fuel latching, the fuel each cylinder took at its last injection (:func:`latch_index`; held
-#: constant between injections: their derivative is zero and the stepper sets them).
+#: constant between injections: their derivative is zero and the stepper sets them), then, with
+#: wall heat transfer, each cylinder's pressure in its closed part (:func:`cyl_index`,
+#: :mod:`.cylinder`; the ``p_<k>`` columns show it there).
 STATE = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
 PHI, T, OMEGA, W_GAS, W_LOAD, W_STARTER = range(6)
 KINETIC = OMEGA
