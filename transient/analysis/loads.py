@@ -320,28 +320,33 @@ def gas_forces(scene, phi: ArrayLike, fuel: ArrayLike = 1.0) -> Array:
     return gas_force_from_pressure(mech, value, scene.gas.p0)
 
 
-def loads_from_trajectory(scene, traj) -> CylinderLoads:
-    """:func:`crank_slider_loads` along a run's trajectory (``phi``, ``omega``, ``epsilon``).
+def trajectory_gas_force(scene, traj) -> Array | None:
+    """Gas force on each piston [N], shape ``(n_cylinders, n)``, along a run's trajectory; None
+    without gas. Any mechanism with ``n_cylinders`` and ``piston_area``.
 
-    The gas force comes from the recorded ``p_<k>`` columns (the value applied at the governor's
-    fuel; Pa, or N for a force model) when present, else from the scene's tables at the recorded
-    ``fuel`` (1 if absent). Note that a prescribed-speed run with ``fuel`` ≠ 1
+    From the recorded ``p_<k>`` columns (the value applied at the governor's fuel; Pa, or N for a
+    force model) when present, else from the scene's tables at the recorded ``fuel`` (1 if
+    absent). Note that a prescribed-speed run with ``fuel`` ≠ 1
     (:func:`transient.simulate.prescribed`) scales the force without recording it in ``p_<k>``.
     """
     from ..assemble import gas_is_force
 
     mech = scene.mechanism
-    phi = np.asarray(traj["phi"], dtype=np.float64)
     names = [f"p_{k + 1}" for k in range(mech.n_cylinders)]
     if scene.gas.model == "none":
-        force = None
-    elif all(n in traj for n in names):
+        return None
+    if all(n in traj for n in names):
         value = np.vstack([np.asarray(traj[n], dtype=np.float64) for n in names])
-        force = value if gas_is_force(scene) else gas_force_from_pressure(mech, value,
-                                                                          scene.gas.p0)
-    else:
-        force = gas_forces(scene, phi, traj.get("fuel", 1.0))
-    return crank_slider_loads(mech, phi, traj["omega"], traj["epsilon"], force)
+        return value if gas_is_force(scene) else gas_force_from_pressure(mech, value,
+                                                                         scene.gas.p0)
+    return gas_forces(scene, np.asarray(traj["phi"], dtype=np.float64), traj.get("fuel", 1.0))
+
+
+def loads_from_trajectory(scene, traj) -> CylinderLoads:
+    """:func:`crank_slider_loads` along a run's trajectory (``phi``, ``omega``, ``epsilon``), the
+    gas force from :func:`trajectory_gas_force`."""
+    return crank_slider_loads(scene.mechanism, np.asarray(traj["phi"], dtype=np.float64),
+                              traj["omega"], traj["epsilon"], trajectory_gas_force(scene, traj))
 
 
 def engine_torque(loads: CylinderLoads) -> Array:

@@ -80,11 +80,10 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import articulated as core
 from ..mechanisms.articulated import Articulated, positions
 from .loads import (
-    gas_force_from_pressure,
-    gas_forces,
     rod_split,
     rotating_inertia_force,
     slider_arrays,
+    trajectory_gas_force,
 )
 
 __all__ = [
@@ -94,7 +93,6 @@ __all__ = [
     "articulated_loads_from_trajectory",
     "pin_forces",
     "row_kinematics",
-    "trajectory_gas_force",
 ]
 
 Array = NDArray[np.float64]
@@ -349,27 +347,6 @@ def articulated_loads(mech: Articulated, phi: ArrayLike, omega: ArrayLike, epsil
         T=row["T"], K_rod=k_rod, T_rod=t_rod, K_crank=k_crank, T_crank=t_crank, R_K=r_k, R_T=r_t,
         R=np.hypot(r_k, r_t), link_power=row["link_power"], throw_torque=(r_t + t_crank) * r,
         r=r, area=mech.piston_area)
-
-
-def trajectory_gas_force(scene, traj) -> Array | None:
-    """Gas force on each piston [N], shape (n_cylinders, n), along a trajectory; None without gas.
-
-    From the recorded ``p_<k>`` columns (the value applied at the governor's fuel; Pa, or N for a
-    force model) when all are present, else from the scene's tables at the recorded ``fuel`` (1 if
-    absent) — the rule of :func:`transient.analysis.loads.loads_from_trajectory`, for any
-    mechanism with ``n_cylinders`` and ``piston_area``.
-    """
-    from ..assemble import gas_is_force
-
-    mech = scene.mechanism
-    names = [f"p_{k + 1}" for k in range(mech.n_cylinders)]
-    if scene.gas.model == "none":
-        return None
-    if all(name in traj for name in names):
-        value = np.vstack([np.asarray(traj[name], dtype=np.float64) for name in names])
-        return value if gas_is_force(scene) else gas_force_from_pressure(mech, value,
-                                                                         scene.gas.p0)
-    return gas_forces(scene, np.asarray(traj["phi"], dtype=np.float64), traj.get("fuel", 1.0))
 
 
 def articulated_loads_from_trajectory(scene, traj) -> ArticulatedLoads:

@@ -64,7 +64,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..core import swash_plate as core
 from ..mechanisms.swash_plate import SwashPlate
-from .loads_radial import trajectory_gas_force
+from .loads import trajectory_gas_force
 
 __all__ = [
     "SwashKinematics",
@@ -257,6 +257,6 @@ def swash_loads(mech: SwashPlate, phi: ArrayLike, omega: ArrayLike, epsilon: Arr
 
 def swash_loads_from_trajectory(scene, traj) -> SwashLoads:
     """:func:`swash_loads` along a run's trajectory (``phi``, ``omega``, ``epsilon``; the gas
-    force of :func:`transient.analysis.loads_radial.trajectory_gas_force`)."""
+    force of :func:`transient.analysis.loads.trajectory_gas_force`)."""
     return swash_loads(scene.mechanism, traj["phi"], traj["omega"], traj["epsilon"],
                        trajectory_gas_force(scene, traj))
