@@ -516,6 +516,12 @@ def _pyplot():
     return plt
 
 
+def _write_columns(path, cols: dict) -> None:
+    """A CSV of equal-length columns, named by the keys (12 significant digits)."""
+    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols),
+               comments="", fmt="%.12g")
+
+
 def _save(fig, path):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -559,25 +565,20 @@ def cmd_kinematics(args) -> int:
 WEAR_HALF_ARC_DEG = 60.0
 
 
-def _crank_slider_scene(res):
-    """The result's scene, or a one-line error (exit 2) if its mechanism is not a crank-slider
-    (nor, for ``loads``, articulated: those go to :func:`_radial_loads`)."""
+def _loads_scene(res):
+    """The result's scene, or a one-line error (exit 2) if ``transient loads`` draws nothing for
+    its mechanism: crank-slider and articulated engines only."""
+    from .mechanisms.articulated import Articulated
     from .mechanisms.crank_slider import CrankSlider
 
     scene = res.scene()
-    if not isinstance(scene.mechanism, CrankSlider):
+    if not isinstance(scene.mechanism, (CrankSlider, Articulated)):
         raise SceneError("mechanism.type", f"load diagrams are drawn for crank-slider and "
                                            f"articulated engines, not "
                                            f"{type(scene.mechanism).__name__} (its forces are "
                                            f"stored by [analysis] loads = true)",
                          file=str(res.path))
     return scene
-
-
-def _is_articulated(scene) -> bool:
-    from .mechanisms.articulated import Articulated
-
-    return isinstance(scene.mechanism, Articulated)
 
 
 def _radial_loads(args, res, scene) -> int:
@@ -625,8 +626,7 @@ def _radial_loads(args, res, scene) -> int:
         for name in ("K", "T", "R_K", "R_T", "R"):
             cols[f"{name}_row{j + 1}_N"] = getattr(loads, name)[j]
     csv = out / f"{stem}_loads.csv"
-    np.savetxt(csv, np.column_stack(list(cols.values())), delimiter=",",
-               header=",".join(cols), comments="", fmt="%.12g")
+    _write_columns(csv, cols)
     written.append(csv)
     print(f"{res.path}: loads over the last cycle (φ = {start:.6g} … "
           f"{start + mech.cycle:.6g} rad, {int(mask.sum())} samples)")
@@ -701,10 +701,12 @@ def cmd_loads(args) -> int:
         running_torques,
     )
 
+    from .mechanisms.articulated import Articulated
+
     res = _open(args.result)
-    if _is_articulated(res.scene()):
-        return _radial_loads(args, res, res.scene())
-    scene = _crank_slider_scene(res)
+    scene = _loads_scene(res)
+    if isinstance(scene.mechanism, Articulated):
+        return _radial_loads(args, res, scene)
     mech = scene.mechanism
     n_cyl = mech.n_cylinders
     if not 1 <= args.cylinder <= n_cyl:
@@ -793,8 +795,7 @@ def cmd_loads(args) -> int:
         for j in range(mj.x.shape[0]):
             cols[f"R_main_{j + 1}_N"] = mj.magnitude[j]
     csv = out / f"{stem}_loads.csv"
-    np.savetxt(csv, np.column_stack(list(cols.values())), delimiter=",",
-               header=",".join(cols), comments="", fmt="%.12g")
+    _write_columns(csv, cols)
     written.append(csv)
 
     area = loads.area
@@ -890,8 +891,7 @@ def cmd_orders(args) -> int:
         cols_csv["W_relative_constant"] = rep.relative_constant[-1]
         cols_csv["W_relative_added"] = rep.relative_added[-1]
     csv = out / f"{stem}_orders.csv"
-    np.savetxt(csv, np.column_stack(list(cols_csv.values())), delimiter=",",
-               header=",".join(cols_csv), comments="", fmt="%.12g")
+    _write_columns(csv, cols_csv)
     written.append(csv)
 
     plt = _pyplot()
@@ -936,8 +936,7 @@ def cmd_orders(args) -> int:
                "omega_mean_rad_s": means}
         run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j] for j in sel})
         csv = out / f"{stem}_orders_runup.csv"
-        np.savetxt(csv, np.column_stack(list(run.values())), delimiter=",",
-                   header=",".join(run), comments="", fmt="%.12g")
+        _write_columns(csv, run)
         written.append(csv)
 
     print(f"{res.path}: orders over the last whole cycle (φ = {starts[-1]:.6g} … "
