@@ -20,6 +20,7 @@ Profiles: CI runs ``EXAMPLES_CI`` examples per mechanism; ``TRANSIENT_STRESS_FUL
 from __future__ import annotations
 
 import contextlib
+import copy
 import math
 import os
 import signal
@@ -292,8 +293,6 @@ GOVERNOR_CORNER = {
 
 
 def test_governor_corner_compiled_against_reference():
-    import copy
-
     check(copy.deepcopy(GOVERNOR_CORNER))
 
 
@@ -323,8 +322,6 @@ MASSLESS_CRANK = {
 
 @pytest.mark.parametrize("crank_mass", [0.0, 2.2250738585e-313])
 def test_simultaneous_pair_switches_and_a_denormal_link(crank_mass):
-    import copy
-
     d = copy.deepcopy(MASSLESS_CRANK)
     d["mechanism"]["crank_mass"] = crank_mass
     data = integrate(scene_of(copy.deepcopy(d), "massless-crank"))
@@ -361,8 +358,6 @@ SHORT_REVERSAL = {
 
 
 def test_short_power_reversal_inside_a_step():
-    import copy
-
     data = integrate(scene_of(copy.deepcopy(SHORT_REVERSAL), "short-reversal"))
     switches = data.events["pair_mode"][:, 1]
     assert np.any(np.abs(switches - 2 * math.pi) < 1e-9)  # into the reversal at the TDC …

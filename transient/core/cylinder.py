@@ -68,10 +68,9 @@ def release_rate(par, x, fuel):
 
 
 @kernel(inline="always")
-def wall_heat(par, burnt, p, V, w):
-    """Q̇_w [W], the heat flow into the walls (Woschni's h, see the module docstring); ``burnt``:
-    past the combustion start (Woschni's combustion term on)."""
-    T = par[T_A] * p * V / (par[P_A] * par[V_A])
+def wall_heat(par, burnt, p, V, T, w):
+    """Q̇_w [W], the heat flow into the walls at gas temperature T (Woschni's h, see the module
+    docstring); ``burnt``: past the combustion start (Woschni's combustion term on)."""
     bore = par[BORE]
     c_m = par[STROKE] * abs(w) / math.pi
     velocity = par[C1] * c_m
@@ -96,5 +95,5 @@ def pressure_rate(mech, par, x, x_sel, local, p, dVdx, w, fuel):
     burnt = x_sel >= par[START]
     release = release_rate(par, x, fuel) if burnt and x_sel < par[START] + par[DURATION] else 0.0
     A = (g - 1.0) / V * release - g * p / V * dVdx
-    B = (g - 1.0) / V * wall_heat(par, burnt, p, V, w)
+    B = (g - 1.0) / V * wall_heat(par, burnt, p, V, T, w)
     return A, B
