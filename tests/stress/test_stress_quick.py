@@ -19,3 +19,16 @@ def test_stress_quick(tmp_path, capsys):
         cells = row.split(" | ")
         assert cells[2] == "pass" or (case.known and cells[2] == "**known failure**"), row
     assert "**FAIL**" not in report
+
+
+def test_the_ladder_rule_catches_a_rise_and_ignores_the_floor():
+    """``tolerance-ladder``'s monotonicity rule: a rise fails it, unless it is above the rtol
+    the rule starts from or below the reference's noise floor."""
+    from transient.stress import LADDER_FLOOR, _falls
+
+    rtols = [1e-3, 1e-4, 1e-5, 1e-6]
+    assert _falls(rtols, [1e-3, 1e-4, 1e-5, 1e-6])
+    assert not _falls(rtols, [1e-3, 2e-3, 1e-5, 1e-6])
+    assert _falls(rtols, [1e-3, 2e-3, 1e-5, 1e-6], below=1e-4)
+    assert not _falls(rtols, [1e-3, 2e-3, 1e-5, 2e-5], below=1e-4)
+    assert _falls(rtols, [1e-3, 1e-4, LADDER_FLOOR / 2, LADDER_FLOOR])
