@@ -10,7 +10,8 @@ For each benchmark scene (:data:`BENCH_SCENES`), over ``revolutions`` (1000):
   paths (:data:`ADAPTIVE`: DOP853 and DOPRI5 in crank angle and in time, DOP853 with the tabulated
   reduced model), and a sweep of the step for the fixed-step DOP853 with tables (:data:`FIXED`,
   :data:`STEPS_PER_REV`), each timed as the median of ``repeat`` runs after a warm-up, the compile
-  (or cache load) apart, integration loop only (``/solver wall_s``);
+  (or cache load) apart, integration loop only (``/solver wall_s``), writing one output sample per
+  revolution (:data:`TIMED_SAMPLES_PER_REV`: the baselines are timed without dense output);
 * baselines in the same run: ``scipy.integrate.solve_ivp`` RK45 and DOP853 with the plain-numpy
   right-hand side of :mod:`transient.reference` (breakpoints as terminal events, only the state
   kept), one run each (they take seconds to minutes), from loose to tight until a run is stopped
@@ -58,6 +59,12 @@ REF_RTOL = 1e-13
 #: The accuracy at which speed is compared: final phase error after 1000 revolutions [rad].
 TARGET_PHASE = 1e-6
 SAMPLES_PER_REV = 72
+#: Output of the timed runs of transient's paths: one sample per turn (in time, one per turn at
+#: the final speed). The baselines are timed without dense output (CyRK keeps each step's state,
+#: solve_ivp only the state), so transient is timed writing as little; the samples of the last
+#: cycle for the L2 error come from an untimed rerun at SAMPLES_PER_REV (the same steps: the
+#: output spacing only bounds the step at 256 samples, far from binding here).
+TIMED_SAMPLES_PER_REV = 1
 
 #: transient's compiled paths in the sweep: label → solver settings. Adaptive ones sweep rtol.
 ADAPTIVE = {
@@ -79,14 +86,13 @@ COLUMNS = ("scene", "method", "rtol", "step_rad", "wall_s", "compile_s", "repeat
            "nsteps", "nreject", "phase_err_rad", "omega_rel_err", "omega_l2_rel_err")
 
 
-def _scene(base, method, rtol, revolutions, dt=0.0, **solver):
+def _scene(base, method, rtol, revolutions, dt=0.0, samples=SAMPLES_PER_REV, **solver):
     """``base`` over ``revolutions`` with a method, rtol (atol = rtol·ATOL_PER_RTOL) and any other
-    solver settings; output at SAMPLES_PER_REV per turn (or every ``dt`` in time)."""
+    solver settings; output at ``samples`` per turn (or every ``dt`` in time)."""
     solver = dc.replace(base.solver, method=method, rtol=rtol, atol=rtol * ATOL_PER_RTOL,
                         **solver)
     return dc.replace(base, run=dc.replace(base.run, revolutions=revolutions, t_end=math.inf),
-                      solver=solver, output=dc.replace(base.output,
-                                                       samples_per_rev=SAMPLES_PER_REV, dt=dt))
+                      solver=solver, output=dc.replace(base.output, samples_per_rev=samples, dt=dt))
 
 
 @dc.dataclass
@@ -154,19 +160,25 @@ def _compiled(name, base, ref, label, settings, rtol, revolutions, repeat, step=
     """One compiled path (``settings``: solver fields) at one rtol or fixed step [rad]."""
     time_domain = settings.get("domain") == "time"
     settings = dict(settings, fixed_step=step)
+    sparse = SAMPLES_PER_REV / TIMED_SAMPLES_PER_REV
     scene = _scene(base, settings.pop("method"), rtol, revolutions,
-                   _dt(base, ref) if time_domain else 0.0, **settings)
+                   _dt(base, ref) * sparse if time_domain else 0.0, TIMED_SAMPLES_PER_REV,
+                   **settings)
     first = integrate(scene, keep=False)
     walls, data = [], None
     for _ in range(repeat):
         data = integrate(scene, keep=False)
         walls.append(data.solver["wall_s"])
-    # The final state from the timed run; the last cycle's samples from an untimed rerun (in time
-    # with 8× denser output, so that the spline through them adds nothing measurable; its step
-    # bound follows the output spacing, so its steps may differ slightly).
+    # The final state from the timed run; the last cycle's samples from an untimed rerun at
+    # SAMPLES_PER_REV (in time with 8× denser output, so that the spline through them adds nothing
+    # measurable; there the step bound, 256 output intervals, can bind, so steps may differ).
     end = data.trajectory
-    full = integrate(dc.replace(scene, output=dc.replace(scene.output, dt=scene.output.dt / 8))
-                     if time_domain else scene)
+    dense = dc.replace(scene.output, samples_per_rev=SAMPLES_PER_REV,
+                       dt=scene.output.dt / sparse / 8)
+    full = integrate(dc.replace(scene, output=dense))
+    if not time_domain and full.solver["nsteps"] != data.solver["nsteps"]:
+        raise RuntimeError(f"{name} {label}: the rerun for the samples took "
+                           f"{full.solver['nsteps']} steps, the timed run {data.solver['nsteps']}")
     tr = full.trajectory
     phase, w_err = _end_errors(ref, end["t"][-1], end["omega"][-1])
     l2 = _l2_error(ref, tr["phi"], tr["omega"])
@@ -407,7 +419,10 @@ def write_record(rows, refs, out: Path, revolutions) -> None:
     lines = [f"# Work-precision record ({revolutions:g} revolutions)", "",
              "Written by `transient bench` (see its docstring for what is measured). Compiled "
              "paths and CyRK: median of the runs after a warm-up, compile apart; solve_ivp: one "
-             f"run. Speed compared at a final phase error ≤ {TARGET_PHASE:g} rad.", ""]
+             f"run. Speed compared at a final phase error ≤ {TARGET_PHASE:g} rad. Output while "
+             f"timed: transient {TIMED_SAMPLES_PER_REV} sample per revolution, CyRK the state at "
+             "each step, solve_ivp the state (no dense output for any); the last cycle's samples "
+             "for the L2 error come from untimed reruns.", ""]
     for scene, ref in refs.items():
         lines += [f"## {scene}", "",
                   f"Reference: DOP853 in crank angle at rtol = atol = {REF_RTOL:g}; the same in "
