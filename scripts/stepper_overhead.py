@@ -1,6 +1,7 @@
 """Stepper overhead: wall time of a run against (RHS evaluations × cost of one compiled RHS
 call), for the benchmark scenes and the Gots spin-up with and without friction pairs, at rtol 1e-8
-over 1000 revolutions (issue 5's target: ≤ 30 %).
+over 1000 revolutions (issue 5's target: ≤ 30 %), writing 72 output samples per turn and writing
+one (as ``transient bench`` times its runs).
 The cost of one call is timed in a compiled loop over 2000 states taken from the run itself (in
 crank angle, as the run integrates), median of 5 loops. Rerun:
 ``.venv/bin/python scripts/stepper_overhead.py`` (about 20 s).
@@ -35,16 +36,22 @@ def rhs_loop(m, states, out, sw, wk):
 
 SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
               gots_friction=CASES / "gots_diesel_friction.toml")
-for name, path in SCENES.items():
-    base = load_scene(path)
-    scene = dc.replace(base, run=dc.replace(base.run, revolutions=1000.0, t_end=np.inf),
-                       solver=dc.replace(base.solver, rtol=1e-8, atol=1e-11))
+def timed(scene, samples_per_rev):
+    """Median wall time of 5 runs after a warm-up, and the runs' RHS evaluations and steps."""
+    scene = dc.replace(scene, output=dc.replace(scene.output, samples_per_rev=samples_per_rev))
     integrate(scene, keep=False)
     walls = []
     for _ in range(5):
         data = integrate(scene, keep=False)
         walls.append(data.solver["wall_s"])
-    wall, nfev = statistics.median(walls), data.solver["nfev"]
+    return statistics.median(walls), data.solver["nfev"], data.solver["nsteps"]
+
+
+for name, path in SCENES.items():
+    base = load_scene(path)
+    scene = dc.replace(base, run=dc.replace(base.run, revolutions=1000.0, t_end=np.inf),
+                       solver=dc.replace(base.solver, rtol=1e-8, atol=1e-11))
+    runs = {n: timed(scene, n) for n in (72, 1)}
     model, _, _ = build_model(scene)
     tr = integrate(dc.replace(scene, run=dc.replace(scene.run, revolutions=50.0))).trajectory
     pick = np.linspace(0, tr["t"].size - 1, 2000).astype(int)
@@ -63,5 +70,8 @@ for name, path in SCENES.items():
             rhs_loop(model, states, out, sw, wk)
         loops.append((time.perf_counter() - t0) / (50 * pick.size))
     per_call = statistics.median(loops)
-    print(f"{name}: {nfev} RHS evaluations, {wall:.4g} s, one call {per_call * 1e6:.3f} µs → "
-          f"RHS {nfev * per_call:.4g} s, stepper overhead {wall / (nfev * per_call) - 1:+.0%}")
+    for n, (wall, nfev, nsteps) in runs.items():
+        print(f"{name}, {n} samples/turn: {nfev} RHS evaluations, {nsteps} steps, {wall:.4g} s, "
+              f"one call {per_call * 1e6:.3f} µs → RHS {nfev * per_call:.4g} s, stepper overhead "
+              f"{wall / (nfev * per_call) - 1:+.0%} ({(wall - nfev * per_call) / nsteps * 1e6:.2f}"
+              f" µs a step)")
