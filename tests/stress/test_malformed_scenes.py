@@ -18,45 +18,14 @@ from pathlib import Path
 
 import h5py
 import pytest
+from scene_texts import SMALL
 
 from transient.cli import main
 from transient.results import PROBE_BYTES
 
 REPO = Path(__file__).resolve().parents[2]
 
-VALID = """\
-[scene]
-name = "small"
-
-[mechanism]
-type = "crank-slider"
-crank_radius_mm = 47
-rod_length_mm = 148
-bore_mm = 88
-piston_mass = 1.520
-crank_mass = 0.912
-
-[mechanism.rod]
-model = "two-mass"
-mass = 1.752
-cg_from_pin_mm = 107.3
-
-[inertia]
-shaft = 0.02
-
-[initial]
-omega_rpm = 1000
-
-[run]
-revolutions = 2
-
-[solver]
-rtol = 1e-6
-atol = 1e-8
-
-[output]
-samples_per_rev = 12
-"""
+VALID = SMALL
 
 SWASH = (REPO / "cases" / "swash_plate_4cyl.toml").read_text(encoding="utf-8")
 

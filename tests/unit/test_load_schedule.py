@@ -19,43 +19,16 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scene_texts import SMALL
 
 from transient.assemble import build_model
 from transient.cli import main
 from transient.core import model as cm
 from transient.scene import Load, load_scene, scene_from_dict, to_toml
 
-BASE = """\
-[scene]
-name = "small"
-
-[mechanism]
-type = "crank-slider"
-crank_radius_mm = 47
-rod_length_mm = 148
-bore_mm = 88
-piston_mass = 1.520
-crank_mass = 0.912
-
-[mechanism.rod]
-model = "two-mass"
-mass = 1.752
-cg_from_pin_mm = 107.3
-
-[inertia]
-shaft = 0.02
-
-[initial]
-omega_rpm = 1000
-phi_deg = 30
-
-[run]
-revolutions = 2
-
-[solver]
-rtol = 1e-6
-atol = 1e-8
-"""
+# the small scene from 30°, with the default output
+BASE = SMALL.replace("omega_rpm = 1000\n", "omega_rpm = 1000\nphi_deg = 30\n").replace(
+    "\n[output]\nsamples_per_rev = 12\n", "")
 
 
 def with_load(lines: str, extra: str = "") -> str:

@@ -13,45 +13,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from scene_texts import SMALL
 
 from transient.cli import main
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
-VALID = """\
-[scene]
-name = "small"
-description = "a valid small scene; every case below breaks one thing"
-
-[mechanism]
-type = "crank-slider"
-crank_radius_mm = 47
-rod_length_mm = 148
-bore_mm = 88
-piston_mass = 1.520
-crank_mass = 0.912
-
-[mechanism.rod]
-model = "two-mass"
-mass = 1.752
-cg_from_pin_mm = 107.3
-
-[inertia]
-shaft = 0.02
-
-[initial]
-omega_rpm = 1000
-
-[run]
-revolutions = 2
-
-[solver]
-rtol = 1e-6
-atol = 1e-8
-
-[output]
-samples_per_rev = 12
-"""
+VALID = SMALL  # (every case below breaks one thing of it)
 
 MIXED_CYCLE = """
 [gas]
@@ -445,7 +413,7 @@ def test_misleading_key_or_message(tmp_path, capsys, text, key, fragment):
 
 def test_scene_file_not_utf8(tmp_path, capsys):
     scene = tmp_path / "latin1.toml"
-    scene.write_bytes(replace("a valid small scene", "Kolbenmotor für Prüfstand")
+    scene.write_bytes(replace('name = "small"', 'name = "Kolbenmotor für Prüfstand"')
                       .encode("latin-1"))
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2

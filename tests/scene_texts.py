@@ -1,0 +1,38 @@
+"""Scene files the tests share, as TOML text: one copy of each (on ``pythonpath``, pyproject)."""
+
+#: A valid small scene: one crank-slider cylinder (the Gots diesel's, two-mass rod), no forces,
+#: 2 revolutions from 1000 rpm, coarse output. The scene-error tests break one thing of it; line
+#: numbers in their TOML syntax errors count from its first line.
+SMALL = """\
+[scene]
+name = "small"
+
+[mechanism]
+type = "crank-slider"
+crank_radius_mm = 47
+rod_length_mm = 148
+bore_mm = 88
+piston_mass = 1.520
+crank_mass = 0.912
+
+[mechanism.rod]
+model = "two-mass"
+mass = 1.752
+cg_from_pin_mm = 107.3
+
+[inertia]
+shaft = 0.02
+
+[initial]
+omega_rpm = 1000
+
+[run]
+revolutions = 2
+
+[solver]
+rtol = 1e-6
+atol = 1e-8
+
+[output]
+samples_per_rev = 12
+"""
