@@ -525,12 +525,6 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction,
 
     v_a = _scalar(volume, st.ivc)
     q_total = fuel_mass * st.lhv * st.efficiency
-    end = st.start + st.duration
-    breaks = [st.ivc]
-    for b in (st.start, end, st.evo):
-        if b > breaks[-1]:
-            breaks.append(b)
-    breaks = np.array(breaks)
     t_scale = st.t_a / (st.p_a * v_a)   # T = t_scale·p·V
     g0, gk, tref = st.gamma, st.gamma_slope, st.gamma_t_ref
 
@@ -538,14 +532,8 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction,
         xw = np.array([wrap(x)])
         return float(np.asarray(volume(xw)).ravel()[0]), float(np.asarray(dvolume(xw)).ravel()[0])
 
-    segments = []
-    y0 = np.array([st.p_a, 0.0])
-    atol = np.array([1e-3 * st.rtol * st.p_a, 1e-3 * st.rtol * st.p_a * v_a])
-    for lo, hi in itertools.pairwise(breaks):
-        burning = q_total > 0.0 and lo >= st.start and hi <= end
-        power = st.m + 1.0 if burning and st.m < 0.0 else None
-
-        def rhs(u, y, lo=lo, hi=hi, burning=burning, power=power):
+    def segment_rhs(lo, hi, burning, power):
+        def rhs(u, y):
             if power is None:
                 x, dxdu = u, 1.0
                 dq = q_total * _rate_scalar((x - st.start) / st.duration, st.a,
@@ -563,17 +551,47 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction,
             dvdu = dv * dxdu
             return [(g - 1.0) / v * dq - g * p / v * dvdu, p * dvdu]
 
+        return rhs
+
+    atol = np.array([1e-3 * st.rtol * st.p_a, 1e-3 * st.rtol * st.p_a * v_a])
+    breaks, segments = closed_segments(st, q_total, segment_rhs, np.array([st.p_a, 0.0]), atol,
+                                       _Segment)
+    return ClosedPart(start=st.ivc, end=st.evo, breaks=breaks, segments=tuple(segments),
+                      p_a=st.p_a, v_a=v_a, t_a=st.t_a)
+
+
+def closed_segments(st: _Setup, q_total: float, segment_rhs, y0: NDArray[np.float64],
+                    atol: NDArray[np.float64], segment_type) -> tuple[NDArray[np.float64], list]:
+    """The closed part integrated with DOP853 segment by segment, from intake closing to exhaust
+    opening, split at the combustion start and end so that the right-hand side is smooth inside
+    every segment; y[0] is the pressure. Inside a combustion with m < 0 a segment is integrated
+    in the variable u = y**(m + 1) on [0, 1] (``power`` = m + 1; its right-hand side maps u to
+    the angle), else in the angle itself (``power`` None).
+
+    ``segment_rhs(lo, hi, burning, power)`` gives f(u, y) of the segment [lo, hi]; ``burning``:
+    fuel burns over it. Returns the breaks and one ``segment_type(lo, hi, power, sol)`` per
+    segment (``sol``: the dense solution in u). The pressure carried into the next segment is
+    clipped at 0 (a rounding below it)."""
+    end = st.start + st.duration
+    breaks = [st.ivc]
+    for b in (st.start, end, st.evo):
+        if b > breaks[-1]:
+            breaks.append(b)
+    breaks = np.array(breaks)
+    segments = []
+    for lo, hi in itertools.pairwise(breaks):
+        burning = q_total > 0.0 and lo >= st.start and hi <= end
+        power = st.m + 1.0 if burning and st.m < 0.0 else None
         u_lo, u_hi = (lo, hi) if power is None else (0.0, 1.0)
-        sol = solve_ivp(rhs, (u_lo, u_hi), y0, method="DOP853", rtol=st.rtol, atol=atol,
-                        dense_output=True)
+        sol = solve_ivp(segment_rhs(lo, hi, burning, power), (u_lo, u_hi), y0, method="DOP853",
+                        rtol=st.rtol, atol=atol, dense_output=True)
         if sol.status != 0:
             raise RuntimeError(f"closed-cycle integration failed from {_deg(lo)} to {_deg(hi)}: "
                                f"{sol.message}")
-        segments.append(_Segment(lo=float(lo), hi=float(hi), power=power, sol=sol.sol))
+        segments.append(segment_type(lo=float(lo), hi=float(hi), power=power, sol=sol.sol))
         y0 = sol.y[:, -1].copy()
         y0[0] = max(y0[0], 0.0)
-    return ClosedPart(start=st.ivc, end=st.evo, breaks=breaks, segments=tuple(segments),
-                      p_a=st.p_a, v_a=v_a, t_a=st.t_a)
+    return breaks, segments
 
 
 def _peak(closed: ClosedPart, volume: VolumeFunction, period: float

@@ -50,7 +50,6 @@ What is not modelled
 """
 from __future__ import annotations
 
-import itertools
 import math
 import types
 from collections.abc import Callable
@@ -58,7 +57,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from transient.errors import SceneError
 from transient.forces.wiebe import (
@@ -77,6 +75,7 @@ from transient.forces.wiebe import (
     _Setup,
     _setup,
     _volume_derivative,
+    closed_segments,
 )
 
 __all__ = [
@@ -543,7 +542,7 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction, dvolume: Vo
                ) -> tuple[NDArray[np.float64], list[_Segment3], float]:
     """Integrate (p, W, Q_w) over the closed part, segment by segment, with DOP853.
 
-    The segments and the m < 0 substitution are those of ``wiebe._integrate``; c2 is switched
+    The segments and the m < 0 substitution are those of ``wiebe.closed_segments``; c2 is switched
     on from the segment that starts at the combustion start, so that the right-hand side is
     smooth inside every segment except where p crosses p_mot (a kink of max(p − p_mot, 0)).
     """
@@ -554,12 +553,6 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction, dvolume: Vo
 
     v_a = _scalar(volume, st.ivc)
     q_total = fuel_mass * st.lhv * st.efficiency
-    end = st.start + st.duration
-    breaks = [st.ivc]
-    for b in (st.start, end, st.evo):
-        if b > breaks[-1]:
-            breaks.append(b)
-    breaks = np.array(breaks)
     # Without heat transfer: c1 = c2 = 0 make w = 0 and h = 0 exactly; the geometry is unused.
     wp = woschni or types.SimpleNamespace(c1=0.0, c2=0.0, wall_temperature=1.0, bore=1.0,
                                           stroke=1.0)
@@ -570,15 +563,10 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction, dvolume: Vo
         xw = np.array([wrap(x)])
         return float(np.asarray(volume(xw)).ravel()[0]), float(np.asarray(dvolume(xw)).ravel()[0])
 
-    segments = []
-    y0 = np.array([st.p_a, 0.0, 0.0])
-    atol = 1e-3 * st.rtol * np.array([st.p_a, st.p_a * v_a, st.p_a * v_a])
-    for lo, hi in itertools.pairwise(breaks):
-        burning = q_total > 0.0 and lo >= st.start and hi <= end
+    def segment_rhs(lo, hi, burning, power):
         c2_now = wp.c2 if lo >= st.start else 0.0
-        power = st.m + 1.0 if burning and st.m < 0.0 else None
 
-        def rhs(u, y, lo=lo, hi=hi, burning=burning, c2_now=c2_now, power=power):
+        def rhs(u, y):
             p = y[0]
             if power is None:
                 x = u
@@ -607,15 +595,11 @@ def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction, dvolume: Vo
             return [first_law_rate(p, v, dvdu, q_total * st.a * math.exp(-st.a * uc), dq_w, g),
                     p * dvdu, dq_w]
 
-        u_lo, u_hi = (lo, hi) if power is None else (0.0, 1.0)
-        sol = solve_ivp(rhs, (u_lo, u_hi), y0, method="DOP853", rtol=st.rtol, atol=atol,
-                        dense_output=True)
-        if sol.status != 0:
-            raise RuntimeError(f"closed-cycle integration failed from {_deg(lo)} to {_deg(hi)}: "
-                               f"{sol.message}")
-        segments.append(_Segment3(lo=float(lo), hi=float(hi), power=power, sol=sol.sol))
-        y0 = sol.y[:, -1].copy()
-        y0[0] = max(y0[0], 0.0)
+        return rhs
+
+    atol = 1e-3 * st.rtol * np.array([st.p_a, st.p_a * v_a, st.p_a * v_a])
+    breaks, segments = closed_segments(st, q_total, segment_rhs, np.array([st.p_a, 0.0, 0.0]),
+                                       atol, _Segment3)
     return breaks, segments, v_a
 
 
