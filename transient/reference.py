@@ -639,6 +639,11 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             level = up if y[1] >= 0 else down
             y[0] = level
             events["breakpoint"].append((t, y[0]))
+            if level >= phi_end:
+                # The end sits on this breakpoint to rounding (2 revolutions less an ulp):
+                # solve_ivp reports the first of two terminal events at one time only, and past
+                # the end its event would never cross again.
+                break
             if ref.cylinders is not None:
                 ref.cylinders.close_intakes(y[0], y)
             if ref.latched is not None and y[1] > 0:  # a cylinder's start of injection

@@ -49,6 +49,13 @@ PROFILE = "stress-full" if FULL else "stress-ci"
 #: measured e = 1010 over ~10⁴ steps).
 E_AGREE = 200.0
 
+#: The reference path chooses the pairs' modes inside its right-hand side (a kink it does not
+#: locate), so there its error can exceed its rtol: on a random crank-slider that reverses
+#: (rtol 1e-9, one pair) its final ω was off by 2.4e-6 relative while the compiled run's was
+#: 4.3e-9 (both against the compiled run at 1e-13); at rtol 1e-11 the reference's was 5.6e-9.
+#: With pairs it runs this many times tighter, to stay a reference.
+REF_TIGHTER = 100.0
+
 #: CI profile: the reference path (solve_ivp, ~40 fevals per step with pairs at ~50 µs each) is
 #: run only for scenes of at most this many compiled steps; the full profile runs it always.
 REF_STEPS_CI = 300
@@ -214,8 +221,12 @@ def check(d):
     # The reference with short steps (0.5°, as tests/validation/test_reference_path.py): solve_ivp
     # sees an event only where its function changes sign between step ends, and the speed can
     # cross a governor corner and come back within one of its own long steps
-    # (test_governor_corner_compiled_against_reference).
-    ref_d = dict(d, solver=dict(d["solver"], method="scipy-DOP853", max_step_deg=0.5))
+    # (test_governor_corner_compiled_against_reference). With pairs, REF_TIGHTER times tighter.
+    solver = d["solver"]
+    tighter = REF_TIGHTER if d.get("friction", {}).get("pairs") else 1.0
+    ref_d = dict(d, solver=dict(solver, method="scipy-DOP853", max_step_deg=0.5,
+                                rtol=max(solver["rtol"] / tighter, 1e-13),
+                                atol=solver["atol"] / tighter))
     ref_d["solver"].pop("domain", None)
     ref_d["solver"].pop("max_step", None)
     try:
@@ -363,3 +374,67 @@ def test_short_power_reversal_inside_a_step():
     assert np.any(np.abs(switches - 2 * math.pi) < 1e-9)  # into the reversal at the TDC …
     assert np.any(np.abs(switches - 6.37005) < 1e-4)  # … and out of it 0.087 rad later
     check(copy.deepcopy(SHORT_REVERSAL))
+
+
+# Two more failures of the full profile, both of the reference path. (1) A 4-cylinder 2-stroke
+# with one pair reverses and runs backwards: the reference at rtol 1e-9 ended 2.4e-6 off in ω,
+# the compiled run 4.3e-9 (REF_TIGHTER). (2) A swash plate whose run ends by 2 revolutions less
+# an ulp, on a breakpoint to rounding: solve_ivp reported the breakpoint and not the end (one
+# terminal event per time), and past the end the reference ran on to t_end (t 0.3 against the
+# compiled 0.2951 s); it now ends on such a breakpoint (transient.reference.run_reference).
+REVERSING_WITH_A_PAIR = {
+    "mechanism": {"type": "crank-slider", "crank_radius_mm": 41.600636310543265,
+                  "rod_length_mm": 82.03812284384139, "bore_mm": 100.0,
+                  "piston_mass": 2.932138615881926, "crank_mass": 0.0, "strokes": 2,
+                  "cylinders": 4, "offset_mm": 18.122313212234044,
+                  "firing_deg": [0.0, 90.0, 180.0, 270.0],
+                  "rod": {"model": "two-mass", "mass": 1.6219739484684879,
+                          "cg_from_pin_mm": 32.49556452965352}},
+    "gas": {"model": "table", "p0_MPa": 0.1,
+            "phi": [0.0, 3.141592653589793, 3.142592653589793, 3.742592653589793,
+                    4.71238898038469, 6.283185307179586],
+            "corners": [3.141592653589793, 3.142592653589793, 3.742592653589793,
+                        4.71238898038469],
+            "p_bar": [1.0, 1.0, 84.76970949435773, 30.0, 1.0, 1.0], "interpolation": "linear"},
+    "inertia": {"shaft": 0.44390476155924324},
+    "load": {"torque": 29.372416890282143, "linear": 0.0, "fan": 0.0},
+    "initial": {"phi": 0.0, "omega": 51.2800529229541},
+    "run": {"revolutions": 1.899475191502139, "t_end": 0.3},
+    "solver": {"rtol": 1e-09, "atol": 1e-11, "domain": "auto"},
+    "output": {"samples_per_rev": 72, "dt": 0.0002},
+    "friction": {"pairs": [{"between": ["shaft", "crank"], "eta_forward": 0.8197629202443424,
+                            "eta_backward": 0.6960757013080383}]},
+}
+END_ON_A_BREAKPOINT = {
+    "mechanism": {"type": "swash-plate", "joint_radius_mm": 136, "cylinder_radius_mm": 131.31,
+                  "rod_length_mm": 300, "halves": 1, "hinge": "in-plane",
+                  "rod": {"model": "two-mass", "cg_from_pin_mm": 150, "mass": 2.0},
+                  "swash_deg": 13.0, "cylinders": 6, "bore_mm": 100.0, "piston_mass": 5.0,
+                  "link_inertia": 0.0, "cross_inertia": 0.5},
+    "inertia": {"shaft": 0.5},
+    "gas": {"model": "trapezoid", "duration_deg": 180, "amplitude": 11341.0, "ramp_deg": 7.0},
+    "load": {"fan": 0.12867},
+    "governor": {"model": "droop", "speed_full": 45.0, "speed_zero": 60.0},
+    "initial": {"phi": 0.0, "omega": 6.0},
+    "run": {"revolutions": 1.9999999999999998, "t_end": 0.3},
+    "friction": {"pairs": [{"between": ["shaft", "link"], "eta_forward": 1.0,
+                            "eta_backward": 0.5625}]},
+    "solver": {"rtol": 1e-06, "atol": 1e-08, "domain": "auto"},
+    "output": {"samples_per_rev": 72, "dt": 0.0002},
+}
+
+
+def test_reversing_with_a_pair_against_the_reference():
+    data = integrate(scene_of(copy.deepcopy(REVERSING_WITH_A_PAIR), "reversing"))
+    assert "speed_reversal" in data.events and data.trajectory["omega"][-1] < 0.0
+    check(copy.deepcopy(REVERSING_WITH_A_PAIR))
+
+
+def test_the_reference_ends_on_a_breakpoint_at_the_end():
+    d = copy.deepcopy(END_ON_A_BREAKPOINT)
+    ref_d = dict(copy.deepcopy(d), solver=dict(d["solver"], method="scipy-DOP853",
+                                                max_step_deg=0.5))
+    ref_d["solver"].pop("domain")
+    tr = integrate(scene_of(ref_d, "end-on-breakpoint")).trajectory
+    assert tr["t"][-1] < 0.2952 and abs(tr["phi"][-1] - 4 * math.pi) < 1e-12, tr["t"][-1]
+    check(d)
