@@ -371,8 +371,11 @@ class ReferenceModel:
         J, dJ, Mg, Ml, Ms, pc = self.moments(phi, w, y)
         if self.chain is None:
             return (J, dJ, Mg, Ml, Ms, pc), (Mg + Ml + Ms - 0.5 * dJ * w * w) / J, (), ()
-        sigma = np.sign(w) or self.sigma
-        a, S, eta = self.chain.solve(*self.chain.split(J, dJ, Mg, Ml + Ms), w, sigma)
+        # σ is held over a segment and changed only at rest, as the compiled path holds it: taken
+        # from sign ω, the friction would flip inside a step where the shaft comes to rest
+        # against pairs that lock, and solve_ivp's steps would shrink towards ω = 0 for ever
+        # instead of crossing it to the rest event.
+        a, S, eta = self.chain.solve(*self.chain.split(J, dJ, Mg, Ml + Ms), w, self.sigma)
         return (J, dJ, Mg, Ml, Ms, pc), a, S, eta
 
     def rhs(self, t, y):

@@ -438,3 +438,34 @@ def test_the_reference_ends_on_a_breakpoint_at_the_end():
     tr = integrate(scene_of(ref_d, "end-on-breakpoint")).trajectory
     assert tr["t"][-1] < 0.2952 and abs(tr["phi"][-1] - 4 * math.pi) < 1e-12, tr["t"][-1]
     check(d)
+
+
+# A third, again of the reference path: a single 2-stroke cylinder whose one pair locks it after
+# five reversals. The reference took σ from sign ω inside its right-hand side, so where the shaft
+# came to rest against the locking pair the friction flipped inside every step crossing ω = 0:
+# solve_ivp's steps shrank towards it for ever (stopped by the 30 s guard). σ is now held over a
+# segment, as in the compiled path; both end locked at t = 0.2566886 s.
+LOCKING_AT_REST = {
+    "mechanism": {"type": "crank-slider", "crank_radius_mm": 31.012483354310735,
+                  "rod_length_mm": 55.16312223268926, "bore_mm": 50.0,
+                  "piston_mass": 2.210753868208682, "crank_mass": 0.0, "strokes": 2,
+                  "cylinders": 1, "offset_mm": 0.0, "firing_deg": [0.0],
+                  "rod": {"model": "two-mass", "mass": 2.00001,
+                          "cg_from_pin_mm": 18.43436357317856}},
+    "gas": {"model": "trapezoid", "amplitude": 3983.798008271121,
+            "ramp_deg": 17.487812693932963, "duration_deg": 180.0},
+    "inertia": {"shaft": 0.01},
+    "load": {"torque": 8.072691249778599, "linear": 0.040033652467152486, "fan": 0.0},
+    "initial": {"phi": 2.7733299201757995, "omega": 44.800495613044944},
+    "run": {"revolutions": 0.5, "t_end": 0.3},
+    "solver": {"rtol": 1e-06, "atol": 1e-08, "domain": "auto"},
+    "output": {"samples_per_rev": 72, "dt": 0.0002},
+    "friction": {"pairs": [{"between": ["shaft", "crank"], "eta_forward": 0.5597351227819538,
+                            "eta_backward": 0.7087263776469912}]},
+}
+
+
+def test_coming_to_rest_against_a_locking_pair():
+    data = integrate(scene_of(copy.deepcopy(LOCKING_AT_REST), "locking"))
+    assert data.message.startswith("locked"), data.message
+    check(copy.deepcopy(LOCKING_AT_REST))
