@@ -36,6 +36,8 @@ def rhs_loop(m, states, out, sw, wk):
 
 SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
               gots_friction=CASES / "gots_diesel_friction.toml")
+
+
 def timed(scene, samples_per_rev):
     """Median wall time of 5 runs after a warm-up, and the runs' RHS evaluations and steps."""
     scene = dc.replace(scene, output=dc.replace(scene.output, samples_per_rev=samples_per_rev))
