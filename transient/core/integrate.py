@@ -229,6 +229,14 @@ def _dense_eval(F, y, theta, out):
         out[i] = y[i] + acc
 
 
+@kernel(inline="always")
+def _dense_state(F, y, x, h, theta, ix, out):
+    """State at fraction θ of the last step (from x, size h), its independent variable ``ix``
+    exactly x + θh."""
+    _dense_eval(F, y, theta, out)
+    out[ix] = x + theta * h
+
+
 @kernel
 def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
     """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
@@ -304,9 +312,7 @@ def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
     holds the step's start and row N its end already)."""
     ix = PHI if angle_mode else T
     for j in range(1, N_MARGIN_SAMPLES):
-        theta = j / N_MARGIN_SAMPLES
-        _dense_eval(F, y, theta, tmp)
-        tmp[ix] = x + theta * h
+        _dense_state(F, y, x, h, j / N_MARGIN_SAMPLES, ix, tmp)
         margins_at(m, angle_mode, tmp, sel, sw, wk)
         for k in range(m.n_pairs):
             gs[j, k] = wk[WK_G, k]
@@ -329,8 +335,7 @@ def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel,
     g_prev = ga
     for j in range(1, n_samples + 1):
         theta = j / n_samples
-        _dense_eval(F, y, theta, tmp)
-        tmp[ix] = x + theta * h
+        _dense_state(F, y, x, h, theta, ix, tmp)
         g = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
         if _crosses(g_prev, g, direction):
             root, evals = _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
@@ -371,10 +376,8 @@ def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
     th_prev = 0.0
     for j in range(1, N_FINE_SAMPLES + 1):
         theta = theta_end * j / N_FINE_SAMPLES
-        _dense_eval(F, y, theta, tmp)
-        tmp[ix] = x + theta * h
-        margins_at(m, angle_mode, tmp, sel, sw, wk)
-        g = wk[WK_G, k]
+        _dense_state(F, y, x, h, theta, ix, tmp)
+        g = _event_g(m, angle_mode, tmp, PAIR_COMP + k, 0.0, sel, sw, wk)
         if rose and g <= 0.0:
             root, evals = _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
                                 th_prev, theta, g_prev, g)
@@ -892,14 +895,13 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                 if ends:
                     theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
                 else:
-                    theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, level,
-                                                    direction, ga, sel, sw, tmp, wk,
-                                                    N_MARGIN_SAMPLES)
-                    if theta > 1.0:
+                    for n_samples in (N_MARGIN_SAMPLES, N_FINE_SAMPLES):  # coarse, then fine
                         theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, level,
                                                         direction, ga, sel, sw, tmp, wk,
-                                                        N_FINE_SAMPLES)
-                    ist[I_NFEV] += evals
+                                                        n_samples)
+                        ist[I_NFEV] += evals
+                        if theta <= 1.0:
+                            break
                 if theta < ev_theta:
                     ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
                     # the crossing's direction: from below (an 'inside' crossing is the first
