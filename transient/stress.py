@@ -612,18 +612,18 @@ def tolerance_ladder(quick: bool, ctx: Context) -> Outcome:
                 mine, theirs = end_error(r, ref), end_error(s, ref)
                 if mine > max(theirs, LADDER_FLOOR):
                     worse.append(f"{rtol:.0e} ({mine:.1e} against {theirs:.1e})")
+        ladder = " ".join(f"{e:.1e}" for e in errs)
         if domain == "auto":
             mono = _falls(rtols, errs)
-            o.notes.append("crank angle: largest error of t, ω " + " ".join(
-                f"{e:.1e}" for e in errs) + ("" if mono else " — NOT monotone"))
+            o.notes.append(f"crank angle: largest error of t, ω {ladder}"
+                           + ("" if mono else " — NOT monotone"))
         else:
-            mono = _falls(rtols, errs, TIME_MONOTONE_FROM) and not worse
-            o.notes.append("time: largest error of t, ω " + " ".join(f"{e:.1e}" for e in errs)
-                           + (f" (monotone from {TIME_MONOTONE_FROM:.0e} down"
-                              + (")" if _falls(rtols, errs, TIME_MONOTONE_FROM) else
-                                 ": NOT)"))
-                           + ("; final state no worse than scipy's DOP853 at every rtol" if
-                              not worse else "; worse than scipy's DOP853 at " + ", ".join(worse)))
+            falls = _falls(rtols, errs, TIME_MONOTONE_FROM)
+            mono = falls and not worse
+            against = ("final state no worse than scipy's DOP853 at every rtol" if not worse
+                       else "worse than scipy's DOP853 at " + ", ".join(worse))
+            o.notes.append(f"time: largest error of t, ω {ladder} (monotone from "
+                           f"{TIME_MONOTONE_FROM:.0e} down{'' if falls else ': NOT'}); {against}")
         o.ok = o.ok and mono
     return o
 
