@@ -6,6 +6,7 @@ partial result is kept and marked incomplete).
 from __future__ import annotations
 
 import argparse
+import gc
 import math
 import os
 import sys
@@ -25,8 +26,14 @@ _BROKEN_WRITE: WriteFailed | None = None
 def entry() -> None:
     """The ``transient`` command: :func:`main`, then exit with its code. After a failed write
     (:class:`~transient.errors.WriteFailed`) the process leaves by ``os._exit``, skipping the
-    interpreter's teardown, in which HDF5 would retry the writes of the broken file and crash."""
+    interpreter's teardown, in which HDF5 would retry the writes of the broken file and crash.
+
+    Before exiting, every live object is frozen out of the garbage collector: the interpreter's
+    final collections would otherwise walk numba's type system, a quarter of a second of a
+    one-second run (measured, README *Start-up*). Files are closed by then; reference counting
+    still tears the modules down."""
     code = main()
+    gc.freeze()
     if _BROKEN_WRITE is not None:
         sys.stdout.flush()
         sys.stderr.flush()

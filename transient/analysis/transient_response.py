@@ -70,10 +70,13 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicHermiteSpline
 
 #: Default share of a segment, at its end, over which the steady speed is taken.
 SETTLE_SHARE = 0.25
@@ -208,6 +211,9 @@ def _monotone_hermite(x, y, slope) -> CubicHermiteSpline:
     rest, a solver wiggle) the PCHIP slope replaces it. Slopes are limited to
     0 ≤ m ≤ 3·min(adjacent secants), Fritsch & Carlson's bound, so the interpolant is monotone.
     """
+    # (lazily: scipy.interpolate is a tenth of a second of every run's start-up)
+    from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
+
     secant = np.diff(y) / np.diff(x)
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(slope) & (slope >= 0)
