@@ -606,7 +606,7 @@ def _reset_output_grid(cfg, ist, fst, y):
     fst[F_NEXT_OUT] = j * d
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
 def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 

@@ -1,0 +1,62 @@
+"""simulate._WriteBehind: a result's blocks are written in a second thread while the stepper
+computes the next, one at a time and in order; a failed write is raised in the caller."""
+import threading
+import time
+
+import pytest
+
+from transient.core import integrate as ci
+from transient.simulate import _WriteBehind
+
+
+def test_blocks_are_written_in_order_one_at_a_time():
+    log = []
+    busy = threading.Lock()
+
+    def write(k):
+        assert busy.acquire(blocking=False), "two writes at once"
+        log.append(("start", k, threading.current_thread().name))
+        time.sleep(0.01)
+        log.append(("end", k))
+        busy.release()
+
+    writes = _WriteBehind()
+    for k in range(5):
+        writes.start(write, k)
+    writes.wait()
+    writes.shutdown()
+    assert [e[:2] for e in log] == [(w, k) for k in range(5) for w in ("start", "end")]
+    assert all(e[2] != threading.current_thread().name for e in log if e[0] == "start")
+
+
+def test_the_caller_goes_on_while_a_block_is_written():
+    release = threading.Event()
+    released = []
+    writes = _WriteBehind()
+    # the write waits for the caller: had start() waited for the write, it would time out
+    writes.start(lambda: released.append(release.wait(5.0)))
+    release.set()
+    writes.wait()
+    writes.shutdown()
+    assert released == [True]
+
+
+def test_a_failed_write_is_raised_by_the_next_wait_and_only_once():
+    def write(k):
+        if k == 1:
+            raise OSError("disk full")
+
+    writes = _WriteBehind()
+    writes.start(write, 0)
+    writes.start(write, 1)
+    with pytest.raises(OSError, match="disk full"):
+        writes.start(write, 2)  # waits for write 1 first
+    writes.wait()  # nothing in progress: write 2 never started
+    writes.start(write, 1)
+    writes.settle()  # a failure ignored where another one is being reported
+    writes.shutdown()
+
+
+def test_the_stepper_releases_the_gil():
+    """The overlap needs the compiled stepper to run without the GIL."""
+    assert ci.advance.targetoptions.get("nogil") is True
