@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from .core import cylinder as cyl
 from .core import governor as gv
 from .core.model import (PAPER, PHI, POWER_FLOW, TABULATED, T, Model, applied_value, fuel,
-                         governor_branch, mechanism_terms)
+                         governor_branch, mechanism_terms, select_pieces, work_array)
 from .forces.gas import PressureTable, _shift_cubic, mixed_cycle, table_from_points
 from .forces.trapezoid import trapezoid_table
 
@@ -340,11 +340,14 @@ def initial_cylinders(scene, model: Model, f0: float) -> list[float]:
     if not model.woschni:
         return []
     phi0 = scene.initial.phi
+    sel = phi0 + 1e-9  # (the piece just ahead)
+    wk = work_array(model)
+    select_pieces(model, sel, wk)
     out = []
     for k in range(model.ncyl):
         local = (phi0 - model.gas_phase[k]) % model.period
         closed = cyl.closed_angle(model.cyl_par, local, model.period) >= 0.0
-        out.append(applied_value(model, k, phi0, phi0 + 1e-9, f0) if closed
+        out.append(applied_value(model, k, phi0, sel, f0, wk) if closed
                    else model.cyl_par[cyl.P_A])
     return out
 

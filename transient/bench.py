@@ -240,7 +240,7 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     rhs = rhs_cache[name]
     y0 = np.zeros(cm.n_state(model))
     y0[cm.PHI], y0[cm.OMEGA] = base.initial.phi, base.initial.omega
-    args = np.zeros(cm.work_array(model).size)
+    args = cm.work_array(model).ravel()  # (as allocated: no gas table piece selected yet)
     span = (0.0, ref.t_end)
 
     def solve(dense=False):

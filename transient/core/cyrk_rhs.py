@@ -19,8 +19,9 @@ SIGNATURE = nb.types.void(nb.types.CPointer(nb.types.float64), nb.types.float64,
 
 
 def make_rhs(m):
-    """A C callback dy/dt = f(y) of model ``m``; ``args`` must hold ``work_array(m).size``
-    doubles of scratch space. Compiled for this model (its arrays are frozen into the code)."""
+    """A C callback dy/dt = f(y) of model ``m``; ``args`` must be ``work_array(m)``, flattened,
+    as allocated (its scratch space, which marks no gas table piece selected yet). Compiled for
+    this model (its arrays are frozen into the code)."""
     n = cm.n_state(m)
     shape = cm.work_array(m).shape
 

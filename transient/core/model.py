@@ -82,9 +82,11 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, their least value
 #: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
 #: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
-#: of the PI governor's demand u (WK_DEMAND).
+#: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
+#: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
+#: (:func:`select_pieces`).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
- WK_SPEED, WK_DEMAND, WK_SCRATCH) = range(14)
+ WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_SCRATCH) = range(17)
 N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
 
 Model = namedtuple(
@@ -170,7 +172,9 @@ def n_outputs(m):
 @njit(cache=True)
 def work_array(m):
     """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
-    return np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
+    wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
+    wk[WK_SEL, 0] = np.nan  # no pieces selected yet
+    return wk
 
 
 @kernel(inline="always")
@@ -186,52 +190,67 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du):
 
 
 @kernel(inline="always")
-def gas_value(m, k, phi, sel):
+def select_pieces(m, sel, wk):
+    """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL) and the gas table's piece there
+    (WK_PIECE). ``sel`` is one angle for a whole step, so they are computed when it changes and
+    kept (a float modulo and a search per cylinder in each of a step's right-hand sides were
+    measured at ~5 % of the diesel's run)."""
+    if wk[WK_SEL, 0] != sel:
+        for k in range(m.ncyl):
+            local_sel = (sel - m.gas_phase[k]) % m.period
+            wk[WK_LOCAL, k] = local_sel
+            wk[WK_PIECE, k] = find_piece(m.knots, m.piece_knot, local_sel)
+        wk[WK_SEL, 0] = sel
+
+
+@kernel(inline="always")
+def gas_value(m, k, phi, sel, wk):
     """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
     ends exactly on a corner keeps using the piece it integrates over (DESIGN §2, breakpoints).
+    The piece is the one :func:`select_pieces` left in ``wk`` for it.
     """
-    local_sel = (sel - m.gas_phase[k]) % m.period
-    piece = find_piece(m.knots, m.piece_knot, local_sel)
-    value, _ = table_eval(m.knots, m.coef, m.piece_knot, piece, local_sel + (phi - sel))
+    local_sel = wk[WK_LOCAL, k]
+    value, _ = table_eval(m.knots, m.coef, m.piece_knot, int(wk[WK_PIECE, k]),
+                          local_sel + (phi - sel))
     return value
 
 
 @kernel(inline="always")
-def gas_pair(m, k, phi, sel):
+def gas_pair(m, k, phi, sel, wk):
     """Full-load and motored table values of cylinder k at shaft angle ``phi`` (``m.has_motored``
-    only: ``m.coef`` pairs the two curves on common knots); ``sel`` as in :func:`gas_value`."""
-    local_sel = (sel - m.gas_phase[k]) % m.period
-    piece = find_piece(m.knots, m.piece_knot, local_sel)
-    return table_eval_pair(m.knots, m.coef, m.piece_knot, piece, local_sel + (phi - sel))
+    only: ``m.coef`` pairs the two curves on common knots); ``sel``, ``wk`` as in
+    :func:`gas_value`."""
+    local_sel = wk[WK_LOCAL, k]
+    return table_eval_pair(m.knots, m.coef, m.piece_knot, int(wk[WK_PIECE, k]),
+                           local_sel + (phi - sel))
 
 
 @kernel(inline="always")
-def applied_value(m, k, phi, sel, f):
+def applied_value(m, k, phi, sel, f, wk):
     """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot).
 
     Without a motored table the motored curve is the constant ``gas_offset`` (p0), and at f = 1
     the value is the table's to the last bit.
     """
     if m.has_motored:
-        p, p_mot = gas_pair(m, k, phi, sel)
+        p, p_mot = gas_pair(m, k, phi, sel, wk)
         return p_mot + f * (p - p_mot)
-    p = gas_value(m, k, phi, sel)
+    p = gas_value(m, k, phi, sel, wk)
     if f == 1.0:
         return p
     return m.gas_offset + f * (p - m.gas_offset)
 
 
 @kernel(inline="always")
-def cylinder_value(m, k, y, sel, f):
+def cylinder_value(m, k, y, sel, f, wk):
     """The pressure on piston k: its state in the closed part with wall heat transfer
     (``m.woschni``, :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
     if m.woschni:
-        local_sel = (sel - m.gas_phase[k]) % m.period
-        if cyl.closed_angle(m.cyl_par, local_sel, m.period) >= 0.0:
+        if cyl.closed_angle(m.cyl_par, wk[WK_LOCAL, k], m.period) >= 0.0:
             return y[cyl_index(m) + k]
-    return applied_value(m, k, y[PHI], sel, f)
+    return applied_value(m, k, y[PHI], sel, f, wk)
 
 
 @kernel(inline="always")
@@ -241,8 +260,9 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
     outside the closed part. dV/dφ = F_p·u_k from the row u of ``wk`` (left by :func:`moments`)."""
     c = cyl_index(m)
     lc = latch_index(m)
+    select_pieces(m, sel, wk)
     for k in range(m.ncyl):
-        local_sel = (sel - m.gas_phase[k]) % m.period
+        local_sel = wk[WK_LOCAL, k]
         x_sel = cyl.closed_angle(m.cyl_par, local_sel, m.period)
         if x_sel < 0.0:
             out[c + k] = 0.0
@@ -408,14 +428,15 @@ def moments(m, angle_mode, y, sel, sw, wk):
     M_gas = 0.0
     if m.has_gas:
         f = command(m, w, y, sw)
+        select_pieces(m, sel, wk)
         if m.latch or m.has_motored:  # p = p_mot + f_k·(p_full − p_mot), per cylinder
             c = latch_index(m)
             for k in range(m.ncyl):
                 f_k = y[c + k] if m.latch else f
-                M_gas += m.gas_scale[k] * (cylinder_value(m, k, y, sel, f_k) - m.gas_offset) * u[k]
+                M_gas += m.gas_scale[k] * (cylinder_value(m, k, y, sel, f_k, wk) - m.gas_offset) * u[k]
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
-                M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel) - m.gas_offset) * u[k]
+                M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel, wk) - m.gas_offset) * u[k]
             M_gas *= f
     # (with s = 1 exactly the formula without a schedule, to the last bit)
     s = load_scale(m, y, sw[SW_LOAD])
@@ -617,9 +638,11 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
     c = latch_index(m)
+    if m.has_gas:
+        select_pieces(m, sel, wk)
     for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
         f_k = y[c + k] if m.latch else f
-        row[N_OUT_FIXED + k] = cylinder_value(m, k, y, sel, f_k) if m.has_gas else 0.0
+        row[N_OUT_FIXED + k] = cylinder_value(m, k, y, sel, f_k, wk) if m.has_gas else 0.0
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
     j = N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
     for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels
