@@ -414,14 +414,23 @@ class ReferenceModel:
 def _speed_crossing(ref, t, y, level):
     """Terminal event ω = level in the direction ω must go to reach it; starting on the level
     (just after stopping there), the direction away from where the speed is heading now, so
-    that solve_ivp does not stop again at once."""
+    that solve_ivp does not stop again at once.
+
+    Starting on the level, g is also given the sign of the side the speed heads to at the start
+    itself: with g = 0 there, a step that ends across the level (the speed turning back within
+    it) had its root put at the start by the root finder, and the run stopped there again and
+    again without advancing (found on the governed diesel by RK45 at rtol 1e-5)."""
     gap = y[1] - level
-    if abs(gap) <= 1e-12 * max(1.0, abs(level)):
+    on_level = abs(gap) <= 1e-12 * max(1.0, abs(level))
+    if on_level:
         direction = -np.sign(ref.rhs(t, y)[1]) or 1.0
     else:
         direction = -np.sign(gap)
+    t_start = t
 
     def g(t, yy):
+        if on_level and t == t_start:
+            return -direction * 1e-300  # (just on the side the speed heads to)
         return yy[1] - level
     g.terminal, g.direction = True, direction
     return g

@@ -224,3 +224,20 @@ def test_chain_of_a_nonfinite_trial_stage_is_not_a_number():
     for Mk in (np.array([np.inf] + [0.0] * n), np.array([1e308] * (n + 1))):
         a, S, eta = chain.solve(Jk, dJk, Mk, 100.0, 1.0)
         assert np.isnan(a) and np.all(np.isnan(S)) and np.all(np.isnan(eta))
+
+
+def test_a_segment_started_on_a_governor_corner_does_not_stop_at_once(monkeypatch):
+    """The governed diesel by RK45 at rtol 1e-5 (scripts/rk45_diesel.py): at t = 0.66299 s a
+    segment started on the droop corner with the speed heading up, and its first step ended
+    below the corner (the speed turning back within it). The event function was 0 at the start,
+    so the root finder put the crossing there: the run stopped at once, flipped the governor's
+    branch and started again, for ever (was a bug: 9.7 million right-hand sides in 20 minutes at
+    the same t). The run now passes it, crossing the corner where the speed does."""
+    base = load_scene(CASES / "gots_diesel_governed.toml")
+    solver = replace(base.solver, method="scipy-RK45", rtol=1e-5, atol=1e-8)
+    scene = replace(base, solver=solver, run=replace(base.run, revolutions=math.inf, t_end=0.67))
+    with watched_reference(monkeypatch):
+        data = reference.run_reference(scene, state_only=True)
+    assert data.trajectory["t"][-1] == 0.67
+    corners = data.events["governor_corner"]
+    assert len(corners) >= 2 and all(b[0] > a[0] for a, b in zip(corners, corners[1:])), corners
