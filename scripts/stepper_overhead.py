@@ -3,7 +3,10 @@ call), for the benchmark scenes and the Gots spin-up with and without friction p
 over 1000 revolutions (issue 5's target: ≤ 30 %), writing 72 output samples per turn and writing
 one (as ``transient bench`` times its runs).
 The cost of one call is timed in a compiled loop over 2000 states taken from the run itself (in
-crank angle, as the run integrates), median of 5 loops. Rerun:
+crank angle, as the run integrates), median of 5 loops: once with the calls independent (the
+RHS's throughput) and once chained, each call's state depending on the previous result as a
+step's stages do (its latency: the divisions, square root and sine of a call can no longer
+overlap the next call's). Rerun:
 ``.venv/bin/python scripts/stepper_overhead.py`` (about 20 s).
 """
 import dataclasses as dc
@@ -32,6 +35,32 @@ def rhs_loop(m, states, out, sw, wk):
         cm.derivative(m, True, states[i], states[i, cm.PHI], sw, wk, out)
         acc += out[cm.KINETIC]
     return acc
+
+
+@kernel
+def rhs_chain(m, states, y, out, sw, wk):
+    """The same evaluations, each at a state that depends on the previous result (0·out still
+    has to wait for out), as a Runge–Kutta step's stages do: the RHS's latency, where
+    ``rhs_loop``, whose calls are independent, measures its throughput."""
+    acc = 0.0
+    for i in range(states.shape[0]):
+        for j in range(y.shape[0]):
+            y[j] = states[i, j] + 0.0 * out[j]
+        cm.derivative(m, True, y, y[cm.PHI], sw, wk, out)
+        acc += out[cm.KINETIC]
+    return acc
+
+
+def per_call(loop, *args):
+    """Median over 5 rounds of 50 loops of the time of one RHS call [s]."""
+    loop(*args)
+    rounds = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(50):
+            loop(*args)
+        rounds.append((time.perf_counter() - t0) / (50 * args[1].shape[0]))
+    return statistics.median(rounds)
 
 
 SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
@@ -64,16 +93,12 @@ for name, path in SCENES.items():
     sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
     sw[cm.SW_DIRECTION] = 1
     wk = cm.work_array(model)
-    rhs_loop(model, states, out, sw, wk)
-    loops = []
-    for _ in range(5):
-        t0 = time.perf_counter()
-        for _ in range(50):
-            rhs_loop(model, states, out, sw, wk)
-        loops.append((time.perf_counter() - t0) / (50 * pick.size))
-    per_call = statistics.median(loops)
+    out[:] = 0.0
+    call = per_call(rhs_loop, model, states, out, sw, wk)
+    chained = per_call(rhs_chain, model, states, np.empty_like(out), out, sw, wk)
     for n, (wall, nfev, nsteps) in runs.items():
         print(f"{name}, {n} samples/turn: {nfev} RHS evaluations, {nsteps} steps, {wall:.4g} s, "
-              f"one call {per_call * 1e6:.3f} µs → RHS {nfev * per_call:.4g} s, stepper overhead "
-              f"{wall / (nfev * per_call) - 1:+.0%} ({(wall - nfev * per_call) / nsteps * 1e6:.2f}"
-              f" µs a step)")
+              f"one call {call * 1e6:.3f} µs → RHS {nfev * call:.4g} s, stepper overhead "
+              f"{wall / (nfev * call) - 1:+.0%} ({(wall - nfev * call) / nsteps * 1e6:.2f}"
+              f" µs a step); one call chained {chained * 1e6:.3f} µs → overhead "
+              f"{wall / (nfev * chained) - 1:+.0%}")
