@@ -257,10 +257,10 @@ def cylinder_value(m, k, y, sel, f, wk):
 def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
     """dp_k/dφ (crank angle) or dp_k/dt (time) of the cylinder pressure states (``m.woschni``):
     the first law with Wiebe's heat release and Woschni's wall heat (:mod:`.cylinder`); zero
-    outside the closed part. dV/dφ = F_p·u_k from the row u of ``wk`` (left by :func:`moments`)."""
+    outside the closed part. dV/dφ = F_p·u_k from the row u of ``wk``, the cylinders' angles in
+    their cycles from WK_LOCAL (both left by :func:`moments`)."""
     c = cyl_index(m)
     lc = latch_index(m)
-    select_pieces(m, sel, wk)
     for k in range(m.ncyl):
         local_sel = wk[WK_LOCAL, k]
         x_sel = cyl.closed_angle(m.cyl_par, local_sel, m.period)
@@ -413,7 +413,8 @@ def moments(m, angle_mode, y, sel, sw, wk):
     """Reduced inertia, speed and moments at state ``y``.
 
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; the rows u, u′ of ``wk`` are left holding
-    the transfer functions. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force
+    the transfer functions and, with gas, WK_LOCAL and WK_PIECE the cylinders' pieces at ``sel``
+    (:func:`select_pieces`), for :func:`cylinder_rates` and :func:`output_row`. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force
     of cylinder k is (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel
     f (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
     P/max(ω, ω_min)), s from the schedule's segment ``sw[SW_LOAD]`` and the max from the
@@ -639,8 +640,6 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
     c = latch_index(m)
-    if m.has_gas:
-        select_pieces(m, sel, wk)
     for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
         f_k = y[c + k] if m.latch else f
         row[N_OUT_FIXED + k] = cylinder_value(m, k, y, sel, f_k, wk) if m.has_gas else 0.0
