@@ -414,26 +414,35 @@ class ReferenceModel:
 def _speed_crossing(ref, t, y, level):
     """Terminal event ω = level in the direction ω must go to reach it; starting on the level
     (just after stopping there), the direction away from where the speed is heading now, so
-    that solve_ivp does not stop again at once.
-
-    Starting on the level, g is also given the sign of the side the speed heads to at the start
-    itself: with g = 0 there, a step that ends across the level (the speed turning back within
-    it) had its root put at the start by the root finder, and the run stopped there again and
-    again without advancing (found on the governed diesel by RK45 at rtol 1e-5)."""
+    that solve_ivp does not stop again at once (and :func:`_leaving_start`)."""
     gap = y[1] - level
-    on_level = abs(gap) <= 1e-12 * max(1.0, abs(level))
-    if on_level:
+    if abs(gap) <= 1e-12 * max(1.0, abs(level)):
         direction = -np.sign(ref.rhs(t, y)[1]) or 1.0
     else:
         direction = -np.sign(gap)
-    t_start = t
 
     def g(t, yy):
-        if on_level and t == t_start:
-            return -direction * 1e-300  # (just on the side the speed heads to)
         return yy[1] - level
     g.terminal, g.direction = True, direction
     return g
+
+
+def _leaving_start(g, t_start):
+    """The terminal event ``g`` of a segment starting at ``t_start``, except that where the
+    state starts exactly on its level, g there takes the sign of the side its direction leaves
+    from: the event then fires only when the state comes back across the level later.
+
+    With g = 0 at the start, a step that ends across the level (the speed turning back within
+    it) had its root put at the start by solve_ivp's root finder, and the run stopped there again
+    and again without advancing (found on the governed diesel by RK45 at rtol 1e-5: a segment
+    starting on the droop corner)."""
+    def h(t, yy):
+        v = g(t, yy)
+        if v == 0.0 and t == t_start:
+            return -g.direction * 1e-300
+        return v
+    h.terminal, h.direction = g.terminal, g.direction
+    return h
 
 
 def _level_crossing(in_time: bool, level: float, direction: int):
@@ -576,8 +585,8 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             evs.append(("starter_cutout", cut))
         dense = dense_tail > 0 and not up < phi_end - dense_tail  # may reach the tail
         sol = solve_ivp(ref.rhs, (t, t_end), y, method=method, rtol=sv.rtol, atol=sv.atol,
-                        events=[e for _, e in evs] or None, max_step=max_step,
-                        dense_output=dense)
+                        events=[_leaving_start(e, t) for _, e in evs] or None,
+                        max_step=max_step, dense_output=dense)
         if sol.status == -1:
             raise SimulationError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
         nfev += sol.nfev
