@@ -8,23 +8,22 @@ scene against the same scene carrying unused options.
   baseline a user would write), plain ``numba.njit``; returns dt/dφ and dK/dφ = −M_load.
 * ``transient exact`` / ``transient tabulated``: ``transient.core.model.derivative`` on the
   scene's Model (crank-angle mode), exact kernel or tables.
-Each is timed in a compiled loop over 2000 states (median of 7 × 100 loops); then full runs
-(1000 revolutions, rtol 1e-8, median of 5) of the bare scene and of the bare scene with a droop
-governor, a zero-torque starter and a zero load, none of which ever acts.
+Each is timed in a compiled loop over 2000 states (median of 7 × 100 loops, ``rhs_timing.py``);
+then full runs (1000 revolutions, rtol 1e-8, median of 5) of the bare scene and of the bare
+scene with a droop governor, a zero-torque starter and a zero load, none of which ever acts.
 Rerun: ``.venv/bin/python scripts/handwritten_kernel.py`` (about 20 s).
 """
 import dataclasses as dc
 import math
 import statistics
-import time
 from pathlib import Path
 
 import numpy as np
 from numba import njit
+from rhs_timing import per_call, rhs_loop
 
 from transient.assemble import build_model
 from transient.core import model as cm
-from transient.core.jit import kernel
 from transient.scene import Governor, Starter, load_scene
 from transient.simulate import integrate
 
@@ -60,27 +59,6 @@ def hand_loop(p, states, out):
     return acc
 
 
-@kernel
-def model_loop(m, states, out, sw, wk):
-    """The loop as the stepper calls the RHS: a kernel (core.jit), buffers allocated outside."""
-    acc = 0.0
-    for i in range(states.shape[0]):
-        cm.derivative(m, True, states[i], states[i, cm.PHI], sw, wk, out)
-        acc += out[cm.T]
-    return acc
-
-
-def per_call(fn, *args, n=2000):
-    fn(*args)
-    loops = []
-    for _ in range(7):
-        t0 = time.perf_counter()
-        for _ in range(100):
-            fn(*args)
-        loops.append((time.perf_counter() - t0) / (100 * n))
-    return statistics.median(loops)
-
-
 def run_wall(scene):
     integrate(scene, keep=False)
     return statistics.median(integrate(scene, keep=False).solver["wall_s"] for _ in range(5))
@@ -104,14 +82,14 @@ o1, o2 = np.empty(6), np.empty(6)
 hand_rhs(p, states[7], o1)
 sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
 sw[cm.SW_DIRECTION] = 1
-model_loop(m_exact, states[7:8], o2, sw, cm.work_array(m_exact))
+rhs_loop(m_exact, states[7:8], o2, sw, cm.work_array(m_exact))
 assert abs(o1[1] / o2[1] - 1.0) < 1e-13, (o1, o2)
 t_hand = per_call(hand_loop, p, states, out)
 print(f"hand-written (18): {t_hand * 1e9:.1f} ns per call")
 for kin in ("exact", "tabulated"):
     scene = dc.replace(base, solver=dc.replace(base.solver, kinematics=kin))
     m, _, _ = build_model(scene)
-    t = per_call(model_loop, m, states, out, sw, cm.work_array(m))
+    t = per_call(rhs_loop, m, states, out, sw, cm.work_array(m))
     print(f"transient {kin}: {t * 1e9:.1f} ns per call ({t / t_hand:.3f}× hand-written)")
 
 bare = dc.replace(base, run=dc.replace(base.run, revolutions=1000.0),

@@ -3,64 +3,26 @@ call), for the benchmark scenes and the Gots spin-up with and without friction p
 over 1000 revolutions (issue 5's target: ≤ 30 %), writing 72 output samples per turn and writing
 one (as ``transient bench`` times its runs).
 The cost of one call is timed in a compiled loop over 2000 states taken from the run itself (in
-crank angle, as the run integrates), median of 5 loops: once with the calls independent (the
-RHS's throughput) and once chained, each call's state depending on the previous result as a
+crank angle, as the run integrates), median of 7 rounds of 100 loops (``rhs_timing.py``): once
+with the calls independent (the RHS's throughput) and once chained, each call's state depending on the previous result as a
 step's stages do (its latency: the divisions, square root and sine of a call can no longer
 overlap the next call's). Rerun:
 ``.venv/bin/python scripts/stepper_overhead.py`` (about 20 s).
 """
 import dataclasses as dc
 import statistics
-import time
 from pathlib import Path
 
 import numpy as np
+from rhs_timing import per_call, rhs_chain, rhs_loop
 
 from transient.assemble import build_model
 from transient.bench import BENCH_SCENES
 from transient.core import model as cm
-from transient.core.jit import kernel
 from transient.scene import load_scene
 from transient.simulate import integrate
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
-
-
-@kernel
-def rhs_loop(m, states, out, sw, wk):
-    """Evaluate the crank-angle RHS at every state (rows: φ, t, K, works); return a checksum.
-    A kernel with its buffers from outside, as the stepper calls the RHS (core.jit)."""
-    acc = 0.0
-    for i in range(states.shape[0]):
-        cm.derivative(m, True, states[i], states[i, cm.PHI], sw, wk, out)
-        acc += out[cm.KINETIC]
-    return acc
-
-
-@kernel
-def rhs_chain(m, states, y, out, sw, wk):
-    """The same evaluations, each at a state that depends on the previous result (0·out still
-    has to wait for out), as a Runge–Kutta step's stages do: the RHS's latency, where
-    ``rhs_loop``, whose calls are independent, measures its throughput."""
-    acc = 0.0
-    for i in range(states.shape[0]):
-        for j in range(y.shape[0]):
-            y[j] = states[i, j] + 0.0 * out[j]
-        cm.derivative(m, True, y, y[cm.PHI], sw, wk, out)
-        acc += out[cm.KINETIC]
-    return acc
-
-
-def per_call(loop, *args):
-    """Median over 5 rounds of 50 loops of the time of one RHS call [s]."""
-    loop(*args)
-    rounds = []
-    for _ in range(5):
-        t0 = time.perf_counter()
-        for _ in range(50):
-            loop(*args)
-        rounds.append((time.perf_counter() - t0) / (50 * args[1].shape[0]))
-    return statistics.median(rounds)
 
 
 SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
