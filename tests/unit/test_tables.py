@@ -225,3 +225,31 @@ def test_malformed_table_is_rejected():
         PressureTable(np.array([0.0, 1.0, 2.0]), np.zeros((2, 4)), np.array([0, 1]), 2.0)
     with pytest.raises(ValueError):
         PressureTable(np.array([0.0, 1.0, 2.0]), np.zeros((2, 4)), np.array([0, 2]), 3.0)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5, 12, 400])
+def test_not_a_knot_spline_is_scipys_curve(n):
+    """The hand-written spline (kept out of scipy.interpolate for start-up time) against
+    scipy.interpolate.CubicSpline, an independent implementation: the same coefficients on
+    uneven knots and noisy data, to rounding."""
+    from scipy.interpolate import CubicSpline
+
+    from transient.forces.gas import _not_a_knot_coef
+    rng = np.random.default_rng(n)
+    x = np.sort(rng.uniform(0.0, 3.0, n))
+    y = np.sin(3.0 * x) + rng.normal(0.0, 0.1, n)
+    ref = CubicSpline(x, y, bc_type="not-a-knot" if n > 2 else "natural").c[::-1].T
+    np.testing.assert_allclose(_not_a_knot_coef(x, y), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_rising_crossing_is_the_root_to_the_last_bit():
+    """Bisection of an increasing function: g < 0 one ulp below the result and g >= 0 at it,
+    and the same root as brentq's to a few ulp."""
+    from scipy.optimize import brentq
+
+    from transient.forces.gas import _rising_crossing
+    g = lambda x: math.expm1(x) - 0.3  # noqa: E731 (root log(1.3))
+    x = _rising_crossing(g, 0.0, 2.0)
+    assert g(x) >= 0.0 > g(np.nextafter(x, -np.inf))
+    assert abs(x - brentq(g, 0.0, 2.0, xtol=1e-15, rtol=4 * np.finfo(float).eps)) <= 4 * np.spacing(x)
+    assert abs(x - math.log(1.3)) <= 2 * np.spacing(x)

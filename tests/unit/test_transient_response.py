@@ -455,3 +455,19 @@ def test_bad_arguments_elsewhere(run):
         spin_up_metrics(t, p, w, -1.0, C4)
     with pytest.raises(ValueError, match="outside the run"):
         spin_up_metrics(t, p, w, RATED, C4, t_end=10.0)
+
+
+def test_hermite_is_scipys_curve():
+    """The hand-written Hermite interpolant (kept out of scipy.interpolate for start-up time)
+    against scipy.interpolate.CubicHermiteSpline, an independent implementation: inside, on the
+    knots and extrapolated past both ends, to rounding."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    from transient.analysis.transient_response import _hermite
+    rng = np.random.default_rng(3)
+    x = np.sort(rng.uniform(0.0, 10.0, 40))
+    y, m = rng.normal(size=40), rng.normal(size=40)
+    q = np.concatenate([rng.uniform(-1.0, 11.0, 500), x])
+    np.testing.assert_allclose(_hermite(x, y, m)(q), CubicHermiteSpline(x, y, m)(q),
+                               rtol=0, atol=1e-12)
+    assert float(_hermite(x, y, m)(x[7])) == pytest.approx(y[7], abs=1e-14)

@@ -210,6 +210,53 @@ def _ppoly_coef(interp) -> NDArray[np.float64]:
     return np.ascontiguousarray(interp.c[::-1].T, dtype=np.float64)
 
 
+def _not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Ascending local coefficients (k, 4) of the not-a-knot cubic spline through (x, y): the
+    curve of :class:`scipy.interpolate.CubicSpline` (``bc_type="not-a-knot"``; its algorithm, the
+    slopes from one tridiagonal system, de Boor ch. IV), which the tests compare it with.
+
+    Written out because importing scipy.interpolate (it imports scipy.optimize) costs 0.11–0.14 s,
+    a tenth of a warm ``transient run`` of the diesel (issue 5's 1 s target), while
+    scipy.linalg, which numba imports anyway, has the banded solver. With 3 points it is the
+    parabola through them, with 2 the straight line (CubicSpline's choices there).
+    """
+    dx = np.diff(x)
+    slope = np.diff(y) / dx
+    n = x.size
+    if n == 2:
+        s = np.array([slope[0], slope[0]])
+    elif n == 3:
+        # one parabola: its slopes at the ends and the middle (CubicSpline's 3-point case)
+        A = np.array([[1.0, 1.0, 0.0],
+                      [dx[1], 2.0 * (dx[0] + dx[1]), dx[0]],
+                      [0.0, 1.0, 1.0]])
+        b = np.array([2.0 * slope[0], 3.0 * (dx[0] * slope[1] + dx[1] * slope[0]),
+                      2.0 * slope[1]])
+        s = np.linalg.solve(A, b)
+    else:
+        from scipy.linalg import solve_banded  # (already imported by numba's start)
+
+        # C² at the interior knots: dx_i s_{i-1} + 2(dx_{i-1} + dx_i) s_i + dx_{i-1} s_{i+1} = …
+        ab = np.zeros((3, n))  # the bands: upper, diagonal, lower
+        ab[0, 2:] = dx[:-1]
+        ab[1, 1:-1] = 2.0 * (dx[:-1] + dx[1:])
+        ab[2, :-2] = dx[1:]
+        b = np.empty(n)
+        b[1:-1] = 3.0 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
+        # not-a-knot: the third derivative continuous at x_1 and at x_{n-2}, eliminated to
+        # keep the system tridiagonal
+        d = x[2] - x[0]
+        ab[1, 0], ab[0, 1] = dx[1], d
+        b[0] = ((dx[0] + 2.0 * d) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / d
+        d = x[-1] - x[-3]
+        ab[1, -1], ab[2, -2] = dx[-2], d
+        b[-1] = (dx[-1] ** 2 * slope[-2] + (2.0 * d + dx[-1]) * dx[-2] * slope[-1]) / d
+        s = solve_banded((1, 1), ab, b, check_finite=False)
+    # each interval's cubic Hermite polynomial from its end values and slopes
+    t = (s[:-1] + s[1:] - 2.0 * slope) / dx
+    return np.column_stack([y[:-1], s[:-1], (slope - s[:-1]) / dx - t, t / dx])
+
+
 def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: float,
                 interpolation: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Knots and coefficients of one piece [a, b] interpolating (x, y), a <= x[0] < ... <= b.
@@ -226,11 +273,7 @@ def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: flo
 
         coef = _ppoly_coef(PchipInterpolator(x, y))
     else:
-        # not-a-knot needs 4 points for a true cubic; with 3 scipy gives the parabola through
-        # them, and with 2 the natural spline is the straight line.
-        from scipy.interpolate import CubicSpline  # (lazily: start-up time)
-
-        coef = _ppoly_coef(CubicSpline(x, y, bc_type="not-a-knot" if x.size > 2 else "natural"))
+        coef = _not_a_knot_coef(x, y)
     knots = x.copy()
     if x[0] > a:
         coef = np.vstack([_shift_cubic(coef[0], a - x[0]), coef])
@@ -290,9 +333,9 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
         corner between two samples is allowed; both neighbouring pieces then extrapolate to it.
     interpolation : {"linear", "pchip", "spline"}
         Per piece: straight lines; shape-preserving C¹ cubic (no overshoot,
-        :class:`scipy.interpolate.PchipInterpolator`); or C² not-a-knot cubic spline
-        (:class:`scipy.interpolate.CubicSpline`, natural if the piece has 2 points). Pieces are
-        interpolated independently, so nothing is smoothed across a corner.
+        :class:`scipy.interpolate.PchipInterpolator`); or C² not-a-knot cubic spline (the
+        curve of :class:`scipy.interpolate.CubicSpline`, a line if the piece has 2 points).
+        Pieces are interpolated independently, so nothing is smoothed across a corner.
 
     Returns
     -------
@@ -512,6 +555,20 @@ def _scalar_volume(volume: Callable[[NDArray[np.float64]], ArrayLike], x: float)
     return float(np.asarray(volume(np.array([x], dtype=np.float64)), dtype=np.float64).ravel()[0])
 
 
+def _rising_crossing(g: Callable[[float], float], a: float, b: float) -> float:
+    """The x in [a, b] where the increasing function g crosses zero (g(a) < 0 < g(b)), by
+    bisection until the bracket cannot shrink: the smallest float with g(x) >= 0 to within
+    rounding of g."""
+    while True:
+        c = 0.5 * (a + b)
+        if not a < c < b:
+            return b
+        if g(c) < 0.0:
+            a = c
+        else:
+            b = c
+
+
 def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compression_ratio: float,
                 p_a: float, n1: float, p_z: float, rho: float, n2: float,
                 p_intake: float | None = None, p_exhaust: float | None = None, strokes: int = 4,
@@ -624,12 +681,10 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
 
     angle_z = x_tdc
     if rho > 1.0:
-        # V rises monotonically from TDC to BDC on a crank slider; brentq finds the crossing to
-        # about machine precision, so the expansion starts at p_z to ~1e-15 relative.
-        from scipy.optimize import brentq  # (lazily: start-up time)
-
-        angle_z = brentq(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc,
-                         xtol=1e-15, rtol=4.0 * np.finfo(float).eps, maxiter=200)
+        # V rises monotonically from TDC to BDC on a crank slider: bisection finds the crossing
+        # to the last bit, so the expansion starts at p_z to ~1e-15 relative. (Not brentq:
+        # importing scipy.optimize costs 0.08–0.1 s of start-up, see _not_a_knot_coef.)
+        angle_z = _rising_crossing(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc)
     # A ρ within rounding of 1 leaves no isobar worth a piece (and no zero-length interval).
     has_isobar = angle_z - x_tdc > 1e-12
     if not has_isobar:
