@@ -97,21 +97,29 @@ def test_energy_closes_from_rest_through_both_domains(policy):
 def test_power_flow_modes_against_the_reference_path():
     """Compiled stepper (modes held per step, switched by events) and the reference path
     (solve_ivp; the chain solved by bracketing the last sub-chain's residual on every call,
-    no held modes) agree on ω and on the energy lost in each pair."""
-    def run(method):
+    no held modes) agree on ω and on the energy lost in each pair.
+
+    The compiled run at rtol = atol = 1e-10 is compared with the reference at 1e-12: the
+    reference at 1e-10 is itself off by up to ~120 units of that tolerance in W_loss_1 (measured
+    against the compiled path at 1e-13: 1e-10 → −122, 1e-11 → 0.07, 1e-12 → −1.6 units), and
+    the compiled run is off by 12."""
+    def run(method, tol):
         scene = friction_scene(
             run=Run(revolutions=6.0),
             solver=replace(load_scene(CASES / "gots_diesel_friction.toml").solver,
-                           method=method, rtol=1e-10, atol=1e-10))
+                           method=method, rtol=tol, atol=tol))
         data = integrate(scene)
         assert data.complete, data.message
         return data.trajectory
 
-    c, r = run("dop853"), run("scipy-DOP853")
-    assert c["phi"][-1] == r["phi"][-1]  # both end exactly 6 revolutions on
+    c, r = run("dop853", 1e-10), run("scipy-DOP853", 1e-12)
+    # The compiled stepper lands on the end; solve_ivp's root finder finds it to rounding.
+    phi_end = friction_scene().initial.phi + 12.0 * math.pi
+    assert c["phi"][-1] == phi_end
+    assert abs(r["phi"][-1] - phi_end) <= 4.0 * np.spacing(phi_end)
     for name in ("t", "omega", "W_gas", "W_loss_1", "W_loss_2"):
         e = (c[name][-1] - r[name][-1]) / (1e-10 + 1e-10 * abs(r[name][-1]))
-        assert abs(e) <= 100, (name, e)
+        assert abs(e) <= 30, (name, e)
 
 
 def static_lock(scene, phi):
