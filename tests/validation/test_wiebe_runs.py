@@ -298,16 +298,22 @@ def test_governed_mixed_cycle_unchanged():
     (issue 5: scipy.optimize kept out of the start-up), which moved it by 2 ulp (both are roots
     to rounding of V): t by 7.5e-15 s, ω by 2.7e-12 rad/s, W_gas by 9.0e-10 J, fuel by 4.3e-14
     (values before: 2.4135048520304014, 429.0454495403231, 182400.97323543185,
-    0.8381962561239888)."""
+    0.8381962561239888).
+
+    Re-recorded when the crank-slider began to take each cylinder's sine and cosine from the
+    shaft angle's by the angle-difference formulas (issue 5: one sincos per right-hand side):
+    a change of rounding — t by 9.3e-15 s, ω by 2.7e-12 rad/s, W_gas by 2.2e-9 J, fuel by
+    4.3e-14 (values before: 2.413504852030394, 429.04544954032576, 182400.97323543276,
+    0.8381962561239463)."""
     scene = load_scene(CASES / "gots_diesel_governed.toml")
     scene = replace(scene, run=replace(scene.run, revolutions=150.0))
     assert not build_model(scene)[0].has_motored
     tr = integrate(scene).trajectory
-    assert tr["t"][-1] == 2.413504852030394
+    assert tr["t"][-1] == 2.413504852030403
     assert tr["phi"][-1] == 942.4777960769379
-    assert tr["omega"][-1] == 429.04544954032576
-    assert tr["W_gas"][-1] == 182400.97323543276
-    assert tr["fuel"][-1] == 0.8381962561239463
+    assert tr["omega"][-1] == 429.04544954032303
+    assert tr["W_gas"][-1] == 182400.97323543052
+    assert tr["fuel"][-1] == 0.8381962561239897
     # The p_k columns are now the pressure applied: p0 + f·(p − p0) (the table itself at f = 1).
     table = gas_tables(scene)[0]
     model = build_model(scene)[0]

@@ -140,7 +140,8 @@ class CrankSlider:
     def pack(self) -> NDArray[np.float64]:
         """Parameter array for :func:`transient.core.crank_slider.crank_slider_terms`."""
         l = self.rod_length
-        mp = np.zeros(core.PHASE0 + self.n_cylinders)
+        n = self.n_cylinders
+        mp = np.zeros(core.PHASE0 + 3 * n)
         mp[core.R] = self.crank_radius
         mp[core.L] = l
         mp[core.E] = self.offset
@@ -154,7 +155,10 @@ class CrankSlider:
             mp[core.ROD_CG] = self.rod_cg_from_pin
             mp[core.I_ROD] = self.rod_inertia_cg
         mp[core.N_CYL] = self.n_cylinders
-        mp[core.PHASE0:] = self.firing_angles
+        phase = np.asarray(self.firing_angles, dtype=np.float64)
+        mp[core.PHASE0:core.PHASE0 + n] = phase
+        mp[core.PHASE0 + n:core.PHASE0 + 2 * n] = np.sin(phase)
+        mp[core.PHASE0 + 2 * n:] = np.cos(phase)
         return mp
 
     def toml_lines(self) -> list[str]:
