@@ -91,8 +91,8 @@ def crank_slider_terms(mp, phi, u, du):
     """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
 
     ``u[k] = ds_k/dφ`` and ``du[k] = d²s_k/dφ²`` for cylinder k at local angle φ − mp[PHASE0 + k].
-    Its sine and cosine come from φ's by the angle-difference formulas: one sincos per call, not
-    one per cylinder (3 sincos were 16 % of the diesel's samples under ``perf``).
+    The local angle's sine and cosine come from φ's by the angle-difference formulas: one sincos
+    per call, not one per cylinder (3 sincos were 16 % of the diesel's samples under ``perf``).
     """
     n = int(mp[N_CYL])
     sp = sin(phi)

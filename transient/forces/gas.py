@@ -212,8 +212,8 @@ def _ppoly_coef(interp) -> NDArray[np.float64]:
 
 def _not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
     """Ascending local coefficients (k, 4) of the not-a-knot cubic spline through (x, y): the
-    curve of :class:`scipy.interpolate.CubicSpline` (``bc_type="not-a-knot"``; its algorithm, the
-    slopes from one tridiagonal system, de Boor ch. IV), which the tests compare it with.
+    curve of :class:`scipy.interpolate.CubicSpline` (``bc_type="not-a-knot"``; its algorithm: the
+    knots' slopes from one tridiagonal system), which the tests compare it with.
 
     Written out because importing scipy.interpolate (it imports scipy.optimize) costs 0.11–0.14 s,
     a tenth of a warm ``transient run`` of the diesel (issue 5's 1 s target), while
