@@ -17,9 +17,9 @@ from .jit import kernel
 #: Layout of the parameter array ``mp`` of :func:`crank_slider_terms` (filled by
 #: ``transient.mechanisms.crank_slider.CrankSlider.pack``).
 R, L, E, M_PISTON, M_PIN, M_CRANKPIN, M_ROD, ROD_CG, I_ROD, M_CRANK, N_CYL = range(11)
-#: mp[PHASE0 + k]: shaft angle at which cylinder k has local angle 0; its sine and cosine follow
-#: at mp[PHASE0 + n + k] and mp[PHASE0 + 2n + k] (n cylinders).
-PHASE0 = 11
+#: mp[SIN0 + k], mp[SIN0 + n + k]: sine and cosine of the shaft angle φ_k at which cylinder k
+#: (of n) has local angle 0 (its firing angle).
+SIN0 = 11
 
 
 @kernel
@@ -90,7 +90,7 @@ def cylinder_terms_sc(sa, ca, mp):
 def crank_slider_terms(mp, phi, u, du):
     """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
 
-    ``u[k] = ds_k/dφ`` and ``du[k] = d²s_k/dφ²`` for cylinder k at local angle φ − mp[PHASE0 + k].
+    ``u[k] = ds_k/dφ`` and ``du[k] = d²s_k/dφ²`` for cylinder k at local angle φ − φ_k.
     The local angle's sine and cosine come from φ's by the angle-difference formulas: one sincos
     per call, not one per cylinder (3 sincos were 16 % of the diesel's samples under ``perf``).
     """
@@ -100,8 +100,8 @@ def crank_slider_terms(mp, phi, u, du):
     J = 0.0
     dJ = 0.0
     for k in range(n):
-        s0 = mp[PHASE0 + n + k]
-        c0 = mp[PHASE0 + 2 * n + k]
+        s0 = mp[SIN0 + k]
+        c0 = mp[SIN0 + n + k]
         Jk, dJk, u[k], du[k] = cylinder_terms_sc(sp * c0 - cp * s0, cp * c0 + sp * s0, mp)
         J += Jk
         dJ += dJk

@@ -414,9 +414,11 @@ def moments(m, angle_mode, y, sel, sw, wk):
 
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; the rows u, u′ of ``wk`` are left holding
     the transfer functions and, with gas, WK_LOCAL and WK_PIECE the cylinders' pieces at ``sel``
-    (:func:`select_pieces`), for :func:`cylinder_rates` and :func:`output_row`. Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force
-    of cylinder k is (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel
-    f (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
+    (:func:`select_pieces`), for :func:`cylinder_rates` and :func:`output_row`.
+
+    Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force of cylinder k is
+    (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel f
+    (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
     P/max(ω, ω_min)), s from the schedule's segment ``sw[SW_LOAD]`` and the max from the
     generator's branch ``sw[SW_GENERATOR]``. With fuel latching cylinder k burns the fuel it
     took at its last injection, else every cylinder the governor's command (:func:`command`).

@@ -141,7 +141,7 @@ class CrankSlider:
         """Parameter array for :func:`transient.core.crank_slider.crank_slider_terms`."""
         l = self.rod_length
         n = self.n_cylinders
-        mp = np.zeros(core.PHASE0 + 3 * n)
+        mp = np.zeros(core.SIN0 + 2 * n)
         mp[core.R] = self.crank_radius
         mp[core.L] = l
         mp[core.E] = self.offset
@@ -156,9 +156,8 @@ class CrankSlider:
             mp[core.I_ROD] = self.rod_inertia_cg
         mp[core.N_CYL] = self.n_cylinders
         phase = np.asarray(self.firing_angles, dtype=np.float64)
-        mp[core.PHASE0:core.PHASE0 + n] = phase
-        mp[core.PHASE0 + n:core.PHASE0 + 2 * n] = np.sin(phase)
-        mp[core.PHASE0 + 2 * n:] = np.cos(phase)
+        mp[core.SIN0:core.SIN0 + n] = np.sin(phase)
+        mp[core.SIN0 + n:] = np.cos(phase)
         return mp
 
     def toml_lines(self) -> list[str]:
