@@ -2,8 +2,9 @@
 call), for the benchmark scenes and the Gots spin-up with and without friction pairs, at rtol 1e-8
 over 1000 revolutions (issue 5's target: ≤ 30 %), writing 72 output samples per turn and writing
 one (as ``transient bench`` times its runs).
-The cost of one call is timed in a compiled loop over 2000 states taken from the run itself (in
-crank angle, as the run integrates), median of 7 rounds of 100 loops (``rhs_timing.py``): once
+The cost of one call is timed in a compiled loop over 2000 states along the run's last cycle (in
+crank angle, as the run integrates; the gas table pieces picked once per CALLS_PER_STEP calls,
+as once per step in the run), median of 7 rounds of 100 loops (``rhs_timing.py``): once
 with the calls independent (the RHS's throughput) and once chained, each call's state depending on the previous result as a
 step's stages do (its latency: the divisions, square root and sine of a call can no longer
 overlap the next call's). Rerun:
@@ -47,10 +48,11 @@ for name, path in SCENES.items():
     runs = {n: timed(scene, n) for n in (72, 1)}
     model, _, _ = build_model(scene)
     tr = integrate(dc.replace(scene, run=dc.replace(scene.run, revolutions=50.0))).trajectory
-    pick = np.linspace(0, tr["t"].size - 1, 2000).astype(int)
-    states = np.zeros((pick.size, cm.n_state(model)))
-    states[:, cm.PHI], states[:, cm.T] = tr["phi"][pick], tr["t"][pick]
-    states[:, cm.KINETIC] = 0.5 * tr["J"][pick] * tr["omega"][pick] ** 2
+    # 2000 states over the run's last cycle: CALLS_PER_STEP of them span ~0.08 rad, about a step
+    phi = np.linspace(tr["phi"][-1] - model.period, tr["phi"][-1], 2000)
+    states = np.zeros((phi.size, cm.n_state(model)))
+    states[:, cm.PHI], states[:, cm.T] = phi, np.interp(phi, tr["phi"], tr["t"])
+    states[:, cm.KINETIC] = np.interp(phi, tr["phi"], 0.5 * tr["J"] * tr["omega"] ** 2)
     out = np.empty(cm.n_state(model))
     sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
     sw[cm.SW_DIRECTION] = 1
