@@ -129,7 +129,7 @@ def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64
     u, du = np.empty(mech.n_cylinders), np.empty(mech.n_cylinders)
     packed, no_table = mech.pack(), np.zeros((1, 1, 6))
     for j, angle in enumerate(bp):
-        mechanism_terms(int(mech.kind), packed, no_table, angle, u, du)
+        mechanism_terms(int(mech.kind), packed, no_table, angle, u, du, False)
         reach = 1e-9 * np.abs(u).max()  # u_k below it: a dead centre, to rounding
         for table in (t for t in tables if t is not None):
             corners = table.corners[:-1]

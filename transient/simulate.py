@@ -228,7 +228,7 @@ def switch_inertia(model, extra: float, y, ist):
     (the governor's branch, the generator's); returns the model with the extra inertia on the
     shaft (``J0``)."""
     angle_mode = ist[ci.I_ANGLE_MODE] == 1
-    J, _ = cm.inertia(model, y[cm.PHI], cm.work_array(model))
+    J = cm.inertia(model, y[cm.PHI], cm.work_array(model))
     w = cm.speed(J, angle_mode, y)
     w_new = J * w / (J + extra)
     y[cm.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new

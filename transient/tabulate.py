@@ -44,7 +44,7 @@ def exact_terms(kind: int, mech: NDArray[np.float64], ncyl: int, phi: NDArray[np
     u, du = np.empty(ncyl), np.empty(ncyl)
     no_table = np.zeros((1, 1, 6))
     for j, p in enumerate(phi):
-        out[0, j], out[1, j] = mechanism_terms(kind, mech, no_table, p, u, du)
+        out[0, j], out[1, j] = mechanism_terms(kind, mech, no_table, p, u, du, True)
         out[2: 2 + ncyl, j] = u
         out[2 + ncyl:, j] = du
     return out

@@ -326,8 +326,8 @@ def pure_python_twins():
     """
     glob = dict(core.crank_slider_terms.py_func.__globals__)
     twins = {}
-    for name in ("slider", "slider_sc", "cylinder_terms", "cylinder_terms_sc",
-                 "crank_slider_terms"):
+    for name in ("slider", "slider_sc", "rod_and_piston", "rod_and_piston_second",
+                 "cylinder_terms", "cylinder_terms_sc", "crank_slider_terms"):
         fn = getattr(core, name).py_func
         twins[name] = types.FunctionType(fn.__code__, glob, name, fn.__defaults__, fn.__closure__)
     glob.update(twins)
@@ -357,6 +357,22 @@ def test_kernels_equal_their_py_func_twins(geom, layout):
         assert dJ1 == pytest.approx(dJ2, rel=0, abs=1e-13 * J2)
         np.testing.assert_allclose(u1, u2, rtol=0, atol=1e-13 * r)
         np.testing.assert_allclose(du1, du2, rtol=0, atol=1e-13 * r)
+
+
+@pytest.mark.parametrize("geom,layout", CASES)
+def test_terms_without_dJ_are_the_same_J_and_u(geom, layout):
+    """``with_dJ=False`` (the crank-angle right-hand side without pairs) skips the second
+    derivatives: J and u to the last bit of the full evaluation, dJ and du NaN, never stale."""
+    mech = geometry_mech(geom, layout)
+    mp = mech.pack()
+    n = mech.n_cylinders
+    for p in ALPHA:
+        u1, du1, u2, du2 = np.empty(n), np.empty(n), np.zeros(n), np.zeros(n)
+        J1, _ = core.crank_slider_terms(mp, p, u1, du1, True)
+        J2, dJ2 = core.crank_slider_terms(mp, p, u2, du2, False)
+        assert J2 == J1
+        np.testing.assert_array_equal(u2, u1)
+        assert np.isnan(dJ2) and np.isnan(du2).all()
 
 
 @pytest.mark.parametrize("turns", [0, 1000, 100000])

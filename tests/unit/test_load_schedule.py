@@ -246,7 +246,7 @@ def moments_load(m, w, seg=0, gen_low=0, x=0.0):
     sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
     sw[cm.SW_LOAD] = seg
     sw[cm.SW_GENERATOR] = gen_low
-    return cm.moments(m, False, y, 0.0, sw, cm.work_array(m))[4]
+    return cm.moments(m, False, y, 0.0, sw, cm.work_array(m), True)[4]
 
 
 def test_default_load_moment_is_the_formula_bit_for_bit():

@@ -35,7 +35,7 @@ def forward(model, phi, omega, modes):
     wk = cm.work_array(model)
     sw = np.array([0, 0, modes, 1 if omega >= 0 else -1])
     y = state(model, phi, omega)
-    J, dJ, w, Mg, Ml, Ms = cm.moments(model, False, y, phi, sw, wk)
+    J, dJ, w, Mg, Ml, Ms = cm.moments(model, False, y, phi, sw, wk, True)
     a = cm.acceleration(model, J, dJ, w, Mg, Ml, Ms, sw, wk)
     return a, J, dJ, Mg + Ml + Ms, wk, sw, y
 
@@ -143,7 +143,7 @@ def test_locked_at_rest_when_friction_holds_starter_against_compression():
     y = state(model, phi, 0.0)
     wk = cm.work_array(model)
     sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-    _, _, _, Mg, _, _ = cm.moments(model, False, y, phi, sw, wk)
+    _, _, _, Mg, _, _ = cm.moments(model, False, y, phi, sw, wk, True)
     assert Mg < 0  # the gas resists forward motion here
     for ratio, locked in ((1.0, True), (1 / 0.9, False), (0.9, False)):
         m = model._replace(starter_torque=-Mg * ratio)
@@ -154,5 +154,5 @@ def test_locked_at_rest_when_friction_holds_starter_against_compression():
             assert sw[cm.SW_DIRECTION] == (1 if ratio > 1 else -1)
     ideal, _, _ = build_model(gots(()))
     ideal = ideal._replace(starter_torque=-Mg * 1.001)
-    J, dJ, w, Mg2, Ml, Ms = cm.moments(ideal, False, y, phi, np.array([1, 0, 0, 1]), wk)
+    J, dJ, w, Mg2, Ml, Ms = cm.moments(ideal, False, y, phi, np.array([1, 0, 0, 1]), wk, True)
     assert cm.acceleration(ideal, J, dJ, w, Mg2, Ml, Ms, np.array([1, 0, 0, 1]), wk) > 0

@@ -44,7 +44,7 @@ def test_coasting_conserves_kinetic_energy_and_phase():
     model, _, _ = build_model(scene)
     wk = work_array(model)
     K = energy[0]
-    turn = quad(lambda p: np.sqrt(inertia(model, p, wk)[0] / (2 * K)), 0, 2 * np.pi,
+    turn = quad(lambda p: np.sqrt(inertia(model, p, wk) / (2 * K)), 0, 2 * np.pi,
                 epsabs=1e-16, epsrel=1e-13, limit=400)[0]
     assert abs(tr["t"][-1] / (1000 * turn) - 1) <= 1e-9
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from math import asin, cos, sin, sqrt
 
+import numpy as np
+
 from .jit import kernel
 
 #: Layout of the parameter array ``mp`` of :func:`crank_slider_terms` (filled by
@@ -40,17 +42,29 @@ def slider(alpha, r, l, e):
 
 
 @kernel(inline="always")
-def slider_sc(sa, ca, r, l, e):
-    """:func:`slider` from sin α and cos α, with sin β in place of β."""
+def rod_and_piston(sa, ca, r, l, e):
+    """sin β, cos β, dβ/dα and the piston's ds/dα from sin α, cos α (Gots (2), (7), (12), (17))."""
     sb = (r * sa - e) / l
     cb = sqrt(1.0 - sb * sb)
     db = r * ca / (l * cb)
+    return sb, cb, db, r * sa + l * sb * db
+
+
+@kernel(inline="always")
+def rod_and_piston_second(sa, ca, r, l, sb, cb, db):
+    """d²β/dα² and d²s/dα² (Gots (8), (18)–(19) at ω = 1), from :func:`rod_and_piston`'s values."""
     ddb = (l * sb * db * db - r * sa) / (l * cb)
+    return ddb, r * ca + l * cb * db * db + l * sb * ddb
+
+
+@kernel(inline="always")
+def slider_sc(sa, ca, r, l, e):
+    """:func:`slider` from sin α and cos α, with sin β in place of β."""
+    sb, cb, db, ds = rod_and_piston(sa, ca, r, l, e)
+    ddb, dds = rod_and_piston_second(sa, ca, r, l, sb, cb, db)
     y_pin = r * ca + l * cb
-    dy_pin = -r * sa - l * sb * db
-    ddy_pin = -r * ca - l * cb * db * db - l * sb * ddb
     y_tdc = sqrt((l + r) ** 2 - e * e)
-    return y_tdc - y_pin, -dy_pin, -ddy_pin, sb, db, ddb
+    return y_tdc - y_pin, ds, dds, sb, db, ddb
 
 
 @kernel
@@ -64,33 +78,38 @@ def cylinder_terms(alpha, mp):
     Returns ``(J, dJ, ds, dds)``: inertia [kg m²], dJ/dα [kg m²/rad], and the piston's transfer
     function and its derivative.
     """
-    return cylinder_terms_sc(sin(alpha), cos(alpha), mp)
+    return cylinder_terms_sc(sin(alpha), cos(alpha), mp, True)
 
 
 @kernel(inline="always")
-def cylinder_terms_sc(sa, ca, mp):
-    """:func:`cylinder_terms` from sin α and cos α."""
+def cylinder_terms_sc(sa, ca, mp, with_dJ):
+    """:func:`cylinder_terms` from sin α and cos α; without ``with_dJ`` only J and ds, dJ and dds
+    NaN (the crank-angle right-hand side without pairs needs no dJ/dφ: 2 ns of its 41 ns)."""
     r = mp[R]
     l = mp[L]
-    s, ds, dds, sb, db, ddb = slider_sc(sa, ca, r, l, mp[E])
+    sb, cb, db, ds = rod_and_piston(sa, ca, r, l, mp[E])
     # Rod centre of mass G = B + f (A − B), f = |BG|/l; B moves only along the axis (B' = (0, −ds)).
     f = mp[ROD_CG] / l
     gx1 = f * r * ca
     gy1 = (1.0 - f) * (-ds) - f * r * sa
-    gx2 = -f * r * sa
-    gy2 = (1.0 - f) * (-dds) - f * r * ca
     m_slide = mp[M_PISTON] + mp[M_PIN]
     m_rot = mp[M_CRANKPIN] + mp[M_CRANK]
     J = m_slide * ds * ds + m_rot * r * r + mp[M_ROD] * (gx1 * gx1 + gy1 * gy1) + mp[I_ROD] * db * db
+    if not with_dJ:
+        return J, np.nan, ds, np.nan
+    ddb, dds = rod_and_piston_second(sa, ca, r, l, sb, cb, db)
+    gx2 = -f * r * sa
+    gy2 = (1.0 - f) * (-dds) - f * r * ca
     dJ = 2.0 * (m_slide * ds * dds + mp[M_ROD] * (gx1 * gx2 + gy1 * gy2) + mp[I_ROD] * db * ddb)
     return J, dJ, ds, dds
 
 
-@kernel
-def crank_slider_terms(mp, phi, u, du):
+@kernel(inline="always")  # as a call: 4 ns of the single cylinder's 39 ns right-hand side
+def crank_slider_terms(mp, phi, u, du, with_dJ=True):
     """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
 
-    ``u[k] = ds_k/dφ`` and ``du[k] = d²s_k/dφ²`` for cylinder k at local angle φ − φ_k.
+    ``u[k] = ds_k/dφ`` and ``du[k] = d²s_k/dφ²`` for cylinder k at local angle φ − φ_k. Without
+    ``with_dJ``, dJ and ``du`` are NaN (:func:`cylinder_terms_sc`).
     The local angle's sine and cosine come from φ's by the angle-difference formulas: one sincos
     per call, not one per cylinder (3 sincos were 16 % of the diesel's samples under ``perf``).
     """
@@ -102,7 +121,8 @@ def crank_slider_terms(mp, phi, u, du):
     for k in range(n):
         s0 = mp[SIN0 + k]
         c0 = mp[SIN0 + n + k]
-        Jk, dJk, u[k], du[k] = cylinder_terms_sc(sp * c0 - cp * s0, cp * c0 + sp * s0, mp)
+        Jk, dJk, u[k], du[k] = cylinder_terms_sc(sp * c0 - cp * s0, cp * c0 + sp * s0, mp,
+                                                   with_dJ)
         J += Jk
         dJ += dJk
     return J, dJ

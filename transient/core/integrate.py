@@ -245,7 +245,7 @@ def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
         margins_at(m, angle_mode, yv, sel, sw, wk)
         return wk[WK_G, comp - PAIR_COMP]
     if comp == OMEGA or comp == DEMAND_COMP:
-        J, _ = inertia(m, yv[PHI], wk)
+        J = inertia(m, yv[PHI], wk)
         w = speed(J, angle_mode, yv)
         return (w if comp == OMEGA else demand(m, w, yv)) - level
     return yv[comp] - level
@@ -520,7 +520,7 @@ def _inject(m, y, sw, evbuf, ist, wk):
     governor's command (``m.latch``). Returns whether any did (the derivative at y changes)."""
     if not m.latch:
         return False
-    J, _ = inertia(m, y[PHI], wk)
+    J = inertia(m, y[PHI], wk)
     w = speed(J, ist[I_ANGLE_MODE] == 1, y)
     if w <= 0.0:
         return False
@@ -575,7 +575,7 @@ def _crosses(g0, g1, direction):
 def _emit_event(m, evbuf, ist, code, y, wk):
     j = ist[I_NEV]
     if j < evbuf.shape[0]:
-        J, _ = inertia(m, y[PHI], wk)
+        J = inertia(m, y[PHI], wk)
         evbuf[j, 0] = code
         evbuf[j, 1] = y[T]
         evbuf[j, 2] = y[PHI]
@@ -975,7 +975,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         elif ev_comp != OMEGA:
             y_evt[ev_comp] = ev_level
         elif angle_mode:  # put the speed exactly on the level: K = ½ J ω²
-            J, _ = inertia(m, y_evt[PHI], wk)
+            J = inertia(m, y_evt[PHI], wk)
             y_evt[KINETIC] = 0.5 * J * ev_level * ev_level
         else:
             y_evt[OMEGA] = ev_level
@@ -1021,7 +1021,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         elif ev_code == EV_GENERATOR:
             ist[I_GEN_LOW] = generator_branch(m, ev_level, ev_rising)
         elif ev_code == EV_SLEEVE_STOP:
-            J, _ = inertia(m, y[PHI], wk)
+            J = inertia(m, y[PHI], wk)
             ist[I_SLEEVE] = _sleeve_stops(m, y, ev_level, speed(J, angle_mode, y))
         elif ev_code == EV_SLEEVE_FREE:
             ist[I_SLEEVE] = gv.FREE
@@ -1038,7 +1038,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
 @kernel
 def _to_angle_mode(m, y, ist, wk):
     """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
-    J, _ = inertia(m, y[PHI], wk)
+    J = inertia(m, y[PHI], wk)
     y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
     ist[I_ANGLE_MODE] = 1
 
@@ -1046,7 +1046,7 @@ def _to_angle_mode(m, y, ist, wk):
 @kernel
 def _to_time_mode(m, y, ist, wk):
     """Time becomes the independent variable; the third state becomes ω."""
-    J, _ = inertia(m, y[PHI], wk)
+    J = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
     ist[I_ANGLE_MODE] = 0
 

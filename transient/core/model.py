@@ -178,12 +178,13 @@ def work_array(m):
 
 
 @kernel(inline="always")
-def mechanism_terms(kind, mech, kin_coef, phi, u, du):
-    """J(φ) and dJ/dφ of the mechanism's moving parts; fills ``u[k]``, ``du[k]`` per cylinder."""
+def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
+    """J(φ) and dJ/dφ of the mechanism's moving parts; fills ``u[k]``, ``du[k]`` per cylinder.
+    Without ``with_dJ`` dJ and ``du`` may be left NaN (the exact crank-slider skips them)."""
     if kind == TABULATED:
         return tabulated_terms(kin_coef, phi, u, du)
     if kind == CRANK_SLIDER:
-        return crank_slider_terms(mech, phi, u, du)
+        return crank_slider_terms(mech, phi, u, du, with_dJ)
     if kind == ARTICULATED:
         return articulated_terms(mech, phi, u, du)
     return swash_terms(mech, phi, u, du)
@@ -276,9 +277,9 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
 
 @kernel(inline="always")
 def inertia(m, phi, wk):
-    """Total reduced inertia J(φ) and dJ/dφ, (19) and (21); fills the rows u, u′ of ``wk``."""
-    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, wk[WK_U], wk[WK_DU])
-    return J + m.J0, dJ
+    """Total reduced inertia J(φ), (19); fills the row u of ``wk``."""
+    J, _ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, wk[WK_U], wk[WK_DU], False)
+    return J + m.J0
 
 
 @kernel(inline="always")
@@ -409,12 +410,13 @@ def generator_branch(m, w, rising):
 
 
 @kernel(inline="always")
-def moments(m, angle_mode, y, sel, sw, wk):
+def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     """Reduced inertia, speed and moments at state ``y``.
 
-    Returns ``(J, dJ, w, M_gas, M_load, M_starter)``; the rows u, u′ of ``wk`` are left holding
-    the transfer functions and, with gas, WK_LOCAL and WK_PIECE the cylinders' pieces at ``sel``
-    (:func:`select_pieces`), for :func:`cylinder_rates` and :func:`output_row`.
+    Returns ``(J, dJ, w, M_gas, M_load, M_starter)``, dJ possibly NaN without ``with_dJ``; the
+    rows u, u′ of ``wk`` are left holding the transfer functions and, with gas, WK_LOCAL and
+    WK_PIECE the cylinders' pieces at ``sel`` (:func:`select_pieces`), for :func:`cylinder_rates`
+    and :func:`output_row`.
 
     Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force of cylinder k is
     (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel f
@@ -425,7 +427,7 @@ def moments(m, angle_mode, y, sel, sw, wk):
     """
     phi = y[PHI]
     u = wk[WK_U]
-    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, u, wk[WK_DU])
+    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, u, wk[WK_DU], with_dJ)
     J += m.J0
     w = speed(J, angle_mode, y)
     M_gas = 0.0
@@ -517,7 +519,9 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
     (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
     """
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
+    with_dJ = not angle_mode or m.n_pairs > 0
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, with_dJ)
     # the speed's range over a step's stages: a speed event inside the step shows here
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w)
     wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w)
@@ -525,7 +529,7 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     loss = 0.0  # Σ (1 − η*) S, the moment equivalent of the pairs' losses
     q = 1.0 if angle_mode else w  # work per unit of the independent variable
     if m.n_pairs == 0:  # equation (18); no chain to solve (a scene without pairs pays nothing)
-        a = (M - 0.5 * dJ * w * w) / J
+        a = (M - 0.5 * dJ * w * w) / J  # read in time mode only (in crank angle dJ may be NaN)
     else:
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
         mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
@@ -574,7 +578,7 @@ def mode_margins(m, sw, wk):
 @kernel
 def margins_at(m, angle_mode, y, sel, sw, wk):
     """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
     acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     mode_margins(m, sw, wk)
 
@@ -590,7 +594,7 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
     ``sw[SW_MODES]``. Returns the status of ``chain.modes_power_flow``: UNIQUE, LOCKED, or (a
     rounding tie S_k ≈ 0, resolved by its documented rule) AMBIGUOUS or NONE_CONSISTENT.
     """
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
     n = m.n_pairs
     if n == 0:
         sw[SW_DIRECTION] = -1 if w < 0.0 else 1
@@ -626,7 +630,7 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
     (p_mot + f·(p_full − p_mot), see :func:`applied_value`), ``PAIR_OUTPUTS`` of each pair, the
     dynamic governor's states and the latched fuels."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
     row[0] = y[T]
     row[1] = y[PHI]
     row[2] = w
@@ -735,7 +739,7 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
         if m.latch:  # (a static governor only) at a prescribed speed each cylinder latches it
             for k in range(m.ncyl):
                 y[latch_index(m) + k] = fuel(m, omega[i], sw[SW_GOVERNOR])
-        J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, phi[i], sw, wk)
+        J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, phi[i], sw, wk, True)
         output_row(m, False, y, phi[i], sw, wk, rows[i])
         rows[i, COL_EPS] = eps[i]
         if n == 0:
