@@ -459,7 +459,7 @@ def _figures(rows, out: Path) -> None:
     import matplotlib.pyplot as plt
 
     for scene in sorted({r["scene"] for r in rows}):
-        fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+        fig, axes = plt.subplots(1, 2, figsize=(12, 5.6))
         for m in sorted({r["method"] for r in rows if r["scene"] == scene}):
             sel = sorted((r for r in rows if r["scene"] == scene and r["method"] == m),
                          key=lambda r: -(r["step_rad"] or r["rtol"]))
@@ -471,8 +471,10 @@ def _figures(rows, out: Path) -> None:
             ax.set_ylabel(label)
             ax.grid(True, which="both", alpha=0.3)
         axes[0].axhline(TARGET_PHASE, color="k", lw=0.6, ls=":")
-        axes[0].legend(fontsize=8)
+        # one legend below both panels: inside an axes it hid the slow baselines' points
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, frameon=False)
         fig.suptitle(f"{scene}: work-precision")
-        fig.tight_layout()
+        fig.tight_layout(rect=(0, 0.1, 1, 1))
         fig.savefig(out / f"work_precision_{scene}.png", dpi=110)
         plt.close(fig)
