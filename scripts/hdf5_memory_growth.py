@@ -1,0 +1,71 @@
+"""Where the result file's residual memory growth is not (README *Speed*, Scale).
+
+Writes 16 columns at 4 samples per revolution through ``results.ResultWriter`` (blocks of 16384
+rows of smooth data, no integration) and prints the process's resident memory and HDF5's
+metadata cache size (``H5Fget_mdc_size``: max, min clean, current, entries) at 10³, 2×10⁵,
+5×10⁵ and 10⁶ revolutions, in one of four variants: ``default``; ``cap``, the metadata cache held
+at 2 MiB (its default starts there and may grow to 32 MiB); ``limits``, HDF5's free lists
+limited to 1 MiB in all and 256 KiB per list (``H5set_free_list_limits``); ``gc``, HDF5's free
+lists emptied at each checkpoint (``H5garbage_collect``). The last two call the libhdf5 that
+h5py bundles through ctypes (h5py does not wrap them).
+
+Rerun: ``for v in default cap limits gc; do .venv/bin/python scripts/hdf5_memory_growth.py $v;
+done`` (about 10 s each; writes /tmp/hdf5_memory_growth_<variant>.h5).
+"""
+import ctypes
+import glob
+import os
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from transient.results import ResultWriter
+
+VARIANTS = ("default", "cap", "limits", "gc")
+ROWS_PER_REV = 4
+BLOCK = 16384
+
+
+def rss_mb() -> float:
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS"):
+                return int(line.split()[1]) / 1024
+    return float("nan")
+
+
+def main(variant: str) -> None:
+    libs = os.path.join(os.path.dirname(h5py.__file__), os.pardir, "h5py.libs", "libhdf5-*.so*")
+    lib = ctypes.CDLL(glob.glob(libs)[0])  # the copy h5py has loaded already
+    if variant == "limits":
+        assert lib.H5set_free_list_limits(1 << 20, 1 << 18, 1 << 20, 1 << 18, 1 << 20, 1 << 18) >= 0
+    columns = {f"c{i}": "-" for i in range(16)}
+    path = Path(f"/tmp/hdf5_memory_growth_{variant}.h5")
+    writer = ResultWriter(path, "growth", "", columns, force=True)
+    if variant == "cap":
+        config = writer.f.id.get_mdc_config()
+        config.set_initial_size, config.initial_size = True, 1 << 21
+        config.min_size, config.max_size = 1 << 20, 1 << 21
+        writer.f.id.set_mdc_config(config)
+    rows = np.arange(BLOCK, dtype=float)
+    done, t0 = 0, time.perf_counter()
+    for revolutions in (1e3, 2e5, 5e5, 1e6):
+        while done < revolutions * ROWS_PER_REV:
+            x = np.sin((rows + done) * 1e-3)
+            writer.append({name: x + i for i, name in enumerate(columns)})
+            done += BLOCK
+        if variant == "gc":
+            assert lib.H5garbage_collect() >= 0
+        print(f"{variant}: {revolutions:.0e} revolutions: RSS {rss_mb():.1f} MB, metadata cache "
+              f"{writer.f.id.get_mdc_size()}, {time.perf_counter() - t0:.1f} s", flush=True)
+    writer.f.close()
+    path.with_name(f".{path.name}.part").unlink(missing_ok=True)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2 or sys.argv[1] not in VARIANTS:
+        sys.exit(f"usage: hdf5_memory_growth.py {{{'|'.join(VARIANTS)}}}")
+    main(sys.argv[1])
