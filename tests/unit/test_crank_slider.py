@@ -326,7 +326,7 @@ def pure_python_twins():
     """
     glob = dict(core.crank_slider_terms.py_func.__globals__)
     twins = {}
-    for name in ("slider", "slider_sc", "rod_and_piston", "rod_and_piston_second",
+    for name in ("slider", "rod_and_piston", "rod_and_piston_second",
                  "cylinder_terms", "cylinder_terms_sc", "crank_slider_terms"):
         fn = getattr(core, name).py_func
         twins[name] = types.FunctionType(fn.__code__, glob, name, fn.__defaults__, fn.__closure__)

@@ -37,7 +37,10 @@ def slider(alpha, r, l, e):
     beta, dbeta, ddbeta : float
         Rod angle [rad] and its derivatives [1, 1/rad] (Gots (7)–(8), (17)–(19) at ω = 1).
     """
-    s, ds, dds, sb, db, ddb = slider_sc(sin(alpha), cos(alpha), r, l, e)
+    sa, ca = sin(alpha), cos(alpha)
+    sb, cb, db, ds = rod_and_piston(sa, ca, r, l, e)
+    ddb, dds = rod_and_piston_second(sa, ca, r, l, sb, cb, db)
+    s = sqrt((l + r) ** 2 - e * e) - (r * ca + l * cb)  # top dead centre minus the pin's height
     return s, ds, dds, asin(sb), db, ddb
 
 
@@ -57,16 +60,6 @@ def rod_and_piston_second(sa, ca, r, l, sb, cb, db):
     return ddb, r * ca + l * cb * db * db + l * sb * ddb
 
 
-@kernel(inline="always")
-def slider_sc(sa, ca, r, l, e):
-    """:func:`slider` from sin α and cos α, with sin β in place of β."""
-    sb, cb, db, ds = rod_and_piston(sa, ca, r, l, e)
-    ddb, dds = rod_and_piston_second(sa, ca, r, l, sb, cb, db)
-    y_pin = r * ca + l * cb
-    y_tdc = sqrt((l + r) ** 2 - e * e)
-    return y_tdc - y_pin, ds, dds, sb, db, ddb
-
-
 @kernel
 def cylinder_terms(alpha, mp):
     """Reduced inertia of one cylinder's moving parts (piston, rod, crank throw) and its derivative.
@@ -84,7 +77,7 @@ def cylinder_terms(alpha, mp):
 @kernel(inline="always")
 def cylinder_terms_sc(sa, ca, mp, with_dJ):
     """:func:`cylinder_terms` from sin α and cos α; without ``with_dJ`` only J and ds, dJ and dds
-    NaN (the crank-angle right-hand side without pairs needs no dJ/dφ: 2 ns of its 41 ns)."""
+    NaN (the crank-angle right-hand side without pairs needs no dJ/dφ; README *Speed*, bare (18))."""
     r = mp[R]
     l = mp[L]
     sb, cb, db, ds = rod_and_piston(sa, ca, r, l, mp[E])
@@ -104,7 +97,7 @@ def cylinder_terms_sc(sa, ca, mp, with_dJ):
     return J, dJ, ds, dds
 
 
-@kernel(inline="always")  # as a call: 4 ns of the single cylinder's 39 ns right-hand side
+@kernel(inline="always")  # inlined with the two above: README *Speed*, bare (18)
 def crank_slider_terms(mp, phi, u, du, with_dJ=True):
     """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
 
