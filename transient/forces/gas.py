@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from transient.errors import SceneError
+from transient.roots import bisect_root
 
 __all__ = [
     "DEFAULT_STEP",
@@ -210,14 +211,38 @@ def _ppoly_coef(interp) -> NDArray[np.float64]:
     return np.ascontiguousarray(interp.c[::-1].T, dtype=np.float64)
 
 
+def _tridiagonal_solve(lower, diag, upper, rhs):
+    """x with A x = rhs for the tridiagonal A (``lower[i] = A[i+1, i]``, ``upper[i] = A[i, i+1]``),
+    by Gaussian elimination without pivoting (the Thomas algorithm).
+
+    Written for the not-a-knot spline's system (:func:`_not_a_knot_coef`) so that a run does not
+    import scipy.linalg for it (README *Start-up*). Without pivoting it is stable there: once the
+    first row is eliminated every row is diagonally dominant (interior rows 2(h₀ + h₁) against
+    h₀ + h₁ off the diagonal, and the first row's elimination leaves h₀ + h₁ against h₀), so
+    every pivot exceeds its row's upper element, and the last row's multiplier is below 1. The
+    tests compare it with scipy.linalg.solve_banded (LU with partial pivoting).
+    """
+    diag = diag.copy()
+    rhs = rhs.copy()
+    for i in range(1, diag.size):
+        w = lower[i - 1] / diag[i - 1]
+        diag[i] -= w * upper[i - 1]
+        rhs[i] -= w * rhs[i - 1]
+    x = np.empty(diag.size)
+    x[-1] = rhs[-1] / diag[-1]
+    for i in range(diag.size - 2, -1, -1):
+        x[i] = (rhs[i] - upper[i] * x[i + 1]) / diag[i]
+    return x
+
+
 def _not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
     """Ascending local coefficients (k, 4) of the not-a-knot cubic spline through (x, y): the
     curve of :class:`scipy.interpolate.CubicSpline` (``bc_type="not-a-knot"``; its algorithm: the
     knots' slopes from one tridiagonal system), which the tests compare it with.
 
     Written out because importing scipy.interpolate (it imports scipy.optimize) costs 0.11–0.14 s,
-    a tenth of a warm ``transient run`` of the diesel (issue 5's 1 s target), while
-    scipy.linalg, which numba imports anyway, has the banded solver. With 3 points it is the
+    a tenth of a warm ``transient run`` of the diesel (issue 5's 1 s target), and scipy.linalg,
+    for a banded solver, 0.1 s more (:func:`_tridiagonal_solve`). With 3 points it is the
     parabola through them, with 2 the straight line (CubicSpline's choices there).
     """
     dx = np.diff(x)
@@ -234,24 +259,22 @@ def _not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[
                       2.0 * slope[1]])
         s = np.linalg.solve(A, b)
     else:
-        from scipy.linalg import solve_banded  # (already imported by numba's start)
-
         # C² at the interior knots: dx_i s_{i-1} + 2(dx_{i-1} + dx_i) s_i + dx_{i-1} s_{i+1} = …
-        ab = np.zeros((3, n))  # the bands: upper, diagonal, lower
-        ab[0, 2:] = dx[:-1]
-        ab[1, 1:-1] = 2.0 * (dx[:-1] + dx[1:])
-        ab[2, :-2] = dx[1:]
+        lower = np.append(dx[1:], 0.0)
+        diag = np.empty(n)
+        diag[1:-1] = 2.0 * (dx[:-1] + dx[1:])
+        upper = np.insert(dx[:-1], 0, 0.0)
         b = np.empty(n)
         b[1:-1] = 3.0 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
         # not-a-knot: the third derivative continuous at x_1 and at x_{n-2}, eliminated to
         # keep the system tridiagonal
         d = x[2] - x[0]
-        ab[1, 0], ab[0, 1] = dx[1], d
+        diag[0], upper[0] = dx[1], d
         b[0] = ((dx[0] + 2.0 * d) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / d
         d = x[-1] - x[-3]
-        ab[1, -1], ab[2, -2] = dx[-2], d
+        diag[-1], lower[-1] = dx[-2], d
         b[-1] = (dx[-1] ** 2 * slope[-2] + (2.0 * d + dx[-1]) * dx[-2] * slope[-1]) / d
-        s = solve_banded((1, 1), ab, b, check_finite=False)
+        s = _tridiagonal_solve(lower, diag, upper, b)
     # each interval's cubic Hermite polynomial from its end values and slopes
     t = (s[:-1] + s[1:] - 2.0 * slope) / dx
     return np.column_stack([y[:-1], s[:-1], (slope - s[:-1]) / dx - t, t / dx])
@@ -555,20 +578,6 @@ def _scalar_volume(volume: Callable[[NDArray[np.float64]], ArrayLike], x: float)
     return float(np.asarray(volume(np.array([x], dtype=np.float64)), dtype=np.float64).ravel()[0])
 
 
-def _rising_crossing(g: Callable[[float], float], a: float, b: float) -> float:
-    """The x in [a, b] where the increasing function g crosses zero (g(a) < 0 < g(b)), by
-    bisection until the bracket cannot shrink: the smallest float with g(x) >= 0 to within
-    rounding of g."""
-    while True:
-        c = 0.5 * (a + b)
-        if not a < c < b:
-            return b
-        if g(c) < 0.0:
-            a = c
-        else:
-            b = c
-
-
 def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compression_ratio: float,
                 p_a: float, n1: float, p_z: float, rho: float, n2: float,
                 p_intake: float | None = None, p_exhaust: float | None = None, strokes: int = 4,
@@ -682,9 +691,8 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
     angle_z = x_tdc
     if rho > 1.0:
         # V rises monotonically from TDC to BDC on a crank slider: bisection finds the crossing
-        # to the last bit, so the expansion starts at p_z to ~1e-15 relative. (Not brentq:
-        # importing scipy.optimize costs 0.08–0.1 s of start-up, see _not_a_knot_coef.)
-        angle_z = _rising_crossing(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc)
+        # to the last bit, so the expansion starts at p_z to ~1e-15 relative.
+        angle_z = bisect_root(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc)
     # A ρ within rounding of 1 leaves no isobar worth a piece (and no zero-length interval).
     has_isobar = angle_z - x_tdc > 1e-12
     if not has_isobar:

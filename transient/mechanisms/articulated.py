@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import articulated as core
 from ..core.model import ARTICULATED
 from ..errors import SceneError
+from ..roots import bisect_root
 from ..tomlout import toml_value
 from .crank_slider import CrankSlider
 
@@ -391,9 +392,9 @@ def dead_centres(mech: Articulated) -> tuple[NDArray[np.float64], NDArray[np.flo
     piston of a row, (1 + z′,) each, the master first (exactly 0 and π).
 
     Semenov (55)–(57) find them by the secant method on his truncated series; here they are the
-    roots of the exact dX/dα, bracketed on a grid and refined by Brent's method, wrapped to [0, 2π).
+    roots of the exact dX/dα, bracketed on a grid and refined by bisection to the last bit,
+    wrapped to [0, 2π).
     """
-    from scipy.optimize import brentq  # (scipy.optimize: start-up time)
 
     grid = np.linspace(0.0, 2.0 * pi, SAMPLES + 1)
     h = grid[1]
@@ -408,7 +409,7 @@ def dead_centres(mech: Articulated) -> tuple[NDArray[np.float64], NDArray[np.flo
     tdc, bdc = np.zeros(1 + mech.n_slaves), np.full(1 + mech.n_slaves, pi)
     for i in range(1, 1 + mech.n_slaves):
         for out, j in ((tdc, np.argmax(x[:, i])), (bdc, np.argmin(x[:, i]))):
-            out[i] = brentq(rate, grid[j] - h, grid[j] + h, args=(i,), xtol=1e-15) % (2.0 * pi)
+            out[i] = bisect_root(lambda a: rate(a, i), grid[j] - h, grid[j] + h) % (2.0 * pi)
     return tdc, bdc
 
 

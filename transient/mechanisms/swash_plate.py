@@ -52,6 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..core import swash_plate as core
 from ..core.model import SWASH_PLATE
 from ..errors import SceneError
+from ..roots import bisect_root
 from ..tomlout import toml_value
 
 if TYPE_CHECKING:
@@ -424,7 +425,8 @@ def positions(geom: SwashPlate, phi: ArrayLike, mirror_x: float | None = None
 def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Shaft angles [rad] of each cylinder's inner (x_D smallest) and outer dead centre, (z,) each.
 
-    The extremes of x_D are found on a grid and refined as roots of u_k = dx_D/dφ (Brent's method).
+    The extremes of x_D are found on a grid and refined as roots of u_k = dx_D/dφ (bisection to the
+    last bit).
     Angles are not wrapped: each lies within a grid step (0.5°) of [0, 2π].
     """
     mp = geom.pack()
@@ -435,14 +437,12 @@ def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.floa
         core.swash_terms(mp, p, u, du)
         return u[k]
 
-    from scipy.optimize import brentq  # (here: scipy.optimize costs 0.2 s of start-up)
-
     grid = np.linspace(0.0, 2.0 * pi, 721)
     h = grid[1]
     x = _points(mp, grid)[2][..., 0]
     inner, outer = np.empty(z), np.empty(z)
     for k in range(z):
-        inner[k], outer[k] = (brentq(rate, grid[j] - h, grid[j] + h, args=(k,), xtol=1e-15)
+        inner[k], outer[k] = (bisect_root(lambda p: rate(p, k), grid[j] - h, grid[j] + h)
                               for j in (np.argmin(x[:, k]), np.argmax(x[:, k])))
     return inner, outer
 
