@@ -501,6 +501,11 @@ def test_prescribed_speed_run_writes_drive_torque(tmp_path, capsys):
     assert mean_drive < 0
     assert mean_drive == pytest.approx(-mean_gas, rel=1e-9)
     assert res.analysis["mean_drive_torque_last_cycle"][0] == pytest.approx(mean_drive, rel=1e-9)
+    # the work columns (written out for start-up time) are scipy's cumulative trapezoid
+    from scipy.integrate import cumulative_trapezoid
+    for name, torque in (("W_gas", "M_gas"), ("W_drive", "M_drive")):
+        np.testing.assert_array_equal(
+            tr[name], cumulative_trapezoid(tr[torque] * tr["omega"], tr["t"], initial=0.0))
 
 
 # ----------------------------------------------------------------------------------------------
