@@ -89,9 +89,8 @@ All kernels take plain float64 arrays; shapes: J, dJ, M: (n + 1,); eta_*, S_out:
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from .jit import kernel
+from .jit import compiled, kernel
 
 #: Largest number of pairs :func:`modes_power_flow` enumerates (2ⁿ candidates).
 MAX_PAIRS = 6
@@ -213,7 +212,7 @@ def _best_candidate(J, dJ, M, eta_fwd, eta_bwd, w, sigma, eta_out, S_out, eta_tr
     return a_best, n_ok
 
 
-@njit(cache=True)
+@compiled
 def modes_power_flow(J, dJ, M, eta_fwd, eta_bwd, w, eta_out, S_out):
     """:func:`modes_power_flow_into` with scratch space of its own (for callers outside the
     compiled loop)."""

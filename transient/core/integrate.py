@@ -21,9 +21,8 @@ the Python caller can stream results, show progress and react to Ctrl-C between 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from .jit import kernel
+from .jit import compiled, kernel
 
 from .chain import AMBIGUOUS, MAX_PAIRS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
@@ -606,7 +605,7 @@ def _reset_output_grid(cfg, ist, fst, y):
     fst[F_NEXT_OUT] = j * d
 
 
-@njit(cache=True, nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
+@compiled(nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
 def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 

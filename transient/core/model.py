@@ -17,9 +17,8 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
-from .jit import kernel
+from .jit import compiled, kernel
 
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import cylinder as cyl
@@ -169,7 +168,7 @@ def n_outputs(m):
             + (m.ncyl if m.latch else 0))
 
 
-@njit(cache=True)
+@compiled
 def work_array(m):
     """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
     wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
@@ -715,7 +714,7 @@ def inverse_chain(m, a, w, sigma, wk):
     return best, n_ok
 
 
-@njit(cache=True)
+@compiled
 def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
     """Prescribed motion: the drive torque on the shaft that the chain needs [N m].
 
