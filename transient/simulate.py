@@ -121,6 +121,18 @@ def _compile(model, tab, cfg, bp) -> float:
     return time.perf_counter() - t0
 
 
+def _events_by_name(rows, switching: bool) -> dict[str, np.ndarray]:
+    """A chunk's events (rows of code, t, φ, ·) by name, each an (n, 2) array of (t, φ) in the
+    order they occurred; the end of a run stopped to switch an inertia in is ``inertia_switch``.
+    (Grouped by numpy: a diesel chunk holds thousands of pair switches and breakpoints.)"""
+    codes = rows[:, 0].astype(np.int64)
+    ev = {}
+    for code in np.unique(codes):
+        name = ci.EVENT_NAMES[code]
+        ev["inertia_switch" if switching and name == "end" else name] = rows[codes == code, 1:3]
+    return ev
+
+
 def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                  progress: Callable[[float], None] | None = None, keep: bool = True) -> RunData:
     """Integrate a dynamic scene with the compiled stepper (``scene.solver.method``: DOP853 or
@@ -152,11 +164,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
             status = ci.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf)
             switching = status == ci.FINISHED and y[cm.T] == switch_at
             block = {name: outbuf[: ist[ci.I_NOUT], j].copy() for j, name in enumerate(names)}
-            ev = {}
-            for code, t, phi, _ in evbuf[: ist[ci.I_NEV]]:
-                name = ci.EVENT_NAMES[int(code)]
-                ev.setdefault("inertia_switch" if switching and name == "end" else name,
-                              []).append((t, phi))
+            ev = _events_by_name(evbuf[: ist[ci.I_NEV]], switching)
             ist[ci.I_NOUT] = 0
             ist[ci.I_NEV] = 0
             if switching:
@@ -166,7 +174,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                 blocks = (blocks if keep else []) + [block]
             if keep:
                 for k, v in ev.items():
-                    events.setdefault(k, []).extend(v)
+                    events.setdefault(k, []).append(v)
             if on_block:
                 on_block(block, ev)
             if progress:
@@ -216,7 +224,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
               "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES]),
               **_kinematics_attrs(scene)}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
-    return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v},
+    return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
                    solver, complete=status == ci.FINISHED, message=message)
 
 
