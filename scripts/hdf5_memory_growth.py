@@ -1,16 +1,19 @@
-"""Where the result file's residual memory growth is not (README *Speed*, Scale).
+"""Where the result file's memory growth comes from (README *Speed*, Scale).
 
 Writes 16 columns at 4 samples per revolution through ``results.ResultWriter`` (blocks of 16384
 rows of smooth data, no integration) and prints the process's resident memory and HDF5's
 metadata cache size (``H5Fget_mdc_size``: max, min clean, current, entries) at 10³, 2×10⁵,
-5×10⁵ and 10⁶ revolutions, in one of four variants: ``default``; ``cap``, the metadata cache held
+5×10⁵ and 10⁶ revolutions, in one of five variants: ``default`` (the file in HDF5's 1.10
+format, ``results.FILE_FORMAT``); ``v108``, the file in h5py's default bounds, the 1.8 format
+(the default until 2026-11-25), whose chunk index is a B-tree; ``cap``, the metadata cache held
 at 2 MiB (its default starts there and may grow to 32 MiB); ``limits``, HDF5's free lists
 limited to 1 MiB in all and 256 KiB per list (``H5set_free_list_limits``); ``gc``, HDF5's free
 lists emptied at each checkpoint (``H5garbage_collect``). The last two call the libhdf5 that
 h5py bundles through ctypes (h5py does not wrap them).
 
-Rerun: ``for v in default cap limits gc; do .venv/bin/python scripts/hdf5_memory_growth.py $v;
-done`` (about 10 s each; writes /tmp/hdf5_memory_growth_<variant>.h5).
+Rerun: ``for v in default v108 cap limits gc; do .venv/bin/python
+scripts/hdf5_memory_growth.py $v; done`` (about 10 s each; writes
+/tmp/hdf5_memory_growth_<variant>.h5).
 """
 import ctypes
 import glob
@@ -22,9 +25,10 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from transient import results
 from transient.results import ResultWriter
 
-VARIANTS = ("default", "cap", "limits", "gc")
+VARIANTS = ("default", "v108", "cap", "limits", "gc")
 ROWS_PER_REV = 4
 BLOCK = 16384
 
@@ -42,6 +46,8 @@ def main(variant: str) -> None:
     lib = ctypes.CDLL(glob.glob(libs)[0])  # the copy h5py has loaded already
     if variant == "limits" and lib.H5set_free_list_limits(*(1 << 20, 1 << 18) * 3) < 0:
         sys.exit("H5set_free_list_limits failed")
+    if variant == "v108":
+        results.FILE_FORMAT = None  # h5py's default bounds
     columns = {f"c{i}": "-" for i in range(16)}
     path = Path(f"/tmp/hdf5_memory_growth_{variant}.h5")
     writer = ResultWriter(path, "growth", "", columns, force=True)

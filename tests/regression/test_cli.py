@@ -255,6 +255,8 @@ def test_run_writes_result_with_design_layout(tmp_path, capsys):
         assert dt.datetime.fromisoformat(a["created"]).tzinfo is not None
         assert a["scene"] == "small-spinup"
         assert bool(a["complete"]) is True
+        # HDF5's 1.10 file format (superblock version 3; results.FILE_FORMAT), not 1.8's (0)
+        assert f.id.get_create_plist().get_version()[0] == 3
         assert "toml" in f["scene"]
         toml = f["scene/toml"][()]
         toml = toml.decode() if isinstance(toml, bytes) else toml
