@@ -68,11 +68,24 @@ CHUNK_ROWS = 4096
 #: made the diesel's 72-samples-per-turn run 9–11 % slower: a block spans more chunks than that.
 CHUNK_CACHE_BYTES = 32 * CHUNK_ROWS * 8
 
-#: HDF5 file-format bounds: the 1.10 format, readable by HDF5 ≥ 1.10 (2016). Its chunk index for
-#: a dataset extended along one axis (an extensible array, not 1.8's B-tree) keeps the writing
-#: process from growing with the run: 0.6 MB from 2×10⁵ to 10⁶ revolutions of 16 columns
-#: against 4.4 MB with 1.8's (``scripts/hdf5_memory_growth.py``; README *Speed*, Scale).
+#: HDF5 format bounds of a result's objects: the 1.10 format, readable by HDF5 ≥ 1.10 (2016). Its
+#: chunk index for a dataset extended along one axis (an extensible array, not 1.8's B-tree) keeps
+#: the writing process from growing with the run: 0.6 MB from 2×10⁵ to 10⁶ revolutions of 16
+#: columns against 4.4 MB with 1.8's (``scripts/hdf5_memory_growth.py``; README *Speed*, Scale).
+#: The file itself keeps the 1.8 format's superblock (:func:`_create_file`).
 FILE_FORMAT = ("v110", "v110")
+
+
+def _create_file(path: Path) -> h5py.File:
+    """A new, empty HDF5 file at ``path``, open for writing objects in :data:`FILE_FORMAT`.
+
+    Created in h5py's default bounds first, so that its superblock is the 1.8 format's (version 0):
+    a 1.10 superblock (version 3) marks the file open for writing until it is closed, and HDF5
+    then refuses to open it elsewhere, while the run writes it or for good after the run was
+    killed (until ``h5clear --status``), which would lose what a killed run computed. Reopened
+    with the 1.10 bounds, the file keeps its superblock."""
+    h5py.File(path, "w").close()
+    return h5py.File(path, "r+", libver=FILE_FORMAT, rdcc_nbytes=CHUNK_CACHE_BYTES)
 
 
 class ResultWriter:
@@ -84,7 +97,7 @@ class ResultWriter:
         check_writable(self.path, force)
         self.tmp = self.path.with_name(f".{self.path.name}.part")
         try:
-            self.f = h5py.File(self.tmp, "w", libver=FILE_FORMAT, rdcc_nbytes=CHUNK_CACHE_BYTES)
+            self.f = _create_file(self.tmp)
             self._start(scene_name, scene_toml, columns)
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
             self._abandon()
