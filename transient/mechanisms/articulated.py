@@ -395,7 +395,6 @@ def dead_centres(mech: Articulated) -> tuple[NDArray[np.float64], NDArray[np.flo
     roots of the exact dX/dα, bracketed on a grid and refined by bisection to the last bit,
     wrapped to [0, 2π).
     """
-
     grid = np.linspace(0.0, 2.0 * pi, SAMPLES + 1)
     h = grid[1]
     x = axial_positions(mech, grid)[0]
