@@ -24,8 +24,9 @@ class _RegistryFreeCache(FunctionCache):
 
     numba's ``load_overload`` begins with ``target_context.refresh()``: it imports and installs
     the typing and lowering registries of everything numba compiles (its numpy, its typed
-    containers, its random generators; ``numba.np.arraymath`` imports scipy.linalg to find BLAS),
-    0.2–0.35 s of every ``transient run`` (README *Start-up*). Those registries serve only
+    containers, its random generators; ``numba.np.arraymath`` imports scipy.linalg to find BLAS):
+    timed around ``load_overload`` in a diesel run, 0.35–0.38 s for the first function loaded,
+    0.003–0.05 s for each of the others (README *Start-up*). Those registries serve only
     compiling. Running loaded machine code needs two things they would have set up: the
     reference-counting runtime (NRT), which the allocating functions call, and the hash secrets
     that numba's hashing code reads as symbols; both are set up here. A function that is not in
