@@ -17,6 +17,14 @@ the dense output (Hairer, Nørsett & Wanner,
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks.
+
+Helpers called once per step or once per root-finding iteration that take the Model are inlined
+(``inline="always"``: the step, the error norm, the stiffness test, the margin samples, the event
+function, a pair's crossing), each at its one call site, or at a few where it is small: a call
+that is not inlined copies the Model's ~150 flattened words onto the stack (:mod:`.jit`). Under
+``perf`` (``scripts/profile_stepper.py``) those copies were 26 % of the diesel's samples in
+numba's code and are now 15–16 %; the rest are calls that run rarely or whose callee is too
+large to copy at several sites (the dense output, the margins).
 """
 from __future__ import annotations
 
@@ -93,7 +101,7 @@ def _controlled(i, ix, g0, g1, c0):
     return i != ix and (i < N_DYNAMIC or g0 <= i < g1 or i >= c0)
 
 
-@kernel
+@kernel(inline="always")
 def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0):
     """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
     the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5), over the components
@@ -125,7 +133,7 @@ def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0):
     return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1 + g1 - g0 + n - c0))
 
 
-@kernel
+@kernel(inline="always")
 def _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol):
     """Estimate of h·λ over the step (Hairer, *Solving ODEs II*, §IV.2): the last main stage and
     the FSAL stage both sit at the step's end, and ‖f(y₁) − f(y_s)‖/‖y₁ − y_s‖ estimates the
@@ -150,7 +158,7 @@ def _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol):
     return abs(h) * np.sqrt(num / den)
 
 
-@kernel
+@kernel(inline="always")
 def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
     """Count an accepted step in Hairer's stiffness test (``STIFF_COUNT``); True when stiff."""
     if _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol) > tab.stiff_bound:
@@ -163,7 +171,7 @@ def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
     return False
 
 
-@kernel
+@kernel(inline="always")
 def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """One Runge–Kutta step of size h from (x, y) with f = y′; K[0] must hold f.
 
@@ -236,7 +244,7 @@ def _dense_state(F, y, x, h, theta, ix, out):
     out[ix] = x + theta * h
 
 
-@kernel
+@kernel(inline="always")
 def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
     """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
     pair comp − PAIR_COMP, the PI demand u − level, else y[comp] − level."""
@@ -305,7 +313,7 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
 N_MARGIN_SAMPLES = 4
 
 
-@kernel
+@kernel(inline="always")
 def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
     """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
     holds the step's start and row N its end already)."""
@@ -344,7 +352,7 @@ def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel,
     return 2.0, n_samples
 
 
-@kernel
+@kernel(inline="always")
 def _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
     margin evaluations (right-hand sides) the root finding took.
@@ -1050,7 +1058,7 @@ def _to_time_mode(m, y, ist, wk):
     ist[I_ANGLE_MODE] = 0
 
 
-@kernel
+@kernel(inline="always")
 def _settle_modes(m, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
     just switched sits on its level (margin 0). Any other pair already past its level here (two

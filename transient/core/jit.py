@@ -55,5 +55,11 @@ def compiled(fn=None, **options):
 
 
 def kernel(fn=None, **options):
-    """``@kernel`` or ``@kernel(inline="always")``: compiled, no reference counting."""
+    """``@kernel`` or ``@kernel(inline="always")``: compiled, no reference counting.
+
+    Without ``inline="always"`` a kernel is a call in machine code, and numba passes a tuple
+    argument flattened, by value: each array as its pointers, sizes, shape and strides. The
+    Model tuple is ~150 words, copied onto the stack at every such call. numba's inlining copies
+    the callee's IR at every call site (a third of a cold compile), so inline what runs per step
+    at one or two sites, not everything (:mod:`.integrate` says what and what it measured)."""
     return compiled(fn, _nrt=False, **options)
