@@ -598,6 +598,19 @@ def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
     fst[F_LAST_PHI] = y[PHI]
 
 
+@kernel
+def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, tmp, wk):
+    """The output samples of the grid (spacing ``d_out``) up to ``x_stop`` inside the last step
+    (from x, size h), from its dense output F. Not inlined: in the stepper's loop each sample's
+    call copied the Model from a frame too large to keep it at hand (README, *Stepper
+    overhead*); here it is copied once per step."""
+    while fst[F_NEXT_OUT] <= x_stop:
+        _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
+        tmp[ix] = fst[F_NEXT_OUT]
+        _emit_row(m, tmp, sel, sw, outbuf, ist, fst, wk)
+        fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
+
+
 @kernel(inline="always")
 def _out_spacing(cfg, angle_mode):
     return cfg[C_DPHI_OUT] if angle_mode else cfg[C_DT_OUT]
@@ -923,16 +936,13 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         n_unseen = 0
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
         # Output samples inside the step (dense output), then the step's end state.
-        d_out = _out_spacing(cfg, angle_mode)
-        if fst[F_NEXT_OUT] <= x_stop and not dense_ready:
-            _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
-            ist[I_NFEV] += n_extra
-            dense_ready = True
-        while fst[F_NEXT_OUT] <= x_stop:
-            _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
-            tmp[ix] = fst[F_NEXT_OUT]
-            _emit_row(m, tmp, sel, sw, outbuf, ist, fst, wk)
-            fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
+        if fst[F_NEXT_OUT] <= x_stop:
+            if not dense_ready:
+                _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+                ist[I_NFEV] += n_extra
+                dense_ready = True
+            _emit_samples(m, F, y, x, h, x_stop, ix, _out_spacing(cfg, angle_mode), sel, sw,
+                          outbuf, ist, fst, tmp, wk)
         ist[I_NSTEPS] += 1
         steps_here += 1
         fst[F_H] = h_next
