@@ -19,12 +19,12 @@ the dense output (Hairer, Nørsett & Wanner,
 the Python caller can stream results, show progress and react to Ctrl-C between chunks.
 
 Helpers called once per step or once per root-finding iteration that take the Model are inlined
-(``inline="always"``: the step, the error norm, the stiffness test, the margin samples, the event
-function, a pair's crossing), each at its one call site, or at a few where it is small: a call
-that is not inlined copies the Model's ~150 flattened words onto the stack (:mod:`.jit`). Under
-``perf`` (``scripts/profile_stepper.py``) those copies were 26 % of the diesel's samples in
-numba's code and are now 15–16 %; the rest are calls that run rarely or whose callee is too
-large to copy at several sites (the dense output, the margins).
+(``inline="always"``: the step, the error norm, the stiffness test, the margin samples, the mode
+settling, the event function, a pair's crossing), each at its one call site, or at a few where it
+is small: a call that is not inlined copies the Model's ~150 flattened words onto the stack
+(:mod:`.jit`). Under ``perf`` (``scripts/profile_stepper.py``) those copies were 26 % of the
+diesel's samples in numba's code and are now 15–16 %; the rest are calls that run rarely or
+whose callee is too large to copy at several sites (the dense output, the margins).
 """
 from __future__ import annotations
 
@@ -601,9 +601,10 @@ def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
 @kernel
 def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, tmp, wk):
     """The output samples of the grid (spacing ``d_out``) up to ``x_stop`` inside the last step
-    (from x, size h), from its dense output F. Not inlined: in the stepper's loop each sample's
-    call copied the Model from a frame too large to keep it at hand (README, *Stepper
-    overhead*); here it is copied once per step."""
+    (from x, size h), from its dense output F. A call of its own: from the stepper's loop, once
+    the step was inlined there, each sample's call into the output row copied the Model at three
+    times the cost (``perf``), and the coasting cylinder's runs at 72 samples per turn were 10 %
+    slower; from here they are not (README, *Calls that copy the Model*)."""
     while fst[F_NEXT_OUT] <= x_stop:
         _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
         tmp[ix] = fst[F_NEXT_OUT]
