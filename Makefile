@@ -23,7 +23,7 @@ run: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q
 
-# The work-precision record in results/benchmarks/ (issue 5; 14 min 23 s measured at a87c692). CyRK, the
+# The work-precision record in results/benchmarks/ (issue 5; 14 min 8 s measured at b0ece4d). CyRK, the
 # compiled peer, comes with the optional `bench` extra.
 bench: $(STAMP)
 	$(PY) -m pip install -q -e '.[test,bench]'

@@ -10,7 +10,7 @@ and ``(%rsp)``, ``push``): passing the Model tuple to a function that is not inl
 an upper bound). ``--calls NAME`` attributes a function's stack moves to the call that follows
 them (approximately: the moves since the previous call).
 
-Needs ``perf`` and binutils (``nm``, ``objdump``). Run (about a minute, warm cache)::
+Needs ``perf`` and binutils (``nm``, ``objdump``). Run (6 s and 1.5 s here, warm cache)::
 
     perf record -o /tmp/perf.data .venv/bin/python scripts/profile_stepper.py run \
         gots_diesel_governed
@@ -65,9 +65,9 @@ def run(name: str, repeats: int = 20) -> None:
         obj = OBJECTS / f"{i}.o"
         obj.write_bytes(obj_code)
         syms = _text_symbols(obj)
-        base = next((lib.codegen._engine.get_function_address(p[3]) - int(p[0], 16)
-                     for p in syms if p[2] == "T"
-                     and lib.codegen._engine.get_function_address(p[3])), None)
+        # one global symbol's address places the whole section (loaded in one piece)
+        placed = [(lib.codegen._engine.get_function_address(p[3]), p) for p in syms if p[2] == "T"]
+        base = next((a - int(p[0], 16) for a, p in placed if a), None)
         if base is not None:
             rows += [(base + int(p[0], 16), int(p[1], 16), p[3], obj) for p in syms]
     SYMBOLS.write_text("".join(f"{a:x} {s:x} {n} {o}\n" for a, s, n, o in sorted(rows)))
