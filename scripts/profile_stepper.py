@@ -13,7 +13,7 @@ them (approximately: the moves since the previous call).
 Needs ``perf`` and binutils (``nm``, ``objdump``). Run (6 s and 1.5 s here, warm cache)::
 
     perf record -o /tmp/perf.data .venv/bin/python scripts/profile_stepper.py run \
-        gots_diesel_governed
+        gots_diesel_governed [REPEATS [SAMPLES_PER_TURN]]
     .venv/bin/python scripts/profile_stepper.py report [--calls _advance]
 """
 from __future__ import annotations
@@ -39,9 +39,10 @@ def _text_symbols(obj: Path) -> list[list[str]]:
             if len(p) == 4 and p[2] in "TtWw"]
 
 
-def run(name: str, repeats: int = 20) -> None:
-    """Integrate the scene ``repeats`` times (1000 revolutions, rtol 1e-8, one sample per turn,
-    as ``stepper_overhead.py``), after writing the address of every loaded numba function."""
+def run(name: str, repeats: int = 20, samples_per_rev: int = 1) -> None:
+    """Integrate the scene ``repeats`` times (1000 revolutions, rtol 1e-8, one sample per turn
+    unless ``samples_per_rev`` says otherwise, as ``stepper_overhead.py``), after writing the
+    address of every loaded numba function."""
     from numba.core import codegen
 
     loaded = []
@@ -56,7 +57,7 @@ def run(name: str, repeats: int = 20) -> None:
     from transient.simulate import integrate
 
     scene = load_scene(CASES / f"{name}.toml")
-    scene = dc.replace(scene, output=dc.replace(scene.output, samples_per_rev=1),
+    scene = dc.replace(scene, output=dc.replace(scene.output, samples_per_rev=samples_per_rev),
                        solver=dc.replace(scene.solver, rtol=1e-8, atol=1e-11))
     integrate(scene, keep=False)  # loads (or compiles) everything
     OBJECTS.mkdir(exist_ok=True)
@@ -145,6 +146,6 @@ def report(calls_of: str | None = None) -> None:
 
 if __name__ == "__main__":
     if sys.argv[1] == "run":
-        run(sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 20)
+        run(sys.argv[2], *(int(a) for a in sys.argv[3:5]))
     else:
         report(sys.argv[3] if len(sys.argv) > 3 and sys.argv[2] == "--calls" else None)

@@ -40,6 +40,18 @@ def rhs_chain(m, states, y, out, sw, wk):
     return acc
 
 
+@kernel
+def margins_loop(m, states, out, sw, wk):
+    """The mode margins at every state as the stepper evaluates them outside its root finder: a
+    call to ``model.margins_at`` (not inlined; it passes the Model by value). ``out`` unused."""
+    acc = 0.0
+    for i in range(states.shape[0]):
+        sel = states[i - i % CALLS_PER_STEP, cm.PHI]
+        cm.margins_at(m, True, states[i], sel, sw, wk)
+        acc += wk[cm.WK_G, 0]
+    return acc
+
+
 def per_call(loop, *args, rounds=7, loops=100):
     """Time of one call [s] of a loop ``loop(x, states, …)`` over the rows of ``states`` (its
     second argument): median over ``rounds`` of ``loops`` loops, after a warm-up."""

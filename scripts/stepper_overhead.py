@@ -7,7 +7,8 @@ crank angle, as the run integrates; the gas table pieces picked once per CALLS_P
 as once per step in the run), median of 7 rounds of 100 loops (``rhs_timing.py``): once
 with the calls independent (the RHS's throughput) and once chained, each call's state depending on the previous result as a
 step's stages do (its latency: the divisions, square root and sine of a call can no longer
-overlap the next call's). Rerun:
+overlap the next call's). For scenes with pairs it prints the cost of one mode-margin
+evaluation as a call too: the stepper counts those among its RHS evaluations. Rerun:
 ``.venv/bin/python scripts/stepper_overhead.py`` (about 20 s).
 """
 import dataclasses as dc
@@ -15,7 +16,7 @@ import statistics
 from pathlib import Path
 
 import numpy as np
-from rhs_timing import per_call, rhs_chain, rhs_loop
+from rhs_timing import margins_loop, per_call, rhs_chain, rhs_loop
 
 from transient.assemble import build_model
 from transient.bench import BENCH_SCENES
@@ -60,6 +61,9 @@ for name, path in SCENES.items():
     out[:] = 0.0
     call = per_call(rhs_loop, model, states, out, sw, wk)
     chained = per_call(rhs_chain, model, states, np.empty_like(out), out, sw, wk)
+    if model.n_pairs:  # the margins, counted among the RHS evaluations, cost more as a call
+        print(f"{name}: one mode-margin evaluation as a call "
+              f"{per_call(margins_loop, model, states, out, sw, wk) * 1e6:.3f} µs")
     for n, (wall, nfev, nsteps) in runs.items():
         print(f"{name}, {n} samples/turn: {nfev} RHS evaluations, {nsteps} steps, {wall:.4g} s, "
               f"one call {call * 1e6:.3f} µs → RHS {nfev * call:.4g} s, stepper overhead "

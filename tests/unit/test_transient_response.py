@@ -471,3 +471,22 @@ def test_hermite_is_scipys_curve():
     np.testing.assert_allclose(_hermite(x, y, m)(q), CubicHermiteSpline(x, y, m)(q),
                                rtol=0, atol=1e-12)
     assert float(_hermite(x, y, m)(x[7])) == pytest.approx(y[7], abs=1e-14)
+
+
+@pytest.mark.parametrize("n", [2, 3, 40])
+def test_pchip_slopes_are_scipys(n):
+    """The hand-written PCHIP slopes (a start from rest needs them; kept out of
+    scipy.interpolate for start-up time) against scipy.interpolate.PchipInterpolator's
+    derivative at the samples, on data with local extrema, flat runs and monotone stretches,
+    and on increasing data (t over φ, as the spin-up's time of angle uses them)."""
+    from scipy.interpolate import PchipInterpolator
+
+    from transient.analysis.transient_response import _pchip_slopes
+    rng = np.random.default_rng(5)
+    x = np.sort(rng.uniform(0.0, 10.0, n))
+    wavy = np.round(rng.normal(size=n), 1)  # rounded: some equal neighbours (zero secants)
+    rising = np.cumsum(rng.uniform(0.0, 1.0, n))
+    for y in (wavy, rising, -rising):
+        expected = PchipInterpolator(x, y).derivative()(x)
+        np.testing.assert_allclose(_pchip_slopes(x, np.diff(y) / np.diff(x)), expected,
+                                   rtol=1e-13, atol=1e-13)

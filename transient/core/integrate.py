@@ -24,7 +24,12 @@ settling, the event function, a pair's crossing), each at its one call site, or 
 is small: a call that is not inlined copies the Model's ~150 flattened words onto the stack
 (:mod:`.jit`). Under ``perf`` (``scripts/profile_stepper.py``) those copies were 26 % of the
 diesel's samples in numba's code and are now 13 %; the rest are calls that run rarely or whose
-callee is too large to copy at several sites (the dense output, the margins).
+callee is too large to copy at several sites (the dense output, the margins, the output row).
+Those two are inlined at one site each, into small functions: the margins into the root finder,
+whose iterations (~7 a pair's mode switch) evaluate them most (``model.margins_inline``), the
+output row into the writing of the grid's samples (``model.output_row_inline``). That cost ~30 s
+of cold compile for the row, none measurable for the margins; the margins inlined into the step's
+samples too cost ~40 s more and were not kept (README, *Calls that copy the Model*).
 """
 from __future__ import annotations
 
@@ -40,7 +45,8 @@ from .model import (KINETIC, N_DYNAMIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW
                     SW_GOVERNOR, SW_LOAD, SW_MODES, SW_SLEEVE, SW_STARTER, T, WK_DEMAND, WK_G,
                     WK_G_MIN, WK_SPEED, choose_modes, command, demand, derivative, generator_branch,
                     cyl_index, gov_index, governor_branch, inertia, is_pi, latch_index, load_segment,
-                    margins_at, n_state, output_row, speed, start_branch, work_array)
+                    margins_at, margins_inline, n_state, output_row, output_row_inline, speed,
+                    start_branch, work_array)
 
 # Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -290,7 +296,11 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense_eval(F, y, c, tmp)
-        gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
+        if comp >= PAIR_COMP:  # most iterations: the margins inlined, no copy of the Model
+            margins_inline(m, angle_mode, tmp, sel, sw, wk)
+            gc = wk[WK_G, comp - PAIR_COMP]
+        else:
+            gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
         if gc == 0.0:
             return c, i + 1
         if (gc > 0.0) == (gb > 0.0):
@@ -592,7 +602,14 @@ def _emit_event(m, evbuf, ist, code, y, wk):
 
 @kernel
 def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
+    """One output row at state ``y`` (an event's): a call into ``model.output_row``."""
     output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
+    _count_row(y, ist, fst)
+
+
+@kernel(inline="always")
+def _count_row(y, ist, fst):
+    """The bookkeeping after a row is written at state ``y``."""
     ist[I_NOUT] += 1
     fst[F_LAST_T] = y[T]
     fst[F_LAST_PHI] = y[PHI]
@@ -601,14 +618,18 @@ def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
 @kernel
 def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, tmp, wk):
     """The output samples of the grid (spacing ``d_out``) up to ``x_stop`` inside the last step
-    (from x, size h), from its dense output F. A call of its own: from the stepper's loop, once
-    the step was inlined there, each sample's call into the output row copied the Model at three
-    times the cost (``perf``), and the coasting cylinder's runs at 72 samples per turn were 10 %
-    slower; from here they are not (README, *Calls that copy the Model*)."""
+    (from x, size h), from its dense output F. A call of its own, with the output row inlined:
+    from the stepper's loop, once the step was inlined there, each sample's call into the output
+    row copied the Model at three times the cost (``perf``), and the coasting cylinder's runs at
+    72 samples per turn were 10 % slower; from here a call per sample still copied it twice
+    (through ``_emit_row``), and inlining only ``_emit_row`` made those runs 17–21 % slower
+    (README, *Calls that copy the Model*)."""
+    angle_mode = ist[I_ANGLE_MODE] == 1
     while fst[F_NEXT_OUT] <= x_stop:
         _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
         tmp[ix] = fst[F_NEXT_OUT]
-        _emit_row(m, tmp, sel, sw, outbuf, ist, fst, wk)
+        output_row_inline(m, angle_mode, tmp, sel, sw, wk, outbuf[ist[I_NOUT]])
+        _count_row(tmp, ist, fst)
         fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
 
 

@@ -574,12 +574,21 @@ def mode_margins(m, sw, wk):
             wk[WK_G, k] = v * sigma
 
 
-@kernel
-def margins_at(m, angle_mode, y, sel, sw, wk):
-    """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``."""
+@kernel(inline="always")
+def margins_inline(m, angle_mode, y, sel, sw, wk):
+    """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``; inlined into the
+    stepper's root finder, whose iterations evaluate them most: there a call would copy the Model
+    at every iteration."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
     acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     mode_margins(m, sw, wk)
+
+
+@kernel
+def margins_at(m, angle_mode, y, sel, sw, wk):
+    """:func:`margins_inline` as a call: one compiled copy of the model's terms for the sites
+    that evaluate the margins rarely."""
+    margins_inline(m, angle_mode, y, sel, sw, wk)
 
 
 @kernel
@@ -626,9 +635,17 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
 
 @kernel
 def output_row(m, angle_mode, y, sel, sw, wk, row):
+    """:func:`output_row_inline` as a call: one compiled copy of the model's terms for the
+    output rows written at events."""
+    output_row_inline(m, angle_mode, y, sel, sw, wk, row)
+
+
+@kernel(inline="always")
+def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
     (p_mot + f·(p_full − p_mot), see :func:`applied_value`), ``PAIR_OUTPUTS`` of each pair, the
-    dynamic governor's states and the latched fuels."""
+    dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
+    samples (``integrate._emit_samples``): there a call would copy the Model for every sample."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
     row[0] = y[T]
     row[1] = y[PHI]
