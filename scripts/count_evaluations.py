@@ -3,8 +3,9 @@ latter by the stepper's function that asked for them, and the root finder's call
 iterations by event component.
 
 The kernels run as Python (``NUMBA_DISABLE_JIT=1``, set here before numba is imported), so that
-the margins and the root finder can be wrapped and counted; the trajectory is the compiled one's
-to rounding. The diesel at rtol 1e-8 over 100 revolutions takes ~5 s::
+the margins and the root finder can be wrapped and counted; the run takes the compiled run's
+steps (on the diesel's 100 revolutions the same 67 500 right-hand sides and 3 395 steps). That
+run takes ~5 s::
 
     .venv/bin/python scripts/count_evaluations.py gots_diesel_governed 100
 """

@@ -223,10 +223,10 @@ def _hermite(x, y, m) -> Callable[[ArrayLike], NDArray[np.float64]]:
 
 def _pchip_slopes(x, secant) -> NDArray[np.float64]:
     """The slopes of :class:`scipy.interpolate.PchipInterpolator` at the samples x, from the
-    secants between them (Fritsch &
-    Butland's weighted harmonic mean of the adjacent secants, 0 at a local extremum; the ends by
-    the shape-preserving three-point formula), which the tests compare with scipy's. Written out
-    for the reason :func:`_hermite` gives: a start from rest (ω = 0) needs them."""
+    secants between them: Fritsch & Butland's weighted harmonic mean of the adjacent secants, 0
+    at a local extremum; the ends by the shape-preserving three-point formula. The tests compare
+    them with scipy's. Written out for the reason :func:`_hermite` gives: a start from rest
+    (ω = 0) needs them."""
     if x.size == 2:
         return np.full(2, secant[0])
     h = np.diff(x)

@@ -25,11 +25,12 @@ is small: a call that is not inlined copies the Model's ~150 flattened words ont
 (:mod:`.jit`). Under ``perf`` (``scripts/profile_stepper.py``) those copies were 26 % of the
 diesel's samples in numba's code and are now 13 %; the rest are calls that run rarely or whose
 callee is too large to copy at several sites (the dense output, the margins, the output row).
-Those two are inlined at one site each, into small functions: the margins into the root finder,
-whose iterations (~7 a pair's mode switch) evaluate them most (``model.margins_inline``), the
-output row into the writing of the grid's samples (``model.output_row_inline``). That cost ~30 s
-of cold compile for the row, none measurable for the margins; the margins inlined into the step's
-samples too cost ~40 s more and were not kept (README, *Calls that copy the Model*).
+The margins and the output row are inlined at one site each, into a small function: the margins
+into the root finder, whose iterations (~7 a pair's mode switch) evaluate them most
+(``model.margins_inline``), the output row into the writing of the grid's samples
+(``model.output_row_inline``). That cost 30–38 s of cold compile for the row, none measurable
+for the margins; the margins inlined into the step's samples too cost ~40 s more and were not
+kept (README, *Calls that copy the Model*).
 """
 from __future__ import annotations
 
@@ -622,7 +623,7 @@ def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, t
     from the stepper's loop, once the step was inlined there, each sample's call into the output
     row copied the Model at three times the cost (``perf``), and the coasting cylinder's runs at
     72 samples per turn were 10 % slower; from here a call per sample still copied it twice
-    (through ``_emit_row``), and inlining only ``_emit_row`` made those runs 17–21 % slower
+    (through ``_emit_row``), and inlining only ``_emit_row`` made those runs 17–22 % slower
     (README, *Calls that copy the Model*)."""
     angle_mode = ist[I_ANGLE_MODE] == 1
     while fst[F_NEXT_OUT] <= x_stop:
