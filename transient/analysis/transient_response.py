@@ -262,7 +262,8 @@ def _monotone_hermite(x, y, slope) -> Callable[[ArrayLike], NDArray[np.float64]]
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(slope) & (slope >= 0)
     m = np.array(slope, dtype=np.float64)
-    m[~ok] = _pchip_slopes(x, secant)[~ok]
+    if not ok.all():  # (only a start from rest: not every run pays for the slopes)
+        m[~ok] = _pchip_slopes(x, secant)[~ok]
     limit = 3.0 * np.minimum(np.r_[secant[0], secant], np.r_[secant, secant[-1]])
     return _hermite(x, y, np.clip(m, 0.0, limit))
 
