@@ -57,23 +57,33 @@ def wiebe_levels(mech, gas) -> tuple:
     ``(motored, full load)``, or ``(motored,)`` with no fuel
     (:class:`~transient.forces.wiebe.WiebeCycle`).
 
-    Cached (the mechanism and the gas model are frozen): ``load_scene`` builds them to validate
-    the scene, and every run of a scene with the same engine and cycle uses them again (~0.2 s).
+    Cached in the process (the mechanism and the gas model are frozen: ``load_scene`` builds them
+    to validate the scene, and every run of a scene with the same engine and cycle uses them
+    again) and on disk between processes (:mod:`transient.forces.wiebe_cache`; a warm start
+    then neither integrates them nor imports scipy's integrators).
     """
-    # (lazily: scipy's integrators, start-up time)
-    from .forces.wiebe import wiebe_tables
+    from .forces.wiebe_cache import cached_cycles  # (lazily: only Wiebe scenes need it)
 
     w = gas.wiebe
     clearance = mech.swept_volume() / (gas.compression_ratio - 1.0)
     levels = [0.0, w.fuel_mass] if w.fuel_mass > 0.0 else [0.0]
-    return wiebe_tables(
-        mech.volume_function(clearance), levels, p_a=gas.p_a, start=w.start,
-        duration=w.duration, a=w.a, m=w.m, lhv=w.lhv, efficiency=w.efficiency, gamma=w.gamma,
-        gamma_slope=w.gamma_slope, gamma_t_ref=w.gamma_t_ref, t_a=w.t_a,
+    cycle = dict(
+        p_a=gas.p_a, start=w.start, duration=w.duration, a=w.a, m=w.m, lhv=w.lhv,
+        efficiency=w.efficiency, gamma=w.gamma, gamma_slope=w.gamma_slope,
+        gamma_t_ref=w.gamma_t_ref, t_a=w.t_a,
         p_intake=gas.p_intake if mech.strokes == 4 else None,
         p_exhaust=gas.p_exhaust if mech.strokes == 4 else None, strokes=mech.strokes,
         intake_closing=w.intake_closing, exhaust_opening=w.exhaust_opening, step=w.step,
         tolerance=w.tolerance)
+
+    def compute() -> tuple:
+        from .forces.wiebe import wiebe_tables
+
+        return wiebe_tables(mech.volume_function(clearance), levels, **cycle)
+
+    # Everything the cycles depend on besides the code, as exact text (floats' reprs round-trip).
+    return cached_cycles(f"{mech!r}\nclearance={clearance!r}\nlevels={levels!r}\n{cycle!r}",
+                         compute)
 
 
 def clearance_volume(scene) -> float:

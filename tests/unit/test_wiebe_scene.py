@@ -42,8 +42,8 @@ def test_scene_keys_in_si():
 
 
 def test_defaults_are_wiebe_cycles():
-    """The scene's defaults are :func:`wiebe_cycle`'s (written twice: scene.py must not import
-    the module, which loads scipy's integrators)."""
+    """The scene's defaults are :func:`wiebe_cycle`'s (written twice: scene.py does not import
+    the module, which only Wiebe scenes need)."""
     params = inspect.signature(wiebe_cycle).parameters
     names = {"a": "a", "m": "m", "lhv": "lhv", "efficiency": "efficiency", "gamma": "gamma",
              "gamma_slope": "gamma_slope", "gamma_t_ref": "gamma_t_ref", "t_a": "t_a",

@@ -37,9 +37,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
-from scipy.interpolate import CubicSpline
-from scipy.optimize import brentq
 
 from transient.errors import SceneError
 from transient.forces.gas import PressureTable
@@ -572,6 +569,10 @@ def closed_segments(st: _Setup, q_total: float, segment_rhs, y0: NDArray[np.floa
     fuel burns over it. Returns the breaks and one ``segment_type(lo, hi, power, sol)`` per
     segment (``sol``: the dense solution in u). The pressure carried into the next segment is
     clipped at 0 (a rounding below it)."""
+    # scipy is imported where it is used: a cycle read from the table cache
+    # (:mod:`transient.forces.wiebe_cache`) must not pay for importing its integrators.
+    from scipy.integrate import solve_ivp
+
     end = st.start + st.duration
     breaks = [st.ivc]
     for b in (st.start, end, st.evo):
@@ -597,6 +598,8 @@ def closed_segments(st: _Setup, q_total: float, segment_rhs, y0: NDArray[np.floa
 def _peak(closed: ClosedPart, volume: VolumeFunction, period: float
           ) -> tuple[float, float, float]:
     """Peak pressure, its unwrapped angle and the peak temperature over the closed part."""
+    from scipy.optimize import brentq
+
     best_p, best_x = -1.0, closed.start
     t_max = 0.0
     for seg in closed.segments:
@@ -708,6 +711,8 @@ def _spline_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.f
     Not-a-knot, as :func:`~transient.forces.gas.table_from_function` (natural with 2 points,
     i.e. the straight line).
     """
+    from scipy.interpolate import CubicSpline
+
     spline = CubicSpline(x, y, bc_type="not-a-knot" if x.size > 2 else "natural")
     return np.ascontiguousarray(spline.c[::-1].T, dtype=np.float64)
 

@@ -1,0 +1,130 @@
+"""Wiebe cycles kept on disk between processes, so that a warm start does not integrate them again.
+
+A scene with ``model = "wiebe"`` needs its motored and full-load cycles
+(:func:`transient.assemble.wiebe_levels`). Integrating them with scipy's DOP853 and importing
+scipy's integrators for it cost about half of the Wiebe case's warm start (README *Start-up*).
+The cycles depend only on their arguments and on the code, so they are stored in
+``$XDG_CACHE_HOME/transient/tables/`` (default ``~/.cache``), one ``.npz`` per set of cycles,
+named by a hash of the arguments' exact text, of every source file of transient and of numpy's
+and scipy's versions: an edit anywhere in the package, or another numpy or scipy, starts afresh.
+
+Stored are the tables and the numbers of each :class:`~transient.forces.wiebe.WiebeCycle`, not the
+dense ODE solution :attr:`~transient.forces.wiebe.WiebeCycle.closed` (scipy objects, used by
+checks): a cycle read from the cache carries a stand-in that knows the closed part's ends and
+integrates the cycles again on first use of anything else.
+
+A file that cannot be read is computed again and replaced; a folder that cannot be written is
+passed over (the run goes on with the cycles it computed). Files are written to a temporary name
+and renamed, so a reader never sees half a file.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+import os
+import tempfile
+import zipfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from transient.forces.wiebe import WiebeCycle
+
+#: WiebeCycle fields written as arrays; every other field but ``closed`` is a number.
+_ARRAYS = ("knots", "coef", "piece_knot")
+
+
+def cache_folder() -> Path:
+    """``$XDG_CACHE_HOME/transient/tables`` (``~/.cache/transient/tables`` when unset), read at
+    every call (tests point it elsewhere)."""
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return base / "transient" / "tables"
+
+
+@functools.cache
+def _code_version() -> str:
+    """Hash of every source file of the package and of numpy's and scipy's versions."""
+    import scipy  # the top-level package only (its version); not its integrators
+
+    h = hashlib.sha256(f"numpy {np.__version__} scipy {scipy.__version__}".encode())
+    root = Path(__file__).resolve().parents[1]
+    for path in sorted(root.rglob("*.py")):
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def cache_path(arguments: str) -> Path:
+    """The file of the cycles computed from ``arguments`` (the exact text of all of them)."""
+    key = hashlib.sha256(f"{_code_version()}\n{arguments}".encode()).hexdigest()[:32]
+    return cache_folder() / f"wiebe-{key}.npz"
+
+
+class _ClosedPartOnDemand:
+    """Stands for the :class:`~transient.forces.wiebe.ClosedPart` of a cycle read from the cache.
+
+    ``start`` and ``end`` (intake closing and exhaust opening, unwrapped, as the assembled Woschni
+    model needs them) are stored; any other attribute, or a call, integrates the cycles again
+    (once for all the cycles of the file) and answers from the fresh ClosedPart."""
+
+    def __init__(self, start: float, end: float, closed_part: Callable) -> None:
+        self.start, self.end, self._closed_part = start, end, closed_part
+
+    def __getattr__(self, name: str):  # only for what __init__ did not set
+        return getattr(self._closed_part(), name)
+
+    def __call__(self, x):
+        return self._closed_part()(x)
+
+
+def _write(path: Path, cycles: tuple[WiebeCycle, ...]) -> None:
+    arrays: dict[str, np.ndarray] = {"n": np.array(len(cycles))}
+    for i, cycle in enumerate(cycles):
+        for field in dataclasses.fields(WiebeCycle):
+            if field.name != "closed":
+                arrays[f"{i}.{field.name}"] = np.asarray(getattr(cycle, field.name))
+        arrays[f"{i}.closed.start"] = np.asarray(cycle.closed.start)
+        arrays[f"{i}.closed.end"] = np.asarray(cycle.closed.end)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.NamedTemporaryFile(dir=path.parent, suffix=".tmp", delete=False) as f:
+        np.savez(f, **arrays)
+    os.replace(f.name, path)
+
+
+def _read(path: Path, compute: Callable[[], tuple]) -> tuple[WiebeCycle, ...]:
+    again = functools.cache(compute)
+    cycles = []
+    with np.load(path) as data:
+        for i in range(int(data["n"])):
+            values = {}
+            for field in dataclasses.fields(WiebeCycle):
+                if field.name in _ARRAYS:
+                    values[field.name] = data[f"{i}.{field.name}"]
+                elif field.name != "closed":
+                    values[field.name] = data[f"{i}.{field.name}"].item()
+            closed = _ClosedPartOnDemand(data[f"{i}.closed.start"].item(),
+                                         data[f"{i}.closed.end"].item(),
+                                         lambda i=i: again()[i].closed)
+            cycles.append(WiebeCycle(closed=closed, **values))
+    return tuple(cycles)
+
+
+def cached_cycles(arguments: str, compute: Callable[[], tuple[WiebeCycle, ...]]
+                  ) -> tuple[WiebeCycle, ...]:
+    """The cycles ``compute()`` returns, read from the cache when a file for ``arguments`` (the
+    exact text of everything ``compute`` depends on besides the code) is there, else computed and
+    stored. A SceneError from ``compute`` (invalid cycle parameters) passes through; nothing is
+    stored then."""
+    path = cache_path(arguments)
+    try:
+        return _read(path, compute)
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
+        pass  # not there yet, or unreadable: computed again and replaced
+    cycles = compute()
+    try:
+        _write(path, cycles)
+    except OSError:
+        pass  # a folder that cannot be written: the run goes on with what it computed
+    return cycles
