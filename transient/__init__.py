@@ -4,7 +4,7 @@ Module map (data flow: scene → mechanism → reduced model → stepper → res
 
 - ``scene``          TOML → frozen dataclasses, validation, resolved TOML out
 - ``mechanisms``     crank_slider, swash_plate: geometry, validation, kinematics tables
-- ``forces``         gas pressure tables and cycles
+- ``forces``         gas pressure tables and cycles (the Wiebe cycles' file cache: ``wiebe_cache``)
 - ``assemble``       scene → compiled model arrays and breakpoints
 - ``core``           every numba kernel: kinematics, reduced model (18), DOP853 stepper
 - ``simulate``       drives the compiled stepper, streams results; prescribed-speed mode
