@@ -15,10 +15,12 @@ integrates the cycles again on first use of anything else.
 
 A file that cannot be read is computed again and replaced; a folder that cannot be written is
 passed over (the run goes on with the cycles it computed). Files are written to a temporary name
-and renamed, so a reader never sees half a file.
+and renamed, so a reader never sees half a file, and the folder keeps the :data:`MAX_FILES` last
+used (a sweep over cycle parameters would otherwise fill it without end).
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import hashlib
@@ -34,6 +36,10 @@ from transient.forces.wiebe import WiebeCycle
 
 #: WiebeCycle fields written as arrays; every other field but ``closed`` is a number.
 _ARRAYS = ("knots", "coef", "piece_knot")
+
+#: Files the folder keeps: writing one more deletes the least recently used beyond it (a file of
+#: the Gots engine's two cycles is 0.26 MB).
+MAX_FILES = 200
 
 
 def cache_folder() -> Path:
@@ -88,9 +94,22 @@ def _write(path: Path, cycles: tuple[WiebeCycle, ...]) -> None:
         arrays[f"{i}.closed.start"] = np.asarray(cycle.closed.start)
         arrays[f"{i}.closed.end"] = np.asarray(cycle.closed.end)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.NamedTemporaryFile(dir=path.parent, suffix=".tmp", delete=False) as f:
-        np.savez(f, **arrays)
-    os.replace(f.name, path)
+    f = tempfile.NamedTemporaryFile(dir=path.parent, suffix=".tmp", delete=False)
+    temporary = Path(f.name)
+    try:
+        with f:
+            np.savez(f, **arrays)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)  # (gone once renamed; a failed write's remains)
+    _prune(path.parent)
+
+
+def _prune(folder: Path) -> None:
+    """Delete the least recently used files beyond :data:`MAX_FILES`."""
+    files = sorted(folder.glob("wiebe-*.npz"), key=lambda p: p.stat().st_mtime)
+    for path in files[:-MAX_FILES]:
+        path.unlink(missing_ok=True)
 
 
 def _read(path: Path, compute: Callable[[], tuple]) -> tuple[WiebeCycle, ...]:
@@ -119,9 +138,13 @@ def cached_cycles(arguments: str, compute: Callable[[], tuple[WiebeCycle, ...]]
     stored then."""
     path = cache_path(arguments)
     try:
-        return _read(path, compute)
+        cycles = _read(path, compute)
     except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
         pass  # not there yet, or unreadable: computed again and replaced
+    else:
+        with contextlib.suppress(OSError):  # (a read-only folder keeps its order)
+            os.utime(path)  # used now: the last to be deleted
+        return cycles
     cycles = compute()
     try:
         _write(path, cycles)
