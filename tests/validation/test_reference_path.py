@@ -31,7 +31,8 @@ Accuracy in the scipy way, e = (y − y_ref)/(atol + rtol·|y_ref|):
   fuel) the reference's row on the corner carries ε from before it, the wrong slope after.
 
 A stalled reference (solve_ivp restarted again and again at the same t) is reported as a failure
-at once rather than hanging the test run; a 60 s alarm backs that up.
+at once rather than hanging the test run; a 300 s alarm backs that up (it was 60 s until the
+Woschni scene's Radau reference took 82.7 s on the fifth session's slower machine).
 """
 from __future__ import annotations
 
@@ -93,7 +94,7 @@ def e(y, y_ref):
 
 
 @contextmanager
-def watched_reference(monkeypatch, limit_s=60.0):
+def watched_reference(monkeypatch, limit_s=300.0):
     """Fail (not hang) if the reference path stalls: solve_ivp called 25 times in a row without
     advancing t, or the run taking more than ``limit_s``."""
     real = reference.solve_ivp
