@@ -3,6 +3,7 @@ computed one to the last bit, its dense solution is integrated again on demand, 
 every argument, and a bad file or an unwritable folder costs a recomputation, never a run."""
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import os
@@ -185,3 +186,14 @@ def test_failed_write_leaves_nothing_behind(folder, monkeypatch):
     cycles = wiebe_cache.cached_cycles(arguments(), compute())
     assert_same_cycles(cycles, compute()())
     assert list(folder.iterdir()) == []
+
+
+def test_stand_in_survives_a_deep_copy(folder):
+    """copy probes a new instance that __init__ never saw: the stand-in must not recurse then."""
+    computed = wiebe_cache.cached_cycles(arguments(), compute())
+    cycle = copy.deepcopy(wiebe_cache.cached_cycles(arguments(), compute())[1])
+    assert isinstance(cycle.closed, wiebe_cache._ClosedPartOnDemand)  # read, not computed
+    np.testing.assert_array_equal(cycle.coef, computed[1].coef)
+    assert cycle.closed.end == computed[1].closed.end
+    x = np.linspace(np.pi, 3 * np.pi, 5)
+    np.testing.assert_array_equal(cycle.closed(x)[0], computed[1].closed(x)[0])

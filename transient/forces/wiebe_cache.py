@@ -1,4 +1,4 @@
-"""Wiebe cycles kept on disk between processes, so that a warm start does not integrate them again.
+"""Wiebe cycles kept on disk between processes: a warm start does not integrate them again.
 
 A scene with ``model = "wiebe"`` needs its motored and full-load cycles
 (:func:`transient.assemble.wiebe_levels`). Integrating them with scipy's DOP853 and importing
@@ -79,6 +79,8 @@ class _ClosedPartOnDemand:
         self.start, self.end, self._closed_part = start, end, closed_part
 
     def __getattr__(self, name: str):  # only for what __init__ did not set
+        if name.startswith("_"):  # (copy and pickle probe an instance that __init__ never saw)
+            raise AttributeError(name)
         return getattr(self._closed_part(), name)
 
     def __call__(self, x):
