@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model, wiebe_levels
+from transient.core import source_hash
 from transient.errors import SceneError
 from transient.forces import wiebe_cache
 from transient.forces.wiebe import WiebeCycle, wiebe_tables
@@ -105,6 +106,20 @@ def test_other_arguments_other_file(folder, change):
     other = wiebe_cache.cached_cycles(arguments(**change), compute(**change))
     assert len(list(folder.iterdir())) == 2
     assert_same_cycles(other, compute(**change)())
+
+
+def test_source_hash_follows_names_and_contents(tmp_path):
+    (tmp_path / "a.py").write_text("x = 1\n")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "b.py").write_text("y = 2\n")
+    first = source_hash(tmp_path, "**/*.py")
+    assert source_hash(tmp_path, "*.py") != first  # the sub-folder's file counts
+    (tmp_path / "sub" / "b.py").write_text("y = 3\n")
+    assert source_hash(tmp_path, "**/*.py") != first
+    (tmp_path / "sub" / "b.py").write_text("y = 2\n")
+    assert source_hash(tmp_path, "**/*.py") == first
+    (tmp_path / "sub" / "b.py").rename(tmp_path / "sub" / "c.py")
+    assert source_hash(tmp_path, "**/*.py") != first
 
 
 def test_code_or_library_version_changes_the_file(folder, monkeypatch):

@@ -14,17 +14,25 @@ from pathlib import Path
 import numba
 
 
-def _source_hash() -> str:
+def source_hash(root: Path, pattern: str) -> str:
+    """SHA-256 of the names (relative to ``root``) and contents of the files ``pattern`` matches
+    under ``root``: the version of the code that a cache's contents come from."""
     h = hashlib.sha256()
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(path.name.encode())
+    for path in sorted(root.glob(pattern)):
+        h.update(str(path.relative_to(root)).encode())
         h.update(path.read_bytes())
-    return h.hexdigest()[:16]
+    return h.hexdigest()
+
+
+def cache_root() -> Path:
+    """``$XDG_CACHE_HOME/transient`` (``~/.cache/transient`` when unset or empty), where
+    transient keeps what it computes once: numba's kernels here, the Wiebe cycles' tables
+    (:mod:`transient.forces.wiebe_cache`)."""
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "transient"
 
 
 def _cache_dir() -> Path:
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return base / "transient" / "numba" / _source_hash()
+    return cache_root() / "numba" / source_hash(Path(__file__).parent, "*.py")[:16]
 
 
 if not os.environ.get("NUMBA_CACHE_DIR"):

@@ -2,8 +2,8 @@
 
 A scene with ``model = "wiebe"`` needs its motored and full-load cycles
 (:func:`transient.assemble.wiebe_levels`). Integrating them with scipy's DOP853 and importing
-scipy's integrators for it cost about half of the Wiebe case's warm start (README *Start-up*).
-The cycles depend only on their arguments and on the code, so they are stored in
+scipy's integrators for it cost about 1 s of the Wiebe case's 2.6–2.9 s warm start (README
+*Start-up*). The cycles depend only on their arguments and on the code, so they are stored in
 ``$XDG_CACHE_HOME/transient/tables/`` (default ``~/.cache``), one ``.npz`` per set of cycles,
 named by a hash of the arguments' exact text, of every source file of transient and of numpy's
 and scipy's versions: an edit anywhere in the package, or another numpy or scipy, starts afresh.
@@ -32,10 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
+from transient.core import cache_root, source_hash
 from transient.forces.wiebe import WiebeCycle
-
-#: WiebeCycle fields written as arrays; every other field but ``closed`` is a number.
-_ARRAYS = ("knots", "coef", "piece_knot")
 
 #: Files the folder keeps: writing one more deletes the least recently used beyond it (a file of
 #: the Gots engine's two cycles is 0.26 MB).
@@ -43,10 +41,9 @@ MAX_FILES = 200
 
 
 def cache_folder() -> Path:
-    """``$XDG_CACHE_HOME/transient/tables`` (``~/.cache/transient/tables`` when unset), read at
-    every call (tests point it elsewhere)."""
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return base / "transient" / "tables"
+    """``tables`` in transient's cache folder (:func:`transient.core.cache_root`), read at every
+    call (tests point it elsewhere)."""
+    return cache_root() / "tables"
 
 
 @functools.cache
@@ -54,12 +51,9 @@ def _code_version() -> str:
     """Hash of every source file of the package and of numpy's and scipy's versions."""
     import scipy  # the top-level package only (its version); not its integrators
 
-    h = hashlib.sha256(f"numpy {np.__version__} scipy {scipy.__version__}".encode())
-    root = Path(__file__).resolve().parents[1]
-    for path in sorted(root.rglob("*.py")):
-        h.update(str(path.relative_to(root)).encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()
+    sources = source_hash(Path(__file__).resolve().parents[1], "**/*.py")
+    return hashlib.sha256(f"numpy {np.__version__} scipy {scipy.__version__} "
+                          f"{sources}".encode()).hexdigest()
 
 
 def cache_path(arguments: str) -> Path:
@@ -121,10 +115,9 @@ def _read(path: Path, compute: Callable[[], tuple]) -> tuple[WiebeCycle, ...]:
         for i in range(int(data["n"])):
             values = {}
             for field in dataclasses.fields(WiebeCycle):
-                if field.name in _ARRAYS:
-                    values[field.name] = data[f"{i}.{field.name}"]
-                elif field.name != "closed":
-                    values[field.name] = data[f"{i}.{field.name}"].item()
+                if field.name != "closed":
+                    value = data[f"{i}.{field.name}"]  # a table's array, or a number (0-d)
+                    values[field.name] = value.item() if value.ndim == 0 else value
             closed = _ClosedPartOnDemand(data[f"{i}.closed.start"].item(),
                                          data[f"{i}.closed.end"].item(),
                                          lambda i=i: again()[i].closed)
