@@ -13,9 +13,15 @@ work arrays) are ``compiled``.
 """
 from __future__ import annotations
 
-from numba import config, njit
+import fcntl
+import os
+
+from numba import config, njit, types
 from numba.core.caching import FunctionCache
 from numba.core.runtime import rtsys
+
+
+SAVE_LOCK = "save.lock"  # in each of numba's cache folders (:meth:`_RegistryFreeCache.save_overload`)
 
 
 class _RegistryFreeCache(FunctionCache):
@@ -43,6 +49,21 @@ class _RegistryFreeCache(FunctionCache):
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
 
+    def save_overload(self, sig, data):
+        """numba's save, holding an exclusive lock on the cache folder.
+
+        numba saves a function's new entry by reading its index, taking the first data-file
+        number the index does not list, then writing the index and the data file. Two processes
+        that compile different signatures of one function at once (``transient sweep``'s
+        workers, the test suite's) both take the same number: one index entry is lost, and the
+        other can name the other process's machine code, which a later run would load for the
+        wrong types. Under the lock the read-modify-write is one at a time; reading needs no lock
+        (numba replaces each file whole, by a rename)."""
+        self._impl.locator.ensure_cache_path()
+        with open(os.path.join(self._cache_path, SAVE_LOCK), "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # (released when the file is closed)
+            super().save_overload(sig, data)
+
 
 def compiled(fn=None, **options):
     """``@compiled`` or ``@compiled(nogil=True)``: njit, cached (:class:`_RegistryFreeCache`)."""
@@ -51,7 +72,28 @@ def compiled(fn=None, **options):
     dispatcher = njit(fn, **options)
     if not config.DISABLE_JIT:  # (then njit returns fn itself)
         dispatcher._cache = _RegistryFreeCache(dispatcher.py_func)  # (what cache=True sets)
+        _compile_per_type(dispatcher)
     return dispatcher
+
+
+def _compile_per_type(dispatcher):
+    """Calls from compiled code compile ``dispatcher`` once per argument types, not once per
+    constant passed.
+
+    numba types a constant argument (an event code, a state index, ``True``) as a literal, and
+    a call from compiled code compiles the callee for exactly the argument types it is given
+    (``Dispatcher.get_call_template``): one machine-code copy per constant. The stepper reports
+    its events with seven different codes, and one of its root finders took both a constant
+    and a variable state index: seven and two copies, ~1.9 s and ~12 s of compiling each. No
+    kernel of transient branches on an argument's value at compile time, so the literal types
+    are widened to their plain types before numba compiles."""
+    per_constant = dispatcher.get_call_template
+
+    def get_call_template(args, kws):
+        return per_constant(tuple(types.unliteral(a) for a in args),
+                            {k: types.unliteral(v) for k, v in kws.items()})
+
+    dispatcher.get_call_template = get_call_template
 
 
 def kernel(fn=None, **options):
