@@ -182,7 +182,8 @@ def common(draw, d, omega=(30.0, 400.0)):
 
 
 #: Hang guard of one reference run [s]: typically 0.01–0.3 s in the CI profile, but one example's
-#: check took 26 s on an idle core of a slower 2-core VM, and more than 30 s with the suite on both cores.
+#: check took 26 s on an idle core of a slower 2-core VM, and its reference more than 30 s with the
+#: suite running on both cores.
 REF_GUARD_S = 300.0
 
 

@@ -1,6 +1,7 @@
-"""numba's on-disk cache as transient uses it (:mod:`transient.core.jit`): saving new machine code
-waits for the cache folder's lock, so that processes compiling at once (``transient sweep``'s
-workers, the parallel test suite) do not hand out the same data file to different signatures."""
+"""How transient compiles and caches with numba (:mod:`transient.core.jit`): saving new machine
+code waits for the cache folder's lock, so that processes compiling at once (``transient sweep``'s
+workers, the parallel test suite) do not hand out the same data file to different signatures; a
+kernel called with different constants is compiled once, for their type."""
 from __future__ import annotations
 
 import fcntl
