@@ -20,10 +20,10 @@ run: $(STAMP)
 	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
 	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results
 
-# One pytest worker per core; worksteal moves queued tests from a busy worker to an idle one (the
-# first runs compile for minutes).
+# One pytest worker per core, at most 4 (a worker compiling the stepper held 1.0 GB); worksteal moves
+# queued tests from a busy worker to an idle one (the first runs compile for minutes).
 test: $(STAMP)
-	$(PY) -m pytest -q -n auto --dist worksteal
+	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
 # The work-precision record in results/benchmarks/ (issue 5; 14 min 8 s measured at b0ece4d). CyRK, the
 # compiled peer, comes with the optional `bench` extra.
