@@ -293,9 +293,13 @@ def cmd_check(args) -> int:
     return EXIT_OK
 
 
+#: The progress bar's words until a compiled run's first block (cmd_run).
+KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
+
+
 def cmd_run(args) -> int:
     from .results import check_writable
-    from .scene import load_scene
+    from .scene import COMPILED_METHODS, load_scene
     from .simulate import simulate
 
     scene = load_scene(args.scene)
@@ -305,8 +309,18 @@ def cmd_run(args) -> int:
     if not args.quiet and sys.stderr.isatty():
         from tqdm import tqdm
 
-        bar = tqdm(total=1000, desc=scene.name, unit="‰", file=sys.stderr, leave=False)
-    progress = (lambda f: bar.update(int(1000 * f) - bar.n)) if bar else None
+        # A compiled run's first block comes once its kernels are loaded from numba's cache, or
+        # compiled, which on a first run (an empty cache) takes minutes (README, Start-up): the
+        # bar says so until then, so that a first run does not look hung.
+        compiled = scene.solver.method in COMPILED_METHODS and scene.run.mode != "prescribed-speed"
+        bar = tqdm(total=1000, desc=f"{scene.name} ({KERNELS_NOTICE})" if compiled else scene.name,
+                   unit="‰", file=sys.stderr, leave=False)
+    progress = None
+    if bar:
+        def progress(fraction):
+            if KERNELS_NOTICE in bar.desc:
+                bar.set_description(scene.name)  # (shown at once, however short the run)
+            bar.update(int(1000 * fraction) - bar.n)
     try:
         data = simulate(scene, path, force=args.force, progress=progress)
     finally:
