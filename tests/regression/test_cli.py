@@ -347,7 +347,11 @@ def _terminal_run(argv, timeout=900.0):
                 break
             received += chunk
     os.close(master)
-    out = proc.communicate(timeout=60.0)[0]
+    try:
+        out = proc.communicate(timeout=60.0)[0]
+    except subprocess.TimeoutExpired:
+        proc.kill()  # (a hung run: fail, and leave no process behind)
+        raise
     return proc.returncode, out.decode(), received.decode(errors="replace")
 
 
