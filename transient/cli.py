@@ -293,13 +293,22 @@ def cmd_check(args) -> int:
     return EXIT_OK
 
 
-#: The progress bar's words until a compiled run's first block (cmd_run).
+#: The progress bar's words until a compiled run's first block (cmd_run) or a sweep's first
+#: finished run (cmd_sweep): the kernels load from numba's cache, or, on a first run (an empty
+#: cache), compile, which takes minutes (README, Start-up); so a first run does not look hung.
 KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
+
+
+def _compiles(scene) -> bool:
+    """Whether running ``scene`` loads (or compiles) the compiled stepper."""
+    from .scene import COMPILED_METHODS
+
+    return scene.solver.method in COMPILED_METHODS and scene.run.mode != "prescribed-speed"
 
 
 def cmd_run(args) -> int:
     from .results import check_writable
-    from .scene import COMPILED_METHODS, load_scene
+    from .scene import load_scene
     from .simulate import simulate
 
     scene = load_scene(args.scene)
@@ -309,12 +318,8 @@ def cmd_run(args) -> int:
     if not args.quiet and sys.stderr.isatty():
         from tqdm import tqdm
 
-        # A compiled run's first block comes once its kernels are loaded from numba's cache, or
-        # compiled, which on a first run (an empty cache) takes minutes (README, Start-up): the
-        # bar says so until then, so that a first run does not look hung.
-        compiled = scene.solver.method in COMPILED_METHODS and scene.run.mode != "prescribed-speed"
-        bar = tqdm(total=1000, desc=f"{scene.name} ({KERNELS_NOTICE})" if compiled else scene.name,
-                   unit="‰", file=sys.stderr, leave=False)
+        bar = tqdm(total=1000, desc=f"{scene.name} ({KERNELS_NOTICE})" if _compiles(scene)
+                   else scene.name, unit="‰", file=sys.stderr, leave=False)
     progress = None
     if bar:
         def progress(fraction):
@@ -1009,6 +1014,8 @@ def cmd_sweep(args) -> int:
         from tqdm import tqdm
 
         bar = tqdm(total=len(sweep.runs), desc=sweep.name, unit="run", file=sys.stderr)
+        if any(_compiles(spec.scene) for spec in sweep.runs):
+            bar.set_postfix_str(KERNELS_NOTICE)  # (replaced by the first run's status)
 
     def on_result(spec, res, done, total):
         if bar is not None:

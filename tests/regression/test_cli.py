@@ -10,17 +10,11 @@ from __future__ import annotations
 
 import ctypes
 import datetime as dt
-import fcntl
 import importlib
 import math
 import os
-import pty
-import select
-import struct
 import subprocess
 import sys
-import termios
-import time
 from dataclasses import fields
 from pathlib import Path
 
@@ -32,6 +26,8 @@ import transient
 import transient.core.integrate as ci
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import to_toml
+
+from terminal import terminal_run
 
 # ``transient.simulate`` is the function re-exported by the package (it shadows the submodule as
 # an attribute), so the module is taken from the import system.
@@ -325,41 +321,11 @@ def test_run_quiet_prints_nothing(tmp_path, capsys):
     assert transient.open_result(tmp_path / "spinup.h5").complete
 
 
-def _terminal_run(argv, timeout=900.0):
-    """``transient`` in a new process whose stderr is a terminal (a pseudo-terminal, read here
-    as it is written, so that the process never waits on a full one): (return code, stdout,
-    what the terminal received)."""
-    master, slave = pty.openpty()
-    # 40 rows of 120 columns (a new pseudo-terminal has 0 × 0, in which tqdm draws nothing)
-    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))
-    proc = subprocess.Popen([sys.executable, "-m", "transient", *argv], cwd=REPO,
-                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave)
-    os.close(slave)
-    received = b""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if select.select([master], [], [], 1.0)[0]:
-            try:
-                chunk = os.read(master, 65536)
-            except OSError:  # EIO: the process has closed the terminal
-                break
-            if not chunk:
-                break
-            received += chunk
-    os.close(master)
-    try:
-        out = proc.communicate(timeout=60.0)[0]
-    except subprocess.TimeoutExpired:
-        proc.kill()  # (a hung run: fail, and leave no process behind)
-        raise
-    return proc.returncode, out.decode(), received.decode(errors="replace")
-
-
 def test_run_in_a_terminal_says_kernels_load_until_the_first_block(tmp_path):
     """The progress bar names the kernels' loading (on a first run, their compiling, minutes)
     until the run's first block, then only the scene; nothing of it goes to stdout."""
     scene = write(tmp_path, "spinup", SPINUP)
-    code, out, terminal = _terminal_run(["run", str(scene), "-o", str(tmp_path)])
+    code, out, terminal = terminal_run(["run", str(scene), "-o", str(tmp_path)])
     assert code == 0, terminal
     assert out.splitlines()[0] == f"wrote {tmp_path / 'spinup.h5'}"
     notice = terminal.find(f"small-spinup ({KERNELS_NOTICE})")

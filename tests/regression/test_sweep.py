@@ -17,10 +17,12 @@ import numpy as np
 import pytest
 
 from transient.analysis.irregularity import summarize
-from transient.cli import main
+from transient.cli import KERNELS_NOTICE, main
 from transient.scene import load_scene
 from transient.simulate import integrate
 from transient.sweep import kernel_loads, load_sweep, run_sweep
+
+from terminal import terminal_run
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -155,6 +157,19 @@ def test_another_sweep_is_never_overwritten(sweep_file, tmp_path, capsys):
                  "--force"]) == 1
     with h5py.File(out / "small.h5", "r") as f:
         assert json.loads(f["runs/run_0002"].attrs["params"])["load.fan"] == 2e-3
+
+
+def test_sweep_in_a_terminal_says_kernels_load_until_the_first_run(sweep_file, tmp_path):
+    """The progress bar names the kernels' loading (on a first run, their compiling, minutes)
+    until the first run is back, then each run's status."""
+    code, out, terminal = terminal_run(["sweep", str(sweep_file), "-o", str(tmp_path / "out"),
+                                        "--scheduler", "serial"])
+    assert code == 1, terminal  # (runs 1 and 3 fail on purpose)
+    assert out.startswith(f"wrote {tmp_path / 'out' / 'small.h5'}"), out
+    notice = terminal.find(KERNELS_NOTICE)
+    status = terminal.find("run 0: ok", notice)
+    assert 0 <= notice < status, terminal
+    assert "run 3: failed" in terminal[status:], terminal
 
 
 def test_default_local_cluster(tmp_path):
