@@ -20,8 +20,8 @@ run: $(STAMP)
 	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
 	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results
 
-# One pytest worker per core, at most 4 (a worker compiling the stepper held 1.0 GB); worksteal moves
-# queued tests from a busy worker to an idle one (the first runs compile for minutes).
+# One pytest worker per core, at most 4 (a process compiling the stepper held 1.0 GB); worksteal
+# moves queued tests from a busy worker to an idle one (the first runs compile for minutes).
 test: $(STAMP)
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 

@@ -299,16 +299,9 @@ def cmd_check(args) -> int:
 KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
 
 
-def _compiles(scene) -> bool:
-    """Whether running ``scene`` loads (or compiles) the compiled stepper."""
-    from .scene import COMPILED_METHODS
-
-    return scene.solver.method in COMPILED_METHODS and scene.run.mode != "prescribed-speed"
-
-
 def cmd_run(args) -> int:
     from .results import check_writable
-    from .scene import load_scene
+    from .scene import load_scene, runs_compiled
     from .simulate import simulate
 
     scene = load_scene(args.scene)
@@ -318,7 +311,7 @@ def cmd_run(args) -> int:
     if not args.quiet and sys.stderr.isatty():
         from tqdm import tqdm
 
-        bar = tqdm(total=1000, desc=f"{scene.name} ({KERNELS_NOTICE})" if _compiles(scene)
+        bar = tqdm(total=1000, desc=f"{scene.name} ({KERNELS_NOTICE})" if runs_compiled(scene)
                    else scene.name, unit="‰", file=sys.stderr, leave=False)
     progress = None
     if bar:
@@ -999,6 +992,7 @@ def cmd_orders(args) -> int:
 
 
 def cmd_sweep(args) -> int:
+    from .scene import runs_compiled
     from .sweep import load_sweep, run_sweep
 
     sweep = load_sweep(args.sweep)  # every scene validated here, before any work (exit 2)
@@ -1014,7 +1008,7 @@ def cmd_sweep(args) -> int:
         from tqdm import tqdm
 
         bar = tqdm(total=len(sweep.runs), desc=sweep.name, unit="run", file=sys.stderr)
-        if any(_compiles(spec.scene) for spec in sweep.runs):
+        if any(runs_compiled(spec.scene) for spec in sweep.runs):
             bar.set_postfix_str(KERNELS_NOTICE)  # (replaced by the first run's status)
 
     def on_result(spec, res, done, total):

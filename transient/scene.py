@@ -528,6 +528,12 @@ COMPILED_METHODS = ("dop853", "dopri5")
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 
 
+def runs_compiled(scene) -> bool:
+    """Whether ``scene`` runs on the compiled stepper (a dynamic run by a compiled method): its
+    results stream to the file, and its kernels load from numba's cache, or compile."""
+    return scene.run.mode == "dynamic" and scene.solver.method in COMPILED_METHODS
+
+
 @dataclass(frozen=True)
 class Pair:
     """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).

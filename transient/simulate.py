@@ -23,7 +23,7 @@ from .core.tableaus import TABLEAUS
 from .core.model import (OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
                          inverse_dynamics, n_outputs, n_state)
 from .errors import SimulationError
-from .scene import COMPILED_METHODS
+from .scene import COMPILED_METHODS, runs_compiled
 
 BUFFER_ROWS = 8192
 EVENT_ROWS = 2048
@@ -419,7 +419,7 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
     writes = _WriteBehind()
     data = None
     try:
-        streamed = scene.run.mode == "dynamic" and scene.solver.method in COMPILED_METHODS
+        streamed = runs_compiled(scene)
 
         def write_block(block, ev):
             writer.append(block)

@@ -648,9 +648,10 @@ def test_warm_run_loads_no_compiler_registries(tmp_path, capsys, case):
     """With numba's cache warm, a new process runs a scene without loading numba's compiler
     registries or scipy.linalg (``core.jit._RegistryFreeCache``, README *Start-up*), nor, for
     the Wiebe case, scipy's integrators (its cycles read from ``forces.wiebe_cache``, which this
-    process's run filled if they were not there yet), and its result is bit-identical to this process's run, in which they
-    are loaded; a function compiled after it in that process works. The diesel's stepper
-    allocates (numba's runtime), its pairs and governor take every event path."""
+    process's run filled if they were not there yet), and its result is bit-identical to this
+    process's run, in which they are loaded; a function compiled after it in that process works.
+    The diesel's stepper allocates (numba's runtime), its pairs and governor take every event
+    path."""
     scene = str(CASES / f"{case}.toml")
     # this process: every function the run needs is compiled or loaded, hence in the cache
     assert cli(capsys, "run", scene, "-q", "-o", str(tmp_path / "here"))[0] == 0

@@ -309,7 +309,8 @@ def test_governed_mixed_cycle_unchanged():
     Compared to 1e-12 of each value since another machine (the fifth session's AMD EPYC with FMA
     and AVX2, the same numba and numpy) ended 6e-15 to 1.2e-13 of each value away (the exact
     comparison failed there at e15a0c8 too; values at 2a716c6): t 2.413504852030418, ω
-    429.0454495403167, W_gas 182400.97323542938, fuel 0.8381962561240901. numba compiles for the host's CPU, so the last bits follow the machine.
+    429.0454495403167, W_gas 182400.97323542938, fuel 0.8381962561240901. numba compiles for the
+    host's CPU, so the last bits follow the machine.
     Every re-recording above moved the values by less than 1e-13 of each, so a change beyond
     rounding still fails the test."""
     scene = load_scene(CASES / "gots_diesel_governed.toml")

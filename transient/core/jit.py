@@ -21,7 +21,8 @@ from numba.core.caching import FunctionCache
 from numba.core.runtime import rtsys
 
 
-SAVE_LOCK = "save.lock"  # in each of numba's cache folders (:meth:`_RegistryFreeCache.save_overload`)
+#: The lock file in each of numba's cache folders (:meth:`_RegistryFreeCache.save_overload`).
+SAVE_LOCK = "save.lock"
 
 
 class _RegistryFreeCache(FunctionCache):
@@ -85,9 +86,9 @@ def _compile_per_type(dispatcher):
     (``Dispatcher.get_call_template``): one machine-code copy per constant. The stepper reports
     its events with seven different codes (seven copies of ``_emit_event``, 1.6–2.8 s of
     compiling each), and ``_crossing`` took both a constant and a variable state index (two
-    copies of it and of the root finder it calls, ~12 s each). No kernel of transient branches
-    on an argument's value at compile time, so the literal types are widened to their plain
-    types before numba compiles."""
+    copies of it, and of the root finder ``_root`` it calls, ~12 s per copy of ``_root``). No
+    kernel of transient branches on an argument's value at compile time, so the literal types
+    are widened to their plain types before numba compiles."""
     per_constant = dispatcher.get_call_template
 
     def get_call_template(args, kws):
