@@ -1,17 +1,15 @@
 """The tabulated reduced model (:mod:`transient.tabulate`, :mod:`transient.core.tabulated`)
 against the exact kernels: values at angles the error estimate never looked at, derivatives by
-finite differences of the tables themselves, the refinement rule and the fallback to exact."""
+finite differences of the tables themselves, the refinement rule; runs with the tables are in
+``tests/validation/test_tabulated_runs.py``."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from transient.assemble import build_model, kinematics_table
-from transient.core.model import TABULATED
 from transient.core.tabulated import tabulated_terms
 from transient.errors import SceneError
 from transient.scene import load_scene
@@ -80,24 +78,6 @@ def test_refinement_doubles_until_the_target():
     sizes = [build_table(kind, mech, ncyl, t).intervals for t in (1e-3, 1e-8, 1e-11)]
     assert sizes[0] == MIN_INTERVALS
     assert sizes == sorted(sizes) and sizes[2] > sizes[0]
-
-
-def test_unreachable_tolerance_falls_back_to_exact():
-    """A tolerance below what the splines reach (~1e-13): no table, the exact kernel, and the run
-    says so; the result is the exact run's."""
-    from transient.simulate import integrate
-
-    base = load_scene(CASES / "coasting_single.toml")
-    base = replace(base, run=replace(base.run, revolutions=5))
-    scene = replace(base, solver=replace(base.solver, kinematics="tabulated",
-                                         table_tolerance=1e-15))
-    assert kinematics_table(scene).coef is None
-    model, _, _ = build_model(scene)
-    assert model.kind != TABULATED
-    data, exact = integrate(scene), integrate(base)
-    assert data.solver["kinematics"].startswith("exact (no table")
-    assert data.solver["table_error"] > 1e-15
-    np.testing.assert_array_equal(data.trajectory["omega"], exact.trajectory["omega"])
 
 
 def test_tabulated_is_for_compiled_methods_only(tmp_path):

@@ -1,5 +1,6 @@
-"""Runs with the tabulated reduced model against the same runs with the exact kernels, and the
-energy law for the tabulated mechanism itself."""
+"""Runs with the tabulated reduced model against the same runs with the exact kernels, the
+energy law for the tabulated mechanism itself, and the fall-back to the exact kernels when no
+table reaches the tolerance asked for."""
 from __future__ import annotations
 
 import math
@@ -9,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from transient.assemble import build_model, kinematics_table
+from transient.core.model import TABULATED
 from transient.scene import Run, load_scene
 from transient.simulate import integrate
 
@@ -50,3 +53,19 @@ def test_tabulated_coasting_in_time_conserves_its_energy():
     drift = np.max(np.abs(K / K[0] - 1))
     print(f"time domain, tabulated: |ΔK/K|max {drift:.2e}")
     assert drift <= 3000 * 1e-10
+
+
+def test_unreachable_tolerance_falls_back_to_exact():
+    """A tolerance below what the splines reach (~1e-13): no table, the exact kernel, and the run
+    says so; the result is the exact run's."""
+    base = load_scene(CASES / "coasting_single.toml")
+    base = replace(base, run=replace(base.run, revolutions=5))
+    scene = replace(base, solver=replace(base.solver, kinematics="tabulated",
+                                         table_tolerance=1e-15))
+    assert kinematics_table(scene).coef is None
+    model, _, _ = build_model(scene)
+    assert model.kind != TABULATED
+    data, exact = integrate(scene), integrate(base)
+    assert data.solver["kinematics"].startswith("exact (no table")
+    assert data.solver["table_error"] > 1e-15
+    np.testing.assert_array_equal(data.trajectory["omega"], exact.trajectory["omega"])

@@ -15,14 +15,20 @@ from __future__ import annotations
 
 import fcntl
 import os
+from contextlib import contextmanager
 
 from numba import config, njit, types
+from numba.core import sigutils
 from numba.core.caching import FunctionCache
+from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
 
 
 #: The lock file in each of numba's cache folders (:meth:`_RegistryFreeCache.save_overload`).
 SAVE_LOCK = "save.lock"
+#: The name of a function's compile lock in its cache folder, after numba's base name of its
+#: cache files (:func:`_compile_once_across_processes`).
+COMPILE_LOCK = "{}.compile.lock"
 
 
 class _RegistryFreeCache(FunctionCache):
@@ -60,9 +66,7 @@ class _RegistryFreeCache(FunctionCache):
         other can name the other process's machine code, which a later run would load for the
         wrong types. Under the lock the read-modify-write is one at a time; reading needs no lock
         (numba replaces each file whole, by a rename)."""
-        self._impl.locator.ensure_cache_path()
-        with open(os.path.join(self._cache_path, SAVE_LOCK), "a") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)  # (released when the file is closed)
+        with _holding_lock(self, SAVE_LOCK):
             super().save_overload(sig, data)
 
 
@@ -74,7 +78,64 @@ def compiled(fn=None, **options):
     if not config.DISABLE_JIT:  # (then njit returns fn itself)
         dispatcher._cache = _RegistryFreeCache(dispatcher.py_func)  # (what cache=True sets)
         _compile_per_type(dispatcher)
+        _compile_once_across_processes(dispatcher)
     return dispatcher
+
+
+def _compile_once_across_processes(dispatcher):
+    """A process about to compile ``dispatcher`` first waits for any other process compiling
+    it, then loads what that one saved instead of compiling it again.
+
+    Processes started together on a cold cache — the test suite's workers, ``transient sweep``'s
+    — otherwise all compile the same stepper at once (~210 s each on the slower test machine,
+    README *Start-up*). numba's ``compile`` tries the cache before compiling, so it runs under an
+    exclusive ``flock`` on the function's lock file in its cache folder: the second process takes
+    the lock once the first has saved, and loads. The lock is taken under numba's compiler lock,
+    so only one thread per process holds such locks; the ones it already holds (a compile inside
+    a compile) are not taken again. Processes cannot wait on each other in a circle, because
+    one waiting for a function another holds would need that function to call, through its
+    callees, one it holds: recursion, which no kernel of transient uses."""
+    compile_here = dispatcher.compile
+    cache = dispatcher._cache
+    name = COMPILE_LOCK.format(cache._impl.filename_base)
+    path = os.path.join(cache._cache_path, name)
+
+    def compile(sig):
+        with global_compiler_lock:  # (reentrant)
+            args, _ = sigutils.normalize_signature(sig)
+            if tuple(args) in dispatcher.overloads or path in _COMPILE_LOCKS_HELD:
+                return compile_here(sig)
+            with _holding_lock(cache, name):
+                _COMPILE_LOCKS_HELD.add(path)
+                try:
+                    return compile_here(sig)
+                finally:
+                    _COMPILE_LOCKS_HELD.discard(path)
+
+    dispatcher.compile = compile
+
+
+@contextmanager
+def _holding_lock(cache, name):
+    """An exclusive ``flock`` on the file ``name`` in ``cache``'s folder, for the with-block;
+    none if that folder cannot be written (numba cannot save there either)."""
+    path = os.path.join(cache._cache_path, name)
+    try:
+        try:
+            lock = open(path, "a")
+        except FileNotFoundError:  # (a cold cache: numba makes its folder when first needed)
+            cache._impl.locator.ensure_cache_path()
+            lock = open(path, "a")
+    except OSError:
+        yield
+        return
+    with lock:  # (closing the file releases the lock)
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+#: The compile locks this process holds (:func:`_compile_once_across_processes`).
+_COMPILE_LOCKS_HELD = set()
 
 
 def _compile_per_type(dispatcher):
