@@ -3,7 +3,7 @@ worksteal``) hands the tests to its workers.
 
 worksteal gives each worker an equal, contiguous share of the collection, in order, and a worker
 that runs out takes the end of a busy one's share. On a cold numba cache the compiled stepper
-takes ~210 s to compile on the slower test machine; one worker compiles it and any other that
+takes ~210–240 s to compile on the slower test machine; one worker compiles it and any other that
 needs it meanwhile waits on its lock (``transient.core.jit``), then loads it. The unit tests
 never run the stepper (runs belong in ``tests/validation``), so they go last: the last worker's
 share is unit tests, which it runs while the first compiles. The stress tests go first, so that

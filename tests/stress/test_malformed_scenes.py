@@ -333,8 +333,8 @@ def test_sigkill_during_writing_leaves_an_incomplete_file(tmp_path):
     part = out / ".long.h5.part"
     try:
         # Wait for the file and for the first trajectory block in it. Hang guard: 600 s, as for
-        # the warm-up runs below, since a cold numba cache compiles the stepper first (~210 s on
-        # the slower test machine; a 120 s guard killed such a run before its first block).
+        # the warm-up runs below, since a cold numba cache compiles the stepper first (~210–240 s
+        # on the slower test machine; a 120 s guard killed such a run before its first block).
         deadline = time.monotonic() + 600.0
         while proc.poll() is None and not _holds_a_block(part):
             assert time.monotonic() < deadline, "no trajectory block written in 600 s"

@@ -87,7 +87,7 @@ def _compile_once_across_processes(dispatcher):
     it, then loads what that one saved instead of compiling it again.
 
     Processes started together on a cold cache — the test suite's workers, ``transient sweep``'s
-    — otherwise all compile the same stepper at once (~210 s each on the slower test machine,
+    — otherwise all compile the same stepper at once (~210–240 s each on the slower test machine,
     README *Start-up*). numba's ``compile`` tries the cache before compiling, so it runs under an
     exclusive ``flock`` on the function's lock file in its cache folder: the second process takes
     the lock once the first has saved, and loads. The lock is taken under numba's compiler lock,
@@ -127,6 +127,8 @@ def _holding_lock(cache, name):
             cache._impl.locator.ensure_cache_path()
             lock = open(path, "a")
     except OSError:
+        lock = None  # (yielded below, not here, so that the block's errors do not chain to it)
+    if lock is None:
         yield
         return
     with lock:  # (closing the file releases the lock)
