@@ -1,8 +1,8 @@
-"""How transient compiles and caches with numba (:mod:`transient.core.jit`): saving new machine
-code waits for the cache folder's lock, so that processes compiling at once (``transient sweep``'s
-workers, the parallel test suite) do not hand out the same data file to different signatures; a
-process about to compile a function another process is compiling waits, then loads that one's
-code; a kernel called with different constants is compiled once, for their type."""
+"""How transient compiles and caches with numba (:mod:`transient.core.jit`): a process about to
+compile a function that another process is compiling (``transient sweep``'s workers, the parallel
+test suite's) waits for the function's lock, then loads that one's code; the lock is per
+function, so that two processes never save different signatures into its index at once; a kernel
+called with different constants is compiled once, for their type."""
 from __future__ import annotations
 
 import fcntl
@@ -16,7 +16,7 @@ import time
 import numba
 
 from transient.core import jit
-from transient.core.jit import COMPILE_LOCK, SAVE_LOCK, compiled
+from transient.core.jit import COMPILE_LOCK, compiled
 
 KERNEL = "def double(x):\n    return 2 * x\n"
 
@@ -31,35 +31,6 @@ def _fresh_function(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "kern", module)  # (numba's cached code names its module)
     spec.loader.exec_module(module)
     return module.double
-
-
-def test_saving_waits_for_the_cache_folder_lock(tmp_path, monkeypatch):
-    double = _fresh_function(tmp_path, monkeypatch)
-    dispatcher = compiled(double)
-    cache = dispatcher._cache
-    cache._impl.locator.ensure_cache_path()
-    lock = open(f"{cache._cache_path}/{SAVE_LOCK}", "a")
-    fcntl.flock(lock, fcntl.LOCK_EX)  # as another process saving would hold it
-    try:
-        worker = threading.Thread(target=dispatcher, args=(1.5,))
-        worker.start()
-        deadline = time.monotonic() + 300.0
-        # numba adds the compiled code to the dispatcher, then saves it
-        while not dispatcher.overloads and time.monotonic() < deadline:
-            time.sleep(0.01)
-        assert dispatcher.overloads, "the function was not compiled"
-        worker.join(1.0)
-        assert worker.is_alive(), "the save did not wait for the lock"
-        assert cache._cache_file._load_index() == {}
-    finally:
-        lock.close()  # releases the lock
-    worker.join(60.0)
-    assert not worker.is_alive()
-    assert len(cache._cache_file._load_index()) == 1
-
-    reloaded = compiled(double)  # a new dispatcher: the saved code, loaded
-    assert reloaded(1.5) == 3.0
-    assert reloaded.stats.cache_hits and not reloaded.stats.cache_misses
 
 
 CALL_IN_ANOTHER_PROCESS = """
@@ -84,25 +55,64 @@ def _waits_for_lock(path, pid):
                for r in rows if len(r) > 6)
 
 
+def _hold_compile_lock(dispatcher):
+    """The compile lock of ``dispatcher``'s function, taken as a process compiling it holds it:
+    (its path, the open file; closing it releases the lock)."""
+    cache = dispatcher._cache
+    cache._impl.locator.ensure_cache_path()
+    path = os.path.join(cache._cache_path, COMPILE_LOCK.format(cache._impl.filename_base))
+    lock = open(path, "a")
+    fcntl.flock(lock, fcntl.LOCK_EX)
+    return path, lock
+
+
+def _wait_until_blocked(path, pid, running):
+    """Wait until process ``pid`` is blocked on the lock ``path``; fail if ``running()`` (the
+    waiting thread or process) turns false first, or if nothing blocks within 300 s."""
+    deadline = time.monotonic() + 300.0
+    while not _waits_for_lock(path, pid):
+        assert running(), "it did not wait for the lock"
+        assert time.monotonic() < deadline, "nothing reached the lock"
+        time.sleep(0.01)
+
+
+def test_a_new_signature_waits_for_the_functions_lock(tmp_path, monkeypatch):
+    """The lock is per function, not per signature: numba saves a new signature by a
+    read-modify-write of the function's index, so a process saving another signature at once
+    would take the same data file."""
+    double = _fresh_function(tmp_path, monkeypatch)
+    dispatcher = compiled(double)
+    assert dispatcher(2) == 4  # (int64,): compiled and saved
+    index = dispatcher._cache._cache_file._load_index
+    path, lock = _hold_compile_lock(dispatcher)  # as another process compiling (float64,) would
+    try:
+        worker = threading.Thread(target=dispatcher, args=(1.5,))
+        worker.start()
+        # (/proc/locks lists a waiting thread under its process's pid)
+        _wait_until_blocked(path, os.getpid(), worker.is_alive)
+        assert len(index()) == 1
+    finally:
+        lock.close()
+    worker.join(300.0)
+    assert not worker.is_alive()
+    assert len(index()) == 2
+
+    reloaded = compiled(double)  # a new dispatcher: both saved signatures, loaded
+    assert reloaded(2) == 4 and reloaded(1.5) == 3.0
+    assert sum(reloaded.stats.cache_hits.values()) == 2 and not reloaded.stats.cache_misses
+
+
 def test_a_process_waits_for_another_compiling_and_loads_its_code(tmp_path, monkeypatch):
     double = _fresh_function(tmp_path, monkeypatch)
     dispatcher = compiled(double)
-    cache = dispatcher._cache
-    cache._impl.locator.ensure_cache_path()
-    lock_path = os.path.join(cache._cache_path, COMPILE_LOCK.format(cache._impl.filename_base))
-    lock = open(lock_path, "a")
-    fcntl.flock(lock, fcntl.LOCK_EX)  # this process compiles first, as a cold suite's worker would
-    monkeypatch.setattr(jit, "_COMPILE_LOCKS_HELD", {lock_path})
+    path, lock = _hold_compile_lock(dispatcher)  # this process compiles first
+    monkeypatch.setattr(jit, "_COMPILE_LOCKS_HELD", {path})
     other = subprocess.Popen(
         [sys.executable, "-c", CALL_IN_ANOTHER_PROCESS, str(tmp_path / "kern.py")],
         env={**os.environ, "NUMBA_CACHE_DIR": numba.config.CACHE_DIR},
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.monotonic() + 300.0
-        while not _waits_for_lock(lock_path, other.pid):
-            assert other.poll() is None, f"it did not wait for the lock: {other.communicate()}"
-            assert time.monotonic() < deadline, "the other process never reached the lock"
-            time.sleep(0.01)
+        _wait_until_blocked(path, other.pid, lambda: other.poll() is None)
         assert dispatcher(1.5) == 3.0  # compiled here, and saved
         assert dispatcher.stats.cache_misses
     finally:

@@ -24,8 +24,6 @@ from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
 
 
-#: The lock file in each of numba's cache folders (:meth:`_RegistryFreeCache.save_overload`).
-SAVE_LOCK = "save.lock"
 #: The name of a function's compile lock in its cache folder, after numba's base name of its
 #: cache files (:func:`_compile_once_across_processes`).
 COMPILE_LOCK = "{}.compile.lock"
@@ -56,19 +54,6 @@ class _RegistryFreeCache(FunctionCache):
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
 
-    def save_overload(self, sig, data):
-        """numba's save, holding an exclusive lock on the cache folder.
-
-        numba saves a function's new entry by reading its index, taking the first data-file
-        number the index does not list, then writing the index and the data file. Two processes
-        that compile different signatures of one function at once (``transient sweep``'s
-        workers, the test suite's) both take the same number: one index entry is lost, and the
-        other can name the other process's machine code, which a later run would load for the
-        wrong types. Under the lock the read-modify-write is one at a time; reading needs no lock
-        (numba replaces each file whole, by a rename)."""
-        with _holding_lock(self, SAVE_LOCK):
-            super().save_overload(sig, data)
-
 
 def compiled(fn=None, **options):
     """``@compiled`` or ``@compiled(nogil=True)``: njit, cached (:class:`_RegistryFreeCache`)."""
@@ -90,22 +75,25 @@ def _compile_once_across_processes(dispatcher):
     — otherwise all compile the same stepper at once (~210–240 s each on the slower test machine,
     README *Start-up*). numba's ``compile`` tries the cache before compiling, so it runs under an
     exclusive ``flock`` on the function's lock file in its cache folder: the second process takes
-    the lock once the first has saved, and loads. The lock is taken under numba's compiler lock,
+    the lock once the first has saved, and loads. The lock is per function, not per signature,
+    because numba saves a new signature by a read-modify-write of the function's index (it takes
+    the first data-file number the index does not list): two processes saving different
+    signatures at once would take the same number, lose one entry, and let a later run load one
+    process's machine code for the other's types. The lock is taken under numba's compiler lock,
     so only one thread per process holds such locks; the ones it already holds (a compile inside
     a compile) are not taken again. Processes cannot wait on each other in a circle, because
     one waiting for a function another holds would need that function to call, through its
     callees, one it holds: recursion, which no kernel of transient uses."""
     compile_here = dispatcher.compile
     cache = dispatcher._cache
-    name = COMPILE_LOCK.format(cache._impl.filename_base)
-    path = os.path.join(cache._cache_path, name)
+    path = os.path.join(cache._cache_path, COMPILE_LOCK.format(cache._impl.filename_base))
 
     def compile(sig):
         with global_compiler_lock:  # (reentrant)
             args, _ = sigutils.normalize_signature(sig)
             if tuple(args) in dispatcher.overloads or path in _COMPILE_LOCKS_HELD:
                 return compile_here(sig)
-            with _holding_lock(cache, name):
+            with _holding_lock(cache, path):
                 _COMPILE_LOCKS_HELD.add(path)
                 try:
                     return compile_here(sig)
@@ -116,10 +104,9 @@ def _compile_once_across_processes(dispatcher):
 
 
 @contextmanager
-def _holding_lock(cache, name):
-    """An exclusive ``flock`` on the file ``name`` in ``cache``'s folder, for the with-block;
+def _holding_lock(cache, path):
+    """An exclusive ``flock`` on the file ``path`` in ``cache``'s folder, for the with-block;
     none if that folder cannot be written (numba cannot save there either)."""
-    path = os.path.join(cache._cache_path, name)
     try:
         try:
             lock = open(path, "a")
