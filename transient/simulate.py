@@ -23,6 +23,7 @@ from .core.tableaus import TABLEAUS
 from .core.model import (OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS,
                          inverse_dynamics, n_outputs, n_state)
 from .errors import SimulationError
+from .precompile import start_helper, stop_helper
 from .scene import COMPILED_METHODS, runs_compiled
 
 BUFFER_ROWS = 8192
@@ -109,15 +110,21 @@ def _fraction_done(scene, y) -> float:
 
 
 def _compile(model, tab, cfg, bp) -> float:
-    """Compile (or load from the numba cache) the stepper; return the seconds it took."""
+    """Compile (or load from the numba cache) the stepper, on a cold cache with a helper process
+    compiling its callees (:mod:`.precompile`); return the seconds it took."""
     t0 = time.perf_counter()
     warm = cfg.copy()
     warm[ci.C_T_END] = 1e-6
     warm[ci.C_PHI_END] = 1e-6
     y = np.zeros(n_state(model))
     y[2] = 1.0
-    ci.advance(model, tab, warm, bp, y, np.zeros(ci.N_FST), np.zeros(ci.N_IST, dtype=np.int64),
-               np.empty((1024, n_outputs(model))), np.empty((64, 4)))
+    helper = start_helper(model, tab)
+    try:
+        ci.advance(model, tab, warm, bp, y, np.zeros(ci.N_FST),
+                   np.zeros(ci.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
+                   np.empty((64, 4)))
+    finally:
+        stop_helper(helper)
     return time.perf_counter() - t0
 
 

@@ -1,0 +1,52 @@
+"""The compile helper (:mod:`transient.precompile`): a process that compiles the stepper's callees
+into the shared numba cache while the stepper is compiled, started only where it can help.
+
+(Which argument types it compiles is checked against the stepper's own calls in
+``tests/validation/test_compile_helper.py``: that needs the stepper compiled.)"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from transient import precompile
+from transient.assemble import build_model
+from transient.core import integrate as ci
+from transient.core.tableaus import TABLEAUS
+from transient.scene import load_scene
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+
+
+def _model_and_tableau():
+    scene = load_scene(CASES / "coasting_single.toml")
+    return build_model(scene)[0], TABLEAUS[scene.solver.method]
+
+
+def test_a_helper_process_compiles_into_the_shared_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # (the helper's, inherited)
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
+    monkeypatch.setattr(precompile, "_cores", lambda: 2)
+    helper = precompile.start_helper(*_model_and_tableau(), callees=(ci.next_breakpoint,))
+    assert helper is not None
+    assert helper.wait(timeout=300) == 0
+    saved = {p.suffix for p in tmp_path.rglob("integrate.next_breakpoint-*")}
+    assert {".nbi", ".nbc"} <= saved, sorted(tmp_path.rglob("*"))  # (index, machine code)
+
+
+def test_no_helper_where_it_cannot_help(monkeypatch):
+    model, tab = _model_and_tableau()
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: True)
+    monkeypatch.setattr(precompile, "_cores", lambda: 2)
+    assert precompile.start_helper(model, tab) is None  # cached: nothing to compile
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
+    monkeypatch.setattr(precompile, "_cores", lambda: 1)
+    assert precompile.start_helper(model, tab) is None  # one core: it would only take turns
+
+
+def test_stop_helper_ends_the_process(monkeypatch, tmp_path):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
+    monkeypatch.setattr(precompile, "_cores", lambda: 2)
+    helper = precompile.start_helper(*_model_and_tableau())  # (all callees: minutes of work)
+    precompile.stop_helper(helper)
+    assert helper.poll() is not None
+    precompile.stop_helper(None)  # (no helper: nothing to do)

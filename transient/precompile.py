@@ -1,0 +1,131 @@
+"""Compile the stepper's callees in a helper process while this process compiles the stepper.
+
+On a cold cache, compiling the stepper (:func:`transient.core.integrate.advance`) takes
+~210–240 s on the slower test machine (README *Start-up*), on one core: while numba types the
+stepper it compiles, one after another, each callee that is not inlined (the dense output, the
+root finders, the output row, the start and the end of a run). A helper process started at the
+same time compiles those callees in the reverse order, each under its compile lock
+(:func:`transient.core.jit._compile_once_across_processes`). The stepper's compile loads each
+callee the helper has saved, waits for the one the helper is compiling, and compiles the others
+itself; nothing is compiled twice.
+
+The helper needs each callee's argument types before the stepper's compile has found them: they
+are named by the callees' parameters (:func:`_types_by_parameter`). Were one wrong, the helper
+would compile a signature the stepper does not call and the stepper would compile its own; the
+test ``test_helper_compiles_the_signatures_the_stepper_calls`` checks each callee's cache. A
+helper that fails costs only its help: the stepper's compile compiles what is missing itself.
+"""
+from __future__ import annotations
+
+import importlib
+import inspect
+import os
+import pickle
+import subprocess
+import sys
+
+from numba import config, typeof, types
+
+from .core import integrate as ci
+from .core import model as cm
+
+#: The stepper's callees compiled apart (not inlined), in the reverse of the order in which the
+#: stepper's compile first calls for them (recorded with numba's "numba:compile" events), so
+#: that the helper and the stepper's compile meet in the middle.
+CALLEES = (
+    ci._to_time_mode,
+    ci._sleeve_stops,
+    ci._at_breakpoint,
+    ci._emit_samples,
+    ci._crossing_inside,
+    ci._fall_after_rise,
+    ci._crossing,
+    ci._dense,
+    ci._finish,
+    ci.next_breakpoint,
+    cm.margins_at,
+    ci._reset_output_grid,
+    ci._to_angle_mode,
+    ci._locked,
+    ci._start_modes,
+    cm.generator_branch,
+    cm.load_segment,
+    cm.start_branch,
+)
+
+
+def _types_by_parameter(model, tab) -> dict:
+    """numba type of each parameter name the callees use, as the stepper passes it."""
+    scalar = {types.boolean: ("angle_mode", "upward", "rising"),
+              types.float64: ("h", "sel", "x", "level", "theta", "theta_end", "x_stop", "d_out",
+                              "ga", "gb", "a", "b", "phi", "period", "w"),
+              types.int64: ("comp", "k", "direction", "code", "ix", "n_samples")}
+    array = {types.float64[::1]: ("y", "y_new", "tmp", "out", "row", "cfg", "fst", "bp"),
+             types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
+             types.int64[::1]: ("ist", "sw")}
+    by_name = {"m": typeof(model), "tab": typeof(tab)}
+    for numba_type, names in (scalar | array).items():
+        by_name.update(dict.fromkeys(names, numba_type))
+    return by_name
+
+
+def signature(fn, model, tab) -> tuple:
+    """The argument types with which the stepper calls the callee ``fn``."""
+    by_name = _types_by_parameter(model, tab)
+    return tuple(by_name[p] for p in inspect.signature(fn.py_func).parameters)
+
+
+def compile_callees(model, tab, callees=CALLEES) -> None:
+    """Compile (or load from the cache) each of ``callees``, in that order."""
+    for fn in callees:
+        fn.compile(signature(fn, model, tab))
+
+
+#: The stepper, whose compile the helper joins (taken at import: tests wrap ``ci.advance``).
+STEPPER = ci.advance
+
+
+def stepper_is_cached() -> bool:
+    """Whether the stepper is compiled in this process or saved in numba's cache."""
+    return bool(STEPPER.overloads) or bool(STEPPER._cache._cache_file._load_index())
+
+
+def _cores() -> int:
+    """The cores this process may run on."""
+    if hasattr(os, "sched_getaffinity"):  # (Linux)
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
+
+
+def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
+    """A helper process compiling ``callees`` (:func:`compile_callees`), or None where it would
+    not help: the stepper is cached, the JIT is off, or this process has one core."""
+    if config.DISABLE_JIT or _cores() < 2 or stepper_is_cached():
+        return None
+    helper = subprocess.Popen([sys.executable, "-c", f"import {__name__} as p; p.helper_main()"],
+                              stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        with helper.stdin:
+            pickle.dump((model, tab, [(fn.__module__, fn.__name__) for fn in callees]),
+                        helper.stdin)
+    except BrokenPipeError:  # (it failed to start: the stepper's compile goes on alone)
+        stop_helper(helper)
+        return None
+    return helper
+
+
+def stop_helper(helper: subprocess.Popen | None) -> None:
+    """End the helper once the stepper is compiled: what it has left is loading from the cache.
+    A kill cannot corrupt the cache: numba writes each file under a temporary name and renames
+    it, and an index entry whose data file is missing counts as not cached."""
+    if helper is not None:
+        helper.kill()
+        helper.wait()
+
+
+def helper_main() -> None:
+    """The helper process: compile the callees named on stdin for the model and tableau there."""
+    model, tab, names = pickle.load(sys.stdin.buffer)
+    compile_callees(model, tab, [getattr(importlib.import_module(mod), name)
+                                 for mod, name in names])
