@@ -1,13 +1,14 @@
 """Compile the stepper's callees in a helper process while this process compiles the stepper.
 
 On a cold cache, compiling the stepper (:func:`transient.core.integrate.advance`) takes
-~210–240 s on the slower test machine (README *Start-up*), on one core: while numba types the
-stepper it compiles, one after another, each callee that is not inlined (the dense output, the
-root finders, the output row, the start and the end of a run). A helper process started at the
-same time compiles those callees in the reverse order, each under its compile lock
+~210–270 s on the slower test machine, on one core: while numba types the stepper it compiles,
+one after another, each callee that is not inlined (the dense output, the root finders, the
+output row, the start and the end of a run), ~110 s of it. A helper process started at the same
+time compiles those callees in the reverse order, each under its compile lock
 (:func:`transient.core.jit._compile_once_across_processes`). The stepper's compile loads each
 callee the helper has saved, waits for the one the helper is compiling, and compiles the others
-itself; nothing is compiled twice.
+itself; nothing is compiled twice. Measured on the coasting cylinder: 141–142 s against 219–242 s
+(README *Start-up*, *A helper compiles the stepper's callees*).
 
 The helper needs each callee's argument types before the stepper's compile has found them: they
 are named by the callees' parameters (:func:`_types_by_parameter`). Were one wrong, the helper
