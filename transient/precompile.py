@@ -103,9 +103,12 @@ def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
     not help: the stepper is cached, the JIT is off, or this process has one core."""
     if config.DISABLE_JIT or _cores() < 2 or stepper_is_cached():
         return None
-    helper = subprocess.Popen([sys.executable, "-c", f"import {__name__} as p; p.helper_main()"],
-                              stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)
+    try:
+        helper = subprocess.Popen(
+            [sys.executable, "-c", f"import {__name__} as p; p.helper_main()"],
+            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    except OSError:  # (no process to be had: the stepper's compile goes on alone)
+        return None
     try:
         with helper.stdin:
             pickle.dump((model, tab, [(fn.__module__, fn.__name__) for fn in callees]),

@@ -40,6 +40,13 @@ def test_no_helper_where_it_cannot_help(monkeypatch):
     monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
     monkeypatch.setattr(precompile, "_cores", lambda: 1)
     assert precompile.start_helper(model, tab) is None  # one core: it would only take turns
+    monkeypatch.setattr(precompile, "_cores", lambda: 2)
+
+    def no_process(*args, **kwargs):
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(precompile.subprocess, "Popen", no_process)
+    assert precompile.start_helper(model, tab) is None  # no process to be had: none, no error
 
 
 def test_stop_helper_ends_the_process(monkeypatch, tmp_path):
