@@ -103,17 +103,15 @@ def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
     not help: the stepper is cached, the JIT is off, or this process has one core."""
     if config.DISABLE_JIT or _cores() < 2 or stepper_is_cached():
         return None
+    helper = None
     try:
         helper = subprocess.Popen(
             [sys.executable, "-c", f"import {__name__} as p; p.helper_main()"],
             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    except OSError:  # (no process to be had: the stepper's compile goes on alone)
-        return None
-    try:
         with helper.stdin:
             pickle.dump((model, tab, [(fn.__module__, fn.__name__) for fn in callees]),
                         helper.stdin)
-    except BrokenPipeError:  # (it failed to start: the stepper's compile goes on alone)
+    except OSError:  # (no process to be had, or it died at once: the compile goes on alone)
         stop_helper(helper)
         return None
     return helper
