@@ -7,10 +7,16 @@ DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
 .PHONY: run test bench install clean
 
+# Bytecode is written here: where PYTHONDONTWRITEBYTECODE is set (as on the machine of
+# results/benchmarks/targets.md), each run would otherwise compile transient's sources again, 0.1–0.2 s of a
+# ~1 s warm start (README, Start-up).
+BYTECODE := $(PY) -m compileall -q transient
+
 $(STAMP): pyproject.toml
 	python3 -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test]'
+	$(BYTECODE)
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -25,10 +31,11 @@ run: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
-# The work-precision record in results/benchmarks/ (issue 5; 14 min 8 s measured at b0ece4d). CyRK, the
-# compiled peer, comes with the optional `bench` extra.
+# The work-precision record and issue 5's targets in results/benchmarks/ (26 min 50 s measured on
+# 2026-11-26). CyRK, the compiled peer, comes with the optional `bench` extra.
 bench: $(STAMP)
 	$(PY) -m pip install -q -e '.[test,bench]'
+	$(BYTECODE)
 	$(VENV)/bin/transient bench -o results/benchmarks
 
 clean:

@@ -95,12 +95,16 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--revolutions", type=float, default=1000.0)
     b.add_argument("--repeat", type=int, default=5, help="timed runs per point (median)")
     b.add_argument("--no-baselines", action="store_true", help="transient's paths only")
-    b.add_argument("--baseline-budget", type=float, default=30.0,
+    # (at 30 s, on a 2-core machine of 2026-11-26, solve_ivp finished no run of two scenes)
+    b.add_argument("--baseline-budget", type=float, default=60.0,
                    help="stop a baseline run after this long, and its tighter tolerances [s]")
     b.add_argument("--quick", action="store_true",
                    help="a smoke test of the harness: 10 revolutions, 3 tolerances, one run each")
     b.add_argument("--report", action="store_true",
-                   help="only rewrite work_precision.md and the figures from the record's CSV")
+                   help="only rewrite work_precision.md, targets.md and the figures from the "
+                        "record's CSV and JSON")
+    b.add_argument("--targets", action="store_true",
+                   help="only measure issue 5's other targets against the record (targets.md)")
     b.add_argument("-o", "--output", default="results/benchmarks", help="folder of the record")
     b.set_defaults(func=cmd_bench)
     e = sub.add_parser("efficiency", help="η_mech against speed at steady speeds and loads")
@@ -255,14 +259,22 @@ def cmd_stress(args) -> int:
 
 def cmd_bench(args) -> int:
     from .bench import BENCH_SCENES, rewrite_report, run_bench
+    from .bench_targets import rewrite_targets, run_targets
     from .scene import load_scene
 
-    if args.report:
+    if args.report or args.targets:
         if not (Path(args.output) / "work_precision.csv").is_file():
-            raise SceneError("bench --report", f"no work_precision.csv in {args.output}; run "
-                                               f"transient bench first")
+            flag = "--report" if args.report else "--targets"
+            raise SceneError(f"bench {flag}", f"no work_precision.csv in {args.output}; run "
+                                              f"transient bench first")
+    if args.report:
         rewrite_report(Path(args.output), args.revolutions)
-        print(f"rewrote {Path(args.output) / 'work_precision.md'} and figures")
+        also = ", targets.md" if rewrite_targets(args.output) else ""
+        print(f"rewrote {Path(args.output) / 'work_precision.md'}{also} and figures")
+        return EXIT_OK
+    if args.targets:
+        run_targets(args.output, args.quick)
+        print(f"wrote {Path(args.output) / 'targets.md'} and targets.json")
         return EXIT_OK
 
     scenes = {Path(p).stem: p for p in args.scenes} if args.scenes else BENCH_SCENES
@@ -276,7 +288,9 @@ def cmd_bench(args) -> int:
         run_bench(scenes, args.revolutions, repeat=args.repeat, baselines=not args.no_baselines,
                   out=args.output, baseline_budget=args.baseline_budget,
                   baseline_tolerances=tuple(10.0 ** -k for k in range(3, 11)))
-    print(f"wrote {Path(args.output) / 'work_precision.csv'}, work_precision.md and figures")
+    run_targets(args.output, args.quick)
+    print(f"wrote {Path(args.output) / 'work_precision.csv'}, work_precision.md, figures, "
+          f"targets.md and targets.json")
     return EXIT_OK
 
 

@@ -811,6 +811,37 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     text = (tmp_path / "work_precision.md").read_text()
     assert all(f"## {s}" in text for s in BENCH_SCENES)
 
+    # the other targets, measured against that record (issue 5): every one has a verdict
+    from transient.bench import cyrk_available
+    from transient.bench_targets import run_targets, verdicts
+
+    res = run_targets(tmp_path, quick=True, progress=lambda line: None)
+    targets = (tmp_path / "targets.md").read_text()
+    n_speed = (1 + cyrk_available()) * len(BENCH_SCENES)  # RK45 (and CyRK) on each
+    assert len(res["speed"]) == n_speed
+    assert {o["scene"] for o in res["overhead"]} == set(BENCH_SCENES)
+    for o in res["overhead"]:
+        assert o["nfev"] > 0 and o["wall_s"] > 0 and o["call_chained_s"] > 0
+    assert [s["revolutions"] for s in res["scale"]] == [10.0, 100.0]
+    assert all(s["peak_mb"] > 10 and s["wall_per_1000_s"] > 0 for s in res["scale"])
+    assert 0 < res["warm_start"]["python_alone_s"] < res["warm_start"]["median_s"]
+    lines = verdicts(res)
+    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 \
+        + len(BENCH_SCENES) * len(ADAPTIVE) + 2
+    for target, case, measured, verdict in lines:
+        assert verdict in ("met", "met at the baseline's best error", "**missed**",
+                           "**not measured**")
+        assert f"| {target} | {case} | {measured} | {verdict} |" in targets
+    # --report rewrites both reports from the stored measurements, unchanged
+    (tmp_path / "targets.md").write_text("stale")
+    assert main(["bench", "--report", "-o", str(tmp_path)]) == 0
+    assert (tmp_path / "targets.md").read_text() == targets
+
+
+def test_bench_targets_needs_a_record(tmp_path, capsys):
+    assert main(["bench", "--targets", "-o", str(tmp_path)]) == 2
+    assert "bench --targets: no work_precision.csv" in capsys.readouterr().err
+
 
 # ----------------------------------------------------------------------------------------------
 # load steps: ISO 8528-5 measures in the summary, a response plot (issue 6)
