@@ -12,8 +12,8 @@ Rerun: ``.venv/bin/python scripts/stepper_overhead.py`` (about a minute).
 from pathlib import Path
 
 from transient.bench import BENCH_SCENES
-from transient.bench_targets import CALLS_PER_STEP, _timed_scene, per_call, rhs_arguments
-from transient.bench_targets import stepper_overhead
+from transient.bench_targets import (CALLS_PER_STEP, per_call, rhs_arguments, stepper_overhead,
+                                     timed_scene)
 from transient.core import model as cm
 from transient.core.jit import kernel
 from transient.scene import load_scene
@@ -45,7 +45,7 @@ for name, path in SCENES.items():
               f"({(o['wall_s'] - o['nfev'] * o['call_independent_s']) / o['nsteps'] * 1e6:.2f} µs"
               f" a step); one call chained {o['call_chained_s'] * 1e6:.3f} µs → overhead "
               f"{o['overhead_chained']:+.0%}")
-    args = rhs_arguments(_timed_scene(load_scene(path)))
+    args = rhs_arguments(timed_scene(load_scene(path)))
     if args[0].n_pairs:  # the margins, counted among the RHS evaluations, cost more as a call
         print(f"{name}: one mode-margin evaluation as a call "
               f"{per_call(margins_loop, *args) * 1e6:.3f} µs")

@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from .assemble import build_model
-from .bench import TARGET_PHASE
+from .bench import BENCH_SCENES, SAMPLES_PER_REV, TARGET_PHASE
 from .core import model as cm
 from .core.jit import kernel
 from .scene import Governor, Starter, load_scene
@@ -45,8 +45,8 @@ CALLS_PER_STEP = 12
 RUN_RTOL, RUN_ATOL = 1e-8, 1e-11
 OVERHEAD_TARGET, BARE_TARGET, WARM_TARGET_S, SCALE_TARGET = 0.30, 0.05, 1.0, 0.10
 SPEED_TARGETS = {"solve_ivp RK45 (numpy RHS)": 300.0, "CyRK DOP853 (transient's compiled RHS)": 2.0}
-_CASES = Path(__file__).resolve().parents[1] / "cases"
-BARE_SCENE = _CASES / "coasting_single.toml"
+#: The bare scene: one cylinder, equation (18) alone (no gas, friction, governor or starter).
+BARE_SCENE = BENCH_SCENES["coasting_single"]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -86,10 +86,11 @@ def per_call(loop, *args, rounds=7, loops=100):
 def rhs_arguments(scene, n_states=2000):
     """(model, states, y, out, sw, wk) for ``rhs_loop``: ``n_states`` states over the last cycle
     of a 50-revolution run of ``scene`` (CALLS_PER_STEP of them span about a step), interpolated
-    between its samples (72 per turn)."""
+    between its samples (SAMPLES_PER_REV per turn)."""
     model, _, _ = build_model(scene)
     tr = integrate(dc.replace(scene, run=dc.replace(scene.run, revolutions=50.0, t_end=math.inf),
-                              output=dc.replace(scene.output, samples_per_rev=72))).trajectory
+                              output=dc.replace(scene.output, samples_per_rev=SAMPLES_PER_REV))
+                   ).trajectory
     phi = np.linspace(tr["phi"][-1] - model.period, tr["phi"][-1], n_states)
     states = np.zeros((phi.size, cm.n_state(model)))
     states[:, cm.PHI], states[:, cm.T] = phi, np.interp(phi, tr["phi"], tr["t"])
@@ -112,9 +113,10 @@ def rhs_costs(scene, rounds=7, loops=100) -> tuple[float, float]:
                  for chained in (False, True))
 
 
-def _timed_scene(base, revolutions=1000.0, samples_per_rev=1, **solver):
+def timed_scene(base, revolutions=1000.0, samples_per_rev=1):
+    """``base`` as the overhead and bare-scene runs time it (RUN_RTOL, RUN_ATOL)."""
     return dc.replace(base, run=dc.replace(base.run, revolutions=revolutions, t_end=math.inf),
-                      solver=dc.replace(base.solver, rtol=RUN_RTOL, atol=RUN_ATOL, **solver),
+                      solver=dc.replace(base.solver, rtol=RUN_RTOL, atol=RUN_ATOL),
                       output=dc.replace(base.output, samples_per_rev=samples_per_rev))
 
 
@@ -130,12 +132,12 @@ def median_walls(*scenes, repeat=5):
     return [statistics.median(w) for w in walls], walls, counts
 
 
-def stepper_overhead(name, path, repeat=5, revolutions=1000.0, samples=(1, 72),
+def stepper_overhead(name, path, repeat=5, revolutions=1000.0, samples=(1, SAMPLES_PER_REV),
                      rounds=7) -> list[dict]:
     """Wall time of ``revolutions`` against RHS calls × cost of one call, at each output
     density ``samples`` (per turn); one row per density."""
     base = load_scene(path)
-    scenes = [_timed_scene(base, revolutions, n) for n in samples]
+    scenes = [timed_scene(base, revolutions, n) for n in samples]
     medians, _, counts = median_walls(*scenes, repeat=repeat)
     independent, chained = rhs_costs(scenes[0], rounds=rounds)
     return [{"scene": name, "samples_per_rev": n, "wall_s": wall, "nfev": c["nfev"],
@@ -276,7 +278,7 @@ def bare_kernel(rounds=7) -> dict:
 def unused_options(repeat=15, revolutions=1000.0) -> dict:
     """Whole runs of the bare scene against the same scene with a droop governor and a starter
     that never act (medians of ``repeat`` alternating runs), and the spread of the bare runs."""
-    bare = _timed_scene(load_scene(BARE_SCENE), revolutions)
+    bare = timed_scene(load_scene(BARE_SCENE), revolutions)
     unused = dc.replace(bare, governor=Governor(model="droop", speed_full=1e4, speed_zero=2e4),
                         starter=Starter(torque=0.0))
     (w_bare, w_unused), (runs, _), _ = median_walls(bare, unused, repeat=repeat)
@@ -403,8 +405,6 @@ def error_monotone(rows, floors: dict[str, float]) -> list[dict]:
 
 def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     """Every target's measurement (``quick``: the harness on short runs, one repeat)."""
-    from .bench import BENCH_SCENES
-
     q = dict(repeat=1, revolutions=10.0, rounds=1) if quick else {}
     res = {"speed": speed_at_equal_accuracy(rows), "monotone": error_monotone(rows, floors),
            "overhead": []}
