@@ -8,8 +8,8 @@ DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 .PHONY: run test bench install clean
 
 # Bytecode is written here: where PYTHONDONTWRITEBYTECODE is set (as on the machine of
-# results/benchmarks/targets.md), each run would otherwise compile transient's sources again, 0.1–0.2 s of a
-# ~1 s warm start (README, Start-up).
+# results/benchmarks/targets.md), each run would otherwise compile transient's sources again,
+# 0.1–0.2 s of a ~1 s warm start (README, Start-up).
 BYTECODE := $(PY) -m compileall -q transient
 
 $(STAMP): pyproject.toml
