@@ -95,9 +95,9 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--revolutions", type=float, default=1000.0)
     b.add_argument("--repeat", type=int, default=5, help="timed runs per point (median)")
     b.add_argument("--no-baselines", action="store_true", help="transient's paths only")
-    # (at 30 s, on a 2-core machine of 2026-11-26, solve_ivp finished no run of two scenes)
-    b.add_argument("--baseline-budget", type=float, default=60.0,
-                   help="stop a baseline run after this long, and its tighter tolerances [s]")
+    b.add_argument("--baseline-budget", type=float, default=None,
+                   help="stop a baseline run after this long, and its tighter tolerances [s] "
+                        "(default: transient.bench.BASELINE_BUDGET_S, 60 s)")
     b.add_argument("--quick", action="store_true",
                    help="a smoke test of the harness: 10 revolutions, 3 tolerances, one run each")
     b.add_argument("--report", action="store_true",
@@ -258,7 +258,7 @@ def cmd_stress(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    from .bench import BENCH_SCENES, rewrite_report, run_bench
+    from .bench import BASELINE_BUDGET_S, BENCH_SCENES, rewrite_report, run_bench
     from .bench_targets import rewrite_targets, run_targets
     from .scene import load_scene
 
@@ -286,7 +286,7 @@ def cmd_bench(args) -> int:
                   baseline_tolerances=(1e-4,), steps_per_rev=(32, 128))
     else:
         run_bench(scenes, args.revolutions, repeat=args.repeat, baselines=not args.no_baselines,
-                  out=args.output, baseline_budget=args.baseline_budget,
+                  out=args.output, baseline_budget=args.baseline_budget or BASELINE_BUDGET_S,
                   baseline_tolerances=tuple(10.0 ** -k for k in range(3, 11)))
     run_targets(args.output, args.quick)
     print(f"wrote {Path(args.output) / 'work_precision.csv'}, work_precision.md, figures, "

@@ -832,6 +832,7 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
         assert verdict in ("met", "met at the baseline's best error", "**missed**",
                            "**not measured**")
         assert f"| {target} | {case} | {measured} | {verdict} |" in targets
+        assert "|" not in target + case + measured  # (a cell's pipe would split the table)
     # --report rewrites both reports from the stored measurements, unchanged
     (tmp_path / "targets.md").write_text("stale")
     assert main(["bench", "--report", "-o", str(tmp_path)]) == 0
