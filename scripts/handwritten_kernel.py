@@ -6,6 +6,7 @@ gas, friction, governor or starter) against a kernel written by hand for that eq
 transient's right-hand side does beyond it; then whole runs of the bare scene against the same
 scene carrying unused options (a droop governor, a zero-torque starter, never acting; medians of
 15 alternating runs). Rerun: ``.venv/bin/python scripts/handwritten_kernel.py`` (about 20 s).
+``scripts/bare_gap.py`` looks at the same difference from transient's side.
 """
 from transient.bench_targets import BARE_SCENE, bare_kernel, hand_written_cost, unused_options
 from transient.scene import load_scene
