@@ -387,12 +387,35 @@ def equal_error_lines(rows, scene) -> list[str]:
     return lines
 
 
+#: Two runs of an adaptive path whose step counts are within this fraction of each other took the
+#: same steps: the tolerance did not set them (the breakpoints and the maximum step did), and
+#: errors within this fraction of each other are the same error (a plateau, not a rise).
+SAME_STEPS = 0.01
+
+
+def loose_to_tight(rows, scene, method):
+    """The runs of one path on one scene, from the loosest rtol (or the longest fixed step)."""
+    return sorted((r for r in rows if r["scene"] == scene and r["method"] == method),
+                  key=lambda r: -(r["step_rad"] or r["rtol"]))
+
+
+def on_plateau(prev, run) -> bool:
+    """Whether ``run`` took the steps of the looser ``prev`` (within ``SAME_STEPS``): tightening
+    the tolerance from there changed neither the steps nor, then, what sets the error."""
+    return prev is not None and run["nsteps"] <= (1.0 + SAME_STEPS) * prev["nsteps"] \
+        and run["step_rad"] == 0.0
+
+
 def order_slope(rows, scene, method, floor):
     """Least-squares slope of log(phase error) against log(rtol) — or against log(step) for a
     fixed-step path — over the runs whose error is above 100× ``floor`` (the reference's own
-    uncertainty)."""
-    pts = [(math.log10(r["step_rad"] or r["rtol"]), math.log10(r["phase_err_rad"])) for r in rows
-           if r["scene"] == scene and r["method"] == method and r["phase_err_rad"] > 100 * floor]
+    uncertainty) and whose steps the tolerance set (not :func:`on_plateau`: on the swash plate,
+    rtol 1e-3 … 1e-6 all take one step per breakpoint segment and give one error, which would
+    flatten the slope without saying anything of the method's order)."""
+    runs = loose_to_tight(rows, scene, method)
+    pts = [(math.log10(r["step_rad"] or r["rtol"]), math.log10(r["phase_err_rad"]))
+           for prev, r in zip([None] + runs, runs)
+           if r["phase_err_rad"] > 100 * floor and not on_plateau(prev, r)]
     if len(pts) < 3:
         return math.nan
     x, y = np.array(pts).T

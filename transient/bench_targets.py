@@ -31,8 +31,9 @@ import numpy as np
 from numba import njit
 
 from .assemble import build_model
-from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAMPLES_PER_REV,
-                    TARGET_PHASE, at_target, fastest_as_accurate, order_slope, read_record)
+from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS,
+                    SAMPLES_PER_REV, TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight,
+                    on_plateau, order_slope, read_record)
 from .core import model as cm
 from .core.jit import kernel
 from .scene import Governor, Starter, load_scene
@@ -406,17 +407,24 @@ def speed_at_equal_accuracy(rows) -> list[dict]:
 
 def error_monotone(rows, floors: dict[str, float]) -> list[dict]:
     """Per scene and adaptive path, from loose to tight rtol: the tolerances at which the final
-    phase error rose (both errors above 100× the scene's reference floor, ``floors``), and the
-    slope of log(error) against log(rtol)."""
+    phase error rose (both errors above 100× the scene's reference floor, ``floors``), those at
+    which it stayed flat (the same steps and the same error, both within ``bench.SAME_STEPS``:
+    the breakpoints set the steps there, not the tolerance; listed, not counted as rises), and
+    the slope of log(error) against log(rtol) where the tolerance set the steps."""
     out = []
     for scene, floor in floors.items():
         for method in ADAPTIVE:
-            runs = sorted((r for r in rows if r["scene"] == scene and r["method"] == method),
-                          key=lambda r: -r["rtol"])
-            errs = [(r["rtol"], r["phase_err_rad"]) for r in runs]
-            rises = [(rtol, e / e_prev) for (_, e_prev), (rtol, e) in zip(errs, errs[1:])
-                     if e > e_prev > 100 * floor]
-            out.append({"scene": scene, "method": method, "rises": rises,
+            runs = loose_to_tight(rows, scene, method)
+            rises, flat = [], []
+            for prev, run in zip(runs, runs[1:]):
+                e_prev, e = prev["phase_err_rad"], run["phase_err_rad"]
+                if not e > e_prev > 100 * floor:
+                    continue
+                if on_plateau(prev, run) and e <= (1.0 + SAME_STEPS) * e_prev:
+                    flat.append((run["rtol"], e / e_prev))
+                else:
+                    rises.append((run["rtol"], e / e_prev))
+            out.append({"scene": scene, "method": method, "rises": rises, "flat": flat,
                         "slope": order_slope(rows, scene, method, floor)})
     return out
 
@@ -480,8 +488,10 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
                   _missed(w["median_s"], WARM_TARGET_S)))
     for m in res["monotone"]:
         rises = ", ".join(f"rtol {r:.0e} ×{k:.3g}" for r, k in m["rises"]) or "none"
+        flat = ", ".join(f"{r:.0e} ×{k:.4f}" for r, k in m.get("flat", []))
+        flat = f"; flat on the same steps at rtol {flat}" if flat else ""
         lines.append(("error falls monotonically with rtol", f"{m['scene']}, {m['method']}",
-                      f"rises: {rises}; slope {m['slope']:.2f}",
+                      f"rises: {rises}{flat}; slope {m['slope']:.2f}",
                       "met" if not m["rises"] else "**missed**"))
     first, last = res["scale"][0], res["scale"][-1]
     growth = last["wall_per_1000_s"] / first["wall_per_1000_s"] - 1.0

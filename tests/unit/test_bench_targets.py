@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from transient import bench_targets as bt
@@ -45,9 +46,11 @@ def test_the_hand_written_kernel_refuses_another_mechanism():
         bt.hand_parameters(load_scene(CASES / "gots_diesel_governed.toml"))
 
 
-def _row(scene, method, rtol, wall, phase):
+def _row(scene, method, rtol, wall, phase, nsteps=None):
+    """A record's row; by default each tighter rtol takes 10 % more steps than the one before."""
+    steps = nsteps if nsteps is not None else round(1000 * 1.1 ** -math.log10(rtol))
     return {"scene": scene, "method": method, "rtol": rtol, "step_rad": 0.0, "wall_s": wall,
-            "phase_err_rad": phase}
+            "phase_err_rad": phase, "nsteps": steps}
 
 
 DEFAULT = "transient DOP853 (crank angle)"
@@ -87,6 +90,26 @@ def test_a_rise_of_the_error_is_found_above_the_references_floor_only():
     # 1e-4 rose ×3; the rise at 1e-7 is within 100× the floor (1e-9): not counted
     assert got["rises"] == [(1e-4, pytest.approx(3.0))]
     assert math.isfinite(got["slope"])
+
+
+def test_a_plateau_on_the_same_steps_is_flat_and_a_rise_on_them_is_still_a_rise():
+    """Where the breakpoints set the steps (the swash plate at loose rtol: one step per segment),
+    tightening rtol changes neither the steps nor the error: flat, not a rise. An error that
+    grows on the same steps (×1.8) is a rise all the same, and the slope leaves out the runs
+    whose steps the tolerance did not set."""
+    method = next(iter(ADAPTIVE))
+    rows = [_row("a", method, r, 0.1, e, n) for r, e, n in
+            ((1e-3, 5.650e-6, 12005), (1e-4, 5.652e-6, 12007), (1e-5, 1.0e-5, 12008),
+             (1e-6, 2e-7, 24006), (1e-7, 2e-8, 36010), (1e-8, 2e-9, 48023))]
+    got = bt.error_monotone(rows, {"a": 1e-13})[0]
+    assert [r for r, _ in got["flat"]] == [1e-4]
+    assert got["rises"] == [(1e-5, pytest.approx(1.0e-5 / 5.652e-6))]
+    # the slope through rtol 1e-3, 1e-6, 1e-7, 1e-8 (1e-4 and 1e-5 took 1e-3's steps)
+    x = np.log10([1e-3, 1e-6, 1e-7, 1e-8])
+    assert got["slope"] == pytest.approx(np.polyfit(x, np.log10([5.65e-6, 2e-7, 2e-8, 2e-9]), 1)[0])
+    line = next(v for t, c, v, _ in bt.verdicts(dict(_results(0.9, 0.29, 0, 0.02), monotone=[got]))
+                if t.startswith("error falls"))
+    assert "flat on the same steps at rtol 1e-04" in line and "rises: rtol 1e-05" in line
 
 
 def _results(warm_s, overhead, change, iqr):
