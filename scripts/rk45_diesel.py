@@ -12,7 +12,8 @@ it, and writes the rows to ``results/benchmarks/rk45_diesel.csv``.
 
 Rerun: ``.venv/bin/python scripts/rk45_diesel.py [TIGHTEST_RTOL]`` (RK45's runs take most of it:
 14 min on a 2-core machine at a87c692 down to rtol 1e-12, where RK45 first reached 1e-6 rad at
-1e-10; ``1e-10`` as TIGHTEST_RTOL stops there: 21 min 27 s on the slower machine of 2026-11-26).
+1e-10; ``1e-10`` as TIGHTEST_RTOL stops there: 21 min 27 s on the slower machine of 2026-11-26,
+4 min 29 s on the machine of 2026-11-27).
 """
 import csv
 import sys
