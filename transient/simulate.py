@@ -92,7 +92,7 @@ def _initial_state(scene, model):
     y[2] = scene.initial.omega
     governor, sleeve = initial_governor(scene, model)
     y[y.size - governor.size:] = governor
-    fst = np.zeros(ci.N_FST)
+    fst = np.zeros(ci.fst_size(model))
     fst[ci.F_PASSED_BP] = np.nan
     ist = np.zeros(ci.N_IST, dtype=np.int64)
     st = scene.starter
@@ -120,7 +120,7 @@ def _compile(model, tab, cfg, bp) -> float:
     y[2] = 1.0
     helper = start_helper(model, tab)
     try:
-        ci.advance(model, tab, warm, bp, y, np.zeros(ci.N_FST),
+        ci.advance(model, tab, warm, bp, y, np.zeros(ci.fst_size(model)),
                    np.zeros(ci.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
                    np.empty((64, 4)))
     finally:
@@ -253,6 +253,7 @@ def switch_inertia(model, extra: float, y, ist):
         y[cm.OMEGA] = w_new
     ist[ci.I_GOV_BRANCH] = cm.start_branch(model, w_new, y)
     ist[ci.I_GEN_LOW] = cm.generator_branch(model, w_new, True)
+    ist[ci.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
     return model._replace(J0=model.J0 + extra)
 
 

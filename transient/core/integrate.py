@@ -61,6 +61,11 @@ N_CFG = 12
 F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH = range(8)
 F_ERR_OLD = 8  # the last accepted step's error norm (≥ 1e-4), for the PI step-size control
 N_FST = 9
+# fst[F_DERIV:F_DERIV + n]: the derivative at y that the last step carried over (FSAL), then the
+# pairs' margins there; kept where a chunk ends with them valid (ist[I_F_VALID]). Chunks end where
+# the output buffer fills: recomputed at each chunk's start (with the table piece ahead of the
+# shaft, not the step's), they made the run depend on the samples per turn in the last bits.
+F_DERIV = N_FST
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
 BP_LANDING = 1e-7
@@ -72,7 +77,10 @@ I_LOAD_SEG, I_GEN_LOW, I_SLEEVE = SW_LOAD, SW_GENERATOR, SW_SLEEVE
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
  I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT, I_STIFF,
  I_NONSTIFF) = range(N_SWITCHES, N_SWITCHES + 17)
-N_IST = N_SWITCHES + 17
+# the last attempt was rejected by the error test; consecutive non-finite attempts; consecutive
+# attempts retaken for a crossing that no sample found
+I_REJECTED, I_NBAD, I_NUNSEEN = range(N_SWITCHES + 17, N_SWITCHES + 20)
+N_IST = N_SWITCHES + 20
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
 # not accuracy, sets the step: the problem is stiff for an explicit method.
@@ -649,6 +657,12 @@ def _reset_output_grid(cfg, ist, fst, y):
     fst[F_NEXT_OUT] = j * d
 
 
+@kernel
+def fst_size(m):
+    """Length of the float stepper state ``fst``: N_FST, then the carried derivative and margins."""
+    return N_FST + n_state(m) + max(m.n_pairs, 1)
+
+
 @compiled(nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
 def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
@@ -664,7 +678,7 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
         Sorted breakpoints in [0, m.period).
     y : float64[model.n_state(m)]
         State, updated in place.
-    fst, ist : float64[N_FST], int64[N_IST]
+    fst, ist : float64[fst_size(m)], int64[N_IST]
         Stepper state kept between calls (zeros before the first call, except
         ``fst[F_PASSED_BP] = nan`` and ``ist[I_STARTER_ON]``).
     outbuf : float64[nbuf, model.n_outputs(m)]
@@ -696,9 +710,6 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
-    n_bad = 0  # consecutive non-finite step attempts
-    n_unseen = 0  # consecutive attempts retaken for a crossing no sample found
-    rejected = False  # the last attempt was rejected by the error test
     g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics,
     g1 = g0 + gv.n_states(m.gov_dyn)
     c0 = cyl_index(m)  # and so are the cylinder pressures y[c0:]
@@ -719,12 +730,19 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         _reset_output_grid(cfg, ist, fst, y)
         _emit_row(m, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, wk)
 
-    ist[I_F_VALID] = 0  # f is local to this call: recompute it once per chunk
+    # As the last chunk left them: its derivative and margins (F_DERIV), if valid, and the
+    # counters of the retaken attempts; kept again where this chunk ends.
+    if ist[I_F_VALID] == 1:
+        _carry(fst, f, gs, m.n_pairs, False)
+    n_bad = ist[I_NBAD]  # consecutive non-finite step attempts
+    n_unseen = ist[I_NUNSEEN]  # consecutive attempts retaken for a crossing no sample found
+    rejected = ist[I_REJECTED] == 1  # the last attempt was rejected by the error test
     steps_here = 0
     while True:
-        if ist[I_NOUT] + margin >= outbuf.shape[0] or ist[I_NEV] + 8 >= evbuf.shape[0]:
-            return RUNNING
-        if steps_here >= cfg[C_CHUNK_STEPS]:
+        if (ist[I_NOUT] + margin >= outbuf.shape[0] or ist[I_NEV] + 8 >= evbuf.shape[0]
+                or steps_here >= cfg[C_CHUNK_STEPS]):
+            _carry(fst, f, gs, m.n_pairs, True)
+            ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
             return RUNNING
         angle_mode = ist[I_ANGLE_MODE] == 1
         sw = ist[:N_SWITCHES]
@@ -1073,6 +1091,24 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             _to_angle_mode(m, y, ist, wk)
             fst[F_H] = h_next * ev_level
             _reset_output_grid(cfg, ist, fst, y)
+
+
+@kernel(inline="always")
+def _carry(fst, f, gs, n_pairs, keep):
+    """The derivative ``f`` at the state and the pairs' margins there (``gs[0]``) into the stepper's
+    state ``fst`` (``keep``) or back from it (F_DERIV): what a chunk leaves valid, the next takes
+    up as it is, so that where chunks end changes nothing in the run."""
+    n = f.shape[0]
+    for i in range(n):
+        if keep:
+            fst[F_DERIV + i] = f[i]
+        else:
+            f[i] = fst[F_DERIV + i]
+    for k in range(n_pairs):
+        if keep:
+            fst[F_DERIV + n + k] = gs[0, k]
+        else:
+            gs[0, k] = fst[F_DERIV + n + k]
 
 
 @kernel
