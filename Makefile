@@ -31,7 +31,7 @@ run: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
-# The work-precision record and issue 5's targets in results/benchmarks/ (20 min 32 s measured on
+# The work-precision record and issue 5's targets in results/benchmarks/ (19 min 55 s measured on
 # 2026-11-27; 27 min 43 s on the slower machine of 2026-11-26). CyRK, the compiled peer, comes with
 # the optional `bench` extra.
 bench: $(STAMP)
