@@ -106,7 +106,8 @@ def test_where_chunks_end_changes_nothing(monkeypatch):
     the samples per turn. What a chunk leaves (the derivative carried over, the pairs' margins,
     the step-size control's memory of a rejection) the next takes up as it is: the governed
     diesel with two friction pairs, at one sample per turn in a buffer that never fills and at
-    72 in one that fills every ~5 turns, takes the same steps to the same bits. (Before, each
+    72 in one that fills every ~1.4 turns (400 rows, 300 of them kept free), takes the same steps
+    to the same bits. (Before, each
     chunk recomputed the derivative with the table piece ahead of the shaft angle and forgot a
     rejection; at rtol 1e-12 the diesel without pairs took 60 129 or 60 134 steps by the output.)
     """
