@@ -7,9 +7,8 @@ DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
 .PHONY: run test bench install clean
 
-# Bytecode is written here: where PYTHONDONTWRITEBYTECODE is set (as on the machine of
-# results/benchmarks/targets.md), each run would otherwise compile transient's sources again,
-# 0.1–0.2 s of a ~1 s warm start (README, Start-up).
+# Bytecode is written at install: where PYTHONDONTWRITEBYTECODE is set, each run would otherwise
+# compile transient's sources again, a noticeable part of a warm start.
 BYTECODE := $(PY) -m compileall -q transient
 
 $(STAMP): pyproject.toml
@@ -26,14 +25,15 @@ run: $(STAMP)
 	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
 	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results
 
-# One pytest worker per core, at most 4 (a process compiling the stepper held 1.0 GB); worksteal
+# The import contracts first (pyproject.toml, [tool.importlinter]), then the suite: one pytest
+# worker per core, at most 4 (a process compiling the stepper holds about a gigabyte); worksteal
 # moves queued tests from a busy worker to an idle one (the first runs compile for minutes).
 test: $(STAMP)
+	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
-# The work-precision record and issue 5's targets in results/benchmarks/ (19 min 55 s measured on
-# 2026-11-27; 27 min 43 s on the slower machine of 2026-11-26). CyRK, the compiled peer, comes with
-# the optional `bench` extra.
+# The work-precision record and its targets in results/benchmarks/ (about twenty minutes; the
+# record says how long). CyRK, the compiled peer, comes with the optional `bench` extra.
 bench: $(STAMP)
 	$(PY) -m pip install -q -e '.[test,bench]'
 	$(BYTECODE)

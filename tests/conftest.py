@@ -15,7 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 TESTS = Path(__file__).resolve().parent
-PARALLEL_ORDER = ("stress", "validation", "regression", "unit")
+PARALLEL_ORDER = ("stress", "validation", "cli", "unit")
 
 
 def pytest_collection_modifyitems(config, items):

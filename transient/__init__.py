@@ -1,25 +1,37 @@
 """transient — transient dynamics of piston machines with variable shaft speed.
 
-Module map (data flow: scene → mechanism → reduced model → stepper → result → analysis/plots):
+The package is laid out as its data flow, scene → mechanism → reduced model → chain → stepper →
+result → analysis, and each layer imports only those below it (the contracts in
+``pyproject.toml``, checked by ``make test``). From the bottom up:
 
-- ``scene``          TOML → frozen dataclasses, validation, resolved TOML out
-- ``mechanisms``     crank_slider, swash_plate: geometry, validation, kinematics tables
-- ``forces``         gas pressure tables and cycles (the Wiebe cycles' file cache: ``wiebe_cache``)
-- ``assemble``       scene → compiled model arrays and breakpoints
-- ``core``           every numba kernel: kinematics, reduced model (18), DOP853 stepper
-- ``simulate``       drives the compiled stepper, streams results; prescribed-speed mode
+- ``core``           numba only: kinematics per mechanism, the reduced model (18), the serial
+                     chain (22), (27), governor, cylinder, RK tableaus, events, the stepper
+- ``errors``, ``roots``, ``tomlout``, ``units``, ``version``, ``precompile``
+                     what every layer shares: errors, scalar roots, TOML values, unit suffixes,
+                     the version, the compile helper process
+- ``mechanisms``     crank_slider, swash_plate, articulated: geometry, checks, kinematics
+- ``forces``         gas pressure tables and cycles (mixed, Wiebe, Woschni), pulses, their cache
+- ``tabulate``, ``assemble``
+                     scene → compiled model arrays and breakpoints (angle-only terms tabulated)
+- ``outputs``        the trajectory columns of a scene and their units
+- ``scene``          TOML or dict → frozen records in SI, validated; resolved TOML out
+- ``results``        the in-memory run, the HDF5 writer (streaming) and reader
 - ``reference``      the same model in plain numpy through ``scipy.integrate.solve_ivp``
-- ``results``        HDF5 writer (streaming) and reader
-- ``analysis``       speed fluctuation, steady state
+- ``analysis``       irregularity, steady state, efficiency, orders, transient response, loads,
+                     the end-of-run summary
+- ``run``            drives the compiled stepper in chunks (or the reference path), prescribed
+                     speed, and :func:`simulate`
 - ``plots``          ax-first plotting helpers
+- ``study``, ``sweep``
+                     many runs: efficiency and flywheel studies; parameter sweeps on Dask
+- ``verify``         the work–precision benchmark, its targets, the stress catalogue
 - ``cli``            the ``transient`` command
 
 Public API: :func:`load_scene`, :func:`simulate`, :func:`open_result`.
 """
-__version__ = "0.1.0"
-
 from .results import open_result  # noqa: E402
+from .run import simulate  # noqa: E402
 from .scene import load_scene  # noqa: E402
-from .simulate import simulate  # noqa: E402
+from .version import __version__
 
 __all__ = ["load_scene", "simulate", "open_result", "__version__"]

@@ -505,7 +505,8 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
     the benchmark times that). ``dense_tail`` > 0: over that last angle [rad] before the end, add
     eight samples per step from solve_ivp's dense output (for error measures between steps).
     """
-    from .simulate import RunData, output_columns
+    from .results import RunData
+    from .outputs import output_columns
 
     ref = ReferenceModel(scene)
     method = scene.solver.method.removeprefix("scipy-")

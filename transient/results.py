@@ -8,17 +8,29 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import h5py
 import numpy as np
 
-from . import __version__
+from .version import __version__
 from .errors import SimulationError, WriteFailed
 
 FORMAT = 1
+
+
+@dataclass
+class RunData:
+    """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics."""
+
+    trajectory: dict[str, np.ndarray]
+    events: dict[str, np.ndarray]
+    solver: dict[str, float | int | str]
+    complete: bool = True
+    message: str = ""
+    extra: dict = field(default_factory=dict)
 
 
 class ResultExists(FileExistsError):
@@ -71,7 +83,7 @@ CHUNK_CACHE_BYTES = 32 * CHUNK_ROWS * 8
 #: HDF5 format bounds of a result's objects: the 1.10 format, readable by HDF5 ≥ 1.10 (2016). Its
 #: chunk index for a dataset extended along one axis (an extensible array, not 1.8's B-tree) keeps
 #: the writing process from growing with the run: 0.6 MB from 2×10⁵ to 10⁶ revolutions of 16
-#: columns against 4.4 MB with 1.8's (``scripts/hdf5_memory_growth.py``; README *Speed*, Scale).
+#: columns against 4.4 MB with 1.8's (``tools/hdf5_memory_growth.py``; README *Speed*, Scale).
 #: The file itself keeps the 1.8 format's superblock (:func:`_create_file`).
 FILE_FORMAT = ("v110", "v110")
 

@@ -8,7 +8,7 @@ and fork-and-blade V-twins, λ 0.22–0.4, no gas or the mixed cycle, up to two 
 
 * the compiled run raises nothing and stores no non-finite value; it completes, or stops with a
   diagnosis naming time and angle (a random load may stall the machine, a random pair set lock it);
-* the work–energy balance closes to ``transient.stress.balance_tolerance(rtol)`` (C·rtol);
+* the work–energy balance closes to ``transient.verify.stress.balance_tolerance(rtol)`` (C·rtol);
 * the reference path (``solver.method = "scipy-DOP853"``) agrees with the compiled one at the end
   of the run: same status, and the end time and speed within e = (y − y_ref)/(atol + rtol·|y_ref|)
   ≤ E_AGREE.
@@ -30,8 +30,8 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, reject, settings
 from hypothesis import strategies as st
 
-from transient.stress import balance_residual, balance_tolerance, base, nonfinite, put, scene_of
-from transient.simulate import integrate
+from transient.verify.stress import balance_residual, balance_tolerance, base, nonfinite, put, scene_of
+from transient.run import integrate
 
 FULL = os.environ.get("TRANSIENT_STRESS_FULL", "") not in ("", "0")
 EXAMPLES_CI, EXAMPLES_FULL = 30, 500

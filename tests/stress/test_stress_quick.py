@@ -3,7 +3,7 @@ passes or is a written-up known failure, and the report lists every case with it
 from __future__ import annotations
 
 from transient.cli import main
-from transient.stress import catalogue
+from transient.verify.stress import catalogue
 
 
 def test_stress_quick(tmp_path, capsys):
@@ -24,7 +24,7 @@ def test_stress_quick(tmp_path, capsys):
 def test_the_ladder_rule_catches_a_rise_and_ignores_the_floor():
     """``tolerance-ladder``'s monotonicity rule: a rise fails it, unless it is above the rtol
     the rule starts from or below the reference's noise floor."""
-    from transient.stress import LADDER_FLOOR, _falls
+    from transient.verify.stress import LADDER_FLOOR, _falls
 
     rtols = [1e-3, 1e-4, 1e-5, 1e-6]
     assert _falls(rtols, [1e-3, 1e-4, 1e-5, 1e-6])

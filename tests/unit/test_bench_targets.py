@@ -1,6 +1,6 @@
-"""Issue 5's targets as ``transient bench`` measures them (:mod:`transient.bench_targets`): the
+"""Issue 5's targets as ``transient bench`` measures them (:mod:`transient.verify.targets`): the
 hand-written (18) it times transient against is the same equation, and the verdicts read the
-record's rows as stated. (The harness end to end, on short runs: ``tests/regression/test_cli.py::
+record's rows as stated. (The harness end to end, on short runs: ``tests/cli/test_cli.py::
 test_bench_quick_writes_a_consistent_record``.)"""
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient import bench_targets as bt
-from transient.bench import ADAPTIVE
+from transient.verify import targets as bt
+from transient.verify.bench import ADAPTIVE
 from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -148,7 +148,7 @@ def test_the_record_extrapolates_to_1e_6_rad_only_from_near_it():
     """A log-log line through the two most accurate runs, if the better is within two decades
     of 1e-6 rad (4e-5 → 1e-6 rad at the slope of 1e-4 → 4e-5: wall ×2 per ×0.4 of error);
     from 0.65 rad, no estimate."""
-    from transient.bench import at_target
+    from transient.verify.bench import at_target
 
     near = [_row("a", RK45, 1e-8, 10.0, 4e-5), _row("a", RK45, 1e-7, 5.0, 1e-4)]
     wall, how = at_target(near, "a", RK45)

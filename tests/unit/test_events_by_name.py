@@ -1,9 +1,9 @@
-"""simulate._events_by_name: a chunk's event rows grouped by name with numpy, against the
+"""run._events_by_name: a chunk's event rows grouped by name with numpy, against the
 row-by-row grouping it replaced (the events' order within a name kept)."""
 import numpy as np
 
 from transient.core import integrate as ci
-from transient.simulate import _events_by_name
+from transient.run import _events_by_name
 
 
 def grouped_row_by_row(rows, switching):

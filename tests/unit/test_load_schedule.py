@@ -296,7 +296,7 @@ def test_prescribed_speed_follows_the_schedule(abscissa):
     scene = replace(base, load=Load(torque=1.0, generator_power=100.0, generator_min_speed=10.0,
                                     **sched),
                     run=replace(base.run, mode="prescribed-speed", speed=100.0, revolutions=1.5))
-    from transient.simulate import integrate
+    from transient.run import integrate
 
     tr = integrate(scene).trajectory
     x = tr["t"] if abscissa == "time" else (tr["phi"] - scene.initial.phi) / (2 * math.pi)

@@ -1,4 +1,4 @@
-"""simulate._WriteBehind: a result's blocks are written in a second thread while the stepper
+"""run._WriteBehind: a result's blocks are written in a second thread while the stepper
 computes the next, one at a time and in order; a failed write is raised in the caller."""
 import threading
 import time
@@ -6,7 +6,7 @@ import time
 import pytest
 
 from transient.core import integrate as ci
-from transient.simulate import _WriteBehind
+from transient.run import _WriteBehind
 
 
 def test_blocks_are_written_in_order_one_at_a_time():

@@ -1,5 +1,6 @@
-"""Shared helpers of the validation tests: where the Gots data live, the scenes in ``cases/``, and
-an accurate quadrature of output samples between known cut points (breakpoints, events)."""
+"""Shared helpers of the validation tests: the Gots tables (``tests/data``), the scenes in
+``cases/``, and an accurate quadrature of output samples between known cut points (breakpoints,
+events)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -9,17 +10,13 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"
-# In CI the repository is cloned with ``shared/`` beside it.
-GOTS_DATA = REPO.parent / "shared" / "reference" / "data"
+#: The Gots tables as printed, with their provenance and misprints (``tests/data/README.md``).
+GOTS_DATA = REPO / "tests" / "data"
 
 
 @pytest.fixture(scope="session")
 def gots_data() -> Path:
-    """Folder of the Gots CSV tables; a missing folder is an error, never a skip."""
-    if not (GOTS_DATA / "gots_P4_1_forces.csv").is_file():
-        raise FileNotFoundError(
-            f"Gots reference tables not found in {GOTS_DATA}: the validation tests need the "
-            f"'shared/' folder (reference/data/*.csv) checked out beside the repository {REPO}")
+    """Folder of the Gots CSV tables."""
     return GOTS_DATA
 
 

@@ -16,7 +16,7 @@ import pytest
 
 from transient.cli import main
 from transient.scene import Gas, Initial, Load, Run, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 SCENES = ("radial_5cyl", "radial_9cyl", "v_twin_fork_blade")

@@ -10,7 +10,7 @@ from transient.assemble import build_model
 from transient.core.tableaus import TABLEAUS
 from transient.precompile import CALLEES, compile_callees, signature
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 from conftest import CASES
 

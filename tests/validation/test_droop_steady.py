@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from transient.scene import Run, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -24,7 +24,7 @@ from scipy.integrate import quad
 
 from transient.core.crank_slider import crank_slider_terms
 from transient.scene import Gas, Initial, Load, Output, Run, Solver, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -276,7 +276,7 @@ def test_time_domain_breakpoints_once_at_loose_tolerances(rtol):
     so that each corner is still reached once (was a bug: the next step crossed the sliver and was
     retaken again, 472 breakpoint events at rtol 1e-3 on the stress suite's 40-revolution
     spin-up against 299 at 1e-9)."""
-    from transient.stress import put, scene_of, spinup
+    from transient.verify.stress import put, scene_of, spinup
 
     def events(r):
         d = put(put(spinup(10), "output", dt=1e-4), "solver", rtol=r, atol=r * 1e-2,

@@ -1,4 +1,4 @@
-"""Flywheel sizing for a target δ (:mod:`transient.analysis.flywheel`, Gots §2.8).
+"""Flywheel sizing for a target δ (:mod:`transient.study.flywheel`, Gots §2.8).
 
 * The flywheel returned for δ_target, put into the Gots diesel spin-up scene as it is (from
   1000 rpm, 1000 revolutions, its own solver): a fresh run, independent of the helper's own runs
@@ -24,10 +24,10 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from transient.analysis.flywheel import flywheel_for_delta
+from transient.study.flywheel import flywheel_for_delta
 from transient.analysis.irregularity import cycle_means, fluctuation, steady_state_time
 from transient.scene import Load, Output, Run, load_scene
-from transient.simulate import integrate, prescribed
+from transient.run import integrate, prescribed
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -23,7 +23,7 @@ from transient.assemble import build_model
 from transient.core.chain import LOCKED, modes_power_flow
 from transient.core.model import WK_DJ, WK_J, WK_M, moments, split_subchains, work_array
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
-from transient.simulate import integrate, prescribed
+from transient.run import integrate, prescribed
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from transient.assemble import gas_table
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

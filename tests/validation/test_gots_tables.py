@@ -30,7 +30,7 @@ import pytest
 from transient.assemble import build_model, gas_phases, gas_table
 from transient.core import crank_slider as core
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 N = 4400.0

@@ -18,7 +18,7 @@ import pytest
 from scipy.interpolate import CubicHermiteSpline
 
 from transient.scene import scene_from_dict
-from transient.simulate import integrate
+from transient.run import integrate
 
 from conftest import CASES
 

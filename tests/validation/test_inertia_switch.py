@@ -17,7 +17,7 @@ import tomllib
 import numpy as np
 
 from transient.scene import scene_from_dict
-from transient.simulate import integrate
+from transient.run import integrate
 
 from conftest import CASES
 

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from transient.scene import Gas, Initial, Load, Output, Run, Solver, Starter, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 W0 = 2000.0 * math.pi / 30.0

@@ -34,7 +34,7 @@ import pytest
 from transient.analysis import loads as L
 from transient.assemble import gas_phases
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 OMEGA = math.pi * 4400.0 / 30.0  # 460.77 rad/s (П4.1 uses πn/30)

@@ -28,7 +28,7 @@ from transient.analysis.loads_swash import swash_loads_from_trajectory
 from transient.cli import main
 from transient.results import open_result
 from transient.scene import Analysis, load_scene
-from transient.simulate import simulate
+from transient.run import simulate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -28,7 +28,7 @@ import pytest
 from transient.analysis.irregularity import fluctuation
 from transient.analysis.orders import order_spectrum, report_for_scene, to_angle_grid
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 REVS = 20

@@ -48,7 +48,7 @@ from scipy.interpolate import CubicHermiteSpline
 
 import transient.reference as reference
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RTOL = ATOL = 1e-10
@@ -228,7 +228,7 @@ def test_chain_of_a_nonfinite_trial_stage_is_not_a_number():
 
 
 def test_a_segment_started_on_a_governor_corner_does_not_stop_at_once(monkeypatch):
-    """The governed diesel by RK45 at rtol 1e-5 (scripts/rk45_diesel.py): at t = 0.66299 s a
+    """The governed diesel by RK45 at rtol 1e-5 (tools/rk45_diesel.py): at t = 0.66299 s a
     segment started on the droop corner with the speed heading up, and its first step ended
     below the corner (the speed turning back within it). The event function was 0 at the start,
     so the root finder put the crossing there: the run stopped at once, flipped the governor's

@@ -11,7 +11,7 @@ import pytest
 from transient.cli import main
 from transient.errors import SimulationError
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "coasting_single.toml"
 

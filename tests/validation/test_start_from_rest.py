@@ -9,7 +9,7 @@ takes over and the starter cuts out at φ ≈ 133.6°, t ≈ 0.095 s; the run en
 What must happen:
 
 * the run starts in time (ω₀ = 0 is below the switch speed) and switches to crank angle once,
-  when ω reaches 1.5 × switch_speed (the switch hysteresis, ``simulate._config``), never back;
+  when ω reaches 1.5 × switch_speed (the switch hysteresis, ``run._config``), never back;
 * the starter cuts out exactly once, at ω = cutout speed to 1e-9 — ω at the event is read from
   the compiled samples before it (a degree-7 polynomial through the last 8, extrapolated to the
   event's φ or t; measured to agree to ~1e-12 at this sampling);
@@ -33,7 +33,7 @@ import pytest
 from numpy.polynomial import Polynomial
 
 from transient.scene import Initial, Output, Run, Starter, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RTOL = ATOL = 1e-10

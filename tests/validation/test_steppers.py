@@ -15,7 +15,7 @@ from scipy.integrate import quad
 
 from transient.core.crank_slider import crank_slider_terms
 from transient.scene import Load, Run, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 REVS = 10

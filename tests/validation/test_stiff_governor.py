@@ -17,7 +17,7 @@ import h5py
 import numpy as np
 
 from transient.scene import scene_from_dict
-from transient.simulate import integrate, run_compiled, simulate
+from transient.run import integrate, run_compiled, simulate
 
 from conftest import CASES
 

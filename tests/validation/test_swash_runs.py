@@ -20,7 +20,7 @@ from transient.analysis.irregularity import fluctuation
 from transient.assemble import build_model
 from transient.core.model import inertia, work_array
 from transient.scene import load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

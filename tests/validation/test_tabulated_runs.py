@@ -13,7 +13,7 @@ import pytest
 from transient.assemble import build_model, kinematics_table
 from transient.core.model import TABULATED
 from transient.scene import Run, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

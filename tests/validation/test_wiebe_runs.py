@@ -31,7 +31,7 @@ import pytest
 from transient.assemble import build_model, gas_tables, wiebe_levels
 from transient.forces.wiebe import wiebe_tables
 from transient.scene import Friction, Governor, Initial, Output, Run, load_scene
-from transient.simulate import integrate
+from transient.run import integrate
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.simulate import integrate
-from transient.stress import balance_residual, base, put, scene_of
+from transient.run import integrate
+from transient.verify.stress import balance_residual, base, put, scene_of
 
 
 def woschni_scene(revolutions=20, **woschni) -> dict:

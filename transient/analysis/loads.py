@@ -327,7 +327,7 @@ def trajectory_gas_force(scene, traj) -> Array | None:
     From the recorded ``p_<k>`` columns (the value applied at the governor's fuel; Pa, or N for a
     force model) when present, else from the scene's tables at the recorded ``fuel`` (1 if
     absent). Note that a prescribed-speed run with ``fuel`` ≠ 1
-    (:func:`transient.simulate.prescribed`) scales the force without recording it in ``p_<k>``.
+    (:func:`transient.run.prescribed`) scales the force without recording it in ``p_<k>``.
     """
     from ..assemble import gas_is_force
 

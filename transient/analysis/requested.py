@@ -88,7 +88,7 @@ def cycle_irregularity(scene, traj) -> dict[str, tuple[Any, str]]:
 
 
 def _column_units(scene) -> dict[str, str]:
-    from ..simulate import output_columns
+    from ..outputs import output_columns
 
     return output_columns(scene)
 

@@ -22,7 +22,7 @@ Helpers called once per step or once per root-finding iteration that take the Mo
 (``inline="always"``: the step, the error norm, the stiffness test, the margin samples, the mode
 settling, the event function, a pair's crossing), each at its one call site, or at a few where it
 is small: a call that is not inlined copies the Model's ~150 flattened words onto the stack
-(:mod:`.jit`). Under ``perf`` (``scripts/profile_stepper.py``) those copies were 26 % of the
+(:mod:`.jit`). Under ``perf`` (``tools/profile_stepper.py``) those copies were 26 % of the
 diesel's samples in numba's code and are now 13 %; the rest are calls that run rarely or whose
 callee is too large to copy at several sites (the dense output, the margins, the output row).
 The margins and the output row are inlined at one site each, into a small function: the margins

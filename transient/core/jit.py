@@ -7,7 +7,7 @@
 an indirect call: measured on the single cylinder (a throwaway loop timing one small kernel),
 passing the Model to it cost 130 ns of 260 ns; without reference counting the same call took
 72 ns. The whole right-hand side went from 0.512 µs per call (the previous record of
-``scripts/stepper_overhead.py``) to 0.036 µs. Kernels under ``kernel`` must not allocate arrays
+``tools/stepper_overhead.py``) to 0.036 µs. Kernels under ``kernel`` must not allocate arrays
 (they work in buffers their caller allocated); the few that allocate (the stepper's ``advance``,
 work arrays) are ``compiled``.
 """

@@ -513,7 +513,7 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
 
     Inlined into its callers: as a call, passing the Model (numba flattens it into ~130 scalar
-    arguments) cost ~40 ns of a ~75 ns right-hand side (``scripts/handwritten_kernel.py``).
+    arguments) cost ~40 ns of a ~75 ns right-hand side (``tools/handwritten_kernel.py``).
 
     In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
     (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.

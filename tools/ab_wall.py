@@ -1,0 +1,50 @@
+"""A/B wall time of the three benchmark scenes (1000 revolutions each as the scenes say): median
+of 5 runs after a warm-up, with RHS calls, steps and rejected steps.
+
+Compare two commits by running it once per checkout, alternately, e.g.
+``git worktree add /tmp/old 705e2d5`` then ``PYTHONPATH=/tmp/old .venv/bin/python
+tools/ab_wall.py`` and ``.venv/bin/python tools/ab_wall.py``, twice each.
+
+``--bench`` times instead the scenes at the settings of ``stepper_overhead.py`` (1000
+revolutions, rtol 1e-8, atol 1e-11), writing 72 and then one sample per turn, median of 9, with
+the Gots spin-up as a fourth scene (README, *Calls that copy the Model*).
+"""
+from __future__ import annotations
+
+import dataclasses as dc
+import statistics
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import transient
+from transient.scene import load_scene
+from transient.run import integrate
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+
+def median_run(scene, repeats):
+    integrate(scene, keep=False)
+    runs = [integrate(scene, keep=False).solver for _ in range(repeats)]
+    return statistics.median(r["wall_s"] for r in runs), runs[0]
+
+
+print(f"transient from {Path(transient.__file__).parent}")
+if "--bench" in sys.argv[1:]:
+    for name in ("coasting_single", "gots_diesel_governed", "swash_plate_4cyl",
+                 "gots_diesel_spinup"):
+        base = load_scene(CASES / f"{name}.toml")
+        for samples in (72, 1):
+            scene = dc.replace(base, run=dc.replace(base.run, revolutions=1000.0, t_end=np.inf),
+                               solver=dc.replace(base.solver, rtol=1e-8, atol=1e-11),
+                               output=dc.replace(base.output, samples_per_rev=samples))
+            wall, s = median_run(scene, 9)
+            print(f"{name:22s} {samples:2d} samples/turn {wall:.4f} s  {s['nfev']} RHS calls, "
+                  f"{s['nsteps']} steps, {s['nreject']} rejected")
+else:
+    for name in ("coasting_single", "gots_diesel_governed", "swash_plate_4cyl"):
+        wall, s = median_run(load_scene(CASES / f"{name}.toml"), 5)
+        print(f"{name:22s} {wall:.4f} s  "
+              f"{s['nfev']} RHS calls, {s['nsteps']} steps, {s['nreject']} rejected")

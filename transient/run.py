@@ -1,0 +1,435 @@
+"""Drive a run: the compiled stepper chunk by chunk (or the reference path), streaming to HDF5.
+
+:func:`integrate` returns the run in memory; :func:`simulate` writes the result file and returns
+the same :class:`RunData`. Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
+"""
+from __future__ import annotations
+
+import math
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import wait as futures_wait
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .assemble import build_model, initial_governor
+from .core import integrate as ci
+from .core import model as cm
+from .core.tableaus import TABLEAUS
+from .core.model import inverse_dynamics, n_outputs, n_state
+from .errors import SimulationError
+from .outputs import output_columns
+from .precompile import start_helper, stop_helper
+from .results import RunData
+from .scene import COMPILED_METHODS, runs_compiled
+
+BUFFER_ROWS = 8192
+EVENT_ROWS = 2048
+#: The end-of-run summary reads back at most this many samples (the end of the run).
+SUMMARY_SAMPLES = 500_000
+
+
+def _config(scene) -> np.ndarray:
+    sv, out, run = scene.solver, scene.output, scene.run
+    cfg = np.zeros(ci.N_CFG)
+    cfg[ci.C_RTOL] = sv.rtol
+    cfg[ci.C_ATOL] = sv.atol
+    cfg[ci.C_T_END] = run.t_end
+    cfg[ci.C_PHI_END] = scene.initial.phi + 2.0 * math.pi * run.revolutions
+    cfg[ci.C_W_LO] = sv.switch_speed
+    cfg[ci.C_W_HI] = 1.5 * sv.switch_speed  # hysteresis: no chatter around the switch speed
+    cfg[ci.C_DPHI_OUT] = 2.0 * math.pi / out.samples_per_rev
+    cfg[ci.C_DT_OUT] = out.dt if out.dt > 0 else cfg[ci.C_DPHI_OUT] / cfg[ci.C_W_HI]
+    cfg[ci.C_MAX_STEP_PHI] = sv.max_step
+    cfg[ci.C_MAX_STEP_T] = sv.max_step / sv.switch_speed
+    if sv.domain == "time":  # never to crank angle; steps bounded by the output spacing only
+        cfg[ci.C_W_LO] = cfg[ci.C_W_HI] = math.inf
+        cfg[ci.C_MAX_STEP_T] = math.inf
+    cfg[ci.C_CHUNK_STEPS] = 20000
+    cfg[ci.C_FIXED_STEP] = sv.fixed_step
+    return cfg
+
+
+def _initial_state(scene, model):
+    y = np.zeros(n_state(model))
+    y[0] = scene.initial.phi
+    y[2] = scene.initial.omega
+    governor, sleeve = initial_governor(scene, model)
+    y[y.size - governor.size:] = governor
+    fst = np.zeros(ci.fst_size(model))
+    fst[ci.F_PASSED_BP] = np.nan
+    ist = np.zeros(ci.N_IST, dtype=np.int64)
+    st = scene.starter
+    ist[ci.I_STARTER_ON] = int(st.torque > 0 and scene.initial.omega < st.cutout_speed)
+    ist[ci.I_SLEEVE] = sleeve
+    return y, fst, ist
+
+
+def _fraction_done(scene, y) -> float:
+    run = scene.run
+    f_t = y[1] / run.t_end if math.isfinite(run.t_end) else 0.0
+    f_phi = ((y[0] - scene.initial.phi) / (2 * math.pi * run.revolutions)
+             if math.isfinite(run.revolutions) else 0.0)
+    return min(1.0, max(f_t, f_phi))
+
+
+def _compile(model, tab, cfg, bp) -> float:
+    """Compile (or load from the numba cache) the stepper, on a cold cache with a helper process
+    compiling its callees (:mod:`.precompile`); return the seconds it took."""
+    t0 = time.perf_counter()
+    warm = cfg.copy()
+    warm[ci.C_T_END] = 1e-6
+    warm[ci.C_PHI_END] = 1e-6
+    y = np.zeros(n_state(model))
+    y[2] = 1.0
+    helper = start_helper(model, tab)
+    try:
+        ci.advance(model, tab, warm, bp, y, np.zeros(ci.fst_size(model)),
+                   np.zeros(ci.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
+                   np.empty((64, 4)))
+    finally:
+        stop_helper(helper)
+    return time.perf_counter() - t0
+
+
+def _events_by_name(rows, switching: bool) -> dict[str, np.ndarray]:
+    """A chunk's events (rows of code, t, φ, ·) by name, each an (n, 2) array of (t, φ) in the
+    order they occurred; the end of a run stopped to switch an inertia in is ``inertia_switch``.
+    (Grouped by numpy: a diesel chunk holds thousands of pair switches and breakpoints.)"""
+    codes = rows[:, 0].astype(np.int64)
+    ev = {}
+    for code in np.unique(codes):
+        name = ci.EVENT_NAMES[code]
+        ev["inertia_switch" if switching and name == "end" else name] = rows[codes == code, 1:3]
+    return ev
+
+
+def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
+                 progress: Callable[[float], None] | None = None, keep: bool = True) -> RunData:
+    """Integrate a dynamic scene with the compiled stepper (``scene.solver.method``: DOP853 or
+    DOPRI5, adaptive or fixed-step); blocks go to ``on_block`` as they come.
+
+    With ``keep = False`` the trajectory is not kept in memory (only its last block), so that a
+    long run streamed to a file needs bounded memory. A Ctrl-C between chunks ends the run with
+    ``complete = False`` and what was computed so far.
+    """
+    model, bp, _ = build_model(scene)
+    cfg = _config(scene)
+    names = list(output_columns(scene))
+    tab = TABLEAUS[scene.solver.method]
+    compile_s = _compile(model, tab, cfg, bp)
+    y, fst, ist = _initial_state(scene, model)
+    outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
+    evbuf = np.empty((EVENT_ROWS, 4))
+    blocks, events = [], {name: [] for name in ci.EVENT_NAMES}  # events kept only with keep
+    status, message = ci.RUNNING, ""
+    # An inertia switched in: the run stops at that time (as at its end), the shaft's inertia and
+    # speed jump (switch_inertia), and the run goes on.
+    switch_at = scene.load.inertia_time if 0.0 < scene.load.inertia and (
+        scene.load.inertia_time < scene.run.t_end) else math.inf
+    run_cfg = cfg.copy()
+    run_cfg[ci.C_T_END] = min(cfg[ci.C_T_END], switch_at)
+    t0 = time.perf_counter()
+    try:
+        while status == ci.RUNNING:
+            status = ci.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf)
+            switching = status == ci.FINISHED and y[cm.T] == switch_at
+            block = {name: outbuf[: ist[ci.I_NOUT], j].copy() for j, name in enumerate(names)}
+            ev = _events_by_name(evbuf[: ist[ci.I_NEV]], switching)
+            ist[ci.I_NOUT] = 0
+            ist[ci.I_NEV] = 0
+            if switching:
+                model = switch_inertia(model, scene.load.inertia, y, ist)
+                run_cfg, switch_at, status = cfg, math.inf, ci.RUNNING
+            if keep or not blocks or block["t"].size:
+                blocks = (blocks if keep else []) + [block]
+            if keep:
+                for k, v in ev.items():
+                    events.setdefault(k, []).append(v)
+            if on_block:
+                on_block(block, ev)
+            if progress:
+                progress(_fraction_done(scene, y))
+    except KeyboardInterrupt:
+        message = "interrupted"
+    wall = time.perf_counter() - t0
+    filled = [b for b in blocks if b["t"].size]
+    last = ({n: filled[-1][n][-1] for n in ("t", "phi", "omega")} if filled
+            else {"t": 0.0, "phi": scene.initial.phi,
+                  "omega": scene.initial.omega})
+    where = (f"t = {last['t']:.9g} s, φ = {last['phi']:.9g} rad ({math.degrees(last['phi']):.6g}°), "
+             f"ω = {last['omega']:.9g} rad/s")
+    if message:
+        message = f"interrupted; last sample at {where}"
+    if status == ci.STALLED:
+        how = "the shaft turned backwards" if y[2] < 0.0 else "the speed reached zero"
+        message = (f"stalled: {how} at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
+                   f"({math.degrees(y[0]):.6g}°) before the {scene.run.revolutions:g} revolutions "
+                   f"the run ends by; give run.t_end to follow the motion after a stall")
+    at = f"t = {y[1]:.9g} s, φ = {y[0]:.9g} rad ({math.degrees(y[0]):.6g}°)"
+    if status == ci.LOCKED:
+        message = (f"locked: at rest at {at} the friction of the non-ideal pairs holds the "
+                   f"applied moments in both directions (nothing changes them later, so the "
+                   f"machine stays there)")
+    if status == ci.CHATTERING:
+        event = ci.EVENT_NAMES[int(ist[ci.I_CHATTER_CODE])]
+        message = (f"chattering: {ci.CHATTER_COUNT} state events in a row ({event}) without "
+                   f"progress at {at} (last sample {where})"
+                   + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
+                      f"sliding mode), the power-flow policy has one at every state"
+                      if event == "pair_mode" and scene.friction.policy != "power-flow" else ""))
+    if status == ci.STIFF:
+        message = (f"stiff at {at}: in {ci.STIFF_COUNT} steps the estimate h·λ of the dominant "
+                   f"eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
+                   f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
+                   f"the step (a governor or actuator far faster than the engine?)")
+    if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
+        cause = ("a non-finite value in the state or its error estimate"
+                 if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")
+        message = (f"integration failed at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
+                   f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
+    solver = {"method": scene.solver.method, "fixed_step": scene.solver.fixed_step,
+              "rtol": scene.solver.rtol, "atol": scene.solver.atol,
+              "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
+              "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
+              "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES]),
+              **_kinematics_attrs(scene)}
+    traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
+    return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
+                   solver, complete=status == ci.FINISHED, message=message)
+
+
+def switch_inertia(model, extra: float, y, ist):
+    """Couple the inertia ``extra`` [kg m²], at rest, to the shaft (an inelastic engagement):
+    J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the energy lost, ½Jω₋² − ½(J + J_x)ω₊², is taken
+    from ``W_load``, so that the work–energy balance still closes. Updates the state ``y`` and
+    the switches that depend on the speed, which jumped across their levels without an event
+    (the governor's branch, the generator's); returns the model with the extra inertia on the
+    shaft (``J0``)."""
+    angle_mode = ist[ci.I_ANGLE_MODE] == 1
+    J = cm.inertia(model, y[cm.PHI], cm.work_array(model))
+    w = cm.speed(J, angle_mode, y)
+    w_new = J * w / (J + extra)
+    y[cm.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new
+    if angle_mode:
+        y[cm.KINETIC] = 0.5 * (J + extra) * w_new * w_new
+    else:
+        y[cm.OMEGA] = w_new
+    ist[ci.I_GOV_BRANCH] = cm.start_branch(model, w_new, y)
+    ist[ci.I_GEN_LOW] = cm.generator_branch(model, w_new, True)
+    ist[ci.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
+    return model._replace(J0=model.J0 + extra)
+
+
+def _kinematics_attrs(scene) -> dict:
+    """How J(φ) and u_k(φ) were evaluated: ``kinematics`` exact or tabulated, and for tables
+    their size, estimated relative error and the tolerance they had to meet."""
+    from .assemble import kinematics_table
+
+    kin = kinematics_table(scene)
+    if kin is None:
+        return {"kinematics": "exact"}
+    if kin.coef is None:
+        return {"kinematics": "exact (no table reached the tolerance)",
+                "table_tolerance": kin.target, "table_error": kin.error,
+                "table_intervals": kin.intervals}
+    return {"kinematics": "tabulated", "table_tolerance": kin.target, "table_error": kin.error,
+            "table_intervals": kin.intervals}
+
+
+def prescribed(scene, fuel: float = 1.0) -> RunData:
+    """Inverse dynamics at a prescribed speed: the drive torque on the shaft that the chain needs
+    (the textbook analysis at given ω). ``fuel`` sets the pressure between the motored and the
+    full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot the
+    crankcase pressure p0, or zero force, for the models without a motored curve): the tables'
+    cubics are blended, so the ``p_<k>`` columns hold the pressure applied."""
+    model, _, _ = build_model(scene)
+    coef = model.coef.copy()
+    if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.model.Model)
+        coef[:, :4] = coef[:, 4:] + fuel * (coef[:, :4] - coef[:, 4:])
+    else:
+        coef *= fuel
+        coef[:, 0] += (1.0 - fuel) * model.gas_offset
+    model = model._replace(coef=coef)
+    run = scene.run
+    phi0 = scene.initial.phi
+    dphi = 2.0 * math.pi / scene.output.samples_per_rev
+    if run.time:
+        from scipy.interpolate import CubicSpline
+
+        spline = CubicSpline(run.time, run.speed_table)
+        angle = spline.antiderivative()
+        t_end = min(run.t_end, run.time[-1])
+        n = int(math.ceil((angle(t_end) - angle(run.time[0])) / dphi)) + 1
+        t = np.linspace(run.time[0], t_end, max(n, 2))
+        omega, eps, phi = spline(t), spline(t, 1), phi0 + angle(t) - angle(run.time[0])
+        stop = phi <= phi0 + 2 * math.pi * run.revolutions
+        t, omega, eps, phi = t[stop], omega[stop], eps[stop], phi[stop]
+    else:
+        w = run.speed
+        phi_end = phi0 + min(2 * math.pi * run.revolutions, w * run.t_end)
+        phi = np.linspace(phi0, phi_end, int(round((phi_end - phi0) / dphi)) + 1)
+        t = (phi - phi0) / w
+        omega = np.full_like(phi, w)
+        eps = np.zeros_like(phi)
+    rows = np.empty((phi.size, n_outputs(model)))
+    drive = np.empty(phi.size)
+    n_ok = np.empty(phi.size, dtype=np.int64)
+    t0 = time.perf_counter()
+    inverse_dynamics(model, t[:1], phi[:1], omega[:1], eps[:1], rows[:1], drive[:1], n_ok[:1])
+    compile_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    inverse_dynamics(model, t, phi, omega, eps, rows, drive, n_ok)
+    names = list(output_columns(scene))
+    traj = {name: rows[:, j].copy() for j, name in enumerate(names) if name not in ("M_drive", "W_drive")}
+    traj["M_drive"] = drive
+    _work_columns(traj, len(scene.friction.pairs))
+    solver = {"method": "prescribed", "rtol": 0.0, "atol": 0.0, "nfev": int(phi.size),
+              "nsteps": 0, "nreject": 0, "wall_s": time.perf_counter() - t0,
+              "compile_s": compile_s, "ambiguous_samples": int(np.count_nonzero(n_ok > 1)),
+              "inconsistent_samples": int(np.count_nonzero(n_ok == 0))}
+    return RunData(traj, {}, solver)
+
+
+def _work_columns(traj: dict, n_pairs: int) -> None:
+    """Work integrals of a prescribed run, by the trapezoidal rule over its samples [J]
+    (a dynamic run integrates them with the motion instead). Written out (the arithmetic of
+    scipy's ``cumulative_trapezoid``) because importing scipy.integrate took 0.28–0.47 s after
+    numpy (five fresh interpreters; it imports scipy.linalg and scipy.optimize), while a warm
+    ``transient run cases/gots_diesel_4400.toml`` takes 0.51–0.54 s of process wall without it
+    (README *Start-up*)."""
+    t, w = traj["t"], traj["omega"]
+    dt = np.diff(t)
+    for name, power in (("W_gas", traj["M_gas"] * w), ("W_load", traj["M_load"] * w),
+                        ("W_starter", traj["M_starter"] * w), ("W_drive", traj["M_drive"] * w),
+                        *((f"W_loss_{k + 1}", traj[f"P_loss_{k + 1}"]) for k in range(n_pairs))):
+        traj[name] = np.concatenate([[0.0], np.cumsum(dt * (power[1:] + power[:-1]) / 2.0)])
+
+
+def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
+    """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
+    for ``keep``."""
+    if scene.run.mode == "prescribed-speed":
+        data = prescribed(scene)
+    elif scene.solver.method in COMPILED_METHODS:
+        data = run_compiled(scene, on_block, progress, keep)
+        if data.message.startswith("stiff"):
+            data = _implicit_rerun(scene, data, on_block, progress)
+    else:
+        from .reference import run_reference
+
+        data = run_reference(scene, on_block, progress)
+    return data
+
+
+def _implicit_rerun(scene, stiff: RunData, on_block, progress) -> RunData:
+    """A stiff scene again from the start by the reference path's implicit Radau method
+    (solve_ivp), which stability does not bound; the result says so (``solver.stiff_rerun``)."""
+    import dataclasses
+
+    from .reference import run_reference
+
+    note = f"{stiff.message}; rerun from the start with the implicit scipy-Radau"
+    radau = dataclasses.replace(scene, solver=dataclasses.replace(scene.solver,
+                                                                  method="scipy-Radau"))
+    if on_block:  # (what the explicit run streamed is superseded: start the file afresh)
+        on_block(None, None)
+    data = run_reference(radau, None, progress)
+    data.solver["stiff_rerun"] = note
+    data.solver["explicit_nsteps"] = stiff.solver["nsteps"]
+    return data
+
+
+class _WriteBehind:
+    """Writes a block in a second thread while the stepper computes the next one: the compiled
+    ``advance`` runs without the GIL (``nogil``), and compressing a block costs about a third of
+    computing it at 72 samples per revolution (README *Start-up*). One write at a time, so the
+    file takes the blocks in the run's order and memory stays bounded; a write's exception is
+    raised in the caller by :meth:`wait`."""
+
+    def __init__(self) -> None:
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="transient-write")
+        self._pending: Future | None = None
+
+    def start(self, fn, *args) -> None:
+        """Begin ``fn(*args)`` after the write in progress has ended."""
+        self.wait()
+        self._pending = self._pool.submit(fn, *args)
+
+    def wait(self) -> None:
+        """Wait for the write in progress, raising what it raised. (A Ctrl-C while waiting
+        leaves it in progress, to be waited for again.)"""
+        if self._pending is not None:
+            futures_wait([self._pending])
+            pending, self._pending = self._pending, None
+            pending.result()
+
+    def settle(self) -> None:
+        """Wait for the write in progress, ignoring its failure (the run has failed already,
+        and the writer remembers a broken write)."""
+        try:
+            self.wait()
+        except Exception:  # noqa: BLE001 — reported by the exception being handled
+            pass
+
+    def shutdown(self) -> None:
+        self.settle()
+        self._pool.shutdown(wait=True)
+
+
+def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> RunData:
+    """Run ``scene`` and write the result file ``path`` (streamed; see :mod:`transient.results`).
+
+    Raises :class:`transient.errors.SimulationError` after writing the partial result when the run
+    fails or is interrupted.
+    """
+    from .analysis.summary import summarize
+    from .results import ResultWriter
+    from .scene import to_toml
+
+    writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene), force)
+    writes = _WriteBehind()
+    data = None
+    try:
+        streamed = runs_compiled(scene)
+
+        def write_block(block, ev):
+            writer.append(block)
+            writer.events(ev)
+
+        def on_block(block, ev):
+            writes.wait()
+            if block is None:  # the run starts again (a stiff scene, by an implicit method)
+                writer.restart()
+                return
+            writes.start(write_block, block, ev)
+
+        data = integrate(scene, on_block=on_block, progress=progress, keep=False)
+        writes.wait()
+        if not streamed or "stiff_rerun" in data.solver:
+            writer.append(data.trajectory)
+            writer.events(data.events)
+        writer.solver(data.solver)
+        # The summary looks at the end of the run: its last SUMMARY_SAMPLES samples, so that
+        # memory stays bounded however long the run (steady state, efficiency are found there).
+        data.trajectory = writer.read_trajectory(last=SUMMARY_SAMPLES)
+        data.events = writer.read_events(t_from=data.trajectory["t"][0]
+                                         if data.trajectory["t"].size else -math.inf)
+        summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
+                   else {})
+        for name, (value, unit) in summary.items():
+            writer.analysis(name, value, unit)
+        data.extra["summary"] = summary
+    except BaseException as exc:
+        writes.settle()
+        msg = data.message if data is not None and data.message else f"{type(exc).__name__}: {exc}"
+        writer.close(False, msg)
+        raise
+    finally:
+        writes.shutdown()
+    writer.close(data.complete, data.message)
+    if not data.complete:
+        raise SimulationError(f"{data.message}; partial result kept in {path} (complete = false)")
+    return data

@@ -1,0 +1,2 @@
+"""Studies that run a scene many times to answer one design question: mechanical efficiency over
+speed and load (:mod:`.efficiency`), the flywheel for a speed fluctuation (:mod:`.flywheel`)."""

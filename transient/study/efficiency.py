@@ -1,0 +1,98 @@
+"""Efficiency study: η_mech of an engine at a set of steady speeds and loads (issue 4).
+
+Each point is a prescribed constant speed (a dynamometer holding ω, the textbook setting and the
+limit of a large flywheel), one engine cycle of inverse dynamics through the serial chain: the
+motion is periodic, so one cycle is the steady state. The load is the gas-force fraction
+``fuel`` (1 full load), as the swash-plate paper's governor sets it. η_mech is the work ratio of
+:mod:`transient.analysis.efficiency`, and each pair's loss and circulated energy say why it falls
+with speed: the inertia torques ½J′(φ)ω² grow as ω², and the power they send back and forth
+through the pairs is lost on too.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from ..analysis.efficiency import mechanical_efficiency
+from ..scene import Friction, Initial, Output, Run
+from ..run import prescribed
+
+#: Columns of a study row besides the per-pair ones.
+STUDY_COLUMNS = ("policy", "fuel", "rpm", "eta_mech_work", "eta_mech_printed",
+                 "eta_mech_printed_excluded", "W_in_per_cycle", "W_out_per_cycle",
+                 "energy_balance_residual", "inconsistent_samples")
+
+
+def point_scene(scene, omega: float, policy: str, samples_per_rev: int):
+    """The scene as one cycle at the constant speed ``omega`` [rad/s] under ``policy``."""
+    cycle = scene.mechanism.cycle
+    return dataclasses.replace(
+        scene,
+        run=Run(mode="prescribed-speed", speed=omega, revolutions=cycle / (2 * math.pi)),
+        initial=Initial(phi=0.0, omega=omega),
+        output=Output(samples_per_rev=samples_per_rev),
+        friction=Friction(policy, scene.friction.pairs))
+
+
+def efficiency_study(scene, rpm, fuels=(1.0,), policies=None, samples_per_rev: int = 1440,
+                     progress=None) -> list[dict]:
+    """One row per (policy, fuel, speed): η_mech in both forms and each pair's budget per cycle."""
+    policies = policies or (scene.friction.policy,)
+    rows = []
+    points = [(p, f, n) for p in policies for f in fuels for n in rpm]
+    for i, (policy, fuel, n) in enumerate(points):
+        sc = point_scene(scene, n * math.pi / 30.0, policy, samples_per_rev)
+        data = prescribed(sc, fuel)
+        eff = mechanical_efficiency(sc, data.trajectory)
+        row = {"policy": policy, "fuel": fuel, "rpm": n,
+               "inconsistent_samples": data.solver["inconsistent_samples"]}
+        row.update({k: v for k, (v, _) in eff.items()})
+        rows.append(row)
+        if progress:
+            progress((i + 1) / len(points))
+    return rows
+
+
+def write_csv(rows: list[dict], path) -> None:
+    """The study as CSV, one row per point; columns STUDY_COLUMNS then the per-pair ones."""
+    extra = sorted({k for r in rows for k in r} - set(STUDY_COLUMNS) - {"steady_phi_start",
+                                                                        "steady_cycles"})
+    cols = list(STUDY_COLUMNS) + extra
+    lines = [",".join(cols)]
+    for r in rows:
+        lines.append(",".join(str(r.get(c, "")) if isinstance(r.get(c), str)
+                              else f"{r.get(c, math.nan):.10g}" for c in cols))
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
+    """η_mech against speed (one line per policy and fuel; policies that coincide stay visible by
+    their markers) on ``ax_eta``; for the first policy at its largest fuel, each pair's loss [% of
+    W_in] on ``ax_loss`` and the energy it circulates [× W_in] on a twin axis. Returns the artists."""
+    keys = sorted({(r["policy"], r["fuel"]) for r in rows}, key=lambda k: (k[0], -k[1]))
+    styles = {p: s for p, s in zip(sorted({k[0] for k in keys}), (("o", "-"), ("x", "--")))}
+    artists = []
+    for policy, fuel in keys:
+        sel = [r for r in rows if r["policy"] == policy and r["fuel"] == fuel]
+        marker, line = styles.get(policy, ("o", "-"))
+        artists += ax_eta.plot([r["rpm"] for r in sel], [r["eta_mech_work"] for r in sel],
+                               marker=marker, linestyle=line, label=f"{policy}, fuel {fuel:g}")
+    ax_eta.set_ylabel("η_mech = W_out / W_in")
+    ax_eta.legend(fontsize=8)
+    ax_eta.grid(alpha=0.3)
+    policy, fuel = keys[0]
+    sel = [r for r in rows if r["policy"] == policy and r["fuel"] == fuel]
+    n = [r["rpm"] for r in sel]
+    twin = ax_loss.twinx()
+    for k in range(n_pairs):
+        artists += ax_loss.plot(n, [100 * r[f"loss_share_{k + 1}"] for r in sel], "o-",
+                                label=f"loss, {names[k]}")
+        artists += twin.plot(n, [r[f"W_circulated_{k + 1}_per_cycle"] / r["W_in_per_cycle"]
+                                 for r in sel], "s:", label=f"circulated, {names[k]}")
+    ax_loss.set_xlabel("speed [rpm]")
+    ax_loss.set_ylabel(f"loss [% of W_in] ({policy}, fuel {fuel:g})")
+    twin.set_ylabel("energy circulated through the pair [× W_in]")
+    ax_loss.legend(loc="upper left", fontsize=8)
+    twin.legend(loc="upper right", fontsize=8)
+    ax_loss.grid(alpha=0.3)
+    return artists
