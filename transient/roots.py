@@ -1,9 +1,8 @@
 """Roots of scalar functions of one variable, for the set-up code (dead centres, the mixed
 cycle's isobar).
 
-Not scipy.optimize: importing it (it imports scipy.linalg) took 0.28–0.31 s after numpy
-(five fresh interpreters, 2026-11-25), a third of a warm ``transient run`` (README *Start-up*),
-and these roots are few.
+Not scipy.optimize: importing it (and with it scipy.linalg) would be a large part of a warm
+``transient run``'s start, and these roots are few.
 """
 from __future__ import annotations
 
