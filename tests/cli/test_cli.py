@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import ctypes
 import datetime as dt
-import importlib
 import math
 import os
 import subprocess
@@ -29,9 +28,7 @@ from transient.scene import to_toml
 
 from terminal import terminal_run
 
-# ``transient.simulate`` is the function re-exported by the package (it shadows the submodule as
-# an attribute), so the module is taken from the import system.
-sim = importlib.import_module("transient.simulate")
+import transient.run as sim
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"
