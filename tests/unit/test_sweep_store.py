@@ -114,6 +114,10 @@ def test_a_run_is_stored_as_a_result_file_stores_it(sweep, tmp_path, ok):
             assert k == "created" or _same(g.attrs[k], v), k
         assert g.attrs["message"] == res["message"]
         assert s.attrs["creator"] == f.attrs["creator"] and s.attrs["format"] == f.attrs["format"]
+        # both files in the result files' HDF5 bounds: the 1.8 superblock (a killed writer's
+        # file stays readable)
+        assert s.id.get_create_plist().get_version()[0] == 0
+        assert f.id.get_create_plist().get_version()[0] == 0
 
 
 def test_a_run_reads_back_as_a_result(sweep, tmp_path):

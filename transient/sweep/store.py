@@ -248,9 +248,7 @@ class SweepTable:
 def read_summary(path: str | Path) -> SweepTable:
     """``/analysis/summary`` of a sweep file (complete or a ``.part``)."""
     path = Path(path)
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("kind") != "sweep":
-            raise ValueError("not a transient sweep file")
+    with _open_sweep(path) as f:
         if "summary" not in f["analysis"]:
             raise ValueError("no summary yet (the sweep did not finish; rerun it to resume)")
         ds = f["analysis/summary"]
@@ -267,10 +265,17 @@ def open_run(path: str | Path, index: int) -> results.Result:
     files' own reader since a run is stored in their layout. Raises KeyError if the file holds
     no finished run of that index."""
     path = Path(path)
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("kind") != "sweep":
-            raise ValueError("not a transient sweep file")
+    with _open_sweep(path) as f:
         g = f["runs"].get(group_name(index, int(f.attrs["n_runs"])))
         if g is None or "status" not in g.attrs:
             raise KeyError(f"{path}: no finished run {index}")
         return results.read_run(g, path)
+
+
+def _open_sweep(path: Path) -> h5py.File:
+    """A sweep file open for reading; ValueError if it is another file (a result, say)."""
+    f = h5py.File(path, "r")
+    if f.attrs.get("kind") != "sweep":
+        f.close()
+        raise ValueError("not a transient sweep file")
+    return f
