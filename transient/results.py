@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 
 from .version import __version__
-from .errors import SimulationError, WriteFailed
+from .errors import WriteFailed
 
 #: Root attribute ``creator`` of every file written here (result or sweep).
 CREATOR = "transient"
@@ -279,7 +279,8 @@ class ResultWriter:
     def close(self, complete: bool, message: str = "") -> Path:
         """Mark the file complete or not, close it and move it to its final name. After a failed
         write the file is left as it is under its temporary name (it says complete = false if
-        its header reached the disk) and :class:`SimulationError` says so."""
+        its header reached the disk) and :class:`~transient.errors.WriteFailed` (a
+        SimulationError) says so."""
         if self.broken:
             # (not closed: HDF5 would retry the failed writes, print and crash; cli.entry exits
             # without freeing it)
