@@ -1,4 +1,9 @@
-"""Result files (HDF5, format 1; DESIGN §4): a streaming writer and a reader.
+"""Result files (HDF5, format 1; DESIGN §4): the layout, a streaming writer and a reader.
+
+The layout of a run — header attributes, ``scene/toml``, ``trajectory/<column>``,
+``events/<name>/{t,phi}``, ``solver`` attributes, ``analysis/<name>`` — is written by the
+functions below and nowhere else, so that a result file and each run of a sweep file
+(:mod:`transient.sweep.store`) hold the same thing in the same form and read back alike.
 
 The writer works on a temporary name beside the final one, flushes after every block so that a
 killed run leaves a readable file, and renames it when the run ends — ``complete = True`` after a
@@ -16,8 +21,11 @@ import h5py
 import numpy as np
 
 from .version import __version__
-from .errors import SimulationError, WriteFailed
+from .errors import WriteFailed
 
+#: Root attribute ``creator`` of every file written here (result or sweep).
+CREATOR = "transient"
+#: Root attribute ``format``: the version of the layout below.
 FORMAT = 1
 
 
@@ -73,22 +81,20 @@ def check_writable(path: Path, force: bool) -> None:
 PROBE_BYTES = 1 << 16
 #: Rows per chunk of a trajectory column (gzip-compressed float64).
 CHUNK_ROWS = 4096
-#: HDF5's chunk cache per dataset [bytes]: 32 chunks of a column, 1 MiB (HDF5 1.x's default).
-#: HDF5 2.0's default of 8 MiB per dataset let the process grow by ~100 MB over 2×10⁵ revolutions
-#: of a 16-column result (peak RSS after the integration 287 MB, 205 MB with this; `heaptrack`:
-#: chunks held by ``H5D__chunk_lock``; README *Speed*, Scale). Smaller caches (4 or 16 chunks)
-#: made the diesel's 72-samples-per-turn run 9–11 % slower: a block spans more chunks than that.
+#: HDF5's chunk cache per dataset [bytes]: 32 chunks of a column, 1 MiB. A larger cache (HDF5
+#: 2.0's default is 8 MiB per dataset) makes a long run's process grow with every column, since
+#: the cache holds chunks of each; a smaller one slows the writing, since a block then spans more
+#: chunks than the cache holds.
 CHUNK_CACHE_BYTES = 32 * CHUNK_ROWS * 8
 
-#: HDF5 format bounds of a result's objects: the 1.10 format, readable by HDF5 ≥ 1.10 (2016). Its
-#: chunk index for a dataset extended along one axis (an extensible array, not 1.8's B-tree) keeps
-#: the writing process from growing with the run: 0.6 MB from 2×10⁵ to 10⁶ revolutions of 16
-#: columns against 4.4 MB with 1.8's (``tools/hdf5_memory_growth.py``; README *Speed*, Scale).
-#: The file itself keeps the 1.8 format's superblock (:func:`_create_file`).
+#: HDF5 format bounds of a result's objects: the 1.10 format, whose chunk index for a dataset
+#: extended along one axis (an extensible array, not 1.8's B-tree) keeps the writing process from
+#: growing with the run (``tools/hdf5_memory_growth.py`` measures both). The file itself keeps the
+#: 1.8 format's superblock (:func:`create_file`).
 FILE_FORMAT = ("v110", "v110")
 
 
-def _create_file(path: Path) -> h5py.File:
+def create_file(path: Path) -> h5py.File:
     """A new, empty HDF5 file at ``path``, open for writing objects in :data:`FILE_FORMAT`.
 
     Created in h5py's default bounds first, so that its superblock is the 1.8 format's (version 0):
@@ -97,7 +103,88 @@ def _create_file(path: Path) -> h5py.File:
     killed (until ``h5clear --status``), which would lose what a killed run computed. Reopened
     with the 1.10 bounds, the file keeps its superblock."""
     h5py.File(path, "w").close()
+    return reopen_file(path)
+
+
+def reopen_file(path: Path) -> h5py.File:
+    """An existing file open for writing more objects in :data:`FILE_FORMAT` (a resumed sweep),
+    with the chunk cache of :data:`CHUNK_CACHE_BYTES`."""
     return h5py.File(path, "r+", libver=FILE_FORMAT, rdcc_nbytes=CHUNK_CACHE_BYTES)
+
+
+def now() -> str:
+    """The time of writing as it is stored (``created``): UTC, ISO 8601, whole seconds."""
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def write_header(node: h5py.Group, **attrs: Any) -> None:
+    """The attributes that open a result (a file's root, or a run's group in a sweep file): who
+    wrote it, in which format and when, then ``attrs`` (``scene``, ``complete``, …)."""
+    node.attrs.update(creator=CREATOR, version=__version__, format=FORMAT, created=now(), **attrs)
+
+
+def write_layout(node: h5py.Group, scene_toml: str, units: dict[str, str],
+                 trajectory: dict[str, np.ndarray] | None = None) -> dict[str, h5py.Dataset]:
+    """A result's groups under ``node``: ``scene/toml``, one column a unit in ``trajectory``
+    (empty, or holding ``trajectory[name]``), and ``events``, ``solver``, ``analysis``. Returns
+    the columns' datasets.
+
+    The columns are extendable in chunks of :data:`CHUNK_ROWS` whether streamed or written whole,
+    so that a stored column is one kind of dataset wherever it was written (and an empty one can
+    still be chunked)."""
+    node.create_group("scene").create_dataset("toml", data=scene_toml)
+    traj = node.create_group("trajectory")
+    columns = {}
+    for name, unit in units.items():
+        data = np.zeros(0) if trajectory is None else np.asarray(trajectory[name], dtype=float)
+        ds = columns[name] = traj.create_dataset(name, data=data, maxshape=(None,), dtype="f8",
+                                                 chunks=(CHUNK_ROWS,), compression="gzip",
+                                                 compression_opts=1, shuffle=True)
+        ds.attrs["unit"] = unit
+    for name in ("events", "solver", "analysis"):
+        node.create_group(name)
+    return columns
+
+
+def append_events(events_group: h5py.Group, events: dict[str, np.ndarray]) -> None:
+    """Append events: ``events[name]`` is an (n, 2) array (or list of pairs) of (t, φ).
+    Extendable datasets, so that a long run streams its events too."""
+    for name, rows in events.items():
+        rows = np.asarray(rows, dtype=float).reshape(-1, 2)
+        g = events_group.require_group(name)
+        for j, (col, unit) in enumerate((("t", "s"), ("phi", "rad"))):
+            if col not in g:
+                g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
+                                 chunks=(1024,)).attrs["unit"] = unit
+            ds = g[col]
+            ds.resize(ds.shape[0] + rows.shape[0], axis=0)
+            ds[ds.shape[0] - rows.shape[0]:] = rows[:, j]
+
+
+def write_solver(solver_group: h5py.Group, attrs: dict[str, Any]) -> None:
+    """Solver statistics and settings, as attributes of ``solver``."""
+    solver_group.attrs.update(attrs)
+
+
+def write_analysis(analysis_group: h5py.Group, name: str, value: Any, unit: str) -> None:
+    """One derived quantity with its unit, replacing an earlier one of that name."""
+    if name in analysis_group:
+        del analysis_group[name]
+    analysis_group.create_dataset(name, data=value).attrs["unit"] = unit
+
+
+def write_run(node: h5py.Group, scene_name: str, scene_toml: str, data: RunData,
+              units: dict[str, str], analysis: dict[str, tuple[Any, str]]) -> None:
+    """A run held in memory, whole, in a result's layout under ``node`` (a sweep's run): the
+    header (``complete`` and ``message`` from ``data``), the columns of ``data.trajectory`` with
+    their ``units``, its events and solver statistics, and ``analysis`` (name → (value, unit))."""
+    write_header(node, scene=scene_name, complete=bool(data.complete), message=data.message)
+    write_layout(node, scene_toml, {c: units.get(c, "") for c in data.trajectory},
+                 data.trajectory)
+    append_events(node["events"], data.events)
+    write_solver(node["solver"], data.solver)
+    for name, (value, unit) in analysis.items():
+        write_analysis(node["analysis"], name, value, unit)
 
 
 class ResultWriter:
@@ -109,7 +196,7 @@ class ResultWriter:
         check_writable(self.path, force)
         self.tmp = self.path.with_name(f".{self.path.name}.part")
         try:
-            self.f = _create_file(self.tmp)
+            self.f = create_file(self.tmp)
             self._start(scene_name, scene_toml, columns)
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
             self._abandon()
@@ -126,27 +213,11 @@ class ResultWriter:
 
     def _start(self, scene_name: str, scene_toml: str, columns: dict[str, str]) -> None:
         self.broken = ""  # why a write failed, if one did
-        a = self.f.attrs
-        a["creator"] = "transient"
-        a["version"] = __version__
-        a["format"] = FORMAT
-        a["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-        a["scene"] = scene_name
-        a["complete"] = False
-        self.f.create_group("scene").create_dataset("toml", data=scene_toml)
-        traj = self.f.create_group("trajectory")
+        write_header(self.f, scene=scene_name, complete=False)
         self.columns = columns
         # The columns' datasets stay open for the file's life: a dataset object freed after a
         # failed write would make HDF5 retry it (and print its failure) on closing.
-        self.datasets = {}
-        for name, unit in columns.items():
-            ds = self.datasets[name] = traj.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
-                                     chunks=(CHUNK_ROWS,), compression="gzip", compression_opts=1,
-                                     shuffle=True)
-            ds.attrs["unit"] = unit
-        self.f.create_group("events")
-        self.f.create_group("solver")
-        self.f.create_group("analysis")
+        self.datasets = write_layout(self.f, scene_toml, columns)
         self.f.flush()
 
     def append(self, block: dict[str, np.ndarray]) -> None:
@@ -179,18 +250,8 @@ class ResultWriter:
         return {name: self.f["trajectory"][name][start:] for name in self.columns}
 
     def events(self, events: dict[str, np.ndarray]) -> None:
-        """Append events: ``events[name]`` is an (n, 2) array (or list of pairs) of (t, φ).
-        Extendable datasets, so that a long run streams its events too."""
-        for name, rows in events.items():
-            rows = np.asarray(rows, dtype=float).reshape(-1, 2)
-            g = self.f["events"].require_group(name)
-            for j, (col, unit) in enumerate((("t", "s"), ("phi", "rad"))):
-                if col not in g:
-                    g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
-                                     chunks=(1024,)).attrs["unit"] = unit
-                ds = g[col]
-                ds.resize(ds.shape[0] + rows.shape[0], axis=0)
-                ds[ds.shape[0] - rows.shape[0]:] = rows[:, j]
+        """Append events (:func:`append_events`)."""
+        append_events(self.f["events"], events)
 
     def read_events(self, t_from: float = -np.inf) -> dict[str, np.ndarray]:
         """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ). Events are
@@ -210,20 +271,16 @@ class ResultWriter:
         return out
 
     def solver(self, attrs: dict[str, Any]) -> None:
-        for k, v in attrs.items():
-            self.f["solver"].attrs[k] = v
+        write_solver(self.f["solver"], attrs)
 
     def analysis(self, name: str, value: Any, unit: str) -> None:
-        g = self.f["analysis"]
-        if name in g:
-            del g[name]
-        ds = g.create_dataset(name, data=value)
-        ds.attrs["unit"] = unit
+        write_analysis(self.f["analysis"], name, value, unit)
 
     def close(self, complete: bool, message: str = "") -> Path:
         """Mark the file complete or not, close it and move it to its final name. After a failed
         write the file is left as it is under its temporary name (it says complete = false if
-        its header reached the disk) and :class:`SimulationError` says so."""
+        its header reached the disk) and :class:`~transient.errors.WriteFailed` (a
+        SimulationError) says so."""
         if self.broken:
             # (not closed: HDF5 would retry the failed writes, print and crash; cli.entry exits
             # without freeing it)
@@ -264,17 +321,23 @@ def open_result(path: str | Path) -> Result:
     """Read a result file (complete or not) into a :class:`Result`."""
     path = Path(path)
     with h5py.File(path, "r") as f:
-        if f.attrs.get("creator") != "transient":
+        if f.attrs.get("creator") != CREATOR:
             raise ValueError(f"{path}: not a transient result file")
-        traj = {k: f["trajectory"][k][()] for k in f["trajectory"]}
-        units = {k: str(f["trajectory"][k].attrs.get("unit", "")) for k in f["trajectory"]}
-        events = {k: {c: g[c][()] for c in g} for k, g in f["events"].items()}
-        analysis = {}
-        for k, ds in f["analysis"].items():
-            value = ds[()]
-            analysis[k] = (value.decode() if isinstance(value, bytes) else value,
-                           str(ds.attrs.get("unit", "")))
-        toml = f["scene"]["toml"][()]
-        return Result(path=path, attrs=dict(f.attrs), trajectory=traj, units=units, events=events,
-                      solver=dict(f["solver"].attrs), analysis=analysis,
-                      scene_toml=toml.decode() if isinstance(toml, bytes) else str(toml))
+        return read_run(f, path)
+
+
+def read_run(node: h5py.Group, path: Path) -> Result:
+    """The result laid out under ``node`` (a file's root or a sweep's run), read into memory;
+    ``path`` names the file it came from."""
+    traj = {k: node["trajectory"][k][()] for k in node["trajectory"]}
+    units = {k: str(node["trajectory"][k].attrs.get("unit", "")) for k in node["trajectory"]}
+    events = {k: {c: g[c][()] for c in g} for k, g in node["events"].items()}
+    analysis = {}
+    for k, ds in node["analysis"].items():
+        value = ds[()]
+        analysis[k] = (value.decode() if isinstance(value, bytes) else value,
+                       str(ds.attrs.get("unit", "")))
+    toml = node["scene"]["toml"][()]
+    return Result(path=path, attrs=dict(node.attrs), trajectory=traj, units=units, events=events,
+                  solver=dict(node["solver"].attrs), analysis=analysis,
+                  scene_toml=toml.decode() if isinstance(toml, bytes) else str(toml))

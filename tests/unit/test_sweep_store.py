@@ -1,0 +1,199 @@
+"""The sweep file keeps each run in a result file's layout: a run written by the sweep's store
+and the same run written by the streaming result writer hold the same objects, attributes and
+values; a run reads back as a Result; the summary round-trips; a part resumes; a file written
+before the runs had that layout still resumes and summarises. No run is integrated here: the
+runs are made up, so no kernel is compiled."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from transient import results
+from transient.sweep import SweepStore, load_sweep, open_run, read_summary
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+
+SWEEP = f"""\
+[sweep]
+name = "small"
+base = "{CASES / 'gots_diesel_friction.toml'}"
+collect = ["mean_speed_rpm", "delta", "final_t"]
+columns = ["t", "phi", "omega"]
+
+[set]
+"run.revolutions" = 12
+
+[[axis]]
+key = "load.torque"
+values = [0.0, 400.0, 10.0]
+"""
+UNITS = {"t": "s", "phi": "rad", "omega": "rad/s", "epsilon": "rad/s^2"}
+
+
+@pytest.fixture()
+def sweep(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(SWEEP)
+    return load_sweep(path)
+
+
+def _res(ok: bool, n: int = 5000, seed: int = 0) -> dict:
+    """What run_one returns, made up: a complete run, or one that stopped with a message."""
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(1e-4, 2e-4, n))
+    return {"status": "ok" if ok else "failed", "complete": ok,
+            "message": "" if ok else "stalled at t = 0.1 s",
+            "trajectory": {"t": t, "phi": 300.0 * t, "omega": 300.0 + rng.normal(size=n)},
+            "events": {"breakpoint": np.column_stack([t[::700], 300.0 * t[::700]]),
+                       "steady": np.zeros((0, 2))},
+            "solver": {"method": "dop853", "rtol": 1e-8, "nfev": 1234, "compile_s": 0.0},
+            "summary": ({"mean_omega_last_cycle": (301.5, "rad/s"), "delta_last_cycle": (0.01, "1"),
+                         "final_t": (float(t[-1]), "s"), "note": ("text", "")} if ok else {}),
+            "units": UNITS, "worker": "host:1", "wall_s": 0.25}
+
+
+def _tree(node: h5py.Group) -> dict:
+    """Every object under ``node``: its attributes, and for a dataset its data and storage."""
+    out = {}
+
+    def visit(name, obj):
+        entry = {"attrs": {k: v for k, v in obj.attrs.items() if k != "created"}}
+        if isinstance(obj, h5py.Dataset):
+            entry.update(data=obj[()], dtype=obj.dtype, chunks=obj.chunks, maxshape=obj.maxshape,
+                         compression=obj.compression, opts=obj.compression_opts,
+                         shuffle=obj.shuffle)
+        out[name] = entry
+
+    node.visititems(visit)
+    return out
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return np.array_equal(np.asarray(a), np.asarray(b))
+    return a == b
+
+
+@pytest.mark.parametrize("ok", [True, False])
+def test_a_run_is_stored_as_a_result_file_stores_it(sweep, tmp_path, ok):
+    spec, res = sweep.runs[0], _res(ok)
+    store = SweepStore(tmp_path / "out" / "small.h5", sweep)
+    store.write_run(spec, res)
+    store.close(False)
+
+    w = results.ResultWriter(tmp_path / "r.h5", spec.scene.name, spec.toml,
+                             {c: UNITS[c] for c in res["trajectory"]})
+    for k in range(0, 5000, 1500):  # streamed in blocks, as a run writes it
+        w.append({c: v[k:k + 1500] for c, v in res["trajectory"].items()})
+    w.events(res["events"])
+    w.solver(res["solver"])
+    for name, (value, unit) in res["summary"].items():
+        w.analysis(name, value, unit)
+    w.close(ok, res["message"])
+
+    with h5py.File(tmp_path / "r.h5", "r") as f, \
+            h5py.File(tmp_path / "out" / ".small.h5.part", "r") as s:
+        g = s["runs/run_0000"]
+        single, run = _tree(f), _tree(g)
+        assert run.keys() == single.keys()
+        for name, entry in single.items():
+            for key, value in entry.items():
+                if key != "attrs":
+                    assert _same(run[name][key], value), (name, key)
+            assert all(_same(run[name]["attrs"][k], v) for k, v in entry["attrs"].items()), name
+        header = dict(f.attrs)
+        sweep_own = {"index", "params", "scene_toml", "worker", "wall_s", "status"}
+        # a complete result file has no message; a run always says one (empty when ok)
+        assert set(g.attrs) == set(header) | sweep_own | {"message"}
+        for k, v in header.items():
+            assert k == "created" or _same(g.attrs[k], v), k
+        assert g.attrs["message"] == res["message"]
+        assert s.attrs["creator"] == f.attrs["creator"] and s.attrs["format"] == f.attrs["format"]
+        # both files in the result files' HDF5 bounds: the 1.8 superblock (a killed writer's
+        # file stays readable)
+        assert s.id.get_create_plist().get_version()[0] == 0
+        assert f.id.get_create_plist().get_version()[0] == 0
+
+
+def test_a_run_reads_back_as_a_result(sweep, tmp_path):
+    store = SweepStore(tmp_path / "small.h5", sweep)
+    res = _res(True)
+    store.write_run(sweep.runs[2], res)
+    store.close(False)
+    r = open_run(tmp_path / ".small.h5.part", 2)
+    assert isinstance(r, results.Result) and r.complete
+    assert r.attrs["creator"] == "transient" and r.attrs["scene"] == sweep.runs[2].scene.name
+    for c, v in res["trajectory"].items():
+        assert np.array_equal(r.trajectory[c], v) and r.units[c] == UNITS[c]
+    assert np.array_equal(r.events["breakpoint"]["t"], res["events"]["breakpoint"][:, 0])
+    assert r.events["steady"]["phi"].size == 0
+    assert r.solver == res["solver"]
+    assert r.analysis == res["summary"]
+    assert r.scene() == sweep.runs[2].scene  # the stored scene is the run's
+    with pytest.raises(KeyError, match="no finished run 1"):
+        open_run(tmp_path / ".small.h5.part", 1)
+
+
+def test_summary_round_trips_and_a_part_resumes(sweep, tmp_path):
+    path = tmp_path / "small.h5"
+    store = SweepStore(path, sweep)
+    store.write_run(sweep.runs[0], _res(True))
+    store.write_run(sweep.runs[1], _res(False))
+    created = store.f["runs/run_0000"].attrs["created"]
+    store.close(False)  # interrupted
+
+    again = SweepStore(path, sweep)
+    assert again.finished == {0, 1}
+    again.write_run(sweep.runs[2], _res(True, seed=2))
+    rows = again.write_summary(tmp_path / "small_summary.csv")
+    assert again.close(True) == path
+    assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
+    tab = read_summary(path)
+    assert list(tab.columns["run"]) == [0, 1, 2]
+    assert list(tab.columns["status"]) == ["ok", "failed", "ok"]
+    assert tab.columns["mean_speed_rpm"][0] == pytest.approx(301.5 * 30 / math.pi, rel=1e-15)
+    assert math.isnan(tab.columns["mean_speed_rpm"][1])
+    assert tab.units["mean_speed_rpm"] == "rpm" and tab.units["final_t"] == "s"
+    assert list(tab.columns["load.torque"]) == [0.0, 400.0, 10.0]
+    assert tab.axes == [{"key": "load.torque", "group": "#0", "values": [0.0, 400.0, 10.0]}]
+    with h5py.File(path, "r") as f:
+        assert f.attrs["complete"] and f.attrs["kind"] == "sweep" and f.attrs["n_runs"] == 3
+        assert f["runs/run_0000"].attrs["created"] == created  # kept, not rewritten
+
+
+def test_a_file_in_the_earlier_layout_resumes(sweep, tmp_path):
+    """Runs stored before they had a result's header and ``scene`` group (the scene only as the
+    ``scene_toml`` attribute, columns neither chunked nor extendable) are kept on resuming and
+    summarised with the new ones."""
+    part = tmp_path / ".small.h5.part"
+    res = _res(True)
+    with h5py.File(part, "w") as f:
+        f.attrs.update(creator="transient", version="0", format=1, created="2000-01-01T00:00:00",
+                       kind="sweep", sweep="small", complete=False, n_runs=3)
+        f.create_group("sweep").create_dataset("toml", data=sweep.text)
+        f.create_group("analysis")
+        g = f.create_group("runs").create_group("run_0000")
+        g.attrs.update(index=0, params=json.dumps(sweep.runs[0].params),
+                       scene_toml=sweep.runs[0].toml, message="", worker="w", wall_s=1.0,
+                       created="2000-01-01T00:00:00")
+        for c, v in res["trajectory"].items():
+            g.create_dataset(f"trajectory/{c}", data=v).attrs["unit"] = UNITS[c]
+        g.create_group("events")
+        g.create_group("solver").attrs.update(res["solver"])
+        for name, (value, unit) in res["summary"].items():
+            g.create_dataset(f"analysis/{name}", data=value).attrs["unit"] = unit
+        g.attrs["status"] = "ok"
+    store = SweepStore(tmp_path / "small.h5", sweep)
+    assert store.finished == {0}
+    store.write_run(sweep.runs[1], _res(False))
+    store.write_run(sweep.runs[2], _res(True, seed=3))
+    rows = store.write_summary(tmp_path / "small_summary.csv")
+    store.close(True)
+    assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
+    assert rows[0]["mean_speed_rpm"] == pytest.approx(301.5 * 30 / math.pi, rel=1e-15)
+    assert read_summary(tmp_path / "small.h5").columns["final_t"][0] == res["summary"]["final_t"][0]

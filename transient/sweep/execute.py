@@ -1,0 +1,237 @@
+"""Running a sweep: the runs on Dask workers (or in this process), their results to the store.
+
+Workers (Dask processes, one thread each) run :func:`run_one` and return arrays; only the client
+writes, into one HDF5 file ``DIR/<stem>.h5`` (:class:`~transient.sweep.store.SweepStore`), run by
+run as results arrive, so that an interrupted sweep resumes from what is there. The summary
+table goes to ``/analysis/summary`` and ``DIR/<stem>_summary.csv``.
+"""
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import signal
+import socket
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import SceneError
+from ..version import __version__
+from .spec import RunSpec, Sweep
+from .store import SweepStore
+
+
+# ------------------------------------------------------------------------------------------------
+# A worker's part: one run, arrays back to the client
+
+
+def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
+    """Integrate one scene and summarise it (on a worker); never raises: a failure comes back
+    as ``status = "failed"`` with its message (and the partial trajectory, if any).
+
+    The imports stay in this process (a Dask worker runs many tasks), so numba loads each kernel
+    once per worker, from its on-disk cache; ``compile_s`` shows it (≈ 0 after the first run).
+    """
+    from ..analysis.summary import summarize
+    from ..run import integrate
+    from ..outputs import output_columns
+
+    t0 = time.perf_counter()
+    out: dict[str, Any] = {"status": "failed", "complete": False, "message": "",
+                           "trajectory": {}, "events": {}, "solver": {}, "summary": {},
+                           "units": output_columns(scene),
+                           "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    try:
+        data = integrate(scene, keep=True)
+        out["solver"] = data.solver
+        out["events"] = data.events
+        keep = data.trajectory if columns is None else {c: data.trajectory[c] for c in columns}
+        out["trajectory"] = keep
+        out["complete"] = data.complete
+        if data.complete:
+            out["summary"] = summarize(scene, data.trajectory, data.events)
+            out["status"] = "ok"
+        out["message"] = data.message
+    except Exception as exc:  # noqa: BLE001 (this run failed: say so, the sweep goes on)
+        out["message"] = f"{type(exc).__name__}: {exc}"
+    out["wall_s"] = time.perf_counter() - t0
+    return out
+
+
+def worker_info() -> dict[str, str]:
+    """Run on every worker before the sweep: imports the simulator once (and so tells at once
+    if a cluster's workers cannot), and reports the version they run."""
+    from .. import run  # noqa: F401  (the import is the point)
+
+    return {"version": __version__, "python": sys.version.split()[0]}
+
+
+def kernel_loads() -> dict[str, int]:
+    """How often this process compiled or loaded the stepper from numba's cache (its signatures
+    and cache hits + misses): 1 after any number of runs of one kind of scene."""
+    from ..core import integrate as ci
+
+    st = ci.advance.stats
+    return {"signatures": len(ci.advance.signatures),
+            "loads": sum(st.cache_hits.values()) + sum(st.cache_misses.values())}
+
+
+# ------------------------------------------------------------------------------------------------
+# The client's part: the runs to do, the cluster, the one writer of the sweep file
+
+
+@dataclass
+class Outcome:
+    """What a sweep did: the file, the runs computed now, those found finished, and the rows."""
+
+    path: Path
+    csv: Path
+    computed: list[int]
+    skipped: list[int]
+    rows: list[dict[str, Any]]
+
+    @property
+    def failed(self) -> list[dict[str, Any]]:
+        return [r for r in self.rows if r["status"] != "ok"]
+
+
+def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | None = None,
+              workers: int | None = None, force: bool = False, retry_failed: bool = False,
+              on_result: Callable[[RunSpec, dict, int, int], None] | None = None) -> Outcome:
+    """Run the sweep's unfinished runs and write the file and the summary (module docstring).
+
+    ``scheduler``: None for a LocalCluster of ``workers`` processes (default one per core), a
+    ``tcp://host:port`` address of a running Dask scheduler, or ``"serial"`` (this process, no
+    Dask: debugging and the benchmark's baseline). ``on_result(spec, result, done, total)`` is
+    called after each run is written (the progress bar). On KeyboardInterrupt the file keeps the
+    finished runs (``complete = false``) and the interrupt goes on.
+    """
+    out_dir = Path(out_dir)
+    stem = sweep.path.stem
+    store = SweepStore(out_dir / f"{stem}.h5", sweep, force)
+    if retry_failed:
+        store.drop_failed()
+    skipped = sorted(store.finished)
+    todo = [s for s in sweep.runs if s.index not in store.finished]
+    computed: list[int] = []
+    try:
+        # closing(): an interrupt here shuts the cluster down at once, not when the generator
+        # is collected
+        with contextlib.closing(_execute(todo, sweep.columns, scheduler, workers)) as arriving:
+            for spec, res in arriving:
+                store.write_run(spec, res)
+                computed.append(spec.index)
+                if on_result:
+                    on_result(spec, res, len(store.finished), len(sweep.runs))
+    except BaseException:
+        store.close(False)
+        raise
+    csv_path = out_dir / f"{stem}_summary.csv"
+    rows = store.write_summary(csv_path)
+    path = store.close(True)
+    return Outcome(path, csv_path, computed, skipped, rows)
+
+
+def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int | None
+             ) -> Iterator[tuple[RunSpec, dict]]:
+    """(spec, result) of each run as it finishes."""
+    if not todo:
+        return
+    if scheduler == "serial":
+        for spec in todo:
+            yield spec, run_one(spec.scene, columns)
+        return
+    from dask.distributed import as_completed
+
+    with _client(scheduler, workers) as client:
+        futures = {client.submit(run_one, s.scene, columns, pure=False,
+                                 key=f"transient-run-{s.index}-{os.urandom(4).hex()}"): s
+                   for s in todo}
+        try:
+            for fut in as_completed(futures):
+                spec = futures.pop(fut)
+                try:
+                    res = fut.result()
+                except Exception as exc:  # noqa: BLE001 (a lost worker or task: this run only)
+                    res = _lost(exc)
+                fut.release()
+                yield spec, res
+        finally:
+            client.cancel(list(futures))
+
+
+def _lost(exc: BaseException) -> dict[str, Any]:
+    """A run whose task or worker was lost, as a failed run of :func:`run_one` (nothing computed
+    comes back), so that the sweep records it and goes on."""
+    return {"status": "failed", "complete": False,
+            "message": f"{type(exc).__name__} (on the cluster): {exc}",
+            "trajectory": {}, "events": {}, "solver": {}, "summary": {}, "units": {},
+            "worker": "?", "wall_s": math.nan}
+
+
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored while processes are started (they keep ignoring it: Python installs no
+    KeyboardInterrupt handler where SIGINT is ignored at start), so that a Ctrl-C reaches the
+    client alone, which stops the cluster in order; the main thread only (signals need it)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+class _client:
+    """A Dask client: on a new LocalCluster (one single-threaded process per core, loopback
+    only) or connected to ``address``; checks that the workers can import transient."""
+
+    def __init__(self, address: str | None, workers: int | None) -> None:
+        self.address, self.workers = address, workers
+        self.cluster = self.client = None
+
+    def __enter__(self):
+        import logging
+
+        from dask.distributed import Client, LocalCluster
+
+        if self.address is None:
+            # Processes, not threads: the runs hold the GIL in Python between compiled chunks.
+            # Loopback only; the scheduler's HTTP server (always started) on a free port.
+            with _sigint_ignored():  # Ctrl-C is the client's to handle: the workers inherit this
+                self.cluster = LocalCluster(n_workers=self.workers or os.cpu_count() or 1,
+                                            threads_per_worker=1, processes=True,
+                                            host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                                            silence_logs=logging.ERROR)
+            self.client = Client(self.cluster)
+        else:
+            try:
+                self.client = Client(self.address, timeout="10s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise SceneError("--scheduler", f"cannot connect to {self.address!r}: {exc}; "
+                                                f"give tcp://host:port of a running Dask "
+                                                f"scheduler") from None
+        try:
+            info = self.client.run(worker_info)
+        except Exception as exc:  # noqa: BLE001 (whatever the workers raise, said in one line)
+            self.__exit__(None, None, None)
+            raise SceneError("--scheduler", f"the workers cannot import transient ({exc}); "
+                                            f"install it in the workers' environment") from None
+        other = {w: i["version"] for w, i in info.items() if i["version"] != __version__}
+        if other:
+            print(f"transient sweep: warning: workers run other versions of transient: {other}",
+                  file=sys.stderr)
+        return self.client
+
+    def __exit__(self, *exc) -> None:
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()

@@ -1,0 +1,411 @@
+"""The sweep file: a base scene, parameter axes, the quantities to collect; every run's scene.
+
+A **sweep file** (TOML; examples in ``cases/sweeps/``)::
+
+    [sweep]
+    name = "gots-eta"                      # default: the file's stem
+    base = "../gots_diesel_friction.toml"  # relative to this file (or inline: a [base] table)
+    method = "grid"                        # grid | list | random
+    collect = ["mean_speed_rpm", "eta_mech"]
+    columns = ["t", "phi", "omega"]        # trajectory columns to store (default all; [] none)
+
+    [set]                                  # constant changes to the base scene
+    "run.revolutions" = 200
+
+    [[axis]]
+    key = "load.torque"                    # a dotted scene key, unit suffix allowed
+    values = [50.0, 100.0, 150.0]          # or from/to/num (+ spacing = "log"); random: low/high
+
+Keys address the scene's TOML tables (``mechanism.rod.mass``, ``friction.pairs[1].eta_forward``);
+a key with a unit suffix replaces the quantity however the base wrote it
+(``governor.speed_full_rpm`` replaces ``speed_full = 45.0``). ``grid`` runs every combination of
+the axes; axes that share a ``group`` move together (equal lengths). ``list`` runs the axes' i-th
+values together. ``random`` draws ``samples`` points with ``seed``, uniformly in [low, high]
+(log-uniform with ``spacing = "log"``) or from ``values``.
+
+Every resolved scene is validated here, before any work, so that a bad point stops the sweep
+with one line instead of failing on a worker.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import itertools
+import math
+import re
+import tomllib
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import SceneError
+from ..units import ALL_SUFFIXES
+
+METHODS = ("grid", "list", "random")
+SPACINGS = ("linear", "log")
+RPM = 30.0 / math.pi
+
+
+def _has_load_step(scene) -> bool:
+    """Whether the load schedule steps (two equal instants): the load-change quantities need one."""
+    x = scene.load.schedule_time or scene.load.schedule_revolutions
+    return any(a == b for a, b in itertools.pairwise(x))
+
+
+#: Short names of common quantities: name -> (summary entry of /analysis, factor, unit, what it
+#: is, a check of the scene that it can be measured, or None). Any other name is taken as an
+#: /analysis entry as it is (e.g. "load_change_2_recovery_s", "steady_state_t").
+QUANTITIES: dict[str, tuple[str, float, str, str, Callable | None]] = {
+    "mean_speed_rpm": ("mean_omega_last_cycle", RPM, "rpm",
+                       "cycle-mean speed over the last whole cycle", None),
+    "final_speed_rpm": ("final_omega", RPM, "rpm", "speed at the end of the run", None),
+    "delta": ("delta_last_cycle", 1.0, "1",
+              "speed non-uniformity δ = (ω_max − ω_min)/ω_mean over the last cycle", None),
+    "eta_mech": ("eta_mech_work", 1.0, "1", "mechanical efficiency W_out/W_in, steady cycles",
+                 lambda s: s.gas.model != "none"),
+    "speed_dip_pct": ("load_change_1_dev_max_pct", 1.0, "%",
+                      "ISO 8528-5 transient speed deviation after the first load step",
+                      _has_load_step),
+    "recovery_time_s": ("load_change_1_recovery_s", 1.0, "s",
+                        "ISO 8528-5 recovery time (±1 %) after the first load step",
+                        _has_load_step),
+    "droop_pct": ("load_change_1_droop_pct", 1.0, "%", "steady speed change at the first load step",
+                  _has_load_step),
+    "spin_up_t90_s": ("spin_up_t90_s", 1.0, "s", "time to 90 % of the final speed", None),
+}
+DEFAULT_COLLECT = ("mean_speed_rpm", "delta")
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+_KEY_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept scene key and its values (numbers, or strings and booleans for ``values``)."""
+
+    key: str
+    values: tuple
+    group: str
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a sweep: its index, the axis values, the validated scene and its resolved TOML."""
+
+    index: int
+    params: dict[str, Any]
+    scene: Any
+    toml: str
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A validated sweep file and its runs."""
+
+    name: str
+    path: Path
+    text: str
+    method: str
+    axes: tuple[Axis, ...]
+    collect: tuple[str, ...]
+    columns: tuple[str, ...] | None  # None: every trajectory column
+    runs: tuple[RunSpec, ...]
+
+    @property
+    def groups(self) -> list[list[Axis]]:
+        """Axes by group, in the order of first appearance (a grid's dimensions)."""
+        out: dict[str, list[Axis]] = {}
+        for a in self.axes:
+            out.setdefault(a.group, []).append(a)
+        return list(out.values())
+
+
+class _Table:
+    """A table of the sweep file: takes keys off it, reports unknown ones (as scene.Section)."""
+
+    def __init__(self, data: Any, where: str, file: str) -> None:
+        if not isinstance(data, dict):
+            raise SceneError(where, f"must be a table, got {type(data).__name__}", file=file)
+        self.data, self.where, self.file, self.known = dict(data), where, file, []
+
+    def error(self, key: str, message: str) -> SceneError:
+        return SceneError(f"{self.where}.{key}" if self.where else key, message, file=self.file)
+
+    def get(self, key: str, types: tuple, default: Any = None, what: str = "") -> Any:
+        self.known.append(key)
+        if key not in self.data:
+            return default
+        value = self.data.pop(key)
+        if isinstance(value, bool) and bool not in types or not isinstance(value, types):
+            raise self.error(key, f"must be {what}, got {value!r}")
+        return value
+
+    def finish(self) -> None:
+        for key in self.data:
+            raise self.error(key, f"unknown key; allowed here: {', '.join(self.known)}")
+
+
+def load_sweep(source: str | Path) -> Sweep:
+    """Read and validate a sweep file and every scene it resolves to. Raises SceneError."""
+    path = Path(source)
+    file = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
+    except OSError as exc:
+        raise SceneError("(file)", f"cannot read: {exc.strerror}", file=file) from None
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise SceneError("(syntax)", f"not valid TOML (UTF-8): {exc}", file=file) from None
+    root = _Table(data, "", file)
+    head = _Table(root.get("sweep", (dict,), None, "a table") or {}, "sweep", file)
+    name = head.get("name", (str,), path.stem, "a string")
+    base_path = head.get("base", (str,), None, "a scene file path (string)")
+    inline = root.get("base", (dict,), None, "a table holding the whole base scene")
+    if (base_path is None) == (inline is None):
+        raise head.error("base", "give the base scene either as a file (sweep.base = \"x.toml\") "
+                                 "or inline as a [base] table, exactly one of them")
+    method = head.get("method", (str,), "grid", "a string")
+    if method not in METHODS:
+        raise head.error("method", f"unknown value {method!r}; allowed: {', '.join(METHODS)}")
+    samples = head.get("samples", (int,), None, "a whole number ≥ 1")
+    seed = head.get("seed", (int,), None, "a whole number")
+    if method == "random" and (samples is None or samples < 1 or seed is None):
+        raise head.error("samples" if samples is None or samples < 1 else "seed",
+                         "method = \"random\" needs samples (≥ 1) and seed (a whole number)")
+    if method != "random" and (samples is not None or seed is not None):
+        raise head.error("samples" if samples is not None else "seed",
+                         f"only for method = \"random\", not {method!r}")
+    collect = _collect(head, head.get("collect", (list,), list(DEFAULT_COLLECT),
+                                      "a list of quantity names"))
+    columns = head.get("columns", (list,), None, "a list of trajectory column names")
+    if columns is not None and not all(isinstance(c, str) for c in columns):
+        raise head.error("columns", f"must be a list of strings, got {columns!r}")
+    head.finish()
+    changes = _flatten(root.get("set", (dict,), {}, "a table of dotted scene keys and values"))
+    for key in changes:
+        _check_key(key, SceneError(f"set.{key}", "", file=file))
+    axes = tuple(_axis(_Table(a, f"axis[{i}]", file), method, samples, seed, i)
+                 for i, a in enumerate(_axis_list(root, file)))
+    root.finish()
+    _check_distinct(axes, file)
+    if inline is not None:
+        base, base_file, base_dir = inline, f"{file}:[base]", path.parent
+    else:
+        base_file = path.parent / base_path
+        base, base_dir = _read_base(base_file, file), base_file.parent
+    sweep = Sweep(name, path, text, method, axes, collect,
+                  None if columns is None else tuple(columns), ())
+    runs = tuple(_resolve(sweep, base, changes, params, i, str(base_file), base_dir)
+                 for i, params in enumerate(_points(sweep)))
+    _check_columns(sweep, runs)
+    return dataclasses.replace(sweep, runs=runs)
+
+
+def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
+    """``[set]`` as dotted keys: ``"run.t_end" = 2``, ``run.t_end = 2`` and ``[set.run]``
+    ``t_end = 2`` all mean the same change (not a replacement of the whole ``[run]`` table)."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
+def _collect(head: _Table, names: list) -> tuple[str, ...]:
+    for n in names:
+        if not isinstance(n, str) or not _NAME.match(n):
+            raise head.error("collect", f"{n!r} is not a quantity name; give names such as "
+                                        f"{', '.join(QUANTITIES)}, or any /analysis entry")
+    if len(set(names)) != len(names):
+        raise head.error("collect", "names must not repeat")
+    return tuple(names)
+
+
+def _axis_list(root: _Table, file: str) -> list:
+    axes = root.get("axis", (list,), None, "an array of tables [[axis]]")
+    if not axes:
+        raise SceneError("axis", "is missing; give at least one [[axis]] with a key and its "
+                                 "values", file=file)
+    return axes
+
+
+def _check_key(key: str, err: SceneError) -> list[tuple[str, int | None]]:
+    """The parts of a dotted scene key, name and optional [index] each; err if malformed."""
+    parts = [_KEY_PART.match(p) for p in key.split(".")]
+    if not key or not all(parts):
+        err.message = (f"{key!r} is not a scene key; give dotted TOML keys such as "
+                       f"'load.torque' or 'friction.pairs[0].eta_forward'")
+        err.args = (err.line(),)
+        raise err
+    return [(m.group(1), None if m.group(2) is None else int(m.group(2))) for m in parts]
+
+
+def _quantity_key(key: str) -> str:
+    """A key without the unit suffix of its last part: the quantity it sets."""
+    head, _, leaf = key.rpartition(".")
+    stem, _, suffix = leaf.rpartition("_")
+    return f"{head}.{stem}" if suffix in ALL_SUFFIXES else key
+
+
+def _check_distinct(axes: tuple[Axis, ...], file: str) -> None:
+    seen: dict[str, int] = {}
+    for i, a in enumerate(axes):
+        j = seen.setdefault(_quantity_key(a.key), i)
+        if j != i:
+            raise SceneError(f"axis[{i}].key", f"{a.key!r} sets the quantity of axis[{j}] "
+                                               f"({axes[j].key!r}) again; give each quantity one "
+                                               f"axis", file=file)
+
+
+def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int) -> Axis:
+    key = t.get("key", (str,), None, "a dotted scene key (string)")
+    if key is None:
+        raise t.error("key", "is missing; give the dotted scene key this axis sets, e.g. "
+                             "'load.torque'")
+    _check_key(key, t.error("key", ""))
+    group = t.get("group", (str,), f"#{i}", "a string")
+    values = t.get("values", (list,), None, "a list of values")
+    lo_hi = {k: t.get(k, (int, float), None, "a number")
+             for k in (("low", "high") if method == "random" else ("from", "to"))}
+    num = t.get("num", (int,), None, "a whole number ≥ 2") if method != "random" else None
+    spacing = t.get("spacing", (str,), "linear", "a string")
+    t.finish()
+    if spacing not in SPACINGS:
+        raise t.error("spacing", f"unknown value {spacing!r}; allowed: {', '.join(SPACINGS)}")
+    given = [k for k, v in lo_hi.items() if v is not None] + (["num"] if num is not None else [])
+    if values is not None and given:
+        raise t.error(given[0], "given together with 'values'; give a list of values or a range, "
+                                "not both")
+    if values is not None:
+        if not values or not all(isinstance(v, (int, float, str, bool)) for v in values):
+            raise t.error("values", f"must be a non-empty list of numbers, strings or booleans, "
+                                    f"got {values!r}")
+        if method == "random":  # draw from the list
+            picks = np.random.default_rng([seed, i]).integers(0, len(values), samples)
+            values = [values[k] for k in picks]
+        return Axis(key, tuple(values), group)
+    need = list(lo_hi) + ([] if method == "random" else ["num"])
+    missing = [k for k in need if k not in given]
+    if missing:
+        raise t.error(missing[0], f"is missing; give 'values' = [...] or {', '.join(need)}")
+    a, b = lo_hi.values()
+    if spacing == "log" and not (a > 0 and b > 0):
+        raise t.error(need[0], f"spacing = \"log\" needs positive bounds, got {a:g} and {b:g}")
+    if method == "random":
+        if not a < b:
+            raise t.error("high", f"must be > low ({a:g}), got {b:g}")
+        return Axis(key, _draw(a, b, spacing, samples, seed, i), group)
+    if num < 2:
+        raise t.error("num", f"must be ≥ 2, got {num}")
+    grid = np.geomspace(a, b, num) if spacing == "log" else np.linspace(a, b, num)
+    return Axis(key, tuple(float(v) for v in grid), group)
+
+
+def _draw(a: float, b: float, spacing: str, samples: int, seed: int, i: int) -> tuple:
+    """``samples`` random values in [a, b]; axis i has its own stream of the seed, so adding an
+    axis does not change the draws of the others."""
+    rng = np.random.default_rng([seed, i])
+    if spacing == "log":
+        return tuple(float(v) for v in np.exp(rng.uniform(math.log(a), math.log(b), samples)))
+    return tuple(float(v) for v in rng.uniform(a, b, samples))
+
+
+def _points(sweep: Sweep) -> Iterator[dict[str, Any]]:
+    """The axis values of each run, in run order."""
+    axes = sweep.axes
+    if sweep.method == "random":  # every axis holds its `samples` draws
+        yield from (dict(zip((a.key for a in axes), row)) for row in zip(*(a.values for a in axes)))
+        return
+    groups = ([[a] for a in axes] if sweep.method == "list" else
+              [[a for a in axes if a.group == g] for g in dict.fromkeys(a.group for a in axes)])
+    moving = [a for g in groups for a in g] if sweep.method == "list" else None
+    for g in (groups if moving is None else [moving]):
+        lengths = {len(a.values) for a in g}
+        if len(lengths) > 1:
+            what = "method = \"list\"" if moving else f"group {g[0].group!r}"
+            raise SceneError(f"axis ({g[0].key})",
+                             f"the axes of {what} move together and need equally many values; "
+                             f"got {', '.join(f'{a.key}: {len(a.values)}' for a in g)}",
+                             file=str(sweep.path))
+    if moving is not None:
+        yield from (dict(zip((a.key for a in moving), row))
+                    for row in zip(*(a.values for a in moving)))
+        return
+    for combo in itertools.product(*(range(len(g[0].values)) for g in groups)):
+        yield {a.key: a.values[k] for g, k in zip(groups, combo) for a in g}
+
+
+def _read_base(path: Path, sweep_file: str) -> dict:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SceneError("sweep.base", f"cannot read the base scene {str(path)!r}: "
+                                       f"{exc.strerror}", file=sweep_file) from None
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise SceneError("sweep.base", f"the base scene {str(path)!r} is not valid TOML: {exc}",
+                         file=sweep_file) from None
+
+
+def set_key(data: dict, key: str, value: Any) -> None:
+    """Set a dotted scene key in parsed TOML, creating tables on the way. A leaf written with a
+    unit suffix (or without) replaces every other spelling of the same quantity, so that an axis
+    ``governor.speed_full_rpm`` overrides ``speed_full = 45.0`` of the base."""
+    parts = _check_key(key, SceneError(key, ""))
+    node = data
+    for name, index in parts[:-1]:
+        node = node.setdefault(name, {})
+        if index is not None:
+            if not isinstance(node, list) or index >= len(node):
+                raise SceneError(key, f"{name}[{index}]: the base scene has no such entry "
+                                      f"(an array of tables, indexed from 0)")
+            node = node[index]
+        if not isinstance(node, dict):
+            raise SceneError(key, f"{name!r} is a value in the base scene, not a table")
+    leaf, index = parts[-1]
+    if index is not None:
+        raise SceneError(key, "the last part must name a value, not an array entry")
+    stem = leaf.rpartition("_")[0] if leaf.rpartition("_")[2] in ALL_SUFFIXES else leaf
+    for spelling in [stem] + [f"{stem}_{s}" for s in ALL_SUFFIXES]:
+        node.pop(spelling, None)
+    node[leaf] = value
+
+
+def _resolve(sweep: Sweep, base: dict, changes: dict, params: dict, i: int, base_file: str,
+             base_dir: Path) -> RunSpec:
+    """Run i's scene: the base with the constant changes and the axis values, validated."""
+    from ..scene import scene_from_dict, to_toml
+
+    data = copy.deepcopy(base)
+    shown = ", ".join(f"{k} = {v!r}" for k, v in params.items())
+    try:
+        for key, value in itertools.chain(changes.items(), params.items()):
+            set_key(data, key, value)
+        scene = scene_from_dict(data, file=base_file, base_dir=base_dir)
+    except SceneError as exc:
+        raise SceneError(f"run {i} ({shown})", f"scene {exc.key}: {exc.message}",
+                         file=str(sweep.path)) from None
+    return RunSpec(i, params, scene, to_toml(scene))
+
+
+def _check_columns(sweep: Sweep, runs: tuple[RunSpec, ...]) -> None:
+    """Collected short names must be measurable, stored columns must exist, in every scene."""
+    from ..outputs import output_columns
+
+    for spec in runs:
+        for q in sweep.collect:
+            check = QUANTITIES.get(q, (None,) * 5)[4]
+            if check is not None and not check(spec.scene):
+                what = "gas forces" if q == "eta_mech" else "load step"
+                raise SceneError("sweep.collect", f"{q!r} ({QUANTITIES[q][3]}) cannot be measured "
+                                                  f"in run {spec.index}: its scene has no {what}",
+                                 file=str(sweep.path))
+        have = output_columns(spec.scene)
+        for c in sweep.columns or ():
+            if c not in have:
+                raise SceneError("sweep.columns", f"unknown column {c!r} in run {spec.index}; "
+                                                  f"allowed: {', '.join(have)}",
+                                 file=str(sweep.path))

@@ -1,0 +1,281 @@
+"""The sweep file (HDF5): each run in a result's layout, and the summary table of the sweep.
+
+Only the client writes it (:class:`SweepStore`), run by run as results arrive, so that an
+interrupted sweep resumes from what is there. What a run stores — header, ``scene/toml``,
+``trajectory``, ``events``, ``solver``, ``analysis`` — is written by :mod:`transient.results`,
+so a run of a sweep reads back as a :class:`~transient.results.Result` (:func:`open_run`); what
+is the sweep's own — the sweep file, its axes, the runs' index and status, the summary — is
+written here.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from .. import results
+from ..errors import SceneError
+from ..units import ALL_SUFFIXES
+from .spec import QUANTITIES, RunSpec, Sweep
+
+
+def group_name(index: int, n_runs: int) -> str:
+    """The group of run ``index`` under ``/runs``: zero-padded so that the groups sort in run
+    order."""
+    return f"run_{index:0{max(4, len(str(n_runs - 1)))}d}"
+
+
+class SweepStore:
+    """The sweep file (HDF5), written by the client only.
+
+    Layout: root attributes as a result file (``creator``, ``version``, ``format``, ``created``,
+    ``complete``) plus ``kind = "sweep"``, ``sweep`` (its name) and ``n_runs``; ``/sweep/toml``
+    the sweep file; ``/sweep`` attributes ``method``, ``axes`` and ``collect`` (JSON);
+    ``/runs/run_<i>`` one group per run, laid out as a result file's root
+    (:func:`transient.results.write_run`: header attributes with ``scene``, ``complete`` and
+    ``message``; ``scene/toml``; ``trajectory/<col>`` with ``unit``; ``events/<name>/{t,phi}``;
+    ``solver`` attributes; ``analysis/<name>``, the run's summary, with ``unit``), with the
+    sweep's attributes ``index``, ``params`` (JSON), ``scene_toml`` (the resolved scene, which a
+    resumed sweep compares), ``worker``, ``wall_s`` and ``status`` (``ok`` or ``failed``, written
+    last: a group without it is unfinished); ``/analysis/summary`` the table of collected
+    quantities (attribute ``units``, JSON).
+
+    While the sweep runs the file is ``.<name>.h5.part``; it is renamed when every run is done.
+    An existing file of the same sweep is resumed (finished runs are kept); one of another sweep
+    is never overwritten without ``force``.
+    """
+
+    def __init__(self, path: Path, sweep: Sweep, force: bool = False) -> None:
+        self.path, self.sweep = Path(path), sweep
+        self.part = self.path.with_name(f".{self.path.name}.part")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        if not os.access(self.path.parent, os.W_OK):
+            raise PermissionError(f"{self.path.parent}: folder is not writable")
+        if force:
+            for p in (self.path, self.part, self.path.with_name(f"{self.path.stem}_summary.csv")):
+                p.unlink(missing_ok=True)
+        found = next((p for p in (self.part, self.path) if p.exists()), None)
+        if found is None:
+            self.f = self._create(self.part)
+        else:
+            self._check(found)  # raises, changing nothing, if it is another sweep
+            os.replace(found, self.part)  # a finished file being resumed is a part again
+            self.f = results.reopen_file(self.part)
+        self.finished = self._prepare()
+
+    def _check(self, path: Path) -> None:
+        """An existing file must hold this sweep: every stored run's scene equal to ours."""
+        other = (f"{path}: exists and holds another sweep ({{}}); use --force to replace it or "
+                 f"-o another folder")
+        try:
+            with h5py.File(path, "r") as f:
+                if f.attrs.get("kind") != "sweep" or int(f.attrs.get("n_runs", -1)) != len(
+                        self.sweep.runs):
+                    raise FileExistsError(other.format(f"not {len(self.sweep.runs)} runs"))
+                for name, g in f["runs"].items():
+                    i = int(g.attrs.get("index", -1))
+                    same = (0 <= i < len(self.sweep.runs)
+                            and g.attrs["scene_toml"] == self.sweep.runs[i].toml)
+                    if "status" in g.attrs and not same:
+                        raise FileExistsError(other.format(f"the scene of {name} differs from "
+                                                           f"run {i} of {self.sweep.path}"))
+        except OSError as exc:
+            if isinstance(exc, FileExistsError):
+                raise
+            raise SceneError("(file)", f"cannot open to resume: {exc}; use --force to start "
+                                       f"afresh", file=str(path)) from None
+
+    def _create(self, path: Path) -> h5py.File:
+        f = results.create_file(path)
+        results.write_header(f, kind="sweep", sweep=self.sweep.name, complete=False,
+                             n_runs=len(self.sweep.runs))
+        f.create_group("sweep").create_dataset("toml", data=self.sweep.text)
+        f.create_group("runs")
+        f.create_group("analysis")
+        return f
+
+    def _prepare(self) -> set[int]:
+        """Indices of the finished runs; groups left half-written by an interrupt are removed
+        (they run again). The sweep's text and axes are (re)written: a resumed sweep may collect
+        other quantities."""
+        runs = self.f["runs"]
+        for name in [n for n, g in runs.items() if "status" not in g.attrs]:
+            del runs[name]
+        done = {int(g.attrs["index"]) for g in runs.values()}
+        g = self.f["sweep"]
+        del g["toml"]
+        g.create_dataset("toml", data=self.sweep.text)
+        g.attrs.update(method=self.sweep.method, collect=json.dumps(self.sweep.collect),
+                       axes=json.dumps([{"key": a.key, "group": a.group, "values": list(a.values)}
+                                        for a in self.sweep.axes]))
+        self.f.flush()
+        return done
+
+    def group_name(self, index: int) -> str:
+        return group_name(index, len(self.sweep.runs))
+
+    def drop_failed(self) -> None:
+        """Forget the failed runs so that they run again (``--retry-failed``)."""
+        for spec in self.sweep.runs:
+            name = self.group_name(spec.index)
+            if spec.index in self.finished and self.f["runs"][name].attrs["status"] != "ok":
+                del self.f["runs"][name]
+                self.finished.discard(spec.index)
+
+    def write_run(self, spec: RunSpec, res: dict[str, Any]) -> None:
+        """One run's group (``res`` from :func:`~transient.sweep.execute.run_one`); ``status``
+        is written last and flushed, marking it finished."""
+        runs = self.f["runs"]
+        name = self.group_name(spec.index)
+        if name in runs:
+            del runs[name]
+        g = runs.create_group(name)
+        g.attrs.update(index=spec.index, params=json.dumps(spec.params), scene_toml=spec.toml,
+                       worker=res["worker"], wall_s=res["wall_s"])
+        data = results.RunData(res["trajectory"], res["events"], res["solver"],
+                               complete=res["complete"], message=res["message"])
+        results.write_run(g, spec.scene.name, spec.toml, data, res["units"], res["summary"])
+        g.attrs["status"] = res["status"]
+        self.f.flush()
+        self.finished.add(spec.index)
+
+    def summary(self) -> tuple[list[dict[str, Any]], dict[str, str]]:
+        """The summary rows (run order) and the units of their columns, from the stored runs."""
+        units = {"run": "", "status": "", **{a.key: _suffix_unit(a.key) for a in self.sweep.axes},
+                 **{q: "" for q in self.sweep.collect}}
+        rows = []
+        for spec in self.sweep.runs:
+            g = self.f["runs"].get(self.group_name(spec.index))
+            if g is None or "status" not in g.attrs:
+                continue
+            row = {"run": spec.index, "status": str(g.attrs["status"]), **spec.params}
+            for q in self.sweep.collect:
+                value, unit = _quantity(g["analysis"], q)
+                row[q] = value if row["status"] == "ok" else math.nan
+                units[q] = units[q] or unit
+            row["wall_s"] = float(g.attrs["wall_s"])
+            row["compile_s"] = float(g["solver"].attrs.get("compile_s", math.nan))
+            row["message"] = str(g.attrs["message"])
+            rows.append(row)
+        units.update(wall_s="s", compile_s="s", message="")
+        return rows, units
+
+    def write_summary(self, csv_path: Path) -> list[dict[str, Any]]:
+        """``/analysis/summary`` and the CSV beside the file; returns the rows."""
+        rows, units = self.summary()
+        names = list(units)
+        an = self.f["analysis"]
+        if "summary" in an:
+            del an["summary"]
+        table = np.zeros(len(rows), dtype=[(n, _column_dtype(n, rows)) for n in names])
+        for n in names:
+            table[n] = [r.get(n, math.nan) for r in rows]
+        ds = an.create_dataset("summary", data=table)
+        ds.attrs["units"] = json.dumps(units)
+        self.f.flush()
+        with open(csv_path, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(names)
+            w.writerows([[_csv(r.get(n, "")) for n in names] for r in rows])
+        return rows
+
+    def close(self, complete: bool) -> Path:
+        """Close; a complete sweep gets its final name, an incomplete one stays a part."""
+        if not self.f.id.valid:
+            return self.part
+        self.f.attrs["complete"] = bool(complete)
+        self.f.close()
+        if complete:
+            os.replace(self.part, self.path)
+            return self.path
+        return self.part
+
+
+def _suffix_unit(key: str) -> str:
+    """The unit an axis key names by its suffix (``_rpm``, ``_deg`` …); "" for SI."""
+    suffix = key.rpartition("_")[2]
+    return suffix if suffix in ALL_SUFFIXES else ""
+
+
+def _quantity(analysis, name: str) -> tuple[float, str]:
+    """A collected quantity from a run's /analysis (a short name of QUANTITIES, or as stored)."""
+    entry, factor, unit = QUANTITIES[name][:3] if name in QUANTITIES else (name, 1.0, None)
+    if entry not in analysis:
+        return math.nan, unit or ""
+    return float(analysis[entry][()]) * factor, unit or str(analysis[entry].attrs.get("unit", ""))
+
+
+def _column_dtype(name: str, rows: list[dict]) -> Any:
+    """A summary column's type in the HDF5 table: run indices whole, text as strings (a
+    status, a message, a string axis), every other column float (NaN where a run failed)."""
+    values = [r.get(name) for r in rows]
+    if name == "run":
+        return "<i8"
+    if any(isinstance(v, str) for v in values):
+        return h5py.string_dtype()
+    return "<f8"
+
+
+def _csv(value: Any) -> Any:
+    """A CSV cell: floats by ``repr``, so that the CSV holds every digit of the table."""
+    return repr(value) if isinstance(value, float) else value
+
+
+# ------------------------------------------------------------------------------------------------
+# Reading a sweep file back (plots, a run's whole result)
+
+
+@dataclass
+class SweepTable:
+    """The summary of a sweep file: columns by name, their units, the axes and the method."""
+
+    path: Path
+    name: str
+    method: str
+    axes: list[dict[str, Any]]
+    collect: list[str]
+    columns: dict[str, np.ndarray]
+    units: dict[str, str]
+
+
+def read_summary(path: str | Path) -> SweepTable:
+    """``/analysis/summary`` of a sweep file (complete or a ``.part``)."""
+    path = Path(path)
+    with _open_sweep(path) as f:
+        if "summary" not in f["analysis"]:
+            raise ValueError("no summary yet (the sweep did not finish; rerun it to resume)")
+        ds = f["analysis/summary"]
+        table = ds[()]
+        cols = {n: (np.array([v.decode() if isinstance(v, bytes) else v for v in table[n]])
+                    if table.dtype[n].kind == "O" else table[n]) for n in table.dtype.names}
+        s = f["sweep"].attrs
+        return SweepTable(path, str(f.attrs["sweep"]), str(s["method"]), json.loads(s["axes"]),
+                          json.loads(s["collect"]), cols, json.loads(ds.attrs["units"]))
+
+
+def open_run(path: str | Path, index: int) -> results.Result:
+    """Run ``index`` of a sweep file (complete or a ``.part``) as a result, read by the result
+    files' own reader since a run is stored in their layout. Raises KeyError if the file holds
+    no finished run of that index."""
+    path = Path(path)
+    with _open_sweep(path) as f:
+        g = f["runs"].get(group_name(index, int(f.attrs["n_runs"])))
+        if g is None or "status" not in g.attrs:
+            raise KeyError(f"{path}: no finished run {index}")
+        return results.read_run(g, path)
+
+
+def _open_sweep(path: Path) -> h5py.File:
+    """A sweep file open for reading; ValueError if it is another file (a result, say)."""
+    f = h5py.File(path, "r")
+    if f.attrs.get("kind") != "sweep":
+        f.close()
+        raise ValueError("not a transient sweep file")
+    return f
