@@ -45,7 +45,7 @@ from ..run import integrate
 
 #: Benchmark scenes: the single-cylinder crank (equation (18) alone), the Gots diesel with
 #: friction pairs and a governor, the 4-cylinder swash-plate engine.
-_CASES = Path(__file__).resolve().parents[1] / "cases"
+_CASES = Path(__file__).resolve().parents[2] / "cases"
 BENCH_SCENES = {path.stem: path for path in (_CASES / "coasting_single.toml",
                                              _CASES / "gots_diesel_governed.toml",
                                              _CASES / "swash_plate_4cyl.toml")}

@@ -40,7 +40,7 @@ from typing import Callable
 
 import numpy as np
 
-CASES_DIR = Path(__file__).resolve().parents[1] / "cases"
+CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
 
 #: Work–energy balance tolerance: C_BALANCE·rtol of the energy throughput (max K + max |W|).
