@@ -73,3 +73,29 @@ def last_cycle_ranges(traj, cycle) -> dict[str, tuple[float, str]]:
             "M_gas_swing_last_cycle": (swing(traj["M_gas"][sel]), "N m"),
             "M_inertia_swing_last_cycle": (swing(inertia), "N m"),
             "gas_1_swing_last_cycle": (swing(gas1), "Pa or N")}
+
+
+class NoWholeCycle(ValueError):
+    """The trajectory holds no whole engine cycle, which a last-cycle analysis needs."""
+
+
+def last_cycle_window(t: NDArray[np.float64], phi: NDArray[np.float64], cycle: float,
+                      phi0: float) -> tuple[NDArray[np.bool_], float]:
+    """The samples of the last whole cycle counted from φ0, as :func:`cycle_boundaries` counts
+    cycles.
+
+    Returns the mask of the samples, the cycle's end marks included (to 1e-9 of the cycle, so
+    that a sample on a mark up to rounding counts), and the cycle's start angle [rad]. Only
+    samples after the last backward motion count: a run that reversed passes these angles
+    twice. Raises :class:`NoWholeCycle` if the run holds no whole cycle.
+    """
+    _, marks = cycle_boundaries(t, phi, cycle, phi0)
+    if marks.size < 2:
+        raise NoWholeCycle(f"the run holds no whole cycle of {math.degrees(cycle):g}°")
+    a, b = marks[-2], marks[-1]
+    tol = 1e-9 * cycle
+    back = np.nonzero(np.diff(phi) < 0)[0]
+    start = back[-1] + 1 if back.size else 0
+    mask = (phi >= a - tol) & (phi <= b + tol)
+    mask[:start] = False
+    return mask, a

@@ -40,6 +40,10 @@ Functions
 :func:`odd_harmonic_report`, :func:`report_for_scene`
     Orders of the piston acceleration of a run against the same engine at its mean speed
     (:class:`OddHarmonicReport`).
+:func:`run_orders`, :func:`orders_up_to`, :func:`strongest_orders`
+    What ``transient orders`` shows of a run: the spectra of ω per cycle, of the gas torque and
+    of the piston acceleration over the last cycle, δ and the cycle-mean speeds
+    (:class:`RunOrders`).
 """
 from __future__ import annotations
 
@@ -51,6 +55,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core.crank_slider import slider
+from .irregularity import NoWholeCycle, cycle_means, fluctuation
 
 #: Orders closer than this to a whole number are whole orders (the grid gives ν = 2πk/Φ exactly
 #: up to rounding).
@@ -261,13 +266,14 @@ def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
         name → (n_cycles·N,) array.
 
     Only the part of the run after its last backward motion (φ decreasing, or ω ≤ 0) is used.
+    Raises :class:`~.irregularity.NoWholeCycle` (a ValueError) if it holds no whole cycle.
     """
     part = _increasing_part(traj)
     phi = np.asarray(traj["phi"], dtype=float)[part]
     marks = cycle_marks(phi, cycle, phi0)
     n_cyc = marks.size - 1
     if n_cyc < 1:
-        raise ValueError(f"the run holds no whole cycle of {math.degrees(cycle):g}° from "
+        raise NoWholeCycle(f"the run holds no whole cycle of {math.degrees(cycle):g}° from "
                          f"φ0 = {phi0:g} rad (φ from {phi[0] if phi.size else math.nan:.6g} to "
                          f"{phi[-1] if phi.size else math.nan:.6g} rad)")
     if cycles is not None:
@@ -695,3 +701,104 @@ def report_for_scene(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: i
     return odd_harmonic_report(traj, m.crank_radius, m.rod_length, m.offset, cycle=m.cycle,
                                phi0=scene.initial.phi, phase=m.firing_angles[cylinder - 1],
                                **options)
+
+
+# ------------------------------------------------------------------------------------------------
+# The orders of a stored run
+
+
+@dataclass(frozen=True)
+class RunOrders:
+    """Order spectra of a run (:func:`run_orders`).
+
+    Attributes
+    ----------
+    cycle_start : (n_cycles,) array
+        Angle [rad] at which each whole cycle starts.
+    omega : OrderSpectrum
+        ω of every whole cycle (the run-up waterfall's rows; the last row is the last cycle).
+    omega_mean : (n_cycles,) array
+        Cycle-mean speed of each of those cycles [rad/s] (:func:`.irregularity.cycle_means`).
+    delta : float
+        δ of the last whole cycle (:func:`.irregularity.fluctuation`).
+    detrend : str
+        ``"ramp"`` or ``"none"``: what was done to ω before each cycle's DFT.
+    gas_torque : OrderSpectrum or None
+        M_gas over the last whole cycle, where the run has gas forces.
+    piston : OddHarmonicReport or None
+        The piston acceleration of one cylinder over the last whole cycle, where asked for.
+    """
+
+    cycle_start: NDArray[np.float64]
+    omega: OrderSpectrum
+    omega_mean: NDArray[np.float64]
+    delta: float
+    detrend: str
+    gas_torque: OrderSpectrum | None = None
+    piston: OddHarmonicReport | None = None
+
+    @property
+    def orders(self) -> NDArray[np.float64]:
+        return self.omega.orders
+
+    @property
+    def cycles(self) -> int:
+        return self.cycle_start.size
+
+
+def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle: int, *,
+               cuts: ArrayLike = (), detrend: str = "auto", piston_cylinder: int | None = None
+               ) -> RunOrders:
+    """The order spectra of a run of ``scene`` on a grid of ``samples_per_cycle`` points per
+    engine cycle, whole cycles counted from φ0 as :mod:`.irregularity` counts them.
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene (cycle, φ0, initial speed, gas model).
+    traj : mapping
+        Its trajectory columns (``t``, ``phi``, ``omega``, ``epsilon``; ``M_gas`` if stored).
+    samples_per_cycle : int
+        N; orders up to N/2 per cycle.
+    cuts : array, optional
+        Corner angles (the run's breakpoints), see :func:`resample_angle`.
+    detrend : ``"auto"``, ``"ramp"`` or ``"none"``
+        For ω, as :func:`resolve_detrend`: a spin-up's trend would otherwise leak into every
+        order of each cycle.
+    piston_cylinder : int, optional
+        Cylinder (1-based) of a crank-slider whose piston acceleration is reported
+        (:func:`report_for_scene`); None: no report.
+
+    Raises :class:`~.irregularity.NoWholeCycle` if the run holds no whole cycle.
+    """
+    cycle, phi0 = scene.mechanism.cycle, scene.initial.phi
+    n = int(samples_per_cycle)
+    detrend = resolve_detrend(detrend, scene.initial.omega, float(traj["omega"][-1]))
+    starts, omega = cycle_spectra(traj, "omega", n, cycle, phi0=phi0, cuts=cuts,
+                                  detrend=detrend)
+    gas = None
+    if "M_gas" in traj and scene.gas.model != "none":
+        _, cm = to_angle_grid(traj, ("M_gas",), n, cycle, phi0=phi0, cycles=1, cuts=cuts)
+        gas = order_spectrum(cm["M_gas"], n, cycle)
+    piston = None
+    if piston_cylinder is not None:
+        piston = report_for_scene(scene, traj, piston_cylinder, samples_per_cycle=n, cycles=1,
+                                  cuts=cuts)
+    t, phi = traj["t"], traj["phi"]
+    delta = fluctuation(t, phi, traj["omega"], cycle, phi0)
+    means, _ = cycle_means(t, phi, cycle, phi0)
+    return RunOrders(starts, omega, means[-starts.size:], delta, detrend, gas, piston)
+
+
+def orders_up_to(orders: ArrayLike, max_order: float) -> NDArray[np.intp]:
+    """Indices of the orders 0 < ν ≤ ``max_order`` (the mean left out)."""
+    orders = np.asarray(orders)
+    return np.nonzero((orders > 0.0) & (orders <= max_order + _ORDER_TOL))[0]
+
+
+def strongest_orders(orders: ArrayLike, amplitude: ArrayLike, max_order: float, count: int = 6
+                     ) -> NDArray[np.intp]:
+    """Indices of the ``count`` largest amplitudes among the orders 0 < ν ≤ ``max_order``,
+    largest first."""
+    shown = orders_up_to(orders, max_order)
+    return shown[np.argsort(np.asarray(amplitude)[shown])[::-1][:count]]

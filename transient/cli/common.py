@@ -1,0 +1,77 @@
+"""What the command modules share: exit codes, option checks, reading a result, figures and CSV.
+
+Heavy modules (matplotlib, the result reader) are imported inside the helpers, so that a command
+that does not need them starts without them.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+
+EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
+
+#: The progress bar's words until a compiled run's first block (``run``) or a sweep's first
+#: finished run (``sweep``): the kernels load from numba's cache, or, on a first run (an empty
+#: cache), compile, which takes minutes; so a first run does not look hung.
+KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
+
+
+def number_list(text: str, option: str, low: float, high: float = math.inf) -> list[float]:
+    """Comma-separated numbers in (low, high], or a one-line error (exit 2)."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise SceneError(option, f"must be comma-separated numbers, got {text!r}") from None
+    bad = [v for v in values if not (low < v <= high)]
+    if not values or bad:
+        raise SceneError(option, f"values must lie in ({low:g}, {high:g}], got {text!r}")
+    return values
+
+
+def read_result(path):
+    """The result file at ``path``; a missing file or one that is not a transient result is a
+    one-line error (exit 2), not a traceback."""
+    from ..results import open_result
+
+    if not Path(path).is_file():
+        raise FileNotFoundError(f"{path}: no such result file")
+    try:
+        return open_result(path)
+    except (OSError, ValueError) as exc:
+        raise SceneError("(file)", f"not a readable transient result: {exc}", file=str(path)) from None
+
+
+def output_folder(option: str | None, default: Path) -> Path:
+    """The folder given by ``-o`` (else ``default``), created if missing."""
+    out = Path(option) if option else default
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def pyplot():
+    """matplotlib's pyplot on the file-only Agg backend (the CLI never opens windows)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, path):
+    """Write ``fig`` as a PNG at ``path`` and close it (a long command draws many); returns
+    ``path``."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+    return path
+
+
+def write_columns(path, cols: dict) -> None:
+    """A CSV of equal-length columns, named by the keys (12 significant digits)."""
+    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols),
+               comments="", fmt="%.12g")

@@ -1,0 +1,46 @@
+"""``transient kinematics``: positions, transfer functions, J and dJ/dφ over one cycle."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .common import EXIT_OK, pyplot, save
+
+
+def register(sub) -> None:
+    k = sub.add_parser("kinematics", help="tabulate positions, transfer functions, J and dJ/dφ")
+    k.add_argument("scene")
+    k.add_argument("-o", "--output", default=None, help="CSV file (default: standard output)")
+    k.add_argument("--points", type=int, default=361, help="points over one cycle")
+    k.add_argument("--plot", default=None, help="also write a PNG of the transfer functions and J")
+    k.set_defaults(func=cmd_kinematics)
+
+
+def cmd_kinematics(args) -> int:
+    from ..scene import load_scene
+
+    scene = load_scene(args.scene)
+    mech = scene.mechanism
+    phi = np.linspace(0.0, mech.cycle, args.points)
+    table = mech.kinematics_table(phi)
+    header = ",".join(table)
+    data = np.column_stack(list(table.values()))
+    if args.output:
+        np.savetxt(args.output, data, delimiter=",", header=header, comments="", fmt="%.12g")
+        print(f"wrote {args.output}")
+    else:
+        np.savetxt(sys.stdout, data, delimiter=",", header=header, comments="", fmt="%.12g")
+    if args.plot:
+        plt = pyplot()
+
+        from .. import plots
+
+        fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+        plots.transfer_functions(a1, table)
+        plots.reduced_inertia(a2, table)
+        a1.set_title(f"{scene.name}: transfer functions and reduced inertia")
+        # (a table on standard output stays a clean CSV: the message goes to standard error)
+        print(f"wrote {save(fig, Path(args.plot))}", file=sys.stderr if not args.output else sys.stdout)
+    return EXIT_OK

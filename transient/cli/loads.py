@@ -1,0 +1,224 @@
+"""``transient loads``: load diagrams of a stored run's last whole cycle as PNG and CSV files
+(:mod:`transient.analysis.load_diagrams`); the result file is only read."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SceneError
+from .common import EXIT_OK, output_folder, pyplot, read_result, save, write_columns
+
+
+def register(sub) -> None:
+    lo = sub.add_parser(
+        "loads", help="crankpin, main-journal loads and running torques along a crank-slider "
+                      "result, crankpin and link-pin loads along an articulated one (PNG + CSV "
+                      "files; the result file is not changed)",
+        description="Loads along the stored trajectory (transient.analysis.loads): polar "
+                    "diagrams of the crankpin and of the most loaded main journal, |R| over the "
+                    "last cycle, the wear diagram (Gots §2.6, ±60° rule), running torques; peak "
+                    "values on standard output; the last cycle's loads as CSV. Results are "
+                    "written as files into DIR, never into the HDF5 result (read only here).")
+    lo.add_argument("result")
+    lo.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    lo.add_argument("--cylinder", type=int, default=1,
+                    help="cylinder (1-based, from the nose) whose crankpin is drawn (default 1)")
+    lo.set_defaults(func=cmd_loads)
+
+
+def _loads_scene(res):
+    """The result's scene, or a one-line error (exit 2) if ``transient loads`` draws nothing for
+    its mechanism: crank-slider and articulated engines only."""
+    from ..mechanisms.articulated import Articulated
+    from ..mechanisms.crank_slider import CrankSlider
+
+    scene = res.scene()
+    if not isinstance(scene.mechanism, (CrankSlider, Articulated)):
+        raise SceneError("mechanism.type", f"load diagrams are drawn for crank-slider and "
+                                           f"articulated engines, not "
+                                           f"{type(scene.mechanism).__name__} (its forces are "
+                                           f"stored by [analysis] loads = true)",
+                         file=str(res.path))
+    return scene
+
+
+def _diagrams(compute, res, *args):
+    """``compute(*args)``, a run shorter than a cycle being a one-line error (exit 2)."""
+    from ..analysis.irregularity import NoWholeCycle
+
+    try:
+        return compute(*args)
+    except NoWholeCycle as exc:
+        raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
+
+
+def cmd_loads(args) -> int:
+    from ..analysis.load_diagrams import crank_slider_diagrams
+    from ..mechanisms.articulated import Articulated
+
+    res = read_result(args.result)
+    scene = _loads_scene(res)
+    if isinstance(scene.mechanism, Articulated):
+        return _radial_loads(args, res, scene)
+    mech = scene.mechanism
+    n_cyl = mech.n_cylinders
+    if not 1 <= args.cylinder <= n_cyl:
+        raise SceneError("--cylinder", f"must be 1 … {n_cyl}, got {args.cylinder}")
+    d = _diagrams(crank_slider_diagrams, res, scene, res.trajectory, args.cylinder)
+    win, deg, loads = d.window.columns, d.window.angle_deg, d.loads
+    k = args.cylinder - 1
+    out = output_folder(args.output, res.path.parent)
+    stem = res.path.stem
+    plt = pyplot()
+
+    from .. import plots
+
+    written = []
+    ncols = 2 if d.inline else 1
+    fig, axes = plt.subplots(1, ncols, figsize=(6 * ncols, 5.5), squeeze=False)
+    plots.polar_load(axes[0, 0], d.crankpin_x, d.crankpin_y)
+    axes[0, 0].set_xlabel("R_T = T + T_rш [kN] (direction of rotation)")
+    axes[0, 0].set_ylabel("−R_K = −(K + K_rш) [kN] (crank outward)")
+    axes[0, 0].set_title(f"crankpin {args.cylinder}, crank frame", fontsize=9)
+    if d.inline:
+        best = d.most_loaded
+        plots.polar_load(axes[0, 1], d.journal_x, d.journal_y)
+        axes[0, 1].set_xlabel("R_x [kN] (along T₁, direction of rotation)")
+        axes[0, 1].set_ylabel("−R_y [kN] (crank 1 outward)")
+        axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
+                             f"(split beam, (58))", fontsize=9)
+    fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle")
+    written.append(save(fig, out / f"{stem}_loads_polar.png"))
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for j in range(n_cyl):
+        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin {j + 1}")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
+    written.append(save(fig, out / f"{stem}_loads_crankpin.png"))
+
+    rays, sums = d.crankpin_wear
+    fig, axes = plt.subplots(1, ncols, figsize=(5.5 * ncols, 5.5), squeeze=False)
+    plots.wear_diagram(axes[0, 0], rays, sums)
+    axes[0, 0].set_title(f"crankpin {args.cylinder} (frame of its polar diagram)", fontsize=9)
+    if d.inline:
+        plots.wear_diagram(axes[0, 1], *d.journal_wear)
+        axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
+    fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6: each load wears ±60° around its "
+                 f"direction)", fontsize=10)
+    written.append(save(fig, out / f"{stem}_loads_wear.png"))
+
+    if d.inline:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
+        ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
+        written.append(save(fig, out / f"{stem}_loads_running_torques.png"))
+
+    cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
+            "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
+    for j in range(n_cyl):
+        for name in ("P_g", "P_j", "P", "N", "S", "K", "T", "R_K", "R_T", "R"):
+            cols[f"{name}_{j + 1}_N"] = getattr(loads, name)[j]
+        cols[f"M_{j + 1}_Nm"] = loads.torque[j]
+    cols["M_engine_Nm"] = d.engine_torque
+    if d.inline:
+        for j in range(d.journal_torques.shape[0]):
+            cols[f"M_journal_{j + 1}_Nm"] = d.journal_torques[j]
+        for j in range(d.crankpin_torques.shape[0]):
+            cols[f"M_crankpin_{j + 1}_Nm"] = d.crankpin_torques[j]
+        for j in range(d.main_journals.x.shape[0]):
+            cols[f"R_main_{j + 1}_N"] = d.main_journals.magnitude[j]
+    csv = out / f"{stem}_loads.csv"
+    write_columns(csv, cols)
+    written.append(csv)
+
+    area = loads.area
+    start = d.window.start
+    print(f"{res.path}: loads over the last cycle (φ = {start:.6g} … "
+          f"{start + mech.cycle:.6g} rad, {d.window.samples} samples)")
+    for j in range(n_cyl):
+        i = int(np.argmax(loads.R[j]))
+        print(f"  crankpin {j + 1}: |R| max {loads.R[j][i] / 1e3:.6g} kN "
+              f"({loads.R[j][i] / area / 1e6:.4g} MPa on the piston area) at "
+              f"{deg[i]:.4g}° of the cycle, mean {np.mean(loads.R[j]) / 1e3:.6g} kN, "
+              f"min {loads.R[j].min() / 1e3:.6g} kN")
+    s, n = loads.S[k], loads.N[k]
+    print(f"  cylinder {args.cylinder}: rod force S from {s.min() / 1e3:.6g} to "
+          f"{s.max() / 1e3:.6g} kN (compression > 0), side force |N| max "
+          f"{np.abs(n).max() / 1e3:.6g} kN, T from {loads.T[k].min() / 1e3:.6g} to "
+          f"{loads.T[k].max() / 1e3:.6g} kN")
+    m = d.engine_torque
+    print(f"  engine torque Σ T r: mean {np.mean(m):.6g} N m (sample mean), from "
+          f"{m.min():.6g} to {m.max():.6g} N m")
+    if d.inline:
+        for j in range(d.main_journals.x.shape[0]):
+            print(f"  main journal {j + 1}: |R| max {d.main_journals.magnitude[j].max() / 1e3:.6g} kN")
+        for j in range(1, d.journal_torques.shape[0]):
+            print(f"  running torque journal {j + 1}: max |M| "
+                  f"{np.abs(d.journal_torques[j]).max():.6g} N m")
+        for j in range(d.crankpin_torques.shape[0]):
+            print(f"  running torque crankpin {j + 1}: max |M| "
+                  f"{np.abs(d.crankpin_torques[j]).max():.6g} N m")
+    else:
+        print("  main journals and running torques: in-line engines only (skipped)")
+    print(f"  wear diagram of crankpin {args.cylinder}: least loaded ray at "
+          f"{rays[np.argmin(sums)]:g}° (counter-clockwise from the direction of rotation, "
+          f"crank up)")
+    for w in written:
+        print(f"wrote {w}")
+    return EXIT_OK
+
+
+def _radial_loads(args, res, scene) -> int:
+    """``transient loads`` of an articulated engine: each row's master crankpin in its crank
+    frame (polar), the crankpin and link-pin loads over the last cycle, and a CSV; main journals
+    and running torques do not apply."""
+    from .. import plots
+    from ..analysis.load_diagrams import articulated_diagrams
+
+    mech = scene.mechanism
+    d = _diagrams(articulated_diagrams, res, scene, res.trajectory)
+    win, deg, loads = d.window.columns, d.window.angle_deg, d.loads
+    rows, n_links = loads.R.shape[0], loads.link_x.shape[0]
+    out = output_folder(args.output, res.path.parent)
+    stem = res.path.stem
+    plt = pyplot()
+    written = []
+    fig, axes = plt.subplots(1, rows, figsize=(6 * rows, 5.5), squeeze=False)
+    for j in range(rows):
+        plots.crankpin_polar(axes[0, j], loads.R_K[j], loads.R_T[j])
+        axes[0, j].set_title(f"master crankpin of row {j + 1}, crank frame", fontsize=9)
+    fig.suptitle(f"{scene.name}: polar load diagram over the last cycle")
+    written.append(save(fig, out / f"{stem}_loads_polar.png"))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for j in range(rows):
+        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin, row {j + 1}")
+    for i in range(n_links):
+        plots.load_against_angle(ax, deg, d.link_load[i], label=f"link pin {i + 1}")
+    ax.legend(fontsize=8)
+    ax.set_title(f"{scene.name}: crankpin and link-pin loads over the last cycle (dashed: mean)")
+    written.append(save(fig, out / f"{stem}_loads_crankpin.png"))
+    cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
+            "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
+    for k in range(loads.P.shape[0]):
+        for name in ("P_g", "P_j", "P", "N", "S", "torque"):
+            cols[f"{name}_{k + 1}_{'Nm' if name == 'torque' else 'N'}"] = getattr(loads, name)[k]
+    for i in range(n_links):
+        cols[f"link_x_{i + 1}_N"], cols[f"link_y_{i + 1}_N"] = loads.link_x[i], loads.link_y[i]
+    for j in range(rows):
+        for name in ("K", "T", "R_K", "R_T", "R"):
+            cols[f"{name}_row{j + 1}_N"] = getattr(loads, name)[j]
+    csv = out / f"{stem}_loads.csv"
+    write_columns(csv, cols)
+    written.append(csv)
+    start = d.window.start
+    print(f"{res.path}: loads over the last cycle (φ = {start:.6g} … "
+          f"{start + mech.cycle:.6g} rad, {d.window.samples} samples)")
+    for j in range(rows):
+        i = int(np.argmax(loads.R[j]))
+        print(f"  master crankpin, row {j + 1}: |R| max {loads.R[j][i] / 1e3:.6g} kN at "
+              f"{deg[i]:.4g}° of the cycle, mean {np.mean(loads.R[j]) / 1e3:.6g} kN")
+    for i in range(n_links):
+        print(f"  link pin {i + 1}: |F| max {d.link_load[i].max() / 1e3:.6g} kN")
+    for path in written:
+        print(f"  wrote {path}")
+    return EXIT_OK

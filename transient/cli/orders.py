@@ -1,0 +1,151 @@
+"""``transient orders``: order spectra of a stored run as PNG and CSV files
+(:func:`transient.analysis.orders.run_orders`); the result file is only read."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import SceneError
+from .common import EXIT_OK, output_folder, pyplot, read_result, save, write_columns
+
+
+def register(sub) -> None:
+    od = sub.add_parser(
+        "orders", help="order spectra of ω, M_gas and the piston acceleration (PNG + CSV "
+                       "files; the result file is not changed)",
+        description="Order spectra over the last whole cycle (transient.analysis.orders): ω, "
+                    "the gas torque M_gas and, for a crank-slider, the piston acceleration of "
+                    "cylinder 1 against the same engine at constant mean speed (odd-harmonic "
+                    "report); δ of the last cycle; with two or more whole cycles, a run-up "
+                    "waterfall and order tracks of ω against the cycle-mean speed. Results are "
+                    "written as files into DIR, never into the HDF5 result (read only here).")
+    od.add_argument("result")
+    od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    od.add_argument("--samples-per-cycle", type=int, default=720,
+                    help="crank-angle grid points per engine cycle (default 720); orders up to "
+                         "half of it per cycle")
+    od.add_argument("--max-order", type=float, default=12.0,
+                    help="highest order in the tables and figures (default 12)")
+    od.add_argument("--detrend", choices=("auto", "ramp", "none"), default="auto",
+                    help="remove each cycle's ramp from ω before its DFT (default auto: for a "
+                         "spin-up, a run starting below 90 %% of its final speed)")
+    od.set_defaults(func=cmd_orders)
+
+
+def cmd_orders(args) -> int:
+    from ..analysis.irregularity import NoWholeCycle
+    from ..analysis.orders import orders_up_to, run_orders, strongest_orders
+    from ..mechanisms.crank_slider import CrankSlider
+
+    res = read_result(args.result)
+    scene = res.scene()
+    mech = scene.mechanism
+    n = args.samples_per_cycle
+    if n < 16:
+        raise SceneError("--samples-per-cycle", f"must be ≥ 16, got {n}")
+    if not args.max_order > 0:
+        raise SceneError("--max-order", f"must be > 0, got {args.max_order:g}")
+    traj = res.trajectory
+    cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
+    try:
+        ro = run_orders(scene, traj, n, cuts=cuts, detrend=args.detrend,
+                        piston_cylinder=1 if isinstance(mech, CrankSlider) else None)
+    except NoWholeCycle as exc:
+        raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
+    spec_w, spec_m, rep = ro.omega, ro.gas_torque, ro.piston
+    starts, means, n_cyc, detrend = ro.cycle_start, ro.omega_mean, ro.cycles, ro.detrend
+    rpm = 30.0 / math.pi
+    orders = ro.orders
+    top = args.max_order
+
+    out = output_folder(args.output, res.path.parent)
+    stem = res.path.stem
+    written = []
+    cols_csv = {"order": orders, "omega_amplitude_rad_s": spec_w.amplitude[-1],
+                "omega_phase_rad": spec_w.phase[-1]}
+    if spec_m is not None:
+        cols_csv["M_gas_amplitude_Nm"] = spec_m.amplitude[-1]
+        cols_csv["M_gas_phase_rad"] = spec_m.phase[-1]
+    if rep is not None:
+        cols_csv["W_amplitude_m_s2"] = rep.amplitude[-1]
+        cols_csv["W_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
+        cols_csv["W_relative"] = rep.relative[-1]
+        cols_csv["W_relative_constant"] = rep.relative_constant[-1]
+        cols_csv["W_relative_added"] = rep.relative_added[-1]
+    csv = out / f"{stem}_orders.csv"
+    write_columns(csv, cols_csv)
+    written.append(csv)
+
+    plt = pyplot()
+
+    from .. import plots
+
+    rows = 1 + (spec_m is not None) + (rep is not None)
+    fig, axes = plt.subplots(rows, 1, figsize=(9, 3.2 * rows), squeeze=False)
+    axes = axes[:, 0]
+    plots.order_bars(axes[0], orders, spec_w.amplitude[-1], "ω amplitude [rad/s]", top)
+    axes[0].set_title(f"{scene.name}: orders over the last cycle (mean ω "
+                      f"{means[-1] * rpm:.5g} rpm, δ = {ro.delta:.4g}"
+                      f"{', detrended' if detrend == 'ramp' else ''})", fontsize=10)
+    i = 1
+    if spec_m is not None:
+        plots.order_bars(axes[i], orders, spec_m.amplitude[-1], "M_gas amplitude [N m]", top)
+        i += 1
+    if rep is not None:
+        plots.order_bars(axes[i], orders, rep.relative[-1], "W / W₁ (cylinder 1)", top,
+                         width=0.2, offset=-0.1, label="run", log=True)
+        plots.order_bars(axes[i], orders, rep.relative_constant[-1], "W / W₁ (cylinder 1)", top,
+                         width=0.2, offset=0.1, label="constant ω̄", log=True)
+        axes[i].legend(fontsize=8)
+    written.append(save(fig, out / f"{stem}_orders.png"))
+
+    if n_cyc >= 2:
+        amp = spec_w.amplitude
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5))
+        # (at most 60 cycles, evenly spread: more lines would not be told apart)
+        pick = np.unique(np.linspace(0, n_cyc - 1, min(n_cyc, 60)).round().astype(int))
+        plots.order_waterfall(a1, means[pick] * rpm, orders, amp[pick], top)
+        a1.set_title(f"ω spectrum per cycle ({pick.size} of {n_cyc} cycles)", fontsize=9)
+        # the last cycle's strongest orders, in order of the order
+        tracks = {f"order {orders[j]:g}": amp[:, j]
+                  for j in sorted(strongest_orders(orders, amp[-1], top))}
+        plots.order_tracks(a2, means * rpm, tracks, "ω amplitude [rad/s]")
+        a2.set_title("order tracks of ω against the cycle-mean speed", fontsize=9)
+        fig.suptitle(f"{scene.name}: run-up orders of ω")
+        written.append(save(fig, out / f"{stem}_orders_runup.png"))
+        run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": starts,
+               "omega_mean_rad_s": means}
+        run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j]
+                    for j in orders_up_to(orders, top)})
+        csv = out / f"{stem}_orders_runup.csv"
+        write_columns(csv, run)
+        written.append(csv)
+
+    print(f"{res.path}: orders over the last whole cycle (φ = {starts[-1]:.6g} … "
+          f"{starts[-1] + mech.cycle:.6g} rad, {n} points; {n_cyc} whole cycle(s); ω spectra "
+          f"{'detrended (ramp)' if detrend == 'ramp' else 'not detrended'})")
+    print(f"  δ = {ro.delta:.12g} (last cycle, (ω_max − ω_min)/ω_mean), cycle-mean ω = "
+          f"{means[-1]:.6g} rad/s ({means[-1] * rpm:.6g} rpm)")
+    print("  ω, strongest orders: " + ", ".join(
+        f"{orders[j]:g}: {spec_w.amplitude[-1][j]:.4g} rad/s"
+        for j in strongest_orders(orders, spec_w.amplitude[-1], top)))
+    if spec_m is not None:
+        print(f"  M_gas (mean {spec_m.mean[-1]:.6g} N m), strongest orders: " + ", ".join(
+            f"{orders[j]:g}: {spec_m.amplitude[-1][j]:.4g} N m"
+            for j in strongest_orders(orders, spec_m.amplitude[-1], top)))
+    if rep is not None:
+        print(f"  piston acceleration W of cylinder 1, relative to its first order "
+              f"(|W₁| = {rep.first[-1]:.6g} m/s²), against the same engine at constant "
+              f"ω̄ = {rep.omega_mean[-1]:.6g} rad/s:")
+        print(f"  {'order':>6} {'|W| [m/s²]':>12} {'rel. run':>10} {'rel. ω̄':>10} "
+              f"{'added':>10}  kind")
+        for r in rep.table(-1, max_order=top):
+            print(f"  {r['order']:6g} {r['amplitude']:12.5g} {r['relative']:10.3e} "
+                  f"{r['relative_constant']:10.3e} {r['relative_added']:10.3e}  {r['kind']}")
+        if rep.drift[-1] and abs(rep.drift[-1]) > 1e-6 * rep.first[-1]:
+            print(f"  (the cycle is not periodic: W drifts by {rep.drift[-1]:.3g} m/s² across "
+                  f"it, which leaks into every order)")
+    for w in written:
+        print(f"wrote {w}")
+    return EXIT_OK

@@ -1,0 +1,178 @@
+"""``transient run``, ``check`` and ``info``: simulate a scene, validate one, summarise a result."""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .common import EXIT_OK, KERNELS_NOTICE, read_result
+
+
+def register(sub) -> None:
+    r = sub.add_parser("run", help="simulate a scene and write DIR/<scene stem>.h5")
+    r.add_argument("scene")
+    r.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    r.add_argument("--force", action="store_true", help="overwrite an existing result")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
+    r.set_defaults(func=cmd_run)
+    c = sub.add_parser("check", help="validate a scene only")
+    c.add_argument("scene")
+    c.set_defaults(func=cmd_check)
+    i = sub.add_parser("info", help="summarise a result file")
+    i.add_argument("result")
+    i.set_defaults(func=cmd_info)
+
+
+def cmd_check(args) -> int:
+    from ..scene import load_scene
+
+    scene = load_scene(args.scene)
+    pairs = scene.friction.pairs
+    friction = (f", {len(pairs)} non-ideal pair(s) ({', '.join(p.name for p in pairs)}; "
+                f"policy {scene.friction.policy})" if pairs else "")
+    print(f"{args.scene}: ok ({scene.name}: {type(scene.mechanism).__name__}, "
+          f"{scene.mechanism.n_cylinders} cylinder(s), gas {scene.gas.model}, "
+          f"run {scene.run.mode}{friction})")
+    return EXIT_OK
+
+
+def cmd_run(args) -> int:
+    from ..results import check_writable
+    from ..scene import load_scene, runs_compiled
+    from ..run import simulate
+
+    scene = load_scene(args.scene)
+    path = Path(args.output) / f"{Path(args.scene).stem}.h5"
+    check_writable(path, args.force)
+    bar = None
+    if not args.quiet and sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=1000, desc=f"{scene.name} ({KERNELS_NOTICE})" if runs_compiled(scene)
+                   else scene.name, unit="‰", file=sys.stderr, leave=False)
+    progress = None
+    if bar:
+        def progress(fraction):
+            if KERNELS_NOTICE in bar.desc:
+                bar.set_description(scene.name)  # (shown at once, however short the run)
+            bar.update(int(1000 * fraction) - bar.n)
+    try:
+        data = simulate(scene, path, force=args.force, progress=progress)
+    finally:
+        if bar:
+            bar.close()
+    if not args.quiet:
+        print(f"wrote {path}")
+        _print_summary(data.extra["summary"], data.solver)
+    return EXIT_OK
+
+
+def _print_summary(summary, solver) -> None:
+    rpm = 30.0 / math.pi
+    v = {k: val for k, (val, _) in summary.items()}
+    print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
+          f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
+    print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
+          f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
+    ss = v.get("steady_state_t")
+    if ss is not None:
+        print("  steady state: " + (f"reached at t = {ss:.6g} s" if math.isfinite(ss) else
+                                    "not reached (cycle-mean speed still changing by ≥ 1e-4)"))
+    if "M_gas_swing_last_cycle" in v:
+        print(f"  last cycle: peak |ε| = {v['epsilon_peak_last_cycle']:.4g} rad/s², swing of the "
+              f"gas torque {v['M_gas_swing_last_cycle']:.4g} N m against the inertia torque "
+              f"½J′ω² {v['M_inertia_swing_last_cycle']:.4g} N m")
+    if "mean_drive_torque_last_cycle" in v:
+        print(f"  mean drive torque required over the last cycle: "
+              f"{v['mean_drive_torque_last_cycle']:.6g} N m")
+    _print_response(v)
+    _print_efficiency(v)
+    asked = [k for k, val in v.items() if np.ndim(val) > 0]
+    if asked:
+        print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
+              f"`transient info`)")
+    print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
+          f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
+          f"compile/cache load)")
+    if solver.get("stiff_rerun"):
+        print(f"  {solver['stiff_rerun']}")
+
+
+def _print_response(v: dict) -> None:
+    """ISO 8528-5 measures of each load step and of a spin-up (``analysis.transient_response``)."""
+    rpm = 30.0 / math.pi
+    k = 1
+    while f"load_change_{k}_t_s" in v:
+        p = f"load_change_{k}_"
+        rec = (f"recovered into ±{v[p + 'band_pct']:.3g} % after {v[p + 'recovery_s']:.4g} s"
+               if v[p + "recovered"] else "not recovered by the end of its segment")
+        print(f"  load step {k} at t = {v[p + 't_s']:.6g} s: cycle-mean speed "
+              f"{v[p + 'omega_before_rad_s'] * rpm:.6g} → {v[p + 'omega_after_rad_s'] * rpm:.6g} "
+              f"rpm, transient deviation {v[p + 'dev_max_pct']:+.4g} %, {rec}, steady change "
+              f"(droop) {v[p + 'droop_pct']:+.4g} %"
+              + ("" if v[p + "settled"] else " (not settled: segment too short)"))
+        k += 1
+    if "spin_up_t90_s" in v:
+        print(f"  spin-up: 90 % of the final {v['spin_up_omega_final_rad_s'] * rpm:.6g} rpm after "
+              f"{v['spin_up_t90_s']:.4g} s, in ±1 % after {v['spin_up_settling_s']:.4g} s, "
+              f"overshoot {v['spin_up_overshoot_pct']:.3g} %")
+
+
+def _print_efficiency(v: dict) -> None:
+    """η_mech in both forms and each pair's budget per cycle (``analysis.efficiency``)."""
+    if "eta_mech_work" not in v:
+        return
+    print(f"  mechanical efficiency over {v['steady_cycles']:.0f} steady cycle(s): "
+          f"η = W_out/W_in = {v['eta_mech_work']:.6f} (work ratio; W_in = "
+          f"{v['W_in_per_cycle']:.6g} J/cycle; energy balance residual "
+          f"{v['energy_balance_residual']:.2e})")
+    if "eta_mech_printed" in v:
+        print(f"    (30) as printed, time average of P_out/P_in: {v['eta_mech_printed']:.6g} "
+              f"(ill-posed where P_in crosses zero; {100 * v['eta_mech_printed_excluded']:.3g} % "
+              f"of the time left out)")
+    k = 1
+    while f"W_loss_{k}_per_cycle" in v:
+        print(f"    pair {k}: loss {v[f'W_loss_{k}_per_cycle']:.6g} J/cycle "
+              f"({100 * v[f'loss_share_{k}']:.4g} % of W_in), circulated "
+              f"{v[f'W_circulated_{k}_per_cycle']:.6g} J/cycle, far side driving "
+              f"{100 * v[f'backward_share_{k}']:.3g} % of the time, mode against the power "
+              f"{100 * v[f'mode_against_power_share_{k}']:.3g} % of the time")
+        k += 1
+    if "pair_mode_switches_per_cycle" in v:
+        print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
+
+
+def cmd_info(args) -> int:
+    res = read_result(args.result)
+    a = res.attrs
+    print(f"{res.path}: scene {a['scene']!r}, transient {a['version']}, format {a['format']}, "
+          f"created {a['created']}, complete = {bool(a['complete'])}")
+    if a.get("message"):
+        print(f"  message: {a['message']}")
+    n = res.trajectory["t"].size
+    print(f"  trajectory: {n} samples; " + ", ".join(f"{k} [{u}]" for k, u in res.units.items()))
+    for name, ev in res.events.items():
+        print(f"  events {name}: {ev['t'].size}")
+    s = res.solver
+    if s:
+        print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
+              f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
+              f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
+        if s.get("stiff_rerun"):
+            print(f"  {s['stiff_rerun']}")
+    values = {k: v for k, (v, _) in res.analysis.items()}
+    _print_response(values)
+    _print_efficiency(values)
+    arrays = []
+    for k, (v, unit) in res.analysis.items():
+        if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped
+            arrays.append(f"{k} {'×'.join(map(str, np.shape(v)))} [{unit}]")
+        else:
+            print(f"  {k} = {v:.9g} {unit}" if isinstance(v, (int, float, np.number))
+                  else f"  {k} = {v} {unit}")
+    if arrays:
+        print(f"  analyses asked for by the scene ([analysis]; {len(arrays)} arrays): "
+              + ", ".join(arrays))
+    return EXIT_OK
