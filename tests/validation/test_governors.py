@@ -1,4 +1,4 @@
-"""Dynamic governors and fuel latching (issue 6): the PI governor's zero steady error and its
+"""Dynamic governors and fuel latching: the PI governor's zero steady error and its
 anti-windup, the flyweight governor's stops and static characteristic, the latching of each
 cylinder's fuel at its start of injection, and the compiled path against the reference path
 (whose governor is written out again in numpy, ``transient.reference.GovernorNumpy``).
@@ -165,11 +165,10 @@ def test_fuel_latched_exactly_at_each_cylinders_injection():
 ])
 def test_governors_agree_with_the_reference_path(case, sections):
     """Both paths at rtol = atol = 1e-10: the final state (speed, governor states, latched fuels)
-    and every governor event (sleeve stops and lift-offs, injections) in t and φ. Measured worst:
-    1.7e-7 relative (the PID's derivative filter; ω 7.5e-8, injections 2.6e-8 s or rad) for the
-    PID with its rate limit, a kink both paths take by step-size control alone (the reference
-    path takes the clipping of the demand so too; the compiled one switches it by events);
-    bound 1e-6."""
+    and every governor event (sleeve stops and lift-offs, injections) in t and φ. The paths
+    differ most on the PID with its rate limit (in its derivative filter), a kink both paths take
+    by step-size control alone (the reference path takes the clipping of the demand so too; the
+    compiled one switches it by events); bound 1e-6, above that difference."""
     solver = {"rtol": 1e-10, "atol": 1e-10}
     fast = run(scene(case, solver=solver, **sections))
     ref = run(scene(case, solver={**solver, "method": "scipy-DOP853"}, **sections))
