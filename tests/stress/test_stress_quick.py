@@ -1,4 +1,4 @@
-"""``transient stress --quick`` end to end (the CI run of the stress suite, issue 9): every case
+"""``transient stress --quick`` end to end (the CI run of the stress suite): every case
 passes or is a written-up known failure, and the report lists every case with its numbers."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A governor far faster than the engine (issue 9): detected by the stiffness test of the
+"""A governor far faster than the engine: detected by the stiffness test of the
 compiled stepper and rerun by the implicit Radau method, with a message saying so.
 
 The scene: the Gots PI generator set (``cases/gots_diesel_pi.toml``) with an actuator lag of

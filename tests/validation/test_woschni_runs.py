@@ -1,4 +1,4 @@
-"""Wall heat transfer in the ODE (issue 6, ``[gas.woschni]``): the cylinder pressures of the closed
+"""Wall heat transfer in the ODE (``[gas.woschni]``): the cylinder pressures of the closed
 part are states of the compiled stepper (``transient.core.cylinder``).
 
 Independent checks:
