@@ -1,7 +1,7 @@
 """The performance targets as ``transient bench`` measures them
 (:mod:`transient.verify.targets`): the hand-written (18) it times transient against is the same
-equation, and the verdicts read the record's rows as stated. (The harness end to end, on short runs: ``tests/cli/test_cli.py::
-test_bench_quick_writes_a_consistent_record``.)"""
+equation, and the verdicts read the record's rows as stated. (The harness end to end, on short
+runs: ``tests/cli/test_cli.py::test_bench_quick_writes_a_consistent_record``.)"""
 from __future__ import annotations
 
 import math

@@ -61,7 +61,7 @@ def jittered(h0, span=FOUR_PI, seed=0):
 @pytest.mark.parametrize("seed", range(4))
 def test_resample_hermite_and_spline_within_stated_bounds(seed):
     """Hermite ≤ h⁴M₄/384; spline ≤ (5/384)h⁴M₄ three intervals away from the ends, ≤ twice it
-    next to them: bounds with room over seeds 0–39 and h = 0.005…0.056 (the ratios print with -s)."""
+    next to them: bounds with room over seeds 0–39 and h = 0.005…0.056 (-s prints the ratios)."""
     for h0 in (0.04, 0.01):
         x, h = jittered(h0, seed=seed)
         g = np.linspace(x[0], x[-1], 4001)
