@@ -57,7 +57,7 @@ TOLERANCES = tuple(10.0 ** -k for k in range(3, 13))
 ATOL_PER_RTOL = 1e-3
 REF_RTOL = 1e-13
 #: Each solve_ivp run is stopped after this long [s], and its tighter tolerances skipped (long
-#: enough for RK45 to finish runs on every scene on a 2-core machine; half of it was not).
+#: enough for RK45 to finish runs on every scene on a 2-core machine, which half of it is not).
 BASELINE_BUDGET_S = 60.0
 #: The accuracy at which speed is compared: final phase error after 1000 revolutions [rad].
 TARGET_PHASE = 1e-6

@@ -224,8 +224,8 @@ def make_hand_rhs(layout=False, loads=False, records=False):
 
 def make_hand_loop(rhs):
     # Without reference counting, as transient's kernels: with it, the view states[i] is increfed
-    # and decrefed at every call unless numba's pruning removes the pair, which it did for the
-    # bare kernel but not once the load's branches were added.
+    # and decrefed at every call unless numba's pruning removes the pair, which it does for the
+    # bare kernel but not once the load's branches are in.
     @njit(_nrt=False)
     def loop(p, states, out, rec):
         acc = 0.0
