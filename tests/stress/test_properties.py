@@ -251,18 +251,21 @@ def check(d):
             assert abs(e) <= bound, (name, y, y_ref, e, bound, d)
 
 
+@pytest.mark.slow
 @settings.get_profile(PROFILE)
 @given(crank_slider_scenes())
 def test_random_crank_slider_scenes(d):
     check(d)
 
 
+@pytest.mark.slow
 @settings.get_profile(PROFILE)
 @given(swash_plate_scenes())
 def test_random_swash_plate_scenes(d):
     check(d)
 
 
+@pytest.mark.slow
 @settings.get_profile(PROFILE)
 @given(articulated_scenes())
 def test_random_articulated_scenes(d):

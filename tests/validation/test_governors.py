@@ -155,9 +155,10 @@ def test_fuel_latched_exactly_at_each_cylinders_injection():
 
 
 @pytest.mark.parametrize("case,sections", [
-    ("gots_diesel_pi.toml", dict(load={"schedule_time": [0.1, 0.1], "schedule_scale": [0.0, 1.0]},
-                                 governor={"gain_d": 0.02, "rate_limit": 5.0},
-                                 run={"t_end": 0.4})),
+    pytest.param("gots_diesel_pi.toml",
+                 dict(load={"schedule_time": [0.1, 0.1], "schedule_scale": [0.0, 1.0]},
+                      governor={"gain_d": 0.02, "rate_limit": 5.0}, run={"t_end": 0.4}),
+                 marks=pytest.mark.slow),
     ("gots_diesel_start_flyweight.toml", dict(
         starter={"torque": 0.0}, initial={"omega": 3550 * RPM},
         load={"fan": 0.6e-3, "schedule_time": [0.25, 0.25], "schedule_scale": [1.0, 2.0]},

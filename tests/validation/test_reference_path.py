@@ -70,6 +70,10 @@ def dynamic_scenes():
 
 
 SCENES = dynamic_scenes()
+#: The scenes whose reference runs (the diesel's mixed cycle with governors, pairs, load steps,
+#: Wiebe or wall heat: plain-Python right-hand sides over many short steps) make the test slow.
+SLOW_SCENES = {"gots_diesel_friction", "gots_diesel_governed", "gots_diesel_load_steps",
+               "gots_diesel_pi", "gots_diesel_wiebe", "gots_diesel_woschni"}
 
 
 def shortened(name, method):
@@ -134,7 +138,8 @@ def compiled_runs():
 
 
 @pytest.mark.parametrize("method", ["scipy-DOP853", "scipy-Radau"])
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.slow)
+                                  if name in SLOW_SCENES else name for name in SCENES])
 def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch):
     comp = compiled_runs[name]
     scene = shortened(name, method)
