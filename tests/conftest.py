@@ -3,11 +3,11 @@ worksteal``) hands the tests to its workers.
 
 worksteal gives each worker an equal, contiguous share of the collection, in order, and a worker
 that runs out takes the end of a busy one's share. On a cold numba cache the compiled stepper
-takes ~210–240 s to compile on the slower test machine; one worker compiles it and any other that
+takes minutes to compile; one worker compiles it and any other that
 needs it meanwhile waits on its lock (``transient.core.jit``), then loads it. The unit tests
 never run the stepper (runs belong in ``tests/validation``), so they go last: the last worker's
 share is unit tests, which it runs while the first compiles. The stress tests go first, so that
-their longest ones (up to ~160 s) start early rather than end the run. A serial run keeps
+their longest ones start early rather than end the run. A serial run keeps
 pytest's own order.
 """
 from __future__ import annotations

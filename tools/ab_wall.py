@@ -2,12 +2,12 @@
 of 5 runs after a warm-up, with RHS calls, steps and rejected steps.
 
 Compare two commits by running it once per checkout, alternately, e.g.
-``git worktree add /tmp/old 705e2d5`` then ``PYTHONPATH=/tmp/old .venv/bin/python
+``git worktree add /tmp/old <commit>`` then ``PYTHONPATH=/tmp/old .venv/bin/python
 tools/ab_wall.py`` and ``.venv/bin/python tools/ab_wall.py``, twice each.
 
 ``--bench`` times instead the scenes at the settings of ``stepper_overhead.py`` (1000
 revolutions, rtol 1e-8, atol 1e-11), writing 72 and then one sample per turn, median of 9, with
-the Gots spin-up as a fourth scene (README, *Calls that copy the Model*).
+the Gots spin-up as a fourth scene.
 """
 from __future__ import annotations
 

@@ -7,9 +7,9 @@ heat, other mechanisms. This script times a copy of ``derivative``'s crank-angle
 branches, then with each of them removed (compiled out: a closure constant), then with all
 removed, each checked against transient's own right-hand side first (the same checksum to 1e-9
 over the states). It also times transient's ``derivative`` itself in this script's loop and in
-``transient bench``'s (``bench_targets.rhs_loop``): the same code in two loops, to show how far
-the compiler's layout alone moves a call. Per-call medians as ``transient bench`` times them.
-Rerun: ``.venv/bin/python tools/bare_gap.py`` (about 90 s, mostly compiling).
+``transient bench``'s (``transient.verify.targets.rhs_loop``): the same code in two loops, to show
+how far the compiler's layout alone moves a call. Per-call medians as ``transient bench`` times
+them. Rerun: ``.venv/bin/python tools/bare_gap.py`` (mostly compiling).
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Sweep speed-up and scheduler overhead (issue 10): the 64-run sweep of
+"""Sweep speed-up and scheduler overhead: the 64-run sweep of
 ``cases/sweeps/gots_eta_speed_load.toml`` serially in one process (``--scheduler serial``, no Dask)
 against a 2-worker Dask LocalCluster, and the per-run overhead of the scheduler.
 
@@ -15,7 +15,7 @@ Per-run overhead: (a) 1000 no-op tasks through the same client and ``as_complete
 per task; (b) from the warm sweep, 2·wall/64 minus the mean time a worker spent in a run.
 
 Rerun: ``.venv/bin/python tools/bench_sweep.py [--revolutions N] [--repeat K]`` (the sweep's
-300 revolutions by default; about a minute per round on 2 free cores).
+300 revolutions by default).
 """
 from __future__ import annotations
 

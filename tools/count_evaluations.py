@@ -4,8 +4,7 @@ iterations by event component.
 
 The kernels run as Python (``NUMBA_DISABLE_JIT=1``, set here before numba is imported), so that
 the margins and the root finder can be wrapped and counted; the run takes the compiled run's
-steps (on the diesel's 100 revolutions the same 67 500 right-hand sides and 3 395 steps). That
-run takes ~5 s::
+steps (the same right-hand sides and steps on the diesel's 100 revolutions). Run::
 
     .venv/bin/python tools/count_evaluations.py gots_diesel_governed 100
 """

@@ -1,7 +1,7 @@
 """The two mode policies of the non-ideal pairs compared on the Gots diesel and the swash-plate
-engine (issue 4): steady speed, η_mech in both forms, each pair's loss and circulated energy per
+engine: steady speed, η_mech in both forms, each pair's loss and circulated energy per
 cycle, how often the paper's criterion runs a pair against the power it transmits, and the cost.
-Rerun: ``.venv/bin/python tools/friction_policy_comparison.py`` (about 10 s).
+Rerun: ``.venv/bin/python tools/friction_policy_comparison.py``.
 """
 import dataclasses as dc
 import math

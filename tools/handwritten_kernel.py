@@ -1,11 +1,11 @@
-"""Issue 5's "bare scene at the speed of bare (18)", with the difference attributed: the cost of
+"""The target "bare scene at the speed of bare (18)", with the difference attributed: the cost of
 one right-hand side of transient for the bare single cylinder (``cases/coasting_single.toml``: no
 gas, friction, governor or starter) against a kernel written by hand for that equation alone
 (``transient.verify.targets.make_hand_rhs``; ``transient bench`` records the two ends in
 ``targets.md``), and between them the hand-written kernel with, one rung at a time, what
 transient's right-hand side does beyond it; then whole runs of the bare scene against the same
 scene carrying unused options (a droop governor, a zero-torque starter, never acting; medians of
-15 alternating runs). Rerun: ``.venv/bin/python tools/handwritten_kernel.py`` (about 20 s).
+15 alternating runs). Rerun: ``.venv/bin/python tools/handwritten_kernel.py``.
 ``tools/bare_gap.py`` looks at the same difference from transient's side.
 """
 from transient.verify.targets import BARE_SCENE, bare_kernel, hand_written_cost, unused_options

@@ -1,19 +1,18 @@
-"""Where the result file's memory growth comes from (README *Speed*, Scale).
+"""Where the result file's memory growth comes from (the scale target's peak memory).
 
 Writes 16 columns at 4 samples per revolution through ``results.ResultWriter`` (blocks of 16384
 rows of smooth data, no integration) and prints the process's resident memory and HDF5's
 metadata cache size (``H5Fget_mdc_size``: max, min clean, current, entries) at 10³, 2×10⁵,
 5×10⁵ and 10⁶ revolutions, in one of five variants: ``default`` (the file in HDF5's 1.10
-format, ``results.FILE_FORMAT``); ``v108``, the file in h5py's default bounds, the 1.8 format
-(the default until 2026-11-25), whose chunk index is a B-tree; ``cap``, the metadata cache held
-at 2 MiB (its default starts there and may grow to 32 MiB); ``limits``, HDF5's free lists
-limited to 1 MiB in all and 256 KiB per list (``H5set_free_list_limits``); ``gc``, HDF5's free
-lists emptied at each checkpoint (``H5garbage_collect``). The last two call the libhdf5 that
-h5py bundles through ctypes (h5py does not wrap them).
+format, ``results.FILE_FORMAT``); ``v108``, the file in h5py's default bounds, the 1.8 format,
+whose chunk index is a B-tree; ``cap``, the metadata cache held at 2 MiB (its default starts
+there and may grow to 32 MiB); ``limits``, HDF5's free lists limited to 1 MiB in all and 256 KiB
+per list (``H5set_free_list_limits``); ``gc``, HDF5's free lists emptied at each checkpoint
+(``H5garbage_collect``). The last two call the libhdf5 that h5py bundles through ctypes (h5py
+does not wrap them).
 
 Rerun: ``for v in default v108 cap limits gc; do .venv/bin/python
-tools/hdf5_memory_growth.py $v; done`` (about 10 s each; writes
-/tmp/hdf5_memory_growth_<variant>.h5).
+tools/hdf5_memory_growth.py $v; done`` (each writes /tmp/hdf5_memory_growth_<variant>.h5).
 """
 import ctypes
 import glob

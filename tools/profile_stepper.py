@@ -10,7 +10,7 @@ and ``(%rsp)``, ``push``): passing the Model tuple to a function that is not inl
 an upper bound). ``--calls NAME`` attributes a function's stack moves to the call that follows
 them (approximately: the moves since the previous call).
 
-Needs ``perf`` and binutils (``nm``, ``objdump``). Run (6 s and 1.5 s here, warm cache)::
+Needs ``perf`` and binutils (``nm``, ``objdump``). Run (warm cache)::
 
     perf record -o /tmp/perf.data .venv/bin/python tools/profile_stepper.py run \
         gots_diesel_governed [REPEATS [SAMPLES_PER_TURN]]

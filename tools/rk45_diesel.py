@@ -1,6 +1,6 @@
-"""Issue 5's ratio to solve_ivp RK45 on the governed Gots diesel, measured instead of bounded.
+"""transient's ratio to solve_ivp RK45 on the governed Gots diesel, measured instead of bounded.
 
-``transient bench`` stops a baseline at 60 s (30 s until 2026-11-26), which RK45 with the numpy
+``transient bench`` stops a baseline at 60 s, which RK45 with the numpy
 right-hand side passes on this scene at rtol 1e-4 or even 1e-3 (machine by machine), so the record
 holds at most a bound of the ratio. This script
 runs the bench's own pieces with an hour's budget per RK45 run: the reference (compiled DOP853 at
@@ -10,10 +10,9 @@ budget or the tolerances end (its error is not monotone in rtol, so it does not 
 run under the target). It prints every row and the ratio at equal error both ways the bench states
 it, and writes the rows to ``results/benchmarks/rk45_diesel.csv``.
 
-Rerun: ``.venv/bin/python tools/rk45_diesel.py [TIGHTEST_RTOL]`` (RK45's runs take most of it:
-14 min on a 2-core machine at a87c692 down to rtol 1e-12, where RK45 first reached 1e-6 rad at
-1e-10; ``1e-10`` as TIGHTEST_RTOL stops there: 21 min 27 s on the slower machine of 2026-11-26,
-4 min 29 s on the machine of 2026-11-27).
+Rerun: ``.venv/bin/python tools/rk45_diesel.py [TIGHTEST_RTOL]`` (RK45's runs take most of it,
+down to the bench's tightest rtol by default; RK45 first reaches 1e-6 rad at rtol 1e-10, so
+``1e-10`` as TIGHTEST_RTOL stops there).
 """
 import csv
 import sys

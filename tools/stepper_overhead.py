@@ -1,13 +1,13 @@
 """Stepper overhead: wall time of a run against (RHS evaluations × cost of one compiled RHS
 call), for the benchmark scenes and the Gots spin-up with and without friction pairs, at rtol 1e-8
-over 1000 revolutions (issue 5's target: ≤ 30 %), writing 72 output samples per turn and writing
+over 1000 revolutions (the target: ≤ 30 %), writing 72 output samples per turn and writing
 one (as ``transient bench`` times its runs). The measurement is
 ``transient.verify.targets.stepper_overhead`` (``transient bench`` records it for the three
 benchmark scenes in ``targets.md``): the cost of one call timed in a compiled loop over 2000
 states along the run's last cycle, once with the calls independent (the RHS's throughput) and
 once chained (its latency, as a step's stages are). For scenes with pairs it prints the cost of
 one mode-margin evaluation as a call too: the stepper counts those among its RHS evaluations.
-Rerun: ``.venv/bin/python tools/stepper_overhead.py`` (about a minute).
+Rerun: ``.venv/bin/python tools/stepper_overhead.py``.
 """
 from pathlib import Path
 

@@ -2,7 +2,7 @@
 
 The governor is removed and the fan load sized so that the full-force mean gas torque (119.91 and
 482.52 N m, see the scene files) balances it at each speed; δ over the last turn of a run started
-at that speed. Rerun: ``.venv/bin/python tools/swash_smoothness_vs_speed.py`` (about 10 s).
+at that speed. Rerun: ``.venv/bin/python tools/swash_smoothness_vs_speed.py``.
 """
 import dataclasses as dc
 from pathlib import Path

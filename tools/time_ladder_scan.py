@@ -1,11 +1,11 @@
-"""The time-domain tolerance ladder of issue 9, scanned finer than ``transient stress`` does, with
-scipy's DOP853 beside it: on the Gots spin-up (40 revolutions, output every 1e-4 s, atol =
+"""The stress suite's time-domain tolerance ladder, scanned finer than ``transient stress`` does,
+with scipy's DOP853 beside it: on the Gots spin-up (40 revolutions, output every 1e-4 s, atol =
 rtol/100), transient's compiled DOP853 in time and ``solve_ivp(method="DOP853")`` on the reference
 path's numpy right-hand side, each against the compiled run at rtol 1e-13.
 
 Columns: rtol; transient's largest error along the run (``stress.ladder_error``), its steps; the
 final-state error (larger of |Δt|/t and |Δω|/ω, ``stress.end_error``) of transient and of scipy,
-scipy's steps. Rerun: ``.venv/bin/python tools/time_ladder_scan.py`` (about 20 s).
+scipy's steps. Rerun: ``.venv/bin/python tools/time_ladder_scan.py``.
 """
 import tempfile
 import time

@@ -296,10 +296,9 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
 def _work_columns(traj: dict, n_pairs: int) -> None:
     """Work integrals of a prescribed run, by the trapezoidal rule over its samples [J]
     (a dynamic run integrates them with the motion instead). Written out (the arithmetic of
-    scipy's ``cumulative_trapezoid``) because importing scipy.integrate took 0.28–0.47 s after
-    numpy (five fresh interpreters; it imports scipy.linalg and scipy.optimize), while a warm
-    ``transient run cases/gots_diesel_4400.toml`` takes 0.51–0.54 s of process wall without it
-    (README *Start-up*)."""
+    scipy's ``cumulative_trapezoid``) because importing scipy.integrate (which imports
+    scipy.linalg and scipy.optimize) costs a noticeable part of a warm ``transient run``'s
+    process wall."""
     t, w = traj["t"], traj["omega"]
     dt = np.diff(t)
     for name, power in (("W_gas", traj["M_gas"] * w), ("W_load", traj["M_load"] * w),
@@ -344,10 +343,10 @@ def _implicit_rerun(scene, stiff: RunData, on_block, progress) -> RunData:
 
 class _WriteBehind:
     """Writes a block in a second thread while the stepper computes the next one: the compiled
-    ``advance`` runs without the GIL (``nogil``), and compressing a block costs about a third of
-    computing it at 72 samples per revolution (README *Start-up*). One write at a time, so the
-    file takes the blocks in the run's order and memory stays bounded; a write's exception is
-    raised in the caller by :meth:`wait`."""
+    ``advance`` runs without the GIL (``nogil``), and compressing a block costs a sizeable part
+    of computing it at dense output. One write at a time, so the file takes the blocks in the
+    run's order and memory stays bounded; a write's exception is raised in the caller by
+    :meth:`wait`."""
 
     def __init__(self) -> None:
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="transient-write")

@@ -1,4 +1,4 @@
-"""Property-based tests over random valid scenes of every mechanism (issue 9, item 2).
+"""Property-based tests over random valid scenes of every mechanism.
 
 For each random scene (crank-slider: 1–4 cylinders, 2/4 strokes, λ 0.2–0.6, offset up to half
 its limit, rigid or two-mass rod, no gas / trapezoid pulses / a table, a load, up to two
@@ -44,20 +44,19 @@ PROFILE = "stress-full" if FULL else "stress-ci"
 
 #: Compiled against reference at the end of the run, in units of atol + rtol·|y|: each path's
 #: global error is at most the sum of its local errors (≤ 1 per step in these units) when errors
-#: do not grow, so the bound is E_AGREE + the steps of both runs (tests/validation measured ≤ 4
-#: over 10³ steps; a random scene that reverses and spins up backwards for 2 s at rtol 1e-6
-#: measured e = 1010 over ~10⁴ steps).
+#: do not grow, so the bound is E_AGREE + the steps of both runs (a scene that reverses and spins
+#: up backwards takes ~10⁴ steps, and its e grows with them).
 E_AGREE = 200.0
 
 #: The reference path chooses the pairs' modes inside its right-hand side (a kink it does not
-#: locate), so there its error can exceed its rtol: on a random crank-slider that reverses
-#: (rtol 1e-9, one pair) its final ω was off by 2.4e-6 relative while the compiled run's was
-#: 4.3e-9 (both against the compiled run at 1e-13); at rtol 1e-11 the reference's was 5.6e-9.
-#: With pairs it runs this many times tighter, to stay a reference.
+#: locate), so there its error can exceed its rtol by orders of magnitude where the pair's
+#: power reverses (REVERSING_WITH_A_PAIR below). With pairs it runs this many times tighter, to
+#: stay a reference.
 REF_TIGHTER = 100.0
 
-#: CI profile: the reference path (solve_ivp, ~40 fevals per step with pairs at ~50 µs each) is
-#: run only for scenes of at most this many compiled steps; the full profile runs it always.
+#: CI profile: the reference path (solve_ivp, tens of plain-Python right-hand sides per step with
+#: pairs) is run only for scenes of at most this many compiled steps; the full profile runs it
+#: always.
 REF_STEPS_CI = 300
 
 rtols = st.sampled_from([1e-6, 1e-7, 1e-8, 1e-9])
@@ -181,9 +180,8 @@ def common(draw, d, omega=(30.0, 400.0)):
     d["output"] = {"samples_per_rev": 72, "dt": 2e-4}
 
 
-#: Hang guard of one reference run [s]: typically 0.01–0.3 s in the CI profile, but one example's
-#: check took 26 s on an idle core of a slower 2-core VM, and its reference more than 30 s with the
-#: suite running on both cores.
+#: Hang guard of one reference run [s]: generous, because a reference run that is short on an
+#: idle machine can take many times longer on a slow one with the suite running on every core.
 REF_GUARD_S = 300.0
 
 
@@ -253,18 +251,21 @@ def check(d):
             assert abs(e) <= bound, (name, y, y_ref, e, bound, d)
 
 
+@pytest.mark.slow
 @settings.get_profile(PROFILE)
 @given(crank_slider_scenes())
 def test_random_crank_slider_scenes(d):
     check(d)
 
 
+@pytest.mark.slow
 @settings.get_profile(PROFILE)
 @given(swash_plate_scenes())
 def test_random_swash_plate_scenes(d):
     check(d)
 
 
+@pytest.mark.slow
 @settings.get_profile(PROFILE)
 @given(articulated_scenes())
 def test_random_articulated_scenes(d):
@@ -278,14 +279,11 @@ def test_random_articulated_scenes(d):
     check(d)
 
 
-# A failure found by the swash-plate property test (compiled against reference with the droop
-# governor): the two paths disagreed once the speed crossed the governor's corner ω_a = 45 rad/s
-# late in the run — end time 0.175420 s against 0.174500 s, ω 45.645 against 47.009 rad/s at
-# rtol 1e-8. The reference path was wrong: with its own step choice (up to 0.13 s here) the speed
-# crossed the corner and came back inside one solve_ivp step, which sees events only as sign
-# changes between step ends, so it missed two of the three corner events; the compiled stepper
-# watches the speed's range over its stages. With 0.5° steps the reference finds all three, at the
-# compiled path's times (0.091277, 0.10415, 0.109782 s), and the end agrees to ~4e-12 s.
+# A swash plate with the droop governor whose speed crosses the governor's corner ω_a = 45 rad/s
+# and comes back inside one of solve_ivp's own steps, which sees events only as sign changes
+# between step ends: with its own step choice the reference path misses two of the three corner
+# events, while the compiled stepper watches the speed's range over its stages. With 0.5° steps
+# the reference finds all three, at the compiled path's times.
 GOVERNOR_CORNER = {
     "mechanism": {"type": "swash-plate", "joint_radius_mm": 136, "cylinder_radius_mm": 131.31,
                   "rod_length_mm": 300, "halves": 1, "hinge": "in-plane",
@@ -309,13 +307,12 @@ def test_governor_corner_compiled_against_reference():
     check(copy.deepcopy(GOVERNOR_CORNER))
 
 
-# Two failures found by the full profile (crank-slider). A massless crank between two pairs with
-# η = 1 makes both pairs' margins one function of the state; their events fell within rounding
-# of each other at the BDC, the root finder left the state a hair before the root, and each
-# pair's switch undid the other's: "chattering" at φ = 180° (the fix: an event's state is on the
-# crossed side, transient.core.integrate._root). With a denormal crank mass (2.2e-313 kg) the
-# reference path's bracket for φ̈ divided by that link's inertia, overflowed and handed Brent a
-# NaN (a ValueError, not a one-line failure; the fix: a bound through ΣJ, transient.reference).
+# A massless crank between two pairs with η = 1 makes both pairs' margins one function of the
+# state: their events fall within rounding of each other at the BDC, and a state left a hair
+# before the root would let each pair's switch undo the other's ("chattering" at φ = 180°; an
+# event's state is on the crossed side, transient.core.integrate._root). With a denormal crank
+# mass (2.2e-313 kg), a bracket for φ̈ divided by that link's inertia would overflow and hand
+# Brent a NaN (the reference path bounds it through ΣJ, transient.reference).
 MASSLESS_CRANK = {
     "mechanism": {"type": "crank-slider", "crank_radius_mm": 30.0, "rod_length_mm": 60.0,
                   "bore_mm": 50.0, "piston_mass": 1.0, "crank_mass": 0.0, "strokes": 2,
@@ -342,14 +339,12 @@ def test_simultaneous_pair_switches_and_a_denormal_link(crank_mass):
     check(d)
 
 
-# A failure found by the full profile (crank-slider): a single 2-stroke cylinder with one pair of
-# η = 0.5 coasting into its gas pulse. The pair's power reverses at the TDC (φ = 2π, a breakpoint)
-# for 0.087 rad only. The step from 2π saw the margin below zero in its stages but not at its four
-# samples, and took no event: the compiled end speed was 3.5e-5 off (3534 tolerance units
-# against a bound of 1058). Found by the fine search (64 samples) now; the switch it makes at
-# 2π then met the rule that undid a switch whose margin is below zero a quarter step on, which
-# took the short rise for a touch and chattered; the rule now looks for the rise first
-# (transient.core.integrate._fall_after_rise).
+# A single 2-stroke cylinder with one pair of η = 0.5 coasting into its gas pulse. The pair's
+# power reverses at the TDC (φ = 2π, a breakpoint) for 0.087 rad only: the step from 2π sees the
+# margin below zero in its stages but not at its four samples, so only the fine search (64
+# samples) finds the event; and the switch it makes at 2π must not be taken for a touch and
+# undone a quarter step on (the rule looks for the rise first,
+# transient.core.integrate._fall_after_rise).
 SHORT_REVERSAL = {
     "mechanism": {"type": "crank-slider", "crank_radius_mm": 35.252687217558076,
                   "rod_length_mm": 144.42229924612502, "bore_mm": 50.0,
@@ -378,12 +373,12 @@ def test_short_power_reversal_inside_a_step():
     check(copy.deepcopy(SHORT_REVERSAL))
 
 
-# Two more failures of the full profile, both of the reference path. (1) A 4-cylinder 2-stroke
-# with one pair reverses and runs backwards: the reference at rtol 1e-9 ended 2.4e-6 off in ω,
-# the compiled run 4.3e-9 (REF_TIGHTER). (2) A swash plate whose run ends by 2 revolutions less
-# an ulp, on a breakpoint to rounding: solve_ivp reported the breakpoint and not the end (one
-# terminal event per time), and past the end the reference ran on to t_end (t 0.3 against the
-# compiled 0.2951 s); it now ends on such a breakpoint (transient.reference.run_reference).
+# Two scenes that test the reference path. (1) A 4-cylinder 2-stroke with one pair reverses and
+# runs backwards: at the compiled run's rtol the reference's modes, chosen inside its right-hand
+# side, cost it orders of magnitude in ω (REF_TIGHTER). (2) A swash plate whose run ends by 2
+# revolutions less an ulp, on a breakpoint to rounding: solve_ivp reports the breakpoint and not
+# the end (one terminal event per time), so the reference must end on such a breakpoint itself
+# rather than run on to t_end (transient.reference.run_reference).
 REVERSING_WITH_A_PAIR = {
     "mechanism": {"type": "crank-slider", "crank_radius_mm": 41.600636310543265,
                   "rod_length_mm": 82.03812284384139, "bore_mm": 100.0,
@@ -442,11 +437,11 @@ def test_the_reference_ends_on_a_breakpoint_at_the_end():
     check(d)
 
 
-# A third, again of the reference path: a single 2-stroke cylinder whose one pair locks it after
-# five reversals. The reference took σ from sign ω inside its right-hand side, so where the shaft
-# came to rest against the locking pair the friction flipped inside every step crossing ω = 0:
-# solve_ivp's steps shrank towards it for ever (stopped by the 30 s guard). σ is now held over a
-# segment, as in the compiled path; both end locked at t = 0.2566886 s.
+# A third of the reference path: a single 2-stroke cylinder whose one pair locks it after five
+# reversals. Were σ taken from sign ω inside the reference's right-hand side, the friction would
+# flip inside every step crossing ω = 0 where the shaft comes to rest against the locking pair,
+# and solve_ivp's steps would shrink towards it for ever; σ is held over a segment, as in the
+# compiled path, and both end locked.
 LOCKING_AT_REST = {
     "mechanism": {"type": "crank-slider", "crank_radius_mm": 31.012483354310735,
                   "rod_length_mm": 55.16312223268926, "bore_mm": 50.0,

@@ -1,11 +1,14 @@
-"""``transient stress --quick`` end to end (the CI run of the stress suite, issue 9): every case
+"""``transient stress --quick`` end to end (the CI run of the stress suite): every case
 passes or is a written-up known failure, and the report lists every case with its numbers."""
 from __future__ import annotations
+
+import pytest
 
 from transient.cli import main
 from transient.verify.stress import catalogue
 
 
+@pytest.mark.slow
 def test_stress_quick(tmp_path, capsys):
     code = main(["stress", "--quick", "-o", str(tmp_path)])
     out = capsys.readouterr().out

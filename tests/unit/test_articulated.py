@@ -109,7 +109,7 @@ def test_master_piston_dead_centre_accelerations_and_stroke():
 
 def test_slave_stroke_is_2r_at_0_and_180_deg_and_longer_elsewhere():
     """With r_i + l_i = l the slaves at δ = 0° and 180° (ψ = δ) have stroke 2r exactly; at 72° and
-    144° (Semenov's five-cylinder) it is longer. Measured excess: 0.394 mm at 72°, 1.435 mm at
+    144° (Semenov's five-cylinder) it is longer. The excess: 0.394 mm at 72°, 1.435 mm at
     144° (0.2 % and 0.76 % of 2r)."""
     s = art.piston_strokes(radial([0, 180]))
     np.testing.assert_allclose(s, 2 * R, rtol=1e-13)
@@ -120,7 +120,7 @@ def test_slave_stroke_is_2r_at_0_and_180_deg_and_longer_elsewhere():
 
 def test_slave_dead_centres_are_roots_of_the_velocity():
     """(55)–(57) solved exactly: dX/dα = 0 at both dead centres, the TDC a few degrees off δ_i
-    (measured 2.81° after 72°, 3.67° after 144°), and symmetric for δ ↦ 360° − δ."""
+    (2.81° after 72°, 3.67° after 144°), and symmetric for δ ↦ 360° − δ."""
     mech = radial([72, 144, 216, 288])
     tdc, bdc = art.dead_centres(mech)
     for angles in (tdc, bdc):
@@ -143,7 +143,7 @@ def test_central_articulation_is_the_master_turned_by_delta():
 
 def test_psi_equal_delta_has_no_odd_harmonics_above_the_first():
     """(46)–(54): with ψ_i = δ_i the slave displacement is r cos(φ − δ_i) plus even harmonics: odd
-    orders ≥ 3 below 1e-12 of the first (measured ~1e-16), the first exact to 1e-13·r."""
+    orders ≥ 3 below 1e-12 of the first, the first exact to 1e-13·r."""
     mech = radial([40, 72, 144, 200, 288])
     for h in art.harmonics(mech, orders=9):
         first = hypot = math.hypot(*h.exact[0][1])
@@ -177,8 +177,7 @@ def test_psi_unequal_delta_has_a_third_harmonic_beside_semenov():
 
 def test_series_truncation_errors_are_reported_and_small():
     """The truncation error of (47)/(50) over a turn, for Semenov's five-cylinder radial:
-    displacement ≤ 0.22 mm, acceleration ≤ 1.4e-3 rω²·… (measured 0.050/0.213 mm and
-    3.1e-4/1.35e-3 m/rad² at 72°/144°)."""
+    displacement ≤ 0.22 mm, acceleration ≤ 1.4e-3 rω²·…."""
     for h in art.harmonics(radial([72, 144, 216, 288])):
         print(f"δ = {math.degrees(h.bank):g}°: |ΔS| {h.error[0] * 1e3:.4f} mm, |ΔV/ω| "
               f"{h.error[1] * 1e3:.4f} mm, |ΔW/ω²| {h.error[2] * 1e3:.4f} mm, λ_i {h.lam:.5f} "

@@ -1,7 +1,7 @@
-"""Issue 5's targets as ``transient bench`` measures them (:mod:`transient.verify.targets`): the
-hand-written (18) it times transient against is the same equation, and the verdicts read the
-record's rows as stated. (The harness end to end, on short runs: ``tests/cli/test_cli.py::
-test_bench_quick_writes_a_consistent_record``.)"""
+"""The performance targets as ``transient bench`` measures them
+(:mod:`transient.verify.targets`): the hand-written (18) it times transient against is the same
+equation, and the verdicts read the record's rows as stated. (The harness end to end, on short
+runs: ``tests/cli/test_cli.py::test_bench_quick_writes_a_consistent_record``.)"""
 from __future__ import annotations
 
 import math
@@ -32,8 +32,8 @@ def test_hand_written_18_is_transients_right_hand_side(flags):
 @pytest.mark.parametrize("flags", FLAGS, ids=lambda f: "+".join(f) or "bare")
 def test_hand_written_loop_counts_no_references(flags):
     """The hand-written loop runs without reference counting, as transient's kernels do. With it,
-    once the load's branches were added, numba no longer pruned the incref and decref of the row
-    ``states[i]`` at every call: +31 ns per call, which the rungs charged to the load's terms."""
+    once the load's branches are in, numba does not prune the incref and decref of the row
+    ``states[i]`` at every call, a cost the rungs would charge to the load's terms."""
     base = load_scene(CASES / "coasting_single.toml")
     loop = bt.make_hand_loop(bt.make_hand_rhs(**flags))
     loop(*bt.hand_arguments(base))

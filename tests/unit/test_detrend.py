@@ -1,4 +1,4 @@
-"""Detrended run-up spectra (transient.analysis.orders, ``detrend="ramp"``; issue 7).
+"""Detrended run-up spectra (transient.analysis.orders, ``detrend="ramp"``).
 
 A prescribed ω(φ) = ω₀ + g·φ + a·cos(νφ + θ): a linear run-up plus one harmonic of order ν. Over
 each 4-stroke cycle (Φ = 4π) the trend rises by D = gΦ; the plain DFT sees it as a sawtooth that

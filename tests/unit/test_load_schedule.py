@@ -1,4 +1,4 @@
-"""Load schedules and the generator load (issue 6, part 3): the [load] keys, their validation, and
+"""Load schedules and the generator load: the [load] keys, their validation, and
 the compiled schedule and load moment against plain numpy.
 
 * Parsing: SI values and unit suffixes, the resolved TOML round trip, and every validation error

@@ -17,8 +17,8 @@ Every check is independent of the force algebra it tests:
   to :func:`transient.analysis.loads.crank_slider_loads`;
 * the swash plate's torque at constant ω against the kernel's generalized force Σ P u_k.
 
-Bounds: identities 1e-12 relative to the largest value (round-off of a few dozen operations;
-measured ≤ 2e-15); finite differences 1e-8 (as ``test_loads.py``: truncation ~1e-16, round-off
+Bounds: identities 1e-12 relative to the largest value (round-off of a few dozen operations);
+finite differences 1e-8 (as ``test_loads.py``: truncation ~1e-16, round-off
 ~1e-10 with h = 2e-6 s; accelerations as differences of exact velocities).
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The serial chain inside the compiled model (``transient.core.model``): how a mechanism's links
 become sub-chains, the right-hand side with held pair modes, the forward/inverse consistency of the
-chain, and the choice of modes at a state (issue 4)."""
+chain, and the choice of modes at a state."""
 from __future__ import annotations
 
 import math

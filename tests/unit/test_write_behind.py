@@ -64,7 +64,7 @@ def test_the_stepper_releases_the_gil():
 
 def test_result_files_hold_a_bounded_chunk_cache(tmp_path):
     """The result file is opened with a 1 MiB chunk cache per dataset, not HDF5 2.0's 8 MiB,
-    which held ~100 MB more over a 2×10⁵-revolution run (README *Speed*, Scale); and the
+    which over every column of a long run holds far more memory than the writer needs; and the
     columns' chunks are the rows it is sized for."""
     from transient.results import CHUNK_CACHE_BYTES, CHUNK_ROWS, ResultWriter
 

@@ -1,4 +1,4 @@
-"""The droop governor settles on its characteristic at the applied load (issue 6).
+"""The droop governor settles on its characteristic at the applied load.
 
 Forward: ``cases/gots_diesel_governed.toml`` (droop governor, fan load, two friction pairs) runs
 to steady state; its last cycle's mean speed is ω_ss. Inverse, independently: at the constant
@@ -6,8 +6,7 @@ speed ω_ss the governor's characteristic gives the fuel f(ω_ss), and inverse d
 (``run.mode = "prescribed-speed"``) gives the drive torque the shaft would need with that fuel and
 that load; on the characteristic at the applied load its cycle mean is zero. What is left is the
 effect of the speed's fluctuation within the cycle (δ ≈ 1 %: the fuel and the fan torque vary
-with it) — bounded here by 1 % of the load torque (measured 0.7 %: 1.22 N m of 174.2 N m at
-δ = 0.020).
+with it) — bounded here by 1 % of the load torque.
 """
 from __future__ import annotations
 

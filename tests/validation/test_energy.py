@@ -30,12 +30,11 @@ CASES = Path(__file__).resolve().parents[2] / "cases"
 
 REVS = 1000
 
-# Time-domain energy drift bound, drift ≤ C·rtol over 1000 revolutions. Measured (the four
-# variants below, rtol 1e-8, 1e-9, 1e-10): drift/rtol = 17 … 1150, from 14 000 … 29 500 steps.
-# The stepper keeps each step's error norm ≤ 1 (≈ rtol·ω per step, ≈ 2 rtol·K in energy), and a
-# non-symplectic method accumulates these with a systematic sign, so the a-priori bound is
-# ~N_steps·rtol; the measured drift is ~N/25 … N/15 of it. C = 3000 ≈ 0.1·N_steps (at 1e-10)
-# is 2.6× the largest measured value.
+# Time-domain energy drift bound, drift ≤ C·rtol over 1000 revolutions (10⁴ to 3·10⁴ steps for
+# the variants below). The stepper keeps each step's error norm ≤ 1 (≈ rtol·ω per step, ≈ 2 rtol·K
+# in energy), and a non-symplectic method accumulates these with a systematic sign, so the
+# a-priori bound is ~N_steps·rtol; the drift stays a small fraction of it. C = 3000 ≈ 0.1·N_steps
+# (at 1e-10) leaves a margin above that fraction (run with -s to see the drifts).
 C_DRIFT = 3000.0
 
 
@@ -101,10 +100,7 @@ def time_domain(scene, rtol):
 
 @pytest.mark.parametrize("name", list(VARIANTS))
 def test_coasting_angle_domain_keeps_energy_and_phase(name):
-    """1000 revolutions at rtol 1e-10: K constant to 1e-8, time to 1e-9 of the quadrature.
-
-    Measured: K to ≤ 5e-16, phase ≤ 6e-11 (λ = 0.5) and ~2e-13 otherwise.
-    """
+    """1000 revolutions at rtol 1e-10: K constant to 1e-8, time to 1e-9 of the quadrature."""
     scene = VARIANTS[name]
     t_exact, K0 = coast_time(scene)
     data = integrate(scene)
@@ -214,7 +210,7 @@ def test_work_energy_balance_of_a_driven_run(domain, revs, sample_integral):
     state; in time it checks the integration of (18) with its ½J′ω² term.
 
     Both run lengths end on a breakpoint (an integer number of cycles, and every cylinder's table
-    has a corner at 0 ≡ 720°); measured at 20 revolutions: −2.7e-10 (angle), −4.3e-10 (time).
+    has a corner at 0 ≡ 720°).
     """
     scene = driven_scene(domain, revs)
     data = integrate(scene)
@@ -241,9 +237,8 @@ def test_work_energy_balance_of_a_driven_run(domain, revs, sample_integral):
 
 def test_work_quadrature_is_converged(sample_integral):
     """The quadrature behind the balance: doubling the output sampling (720 → 1440 per revolution)
-    changes the work by < 1e-10 of the total (measured 1.4e-11; 720 → 360 changes it by 2e-10:
-    4th-order convergence, set by the spline table's 1° knots), so the 1e-8 balance measures the
-    integration, not the quadrature."""
+    changes the work by < 1e-10 of the total (4th-order convergence, set by the spline table's 1°
+    knots), so the 1e-8 balance measures the integration, not the quadrature."""
     works = []
     for spr in (720, 1440):
         data = integrate(driven_scene("angle", 20, samples_per_rev=spr))
@@ -273,9 +268,8 @@ def test_time_domain_breakpoints_are_reported_once():
 def test_time_domain_breakpoints_once_at_loose_tolerances(rtol):
     """At loose tolerances a step retaken to end on a corner lands short of it by up to ~1e-3 rad
     (the dense output it is aimed with is that inaccurate); it is lengthened by a secant step,
-    so that each corner is still reached once (was a bug: the next step crossed the sliver and was
-    retaken again, 472 breakpoint events at rtol 1e-3 on the stress suite's 40-revolution
-    spin-up against 299 at 1e-9)."""
+    so that each corner is still reached once (else the next step would cross the sliver and be
+    retaken again, and a corner would count as several breakpoint events)."""
     from transient.verify.stress import put, scene_of, spinup
 
     def events(r):

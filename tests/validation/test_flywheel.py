@@ -9,10 +9,7 @@
   the excess work of M_gas + M_load − ½J′ω² from the constant-speed columns.
 * The operating point of the fan load is where it absorbs the mean indicated torque, 4400 rpm.
 
-Measured (this machine): δ_target 0.01 → estimate 0.3117 kg m², δ 0.01004 (+0.42 %), accepted
-without correction; fresh run δ 0.010042. δ_target 0.02 → 0.1352 kg m², δ +0.85 %. With
-rtol = 1e-3: 0.01 → 0.3132 kg m² in 2 runs, δ −1.8e-5 relative. Heavy flywheel (δ 0.002):
-estimate off by +0.08 %.
+Run with ``-s`` to see the estimates, the runs and their δ.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Runs with non-ideal pairs (issue 4): the work–energy balance, the pairs' modes, locking, the
+"""Runs with non-ideal pairs: the work–energy balance, the pairs' modes, locking, the
 reference path, and η_mech (``cases/gots_diesel_friction.toml``, ``swash_plate_4cyl_friction``).
 
 The balance checked everywhere is ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k
@@ -99,10 +99,9 @@ def test_power_flow_modes_against_the_reference_path():
     (solve_ivp; the chain solved by bracketing the last sub-chain's residual on every call,
     no held modes) agree on ω and on the energy lost in each pair.
 
-    The compiled run at rtol = atol = 1e-10 is compared with the reference at 1e-12: the
-    reference at 1e-10 is itself off by up to ~120 units of that tolerance in W_loss_1 (measured
-    against the compiled path at 1e-13: 1e-10 → −122, 1e-11 → 0.07, 1e-12 → −1.6 units), and
-    the compiled run is off by 12."""
+    The compiled run at rtol = atol = 1e-10 is compared with the reference at 1e-12: against
+    the compiled path at 1e-13, the reference at 1e-10 is itself off in W_loss_1 by about a
+    hundred units of that tolerance, ten times what the compiled run is off by."""
     def run(method, tol):
         scene = friction_scene(
             run=Run(revolutions=6.0),
@@ -252,12 +251,11 @@ def test_gots_policies_disagree_where_inertia_drives():
 
 
 def test_governor_corner_with_pairs_makes_progress():
-    """Found by the benchmark scene: with pairs and a droop governor, the speed fluctuating
-    about the governor's corner within each cycle made the stepper find the event it had just
-    handled again at θ ≈ 0, forever (rounding put the step's start a hair off the level). Now a
-    step that starts on an event's level starts on it, and any 50 events in a row without
-    progress end the run as *chattering* instead of looping. 60 revolutions through the corner
-    (the old code hung at about 33)."""
+    """With pairs and a droop governor (the benchmark scene) the speed fluctuates about the
+    governor's corner within each cycle; a step's start a hair off the level (by rounding) would
+    make the stepper find the event it had just handled again at θ ≈ 0, forever. A step that
+    starts on an event's level starts on it, and any 50 events in a row without progress end the
+    run as *chattering* instead of looping. 60 revolutions through the corner."""
     scene = load_scene(CASES / "gots_diesel_governed.toml")
     scene = replace(scene, run=Run(revolutions=60.0))
     data = integrate(scene)

@@ -167,7 +167,7 @@ def test_rod_centrifugal_force():
 def test_mean_indicated_torque_of_the_ideal_cycle(p42, sample_integral):
     """Mean of −M_drive over a cycle = 3·W/(4π), W the closed-form loop work of the ideal mixed
     cycle (``MixedCycle.work``), to 1e-6: the inertia torque ½J′ω² averages to zero over a turn
-    and ∮p0 dV = 0. Measured 205.766 N·m (tables to 1e-9, quadrature ~1e-13).
+    and ∮p0 dV = 0: 205.766 N·m (tables to 1e-9, quadrature ~1e-13).
 
     Why this is not the book's 149.1 N·m (digest §12.4): the mean of the printed 30°-sampled
     П4.2 sum is only 104.1 N·m, because a 30° grid misses the combustion peak near 360–390°;

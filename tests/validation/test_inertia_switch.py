@@ -1,4 +1,4 @@
-"""An inertia switched in (issue 6, part 3): a load's inertia J_x, at rest, coupled to the shaft
+"""An inertia switched in: a load's inertia J_x, at rest, coupled to the shaft
 by a clutch at ``load.inertia_time`` — an inelastic engagement that conserves the angular
 momentum J(φ)ω.
 

@@ -1,4 +1,4 @@
-"""Runs with load schedules and a generator load (issue 6, part 3) on the compiled path.
+"""Runs with load schedules and a generator load on the compiled path.
 
 The schedule's corners are state events (``load_schedule``): in time they are levels of t, in
 revolutions levels of φ = φ₀ + 2π·rev; on the independent variable the step also ends on them.

@@ -112,8 +112,8 @@ def test_mechanism_is_dinns(engine):
 
 def test_P4_1_inertia_force(engine, tables):
     """p'_j: the package's exact P_j equals Gots' exact closed form (digest §2.3) to 1e-12; the
-    table follows the 2nd-order (6) within 2e-3 MPa (measured 9.9e-4, as the README's 0.0010);
-    the gap between exact and 2nd order is 0.03…0.07 MPa (measured 0.057 at 90°)."""
+    table follows the 2nd-order (6) within 2e-3 MPa (the data README's 0.0010); the gap between
+    exact and 2nd order is 0.03…0.07 MPa (0.057 at 90°)."""
     scene, mech = engine
     p41 = tables["p41"]
     ld, dp = book_loads(scene, mech, p41)
@@ -335,9 +335,9 @@ def test_P4_3_is_not_derived_from_P4_1(gots_data, tables):
     combination, with constant coefficients, of the three throws' T and K. So the best any model
     can do is the least-squares fit R ≈ Σ_k (a_k T_k + b_k K_k) + c, 7 free numbers per
     component, on the 25 rows where П4.1 gives T and K. It leaves an rms residual of
-    0.11/0.12 MPa (measured) — ~60× the table's print resolution — spread over most rows
-    (measured: 11 of 25 off by > 0.1 MPa), so no short list of misprinted rows explains it (digest §12.5:
-    (58) with a constant offset leaves 0.59 MPa). The table comes from another calculation, like
+    0.11/0.12 MPa — ~60× the table's print resolution — spread over most rows (11 of 25 off by
+    more than 0.1 MPa), so no short list of misprinted rows explains it (digest §12.5: (58) with
+    a constant offset leaves 0.59 MPa). The table comes from another calculation, like
     Table 14; the test fails if the data ever become consistent, so this is revisited then.
     It also confirms the text's quotes from the table (§2.9): |R| max 2.596 MPa at 130°, min
     0.415 MPa at 570°."""

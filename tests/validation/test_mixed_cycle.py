@@ -2,7 +2,7 @@
 
 Sources (``reference/gots-crank-dynamics.md``): §10 (App. 2 cycle printout and how table П2.1
 is built), §11 (geometry), §12.4 (mean torque), §14 (the synthetic indicator diagram), and
-``reference/data/README.md`` (misprints in П2.1). Angles follow the Gots tables: 0° is the
+``tests/data/README.md`` (misprints in П2.1). Angles follow the Gots tables: 0° is the
 gas-exchange TDC and 360° the firing TDC. Run with ``-s`` to see the numbers.
 """
 from __future__ import annotations

@@ -43,8 +43,8 @@ def test_reference_path_reports_the_stall_too(tmp_path):
 @pytest.mark.parametrize("start", ["backwards", "from rest"])
 def test_backward_motion_in_a_revolutions_run_is_a_stall(tmp_path, start):
     """A shaft that turns backwards never reaches its revolutions: given a negative speed, or
-    started from rest by a starter weaker than the load (found by the stress suite: the run
-    integrated on without end, its file growing). Reported as a stall, the partial run kept."""
+    started from rest by a starter weaker than the load (else the run would integrate on without
+    end, its file growing). Reported as a stall, the partial run kept."""
     text = CASE.read_text().replace("[initial]", "[load]\ntorque = 10.0\n\n[initial]")
     text = text.replace("omega_rpm = 1000", "omega_rpm = -100" if start == "backwards" else
                         "omega_rpm = 0")

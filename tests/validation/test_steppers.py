@@ -54,10 +54,9 @@ def phase_error(method, **solver):
 def test_fixed_step_converges_with_the_method_order(method, steps):
     """Fixed steps of 2π/N: halving the step divides the phase error by 2^p (p = 8, 5).
 
-    Measured: DOP853 N = 4 → 8: 1.36e-6 → 3.5e-9 (slope 8.6); DOPRI5 N = 32 → 64: 2.2e-11 →
-    6.8e-13 (5.0). Equal steps integrate the periodic part of √(J/2K) spectrally, so at coarser
-    steps the slope is steeper and at finer ones round-off (~1e-14) takes over: the pairs are
-    where the error is ≥ 50× round-off and the method's own truncation error governs.
+    Equal steps integrate the periodic part of √(J/2K) spectrally, so at coarser steps the slope
+    is steeper and at finer ones round-off (~1e-14) takes over: the pairs are where the error is
+    ≥ 50× round-off and the method's own truncation error governs.
     """
     p = ORDER[method]
     errs = []
@@ -73,9 +72,7 @@ def test_fixed_step_converges_with_the_method_order(method, steps):
 
 @pytest.mark.parametrize("method", ["dop853", "dopri5"])
 def test_adaptive_phase_error_falls_with_rtol(method):
-    """Adaptive steps at rtol 1e-6 and 1e-9: phase error ≤ 10·rtol, and 30× smaller at 1e-9.
-
-    Measured: DOP853 4.8e-8, 4.9e-13; DOPRI5 7.0e-8, 3.0e-12."""
+    """Adaptive steps at rtol 1e-6 and 1e-9: phase error ≤ 10·rtol, and 30× smaller at 1e-9."""
     errs = {}
     for rtol in (1e-6, 1e-9):
         e, data = phase_error(method, rtol=rtol, atol=rtol * 1e-3)
@@ -107,9 +104,8 @@ def test_where_chunks_end_changes_nothing(monkeypatch):
     the step-size control's memory of a rejection) the next takes up as it is: the governed
     diesel with two friction pairs, at one sample per turn in a buffer that never fills and at
     72 in one that fills every ~1.4 turns (400 rows, 300 of them kept free), takes the same steps
-    to the same bits. (Before, each
-    chunk recomputed the derivative with the table piece ahead of the shaft angle and forgot a
-    rejection; at rtol 1e-12 the diesel without pairs took 60 129 or 60 134 steps by the output.)
+    to the same bits. (A chunk that recomputed the derivative with the table piece ahead of the
+    shaft angle, or forgot a rejection, would make the steps depend on the output.)
     """
     import transient.run as sim
     base = load_scene(CASES / "gots_diesel_governed.toml")

@@ -1,4 +1,4 @@
-"""A governor far faster than the engine (issue 9): detected by the stiffness test of the
+"""A governor far faster than the engine: detected by the stiffness test of the
 compiled stepper and rerun by the implicit Radau method, with a message saying so.
 
 The scene: the Gots PI generator set (``cases/gots_diesel_pi.toml``) with an actuator lag of
@@ -15,6 +15,7 @@ import tomllib
 
 import h5py
 import numpy as np
+import pytest
 
 from transient.scene import scene_from_dict
 from transient.run import integrate, run_compiled, simulate
@@ -31,6 +32,7 @@ def stiff_scene(**solver):
     return scene_from_dict(copy.deepcopy(d), "stiff.toml")
 
 
+@pytest.mark.slow
 def test_stiffness_detected_and_rerun_by_radau(tmp_path):
     explicit = run_compiled(stiff_scene(), keep=True)
     assert not explicit.complete

@@ -1,4 +1,4 @@
-"""The swash-plate example through the whole stepper (issue 3 acceptance).
+"""The swash-plate example through the whole stepper.
 
 * Coasting conserves ½J(φ)ω² over 1000 revolutions at rtol 1e-10 (≤ 1e-8 relative), with the
   paper's masses: J(φ) of the example varies by about ±30 % (cross 13, link 9), so a wrong J′ in

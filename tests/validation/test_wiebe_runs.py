@@ -6,18 +6,17 @@ the motored cycle (no fuel) and the full-load cycle (``fuel_mass``), both from
 
 * a motored prescribed-speed run (fuel_mass = 0, or the governor at f = 0) does no net gas work
   over whole cycles, to 1e-9 of the compression work, when the intake and exhaust pressures are
-  equal (measured 1.8e-13); with the scene's pressures it does the pumping loop's work,
-  ``ncyl·WiebeCycle.work`` (trapezoidal W_gas column at 1440 samples per revolution: 3.4e-8 of
-  the compression work);
+  equal; with the scene's pressures it does the pumping loop's work, ``ncyl·WiebeCycle.work``, to
+  1e-6 of the compression work (the trapezoidal W_gas column at 1440 samples per revolution);
 * the full-load indicated work per cycle of a prescribed-speed run is ``ncyl·WiebeCycle.work``
-  to 1e-6 (measured 1.1e-8);
+  to 1e-6;
 * in the governor's droop range the pressure applied (the ``p_k`` columns) is
   p_mot + f·(p_full − p_mot) of the tables evaluated in numpy, and M_gas is Σ (p_k − p0)·F_p·u_k;
 * the interpolation in the fuel is exact for a constant γ and is not for γ(T) (the error the
   scene's comment and the Gas docstring quote);
-* scenes without a motored table run as before, to the last bit.
+* scenes without a motored table run as they ran without the fuel command, to rounding.
 
-The compiled path against the reference path on the new scene: ``test_reference_path.py``.
+The compiled path against the reference path on this scene: ``test_reference_path.py``.
 """
 from __future__ import annotations
 
@@ -205,8 +204,7 @@ def test_droop_range_dynamic_run():
 
 def test_case_spins_up_onto_the_droop_line():
     """The whole case: from 1000 rpm to steady running on the droop line (the full-load torque
-    balances the fan near 4270 rpm, above the 4000 rpm corner). Measured: last-cycle mean
-    4022 rpm, fuel 0.96 on average over it."""
+    balances the fan near 4270 rpm, above the 4000 rpm corner)."""
     scene = load_scene(CASES / "gots_diesel_wiebe.toml")
     data = integrate(scene)
     assert data.complete, data.message
@@ -257,8 +255,8 @@ def test_fuel_interpolation_exact_for_constant_gamma():
 
 def test_fuel_interpolation_error_for_gamma_of_t():
     """γ(T) = 1.38 − 1e-4·(T − 300 K) (air-like, as ``test_wiebe_cycle.py``): the numbers quoted
-    by ``transient.scene.Gas`` and the scene's comment. Measured: 1.1 % of p_max at f = 0.5
-    between 0 and 0.02 g; between 0 and 0.031 g 2.1 % (f = 0.5), work 7.6 % low at f = 0.25."""
+    by ``transient.scene.Gas`` and the scene's comment: 1.1 % of p_max at f = 0.5 between 0 and
+    0.02 g; between 0 and 0.031 g 2.1 % (f = 0.5), work 7.6 % low at f = 0.25."""
     scene = load_scene(CASES / "gots_diesel_wiebe.toml")
     gamma = {"gamma": 1.38, "gamma_slope": -1e-4, "gamma_t_ref": 300.0}
     small = interpolation_error(scene, 0.02e-3, [0.5], **gamma)
@@ -276,43 +274,12 @@ def test_fuel_interpolation_error_for_gamma_of_t():
 def test_governed_mixed_cycle_unchanged():
     """gots_diesel_governed.toml (mixed cycle, the constant p0 as motored curve) holds no motored
     table, and 150 revolutions from 1000 rpm (into the droop range, fuel 0.838 at the end) end
-    where they ended before the fuel command was introduced, to the last bit. Recorded on
-    2026-11-22 (issue 6, part 1) at commit 0d35cb5, before the change, with numba 0.68.1 / numpy
-    2.4.6 on the development machine: if another platform differs in the last bits only, compare
-    the compiled path with the reference path instead (test_reference_path.py does).
-
-    Re-recorded after commit 047fd38, when the stepper began to take the table piece ahead of a
-    breakpoint when it evaluates the first stage of a step starting on one (issue 8's radial
-    engines, whose slaves' pressures jump away from their dead centres): for this engine a
-    change of rounding only — t by 5e-15 s, ω by 1.3e-12 rad/s, W_gas by 1.7e-9 J, fuel by
-    2e-13 (values before: 2.413504852030478, 429.0454495403209, 182400.97323543674,
-    0.838196256124024).
-
-    Re-recorded when an event's state began to be taken on the crossed side of its root
-    (``transient.core.integrate._root``, issue 9: two pairs switching at one angle chattered):
-    the governor corners' events moved by less than 1e-12 of a step — t by 7.2e-14 s, ω by
-    2.2e-12 rad/s, W_gas by 3.2e-9 J, fuel by 2.3e-13 (values before: 2.413504852030473,
-    429.04544954030837, 182400.973235435, 0.8381962561242231).
-
-    Re-recorded when the isobar's end angle_z began to be found by bisection instead of brentq
-    (issue 5: scipy.optimize kept out of the start-up), which moved it by 2 ulp (both are roots
-    to rounding of V): t by 7.5e-15 s, ω by 2.7e-12 rad/s, W_gas by 9.0e-10 J, fuel by 4.3e-14
-    (values before: 2.4135048520304014, 429.0454495403231, 182400.97323543185,
-    0.8381962561239888).
-
-    Re-recorded when the crank-slider began to take each cylinder's sine and cosine from the
-    shaft angle's by the angle-difference formulas (issue 5: one sincos per right-hand side):
-    a change of rounding — t by 9.3e-15 s, ω by 2.7e-12 rad/s, W_gas by 2.2e-9 J, fuel by
-    4.3e-14 (values before: 2.413504852030394, 429.04544954032576, 182400.97323543276,
-    0.8381962561239463).
-
-    Compared to 1e-12 of each value since another machine (the fifth session's AMD EPYC with FMA
-    and AVX2, the same numba and numpy) ended 6e-15 to 1.2e-13 of each value away (the exact
-    comparison failed there at e15a0c8 too; values at 2a716c6): t 2.413504852030418, ω
-    429.0454495403167, W_gas 182400.97323542938, fuel 0.8381962561240901. numba compiles for the
-    host's CPU, so the last bits follow the machine.
-    Every re-recording above moved the values by less than 1e-13 of each, so a change beyond
-    rounding still fails the test."""
+    where they ended without the fuel command, to rounding. The recorded values are compared to
+    1e-12 of each: numba compiles for the host's CPU (FMA, vector width), so the last bits follow
+    the machine, while changes of rounding in the stepper and the kernels move the values by less
+    than 1e-13 of each, so that a change beyond rounding still fails the test. If another
+    platform differs by more, compare the compiled path with the reference path instead
+    (test_reference_path.py does)."""
     scene = load_scene(CASES / "gots_diesel_governed.toml")
     scene = replace(scene, run=replace(scene.run, revolutions=150.0))
     assert not build_model(scene)[0].has_motored
@@ -322,7 +289,7 @@ def test_governed_mixed_cycle_unchanged():
                 "W_gas": 182400.97323543052, "fuel": 0.8381962561239897}
     for name, value in recorded.items():
         assert tr[name][-1] == pytest.approx(value, rel=1e-12, abs=0.0), name
-    # The p_k columns are now the pressure applied: p0 + f·(p − p0) (the table itself at f = 1).
+    # The p_k columns are the pressure applied: p0 + f·(p − p0) (the table itself at f = 1).
     table = gas_tables(scene)[0]
     model = build_model(scene)[0]
     local = np.mod(tr["phi"] - model.gas_phase[0], model.period)

@@ -252,10 +252,10 @@ def test_heat_loss_fraction_falls_with_speed(gots):
 def test_magnitudes_against_the_literature(gots):
     """Peak h and the share of the fuel heat lost, Gots diesel at full load, 2000–4400 rpm.
 
-    The windows are order-of-magnitude bounds set for this check (in the task that asked for
-    this module), not numbers read off a published figure or table: peak h in (300, 10 000)
-    W/(m² K) brackets the order 10³ W/(m² K) of Woschni-type coefficients in diesel combustion
-    chambers that Heywood's ch. 12 discusses with eq. (12.19); Q_w/Q_b in (0.03, 0.4) brackets
+    The windows are order-of-magnitude bounds set for this check, not numbers read off a
+    published figure or table: peak h in (300, 10 000) W/(m² K) brackets the order 10³ W/(m² K)
+    of Woschni-type coefficients in diesel combustion chambers that Heywood's ch. 12 discusses
+    with eq. (12.19); Q_w/Q_b in (0.03, 0.4) brackets
     a wall loss of some tens of percent of the fuel heat (Heywood's energy balances, §12.1).
     Pages and figures of Heywood were not re-checked for this test. The Gots App. 2 indicated
     efficiency η_i = 0.428 is a further reference point (this model without heat transfer gives

@@ -1,4 +1,4 @@
-"""Wall heat transfer in the ODE (issue 6, ``[gas.woschni]``): the cylinder pressures of the closed
+"""Wall heat transfer in the ODE (``[gas.woschni]``): the cylinder pressures of the closed
 part are states of the compiled stepper (``transient.core.cylinder``).
 
 Independent checks:
@@ -148,6 +148,7 @@ def test_state_pressure_equals_the_numpy_closed_cycle(rpm):
     assert e_p <= 1e-8 and e_w <= 1e-8
 
 
+@pytest.mark.slow
 def test_compiled_agrees_with_the_reference_path():
     """The scene of cases/gots_diesel_woschni.toml (droop governor, latched fuel, two non-ideal
     pairs) for 4 revolutions: the compiled stepper against solve_ivp on the numpy twin

@@ -26,8 +26,8 @@ frequency droop δf_st          ``droop_pct`` = (ω_before − ω_after)/ω_r   
                                ·100
 =============================  ===========================================  ==================
 
-Points to check against the text of the standard (not at hand when this was written; the
-definitions above are from memory of ISO 8528-5:2005/2013 and are flagged where unsure):
+Points to check against the text of the standard (not at hand: the definitions above are from
+memory of ISO 8528-5:2005/2013 and are flagged where unsure):
 
 * δf_dyn is taken from the *initial* speed (the 2005 edition's form, as recalled); the form
   from rated speed is reported too (``dev_max_rated_pct``). Both divide by rated speed.
@@ -204,8 +204,8 @@ def _hermite(x, y, m) -> Callable[[ArrayLike], NDArray[np.float64]]:
     """The cubic Hermite interpolant through (x, y) with slopes m, extrapolated by its end
     cubics: the curve of :class:`scipy.interpolate.CubicHermiteSpline` (the tests compare them).
 
-    Written out because importing scipy.interpolate costs 0.11–0.14 s of every ``transient run``
-    that summarizes a spin-up (issue 5's 1 s start-up target); evaluating a cubic is three lines.
+    Written out because importing scipy.interpolate costs a noticeable part of the warm start of
+    every ``transient run`` that summarizes a spin-up; evaluating a cubic is three lines.
     """
     dx = np.diff(x)
     secant = np.diff(y) / dx

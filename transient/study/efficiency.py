@@ -1,4 +1,4 @@
-"""Efficiency study: η_mech of an engine at a set of steady speeds and loads (issue 4).
+"""Efficiency study: η_mech of an engine at a set of steady speeds and loads.
 
 Each point is a prescribed constant speed (a dynamometer holding ω, the textbook setting and the
 limit of a large flywheel), one engine cycle of inverse dynamics through the serial chain: the

@@ -1,5 +1,5 @@
-"""``transient bench``: the work-precision record (issue 5) — error against run time over a
-tolerance sweep, for transient's paths and for baselines, in one run on one machine.
+"""``transient bench``: the work-precision record — error against run time over a tolerance
+sweep, for transient's paths and for baselines, in one run on one machine.
 
 For each benchmark scene (:data:`BENCH_SCENES`), over ``revolutions`` (1000):
 
@@ -52,12 +52,12 @@ BENCH_SCENES = {path.stem: path for path in (_CASES / "coasting_single.toml",
 TOLERANCES = tuple(10.0 ** -k for k in range(3, 13))
 #: atol of the sweep, for every method, relative to rtol. With atol = rtol the stepper's control
 #: of the accumulating time (or angle) — scaled by its increment per step, ~1e-4 s — is set by
-#: atol alone and the phase error stops falling with rtol (measured: single cylinder, 1000 rev,
-#: rtol 1e-7 … 1e-9 all ≈ 1e-3 rad); the other methods' states are large, where atol is moot.
+#: atol alone and the phase error stops falling with rtol (a plateau over decades of rtol on the
+#: single cylinder); the other methods' states are large, where atol is moot.
 ATOL_PER_RTOL = 1e-3
 REF_RTOL = 1e-13
-#: Each solve_ivp run is stopped after this long [s], and its tighter tolerances skipped (at
-#: 30 s, on a 2-core machine of 2026-11-26, RK45 finished no run of two scenes).
+#: Each solve_ivp run is stopped after this long [s], and its tighter tolerances skipped (long
+#: enough for RK45 to finish runs on every scene on a 2-core machine, which half of it is not).
 BASELINE_BUDGET_S = 60.0
 #: The accuracy at which speed is compared: final phase error after 1000 revolutions [rad].
 TARGET_PHASE = 1e-6
@@ -332,7 +332,7 @@ def _line(r) -> str:
 
 #: How far a method's most accurate run may be from the target for a log-log extrapolation to it
 #: [decades of phase error]: further, the runs are far from the asymptotic regime (a budgeted
-#: solve_ivp stopped at 0.65 rad extrapolated to 139 s, another at 22 rad to 5e18 s).
+#: solve_ivp stopped far from the target extrapolates to absurd times).
 EXTRAPOLATE_DECADES = 2.0
 
 

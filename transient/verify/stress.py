@@ -1,5 +1,5 @@
-"""The stress suite (issue 9): hostile scenes, each run with a hard time bound, each checked against
-an invariant or an expected diagnosis; the report ``results/stress.md``.
+"""The stress suite: hostile scenes, each run with a hard time bound, each checked against an
+invariant or an expected diagnosis; the report ``results/stress.md``.
 
 Every case ends in one of three ways, and the report says which:
 
@@ -22,7 +22,7 @@ child process that is killed when the case's time bound passes; the long runs st
 ``--quick`` runs the subset marked ``quick`` with shorter runs (the CI smoke test,
 ``tests/stress/test_stress_quick.py``); the full suite adds the 10⁶-revolution runs and the
 longer versions. The property-based tests (``tests/stress/test_properties.py``) are the other
-half of the issue; their full profile is ``TRANSIENT_STRESS_FULL=1 pytest tests/stress``.
+half of the stress testing; their full profile is ``TRANSIENT_STRESS_FULL=1 pytest tests/stress``.
 """
 from __future__ import annotations
 
@@ -45,8 +45,9 @@ RPM = math.pi / 30.0
 
 #: Work–energy balance tolerance: C_BALANCE·rtol of the energy throughput (max K + max |W|).
 #: In crank angle K is a state and the balance closes to rounding; in time the state is ω and
-#: the balance collects the local errors of every step (≈ rtol each, with a systematic sign:
-#: tests/validation/test_energy.py measured drifts up to 1150·rtol over 1000 revolutions).
+#: the balance collects the local errors of every step (≈ rtol each, with a systematic sign, so
+#: that over 1000 revolutions the drift reaches the order of 10³·rtol in
+#: tests/validation/test_energy.py).
 C_BALANCE = 2000.0
 #: Floor of the balance tolerance: rounding of K and of the work integrals (~1e-16 per step,
 #: over up to 10⁶ steps).
@@ -459,7 +460,7 @@ def friction(policy: str = "power-flow", eta: tuple[float, float] | None = None,
 def _pairs_switch(run: Run, o: Outcome) -> bool:
     """Power-flow: many mode switches, every loss ≥ 0. The paper's criterion (25) looks at the
     applied moments only, so coasting it keeps its modes and its losses go negative where inertia
-    drives (README, "Mode policies"): reported, not a failure."""
+    drives: reported, not a failure."""
     n = run.count("pair_mode")
     tr = run.trajectory
     neg = [k + 1 for k in range(len(run.scene.friction.pairs))
@@ -559,9 +560,8 @@ def ladder_error(run: Run, ref: Run, x: str) -> float:
 #: In time the error is monotone in rtol only from here down. Above it, neither transient's DOP853
 #: nor scipy's (``solve_ivp``, an independent code) is: at loose tolerances the steps are set by
 #: the breakpoints (one or two per segment, at 1e-3 … 5e-5 alike), each segment keeps what DOP853
-#: leaves over a steep compression, and these add up with signs that change with rtol (measured on
-#: 40 revolutions: transient 2.5e-4, 7.7e-5, 4.6e-4, 4.3e-5 … at 1e-3, 3e-4, 2e-4, 1e-4; scipy
-#: 1.8e-2, 3.1e-2, 1.5e-2, 7.5e-3; README, Stress suite).
+#: leaves over a steep compression, and these add up with signs that change with rtol (in
+#: transient's errors and scipy's alike).
 TIME_MONOTONE_FROM = 1e-6
 #: Errors below this are the reference run's own noise (rtol 1e-13).
 LADDER_FLOOR = 1e-12

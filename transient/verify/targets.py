@@ -1,6 +1,6 @@
-"""Issue 5's targets, measured by ``transient bench`` beside the work-precision record and written
-to ``targets.md`` and ``targets.json`` in the record's folder: each target with what was measured,
-how, and whether it is met or by how much it is missed.
+"""The performance targets, measured by ``transient bench`` beside the work-precision record and
+written to ``targets.md`` and ``targets.json`` in the record's folder: each target with what was
+measured, how, and whether it is met or by how much it is missed.
 
 * speed at equal accuracy (≥ 300× solve_ivp RK45, ≥ 2× CyRK at a final phase error ≤ 1e-6 rad)
   and the error's fall with the tolerance: read from the record's rows (:mod:`transient.verify.bench`);
@@ -65,8 +65,9 @@ def rhs_loop(m, states, y, out, sw, wk, chained):
     ``chained``: each call's state depends on the previous result (0·out still has to wait for
     out), as a Runge–Kutta step's stages do — the RHS's latency; otherwise the calls are
     independent — its throughput, where the division, square root and sine of one call overlap
-    the next's. Independent calls read the row itself: copying it into ``y`` cost 5–8 ns of ~110
-    on the bare cylinder, and the hand-written loop (:func:`make_hand_loop`) copies nothing."""
+    the next's. Independent calls read the row itself: copying it into ``y`` costs a measurable
+    part of a call on the bare cylinder, and the hand-written loop (:func:`make_hand_loop`) copies
+    nothing."""
     acc = 0.0
     for i in range(states.shape[0]):
         state = states[i]
@@ -172,7 +173,7 @@ def make_hand_rhs(layout=False, loads=False, records=False):
     starter switches; ``records`` the three work integrals and the speed range kept for the event
     search (in ``rec``)."""
 
-    @njit(inline="always")  # a closure's dispatcher is not inlined by LLVM: a call costs ~30 ns
+    @njit(inline="always")  # a closure's dispatcher is not inlined by LLVM
     def rhs(p, y, out, rec):
         r, l, m_rod, cg, I_rod = p[0], p[1], p[4], p[5], p[6]
         f = cg / l
@@ -223,8 +224,8 @@ def make_hand_rhs(layout=False, loads=False, records=False):
 
 def make_hand_loop(rhs):
     # Without reference counting, as transient's kernels: with it, the view states[i] is increfed
-    # and decrefed at every call unless numba's pruning removes the pair, which it did for the
-    # bare kernel but not once the load's branches were added (+31 ns per call on this machine).
+    # and decrefed at every call unless numba's pruning removes the pair, which it does for the
+    # bare kernel but not once the load's branches are in.
     @njit(_nrt=False)
     def loop(p, states, out, rec):
         acc = 0.0
@@ -356,9 +357,9 @@ def scale(lengths=(1e3, 2e5, 1e6), samples_per_rev=SCALE_SAMPLES_PER_REV, scene=
     """Each length run to a result file in a new process (as ``transient run`` does, summary
     included): integration wall time per 1000 revolutions and the process's peak resident memory
     (Linux's ``/proc``; the resident memory after the run is no measure: it is what the allocator
-    kept of the freed summary window, 176 MB at 2×10⁵ revolutions and 196 MB at 10⁶ with the
-    peaks 1.1 MB apart). The summary reads a window of the last SUMMARY_SAMPLES samples, full from
-    125 000 revolutions at 4 samples per turn: the peak is compared from there on."""
+    kept of the freed summary window, which differs between lengths whose peaks agree). The
+    summary reads a window of the last SUMMARY_SAMPLES samples, full from 125 000 revolutions at
+    4 samples per turn: the peak is compared from there on."""
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in lengths:
