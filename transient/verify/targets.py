@@ -516,9 +516,9 @@ def write_targets(res, out: Path) -> Path:
     """``targets.json`` (every measurement) and ``targets.md`` (the verdicts, then the details)."""
     out.mkdir(parents=True, exist_ok=True)
     (out / "targets.json").write_text(json.dumps(res, indent=1) + "\n")
-    md = ["# Issue 5's targets", "",
+    md = ["# Benchmark targets", "",
           "Written by `transient bench` (`transient bench --targets` alone) on this machine, in "
-          "one run; what each measures: `transient/bench_targets.py`. Speed and the error's fall "
+          "one run; what each measures: `transient/verify/targets.py`. Speed and the error's fall "
           "are read from `work_precision.csv` (solve_ivp: each run stopped at the bench's budget, "
           f"{BASELINE_BUDGET_S:g} s by default).", "",
           "| target | case | measured | |", "|---|---|---|---|",
