@@ -617,9 +617,9 @@ def _loads_scene(res):
 def _radial_loads(args, res, scene) -> int:
     """``transient loads`` of an articulated engine: each row's master crankpin in its crank
     frame (polar), the crankpin and link-pin loads over the last cycle, and a CSV
-    (``transient.analysis.loads_radial``; main journals and running torques do not apply)."""
+    (``transient.analysis.loads.articulated``; main journals and running torques do not apply)."""
     from . import plots
-    from .analysis.loads_radial import articulated_loads_from_trajectory
+    from .analysis.loads.articulated import articulated_loads_from_trajectory
 
     mech = scene.mechanism
     traj = res.trajectory
@@ -727,8 +727,7 @@ def _angle_weights(phi: np.ndarray) -> np.ndarray:
 
 
 def cmd_loads(args) -> int:
-    from .analysis.loads import (
-        engine_torque,
+    from .analysis.loads.crank_slider import (
         loads_from_trajectory,
         main_journal_loads,
         running_torques,
@@ -819,7 +818,7 @@ def cmd_loads(args) -> int:
         for name in ("P_g", "P_j", "P", "N", "S", "K", "T", "R_K", "R_T", "R"):
             cols[f"{name}_{j + 1}_N"] = getattr(loads, name)[j]
         cols[f"M_{j + 1}_Nm"] = loads.torque[j]
-    cols["M_engine_Nm"] = engine_torque(loads)
+    cols["M_engine_Nm"] = loads.engine_torque
     if inline:
         for j in range(journals.shape[0]):
             cols[f"M_journal_{j + 1}_Nm"] = journals[j]
@@ -845,7 +844,7 @@ def cmd_loads(args) -> int:
           f"{s.max() / 1e3:.6g} kN (compression > 0), side force |N| max "
           f"{np.abs(n).max() / 1e3:.6g} kN, T from {loads.T[k].min() / 1e3:.6g} to "
           f"{loads.T[k].max() / 1e3:.6g} kN")
-    m = engine_torque(loads)
+    m = loads.engine_torque
     print(f"  engine torque Σ T r: mean {np.mean(m):.6g} N m (sample mean), from "
           f"{m.min():.6g} to {m.max():.6g} N m")
     if inline:

@@ -18,21 +18,21 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   A signal is a trajectory column or ``W_<k>``, the piston acceleration of cylinder k,
   W = ω²s″ + εs′ [m/s²] (crank-slider).
 * ``loads = true`` (crank-slider), over the last whole cycle on a uniform grid of N angles
-  (:mod:`transient.analysis.loads`): ``loads_phi`` (N,) [rad]; ``loads_P``, ``loads_N``,
+  (:mod:`transient.analysis.loads.crank_slider`): ``loads_phi`` (N,) [rad]; ``loads_P``, ``loads_N``,
   ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load ``loads_R_K``,
   ``loads_R_T``, ``loads_R`` ((40)/(41) as vectors), each (n, N) [N]; ``loads_torque`` (n, N)
   and ``loads_engine_torque`` (N,) [N m]; ``loads_crankpin_R_max`` (n,) [N]; in-line engines
   also the running torques ``loads_journal_torque`` (n+1, N), ``loads_crankpin_torque`` (n, N)
   [N m] (§2.8) and the main journals by (58), ``loads_main_x``, ``loads_main_y`` (n+1, N) and
   ``loads_main_R_max`` (n+1,) [N] (frame of crank 1).
-* ``loads = true``, articulated (radial, V; :mod:`transient.analysis.loads_radial`), the same grid
+* ``loads = true``, articulated (radial, V; :mod:`transient.analysis.loads.articulated`), the same grid
   and ``loads_phi``: per cylinder ``loads_P``, ``loads_N``, ``loads_S`` (n, N) [N] and
   ``loads_torque`` = P u (n, N) [N m]; per row (its crankpin, ρ rows) ``loads_K``, ``loads_T``,
   ``loads_R_K``, ``loads_R_T``, ``loads_R`` (ρ, N) and ``loads_crankpin_R_max`` (ρ,) [N]; per link
   pin (ρ·z′ slaves) its load in the row frame ``loads_link_x``, ``loads_link_y`` (ρ·z′, N) and
   ``loads_link_R_max`` (ρ·z′,) [N]; ``loads_engine_torque`` Σ T r (N,) [N m]. No main journals
   or running torques.
-* ``loads = true``, swash plate (:mod:`transient.analysis.loads_swash`): per cylinder (one piston;
+* ``loads = true``, swash plate (:mod:`transient.analysis.loads.swash_plate`): per cylinder (one piston;
   torques count both halves) ``loads_P``, ``loads_S``, ``loads_N_radial``, ``loads_N_tangential``
   (z, N) [N], ``loads_torque`` (z, N) [N m]; ``loads_engine_torque`` (Σ torque) and
   ``loads_shaft_torque`` (with the rods' and link 9's inertia) (N,) [N m]. No crankpin.
@@ -127,7 +127,7 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
 
 def _piston_acceleration(mech, phi, omega, epsilon, k: int) -> np.ndarray:
     """W = ω²s″ + εs′ of cylinder k (1-based) [m/s²] (Semenov §4), exact kinematics."""
-    from .loads import slider_arrays
+    from .loads.crank_slider import slider_arrays
 
     alpha = phi - mech.firing_angles[k - 1]
     _, ds, dds, _, _, _ = slider_arrays(alpha, mech.crank_radius, mech.rod_length, mech.offset)
@@ -136,7 +136,7 @@ def _piston_acceleration(mech, phi, omega, epsilon, k: int) -> np.ndarray:
 
 def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     """Forces, crankpin and main-journal loads and running torques over the last whole cycle."""
-    from .loads import engine_torque, loads_from_trajectory, main_journal_loads, running_torques
+    from .loads.crank_slider import loads_from_trajectory, main_journal_loads, running_torques
 
     mech = scene.mechanism
     n = scene.analysis.samples_per_cycle
@@ -151,7 +151,7 @@ def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R"):
         out[f"loads_{name}"] = (getattr(ld, name), "N")
     out["loads_torque"] = (ld.torque, "N m")
-    out["loads_engine_torque"] = (engine_torque(ld), "N m")
+    out["loads_engine_torque"] = (ld.engine_torque, "N m")
     out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
     if np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12:  # in-line: (58), §2.8
         journals, pins = running_torques(mech, ld)
@@ -182,9 +182,9 @@ def _other_loads(mech):
 
 
 def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
-    """Radial/V rows (:mod:`transient.analysis.loads_radial`): per cylinder, link pin and
+    """Radial/V rows (:mod:`transient.analysis.loads.articulated`): per cylinder, link pin and
     crankpin; no main journals or running torques (one crankpin carries a whole row)."""
-    from .loads_radial import articulated_loads_from_trajectory
+    from .loads.articulated import articulated_loads_from_trajectory
 
     ld = articulated_loads_from_trajectory(scene, traj)
     out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
@@ -198,9 +198,9 @@ def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
 
 
 def _stored_swash_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
-    """Swash plate (:mod:`transient.analysis.loads_swash`): per cylinder and the shaft torque;
+    """Swash plate (:mod:`transient.analysis.loads.swash_plate`): per cylinder and the shaft torque;
     no crankpin, journals or running torques."""
-    from .loads_swash import swash_loads_from_trajectory
+    from .loads.swash_plate import swash_loads_from_trajectory
 
     ld = swash_loads_from_trajectory(scene, traj)
     out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}

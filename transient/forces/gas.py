@@ -27,13 +27,18 @@ from transient.errors import SceneError
 from transient.roots import bisect_root
 
 __all__ = [
+    "ANGLE_TOL",
     "DEFAULT_STEP",
     "INTERPOLATIONS",
+    "IndicatedCycle",
     "MixedCycle",
     "PressureTable",
+    "VolumeFunction",
+    "deg_text",
     "mixed_cycle",
     "table_from_function",
     "table_from_points",
+    "volume_at",
 ]
 
 #: Default knot spacing of :func:`table_from_function` [rad] (0.125°). Measured on the Gots
@@ -46,14 +51,17 @@ DEFAULT_STEP = math.radians(0.125)
 #: Interpolation methods accepted by :func:`table_from_points`.
 INTERPOLATIONS = ("linear", "pchip", "spline")
 
-# Angles read from degrees (scene.py converts ``*_deg`` keys) miss 0 and the period by a few
-# ulp; anything closer than this to a cycle end or a corner is snapped onto it.
-_ANGLE_TOL = 1e-9
+#: Angles read from degrees (scene.py converts ``*_deg`` keys) miss 0, the period or a corner by
+#: a few ulp; anything closer than this (relative to the period) is snapped onto it.
+ANGLE_TOL = 1e-9
 
 PieceFunction = Union[Callable[[NDArray[np.float64]], ArrayLike], float]
 
+#: A cylinder volume V(x) [m³], vectorised over local crank angles x [rad].
+VolumeFunction = Callable[[NDArray[np.float64]], ArrayLike]
 
-def _deg(x: float) -> str:
+
+def deg_text(x: float) -> str:
     """An angle in radians, formatted in degrees for a one-line message."""
     return f"{math.degrees(x):.6g}°"
 
@@ -332,8 +340,8 @@ def _check_corners(corners: ArrayLike, period: float, key: str | None) -> NDArra
     c = np.unique(np.asarray(corners, dtype=np.float64).ravel())
     for ci in c:
         if not (np.isfinite(ci) and 0.0 < ci < period):
-            msg = (f"corner at {_deg(ci)} is outside (0°, {_deg(period)}); corners must lie "
-                   f"strictly inside the cycle (0° and {_deg(period)} are corners already)")
+            msg = (f"corner at {deg_text(ci)} is outside (0°, {deg_text(period)}); corners must lie "
+                   f"strictly inside the cycle (0° and {deg_text(period)} are corners already)")
             raise SceneError(key, msg) if key else ValueError(msg)
     return c
 
@@ -385,16 +393,16 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
                                   "give one pressure per angle")
     if phi.size < 2 or not np.all(np.isfinite(phi)):
         raise SceneError("gas.phi_deg", f"needs at least 2 finite angles from 0° to "
-                                        f"{_deg(period)}, got {phi.size}")
+                                        f"{deg_text(period)}, got {phi.size}")
     bad = np.flatnonzero(~np.isfinite(p) | (p < 0.0))
     if bad.size:
         k = bad[0]
-        raise SceneError("gas.p", f"pressure {p[k]:.6g} Pa at {_deg(phi[k])} is not allowed; "
+        raise SceneError("gas.p", f"pressure {p[k]:.6g} Pa at {deg_text(phi[k])} is not allowed; "
                                   "pressures are absolute, finite and ≥ 0")
-    tol = _ANGLE_TOL * max(period, 1.0)
+    tol = ANGLE_TOL * max(period, 1.0)
     if abs(phi[0]) > tol or abs(phi[-1] - period) > tol:
-        raise SceneError("gas.phi_deg", f"angles run from {_deg(phi[0])} to {_deg(phi[-1])}; "
-                                        f"they must start at 0° and end at {_deg(period)}")
+        raise SceneError("gas.phi_deg", f"angles run from {deg_text(phi[0])} to {deg_text(phi[-1])}; "
+                                        f"they must start at 0° and end at {deg_text(period)}")
     phi[0], phi[-1] = 0.0, period
     corners = _check_corners(corners, period, "gas.corners_deg")
     # Snap angles converted from degrees onto the corner they mean.
@@ -405,15 +413,15 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
     back = np.flatnonzero(steps < 0.0)
     if back.size:
         k = back[0]
-        raise SceneError("gas.phi_deg", f"angles must increase, but {_deg(phi[k + 1])} follows "
-                                        f"{_deg(phi[k])}")
+        raise SceneError("gas.phi_deg", f"angles must increase, but {deg_text(phi[k + 1])} follows "
+                                        f"{deg_text(phi[k])}")
     for k in np.flatnonzero(steps == 0.0):
         a = phi[k]
         if a not in corners:
-            raise SceneError("gas.phi_deg", f"{_deg(a)} is repeated but is not in gas.corners_deg; "
+            raise SceneError("gas.phi_deg", f"{deg_text(a)} is repeated but is not in gas.corners_deg; "
                                             "repeat an angle only at a declared corner (a jump)")
         if np.count_nonzero(phi == a) > 2:
-            raise SceneError("gas.phi_deg", f"{_deg(a)} is given more than twice; a jump takes "
+            raise SceneError("gas.phi_deg", f"{deg_text(a)} is given more than twice; a jump takes "
                                             "exactly two values, left then right")
 
     ends = np.concatenate([[0.0], corners, [period]])
@@ -440,7 +448,7 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
         s, e = first[j], last[j]
         if e - s + 1 < 2:
             raise SceneError("gas.phi_deg",
-                             f"the piece from {_deg(ends[j])} to {_deg(ends[j + 1])} has "
+                             f"the piece from {deg_text(ends[j])} to {deg_text(ends[j + 1])} has "
                              f"{max(e - s + 1, 0)} point(s); each piece between corners needs "
                              "at least 2")
         pieces.append(_piece_coef(phi[s:e + 1], p[s:e + 1], ends[j], ends[j + 1], interpolation))
@@ -509,7 +517,7 @@ def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: floa
         x = np.linspace(a, b, n + 1)
         y = np.asarray(fj(x), dtype=np.float64)
         if y.shape != x.shape or not np.all(np.isfinite(y)):
-            raise ValueError(f"piece {j} ({_deg(a)} to {_deg(b)}) gave non-finite or "
+            raise ValueError(f"piece {j} ({deg_text(a)} to {deg_text(b)}) gave non-finite or "
                              "misshapen values")
         knots, coef = _piece_coef(x, y, a, b, "spline")
         pieces.append((knots, coef))
@@ -527,7 +535,33 @@ def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: floa
 # ----------------------------------------------------------------------------------------
 
 @dataclass(frozen=True, eq=False)
-class MixedCycle(PressureTable):
+class IndicatedCycle(PressureTable):
+    """A pressure table of one cylinder's whole cycle with its indicated loop work, and what
+    follows from the work alone (shared by the mixed and the Wiebe cycle).
+
+    Subclasses give the swept volume ``v_h`` [m³].
+
+    Attributes
+    ----------
+    work : float
+        Indicated loop work ∮p dV per cycle [J] (pumping included).
+    """
+
+    work: float
+
+    @property
+    def mean_torque(self) -> float:
+        """Mean indicated torque of one cylinder [N·m]: the loop work per shaft angle of a cycle."""
+        return self.work / self.period
+
+    @property
+    def mean_pressure(self) -> float:
+        """Mean indicated pressure [Pa]: the loop work over the swept volume ``v_h``."""
+        return self.work / self.v_h
+
+
+@dataclass(frozen=True, eq=False)
+class MixedCycle(IndicatedCycle):
     """Pressure table of an ideal mixed cycle, with its closed-form quantities.
 
     A :class:`PressureTable` (use it wherever one is expected) plus what :func:`mixed_cycle`
@@ -552,7 +586,6 @@ class MixedCycle(PressureTable):
         Relative tabulation error estimate returned by :func:`table_from_function`.
     """
 
-    work: float
     p_c: float
     p_b: float
     angle_z: float
@@ -564,22 +597,17 @@ class MixedCycle(PressureTable):
     interpolation_error: float
 
     @property
-    def mean_torque(self) -> float:
-        """Mean indicated torque of one cylinder [N·m]: the loop work per shaft angle of a cycle."""
-        return self.work / self.period
-
-    @property
-    def mean_pressure(self) -> float:
-        """Mean indicated pressure [Pa]: the loop work over the swept volume ``V_a - V_c``."""
-        return self.work / (self.v_a - self.v_c)
+    def v_h(self) -> float:
+        """Swept volume ``V_a - V_c`` [m³] (the compression starts at a BDC)."""
+        return self.v_a - self.v_c
 
 
-def _scalar_volume(volume: Callable[[NDArray[np.float64]], ArrayLike], x: float) -> float:
+def volume_at(volume: VolumeFunction, x: float) -> float:
     """``volume`` at one angle, through its vectorised interface."""
     return float(np.asarray(volume(np.array([x], dtype=np.float64)), dtype=np.float64).ravel()[0])
 
 
-def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compression_ratio: float,
+def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                 p_a: float, n1: float, p_z: float, rho: float, n2: float,
                 p_intake: float | None = None, p_exhaust: float | None = None, strokes: int = 4,
                 step: float = DEFAULT_STEP) -> MixedCycle:
@@ -666,13 +694,13 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
     x_tdc = 2.0 * math.pi if strokes == 4 else 0.0
     x_bdc = x_tdc + math.pi
     x_start = math.pi  # compression starts at a BDC in both cycles
-    v_c = _scalar_volume(volume, x_tdc)
-    v_a = _scalar_volume(volume, x_start)
-    v_b = _scalar_volume(volume, x_bdc)
+    v_c = volume_at(volume, x_tdc)
+    v_a = volume_at(volume, x_start)
+    v_b = volume_at(volume, x_bdc)
     if not (v_c > 0.0 and v_a > v_c):
         raise SceneError("gas.compression_ratio",
-                         f"the volume gives V({_deg(x_start)}) = {v_a:.6g} m³ and "
-                         f"V({_deg(x_tdc)}) = {v_c:.6g} m³; need V_a > V_c > 0")
+                         f"the volume gives V({deg_text(x_start)}) = {v_a:.6g} m³ and "
+                         f"V({deg_text(x_tdc)}) = {v_c:.6g} m³; need V_a > V_c > 0")
     ratio = v_a / v_c
     if abs(ratio - compression_ratio) > 1e-9 * compression_ratio:
         raise SceneError("gas.compression_ratio",
@@ -693,7 +721,7 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
     if rho > 1.0:
         # V rises monotonically from TDC to BDC on a crank slider: bisection finds the crossing
         # to the last bit, so the expansion starts at p_z to ~1e-15 relative.
-        angle_z = bisect_root(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc)
+        angle_z = bisect_root(lambda x: volume_at(volume, x) - v_z, x_tdc, x_bdc)
     # A ρ within rounding of 1 leaves no isobar worth a piece (and no zero-length interval).
     has_isobar = angle_z - x_tdc > 1e-12
     if not has_isobar:
@@ -714,8 +742,8 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
         funcs = [float(p_intake), compression, *expansion_pieces, float(p_exhaust)]
         corners = [math.pi, x_tdc, *expansion_corners, x_bdc]
         # Pumping loop, from the volumes at the same corners the table uses.
-        v_0 = _scalar_volume(volume, 0.0)
-        v_end = _scalar_volume(volume, period)
+        v_0 = volume_at(volume, 0.0)
+        v_end = volume_at(volume, period)
         work += p_intake * (v_a - v_0) + p_exhaust * (v_end - v_b)
     else:
         funcs = [*expansion_pieces, compression]
