@@ -36,7 +36,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from transient.errors import SceneError
-from transient.forces.gas import ANGLE_TOL, VolumeFunction, deg_text, volume_at
+from transient.forces.gas import (
+    ANGLE_TOL,
+    VolumeFunction,
+    cycle_period,
+    deg_text,
+    gas_exchange_pressures,
+    volume_at,
+)
 
 __all__ = [
     "DEFAULT_A",
@@ -271,17 +278,9 @@ def setup_cycle(*, strokes, p_a, start, duration, a, m, lhv, efficiency, gamma, 
     ValueError
         `rtol` outside [1e-14, 1e-6].
     """
-    if strokes not in (2, 4):
-        raise SceneError("gas.strokes", f"strokes = {strokes!r}; use 4 or 2")
-    period = 2.0 * math.pi * strokes / 2.0
+    period = cycle_period(strokes)
     p_a = _check_positive("gas.p_a", p_a, "the absolute pressure at intake closing")
-    if strokes == 4:
-        for key, value in (("gas.p_intake", p_intake), ("gas.p_exhaust", p_exhaust)):
-            if value is None or not (np.isfinite(value) and value >= 0.0):
-                raise SceneError(key, f"{value!r} Pa; a 4-stroke needs an absolute pressure ≥ 0")
-        p_intake, p_exhaust = float(p_intake), float(p_exhaust)
-    else:
-        p_intake = p_exhaust = float("nan")
+    p_intake, p_exhaust = gas_exchange_pressures(strokes, p_intake, p_exhaust)
     start, duration, a, m = float(start), float(duration), float(a), float(m)
     _check_wiebe(start, duration, a, m)
     lhv = _check_positive("gas.wiebe.lhv", lhv, "the lower heating value [J/kg]")
@@ -321,8 +320,8 @@ def setup_cycle(*, strokes, p_a, start, duration, a, m, lhv, efficiency, gamma, 
                              "TDC) and before 360° (firing TDC)")
         if not (2.0 * math.pi + tol < evo < period - tol):
             raise SceneError("gas.wiebe.exhaust_opening_deg",
-                             f"exhaust opens at {deg_text(evo)}; it must be after 360° (firing TDC) "
-                             "and before 720°")
+                             f"exhaust opens at {deg_text(evo)}; it must be after 360° (firing "
+                             "TDC) and before 720°")
     else:
         if not (tol < ivc < period - tol):
             raise SceneError("gas.wiebe.intake_closing_deg",
@@ -330,8 +329,8 @@ def setup_cycle(*, strokes, p_a, start, duration, a, m, lhv, efficiency, gamma, 
                              "0° being the firing TDC")
         if not (tol < evo < period - tol) or evo > ivc + tol:
             raise SceneError("gas.wiebe.exhaust_opening_deg",
-                             f"exhaust opens at {deg_text(evo)}; it must be inside (0°, 360°) and not "
-                             f"after the port closing at {deg_text(ivc)}")
+                             f"exhaust opens at {deg_text(evo)}; it must be inside (0°, 360°) and "
+                             f"not after the port closing at {deg_text(ivc)}")
         if abs(evo - ivc) <= tol:
             evo = ivc
     evo_table = evo
@@ -375,7 +374,8 @@ def check_volume(st: CycleSetup, volume: VolumeFunction) -> None:
     if v.shape != x.shape or not np.all(np.isfinite(v) & (v > 0.0)):
         raise SceneError("gas.compression_ratio",
                          "the cylinder volume is not finite and > 0 over the closed part "
-                         f"{deg_text(st.ivc)} to {deg_text(st.evo % st.period)}; check the geometry")
+                         f"{deg_text(st.ivc)} to {deg_text(st.evo % st.period)}; check the "
+                         "geometry")
 
 
 # ----------------------------------------------------------------------------------------
@@ -562,8 +562,8 @@ def integrate_closed(st: CycleSetup, fuel_mass: float, volume: VolumeFunction,
         sol = solve_ivp(segment_rhs(lo, hi, burning, power), (u_lo, u_hi), y0, method="DOP853",
                         rtol=st.rtol, atol=atol, dense_output=True)
         if sol.status != 0:
-            raise RuntimeError(f"closed-cycle integration failed from {deg_text(lo)} to {deg_text(hi)}: "
-                               f"{sol.message}")
+            raise RuntimeError(f"closed-cycle integration failed from {deg_text(lo)} to "
+                               f"{deg_text(hi)}: {sol.message}")
         segments.append(Segment(lo=float(lo), hi=float(hi), power=power, sol=sol.sol, size=size))
         y0 = sol.y[:, -1].copy()
         y0[0] = max(y0[0], 0.0)

@@ -34,8 +34,12 @@ __all__ = [
     "MixedCycle",
     "PressureTable",
     "VolumeFunction",
+    "assemble_table",
+    "cycle_period",
     "deg_text",
+    "gas_exchange_pressures",
     "mixed_cycle",
+    "not_a_knot_coef",
     "table_from_function",
     "table_from_points",
     "volume_at",
@@ -64,6 +68,26 @@ VolumeFunction = Callable[[NDArray[np.float64]], ArrayLike]
 def deg_text(x: float) -> str:
     """An angle in radians, formatted in degrees for a one-line message."""
     return f"{math.degrees(x):.6g}°"
+
+
+def cycle_period(strokes: int) -> float:
+    """The cycle's length [rad]: 4π for a 4-stroke, 2π for a 2-stroke; a SceneError (gas.strokes)
+    for any other number of strokes."""
+    if strokes not in (2, 4):
+        raise SceneError("gas.strokes", f"strokes = {strokes!r}; use 4 or 2")
+    return 2.0 * math.pi * strokes / 2.0
+
+
+def gas_exchange_pressures(strokes: int, p_intake: float | None, p_exhaust: float | None
+                           ) -> tuple[float, float]:
+    """The constant intake and exhaust pressures of a 4-stroke [Pa], checked finite and ≥ 0;
+    NaN for a 2-stroke, which has no gas-exchange strokes."""
+    if strokes != 4:
+        return float("nan"), float("nan")
+    for key, value in (("gas.p_intake", p_intake), ("gas.p_exhaust", p_exhaust)):
+        if value is None or not (np.isfinite(value) and value >= 0.0):
+            raise SceneError(key, f"{value!r} Pa; a 4-stroke needs an absolute pressure ≥ 0")
+    return float(p_intake), float(p_exhaust)
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,8 +247,9 @@ def _tridiagonal_solve(lower, diag, upper, rhs):
     """x with A x = rhs for the tridiagonal A (``lower[i] = A[i+1, i]``, ``upper[i] = A[i, i+1]``),
     by Gaussian elimination without pivoting (the Thomas algorithm).
 
-    Written for the not-a-knot spline's system (:func:`_not_a_knot_coef`) so that a run does not
-    import scipy.linalg for it (README *Start-up*). Without pivoting it is stable there: once the
+    Written for the not-a-knot spline's system (:func:`not_a_knot_coef`) so that building a
+    table does not import scipy.linalg, a sizeable part of a warm start. Without pivoting it is
+    stable there: once the
     first row is eliminated every row is diagonally dominant (interior rows 2(h₀ + h₁) against
     h₀ + h₁ off the diagonal, and the first row's elimination leaves h₀ + h₁ against h₀), so
     every pivot exceeds its row's upper element, and the last row's multiplier is below 1. The
@@ -243,16 +268,15 @@ def _tridiagonal_solve(lower, diag, upper, rhs):
     return x
 
 
-def _not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+def not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
     """Ascending local coefficients (k, 4) of the not-a-knot cubic spline through (x, y): the
     curve of :class:`scipy.interpolate.CubicSpline` (``bc_type="not-a-knot"``; its algorithm: the
     knots' slopes from one tridiagonal system), which the tests compare it with.
 
-    Written out because importing scipy.interpolate (it imports scipy.optimize) costs 0.11–0.14 s,
-    a tenth of a warm ``transient run`` of the diesel (issue 5's 1 s target), and scipy.linalg,
-    for a banded solver, 0.12–0.18 s after numpy (five fresh interpreters;
-    :func:`_tridiagonal_solve`). With 3 points it is the parabola through them, with 2 the
-    straight line (CubicSpline's choices there).
+    Written out because importing scipy.interpolate (it imports scipy.optimize) and
+    scipy.linalg, for a banded solver (:func:`_tridiagonal_solve`), would be a sizeable part of a
+    warm ``transient run``. With 3 points it is the parabola through them, with 2 the straight
+    line (CubicSpline's choices there).
     """
     dx = np.diff(x)
     slope = np.diff(y) / dx
@@ -305,7 +329,7 @@ def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: flo
 
         coef = _ppoly_coef(PchipInterpolator(x, y))
     else:
-        coef = _not_a_knot_coef(x, y)
+        coef = not_a_knot_coef(x, y)
     knots = x.copy()
     if x[0] > a:
         coef = np.vstack([_shift_cubic(coef[0], a - x[0]), coef])
@@ -317,8 +341,8 @@ def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: flo
     return knots, coef
 
 
-def _assemble(pieces: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
-              period: float) -> PressureTable:
+def assemble_table(pieces: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
+                   period: float) -> PressureTable:
     """One table from per-piece (knots, coef), pieces in order and sharing their corners."""
     knots = [pieces[0][0]]
     piece_knot = [0, pieces[0][1].shape[0]]
@@ -340,8 +364,9 @@ def _check_corners(corners: ArrayLike, period: float, key: str | None) -> NDArra
     c = np.unique(np.asarray(corners, dtype=np.float64).ravel())
     for ci in c:
         if not (np.isfinite(ci) and 0.0 < ci < period):
-            msg = (f"corner at {deg_text(ci)} is outside (0°, {deg_text(period)}); corners must lie "
-                   f"strictly inside the cycle (0° and {deg_text(period)} are corners already)")
+            msg = (f"corner at {deg_text(ci)} is outside (0°, {deg_text(period)}); corners must "
+                   f"lie strictly inside the cycle (0° and {deg_text(period)} are corners "
+                   "already)")
             raise SceneError(key, msg) if key else ValueError(msg)
     return c
 
@@ -401,8 +426,9 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
                                   "pressures are absolute, finite and ≥ 0")
     tol = ANGLE_TOL * max(period, 1.0)
     if abs(phi[0]) > tol or abs(phi[-1] - period) > tol:
-        raise SceneError("gas.phi_deg", f"angles run from {deg_text(phi[0])} to {deg_text(phi[-1])}; "
-                                        f"they must start at 0° and end at {deg_text(period)}")
+        raise SceneError("gas.phi_deg", f"angles run from {deg_text(phi[0])} to "
+                                        f"{deg_text(phi[-1])}; they must start at 0° and end at "
+                                        f"{deg_text(period)}")
     phi[0], phi[-1] = 0.0, period
     corners = _check_corners(corners, period, "gas.corners_deg")
     # Snap angles converted from degrees onto the corner they mean.
@@ -418,8 +444,9 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
     for k in np.flatnonzero(steps == 0.0):
         a = phi[k]
         if a not in corners:
-            raise SceneError("gas.phi_deg", f"{deg_text(a)} is repeated but is not in gas.corners_deg; "
-                                            "repeat an angle only at a declared corner (a jump)")
+            raise SceneError("gas.phi_deg", f"{deg_text(a)} is repeated but is not in "
+                                            "gas.corners_deg; repeat an angle only at a declared "
+                                            "corner (a jump)")
         if np.count_nonzero(phi == a) > 2:
             raise SceneError("gas.phi_deg", f"{deg_text(a)} is given more than twice; a jump takes "
                                             "exactly two values, left then right")
@@ -452,7 +479,7 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
                              f"{max(e - s + 1, 0)} point(s); each piece between corners needs "
                              "at least 2")
         pieces.append(_piece_coef(phi[s:e + 1], p[s:e + 1], ends[j], ends[j + 1], interpolation))
-    return _assemble(pieces, period)
+    return assemble_table(pieces, period)
 
 
 def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: float,
@@ -527,7 +554,7 @@ def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: floa
         tm = coef[:, 0] + h * (coef[:, 1] + h * (coef[:, 2] + h * coef[:, 3]))
         err = max(err, float(np.max(np.abs(tm - fm))))
         scale = max(scale, float(np.max(np.abs(y))), float(np.max(np.abs(fm))))
-    return _assemble(pieces, period), (err / scale if scale > 0.0 else err)
+    return assemble_table(pieces, period), (err / scale if scale > 0.0 else err)
 
 
 # ----------------------------------------------------------------------------------------
@@ -673,8 +700,7 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         ``gas.strokes``, ``gas.p_a``, ``gas.p_z``, ``gas.n1``, ``gas.n2``, ``gas.rho``,
         ``gas.p_intake``, ``gas.p_exhaust`` for values out of range.
     """
-    if strokes not in (2, 4):
-        raise SceneError("gas.strokes", f"strokes = {strokes!r}; use 4 or 2")
+    period = cycle_period(strokes)
     for key, value in (("gas.p_a", p_a), ("gas.p_z", p_z)):
         if not (np.isfinite(value) and value > 0.0):
             raise SceneError(key, f"{value!r} Pa; an absolute pressure must be finite and > 0")
@@ -682,14 +708,10 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         # n = 1 (isothermal) would need the logarithmic work; real engines have 1.2-1.4.
         if not (np.isfinite(value) and value > 1.0):
             raise SceneError(key, f"polytropic exponent {value!r}; it must be > 1")
-    if strokes == 4:
-        for key, value in (("gas.p_intake", p_intake), ("gas.p_exhaust", p_exhaust)):
-            if value is None or not (np.isfinite(value) and value >= 0.0):
-                raise SceneError(key, f"{value!r} Pa; a 4-stroke needs an absolute pressure ≥ 0")
+    p_intake, p_exhaust = gas_exchange_pressures(strokes, p_intake, p_exhaust)
     if not (np.isfinite(compression_ratio) and compression_ratio > 1.0):
         raise SceneError("gas.compression_ratio", f"{compression_ratio!r}; it must be > 1")
 
-    period = 2.0 * math.pi * strokes / 2.0
     # Angles of the firing TDC and of the BDC that ends the expansion (x_tdc + π).
     x_tdc = 2.0 * math.pi if strokes == 4 else 0.0
     x_bdc = x_tdc + math.pi

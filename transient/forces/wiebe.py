@@ -48,7 +48,14 @@ from transient.forces.closed_cycle import (
     setup_cycle,
     volume_derivative,
 )
-from transient.forces.gas import IndicatedCycle, PressureTable, VolumeFunction, volume_at
+from transient.forces.gas import (
+    IndicatedCycle,
+    PressureTable,
+    VolumeFunction,
+    assemble_table,
+    not_a_knot_coef,
+    volume_at,
+)
 
 __all__ = [
     "DEFAULT_TOLERANCE",
@@ -223,18 +230,6 @@ def _solve(st: CycleSetup, fuel_mass: float, volume: VolumeFunction,
     return _Solved(pieces=pieces, scale=scale, fields=fields)
 
 
-def _spline_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Ascending local cubic coefficients (n, 4) of the spline through (x, y).
-
-    Not-a-knot, as :func:`~transient.forces.gas.table_from_function` (natural with 2 points,
-    i.e. the straight line).
-    """
-    from scipy.interpolate import CubicSpline
-
-    spline = CubicSpline(x, y, bc_type="not-a-knot" if x.size > 2 else "natural")
-    return np.ascontiguousarray(spline.c[::-1].T, dtype=np.float64)
-
-
 def _tabulate(solved: Sequence[_Solved], period: float, step: float, tolerance: float
               ) -> list[tuple[PressureTable, float]]:
     """Tables of several cycles on common knots, refined until the midpoint error is small.
@@ -271,7 +266,7 @@ def _tabulate(solved: Sequence[_Solved], period: float, step: float, tolerance: 
             piece_coef, piece_err = [], []
             bad = np.zeros(h.size, dtype=bool)
             for s, f in zip(solved, funcs):
-                c = _spline_coef(x, f(x))
+                c = not_a_knot_coef(x, f(x))
                 hm = 0.5 * h
                 tm = c[:, 0] + hm * (c[:, 1] + hm * (c[:, 2] + hm * c[:, 3]))
                 e = np.abs(tm - f(xm)) / s.scale
@@ -286,10 +281,8 @@ def _tabulate(solved: Sequence[_Solved], period: float, step: float, tolerance: 
         for i in range(n_cycles):
             coefs[i].append(piece_coef[i])
             errors[i] = max(errors[i], float(np.max(piece_err[i])))
-    all_knots = np.concatenate([knots[0]] + [k[1:] for k in knots[1:]])
-    piece_knot = np.concatenate([[0], np.cumsum([k.size - 1 for k in knots])]).astype(np.int64)
-    return [(PressureTable(knots=all_knots, coef=np.vstack(coefs[i]), piece_knot=piece_knot,
-                           period=period), float(errors[i])) for i in range(n_cycles)]
+    return [(assemble_table(list(zip(knots, coefs[i])), period), float(errors[i]))
+            for i in range(n_cycles)]
 
 
 def _cycles(volume: VolumeFunction, fuel_levels: Sequence[float], *, p_a, start, duration, a,
@@ -424,8 +417,8 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
         ``gas.compression_ratio``
         if the volume is not positive over the closed part.
     """
-    return _cycles(volume, [check_fuel_mass(fuel_mass)], p_a=p_a, start=start, duration=duration, a=a,
-                   m=m, lhv=lhv, efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
+    return _cycles(volume, [check_fuel_mass(fuel_mass)], p_a=p_a, start=start, duration=duration,
+                   a=a, m=m, lhv=lhv, efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
                    gamma_t_ref=gamma_t_ref, t_a=t_a, p_intake=p_intake, p_exhaust=p_exhaust,
                    strokes=strokes, intake_closing=intake_closing,
                    exhaust_opening=exhaust_opening, dvolume=dvolume, step=step,

@@ -491,7 +491,8 @@ def _speed(omega: float | Callable[[float], float] | None, needed: bool
 
 def _wall_loss(st, v_a: float, woschni: WoschniParameters | None,
                omega_at: Callable[[float], float]) -> Callable[[float], SegmentLoss]:
-    """dQ_w/dx = Q̇_w/ω of every segment for :func:`~transient.forces.closed_cycle.integrate_closed`.
+    """dQ_w/dx = Q̇_w/ω of every segment, for
+    :func:`~transient.forces.closed_cycle.integrate_closed`.
 
     c2 is switched on from the segment that starts at the combustion start, so that the loss is
     smooth inside every segment except where p crosses p_mot (a kink of max(p − p_mot, 0)).

@@ -45,9 +45,10 @@ the row has the outward axis d_k = e^{iδ_k} (δ_0 = 0 for the master) and the s
   C = ΔI β̈ + Σ_i (A_i − A) × F_i: the link pins make the master's side force differ from P tan β
   even with massless rods. The rod system's force on the crankpin is Φ_0 + Σ_i F_i, with
   components K (toward the crank axis) and T (direction of rotation), Gots (36)–(37) generalised.
-* **Crankpin load** of the row, a vector as in :mod:`.crank_slider`: R_K = K + K_rш, R_T = T + T_rш with
-  the master rod's rotating mass, K_rш = −m₂ r ω², T_rш = −m₂ r ε (Gots (32) and its ε term); the
-  crank throw's m_k gives K_rk, T_rk the same way (the row's ``crank_mass``).
+* **Crankpin load** of the row, a vector as in :mod:`.crank_slider`: R_K = K + K_rш,
+  R_T = T + T_rш with the master rod's rotating mass, K_rш = −m₂ r ω², T_rш = −m₂ r ε (Gots (32)
+  and its ε term); the crank throw's m_k gives K_rk, T_rk the same way (the row's
+  ``crank_mass``).
 
 Virtual work (the independent checks, ``tests/unit/test_loads_radial_swash.py``)
 --------------------------------------------------------------------------------
@@ -132,7 +133,7 @@ def row_kinematics(mech: Articulated, alpha: ArrayLike) -> RowKinematics:
 
     The master comes from :func:`.crank_slider.slider_arrays` (Semenov (31), exact); the
     slaves' derivatives from the compiled :func:`transient.core.articulated.slave`, one sample at a
-    time (a few µs each: analyses run once per result), and their positions from the plain-numpy
+    time (cheap enough: analyses run once per result), and their positions from the plain-numpy
     :func:`transient.mechanisms.articulated.positions`.
     """
     alpha = np.atleast_1d(np.asarray(alpha, dtype=np.float64))
