@@ -52,6 +52,7 @@ __all__ = [
     "ClosedPart",
     "CycleSetup",
     "Segment",
+    "SegmentLoss",
     "burned_fraction",
     "check_fuel_mass",
     "check_volume",
@@ -447,13 +448,19 @@ class ClosedPart:
         if np.any((x < self.start - 1e-12) | (x > self.end + 1e-12)):
             raise ValueError(f"angles must lie in the closed part [{deg_text(self.start)}, "
                              f"{deg_text(self.end)}]")
-        k = np.clip(np.searchsorted(self.breaks, x, side="right") - 1, 0, len(self.segments) - 1)
+        k = self.segment_index(x)
         out = np.empty((self.segments[0].size,) + x.shape)
         for j, seg in enumerate(self.segments):
             sel = k == j
             if np.any(sel):
                 out[:, sel] = seg(x[sel])
         return tuple(out)
+
+    def segment_index(self, x: ArrayLike) -> NDArray[np.int64]:
+        """Index of the segment holding each unwrapped angle x [rad] (at a segment end, the one
+        that starts there; before the first and past the last, those)."""
+        return np.clip(np.searchsorted(self.breaks, x, side="right") - 1, 0,
+                       len(self.segments) - 1)
 
     def __call__(self, x: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Pressure [Pa] and work ``W(x) = ∫ p dV`` from intake closing to x [J] (as

@@ -179,8 +179,7 @@ def _solve(st: CycleSetup, fuel_mass: float, volume: VolumeFunction,
     pieces: list[tuple[float, float, object]] = []
 
     def closed_piece(lo: float, hi: float, shift: float) -> None:
-        k = int(np.clip(np.searchsorted(closed.breaks, 0.5 * (lo + hi) + shift, side="right") - 1,
-                        0, len(closed.segments) - 1))
+        k = int(closed.segment_index(0.5 * (lo + hi) + shift))
 
         def f(x, seg=closed.segments[k], shift=shift):
             return seg(np.asarray(x, dtype=np.float64) + shift)[0]

@@ -67,6 +67,7 @@ from transient.forces.closed_cycle import (
     DEFAULT_M,
     DEFAULT_RTOL,
     ClosedPart,
+    CycleSetup,
     SegmentLoss,
     burned_fraction,
     check_fuel_mass,
@@ -489,7 +490,7 @@ def _speed(omega: float | Callable[[float], float] | None, needed: bool
     return checked
 
 
-def _wall_loss(st, v_a: float, woschni: WoschniParameters | None,
+def _wall_loss(st: CycleSetup, v_a: float, woschni: WoschniParameters | None,
                omega_at: Callable[[float], float]) -> Callable[[float], SegmentLoss]:
     """dQ_w/dx = Q̇_w/ω of every segment, for
     :func:`~transient.forces.closed_cycle.integrate_closed`.
