@@ -1,4 +1,4 @@
-"""The scene's ``[analysis]`` table end to end (issue 7): ``transient run`` stores what it asks
+"""The scene's ``[analysis]`` table end to end: ``transient run`` stores what it asks
 for under ``/analysis`` with units, ``transient info`` lists it, a scene that asks for nothing
 gets nothing new, and a run too short for a whole cycle says so instead of failing.
 

@@ -1,4 +1,4 @@
-"""``transient loads`` and ``transient orders`` end to end (issue 7): a short Gots spin-up is run
+"""``transient loads`` and ``transient orders`` end to end: a short Gots spin-up is run
 through ``transient.cli.main`` and both analyses are checked against independent calls of the
 analysis functions; a swash-plate result is refused by ``loads`` (exit 2)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Loads of radial and swash-plate runs end to end (issue 7): a run whose scene asks for
+"""Loads of radial and swash-plate runs end to end: a run whose scene asks for
 ``[analysis] loads`` stores them under ``/analysis`` with units, they equal the loads of the stored
 samples, and they balance the simulated shaft.
 

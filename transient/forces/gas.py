@@ -40,6 +40,7 @@ __all__ = [
     "gas_exchange_pressures",
     "mixed_cycle",
     "not_a_knot_coef",
+    "shift_cubic",
     "table_from_function",
     "table_from_points",
     "volume_at",
@@ -229,8 +230,10 @@ class PressureTable:
 # Building tables
 # ----------------------------------------------------------------------------------------
 
-def _shift_cubic(c: NDArray[np.float64], h: float) -> NDArray[np.float64]:
-    """Coefficients of ``q(e) = p(e + h)`` for the ascending cubic ``p`` (used to extrapolate)."""
+def shift_cubic(c: NDArray[np.float64], h: float) -> NDArray[np.float64]:
+    """Coefficients of ``q(e) = p(e + h)`` for the ascending cubic ``p`` (``c`` of shape (4,) or
+    (4, k) with h of shape (k,)): a piece extrapolated to its corner, or a table moved onto other
+    knots."""
     c0, c1, c2, c3 = c
     return np.array([c0 + h * (c1 + h * (c2 + h * c3)),
                      c1 + h * (2.0 * c2 + 3.0 * h * c3),
@@ -332,10 +335,10 @@ def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: flo
         coef = not_a_knot_coef(x, y)
     knots = x.copy()
     if x[0] > a:
-        coef = np.vstack([_shift_cubic(coef[0], a - x[0]), coef])
+        coef = np.vstack([shift_cubic(coef[0], a - x[0]), coef])
         knots = np.concatenate([[a], knots])
     if x[-1] < b:
-        coef = np.vstack([coef, _shift_cubic(coef[-1], x[-1] - x[-2])])
+        coef = np.vstack([coef, shift_cubic(coef[-1], x[-1] - x[-2])])
         knots = np.concatenate([knots, [b]])
     knots[0], knots[-1] = a, b
     return knots, coef
