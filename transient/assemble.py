@@ -15,7 +15,7 @@ from .core import cylinder as cyl
 from .core import governor as gv
 from .core.model import (PAPER, PHI, POWER_FLOW, TABULATED, T, Model, applied_value, fuel,
                          governor_branch, mechanism_terms, select_pieces, work_array)
-from .forces.gas import PressureTable, _shift_cubic, mixed_cycle, table_from_points
+from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .forces.trapezoid import trapezoid_table
 
 
@@ -185,7 +185,7 @@ def paired_table(full: PressureTable, motored: PressureTable
         piece = table.piece_of(mid)
         i = np.clip(np.searchsorted(table.knots, mid, side="right") - 1,
                     table.piece_knot[piece], table.piece_knot[piece + 1] - 1)
-        coefs.append(_shift_cubic(table.coef[i].T, knots[:-1] - table.knots[i]).T)
+        coefs.append(shift_cubic(table.coef[i].T, knots[:-1] - table.knots[i]).T)
     return knots, np.ascontiguousarray(np.hstack(coefs)), piece_knot.astype(np.int64)
 
 

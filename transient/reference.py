@@ -152,18 +152,20 @@ class ChainNumpy:
 
 class CylindersNumpy:
     """The cylinder pressures of the closed part with wall heat transfer (``[gas.woschni]``),
-    from :mod:`transient.forces.woschni`'s scalar functions (not from the kernels of
+    from the scalar functions of :mod:`transient.forces.woschni` and
+    :mod:`transient.forces.closed_cycle` (not from the kernels of
     ``transient.core.cylinder``): the state is ``y[c:]`` of the reference state, in time,
     dp/dt = (γ − 1)/V·(ω dQ_b/dx − Q̇_w) − γ p/V·dV/dt, dV/dt = F_p·u_k·ω. The combustion and
-    Woschni's combustion term are switched by the segment between breakpoints, as in the
-    closed-cycle integration there."""
+    Woschni's combustion term are switched by the segment between breakpoints, as in
+    :func:`transient.forces.closed_cycle.integrate_closed`."""
 
     def __init__(self, scene, phases: np.ndarray, period: float, c: int) -> None:
         from .assemble import clearance_volume, wiebe_levels
-        from .forces import woschni
+        from .forces import closed_cycle, woschni
 
         gas, mech = scene.gas, scene.mechanism
         self.fn, self.w, self.c, self.period, self.phases = woschni, gas.wiebe, c, period, phases
+        self.zone = closed_cycle
         self.heat = woschni.WoschniParameters.of_mechanism(
             mech, c1=gas.woschni.c1, c2=gas.woschni.c2,
             wall_temperature=gas.woschni.wall_temperature)
@@ -198,15 +200,15 @@ class CylindersNumpy:
             burnt = x_mid >= self.start
             burning = burnt and x_mid < self.start + w_.duration
             q = fuel[k] * w_.fuel_mass * w_.lhv * w_.efficiency
-            dq_b = (q * self.fn._rate_scalar(min(max((x - self.start) / w_.duration, 0.0), 1.0),
-                                             w_.a, w_.m) / w_.duration if burning else 0.0)
+            dq_b = (q * self.zone.wiebe_rate_y(min(max((x - self.start) / w_.duration, 0.0), 1.0),
+                                               w_.a, w_.m) / w_.duration if burning else 0.0)
             h = self.heat
             q_w = self.fn.wall_heat_flow(p, v, w, w_.t_a, self.p_a, self.v_a, self.gamma_a, h.c1,
                                          h.c2 if burnt else 0.0, h.wall_temperature, h.bore,
                                          h.stroke)
             g = w_.gamma + w_.gamma_slope * (w_.t_a * p * v / (self.p_a * self.v_a)
                                              - w_.gamma_t_ref)
-            out.append(self.fn.first_law_rate(p, v, self.area * u[k] * w, dq_b * w, q_w, g))
+            out.append(self.zone.first_law_rate(p, v, self.area * u[k] * w, dq_b * w, q_w, g))
         return out
 
     def close_intakes(self, phi, y) -> None:

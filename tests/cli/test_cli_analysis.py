@@ -1,4 +1,4 @@
-"""The scene's ``[analysis]`` table end to end (issue 7): ``transient run`` stores what it asks
+"""The scene's ``[analysis]`` table end to end: ``transient run`` stores what it asks
 for under ``/analysis`` with units, ``transient info`` lists it, a scene that asks for nothing
 gets nothing new, and a run too short for a whole cycle says so instead of failing.
 
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from transient.analysis.irregularity import cycle_boundaries, fluctuation
-from transient.analysis.loads import engine_torque, loads_from_trajectory
+from transient.analysis.loads.crank_slider import loads_from_trajectory
 from transient.cli import main
 from transient.results import open_result
 from transient.scene import load_scene
@@ -91,7 +91,7 @@ def test_irregularity_and_loads_agree_with_the_trajectory(spinup):
     ld = loads_from_trajectory(scene, {k: v[idx] for k, v in tr.items()})
     scale = np.abs(ld.T).max()
     dev = max(np.abs(ld.T - a["loads_T"]).max(), np.abs(ld.R - a["loads_R"]).max()) / scale
-    dev_m = np.abs(engine_torque(ld) - a["loads_engine_torque"]).max() / scale / ld.r
+    dev_m = np.abs(ld.engine_torque - a["loads_engine_torque"]).max() / scale / ld.r
     print(f"stored loads vs the samples: {dev:.1e} (T, R), {dev_m:.1e} (torque), relative")
     assert dev <= 1e-9 and dev_m <= 1e-9
     # the last journal carries every throw's r(T + T_rш + T_rk): ≠ Σ T r while ε ≠ 0 (§2.8)

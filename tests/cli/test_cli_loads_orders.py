@@ -1,4 +1,4 @@
-"""``transient loads`` and ``transient orders`` end to end (issue 7): a short Gots spin-up is run
+"""``transient loads`` and ``transient orders`` end to end: a short Gots spin-up is run
 through ``transient.cli.main`` and both analyses are checked against independent calls of the
 analysis functions; a swash-plate result is refused by ``loads`` (exit 2)."""
 from __future__ import annotations
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from transient.analysis.irregularity import cycle_boundaries, fluctuation
-from transient.analysis.loads import loads_from_trajectory
+from transient.analysis.loads.crank_slider import loads_from_trajectory
 from transient.cli import main
 from transient.results import open_result
 
@@ -144,7 +144,7 @@ def test_loads_refuses_swash_plate(tmp_path, capsys):
 def test_loads_of_a_radial_engine(tmp_path, capsys):
     """An articulated result: the polar diagram of the master crankpin, the load curves and a
     CSV whose crankpin load is the analysis function's on the stored samples of the last cycle."""
-    from transient.analysis.loads_radial import articulated_loads_from_trajectory
+    from transient.analysis.loads.articulated import articulated_loads_from_trajectory
 
     scene = tmp_path / "short_radial.toml"
     scene.write_text(_scene_text("radial_5cyl.toml", "revolutions = 300", "revolutions = 6"))

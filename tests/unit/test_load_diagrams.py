@@ -1,4 +1,4 @@
-"""The load diagrams' analysis (:mod:`transient.analysis.wear`, :mod:`.load_diagrams`,
+"""The load diagrams' analysis (:mod:`transient.analysis.wear`, :mod:`transient.analysis.loads.diagrams`,
 :func:`transient.analysis.irregularity.last_cycle_window`) against hand computations:
 
 * wear rays on a few load vectors whose sums are written out by hand, and on the Gots 36-ray
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from transient.analysis.irregularity import NoWholeCycle, last_cycle_window
-from transient.analysis.loads import loads_from_trajectory, main_journal_loads
+from transient.analysis.loads.crank_slider import loads_from_trajectory, main_journal_loads
 from transient.analysis.wear import WEAR_HALF_ARC_DEG, angle_weights, wear_rays
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -188,7 +188,7 @@ def gots():
 
 
 def test_crank_slider_diagrams(gots):
-    from transient.analysis.load_diagrams import crank_slider_diagrams
+    from transient.analysis.loads.diagrams import crank_slider_diagrams
 
     scene, traj = gots
     assert scene.mechanism.cycle == pytest.approx(CYCLE) and scene.initial.phi == 0.0
@@ -230,7 +230,7 @@ def test_crank_slider_diagrams(gots):
 
 def test_crank_slider_diagrams_of_a_v_engine(gots):
     """Bank angles that differ: no main journals nor running torques (in-line only)."""
-    from transient.analysis.load_diagrams import crank_slider_diagrams
+    from transient.analysis.loads.diagrams import crank_slider_diagrams
 
     scene, traj = gots
     v = replace(scene, mechanism=replace(scene.mechanism, bank_angles=(0.0, 0.5, 0.0)))
@@ -241,7 +241,7 @@ def test_crank_slider_diagrams_of_a_v_engine(gots):
 
 
 def test_crank_slider_diagrams_refuse(gots):
-    from transient.analysis.load_diagrams import crank_slider_diagrams
+    from transient.analysis.loads.diagrams import crank_slider_diagrams
 
     scene, traj = gots
     with pytest.raises(ValueError, match="cylinder must be 1 … 3, got 4"):

@@ -1,4 +1,4 @@
-"""Forces along a trajectory, :mod:`transient.analysis.loads` (reference/gots-crank-dynamics.md
+"""Forces along a trajectory, :mod:`transient.analysis.loads.crank_slider` (reference/gots-crank-dynamics.md
 §4–§9): identities that hold exactly, so the bounds are round-off bounds.
 
 * the vectorised kinematics against the compiled :func:`transient.core.crank_slider.slider`;
@@ -25,7 +25,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis import loads as L
+from transient.analysis.loads import crank_slider as L
+from transient.analysis.loads.common import gas_forces, rod_split
 from transient.core import crank_slider as core
 from transient.mechanisms.crank_slider import CrankSlider
 
@@ -88,7 +89,7 @@ def test_slider_arrays_match_the_kernel(e):
 def test_inertia_force_has_the_epsilon_term(name):
     """P_j = −m_j d/dt(s′(φ)φ̇), the derivative taken numerically from velocities only."""
     mech = MECHS[name]
-    m1, _, _ = L.rod_split(mech)
+    m1, _, _ = rod_split(mech)
     m_j = mech.piston_mass + m1
     phi, omega, eps = motion(T_GRID)
     loads = L.crank_slider_loads(mech, phi, omega, eps)
@@ -130,7 +131,7 @@ def test_crankpin_and_big_end_as_vectors(name):
     with S û plus the rigid rod's H x̂; the rod's m₂ at A adds −m₂ a_A, a_A = −ω²A + ε r t̂."""
     mech = MECHS[name]
     r = mech.crank_radius
-    _, m2, _ = L.rod_split(mech)
+    _, m2, _ = rod_split(mech)
     phi, omega, eps = motion(T_GRID)
     ld = L.crank_slider_loads(mech, phi, omega, eps, gas(mech, phi))
     a, b = ld.alpha, ld.beta
@@ -238,7 +239,7 @@ def test_torque_equals_the_reduced_model(name):
 def test_rigid_rod_virtual_work():
     """T r ω = P ds/dt + C β̇, C = −ΔI β̈ the couple the two-mass split misses."""
     mech = MECHS["offset-rigid"]
-    _, _, d_inertia = L.rod_split(mech)
+    _, _, d_inertia = rod_split(mech)
     assert abs(d_inertia) > 1e-4
     phi, omega, eps = motion(T_GRID)
     ld = L.crank_slider_loads(mech, phi, omega, eps, gas(mech, phi))
@@ -255,7 +256,7 @@ def test_constant_speed_reduces_to_gots():
     w = 460.77
     phi = np.radians(np.arange(0.0, 720.0, 5.0))
     ld = L.crank_slider_loads(mech, phi, w, 0.0)
-    m1, m2, _ = L.rod_split(mech)
+    m1, m2, _ = rod_split(mech)
     lam = mech.lam
     a = ld.alpha
     b = np.arcsin(lam * np.sin(a))
@@ -311,7 +312,7 @@ def test_running_torques():
     assert rel(journals[-1], throw.sum(axis=0)) <= RTOL
     assert rel(pins[1], throw[0] + 0.5 * throw[1]) <= RTOL
     j2, p2 = L.running_torques(mech, ld, include_rotating=False)
-    assert rel(j2[-1], L.engine_torque(ld)) <= RTOL
+    assert rel(j2[-1], ld.engine_torque) <= RTOL
     assert rel(p2[2], ld.torque[0] + ld.torque[1] + 0.5 * ld.torque[2]) <= RTOL
     with pytest.raises(ValueError, match="in-line"):
         L.running_torques(gots_mech(bank_angles=(0.0, 1.0, 0.0)), ld)
@@ -330,9 +331,9 @@ def test_gas_forces_and_trajectory():
     table = gas_table(scene)
     p = np.array([table(phi - ph) for ph in gas_phases(scene)])
     expected = (p - scene.gas.p0) * mech.piston_area
-    got = L.gas_forces(scene, phi)
+    got = gas_forces(scene, phi)
     assert rel(got, expected) <= RTOL
-    half = L.gas_forces(scene, phi, fuel=0.5)
+    half = gas_forces(scene, phi, fuel=0.5)
     assert rel(half, 0.5 * expected) <= RTOL
     traj = {"phi": phi, "omega": np.full_like(phi, 300.0), "epsilon": np.full_like(phi, 50.0)}
     traj.update({f"p_{k + 1}": p[k] for k in range(3)})

@@ -1,5 +1,5 @@
 """Forces along a trajectory for the articulated (radial, V) and swash-plate mechanisms,
-:mod:`transient.analysis.loads_radial` and :mod:`transient.analysis.loads_swash`.
+:mod:`transient.analysis.loads.articulated` and :mod:`transient.analysis.loads.swash_plate`.
 
 Every check is independent of the force algebra it tests:
 
@@ -30,9 +30,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis import loads as L
-from transient.analysis.loads_radial import articulated_loads, row_kinematics
-from transient.analysis.loads_swash import swash_kinematics, swash_loads
+from transient.analysis.loads import crank_slider as L
+from transient.analysis.loads.articulated import articulated_loads, row_kinematics
+from transient.analysis.loads.swash_plate import swash_kinematics, swash_loads
 from transient.core import swash_plate as swash_core
 from transient.core.articulated import articulated_terms
 from transient.mechanisms import articulated as art
@@ -299,7 +299,7 @@ def test_master_cylinder_alone_is_the_crank_slider(rod):
                  "throw_torque"))
     print(f"master alone ({rod} rod) vs crank_slider_loads: {worst:.1e}")
     assert worst <= RTOL
-    assert rel(a.engine_torque, L.engine_torque(c)) <= RTOL
+    assert rel(a.engine_torque, c.engine_torque) <= RTOL
     # The cylinder's share P u leaves out the rigid rod's couple power, which T r holds (loads.py:
     # T r ω = P ds/dt + C β̇); that power is W_links here.
     assert rel(a.torque + a.link_power / omega, c.torque) <= RTOL

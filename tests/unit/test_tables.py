@@ -234,12 +234,12 @@ def test_not_a_knot_spline_is_scipys_curve(n):
     uneven knots and noisy data, to rounding."""
     from scipy.interpolate import CubicSpline
 
-    from transient.forces.gas import _not_a_knot_coef
+    from transient.forces.gas import not_a_knot_coef
     rng = np.random.default_rng(n)
     x = np.sort(rng.uniform(0.0, 3.0, n))
     y = np.sin(3.0 * x) + rng.normal(0.0, 0.1, n)
     ref = CubicSpline(x, y, bc_type="not-a-knot" if n > 2 else "natural").c[::-1].T
-    np.testing.assert_allclose(_not_a_knot_coef(x, y), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    np.testing.assert_allclose(not_a_knot_coef(x, y), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
 
 
 @pytest.mark.parametrize("spread", [0.0, 3.0, 6.0])

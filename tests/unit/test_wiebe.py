@@ -8,7 +8,8 @@ import pytest
 from scipy.integrate import quad
 
 from transient.errors import SceneError
-from transient.forces.wiebe import wiebe_cycle, wiebe_fraction, wiebe_rate, wiebe_tables
+from transient.forces.closed_cycle import wiebe_fraction, wiebe_rate
+from transient.forces.wiebe import wiebe_cycle, wiebe_tables
 
 DEG = math.pi / 180
 START, DURATION = 358 * DEG, 50 * DEG

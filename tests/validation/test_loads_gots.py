@@ -1,4 +1,4 @@
-"""Crank-slider forces of :mod:`transient.analysis.loads` against the Gots worked example at
+"""Crank-slider forces of :mod:`transient.analysis.loads.crank_slider` against the Gots worked example at
 constant 4400 rpm (reference/gots-crank-dynamics.md §2.9, §11, §12; data/README.md): table П4.1
 (p'_j, N, S, K, T of one cylinder), П4.2 (three cylinders and their sum), П4.4/П4.5 (running
 torques on the main journals and crankpins), K′_rш = 2.08 MPa and R′_шш,max = 6.33 MPa.
@@ -31,7 +31,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis import loads as L
+from transient.analysis.loads import crank_slider as L
+from transient.analysis.loads.common import rod_split
 from transient.assemble import gas_phases
 from transient.scene import load_scene
 from transient.run import integrate
@@ -102,7 +103,7 @@ def gots_factors(alpha):
 
 def test_mechanism_is_dinns(engine):
     scene, mech = engine
-    m1, m2, d_inertia = L.rod_split(mech)
+    m1, m2, d_inertia = rod_split(mech)
     assert mech.piston_mass + m1 == pytest.approx(M_J, rel=1e-14)
     assert m2 == pytest.approx(M_2, rel=1e-14)
     assert d_inertia == 0.0
@@ -168,7 +169,7 @@ def test_P4_2_torques(engine, tables):
     devs = [float(np.max(np.abs(m_book[k] - p42[f"M_cyl{k + 1}_N_m"]))) for k in range(3)]
     total = m_book.sum(axis=0)
     dev_sum = float(np.max(np.abs(total - p42["M_sum_N_m"])))
-    raw = float(np.max(np.abs(L.engine_torque(ld) - p42["M_sum_N_m"])))
+    raw = float(np.max(np.abs(ld.engine_torque - p42["M_sum_N_m"])))
     print(f"П4.2: max |ΔM| per cylinder {np.round(devs, 3)}, sum {dev_sum:.3f} N·m "
           f"(exact inertia uncorrected: {raw:.2f} N·m)")
     assert max(devs) <= M_TOL
@@ -255,7 +256,7 @@ def test_prescribed_run_torque_is_the_engine_torque():
     scene = load_scene(path, text=path.read_text().replace("revolutions = 4", "revolutions = 2"))
     tr = integrate(scene).trajectory
     ld = L.loads_from_trajectory(scene, tr)
-    m = L.engine_torque(ld)
+    m = ld.engine_torque
     dev = float(np.max(np.abs(m + tr["M_drive"])) / np.max(np.abs(tr["M_drive"])))
     print(f"Σ T r vs −M_drive: {dev:.1e} relative")
     assert dev <= 1e-9

@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis.loads import rod_split
-from transient.analysis.loads_radial import articulated_loads_from_trajectory
-from transient.analysis.loads_swash import swash_loads_from_trajectory
+from transient.analysis.loads.articulated import articulated_loads_from_trajectory
+from transient.analysis.loads.common import rod_split
+from transient.analysis.loads.swash_plate import swash_loads_from_trajectory
 from transient.cli import main
 from transient.results import open_result
 from transient.scene import Analysis, load_scene

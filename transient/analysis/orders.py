@@ -34,9 +34,9 @@ Functions
     Resample trajectory columns onto a uniform crank-angle grid of whole cycles.
 :func:`order_spectrum`
     Per-cycle amplitude and phase per order (:class:`OrderSpectrum`).
-:func:`slider_arrays`, :func:`piston_acceleration`, :func:`piston_inertia_force`,
-:func:`rod_angular_acceleration`
-    Exact kinematics (:func:`transient.core.crank_slider.slider`) on arrays, with ω and ε.
+:func:`piston_acceleration`, :func:`piston_inertia_force`, :func:`rod_angular_acceleration`
+    Exact kinematics (:func:`transient.analysis.loads.crank_slider.slider_arrays`, the
+    vectorised twin of :func:`transient.core.crank_slider.slider`) with ω and ε.
 :func:`odd_harmonic_report`, :func:`report_for_scene`
     Orders of the piston acceleration of a run against the same engine at its mean speed
     (:class:`OddHarmonicReport`).
@@ -54,8 +54,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core.crank_slider import slider
 from .irregularity import NoWholeCycle, cycle_means, fluctuation
+from .loads.crank_slider import slider_arrays
 
 #: Orders closer than this to a whole number are whole orders (the grid gives ν = 2πk/Φ exactly
 #: up to rounding).
@@ -455,18 +455,6 @@ def cycle_spectra(traj: Mapping[str, NDArray[np.float64]], name: str, samples_pe
 
 # ------------------------------------------------------------------------------------------------
 # Piston kinematics with a variable shaft speed
-
-
-def slider_arrays(alpha: ArrayLike, r: float, l: float, e: float = 0.0
-                  ) -> tuple[NDArray[np.float64], ...]:
-    """:func:`transient.core.crank_slider.slider` on an array of local crank angles.
-
-    Returns s, s′, s″ [m, m/rad, m/rad²] (from the true TDC, positive toward the crank) and β,
-    β′, β″ [rad, 1, 1/rad], each of the shape of ``alpha``.
-    """
-    a = np.asarray(alpha, dtype=float)
-    out = np.array([slider(x, r, l, e) for x in a.ravel()], dtype=float).reshape(a.size, 6)
-    return tuple(out[:, j].reshape(a.shape) for j in range(6))
 
 
 def piston_acceleration(phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLike, r: float,

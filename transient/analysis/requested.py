@@ -18,24 +18,25 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   A signal is a trajectory column or ``W_<k>``, the piston acceleration of cylinder k,
   W = ω²s″ + εs′ [m/s²] (crank-slider).
 * ``loads = true`` (crank-slider), over the last whole cycle on a uniform grid of N angles
-  (:mod:`transient.analysis.loads`): ``loads_phi`` (N,) [rad]; ``loads_P``, ``loads_N``,
-  ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load ``loads_R_K``,
-  ``loads_R_T``, ``loads_R`` ((40)/(41) as vectors), each (n, N) [N]; ``loads_torque`` (n, N)
-  and ``loads_engine_torque`` (N,) [N m]; ``loads_crankpin_R_max`` (n,) [N]; in-line engines
-  also the running torques ``loads_journal_torque`` (n+1, N), ``loads_crankpin_torque`` (n, N)
-  [N m] (§2.8) and the main journals by (58), ``loads_main_x``, ``loads_main_y`` (n+1, N) and
-  ``loads_main_R_max`` (n+1,) [N] (frame of crank 1).
-* ``loads = true``, articulated (radial, V; :mod:`transient.analysis.loads_radial`), the same grid
-  and ``loads_phi``: per cylinder ``loads_P``, ``loads_N``, ``loads_S`` (n, N) [N] and
+  (:mod:`transient.analysis.loads.crank_slider`): ``loads_phi`` (N,) [rad]; ``loads_P``,
+  ``loads_N``, ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load
+  ``loads_R_K``, ``loads_R_T``, ``loads_R`` ((40)/(41) as vectors), each (n, N) [N];
+  ``loads_torque`` (n, N) and ``loads_engine_torque`` (N,) [N m]; ``loads_crankpin_R_max`` (n,)
+  [N]; in-line engines also the running torques ``loads_journal_torque`` (n+1, N),
+  ``loads_crankpin_torque`` (n, N) [N m] (§2.8) and the main journals by (58), ``loads_main_x``,
+  ``loads_main_y`` (n+1, N) and ``loads_main_R_max`` (n+1,) [N] (frame of crank 1).
+* ``loads = true``, articulated (radial, V; :mod:`transient.analysis.loads.articulated`), the
+  same grid and ``loads_phi``: per cylinder ``loads_P``, ``loads_N``, ``loads_S`` (n, N) [N] and
   ``loads_torque`` = P u (n, N) [N m]; per row (its crankpin, ρ rows) ``loads_K``, ``loads_T``,
   ``loads_R_K``, ``loads_R_T``, ``loads_R`` (ρ, N) and ``loads_crankpin_R_max`` (ρ,) [N]; per link
   pin (ρ·z′ slaves) its load in the row frame ``loads_link_x``, ``loads_link_y`` (ρ·z′, N) and
   ``loads_link_R_max`` (ρ·z′,) [N]; ``loads_engine_torque`` Σ T r (N,) [N m]. No main journals
   or running torques.
-* ``loads = true``, swash plate (:mod:`transient.analysis.loads_swash`): per cylinder (one piston;
-  torques count both halves) ``loads_P``, ``loads_S``, ``loads_N_radial``, ``loads_N_tangential``
-  (z, N) [N], ``loads_torque`` (z, N) [N m]; ``loads_engine_torque`` (Σ torque) and
-  ``loads_shaft_torque`` (with the rods' and link 9's inertia) (N,) [N m]. No crankpin.
+* ``loads = true``, swash plate (:mod:`transient.analysis.loads.swash_plate`): per cylinder (one
+  piston; torques count both halves) ``loads_P``, ``loads_S``, ``loads_N_radial``,
+  ``loads_N_tangential`` (z, N) [N], ``loads_torque`` (z, N) [N m]; ``loads_engine_torque``
+  (Σ torque) and ``loads_shaft_torque`` (with the rods' and link 9's inertia) (N,) [N m]. No
+  crankpin.
 """
 from __future__ import annotations
 
@@ -46,7 +47,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .irregularity import cycle_boundaries
-from .orders import order_spectrum, resolve_detrend, to_angle_grid
+from .orders import order_spectrum, piston_acceleration, resolve_detrend, to_angle_grid
 
 #: A derived signal of ``orders``: the piston acceleration of cylinder k.
 PISTON_ACCELERATION = re.compile(r"W_([1-9][0-9]*)$")
@@ -107,7 +108,9 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     grid, cols = to_angle_grid(traj, names, n, cycle, phi0=scene.initial.phi, cuts=cuts,
                                closed=True)
     for s, k in derived.items():
-        cols[s] = _piston_acceleration(mech, grid, cols["omega"], cols["epsilon"], k)
+        # W = ω²s″ + εs′ (Semenov §4), exact kinematics.
+        cols[s] = piston_acceleration(grid, cols["omega"], cols["epsilon"], mech.crank_radius,
+                                      mech.rod_length, mech.offset, mech.firing_angles[k - 1])
         units[s] = "m/s^2"
     mode = resolve_detrend(req.detrend, scene.initial.omega, float(traj["omega"][-1]))
     t_marks = cols["t"][::n]  # every cycle's start and the last one's end (closed grid)
@@ -125,54 +128,26 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     return out
 
 
-def _piston_acceleration(mech, phi, omega, epsilon, k: int) -> np.ndarray:
-    """W = ω²s″ + εs′ of cylinder k (1-based) [m/s²] (Semenov §4), exact kinematics."""
-    from .loads import slider_arrays
-
-    alpha = phi - mech.firing_angles[k - 1]
-    _, ds, dds, _, _, _ = slider_arrays(alpha, mech.crank_radius, mech.rod_length, mech.offset)
-    return omega ** 2 * dds + epsilon * ds
-
-
 def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     """Forces, crankpin and main-journal loads and running torques over the last whole cycle."""
-    from .loads import engine_torque, loads_from_trajectory, main_journal_loads, running_torques
-
     mech = scene.mechanism
     n = scene.analysis.samples_per_cycle
     names = [c for c in ("t", "omega", "epsilon", "fuel") if c in traj]
     names += [f"p_{k + 1}" for k in range(mech.n_cylinders) if f"p_{k + 1}" in traj]
     grid, cols = to_angle_grid(traj, names, n, mech.cycle, phi0=scene.initial.phi, cycles=1,
                                cuts=cuts)
-    if store := _other_loads(mech):  # articulated, swash plate
-        return store(scene, grid, {"phi": grid, **cols})
-    ld = loads_from_trajectory(scene, {"phi": grid, **cols})
-    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
-    for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R"):
-        out[f"loads_{name}"] = (getattr(ld, name), "N")
-    out["loads_torque"] = (ld.torque, "N m")
-    out["loads_engine_torque"] = (engine_torque(ld), "N m")
-    out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
-    if np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12:  # in-line: (58), §2.8
-        journals, pins = running_torques(mech, ld)
-        mj = main_journal_loads(mech, ld, cols["omega"], cols["epsilon"])
-        out["loads_journal_torque"] = (journals, "N m")
-        out["loads_crankpin_torque"] = (pins, "N m")
-        out["loads_main_x"] = (mj.x, "N")
-        out["loads_main_y"] = (mj.y, "N")
-        out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
-    return out
+    return _loads_storer(mech)(scene, grid, {"phi": grid, **cols})
 
 
-def _other_loads(mech):
-    """The storer of a mechanism other than the crank-slider, None for a crank-slider; a one-line
-    :class:`~transient.errors.SceneError` for a mechanism without loads."""
+def _loads_storer(mech):
+    """The storer of the mechanism's loads; a one-line :class:`~transient.errors.SceneError` for
+    a mechanism without loads."""
     from ..mechanisms.articulated import Articulated
     from ..mechanisms.crank_slider import CrankSlider
     from ..mechanisms.swash_plate import SwashPlate
 
     if isinstance(mech, CrankSlider):
-        return None
+        return _stored_crank_slider_loads
     if isinstance(mech, Articulated):
         return _stored_articulated_loads
     if isinstance(mech, SwashPlate):
@@ -181,32 +156,56 @@ def _other_loads(mech):
                                        f"allowed here: false")
 
 
-def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
-    """Radial/V rows (:mod:`transient.analysis.loads_radial`): per cylinder, link pin and
-    crankpin; no main journals or running torques (one crankpin carries a whole row)."""
-    from .loads_radial import articulated_loads_from_trajectory
-
-    ld = articulated_loads_from_trajectory(scene, traj)
+def _stored_record(ld, grid, forces) -> dict[str, tuple[Any, str]]:
+    """What every mechanism stores: the grid, the forces named [N], the cylinders' torques and
+    the engine torque [N m]."""
     out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
-    for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R", "link_x", "link_y"):
+    for name in forces:
         out[f"loads_{name}"] = (getattr(ld, name), "N")
     out["loads_torque"] = (ld.torque, "N m")
     out["loads_engine_torque"] = (ld.engine_torque, "N m")
+    return out
+
+
+def _stored_crank_slider_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
+    """Crank-slider (:mod:`transient.analysis.loads.crank_slider`): per cylinder and crankpin; an
+    in-line engine also its running torques (§2.8) and main journals by (58)."""
+    from .loads.crank_slider import loads_from_trajectory, main_journal_loads, running_torques
+
+    mech = scene.mechanism
+    ld = loads_from_trajectory(scene, traj)
+    out = _stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R"))
+    out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
+    if np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12:  # in-line: (58), §2.8
+        journals, pins = running_torques(mech, ld)
+        mj = main_journal_loads(mech, ld, traj["omega"], traj["epsilon"])
+        out["loads_journal_torque"] = (journals, "N m")
+        out["loads_crankpin_torque"] = (pins, "N m")
+        out["loads_main_x"] = (mj.x, "N")
+        out["loads_main_y"] = (mj.y, "N")
+        out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
+    return out
+
+
+def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
+    """Radial/V rows (:mod:`transient.analysis.loads.articulated`): per cylinder, link pin and
+    crankpin; no main journals or running torques (one crankpin carries a whole row)."""
+    from .loads.articulated import articulated_loads_from_trajectory
+
+    ld = articulated_loads_from_trajectory(scene, traj)
+    out = _stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R", "link_x",
+                                    "link_y"))
     out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
     out["loads_link_R_max"] = (ld.link_R.max(axis=1), "N")
     return out
 
 
 def _stored_swash_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
-    """Swash plate (:mod:`transient.analysis.loads_swash`): per cylinder and the shaft torque;
-    no crankpin, journals or running torques."""
-    from .loads_swash import swash_loads_from_trajectory
+    """Swash plate (:mod:`transient.analysis.loads.swash_plate`): per cylinder and the shaft
+    torque; no crankpin, journals or running torques."""
+    from .loads.swash_plate import swash_loads_from_trajectory
 
     ld = swash_loads_from_trajectory(scene, traj)
-    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
-    for name in ("P", "S", "N_radial", "N_tangential"):
-        out[f"loads_{name}"] = (getattr(ld, name), "N")
-    out["loads_torque"] = (ld.torque, "N m")
-    out["loads_engine_torque"] = (ld.engine_torque, "N m")
+    out = _stored_record(ld, grid, ("P", "S", "N_radial", "N_tangential"))
     out["loads_shaft_torque"] = (ld.shaft_torque, "N m")
     return out

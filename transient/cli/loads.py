@@ -1,5 +1,5 @@
 """``transient loads``: load diagrams of a stored run's last whole cycle as PNG and CSV files
-(:mod:`transient.analysis.load_diagrams`); the result file is only read."""
+(:mod:`transient.analysis.loads.diagrams`); the result file is only read."""
 from __future__ import annotations
 
 import numpy as np
@@ -52,7 +52,7 @@ def _diagrams(compute, res, *args):
 
 
 def cmd_loads(args) -> int:
-    from ..analysis.load_diagrams import crank_slider_diagrams
+    from ..analysis.loads.diagrams import crank_slider_diagrams
     from ..mechanisms.articulated import Articulated
 
     res = read_result(args.result)
@@ -173,7 +173,7 @@ def _radial_loads(args, res, scene) -> int:
     frame (polar), the crankpin and link-pin loads over the last cycle, and a CSV; main journals
     and running torques do not apply."""
     from .. import plots
-    from ..analysis.load_diagrams import articulated_diagrams
+    from ..analysis.loads.diagrams import articulated_diagrams
 
     mech = scene.mechanism
     d = _diagrams(articulated_diagrams, res, scene, res.trajectory)

@@ -27,13 +27,23 @@ from transient.errors import SceneError
 from transient.roots import bisect_root
 
 __all__ = [
+    "ANGLE_TOL",
     "DEFAULT_STEP",
     "INTERPOLATIONS",
+    "IndicatedCycle",
     "MixedCycle",
     "PressureTable",
+    "VolumeFunction",
+    "assemble_table",
+    "cycle_period",
+    "deg_text",
+    "gas_exchange_pressures",
     "mixed_cycle",
+    "not_a_knot_coef",
+    "shift_cubic",
     "table_from_function",
     "table_from_points",
+    "volume_at",
 ]
 
 #: Default knot spacing of :func:`table_from_function` [rad] (0.125°). Measured on the Gots
@@ -46,16 +56,39 @@ DEFAULT_STEP = math.radians(0.125)
 #: Interpolation methods accepted by :func:`table_from_points`.
 INTERPOLATIONS = ("linear", "pchip", "spline")
 
-# Angles read from degrees (scene.py converts ``*_deg`` keys) miss 0 and the period by a few
-# ulp; anything closer than this to a cycle end or a corner is snapped onto it.
-_ANGLE_TOL = 1e-9
+#: Angles read from degrees (scene.py converts ``*_deg`` keys) miss 0, the period or a corner by
+#: a few ulp; anything closer than this (relative to the period) is snapped onto it.
+ANGLE_TOL = 1e-9
 
 PieceFunction = Union[Callable[[NDArray[np.float64]], ArrayLike], float]
 
+#: A cylinder volume V(x) [m³], vectorised over local crank angles x [rad].
+VolumeFunction = Callable[[NDArray[np.float64]], ArrayLike]
 
-def _deg(x: float) -> str:
+
+def deg_text(x: float) -> str:
     """An angle in radians, formatted in degrees for a one-line message."""
     return f"{math.degrees(x):.6g}°"
+
+
+def cycle_period(strokes: int) -> float:
+    """The cycle's length [rad]: 4π for a 4-stroke, 2π for a 2-stroke; a SceneError (gas.strokes)
+    for any other number of strokes."""
+    if strokes not in (2, 4):
+        raise SceneError("gas.strokes", f"strokes = {strokes!r}; use 4 or 2")
+    return 2.0 * math.pi * strokes / 2.0
+
+
+def gas_exchange_pressures(strokes: int, p_intake: float | None, p_exhaust: float | None
+                           ) -> tuple[float, float]:
+    """The constant intake and exhaust pressures of a 4-stroke [Pa], checked finite and ≥ 0;
+    NaN for a 2-stroke, which has no gas-exchange strokes."""
+    if strokes != 4:
+        return float("nan"), float("nan")
+    for key, value in (("gas.p_intake", p_intake), ("gas.p_exhaust", p_exhaust)):
+        if value is None or not (np.isfinite(value) and value >= 0.0):
+            raise SceneError(key, f"{value!r} Pa; a 4-stroke needs an absolute pressure ≥ 0")
+    return float(p_intake), float(p_exhaust)
 
 
 @dataclass(frozen=True, eq=False)
@@ -197,8 +230,10 @@ class PressureTable:
 # Building tables
 # ----------------------------------------------------------------------------------------
 
-def _shift_cubic(c: NDArray[np.float64], h: float) -> NDArray[np.float64]:
-    """Coefficients of ``q(e) = p(e + h)`` for the ascending cubic ``p`` (used to extrapolate)."""
+def shift_cubic(c: NDArray[np.float64], h: float) -> NDArray[np.float64]:
+    """Coefficients of ``q(e) = p(e + h)`` for the ascending cubic ``p`` (``c`` of shape (4,) or
+    (4, k) with h of shape (k,)): a piece extrapolated to its corner, or a table moved onto other
+    knots."""
     c0, c1, c2, c3 = c
     return np.array([c0 + h * (c1 + h * (c2 + h * c3)),
                      c1 + h * (2.0 * c2 + 3.0 * h * c3),
@@ -215,8 +250,9 @@ def _tridiagonal_solve(lower, diag, upper, rhs):
     """x with A x = rhs for the tridiagonal A (``lower[i] = A[i+1, i]``, ``upper[i] = A[i, i+1]``),
     by Gaussian elimination without pivoting (the Thomas algorithm).
 
-    Written for the not-a-knot spline's system (:func:`_not_a_knot_coef`) so that a run does not
-    import scipy.linalg for it (README *Start-up*). Without pivoting it is stable there: once the
+    Written for the not-a-knot spline's system (:func:`not_a_knot_coef`) so that building a
+    table does not import scipy.linalg, a sizeable part of a warm start. Without pivoting it is
+    stable there: once the
     first row is eliminated every row is diagonally dominant (interior rows 2(h₀ + h₁) against
     h₀ + h₁ off the diagonal, and the first row's elimination leaves h₀ + h₁ against h₀), so
     every pivot exceeds its row's upper element, and the last row's multiplier is below 1. The
@@ -235,16 +271,15 @@ def _tridiagonal_solve(lower, diag, upper, rhs):
     return x
 
 
-def _not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
+def not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
     """Ascending local coefficients (k, 4) of the not-a-knot cubic spline through (x, y): the
     curve of :class:`scipy.interpolate.CubicSpline` (``bc_type="not-a-knot"``; its algorithm: the
     knots' slopes from one tridiagonal system), which the tests compare it with.
 
-    Written out because importing scipy.interpolate (it imports scipy.optimize) costs 0.11–0.14 s,
-    a tenth of a warm ``transient run`` of the diesel (issue 5's 1 s target), and scipy.linalg,
-    for a banded solver, 0.12–0.18 s after numpy (five fresh interpreters;
-    :func:`_tridiagonal_solve`). With 3 points it is the parabola through them, with 2 the
-    straight line (CubicSpline's choices there).
+    Written out because importing scipy.interpolate (it imports scipy.optimize) and
+    scipy.linalg, for a banded solver (:func:`_tridiagonal_solve`), would be a sizeable part of a
+    warm ``transient run``. With 3 points it is the parabola through them, with 2 the straight
+    line (CubicSpline's choices there).
     """
     dx = np.diff(x)
     slope = np.diff(y) / dx
@@ -297,20 +332,20 @@ def _piece_coef(x: NDArray[np.float64], y: NDArray[np.float64], a: float, b: flo
 
         coef = _ppoly_coef(PchipInterpolator(x, y))
     else:
-        coef = _not_a_knot_coef(x, y)
+        coef = not_a_knot_coef(x, y)
     knots = x.copy()
     if x[0] > a:
-        coef = np.vstack([_shift_cubic(coef[0], a - x[0]), coef])
+        coef = np.vstack([shift_cubic(coef[0], a - x[0]), coef])
         knots = np.concatenate([[a], knots])
     if x[-1] < b:
-        coef = np.vstack([coef, _shift_cubic(coef[-1], x[-1] - x[-2])])
+        coef = np.vstack([coef, shift_cubic(coef[-1], x[-1] - x[-2])])
         knots = np.concatenate([knots, [b]])
     knots[0], knots[-1] = a, b
     return knots, coef
 
 
-def _assemble(pieces: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
-              period: float) -> PressureTable:
+def assemble_table(pieces: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
+                   period: float) -> PressureTable:
     """One table from per-piece (knots, coef), pieces in order and sharing their corners."""
     knots = [pieces[0][0]]
     piece_knot = [0, pieces[0][1].shape[0]]
@@ -332,8 +367,9 @@ def _check_corners(corners: ArrayLike, period: float, key: str | None) -> NDArra
     c = np.unique(np.asarray(corners, dtype=np.float64).ravel())
     for ci in c:
         if not (np.isfinite(ci) and 0.0 < ci < period):
-            msg = (f"corner at {_deg(ci)} is outside (0°, {_deg(period)}); corners must lie "
-                   f"strictly inside the cycle (0° and {_deg(period)} are corners already)")
+            msg = (f"corner at {deg_text(ci)} is outside (0°, {deg_text(period)}); corners must "
+                   f"lie strictly inside the cycle (0° and {deg_text(period)} are corners "
+                   "already)")
             raise SceneError(key, msg) if key else ValueError(msg)
     return c
 
@@ -385,16 +421,17 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
                                   "give one pressure per angle")
     if phi.size < 2 or not np.all(np.isfinite(phi)):
         raise SceneError("gas.phi_deg", f"needs at least 2 finite angles from 0° to "
-                                        f"{_deg(period)}, got {phi.size}")
+                                        f"{deg_text(period)}, got {phi.size}")
     bad = np.flatnonzero(~np.isfinite(p) | (p < 0.0))
     if bad.size:
         k = bad[0]
-        raise SceneError("gas.p", f"pressure {p[k]:.6g} Pa at {_deg(phi[k])} is not allowed; "
+        raise SceneError("gas.p", f"pressure {p[k]:.6g} Pa at {deg_text(phi[k])} is not allowed; "
                                   "pressures are absolute, finite and ≥ 0")
-    tol = _ANGLE_TOL * max(period, 1.0)
+    tol = ANGLE_TOL * max(period, 1.0)
     if abs(phi[0]) > tol or abs(phi[-1] - period) > tol:
-        raise SceneError("gas.phi_deg", f"angles run from {_deg(phi[0])} to {_deg(phi[-1])}; "
-                                        f"they must start at 0° and end at {_deg(period)}")
+        raise SceneError("gas.phi_deg", f"angles run from {deg_text(phi[0])} to "
+                                        f"{deg_text(phi[-1])}; they must start at 0° and end at "
+                                        f"{deg_text(period)}")
     phi[0], phi[-1] = 0.0, period
     corners = _check_corners(corners, period, "gas.corners_deg")
     # Snap angles converted from degrees onto the corner they mean.
@@ -405,15 +442,16 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
     back = np.flatnonzero(steps < 0.0)
     if back.size:
         k = back[0]
-        raise SceneError("gas.phi_deg", f"angles must increase, but {_deg(phi[k + 1])} follows "
-                                        f"{_deg(phi[k])}")
+        raise SceneError("gas.phi_deg", f"angles must increase, but {deg_text(phi[k + 1])} follows "
+                                        f"{deg_text(phi[k])}")
     for k in np.flatnonzero(steps == 0.0):
         a = phi[k]
         if a not in corners:
-            raise SceneError("gas.phi_deg", f"{_deg(a)} is repeated but is not in gas.corners_deg; "
-                                            "repeat an angle only at a declared corner (a jump)")
+            raise SceneError("gas.phi_deg", f"{deg_text(a)} is repeated but is not in "
+                                            "gas.corners_deg; repeat an angle only at a declared "
+                                            "corner (a jump)")
         if np.count_nonzero(phi == a) > 2:
-            raise SceneError("gas.phi_deg", f"{_deg(a)} is given more than twice; a jump takes "
+            raise SceneError("gas.phi_deg", f"{deg_text(a)} is given more than twice; a jump takes "
                                             "exactly two values, left then right")
 
     ends = np.concatenate([[0.0], corners, [period]])
@@ -440,11 +478,11 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
         s, e = first[j], last[j]
         if e - s + 1 < 2:
             raise SceneError("gas.phi_deg",
-                             f"the piece from {_deg(ends[j])} to {_deg(ends[j + 1])} has "
+                             f"the piece from {deg_text(ends[j])} to {deg_text(ends[j + 1])} has "
                              f"{max(e - s + 1, 0)} point(s); each piece between corners needs "
                              "at least 2")
         pieces.append(_piece_coef(phi[s:e + 1], p[s:e + 1], ends[j], ends[j + 1], interpolation))
-    return _assemble(pieces, period)
+    return assemble_table(pieces, period)
 
 
 def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: float,
@@ -509,7 +547,7 @@ def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: floa
         x = np.linspace(a, b, n + 1)
         y = np.asarray(fj(x), dtype=np.float64)
         if y.shape != x.shape or not np.all(np.isfinite(y)):
-            raise ValueError(f"piece {j} ({_deg(a)} to {_deg(b)}) gave non-finite or "
+            raise ValueError(f"piece {j} ({deg_text(a)} to {deg_text(b)}) gave non-finite or "
                              "misshapen values")
         knots, coef = _piece_coef(x, y, a, b, "spline")
         pieces.append((knots, coef))
@@ -519,7 +557,7 @@ def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: floa
         tm = coef[:, 0] + h * (coef[:, 1] + h * (coef[:, 2] + h * coef[:, 3]))
         err = max(err, float(np.max(np.abs(tm - fm))))
         scale = max(scale, float(np.max(np.abs(y))), float(np.max(np.abs(fm))))
-    return _assemble(pieces, period), (err / scale if scale > 0.0 else err)
+    return assemble_table(pieces, period), (err / scale if scale > 0.0 else err)
 
 
 # ----------------------------------------------------------------------------------------
@@ -527,7 +565,33 @@ def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: floa
 # ----------------------------------------------------------------------------------------
 
 @dataclass(frozen=True, eq=False)
-class MixedCycle(PressureTable):
+class IndicatedCycle(PressureTable):
+    """A pressure table of one cylinder's whole cycle with its indicated loop work, and what
+    follows from the work alone (shared by the mixed and the Wiebe cycle).
+
+    Subclasses give the swept volume ``v_h`` [m³].
+
+    Attributes
+    ----------
+    work : float
+        Indicated loop work ∮p dV per cycle [J] (pumping included).
+    """
+
+    work: float
+
+    @property
+    def mean_torque(self) -> float:
+        """Mean indicated torque of one cylinder [N·m]: the loop work per shaft angle of a cycle."""
+        return self.work / self.period
+
+    @property
+    def mean_pressure(self) -> float:
+        """Mean indicated pressure [Pa]: the loop work over the swept volume ``v_h``."""
+        return self.work / self.v_h
+
+
+@dataclass(frozen=True, eq=False)
+class MixedCycle(IndicatedCycle):
     """Pressure table of an ideal mixed cycle, with its closed-form quantities.
 
     A :class:`PressureTable` (use it wherever one is expected) plus what :func:`mixed_cycle`
@@ -552,7 +616,6 @@ class MixedCycle(PressureTable):
         Relative tabulation error estimate returned by :func:`table_from_function`.
     """
 
-    work: float
     p_c: float
     p_b: float
     angle_z: float
@@ -564,22 +627,17 @@ class MixedCycle(PressureTable):
     interpolation_error: float
 
     @property
-    def mean_torque(self) -> float:
-        """Mean indicated torque of one cylinder [N·m]: the loop work per shaft angle of a cycle."""
-        return self.work / self.period
-
-    @property
-    def mean_pressure(self) -> float:
-        """Mean indicated pressure [Pa]: the loop work over the swept volume ``V_a - V_c``."""
-        return self.work / (self.v_a - self.v_c)
+    def v_h(self) -> float:
+        """Swept volume ``V_a - V_c`` [m³] (the compression starts at a BDC)."""
+        return self.v_a - self.v_c
 
 
-def _scalar_volume(volume: Callable[[NDArray[np.float64]], ArrayLike], x: float) -> float:
+def volume_at(volume: VolumeFunction, x: float) -> float:
     """``volume`` at one angle, through its vectorised interface."""
     return float(np.asarray(volume(np.array([x], dtype=np.float64)), dtype=np.float64).ravel()[0])
 
 
-def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compression_ratio: float,
+def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                 p_a: float, n1: float, p_z: float, rho: float, n2: float,
                 p_intake: float | None = None, p_exhaust: float | None = None, strokes: int = 4,
                 step: float = DEFAULT_STEP) -> MixedCycle:
@@ -645,8 +703,7 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
         ``gas.strokes``, ``gas.p_a``, ``gas.p_z``, ``gas.n1``, ``gas.n2``, ``gas.rho``,
         ``gas.p_intake``, ``gas.p_exhaust`` for values out of range.
     """
-    if strokes not in (2, 4):
-        raise SceneError("gas.strokes", f"strokes = {strokes!r}; use 4 or 2")
+    period = cycle_period(strokes)
     for key, value in (("gas.p_a", p_a), ("gas.p_z", p_z)):
         if not (np.isfinite(value) and value > 0.0):
             raise SceneError(key, f"{value!r} Pa; an absolute pressure must be finite and > 0")
@@ -654,25 +711,21 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
         # n = 1 (isothermal) would need the logarithmic work; real engines have 1.2-1.4.
         if not (np.isfinite(value) and value > 1.0):
             raise SceneError(key, f"polytropic exponent {value!r}; it must be > 1")
-    if strokes == 4:
-        for key, value in (("gas.p_intake", p_intake), ("gas.p_exhaust", p_exhaust)):
-            if value is None or not (np.isfinite(value) and value >= 0.0):
-                raise SceneError(key, f"{value!r} Pa; a 4-stroke needs an absolute pressure ≥ 0")
+    p_intake, p_exhaust = gas_exchange_pressures(strokes, p_intake, p_exhaust)
     if not (np.isfinite(compression_ratio) and compression_ratio > 1.0):
         raise SceneError("gas.compression_ratio", f"{compression_ratio!r}; it must be > 1")
 
-    period = 2.0 * math.pi * strokes / 2.0
     # Angles of the firing TDC and of the BDC that ends the expansion (x_tdc + π).
     x_tdc = 2.0 * math.pi if strokes == 4 else 0.0
     x_bdc = x_tdc + math.pi
     x_start = math.pi  # compression starts at a BDC in both cycles
-    v_c = _scalar_volume(volume, x_tdc)
-    v_a = _scalar_volume(volume, x_start)
-    v_b = _scalar_volume(volume, x_bdc)
+    v_c = volume_at(volume, x_tdc)
+    v_a = volume_at(volume, x_start)
+    v_b = volume_at(volume, x_bdc)
     if not (v_c > 0.0 and v_a > v_c):
         raise SceneError("gas.compression_ratio",
-                         f"the volume gives V({_deg(x_start)}) = {v_a:.6g} m³ and "
-                         f"V({_deg(x_tdc)}) = {v_c:.6g} m³; need V_a > V_c > 0")
+                         f"the volume gives V({deg_text(x_start)}) = {v_a:.6g} m³ and "
+                         f"V({deg_text(x_tdc)}) = {v_c:.6g} m³; need V_a > V_c > 0")
     ratio = v_a / v_c
     if abs(ratio - compression_ratio) > 1e-9 * compression_ratio:
         raise SceneError("gas.compression_ratio",
@@ -693,7 +746,7 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
     if rho > 1.0:
         # V rises monotonically from TDC to BDC on a crank slider: bisection finds the crossing
         # to the last bit, so the expansion starts at p_z to ~1e-15 relative.
-        angle_z = bisect_root(lambda x: _scalar_volume(volume, x) - v_z, x_tdc, x_bdc)
+        angle_z = bisect_root(lambda x: volume_at(volume, x) - v_z, x_tdc, x_bdc)
     # A ρ within rounding of 1 leaves no isobar worth a piece (and no zero-length interval).
     has_isobar = angle_z - x_tdc > 1e-12
     if not has_isobar:
@@ -714,8 +767,8 @@ def mixed_cycle(volume: Callable[[NDArray[np.float64]], ArrayLike], *, compressi
         funcs = [float(p_intake), compression, *expansion_pieces, float(p_exhaust)]
         corners = [math.pi, x_tdc, *expansion_corners, x_bdc]
         # Pumping loop, from the volumes at the same corners the table uses.
-        v_0 = _scalar_volume(volume, 0.0)
-        v_end = _scalar_volume(volume, period)
+        v_0 = volume_at(volume, 0.0)
+        v_end = volume_at(volume, period)
         work += p_intake * (v_a - v_0) + p_exhaust * (v_end - v_b)
     else:
         funcs = [*expansion_pieces, compression]

@@ -1,9 +1,9 @@
 """Wiebe cycles kept on disk between processes: a warm start does not integrate them again.
 
 A scene with ``model = "wiebe"`` needs its motored and full-load cycles
-(:func:`transient.assemble.wiebe_levels`). Integrating them with scipy's DOP853 and importing
-scipy's integrators for it cost about 1 s of the Wiebe case's 2.6–2.9 s warm start (README
-*Start-up*). The cycles depend only on their arguments and on the code, so they are stored in
+(:func:`transient.assemble.wiebe_levels`). Integrating them with scipy's DOP853, and importing
+scipy's integrators for it, is a large part of such a scene's warm start. The cycles depend only
+on their arguments and on the code, so they are stored in
 ``$XDG_CACHE_HOME/transient/tables/`` (default ``~/.cache``), one ``.npz`` per set of cycles,
 named by a hash of the arguments' exact text, of every source file of transient and of numpy's
 and scipy's versions: an edit anywhere in the package, or another numpy or scipy, starts afresh.
@@ -63,7 +63,8 @@ def cache_path(arguments: str) -> Path:
 
 
 class _ClosedPartOnDemand:
-    """Stands for the :class:`~transient.forces.wiebe.ClosedPart` of a cycle read from the cache.
+    """Stands for the :class:`~transient.forces.closed_cycle.ClosedPart` of a cycle read from the
+    cache.
 
     ``start`` and ``end`` (intake closing and exhaust opening, unwrapped, as the assembled Woschni
     model needs them) are stored; any other attribute, or a call, integrates the cycles again

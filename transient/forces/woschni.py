@@ -1,10 +1,10 @@
 """Single-zone closed cycle with Wiebe heat release and Woschni wall heat transfer.
 
 The numpy definition of the physics that the compiled in-ODE gas model is checked against. The
-closed part of the cycle (intake closing IVC → exhaust opening EVO) is one ideal-gas zone at the
-local crank angle x [rad] (the angle convention of :mod:`transient.forces.wiebe`: 4-stroke 0 at
-the gas-exchange TDC and 2π at the firing TDC; the closed part of a 2-stroke runs through
-2π ≡ 0 and is integrated in unwrapped angles past 2π), turning at the shaft speed ω > 0 [rad/s]:
+closed part of the cycle (intake closing IVC → exhaust opening EVO) is the one ideal-gas zone of
+:mod:`transient.forces.closed_cycle` (its angle convention: 4-stroke 0 at the gas-exchange TDC and
+2π at the firing TDC; the closed part of a 2-stroke runs through 2π ≡ 0 and is integrated in
+unwrapped angles past 2π), here losing heat to the walls, at the shaft speed ω > 0 [rad/s]:
 
     dp/dx   = (γ(T) − 1)/V · (dQ_b/dx − Q̇_w/ω) − γ(T)·p/V · dV/dx       first law, one zone
     dQ_b/dx = m_f·LHV·η_c · dx_b/dx                                      Wiebe heat release
@@ -24,13 +24,16 @@ equation for the instantaneous heat transfer coefficient in the internal combust
 670931, 1967) in the form of J. B. Heywood, *Internal Combustion Engine Fundamentals*, §12.4,
 eq. (12.19) (B in m, p in kPa, T in K, w in m/s), with its closed-part constants c1 = 2.28 and
 c2 = 3.24e-3 m/(s K). With c1 = c2 = 0 (h = 0) the model is the closed part of
-:func:`transient.forces.wiebe.wiebe_cycle` exactly (same right-hand side, same segments).
+:func:`transient.forces.wiebe.wiebe_cycle` (the same integrator and segments, with one more
+component, Q_w ≡ 0, in the step control).
 
 The scalar functions (:func:`woschni_coefficient`, :func:`wall_area`, :func:`gas_velocity`,
-:func:`motored_pressure`, :func:`wall_heat_flow`, :func:`first_law_rate`, :func:`closed_rate`)
-take and return floats only and use ``math`` only, so that a compiled twin can be written (or
-decorated) line by line. :func:`closed_cycle` integrates (p, W = ∫p dV, Q_w = ∫Q̇_w/ω dx) over
-the closed part with DOP853; :func:`heat_transfer_rate` is the vectorised h and Q̇_w for plots.
+:func:`motored_pressure`, :func:`wall_heat_flow`, :func:`closed_rate`, and the shared
+:func:`~transient.forces.closed_cycle.first_law_rate`) take and return floats only and use
+``math`` only, so that a compiled twin can be written (or decorated) line by line.
+:func:`closed_cycle` integrates (p, W = ∫p dV, Q_w = ∫Q̇_w/ω dx) over the closed part with
+:func:`~transient.forces.closed_cycle.integrate_closed`; :func:`heat_transfer_rate` is the
+vectorised h and Q̇_w for plots.
 
 Units: SI inside (Pa, m³, K, J, W, rad, rad/s); only h's correlation reads p in kPa.
 
@@ -43,7 +46,7 @@ What is not modelled
   discs and the liner is wetted down to the height V/(π B²/4), clearance height included.
 * Wall temperature dynamics: one uniform, constant T_w for head, crown and liner.
 * Mass change (fuel added, blow-by, crevices), a gas constant that changes with combustion, and
-  dissociation, as in :mod:`transient.forces.wiebe`.
+  dissociation, as in :mod:`transient.forces.closed_cycle`.
 * The motored pressure of Woschni's velocity term is the isentrope from IVC with the constant
   γ(T_a) (the contract of this model), not the motored pressure of this model with heat
   transfer or with a temperature-dependent γ.
@@ -59,24 +62,25 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from transient.errors import SceneError
-from transient.forces.wiebe import (
+from transient.forces.closed_cycle import (
     DEFAULT_A,
     DEFAULT_M,
     DEFAULT_RTOL,
-    WIEBE_STEP,
-    VolumeFunction,
-    _check_volume,
-    _deg,
-    _fraction_y,
-    _peak,
-    _rate_scalar,
-    _scalar,
-    _Segment,
-    _Setup,
-    _setup,
-    _volume_derivative,
-    closed_segments,
+    ClosedPart,
+    CycleSetup,
+    SegmentLoss,
+    burned_fraction,
+    check_fuel_mass,
+    check_volume,
+    first_law_rate,
+    gamma_at,
+    integrate_closed,
+    peak,
+    setup_cycle,
+    volume_derivative,
+    wiebe_rate_y,
 )
+from transient.forces.gas import VolumeFunction, volume_at
 
 __all__ = [
     "DEFAULT_C1",
@@ -87,7 +91,6 @@ __all__ = [
     "WoschniParameters",
     "closed_cycle",
     "closed_rate",
-    "first_law_rate",
     "gas_velocity",
     "heat_transfer_rate",
     "motored_pressure",
@@ -218,16 +221,6 @@ def wall_heat_flow(p: float, v: float, omega: float, t_a: float, p_a: float, v_a
     return woschni_coefficient(p, t, w, bore) * wall_area(v, bore) * (t - wall_temperature)
 
 
-def first_law_rate(p: float, v: float, dv: float, dq_b: float, dq_w: float, g: float) -> float:
-    """dp per unit of the independent variable, first law of one ideal-gas zone.
-
-    ``(γ − 1)/V·(dQ_b − dQ_w) − γ·p/V·dV`` with every increment (dv [m³], dq_b released, dq_w
-    lost to the walls [J]) per unit of the same variable (x, or u inside a Wiebe combustion
-    with m < 0); g = γ(T).
-    """
-    return (g - 1.0) / v * (dq_b - dq_w) - g * p / v * dv
-
-
 def closed_rate(x: float, p: float, v: float, dvdx: float, omega: float, q_total: float,
                 start: float, duration: float, a: float, m: float, burning: bool,
                 gamma: float, gamma_slope: float, gamma_t_ref: float, t_a: float, p_a: float,
@@ -253,7 +246,8 @@ def closed_rate(x: float, p: float, v: float, dvdx: float, omega: float, q_total
         True on a segment inside [start, start + duration], where dQ_b/dx is the Wiebe rate
         ``q_total·dx_b/dy(y)/duration``, y = (x − start)/duration (at y = 0 it is infinite
         for m < 0: :func:`closed_cycle` integrates such a segment in another variable); False
-        elsewhere (dQ_b/dx = 0 also at the segment's ends, as :mod:`transient.forces.wiebe`).
+        elsewhere (dQ_b/dx = 0 also at the segment's ends, as
+        :func:`~transient.forces.closed_cycle.integrate_closed`).
     gamma, gamma_slope, gamma_t_ref : float
         γ(T) = gamma + gamma_slope·(T − gamma_t_ref) [-, 1/K, K].
     t_a, p_a, v_a : float
@@ -269,10 +263,10 @@ def closed_rate(x: float, p: float, v: float, dvdx: float, omega: float, q_total
     float
         dp/dx [Pa/rad].
     """
-    dq_b = q_total * _rate_scalar((x - start) / duration, a, m) / duration if burning else 0.0
-    # The temperature in wiebe.py's order of operations, so that h = 0 reproduces it exactly.
+    dq_b = q_total * wiebe_rate_y((x - start) / duration, a, m) / duration if burning else 0.0
+    # The temperature in the integration's order of operations, so that h = 0 reproduces it.
     t = t_a / (p_a * v_a) * p * v
-    g = gamma + gamma_slope * (t - gamma_t_ref) if gamma_slope != 0.0 else gamma
+    g = gamma_at(t, gamma, gamma_slope, gamma_t_ref)
     gamma_a = gamma + gamma_slope * (t_a - gamma_t_ref)
     q_w = wall_heat_flow(p, v, omega, t_a, p_a, v_a, gamma_a, c1, c2_now, wall_temperature,
                          bore, stroke)
@@ -402,34 +396,19 @@ def heat_transfer_rate(x: ArrayLike, p: ArrayLike, v: ArrayLike, omega: ArrayLik
 # ----------------------------------------------------------------------------------------
 
 @dataclass(frozen=True, eq=False)
-class _Segment3(_Segment):
-    """A :class:`transient.forces.wiebe._Segment` with the components (p, W, Q_w)."""
-
-    def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
-        """(p, W, Q_w) at angles in [lo, hi], shape (3,) + x.shape."""
-        x = np.asarray(x, dtype=np.float64)
-        return np.asarray(self.sol(self.u_of_x(x).ravel())).reshape((3,) + x.shape)
-
-
-@dataclass(frozen=True, eq=False)
-class ClosedCycle:
+class ClosedCycle(ClosedPart):
     """The closed part (IVC → EVO) with wall heat transfer: dense solution and totals.
 
-    Angles are local and unwrapped: from `start` (intake closing) to `end` (exhaust opening),
-    past 2π for a 2-stroke.
+    A :class:`~transient.forces.closed_cycle.ClosedPart` whose segments hold the components
+    (p, W, Q_w) (:meth:`state`). Angles are local and unwrapped: from `start` (intake closing) to
+    `end` (exhaust opening), past 2π for a 2-stroke.
 
     Attributes
     ----------
-    start, end : float
-        Intake closing and exhaust opening [rad].
+    start, end, breaks, segments, p_a, v_a, t_a
+        As :class:`~transient.forces.closed_cycle.ClosedPart`.
     combustion_start : float
         Unwrapped combustion start [rad] (c2 applies from it on).
-    breaks : NDArray[np.float64]
-        Segment ends [rad]: IVC, combustion start and end (where they differ from the ends), EVO.
-    segments : tuple
-        One dense solution per segment, components (p, W, Q_w).
-    p_a, v_a, t_a : float
-        State at intake closing [Pa, m³, K].
     gamma_a : float
         γ(T_a).
     work : float
@@ -453,14 +432,7 @@ class ClosedCycle:
         The heat transfer integrated (None: none).
     """
 
-    start: float
-    end: float
     combustion_start: float
-    breaks: NDArray[np.float64]
-    segments: tuple
-    p_a: float
-    v_a: float
-    t_a: float
     gamma_a: float
     work: float
     heat_released: float
@@ -476,21 +448,6 @@ class ClosedCycle:
     _omega: Callable[[float], float]
     _volume: Callable[[NDArray[np.float64]], NDArray[np.float64]]
 
-    def state(self, x: ArrayLike) -> tuple[NDArray[np.float64], ...]:
-        """Pressure [Pa], work ∫p dV [J] and heat lost ∫Q̇_w/ω dx [J] from IVC to the unwrapped
-        angles x in [start, end] [rad] (at a segment end, the segment that starts there)."""
-        x = np.asarray(x, dtype=np.float64)
-        if np.any((x < self.start - 1e-12) | (x > self.end + 1e-12)):
-            raise ValueError(f"angles must lie in the closed part [{_deg(self.start)}, "
-                             f"{_deg(self.end)}]")
-        k = np.clip(np.searchsorted(self.breaks, x, side="right") - 1, 0, len(self.segments) - 1)
-        out = np.empty((3,) + x.shape)
-        for j, seg in enumerate(self.segments):
-            sel = k == j
-            if np.any(sel):
-                out[:, sel] = seg(x[sel])
-        return out[0], out[1], out[2]
-
     def pressure(self, x: ArrayLike) -> NDArray[np.float64]:
         """Pressure [Pa] at unwrapped angles x in [start, end] [rad]."""
         return self.state(x)[0]
@@ -498,10 +455,6 @@ class ClosedCycle:
     def volume(self, x: ArrayLike) -> NDArray[np.float64]:
         """Cylinder volume [m³] at unwrapped angles x [rad]."""
         return self._volume(np.asarray(x, dtype=np.float64))
-
-    def temperature(self, p: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
-        """Gas temperature [K] from pressure [Pa] and volume [m³]: ``T_a·pV/(p_a V_a)``."""
-        return self.t_a / (self.p_a * self.v_a) * np.asarray(p) * np.asarray(v)
 
     def heat_transfer(self, x: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Woschni h [W/(m² K)] and Q̇_w [W] along the solution at unwrapped angles x [rad]
@@ -537,70 +490,30 @@ def _speed(omega: float | Callable[[float], float] | None, needed: bool
     return checked
 
 
-def _integrate(st: _Setup, fuel_mass: float, volume: VolumeFunction, dvolume: VolumeFunction,
-               woschni: WoschniParameters | None, omega_at: Callable[[float], float]
-               ) -> tuple[NDArray[np.float64], list[_Segment3], float]:
-    """Integrate (p, W, Q_w) over the closed part, segment by segment, with DOP853.
+def _wall_loss(st: CycleSetup, v_a: float, woschni: WoschniParameters | None,
+               omega_at: Callable[[float], float]) -> Callable[[float], SegmentLoss]:
+    """dQ_w/dx = Q̇_w/ω of every segment, for
+    :func:`~transient.forces.closed_cycle.integrate_closed`.
 
-    The segments and the m < 0 substitution are those of ``wiebe.closed_segments``; c2 is switched
-    on from the segment that starts at the combustion start, so that the right-hand side is
+    c2 is switched on from the segment that starts at the combustion start, so that the loss is
     smooth inside every segment except where p crosses p_mot (a kink of max(p − p_mot, 0)).
     """
-    period = st.period
-
-    def wrap(x: float) -> float:
-        return x - period if x > period else x
-
-    v_a = _scalar(volume, st.ivc)
-    q_total = fuel_mass * st.lhv * st.efficiency
     # Without heat transfer: c1 = c2 = 0 make w = 0 and h = 0 exactly; the geometry is unused.
     wp = woschni or types.SimpleNamespace(c1=0.0, c2=0.0, wall_temperature=1.0, bore=1.0,
                                           stroke=1.0)
-    g0, gk, tref = st.gamma, st.gamma_slope, st.gamma_t_ref
-    gamma_a = g0 + gk * (st.t_a - tref)
+    gamma_a = st.gamma_a
 
-    def vol(x: float) -> tuple[float, float]:
-        xw = np.array([wrap(x)])
-        return float(np.asarray(volume(xw)).ravel()[0]), float(np.asarray(dvolume(xw)).ravel()[0])
-
-    def segment_rhs(lo, hi, burning, power):
+    def segment(lo: float) -> SegmentLoss:
         c2_now = wp.c2 if lo >= st.start else 0.0
 
-        def rhs(u, y):
-            p = y[0]
-            if power is None:
-                x = u
-                v, dv = vol(x)
-                om = omega_at(x)
-                q_w = wall_heat_flow(p, v, om, st.t_a, st.p_a, v_a, gamma_a, wp.c1, c2_now,
-                                     wp.wall_temperature, wp.bore, wp.stroke)
-                dp = closed_rate(x, p, v, dv, om, q_total, st.start, st.duration, st.a, st.m,
-                                 burning, g0, gk, tref, st.t_a, st.p_a, v_a, wp.c1, c2_now,
-                                 wp.wall_temperature, wp.bore, wp.stroke)
-                return [dp, p * dv, q_w / om]
-            # x = lo + (hi − lo)·u**(1/power): dx_b/du = a·exp(−a u) is smooth, the Wiebe rate
-            # in x (∝ y**m) is not (wiebe._integrate).
-            uc = min(max(u, 0.0), 1.0)
-            k = 1.0 / power
-            x = lo + (hi - lo) * uc ** k
-            dxdu = (hi - lo) * k * uc ** (k - 1.0)
-            v, dv = vol(x)
+        def loss(x: float, p: float, v: float) -> float:
             om = omega_at(x)
-            q_w = wall_heat_flow(p, v, om, st.t_a, st.p_a, v_a, gamma_a, wp.c1, c2_now,
-                                 wp.wall_temperature, wp.bore, wp.stroke)
-            t = st.t_a / (st.p_a * v_a) * p * v
-            g = g0 + gk * (t - tref) if gk != 0.0 else g0
-            dvdu = dv * dxdu
-            dq_w = q_w / om * dxdu
-            return [first_law_rate(p, v, dvdu, q_total * st.a * math.exp(-st.a * uc), dq_w, g),
-                    p * dvdu, dq_w]
+            return wall_heat_flow(p, v, om, st.t_a, st.p_a, v_a, gamma_a, wp.c1, c2_now,
+                                  wp.wall_temperature, wp.bore, wp.stroke) / om
 
-        return rhs
+        return loss
 
-    atol = 1e-3 * st.rtol * np.array([st.p_a, st.p_a * v_a, st.p_a * v_a])
-    breaks, segments = closed_segments(st, q_total, segment_rhs, np.array([st.p_a, 0.0, 0.0]),
-                                       atol, _Segment3)
-    return breaks, segments, v_a
+    return segment
 
 
 def closed_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: float,
@@ -617,16 +530,18 @@ def closed_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: 
 
     The model of the module docstring: (p, W = ∫p dV, Q_w = ∫Q̇_w/ω dx) from intake closing
     (p = p_a) to exhaust opening with DOP853 at `rtol` (absolute tolerances 1e-3·rtol of p_a and
-    of p_a·V_a), split at the combustion start and end as
-    :func:`~transient.forces.wiebe.wiebe_cycle` (and, like it, in the variable
-    u = y**(m + 1) inside a combustion with m < 0). The inputs are validated by wiebe.py's
-    ``_setup`` (the same errors and angle rules as ``wiebe_cycle``); nothing is tabulated.
+    of p_a·V_a), by :func:`~transient.forces.closed_cycle.integrate_closed` as
+    :func:`~transient.forces.wiebe.wiebe_cycle` (split at the combustion start and end, in the
+    variable u = y**(m + 1) inside a combustion with m < 0). The inputs are validated by
+    :func:`~transient.forces.closed_cycle.setup_cycle` (the same errors and angle rules as
+    ``wiebe_cycle``); nothing is tabulated.
 
     Parameters
     ----------
     volume, dvolume : callable
         Vectorised V(x) [m³] and optional dV/dx [m³/rad] at table angles, as in ``wiebe_cycle``
-        (default dV/dx: wiebe.py's 8th-order central difference).
+        (default dV/dx: the 8th-order central difference of
+        :func:`~transient.forces.closed_cycle.volume_derivative`).
     p_a : float
         Pressure at intake closing [Pa].
     start, duration : float
@@ -634,7 +549,8 @@ def closed_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: 
     fuel_mass : float
         Fuel per cycle [kg], finite and ≥ 0 (0: motored).
     woschni : WoschniParameters, optional
-        Wall heat transfer; None for none (then the result is wiebe.py's closed part).
+        Wall heat transfer; None for none (then the pressure is that of ``wiebe_cycle``'s
+        closed part).
     omega : float or callable, optional
         Shaft speed [rad/s] > 0, constant or ``omega(x)`` of the unwrapped local angle x [rad];
         required with `woschni`.
@@ -659,40 +575,32 @@ def closed_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: 
     ValueError
         `omega` missing with `woschni`, or not finite and > 0 where it is read.
     """
-    if fuel_mass is None or not (np.isfinite(fuel_mass) and fuel_mass >= 0.0):
-        raise SceneError("gas.wiebe.fuel_mass",
-                         f"{fuel_mass!r} kg; the fuel mass per cycle must be finite and ≥ 0")
-    fuel_mass = float(fuel_mass)
-    st = _setup(strokes=strokes, p_a=p_a, start=start, duration=duration, a=a, m=m, lhv=lhv,
-                efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
-                gamma_t_ref=gamma_t_ref, t_a=t_a,
-                p_intake=p_a if p_intake is None else p_intake,
-                p_exhaust=p_a if p_exhaust is None else p_exhaust,
-                intake_closing=intake_closing, exhaust_opening=exhaust_opening, step=WIEBE_STEP,
-                rtol=rtol)
-    _check_volume(st, volume)
-    dvolume = dvolume or _volume_derivative(volume)
+    fuel_mass = check_fuel_mass(fuel_mass)
+    st = setup_cycle(strokes=strokes, p_a=p_a, start=start, duration=duration, a=a, m=m,
+                     lhv=lhv, efficiency=efficiency, gamma=gamma, gamma_slope=gamma_slope,
+                     gamma_t_ref=gamma_t_ref, t_a=t_a,
+                     p_intake=p_a if p_intake is None else p_intake,
+                     p_exhaust=p_a if p_exhaust is None else p_exhaust,
+                     intake_closing=intake_closing, exhaust_opening=exhaust_opening, rtol=rtol)
+    check_volume(st, volume)
+    dvolume = dvolume or volume_derivative(volume)
     omega_at = _speed(omega, woschni is not None)
-    breaks, segments, v_a = _integrate(st, fuel_mass, volume, dvolume, woschni, omega_at)
+    # Q_w is a component even without heat transfer (then ≡ 0): the cycle has the same state
+    # and step control whether or not h vanishes.
+    wall = _wall_loss(st, volume_at(volume, st.ivc), woschni, omega_at)
+    part = integrate_closed(st, fuel_mass, volume, dvolume, wall)
     period = st.period
 
     def unwrapped_volume(x: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.asarray(volume(np.where(x > period, x - period, x)), dtype=np.float64)
 
-    dense = types.SimpleNamespace(
-        start=st.ivc, segments=segments,
-        temperature=lambda p, v: st.t_a / (st.p_a * v_a) * np.asarray(p) * np.asarray(v))
-    p_max, x_max, t_max = _peak(dense, volume, period)
-    p_end, w_end, q_w_end = segments[-1](np.array(st.evo))
+    p_max, x_max, t_max = peak(part, volume, period)
+    p_end, w_end, q_w_end = part.segments[-1](np.array(st.evo))
     v_end = float(unwrapped_volume(np.array([st.evo]))[0])
-    end = st.start + st.duration
-    xb = (float(-np.expm1(-st.a)) if st.evo >= end
-          else float(_fraction_y(np.array((st.evo - st.start) / st.duration), st.a, st.m)))
     return ClosedCycle(
-        start=st.ivc, end=st.evo, combustion_start=st.start, breaks=breaks,
-        segments=tuple(segments), p_a=st.p_a, v_a=v_a, t_a=st.t_a,
-        gamma_a=st.gamma + st.gamma_slope * (st.t_a - st.gamma_t_ref), work=float(w_end),
-        heat_released=fuel_mass * st.lhv * st.efficiency * xb, heat_lost=float(q_w_end),
-        p_end=float(p_end), t_end=st.t_a / (st.p_a * v_a) * float(p_end) * v_end, v_end=v_end,
-        p_max=p_max, angle_max=x_max, t_max=t_max, fuel_mass=fuel_mass, woschni=woschni,
-        _omega=omega_at, _volume=unwrapped_volume)
+        **vars(part), combustion_start=st.start, gamma_a=st.gamma_a, work=float(w_end),
+        heat_released=fuel_mass * st.lhv * st.efficiency * burned_fraction(st),
+        heat_lost=float(q_w_end), p_end=float(p_end),
+        t_end=float(part.temperature(float(p_end), v_end)), v_end=v_end, p_max=p_max,
+        angle_max=x_max, t_max=t_max, fuel_mass=fuel_mass, woschni=woschni, _omega=omega_at,
+        _volume=unwrapped_volume)

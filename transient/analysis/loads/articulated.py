@@ -1,7 +1,7 @@
 """Forces in a master-and-articulated-rod engine (radial; V with fork-and-blade rods) along a
 trajectory φ(t), ω(t), ε(t): pistons, rods, link pins and the master crankpin.
 
-The crank-slider counterpart is :mod:`transient.analysis.loads` (Gots §2.3–§2.6,
+The crank-slider counterpart is :mod:`.crank_slider` (Gots §2.3–§2.6,
 ``reference/gots-crank-dynamics.md`` §4–§7); its conventions are kept, and what differs is that the
 master rod carries the slave rods' link pins, so it is not a two-force member. The kinematics are
 the mechanism's own exact ones (:mod:`transient.core.articulated`, Semenov (8), (31), (40)–(41)
@@ -45,9 +45,10 @@ the row has the outward axis d_k = e^{iδ_k} (δ_0 = 0 for the master) and the s
   C = ΔI β̈ + Σ_i (A_i − A) × F_i: the link pins make the master's side force differ from P tan β
   even with massless rods. The rod system's force on the crankpin is Φ_0 + Σ_i F_i, with
   components K (toward the crank axis) and T (direction of rotation), Gots (36)–(37) generalised.
-* **Crankpin load** of the row, a vector as in :mod:`.loads`: R_K = K + K_rш, R_T = T + T_rш with
-  the master rod's rotating mass, K_rш = −m₂ r ω², T_rш = −m₂ r ε (Gots (32) and its ε term); the
-  crank throw's m_k gives K_rk, T_rk the same way (the row's ``crank_mass``).
+* **Crankpin load** of the row, a vector as in :mod:`.crank_slider`: R_K = K + K_rш,
+  R_T = T + T_rш with the master rod's rotating mass, K_rш = −m₂ r ω², T_rш = −m₂ r ε (Gots (32)
+  and its ε term); the crank throw's m_k gives K_rk, T_rk the same way (the row's
+  ``crank_mass``).
 
 Virtual work (the independent checks, ``tests/unit/test_loads_radial_swash.py``)
 --------------------------------------------------------------------------------
@@ -77,14 +78,19 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core import articulated as core
-from ..mechanisms.articulated import Articulated, positions
-from .loads import (
+from ...core import articulated as core
+from ...mechanisms.articulated import Articulated, positions
+from .common import (
+    Array,
+    CrankpinLoads,
+    along_trajectory,
+    gas_force_array,
     rod_split,
-    rotating_inertia_force,
-    slider_arrays,
-    trajectory_gas_force,
+    rotating_inertia_rows,
+    trajectory_arrays,
+    two_mass_rod,
 )
+from .crank_slider import slider_arrays
 
 __all__ = [
     "ArticulatedLoads",
@@ -94,8 +100,6 @@ __all__ = [
     "pin_forces",
     "row_kinematics",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -127,9 +131,9 @@ class RowKinematics:
 def row_kinematics(mech: Articulated, alpha: ArrayLike) -> RowKinematics:
     """:class:`RowKinematics` at the local angles ``alpha`` [rad].
 
-    The master comes from :func:`transient.analysis.loads.slider_arrays` (Semenov (31), exact); the
+    The master comes from :func:`.crank_slider.slider_arrays` (Semenov (31), exact); the
     slaves' derivatives from the compiled :func:`transient.core.articulated.slave`, one sample at a
-    time (a few µs each: analyses run once per result), and their positions from the plain-numpy
+    time (cheap enough: analyses run once per result), and their positions from the plain-numpy
     :func:`transient.mechanisms.articulated.positions`.
     """
     alpha = np.atleast_1d(np.asarray(alpha, dtype=np.float64))
@@ -184,15 +188,16 @@ def _dot(a, b):
 
 
 @dataclass(frozen=True)
-class ArticulatedLoads:
+class ArticulatedLoads(CrankpinLoads):
     """Forces of every cylinder, link pin and crankpin along a trajectory (module docstring).
 
-    Cylinders k = j(1 + z′) + i (row j, i = 0 the master), shape ``(n_cylinders, n)``:
-    ``s``, ``v`` travel toward the crank [m] and its rate ds/dt [m/s]; ``u`` = ds/dφ [m/rad];
-    ``beta`` rod lean [rad]; ``P_g``, ``P_j``, ``P`` gas, inertia and total piston force toward the
-    crank [N]; ``N`` the wall's force on the piston along m (the side toward which the crank turns
-    at the top) [N]; ``S`` rod force along the rod at the pin, compression > 0 [N]; ``torque`` the
-    cylinder's share P u [N m].
+    A :class:`~.common.CrankpinLoads` with one crankpin per row. Cylinders k = j(1 + z′) + i
+    (row j, i = 0 the master), shape ``(n_cylinders, n)``: ``s``, ``v`` travel toward the crank
+    [m] and its rate ds/dt [m/s]; ``u`` = ds/dφ [m/rad]; ``beta`` rod lean [rad]; ``P_g``,
+    ``P_j``, ``P`` gas, inertia and total piston force toward the crank [N]; ``N`` the wall's
+    force on the piston along m (the side toward which the crank turns at the top) [N]; ``S`` rod
+    force along the rod at the pin, compression > 0 [N]; ``torque`` the cylinder's share P u
+    [N m].
 
     Link pins, slave i of row j at index j z′ + i, shape ``(rows·z′, n)``: ``link_x``, ``link_y``
     the load F_i on the master rod at the link pin in the row frame [N]; ``link_axial``,
@@ -206,38 +211,17 @@ class ArticulatedLoads:
     ``throw_torque`` r (R_T + T_rk), what the row passes to the shaft [N m].
     """
 
-    s: Array
-    v: Array
     u: Array
-    beta: Array
-    P_g: Array
-    P_j: Array
-    P: Array
-    N: Array
-    S: Array
-    torque: Array
     link_x: Array
     link_y: Array
     link_axial: Array
     link_normal: Array
-    alpha: Array
-    K: Array
-    T: Array
-    K_rod: Array
-    T_rod: Array
-    K_crank: Array
-    T_crank: Array
-    R_K: Array
-    R_T: Array
-    R: Array
     link_power: Array
-    throw_torque: Array
-    r: float
-    area: float
 
     @property
     def engine_torque(self) -> Array:
-        """Σ_rows T r [N m], shape (n,): the crank-slider's indicated torque Σ T r generalised."""
+        """Σ_rows T r [N m], shape (n,): the crank-slider's indicated torque Σ T r generalised
+        (Σ P u, the sum of :attr:`torque`, leaves out the link pins' power)."""
         return self.T.sum(axis=0) * self.r
 
     @property
@@ -245,19 +229,13 @@ class ArticulatedLoads:
         """|F_i| of every link pin [N]."""
         return np.hypot(self.link_x, self.link_y)
 
-    def specific(self, name: str) -> Array:
-        """Force ``name`` per piston area [Pa] (Gots' specific forces)."""
-        return getattr(self, name) / self.area
-
 
 def _slave_masses(mech: Articulated) -> tuple[Array, Array, Array]:
-    """(m₁, m₂, ΔI) of every slave rod: its masses at the piston pin and at the link pin [kg] and
-    the inertia beyond the two-mass rod [kg m²] (0 for ``"two-mass"``)."""
-    li = np.asarray(mech.slave_lengths, dtype=np.float64)
-    m, c = mech.slave_rod_mass, mech.slave_rod_cg_from_pin
-    d_inertia = (np.zeros_like(li) if mech.slave_rod_model == "two-mass"
-                 else mech.slave_rod_inertia_cg - m * c * (li - c))
-    return m * (li - c) / li, m * c / li, d_inertia
+    """(m₁, m₂, ΔI) of every slave rod: its masses at the piston pin and at the link pin and the
+    inertia beyond them (:func:`~.common.two_mass_rod`)."""
+    return two_mass_rod(mech.slave_rod_mass, np.asarray(mech.slave_lengths, dtype=np.float64),
+                        mech.slave_rod_cg_from_pin, mech.slave_rod_inertia_cg,
+                        mech.slave_rod_model)
 
 
 def _slave_loads(kin: RowKinematics, i: int, p: Array, length: float, m2: float,
@@ -285,17 +263,15 @@ def articulated_loads(mech: Articulated, phi: ArrayLike, omega: ArrayLike, epsil
     phi, omega, epsilon : array_like, shape (n,) or scalars
         Shaft angle [rad], speed [rad/s], angular acceleration [rad/s²], broadcast together.
     gas_force : array_like, shape (n_cylinders, n) or broadcastable, optional
-        Gas force on each piston toward the crank [N] (:func:`trajectory_gas_force`); 0 if omitted.
+        Gas force on each piston toward the crank [N] (:func:`~.common.trajectory_gas_force`); 0
+        if omitted.
     """
-    phi, omega, epsilon = np.broadcast_arrays(np.atleast_1d(np.asarray(phi, dtype=np.float64)),
-                                              np.asarray(omega, dtype=np.float64),
-                                              np.asarray(epsilon, dtype=np.float64))
+    phi, omega, epsilon = trajectory_arrays(phi, omega, epsilon)
     n, ns, rows = phi.size, mech.n_slaves, mech.rows
     ncyl = mech.n_cylinders
     w2, eps = omega * omega, epsilon
     r, l = mech.crank_radius, mech.rod_length
-    p_g = (np.zeros((ncyl, n)) if gas_force is None
-           else np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (ncyl, n)).copy())
+    p_g = gas_force_array(gas_force, (ncyl, n))
     m1, m2, d_inertia = rod_split(mech.master())
     m1s, m2s, dIs = _slave_masses(mech)
     m_j = mech.piston_mass + np.concatenate(([m1], m1s))[:, None]
@@ -334,10 +310,8 @@ def articulated_loads(mech: Articulated, phi: ArrayLike, omega: ArrayLike, epsil
         row["link_power"][j] = power
         cyl["s"][sl], cyl["u"][sl], cyl["v"][sl] = kin.s, kin.ds, kin.ds * omega
         cyl["beta"][sl], cyl["P_j"][sl] = kin.beta, p_j
-    k_rod, t_rod = (np.broadcast_to(x, (rows, n)).copy()
-                    for x in rotating_inertia_force(m2, r, omega, epsilon))
-    k_crank, t_crank = (np.broadcast_to(x, (rows, n)).copy()
-                        for x in rotating_inertia_force(mech.crank_mass, r, omega, epsilon))
+    k_rod, t_rod = rotating_inertia_rows(m2, r, omega, epsilon, (rows, n))
+    k_crank, t_crank = rotating_inertia_rows(mech.crank_mass, r, omega, epsilon, (rows, n))
     r_k, r_t = row["K"] + k_rod, row["T"] + t_rod
     P = p_g + cyl["P_j"]
     return ArticulatedLoads(
@@ -351,7 +325,6 @@ def articulated_loads(mech: Articulated, phi: ArrayLike, omega: ArrayLike, epsil
 
 def articulated_loads_from_trajectory(scene, traj) -> ArticulatedLoads:
     """:func:`articulated_loads` along a run's trajectory (``phi``, ``omega``, ``epsilon`` and the
-    gas force of :func:`trajectory_gas_force`)."""
-    return articulated_loads(scene.mechanism, traj["phi"], traj["omega"], traj["epsilon"],
-                             trajectory_gas_force(scene, traj))
+    gas force of :func:`~.common.trajectory_gas_force`)."""
+    return along_trajectory(articulated_loads, scene, traj)
 

@@ -1,7 +1,7 @@
 """Forces in a swash-plate engine along a trajectory φ(t), ω(t), ε(t): pistons, rods, the rods'
 joints on link 9 and the torque each cylinder puts on the shaft.
 
-The counterpart of :mod:`transient.analysis.loads` (crank-slider) for the mechanism of Antonyuk et
+The counterpart of :mod:`.crank_slider` for the mechanism of Antonyuk et
 al. (``reference/antonyuk-swashplate-dynamics.md``; exact kinematics of
 :mod:`transient.core.swash_plate`).
 The paper gives the reduced equation (18) with M_П = Σ P_q u_q1 (19)–(20) and no piston or rod
@@ -60,11 +60,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from ..core import swash_plate as core
-from ..mechanisms.swash_plate import SwashPlate
-from .loads import trajectory_gas_force
+from ...core import swash_plate as core
+from ...mechanisms.swash_plate import SwashPlate
+from .common import (
+    Array,
+    PistonLoads,
+    along_trajectory,
+    gas_force_array,
+    rod_split,
+    trajectory_arrays,
+)
 
 __all__ = [
     "SwashKinematics",
@@ -73,8 +80,6 @@ __all__ = [
     "swash_loads",
     "swash_loads_from_trajectory",
 ]
-
-Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -154,35 +159,29 @@ def swash_kinematics(mech: SwashPlate, phi: ArrayLike) -> SwashKinematics:
 
 
 @dataclass(frozen=True)
-class SwashLoads:
+class SwashLoads(PistonLoads):
     """Forces of every cylinder along a trajectory (module docstring), shape ``(z, n)`` unless
     noted; one piston of each cylinder (the mirror one, ``halves = 2``, carries the same).
 
     ``x``, ``v`` joint D's x [m] and its rate [m/s]; ``P_g``, ``P_j``, ``P`` gas, inertia and total
     piston force along +x [N]; ``S`` rod force (compression > 0) [N]; ``N_radial``,
     ``N_tangential`` the wall's force on the piston [N]; ``joint_x``, ``joint_y``, ``joint_z`` the
-    force on link 9 at B, F_B [N]; ``torque`` halves·Φ·B′, ``joint_torque`` halves·F_B·B′ [N m];
-    ``rod_power`` halves·(−ΔI ė·ë) [W]; ``link_torque`` (n,) −(J₉ε + ½J₉′ω²) [N m];
-    ``halves``, ``area`` (piston area [m²]).
+    force on link 9 at B, F_B [N]; ``torque`` halves·Φ·B′ (its sum is :attr:`engine_torque`, the
+    crank-slider's Σ T r), ``joint_torque`` halves·F_B·B′ [N m]; ``rod_power``
+    halves·(−ΔI ė·ë) [W]; ``link_torque`` (n,) −(J₉ε + ½J₉′ω²) [N m]; ``halves``, ``area``
+    (piston area [m²]).
     """
 
     x: Array
-    v: Array
-    P_g: Array
-    P_j: Array
-    P: Array
-    S: Array
     N_radial: Array
     N_tangential: Array
     joint_x: Array
     joint_y: Array
     joint_z: Array
-    torque: Array
     joint_torque: Array
     rod_power: Array
     link_torque: Array
     halves: int
-    area: float
 
     @property
     def N(self) -> Array:
@@ -190,18 +189,9 @@ class SwashLoads:
         return np.hypot(self.N_radial, self.N_tangential)
 
     @property
-    def engine_torque(self) -> Array:
-        """Σ torque [N m], shape (n,): the crank-slider's Σ T r."""
-        return self.torque.sum(axis=0)
-
-    @property
     def shaft_torque(self) -> Array:
         """Σ joint_torque + link_torque [N m], shape (n,): what link 9 passes to the plate."""
         return self.joint_torque.sum(axis=0) + self.link_torque
-
-    def specific(self, name: str) -> Array:
-        """Force ``name`` per piston area [Pa]."""
-        return getattr(self, name) / self.area
 
 
 def _dot(a, b):
@@ -220,18 +210,14 @@ def swash_loads(mech: SwashPlate, phi: ArrayLike, omega: ArrayLike, epsilon: Arr
     gas_force : array_like, shape (z, n) or broadcastable, optional
         Gas force on each piston toward its plate [N]; 0 if omitted.
     """
-    phi, omega, epsilon = np.broadcast_arrays(np.atleast_1d(np.asarray(phi, dtype=np.float64)),
-                                              np.asarray(omega, dtype=np.float64),
-                                              np.asarray(epsilon, dtype=np.float64))
+    phi, omega, epsilon = trajectory_arrays(phi, omega, epsilon)
     kin = swash_kinematics(mech, phi)
     z, n = mech.cylinders, phi.size
     w, eps = omega, epsilon
     w2 = w * w
-    ell, c, m = mech.rod_length, mech.rod_cg_from_pin, mech.rod_mass
-    m_b, m_d = m * c / ell, m * (ell - c) / ell
-    d_inertia = mech.rod_inertia_cg - m * c * (ell - c) if mech.rod_model == "rigid" else 0.0
-    p_g = (np.zeros((z, n)) if gas_force is None
-           else np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (z, n)).copy())
+    ell = mech.rod_length
+    m_d, m_b, d_inertia = rod_split(mech)  # at the piston joint D and at B
+    p_g = gas_force_array(gas_force, (z, n))
     p_j = -(mech.piston_mass + m_d) * (kin.ddx * w2 + kin.dx * eps)
     p = p_g + p_j
     e_dot = kin.de * w[:, None]
@@ -257,6 +243,5 @@ def swash_loads(mech: SwashPlate, phi: ArrayLike, omega: ArrayLike, epsilon: Arr
 
 def swash_loads_from_trajectory(scene, traj) -> SwashLoads:
     """:func:`swash_loads` along a run's trajectory (``phi``, ``omega``, ``epsilon``; the gas
-    force of :func:`transient.analysis.loads.trajectory_gas_force`)."""
-    return swash_loads(scene.mechanism, traj["phi"], traj["omega"], traj["epsilon"],
-                       trajectory_gas_force(scene, traj))
+    force of :func:`~.common.trajectory_gas_force`)."""
+    return along_trajectory(swash_loads, scene, traj)

@@ -68,7 +68,7 @@ cylinders numbered from the nose) crank k leads crank 1 by γ_k = ``firing_angle
 ``firing_angles[k]`` (mod 2π) in the direction of rotation (Gots §2.7.1: clockwise seen from
 the nose).
 
-* **Engine torque**: Σ T_k r (Gots §2.8, table П4.2).
+* **Engine torque**: Σ T_k r (Gots §2.8, table П4.2), :attr:`CylinderLoads.engine_torque`.
 * **Running torques** (§2.8, П4.4/П4.5): journal j carries the torque of the throws ahead of it
   (journal 1 at the nose carries none, the last one the total), crankpin k carries the journal
   ahead of it plus half its own cylinder's torque. With ε ≠ 0 a throw passes to the shaft
@@ -90,24 +90,28 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from .common import (
+    Array,
+    CrankpinLoads,
+    along_trajectory,
+    gas_force_array,
+    rod_split,
+    rotating_inertia_force,
+    rotating_inertia_rows,
+    trajectory_arrays,
+)
 
 __all__ = [
     "CylinderLoads",
     "MainJournalLoads",
     "crank_slider_loads",
-    "engine_torque",
-    "gas_force_from_pressure",
-    "gas_forces",
     "loads_from_trajectory",
     "main_journal_loads",
-    "rod_split",
-    "rotating_inertia_force",
     "running_torques",
     "slider_arrays",
 ]
-
-Array = NDArray[np.float64]
 
 
 def slider_arrays(alpha: ArrayLike, r: float, l: float, e: float = 0.0
@@ -133,41 +137,12 @@ def slider_arrays(alpha: ArrayLike, r: float, l: float, e: float = 0.0
     return y_tdc - y_pin, -dy_pin, -ddy_pin, np.arcsin(sb), db, ddb
 
 
-def rod_split(mech) -> tuple[float, float, float]:
-    """``(m1, m2, dI)``: the rod's mass at the piston pin and at the crankpin [kg] (Gots (20)) and
-    the inertia the two-mass model misses, ΔI = I_G − m l₁(l − l₁) [kg m²] (0 for
-    ``rod_model = "two-mass"``, whose rod has no other inertia; see the module docstring)."""
-    l, l1, m = mech.rod_length, mech.rod_cg_from_pin, mech.rod_mass
-    m1 = m * (l - l1) / l
-    m2 = m * l1 / l
-    d_inertia = 0.0 if mech.rod_model == "two-mass" else mech.rod_inertia_cg - m * l1 * (l - l1)
-    return m1, m2, d_inertia
-
-
-def rotating_inertia_force(mass: float, radius: float, omega: ArrayLike, epsilon: ArrayLike,
-                           angle: float = 0.0) -> tuple[Array, Array]:
-    """d'Alembert force of a point mass turning with the crank, in the crank's (K, T) components.
-
-    The mass sits at ``radius`` on a ray ``angle`` [rad] ahead of the crank in the direction of
-    rotation (0: on the crank, π: a counterweight opposite it). Position ρ = radius·(cos δ ĉ +
-    sin δ t̂), acceleration −ω² ρ + ε dρ/dα, so the force −m·acceleration has
-
-    K = −m radius (ω² cos δ + ε sin δ)   (positive toward the axis along the crank),
-    T = m radius (ω² sin δ − ε cos δ)    (positive in the direction of rotation).
-
-    At δ = 0: K = −m r ω² (Gots (32), K_rш, K_rk) and T = −m r ε.
-    """
-    w2 = np.square(np.asarray(omega, dtype=np.float64))
-    eps = np.asarray(epsilon, dtype=np.float64)
-    c, s = math.cos(angle), math.sin(angle)
-    return -mass * radius * (w2 * c + eps * s), mass * radius * (w2 * s - eps * c)
-
-
 @dataclass(frozen=True)
-class CylinderLoads:
+class CylinderLoads(CrankpinLoads):
     """Forces of every cylinder along a trajectory (module docstring: derivations and signs).
 
-    Arrays have shape ``(n_cylinders, n_samples)``; forces in N, torques in N·m.
+    A :class:`~.common.CrankpinLoads` with one crankpin per cylinder: every array has the shape
+    ``(n_cylinders, n_samples)``; forces in N, torques in N·m.
 
     Attributes
     ----------
@@ -186,45 +161,13 @@ class CylinderLoads:
     R_K, R_T, R : crankpin load K + K_rш, T + T_rш and its magnitude (40)/(41) as vectors.
     R_axial, R_normal : the crankpin load in the rod frame (big-end bearing), see the module
         docstring.
-    torque : cylinder torque T r (38).
+    torque : cylinder torque T r (38); its sum over the cylinders is :attr:`engine_torque`.
     throw_torque : r (T + T_rш + T_rk), what the throw passes to the shaft; = torque at ε = 0.
     r, area : crank radius [m] and piston area F_p [m²].
     """
 
-    alpha: Array
-    s: Array
-    v: Array
-    beta: Array
-    P_g: Array
-    P_j: Array
-    P: Array
-    N: Array
-    S: Array
-    K: Array
-    T: Array
-    K_rod: Array
-    T_rod: Array
-    K_crank: Array
-    T_crank: Array
-    R_K: Array
-    R_T: Array
-    R: Array
     R_axial: Array
     R_normal: Array
-    torque: Array
-    throw_torque: Array
-    r: float
-    area: float
-
-    @property
-    def psi(self) -> Array:
-        """Angle of the crankpin load from the crank toward the axis, tan ψ = R_T/R_K (Gots §2.6)
-        [rad], in (−π, π]."""
-        return np.arctan2(self.R_T, self.R_K)
-
-    def specific(self, name: str) -> Array:
-        """Force ``name`` per piston area [Pa] (Gots' specific forces; /1e6 for MPa)."""
-        return getattr(self, name) / self.area
 
 
 def crank_slider_loads(mech, phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLike,
@@ -240,15 +183,14 @@ def crank_slider_loads(mech, phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLik
         (constant speed: a scalar ω and ε = 0).
     gas_force : array_like, shape (n_cylinders, n) or broadcastable, optional
         Gas force on each piston P_g [N], positive toward the crank
-        (:func:`gas_force_from_pressure`, :func:`gas_forces`). Omitted: 0 (inertia only).
+        (:func:`~.common.gas_force_from_pressure`, :func:`~.common.gas_forces`). Omitted: 0
+        (inertia only).
 
     Returns
     -------
     CylinderLoads
     """
-    phi, omega, epsilon = np.broadcast_arrays(np.atleast_1d(np.asarray(phi, dtype=np.float64)),
-                                              np.asarray(omega, dtype=np.float64),
-                                              np.asarray(epsilon, dtype=np.float64))
+    phi, omega, epsilon = trajectory_arrays(phi, omega, epsilon)
     r, l, e = mech.crank_radius, mech.rod_length, mech.offset
     alpha = phi[None, :] - np.asarray(mech.firing_angles, dtype=np.float64)[:, None]
     w, eps = omega[None, :], epsilon[None, :]
@@ -256,8 +198,7 @@ def crank_slider_loads(mech, phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLik
     s, ds, dds, beta, db, ddb = slider_arrays(alpha, r, l, e)
     m1, m2, d_inertia = rod_split(mech)
     m_j = mech.piston_mass + m1
-    p_g = (np.zeros_like(alpha) if gas_force is None
-           else np.broadcast_to(np.asarray(gas_force, dtype=np.float64), alpha.shape).copy())
+    p_g = gas_force_array(gas_force, alpha.shape)
     p_j = -m_j * (dds * w2 + ds * eps)
     p = p_g + p_j
     cb = np.cos(beta)
@@ -271,87 +212,23 @@ def crank_slider_loads(mech, phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLik
     S = rod + h * np.sin(beta)
     K = rod * cab - h * sa
     T = rod * sab + h * ca
-    k_rod, t_rod = rotating_inertia_force(m2, r, w, eps)
-    k_crank, t_crank = rotating_inertia_force(mech.crank_mass, r, w, eps)
-    full = alpha.shape
-    k_rod, t_rod = np.broadcast_to(k_rod, full), np.broadcast_to(t_rod, full)
-    k_crank, t_crank = np.broadcast_to(k_crank, full), np.broadcast_to(t_crank, full)
+    k_rod, t_rod = rotating_inertia_rows(m2, r, w, eps, alpha.shape)
+    k_crank, t_crank = rotating_inertia_rows(mech.crank_mass, r, w, eps, alpha.shape)
     r_k = K + k_rod
     r_t = T + t_rod
     return CylinderLoads(
         alpha=alpha, s=s, v=ds * w, beta=beta, P_g=p_g, P_j=p_j, P=p, N=N, S=S, K=K, T=T,
-        K_rod=k_rod.copy(), T_rod=t_rod.copy(), K_crank=k_crank.copy(), T_crank=t_crank.copy(),
+        K_rod=k_rod, T_rod=t_rod, K_crank=k_crank, T_crank=t_crank,
         R_K=r_k, R_T=r_t, R=np.hypot(r_k, r_t),
         R_axial=r_k * cab + r_t * sab, R_normal=-r_k * sab + r_t * cab,
         torque=T * r, throw_torque=(T + t_rod + t_crank) * r, r=r,
         area=mech.piston_area)
 
 
-def gas_force_from_pressure(mech, p: ArrayLike, p0: float) -> Array:
-    """P_g = (p − p0)·F_p [N] (Gots (33)) from absolute cylinder pressures ``p`` [Pa]."""
-    return (np.asarray(p, dtype=np.float64) - p0) * mech.piston_area
-
-
-def gas_forces(scene, phi: ArrayLike, fuel: ArrayLike = 1.0) -> Array:
-    """Gas force on each piston of a scene [N], shape ``(n_cylinders, n)``, from its gas tables.
-
-    Cylinder k reads the table at φ − ``gas_phases(scene)[k]``; the pressure is
-    p_mot + f·(p_full − p_mot) at the fuel command ``fuel`` (scalar or per sample), as the
-    compiled model applies it (:class:`transient.scene.Gas`). A force-pulse model (``trapezoid``)
-    gives the force directly.
-    """
-    # (lazily: the table builders import scipy)
-    from ..assemble import gas_is_force, gas_phases, gas_tables
-
-    mech = scene.mechanism
-    phi = np.atleast_1d(np.asarray(phi, dtype=np.float64))
-    full, motored = gas_tables(scene)
-    shape = (mech.n_cylinders, phi.size)
-    if full is None:
-        return np.zeros(shape)
-    x = phi[None, :] - gas_phases(scene)[:, None]
-    value = full(x)
-    f = np.asarray(fuel, dtype=np.float64)
-    force = gas_is_force(scene)
-    base = motored(x) if motored is not None else (0.0 if force else scene.gas.p0)
-    value = base + f * (value - base)
-    if force:
-        return np.broadcast_to(value, shape).copy()
-    return gas_force_from_pressure(mech, value, scene.gas.p0)
-
-
-def trajectory_gas_force(scene, traj) -> Array | None:
-    """Gas force on each piston [N], shape ``(n_cylinders, n)``, along a run's trajectory; None
-    without gas. Any mechanism with ``n_cylinders`` and ``piston_area``.
-
-    From the recorded ``p_<k>`` columns (the value applied at the governor's fuel; Pa, or N for a
-    force model) when present, else from the scene's tables at the recorded ``fuel`` (1 if
-    absent). Note that a prescribed-speed run with ``fuel`` ≠ 1
-    (:func:`transient.run.prescribed`) scales the force without recording it in ``p_<k>``.
-    """
-    from ..assemble import gas_is_force
-
-    mech = scene.mechanism
-    names = [f"p_{k + 1}" for k in range(mech.n_cylinders)]
-    if scene.gas.model == "none":
-        return None
-    if all(n in traj for n in names):
-        value = np.vstack([np.asarray(traj[n], dtype=np.float64) for n in names])
-        return value if gas_is_force(scene) else gas_force_from_pressure(mech, value,
-                                                                         scene.gas.p0)
-    return gas_forces(scene, np.asarray(traj["phi"], dtype=np.float64), traj.get("fuel", 1.0))
-
-
 def loads_from_trajectory(scene, traj) -> CylinderLoads:
     """:func:`crank_slider_loads` along a run's trajectory (``phi``, ``omega``, ``epsilon``), the
-    gas force from :func:`trajectory_gas_force`."""
-    return crank_slider_loads(scene.mechanism, np.asarray(traj["phi"], dtype=np.float64),
-                              traj["omega"], traj["epsilon"], trajectory_gas_force(scene, traj))
-
-
-def engine_torque(loads: CylinderLoads) -> Array:
-    """Indicated engine torque Σ_k T_k r [N·m] (Gots §2.8, table П4.2), shape (n,)."""
-    return loads.torque.sum(axis=0)
+    gas force from :func:`~.common.trajectory_gas_force`."""
+    return along_trajectory(crank_slider_loads, scene, traj)
 
 
 def _check_inline(mech) -> None:

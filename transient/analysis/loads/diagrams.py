@@ -15,17 +15,16 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .irregularity import last_cycle_window
-from .loads import (
+from ..irregularity import last_cycle_window
+from .articulated import ArticulatedLoads, articulated_loads_from_trajectory
+from .crank_slider import (
     CylinderLoads,
     MainJournalLoads,
-    engine_torque,
     loads_from_trajectory,
     main_journal_loads,
     running_torques,
 )
-from .loads_radial import ArticulatedLoads, articulated_loads_from_trajectory
-from .wear import angle_weights, wear_rays
+from ..wear import angle_weights, wear_rays
 
 Array = NDArray[np.float64]
 
@@ -142,7 +141,7 @@ def crank_slider_diagrams(scene, traj: Mapping[str, Array], cylinder: int = 1
     k = cylinder - 1
     x, y = loads.R_T[k], -loads.R_K[k]
     weight = angle_weights(win["phi"])
-    common = dict(window=window, loads=loads, engine_torque=engine_torque(loads),
+    common = dict(window=window, loads=loads, engine_torque=loads.engine_torque,
                   cylinder=cylinder, crankpin_x=x, crankpin_y=y,
                   crankpin_wear=wear_rays(np.arctan2(y, x), loads.R[k], weight))
     inline = n_cyl == 1 or np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12
