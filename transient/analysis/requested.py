@@ -135,18 +135,29 @@ def _piston_acceleration(mech, phi, omega, epsilon, k: int) -> np.ndarray:
 
 
 def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
-    """Forces, crankpin and main-journal loads and running torques over the last whole cycle."""
-    from .loads import engine_torque, loads_from_trajectory, main_journal_loads, running_torques
-
+    """Forces, crankpin and main-journal loads and running torques over the last whole cycle,
+    by the storer :data:`LOADS` names for the mechanism; a one-line
+    :class:`~transient.errors.SceneError` for a mechanism without one."""
     mech = scene.mechanism
     n = scene.analysis.samples_per_cycle
     names = [c for c in ("t", "omega", "epsilon", "fuel") if c in traj]
     names += [f"p_{k + 1}" for k in range(mech.n_cylinders) if f"p_{k + 1}" in traj]
     grid, cols = to_angle_grid(traj, names, n, mech.cycle, phi0=scene.initial.phi, cycles=1,
                                cuts=cuts)
-    if store := _other_loads(mech):  # articulated, swash plate
-        return store(scene, grid, {"phi": grid, **cols})
-    ld = loads_from_trajectory(scene, {"phi": grid, **cols})
+    store = LOADS.get(mech.name)
+    if store is None:
+        raise SceneError("analysis.loads", f"loads are not computed for {type(mech).__name__}; "
+                                           f"allowed here: false")
+    return store(scene, grid, {"phi": grid, **cols})
+
+
+def _stored_crank_slider_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
+    """Crank-slider (:mod:`transient.analysis.loads`): per cylinder and crankpin; in-line
+    engines also the running torques and the main journals."""
+    from .loads import engine_torque, loads_from_trajectory, main_journal_loads, running_torques
+
+    mech = scene.mechanism
+    ld = loads_from_trajectory(scene, traj)
     out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
     for name in ("P", "N", "S", "K", "T", "R_K", "R_T", "R"):
         out[f"loads_{name}"] = (getattr(ld, name), "N")
@@ -155,30 +166,13 @@ def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
     if np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12:  # in-line: (58), §2.8
         journals, pins = running_torques(mech, ld)
-        mj = main_journal_loads(mech, ld, cols["omega"], cols["epsilon"])
+        mj = main_journal_loads(mech, ld, traj["omega"], traj["epsilon"])
         out["loads_journal_torque"] = (journals, "N m")
         out["loads_crankpin_torque"] = (pins, "N m")
         out["loads_main_x"] = (mj.x, "N")
         out["loads_main_y"] = (mj.y, "N")
         out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
     return out
-
-
-def _other_loads(mech):
-    """The storer of a mechanism other than the crank-slider, None for a crank-slider; a one-line
-    :class:`~transient.errors.SceneError` for a mechanism without loads."""
-    from ..mechanisms.articulated import Articulated
-    from ..mechanisms.crank_slider import CrankSlider
-    from ..mechanisms.swash_plate import SwashPlate
-
-    if isinstance(mech, CrankSlider):
-        return None
-    if isinstance(mech, Articulated):
-        return _stored_articulated_loads
-    if isinstance(mech, SwashPlate):
-        return _stored_swash_loads
-    raise SceneError("analysis.loads", f"loads are not computed for {type(mech).__name__}; "
-                                       f"allowed here: false")
 
 
 def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
@@ -210,3 +204,9 @@ def _stored_swash_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
     out["loads_engine_torque"] = (ld.engine_torque, "N m")
     out["loads_shaft_torque"] = (ld.shaft_torque, "N m")
     return out
+
+
+#: The storer of each mechanism's loads by its name in :data:`transient.mechanisms.MECHANISMS`:
+#: (scene, angle grid, trajectory on it) → name → (value, unit).
+LOADS = {"crank-slider": _stored_crank_slider_loads, "articulated": _stored_articulated_loads,
+         "swash-plate": _stored_swash_loads}
