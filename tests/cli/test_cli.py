@@ -29,9 +29,8 @@ from transient.scene import to_toml
 
 from terminal import terminal_run
 
-# ``transient.simulate`` is the function re-exported by the package (it shadows the submodule as
-# an attribute), so the module is taken from the import system.
-sim = importlib.import_module("transient.simulate")
+# The module that drives the stepper (``transient.simulate`` is the function the package exports).
+sim = importlib.import_module("transient.run")
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"

@@ -112,7 +112,7 @@ def test_where_chunks_end_changes_nothing(monkeypatch):
     rejection; at rtol 1e-12 the diesel without pairs took 60 129 or 60 134 steps by the output.)
     """
     import importlib
-    sim = importlib.import_module("transient.simulate")  # (the package exports the function)
+    sim = importlib.import_module("transient.run")
     base = load_scene(CASES / "gots_diesel_governed.toml")
 
     def run(samples, rows):
