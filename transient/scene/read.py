@@ -1,9 +1,10 @@
 """Reading a scene: TOML text or a parsed dict → a validated :class:`~.records.Scene`.
 
 :func:`load_scene` parses the file; :func:`scene_from_dict` reads one table at a time through a
-:class:`~.reader.Section` (the ``[mechanism]`` table by the class :data:`~transient.mechanisms.
-MECHANISMS` names for its ``type``), then runs the checks across tables (:mod:`.checks`). Every
-error is one :class:`~transient.errors.SceneError` naming the file and the key as written.
+:class:`~.reader.Section` (the ``[mechanism]`` table by the class that
+:data:`transient.mechanisms.MECHANISMS` names for its ``type``), then runs the checks across
+tables (:mod:`.checks`). Every error is one :class:`~transient.errors.SceneError` naming the file
+and the key as written.
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from .reader import MISSING, Section, show_value
 from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES,
                       GOVERNOR_KEYS, Analysis, Friction, Gas, Governor, Inertia, Initial, Load,
                       Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+
 
 def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
@@ -123,8 +125,6 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         exc.file = exc.file or file
         exc.args = (exc.line(),)
         raise
-
-
 
 
 def _read_gas(s: Section, base_dir: Path, strokes: int) -> Gas:

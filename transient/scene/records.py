@@ -348,11 +348,12 @@ class Analysis:
     """Derived results computed after the run and stored under ``/analysis`` only when asked
     (:mod:`transient.analysis.requested` lists the names and units).
 
-    ``loads``: forces, crankpin and main-journal loads, running torques over the last cycle
-    (crank-slider). ``orders``: signals whose order spectrum is stored per whole cycle —
-    trajectory columns (``omega``, ``M_gas``, ``p_1`` …) or ``W_<k>``, the piston acceleration of
-    cylinder k. ``irregularity``: δ and the mean speed of every cycle. ``max_order`` [1/rev]:
-    orders stored up to it. ``samples_per_cycle``: crank-angle grid per engine cycle.
+    ``loads``: forces, pin and journal loads and torques over the last cycle, as the mechanism's
+    loads analysis gives them. ``orders``: signals whose order spectrum is stored per whole cycle
+    — trajectory columns (``omega``, ``M_gas``, ``p_1`` …) or ``W_<k>``, the piston acceleration
+    of cylinder k (crank-slider). ``irregularity``: δ and the mean speed of every cycle.
+    ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
+    engine cycle.
     ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
     (:func:`transient.analysis.orders.order_spectrum`).
     """
