@@ -180,7 +180,7 @@ class Articulated:
             rod_cg_from_pin=self.rod_cg_from_pin, rod_inertia_cg=self.rod_inertia_cg,
             strokes=self.strokes, firing_angles=(0.0,), bank_angles=(0.0,))
 
-    # -- validation and packing ------------------------------------------------------------------
+    # -- reading, validation and packing ---------------------------------------------------------
     @classmethod
     def read(cls, s: Section) -> Articulated:
         """An :class:`Articulated` from the ``[mechanism]`` table (its ``type`` is read by the

@@ -22,6 +22,9 @@ from .twins import CrankSliderNumpy
 if TYPE_CHECKING:
     from ..scene.reader import Section
 
+#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
+MAX_CYLINDERS = 64
+
 
 @dataclass(frozen=True)
 class CrankSlider:
@@ -280,6 +283,3 @@ class CrankSlider:
         """Figures of the mechanism itself for a result's ``/analysis``: none here."""
         return {}
 
-
-#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
-MAX_CYLINDERS = 64
