@@ -3,8 +3,8 @@
 a mechanism without naming its class.
 
 A mechanism maps the shaft angle φ to the positions of its bodies and gives the reduced inertia
-J(φ), dJ/dφ and the piston transfer functions u_k(φ) = ds_k/dφ, u′_k(φ): in the compiled core for
-the stepper, in plain Python for the reference path.
+J(φ), dJ/dφ and the piston transfer functions u_k(φ) = ds_k/dφ, u′_k(φ): in the compiled core
+for the stepper, in plain Python for the reference path.
 
 Adding a mechanism takes
 

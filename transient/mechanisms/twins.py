@@ -11,8 +11,8 @@ from ..core import crank_slider as cs
 
 class CrankSliderNumpy:
     """J(φ), dJ/dφ and the piston transfer functions of a crank-slider, in plain numpy, written
-    out again from the Gots relations (exact piston velocity v = rω sin(φ + β)/cos β, Gots §1.2)
-    rather than taken from the kernel."""
+    out again from the Gots relations (exact piston velocity v = rω sin(φ + β)/cos β,
+    Gots §1.2) rather than taken from the kernel."""
 
     def __init__(self, mech) -> None:
         self.mech = mech
