@@ -53,9 +53,10 @@ class Mechanism(Protocol):
     #: Whether a scene may give it wall heat transfer (``[gas.woschni]``): the cylinder ODE of
     #: ``transient.core.cylinder`` is built for the crank-slider's volume.
     wall_heat_transfer: ClassVar[bool]
-    #: Whether the analyses derive its piston accelerations W_k = ω²s″ + εs′ (the ``W_<k>``
-    #: signals of ``[analysis] orders``, the odd-harmonic report) from the crank-slider's law.
-    piston_acceleration: ClassVar[bool]
+    #: Whether every piston follows the crank-slider law s(φ − φ_k) of ``crank_radius``,
+    #: ``rod_length`` and ``offset``, from which the analyses derive the piston accelerations
+    #: W_k = ω²s″ + εs′ (the ``W_<k>`` signals of ``[analysis] orders``, the odd-harmonic report).
+    slider_law: ClassVar[bool]
     #: 2 or 4: the gas cycle's length, ``cycle`` = π·strokes.
     strokes: int
 

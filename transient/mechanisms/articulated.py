@@ -124,8 +124,8 @@ class Articulated:
     kind = ARTICULATED
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
-    #: No piston accelerations W_k in the analyses: they use the crank-slider's slider law.
-    piston_acceleration = False
+    #: The slave pistons do not follow the crank-slider's law, from which the analyses derive W_k.
+    slider_law = False
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, then the
     #: rods with the pistons and gas forces.
     links = ("shaft", "crank", "rod")

@@ -81,8 +81,8 @@ class CrankSlider:
     kind = CRANK_SLIDER
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
     wall_heat_transfer = True
-    #: The analyses derive the piston accelerations W_k from the exact slider law.
-    piston_acceleration = True
+    #: Its pistons follow the slider law the analyses derive piston accelerations W_k from.
+    slider_law = True
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
     #: flywheel and load, the crank, and the rods with pistons and gas forces.
     links = ("shaft", "crank", "rod")

@@ -134,8 +134,8 @@ class SwashPlate:
     kind = SWASH_PLATE
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
-    #: No piston accelerations W_k in the analyses: they use the crank-slider's slider law.
-    piston_acceleration = False
+    #: Its pistons do not follow the crank-slider's law, from which the analyses derive W_k.
+    slider_law = False
     #: Two-stroke: one gas pulse per cylinder and turn.
     strokes = 2
     #: Cycle length in shaft angle [rad].

@@ -105,7 +105,7 @@ def check_analysis(scene: Scene) -> None:
 
     a, mech = scene.analysis, scene.mechanism
     columns = list(output_columns(scene))
-    derived = ([f"W_{k + 1}" for k in range(mech.n_cylinders)] if mech.piston_acceleration
+    derived = ([f"W_{k + 1}" for k in range(mech.n_cylinders)] if mech.slider_law
                else [])
     for name in a.orders:
         if name not in columns + derived:
