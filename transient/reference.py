@@ -1,8 +1,9 @@
 """The reference path: the same model in plain numpy, integrated by ``scipy.integrate.solve_ivp``.
 
 Slow and independent of the compiled stepper: time is always the independent variable, the state
-is (φ, ω), and (18) is written out again here from the Gots relations (exact piston velocity
-v = rω sin(φ + β)/cos β, Gots §1.2) rather than taken from the kernels. Breakpoints and the starter
+is (φ, ω), and (18) is written out again here; the mechanism's J(φ), dJ/dφ and transfer functions
+come from its plain-Python twin (``reference_terms``, :mod:`transient.mechanisms.twins`: the
+crank-slider's from the Gots relations, not from its kernel). Breakpoints and the starter
 cut-out are terminal events of solve_ivp, so every segment between them is smooth.
 """
 from __future__ import annotations
@@ -19,69 +20,6 @@ from .core.integrate import next_breakpoint
 from .core import governor as gv
 from .core.model import T, generator_branch, load_segment
 from .errors import SimulationError
-
-
-class CrankSliderNumpy:
-    """J(φ), dJ/dφ and the piston transfer functions of a crank-slider, in plain numpy."""
-
-    def __init__(self, mech) -> None:
-        self.mech = mech
-        mp = mech.pack()
-        from .core import crank_slider as cs
-
-        self.r, self.l, self.e = mech.crank_radius, mech.rod_length, mech.offset
-        self.m_slide = mp[cs.M_PISTON] + mp[cs.M_PIN]
-        self.m_rot = mp[cs.M_CRANKPIN] + mp[cs.M_CRANK]
-        self.m_rod, self.f_cg, self.I_rod = mp[cs.M_ROD], mp[cs.ROD_CG] / self.l, mp[cs.I_ROD]
-        self.phases = np.asarray(mech.firing_angles)
-
-    def terms(self, phi: float):
-        """(J, dJ, u[k]) at shaft angle φ, all cylinders."""
-        a = phi - self.phases
-        r, l = self.r, self.l
-        beta = np.arcsin((r * np.sin(a) - self.e) / l)
-        cb = np.cos(beta)
-        # Gots §1.2: piston velocity over ω, and its derivative (quotient rule).
-        db = r * np.cos(a) / (l * cb)
-        u = r * np.sin(a + beta) / cb
-        du = r * (np.cos(a + beta) * (1 + db) * cb + np.sin(a + beta) * np.sin(beta) * db) / cb**2
-        ddb = (l * np.sin(beta) * db**2 - r * np.sin(a)) / (l * cb)
-        # Rod centre of mass: G = B + f (A − B); A on the crank circle, B on the cylinder axis.
-        f = self.f_cg
-        g1 = np.array([f * r * np.cos(a), -(1 - f) * u - f * r * np.sin(a)])
-        g2 = np.array([-f * r * np.sin(a), -(1 - f) * du - f * r * np.cos(a)])
-        J = np.sum(self.m_slide * u**2 + self.m_rot * r**2 + self.m_rod * np.sum(g1**2, axis=0)
-                   + self.I_rod * db**2)
-        dJ = 2 * np.sum(self.m_slide * u * du + self.m_rod * np.sum(g1 * g2, axis=0)
-                        + self.I_rod * db * ddb)
-        return J, dJ, u
-
-
-class KernelTwin:
-    """Mechanisms without a numpy twin yet run their kernel's pure-Python code (``.py_func``)."""
-
-    def __init__(self, mech, terms) -> None:
-        self.mp = mech.pack()
-        self.fn = terms.py_func
-        self.u = np.empty(mech.n_cylinders)
-        self.du = np.empty(mech.n_cylinders)
-
-    def terms(self, phi):
-        J, dJ = self.fn(self.mp, phi, self.u, self.du)
-        return J, dJ, self.u.copy()
-
-
-def _mechanism(scene):
-    mech = scene.mechanism
-    if mech.kind == 0:
-        return CrankSliderNumpy(mech)
-    if mech.kind == 3:  # articulated
-        from .core.articulated import articulated_terms
-
-        return KernelTwin(mech, articulated_terms)
-    from .core.swash_plate import swash_terms
-
-    return KernelTwin(mech, swash_terms)
 
 
 class ChainNumpy:
@@ -284,7 +222,7 @@ class ReferenceModel:
         # The motored curve (None: the constant p0) between which and the table the fuel
         # interpolates, as PressureTable objects rather than the model's arrays.
         self.motored = gas_tables(scene)[1]
-        self.mech = _mechanism(scene)
+        self.mechanism_terms = scene.mechanism.reference_terms()
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
         self.pieces = None
         w0 = scene.initial.omega
@@ -328,7 +266,7 @@ class ReferenceModel:
 
     def moments(self, phi: float, w: float, y):
         m = self.model
-        J, dJ, u = self.mech.terms(phi)
+        J, dJ, u = self.mechanism_terms(phi)
         J += m.J0
         M_gas = 0.0
         p = np.zeros(m.ncyl)
@@ -392,7 +330,7 @@ class ReferenceModel:
         if self.cylinders is None:
             return []
         m = self.model
-        u = self.mech.terms(phi)[2]
+        u = self.mechanism_terms(phi)[2]
         fuel = (self.latched if self.latched is not None
                 else np.full(m.ncyl, self.command(w, y)))
         return self.cylinders.rates(np.mod(self.mid - m.gas_phase, m.period), phi - self.mid, u,
@@ -635,7 +573,7 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             events.setdefault("generator_min_speed", []).append((t, y[0]))
         if "inertia_switch" in hit:  # a clutch couples J_x at rest: J(φ)ω is conserved
             t = scene.load.inertia_time
-            J = ref.mech.terms(y[0])[0] + ref.model.J0
+            J = ref.mechanism_terms(y[0])[0] + ref.model.J0
             extra = scene.load.inertia
             w_new = J * y[1] / (J + extra)
             y[3] -= 0.5 * J * y[1] ** 2 - 0.5 * (J + extra) * w_new ** 2  # W_load

@@ -23,7 +23,7 @@ from .errors import SimulationError
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import RunData
-from .scene import COMPILED_METHODS, runs_compiled
+from .scene.records import COMPILED_METHODS, runs_compiled
 
 BUFFER_ROWS = 8192
 EVENT_ROWS = 2048

@@ -20,7 +20,7 @@ from transient.core.model import SWASH_PLATE
 from transient.errors import SceneError
 from transient.forces.gas import mixed_cycle
 from transient.mechanisms import swash_plate as sp
-from transient.scene import Section
+from transient.scene.reader import Section
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 ALPHA = math.radians(21.4)
@@ -38,7 +38,7 @@ def read(table: dict) -> sp.SwashPlate:
     """Read a [mechanism] table as scene_from_dict does: type, the reader, then finish."""
     s = Section(copy.deepcopy(table), "mechanism")
     assert s.string("type") == "swash-plate"
-    mech = sp.read_swash_plate(s)
+    mech = sp.SwashPlate.read(s)
     s.finish()
     return mech
 

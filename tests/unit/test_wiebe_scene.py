@@ -42,7 +42,7 @@ def test_scene_keys_in_si():
 
 
 def test_defaults_are_wiebe_cycles():
-    """The scene's defaults are :func:`wiebe_cycle`'s (written twice: scene.py does not import
+    """The scene's defaults are :func:`wiebe_cycle`'s (written twice: the scene records do not import
     the module, which only Wiebe scenes need)."""
     params = inspect.signature(wiebe_cycle).parameters
     names = {"a": "a", "m": "m", "lhv": "lhv", "efficiency": "efficiency", "gamma": "gamma",

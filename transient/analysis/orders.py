@@ -683,7 +683,7 @@ def report_for_scene(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: i
     """:func:`odd_harmonic_report` for cylinder ``cylinder`` (1-based) of a crank-slider scene:
     r, l, e, Φ, φ0 and the cylinder's firing angle taken from the scene; ``options`` as there."""
     m = scene.mechanism
-    if not hasattr(m, "crank_radius"):
+    if not m.slider_law:
         raise ValueError(f"the odd-harmonic report needs a crank-slider mechanism, "
                          f"not {type(m).__name__}")
     return odd_harmonic_report(traj, m.crank_radius, m.rod_length, m.offset, cycle=m.cycle,

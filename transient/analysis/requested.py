@@ -129,31 +129,20 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
 
 
 def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
-    """Forces, crankpin and main-journal loads and running torques over the last whole cycle."""
+    """Forces, crankpin and main-journal loads and running torques over the last whole cycle,
+    by the storer :data:`LOADS` names for the mechanism; a one-line
+    :class:`~transient.errors.SceneError` for a mechanism without one."""
     mech = scene.mechanism
     n = scene.analysis.samples_per_cycle
     names = [c for c in ("t", "omega", "epsilon", "fuel") if c in traj]
     names += [f"p_{k + 1}" for k in range(mech.n_cylinders) if f"p_{k + 1}" in traj]
     grid, cols = to_angle_grid(traj, names, n, mech.cycle, phi0=scene.initial.phi, cycles=1,
                                cuts=cuts)
-    return _loads_storer(mech)(scene, grid, {"phi": grid, **cols})
-
-
-def _loads_storer(mech):
-    """The storer of the mechanism's loads; a one-line :class:`~transient.errors.SceneError` for
-    a mechanism without loads."""
-    from ..mechanisms.articulated import Articulated
-    from ..mechanisms.crank_slider import CrankSlider
-    from ..mechanisms.swash_plate import SwashPlate
-
-    if isinstance(mech, CrankSlider):
-        return _stored_crank_slider_loads
-    if isinstance(mech, Articulated):
-        return _stored_articulated_loads
-    if isinstance(mech, SwashPlate):
-        return _stored_swash_loads
-    raise SceneError("analysis.loads", f"loads are not computed for {type(mech).__name__}; "
-                                       f"allowed here: false")
+    store = LOADS.get(mech.name)
+    if store is None:
+        raise SceneError("analysis.loads", f"loads are not computed for {type(mech).__name__}; "
+                                           f"allowed here: false")
+    return store(scene, grid, {"phi": grid, **cols})
 
 
 def _stored_record(ld, grid, forces) -> dict[str, tuple[Any, str]]:
@@ -209,3 +198,9 @@ def _stored_swash_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
     out = _stored_record(ld, grid, ("P", "S", "N_radial", "N_tangential"))
     out["loads_shaft_torque"] = (ld.shaft_torque, "N m")
     return out
+
+
+#: The storer of each mechanism's loads by its name in :data:`transient.mechanisms.MECHANISMS`:
+#: (scene, angle grid, trajectory on it) → name → (value, unit).
+LOADS = {"crank-slider": _stored_crank_slider_loads, "articulated": _stored_articulated_loads,
+         "swash-plate": _stored_swash_loads}

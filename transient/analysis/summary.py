@@ -50,5 +50,5 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
         out.update(mechanical_efficiency(scene, traj, events))
     out.update(requested)
     # the mechanism's own figures (articulated rods: slave harmonics against Semenov's series)
-    out.update(getattr(scene.mechanism, "analysis_summary", dict)())
+    out.update(scene.mechanism.analysis_summary())
     return out

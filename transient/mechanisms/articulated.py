@@ -11,7 +11,7 @@ A row is one crankpin with a master rod and z′ slaves; all rows share one geom
 angle of their master cylinder (``row_banks``) and of their crankpin (``row_cranks``). Cylinders
 are numbered row by row, the master first: k = j(1 + z′) + i, i = 0 the master.
 
-Interface choices (as :class:`~.crank_slider.CrankSlider` elsewhere):
+How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 
 * ``volume_function`` and ``stroke`` describe the master cylinder, an exact centred crank-slider
   (stroke 2r, dead centres at α = 0, π). Every cylinder gets the same pressure table, shifted to its
@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 from math import cos, degrees, hypot, pi, sin, sqrt
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,13 +37,27 @@ from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
 from .crank_slider import CrankSlider
+from .twins import KernelTwin
 
 if TYPE_CHECKING:
-    from ..scene import Section
+    from ..scene.reader import Section
 
 #: Samples per turn of the sampled checks and of the Fourier analysis (exact to rounding: the
 #: harmonics fall like λ^k, and 512 samples alias order 512 − k onto k).
 SAMPLES = 512
+
+
+def _per_slave(s: Section, name: str, n: int) -> tuple[float, ...] | None:
+    """A length given once for every slave or as a list of one per slave; None if absent."""
+    raw = next((s.data[k] for k in (name, f"{name}_mm") if k in s.data), None)
+    if isinstance(raw, list):
+        values = s.numbers(name, "length")
+        if len(values) != n:
+            raise s.rename(SceneError(s.key(name), f"has {len(values)} entries; must have one per "
+                                                   f"slave cylinder ({n}), or give one number"))
+        return values
+    value = s.number(name, "length", None)
+    return None if value is None else (value,) * n
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -104,8 +118,14 @@ class Articulated:
     row_cranks: tuple[float, ...] = (0.0,)
     firing: tuple[float, ...] = ()
 
+    #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
+    name = "articulated"
     #: Model.kind of the compiled kernel (transient.core.model.ARTICULATED).
-    kind = core_kind = ARTICULATED
+    kind = ARTICULATED
+    #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
+    wall_heat_transfer = False
+    #: The slave pistons do not follow the crank-slider's law, from which the analyses derive W_k.
+    slider_law = False
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, then the
     #: rods with the pistons and gas forces.
     links = ("shaft", "crank", "rod")
@@ -160,7 +180,81 @@ class Articulated:
             rod_cg_from_pin=self.rod_cg_from_pin, rod_inertia_cg=self.rod_inertia_cg,
             strokes=self.strokes, firing_angles=(0.0,), bank_angles=(0.0,))
 
-    # -- validation and packing ------------------------------------------------------------------
+    # -- reading, validation and packing ---------------------------------------------------------
+    @classmethod
+    def read(cls, s: Section) -> Articulated:
+        """An :class:`Articulated` from the ``[mechanism]`` table (its ``type`` is read by the
+        caller).
+
+        Keys (lengths in m or ``_mm``, angles in rad or ``_deg``): the master cylinder as a
+        crank-slider's — ``crank_radius``, ``rod_length``, ``bore``, ``piston_mass``,
+        ``crank_mass`` (per row), ``strokes``, and the master rod in ``[mechanism.rod]``; the
+        slaves — ``bank`` (δ_i, a list), ``link_angle`` (ψ_i, default = bank), ``link_radius``
+        (r_i) and/or ``slave_rod_length`` (l_i), each one number or a list, the missing one from
+        Semenov (6)–(7), and every slave rod in ``[mechanism.slave_rod]``; ``rows`` (1),
+        ``row_bank`` (0 …), ``row_crank`` (360°·j/rows), ``firing`` (optional, one per
+        cylinder).
+        """
+        r = s.number("crank_radius", "length", gt=0.0)
+        l = s.number("rod_length", "length", gt=0.0)
+        strokes_ = s.integer("strokes", 4, choices=(2, 4))
+        banks = s.numbers("bank", "angle")
+        n = len(banks)
+        if n < 1:
+            raise s.rename(SceneError(s.key("bank"), "must list at least one slave cylinder"))
+        psi = s.numbers("link_angle", "angle", banks)
+        if len(psi) != n:
+            raise s.rename(SceneError(s.key("link_angle"), f"has {len(psi)} entries; must have one "
+                                                           f"per slave cylinder ({n})"))
+        ri = _per_slave(s, "link_radius", n)
+        li = _per_slave(s, "slave_rod_length", n)
+        if ri is None and li is None:
+            raise SceneError(s.key("link_radius"), "is missing; give link_radius and/or "
+                                                   "slave_rod_length (the other follows from "
+                                                   "Semenov (6)–(7))")
+        if (ri is None or li is None) and r >= l:
+            raise s.rename(SceneError(s.key("rod_length"), f"must be longer than the crank radius "
+                                                           f"({r * 1e3:g} mm)"))
+        if ri is None or li is None:
+            dims = [slave_dimensions(r, l, d, None if ri is None else ri[i],
+                                     None if li is None else li[i]) for i, d in enumerate(banks)]
+            computed = "link_radius" if ri is None else "slave_rod_length"
+            ri, li = tuple(x for x, _ in dims), tuple(y for _, y in dims)
+        else:
+            computed = None
+        rows = s.integer("rows", 1, ge=1)
+        row_bank = s.numbers("row_bank", "angle", (0.0,) * rows)
+        row_crank = s.numbers("row_crank", "angle", tuple(2 * pi * j / rows for j in range(rows)))
+        if len(row_bank) != rows:
+            raise s.rename(SceneError(s.key("row_bank"), f"has {len(row_bank)} entries; must have "
+                                                         f"one per row ({rows})"))
+        rods = {}
+        for table in ("rod", "slave_rod"):
+            rod = s.sub(table, required=True)
+            model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
+            rods[table] = dict(model=model, mass=rod.number("mass", ge=0.0),
+                               cg_from_pin=rod.number("cg_from_pin", "length"),
+                               inertia_cg=(rod.number("inertia_cg", default=0.0, ge=0.0)
+                                           if model == "rigid" else 0.0))
+            rod.finish()
+        mech = cls(
+            crank_radius=r, rod_length=l, bore=s.number("bore", "length"),
+            piston_mass=s.number("piston_mass"), crank_mass=s.number("crank_mass", default=0.0),
+            **{f"rod_{k}": v for k, v in rods["rod"].items()},
+            slave_banks=banks, link_angles=psi, link_radii=ri, slave_lengths=li,
+            **{f"slave_rod_{k}": v for k, v in rods["slave_rod"].items()},
+            strokes=strokes_, row_banks=row_bank, row_cranks=row_crank,
+            firing=s.numbers("firing", "angle", ()))
+        try:
+            mech.validate()
+        except SceneError as exc:
+            if computed and exc.key == f"mechanism.{computed}":
+                exc.key = s.key("link_radius" if computed == "slave_rod_length" else
+                                "slave_rod_length")
+                exc.message += f" ({computed} from Semenov (6)–(7))"
+            raise s.rename(exc) from None
+        return mech
+
     def validate(self) -> None:
         """Raise :class:`SceneError` for a geometry or mass set that cannot work or assemble."""
         self.master().validate()
@@ -265,6 +359,11 @@ class Articulated:
         """V(x) of the master cylinder over its local angle x [rad] (vectorised)."""
         return self.master().volume_function(clearance)
 
+    def reference_terms(self) -> Callable[[float], tuple]:
+        """φ ↦ (J, dJ/dφ, u_k) for the reference path: the kernel's pure-Python code
+        (:class:`~.twins.KernelTwin`), there being no numpy twin of it."""
+        return KernelTwin(self, core.articulated_terms).terms
+
     def kinematics_table(self, phi: ArrayLike) -> dict[str, NDArray[np.float64]]:
         """Columns ``phi_deg``, ``J``, ``dJ_dphi`` and per cylinder k: ``s_k`` travel from its outer
         dead centre [m], ``u_k`` [m/rad], ``du_k`` [m/rad²] (the kernel's)."""
@@ -303,8 +402,8 @@ class Articulated:
 
     def toml_lines(self) -> list[str]:
         """The ``[mechanism]``, ``[mechanism.rod]`` and ``[mechanism.slave_rod]`` tables in SI,
-        which :func:`read_articulated` reads back to an equal object."""
-        keys = {"type": "articulated", "crank_radius": self.crank_radius,
+        which :meth:`read` reads back to an equal object."""
+        keys = {"type": self.name, "crank_radius": self.crank_radius,
                 "rod_length": self.rod_length, "bore": self.bore,
                 "piston_mass": self.piston_mass, "crank_mass": self.crank_mass,
                 "strokes": self.strokes, "bank": list(self.slave_banks),
@@ -592,91 +691,3 @@ def _derive(coef: NDArray[np.float64], order: int) -> NDArray[np.float64]:
         return np.column_stack([k * b, -k * a])
     return np.column_stack([-k * k * a, -k * k * b])
 
-
-# ------------------------------------------------------------------------------------------------
-# Scene reading
-
-
-def _per_slave(s: "Section", name: str, n: int) -> tuple[float, ...] | None:
-    """A length given once for every slave or as a list of one per slave; None if absent."""
-    raw = next((s.data[k] for k in (name, f"{name}_mm") if k in s.data), None)
-    if isinstance(raw, list):
-        values = s.numbers(name, "length")
-        if len(values) != n:
-            raise s.rename(SceneError(s.key(name), f"has {len(values)} entries; must have one per "
-                                                   f"slave cylinder ({n}), or give one number"))
-        return values
-    value = s.number(name, "length", None)
-    return None if value is None else (value,) * n
-
-
-def read_articulated(s: "Section") -> Articulated:
-    """An :class:`Articulated` from the ``[mechanism]`` table (its ``type`` is read by the caller).
-
-    Keys (lengths in m or ``_mm``, angles in rad or ``_deg``): the master cylinder as a
-    crank-slider's — ``crank_radius``, ``rod_length``, ``bore``, ``piston_mass``, ``crank_mass``
-    (per row), ``strokes``, and the master rod in ``[mechanism.rod]``; the slaves — ``bank`` (δ_i,
-    a list), ``link_angle`` (ψ_i, default = bank), ``link_radius`` (r_i) and/or
-    ``slave_rod_length`` (l_i), each one number or a list, the missing one from Semenov (6)–(7),
-    and every slave rod in ``[mechanism.slave_rod]``; ``rows`` (1), ``row_bank`` (0 …),
-    ``row_crank`` (360°·j/rows), ``firing`` (optional, one per cylinder).
-    """
-    r = s.number("crank_radius", "length", gt=0.0)
-    l = s.number("rod_length", "length", gt=0.0)
-    strokes_ = s.integer("strokes", 4, choices=(2, 4))
-    banks = s.numbers("bank", "angle")
-    n = len(banks)
-    if n < 1:
-        raise s.rename(SceneError(s.key("bank"), "must list at least one slave cylinder"))
-    psi = s.numbers("link_angle", "angle", banks)
-    if len(psi) != n:
-        raise s.rename(SceneError(s.key("link_angle"), f"has {len(psi)} entries; must have one "
-                                                       f"per slave cylinder ({n})"))
-    ri = _per_slave(s, "link_radius", n)
-    li = _per_slave(s, "slave_rod_length", n)
-    if ri is None and li is None:
-        raise SceneError(s.key("link_radius"), "is missing; give link_radius and/or "
-                                               "slave_rod_length (the other follows from "
-                                               "Semenov (6)–(7))")
-    if (ri is None or li is None) and r >= l:
-        raise s.rename(SceneError(s.key("rod_length"), f"must be longer than the crank radius "
-                                                       f"({r * 1e3:g} mm)"))
-    if ri is None or li is None:
-        dims = [slave_dimensions(r, l, d, None if ri is None else ri[i],
-                                 None if li is None else li[i]) for i, d in enumerate(banks)]
-        computed = "link_radius" if ri is None else "slave_rod_length"
-        ri, li = tuple(x for x, _ in dims), tuple(y for _, y in dims)
-    else:
-        computed = None
-    rows = s.integer("rows", 1, ge=1)
-    row_bank = s.numbers("row_bank", "angle", (0.0,) * rows)
-    row_crank = s.numbers("row_crank", "angle", tuple(2 * pi * j / rows for j in range(rows)))
-    if len(row_bank) != rows:
-        raise s.rename(SceneError(s.key("row_bank"), f"has {len(row_bank)} entries; must have "
-                                                     f"one per row ({rows})"))
-    rods = {}
-    for table in ("rod", "slave_rod"):
-        rod = s.sub(table, required=True)
-        model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
-        rods[table] = dict(model=model, mass=rod.number("mass", ge=0.0),
-                           cg_from_pin=rod.number("cg_from_pin", "length"),
-                           inertia_cg=(rod.number("inertia_cg", default=0.0, ge=0.0)
-                                       if model == "rigid" else 0.0))
-        rod.finish()
-    mech = Articulated(
-        crank_radius=r, rod_length=l, bore=s.number("bore", "length"),
-        piston_mass=s.number("piston_mass"), crank_mass=s.number("crank_mass", default=0.0),
-        **{f"rod_{k}": v for k, v in rods["rod"].items()},
-        slave_banks=banks, link_angles=psi, link_radii=ri, slave_lengths=li,
-        **{f"slave_rod_{k}": v for k, v in rods["slave_rod"].items()},
-        strokes=strokes_, row_banks=row_bank, row_cranks=row_crank,
-        firing=s.numbers("firing", "angle", ()))
-    try:
-        mech.validate()
-    except SceneError as exc:
-        if computed and exc.key == f"mechanism.{computed}":
-            exc.key = s.key("link_radius" if computed == "slave_rod_length" else
-                            "slave_rod_length")
-            exc.message += f" ({computed} from Semenov (6)–(7))"
-        raise s.rename(exc) from None
-    return mech

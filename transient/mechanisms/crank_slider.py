@@ -5,17 +5,25 @@ description (SI units) and packs it for the kernel.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from math import asin, degrees, pi
-
-import math
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..core import crank_slider as core
+from ..core.model import CRANK_SLIDER
 from ..errors import SceneError
 from ..tomlout import toml_value
+from .twins import CrankSliderNumpy
+
+if TYPE_CHECKING:
+    from ..scene.reader import Section
+
+#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
+MAX_CYLINDERS = 64
 
 
 @dataclass(frozen=True)
@@ -67,7 +75,14 @@ class CrankSlider:
     firing_angles: tuple[float, ...]
     bank_angles: tuple[float, ...]
 
-    kind = core_kind = 0
+    #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
+    name = "crank-slider"
+    #: Model.kind of the compiled kernel (transient.core.model.CRANK_SLIDER).
+    kind = CRANK_SLIDER
+    #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
+    wall_heat_transfer = True
+    #: Its pistons follow the slider law the analyses derive piston accelerations W_k from.
+    slider_law = True
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
     #: flywheel and load, the crank, and the rods with pistons and gas forces.
     links = ("shaft", "crank", "rod")
@@ -94,6 +109,44 @@ class CrankSlider:
     def lam(self) -> float:
         """λ = r/l."""
         return self.crank_radius / self.rod_length
+
+    @classmethod
+    def read(cls, s: Section) -> CrankSlider:
+        """A :class:`CrankSlider` from the ``[mechanism]`` table (its ``type`` is read by the
+        caller, who also finishes ``s``); errors name the keys as written."""
+        r = s.number("crank_radius", "length")
+        l = s.number("rod_length", "length")
+        strokes = s.integer("strokes", 4, choices=(2, 4))
+        n = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
+        cycle = math.pi * strokes
+        order = s.integers("firing_order", tuple(range(1, n + 1)))
+        if sorted(order) != list(range(1, n + 1)):
+            raise SceneError(s.key("firing_order"),
+                             f"must list each cylinder 1 … {n} once, got {list(order)}")
+        even = [0.0] * n
+        for j, c in enumerate(order):
+            even[c - 1] = j * cycle / n
+        firing = s.numbers("firing", "angle", tuple(even))
+        banks = s.numbers("bank", "angle", (0.0,) * n)
+        for key, values in (("firing", firing), ("bank", banks)):
+            if len(values) != n:
+                raise s.rename(SceneError(s.key(key), f"has {len(values)} entries; must have "
+                                                      f"one per cylinder ({n})"))
+        rod = s.sub("rod", required=True)
+        model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
+        mech = cls(
+            crank_radius=r, rod_length=l, offset=s.number("offset", "length", 0.0),
+            bore=s.number("bore", "length"), piston_mass=s.number("piston_mass"),
+            crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
+            rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
+            rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
+            strokes=strokes, firing_angles=firing, bank_angles=banks)
+        rod.finish()
+        try:
+            mech.validate()
+        except SceneError as exc:
+            raise rod.rename(s.rename(exc)) from None
+        return mech
 
     def validate(self) -> None:
         """Raise :class:`SceneError` for a geometry or mass set that cannot work."""
@@ -162,8 +215,8 @@ class CrankSlider:
 
     def toml_lines(self) -> list[str]:
         """The ``[mechanism]`` and ``[mechanism.rod]`` tables in SI, read back by
-        :func:`read_crank_slider` to an equal object."""
-        keys = {"type": "crank-slider", "crank_radius": self.crank_radius,
+        :meth:`read` to an equal object."""
+        keys = {"type": self.name, "crank_radius": self.crank_radius,
                 "rod_length": self.rod_length, "offset": self.offset, "bore": self.bore,
                 "piston_mass": self.piston_mass, "crank_mass": self.crank_mass,
                 "strokes": self.strokes, "cylinders": self.n_cylinders,
@@ -221,43 +274,12 @@ class CrankSlider:
 
         return volume
 
+    def reference_terms(self) -> Callable[[float], tuple]:
+        """φ ↦ (J, dJ/dφ, u_k) for the reference path: the numpy twin written from the Gots
+        relations (:class:`~.twins.CrankSliderNumpy`), independent of the kernel."""
+        return CrankSliderNumpy(self).terms
 
-#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
-MAX_CYLINDERS = 64
+    def analysis_summary(self) -> dict[str, tuple[float, str]]:
+        """Figures of the mechanism itself for a result's ``/analysis``: none here."""
+        return {}
 
-
-def read_crank_slider(s) -> CrankSlider:
-    """A :class:`CrankSlider` from the ``[mechanism]`` table (a ``transient.scene.Section``)."""
-    r = s.number("crank_radius", "length")
-    l = s.number("rod_length", "length")
-    strokes = s.integer("strokes", 4, choices=(2, 4))
-    n = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
-    cycle = math.pi * strokes
-    order = s.integers("firing_order", tuple(range(1, n + 1)))
-    if sorted(order) != list(range(1, n + 1)):
-        raise SceneError(s.key("firing_order"),
-                         f"must list each cylinder 1 … {n} once, got {list(order)}")
-    even = [0.0] * n
-    for j, c in enumerate(order):
-        even[c - 1] = j * cycle / n
-    firing = s.numbers("firing", "angle", tuple(even))
-    banks = s.numbers("bank", "angle", (0.0,) * n)
-    for key, values in (("firing", firing), ("bank", banks)):
-        if len(values) != n:
-            raise s.rename(SceneError(s.key(key), f"has {len(values)} entries; must have one per "
-                                                  f"cylinder ({n})"))
-    rod = s.sub("rod", required=True)
-    model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
-    mech = CrankSlider(
-        crank_radius=r, rod_length=l, offset=s.number("offset", "length", 0.0),
-        bore=s.number("bore", "length"), piston_mass=s.number("piston_mass"),
-        crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
-        rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
-        rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
-        strokes=strokes, firing_angles=firing, bank_angles=banks)
-    rod.finish()
-    try:
-        mech.validate()
-    except SceneError as exc:
-        raise rod.rename(s.rename(exc)) from None
-    return mech

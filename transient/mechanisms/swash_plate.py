@@ -19,7 +19,7 @@ Choices the paper leaves open (``reference/antonyuk-swashplate-dynamics.md``, [D
 * ``halves = 2`` adds the mirror image through the plane I–I: plate 4, link 10, cross 15, rods 8 and
   pistons 6 (opposed pistons in the same cylinders, same gas force).
 
-The mechanism interface the rest of the package uses (as :class:`~.crank_slider.CrankSlider`):
+How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 
 * ``kind = 1`` (``core.model.SWASH_PLATE``), ``strokes = 2`` (two-stroke, one power pulse per turn),
   ``cycle = 2π``; ``bank_angles`` are the cylinder angles ψ_Dk.
@@ -54,13 +54,17 @@ from ..core.model import SWASH_PLATE
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
+from .twins import KernelTwin
 
 if TYPE_CHECKING:
-    from ..scene import Section
+    from ..scene.reader import Section
 
 #: Housing hinge of cross 13 → (phase φ_h of the Hooke relation, hinge axis a = R_x(−φ_h) e_z);
 #: see transient.core.swash_plate.
 HINGES = {"normal": (0.0, (0.0, 0.0, 1.0)), "in-plane": (pi / 2.0, (0.0, 1.0, 0.0))}
+
+#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
+MAX_CYLINDERS = 64
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -124,8 +128,14 @@ class SwashPlate:
     link_diametral_inertia: float
     cross_inertia: float
 
+    #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
+    name = "swash-plate"
     #: Model.kind of the compiled kernel (transient.core.model.SWASH_PLATE).
-    kind = core_kind = SWASH_PLATE
+    kind = SWASH_PLATE
+    #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
+    wall_heat_transfer = False
+    #: Its pistons do not follow the crank-slider's law, from which the analyses derive W_k.
+    slider_law = False
     #: Two-stroke: one gas pulse per cylinder and turn.
     strokes = 2
     #: Cycle length in shaft angle [rad].
@@ -171,6 +181,75 @@ class SwashPlate:
     def piston_area(self) -> float:
         """π bore²/4 [m²]."""
         return pi * self.bore**2 / 4.0
+
+    @classmethod
+    def read(cls, s: Section) -> SwashPlate:
+        """A :class:`SwashPlate` from the ``[mechanism]`` table (its ``type`` is read by the
+        caller).
+
+        Keys (lengths plain in m or with ``_mm``, the angle plain in rad or with ``_deg``):
+        ``swash``, ``joint_radius``, ``cylinder_radius``, ``rod_length``, ``bore``,
+        ``cylinders`` (default 1), ``halves`` (1 | 2, default 1), ``hinge`` (``"in-plane"``
+        default | ``"normal"``), ``piston_mass`` [kg], link 9 either ``link_inertia`` (isotropic)
+        or both ``link_polar_inertia`` and ``link_diametral_inertia`` [kg m²], ``cross_inertia``
+        [kg m²] (default 0); and the table ``[mechanism.rod]``: ``model`` (``"two-mass"`` default
+        | ``"rigid"``), ``mass`` [kg], ``cg_from_pin`` (length, from the piston joint D),
+        ``inertia_cg`` [kg m²] (rigid model only, default 0). Unknown keys of the rod table are
+        rejected here; the caller finishes ``s``.
+
+        Every error names the key as written in the file (``mechanism.swash_deg`` if the user
+        wrote ``swash_deg``, ``mechanism.swash`` if they wrote ``swash``): :meth:`validate`
+        reports its canonical keys (angles as ``*_deg``, everything else by its SI name), which
+        are mapped here.
+        """
+        swash = s.number("swash", "angle")
+        R = s.number("joint_radius", "length", gt=0.0)
+        r1 = s.number("cylinder_radius", "length", gt=0.0)
+        ell = s.number("rod_length", "length", gt=0.0)
+        bore = s.number("bore", "length", gt=0.0)
+        z = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
+        halves = s.integer("halves", 1, choices=(1, 2))
+        hinge = s.string("hinge", "in-plane", choices=tuple(HINGES))
+        piston_mass = s.number("piston_mass", ge=0.0)
+        iso = s.number("link_inertia", default=None, ge=0.0)
+        polar = s.number("link_polar_inertia", default=None, ge=0.0)
+        diametral = s.number("link_diametral_inertia", default=None, ge=0.0)
+        if iso is not None:
+            if polar is not None or diametral is not None:
+                raise SceneError(s.key("link_inertia"),
+                                 "give either link_inertia (isotropic link 9) or both "
+                                 "link_polar_inertia and link_diametral_inertia, not both forms")
+            polar = diametral = iso
+        elif polar is None and diametral is None:
+            raise SceneError(s.key("link_inertia"),
+                             "is missing; give link_inertia [kg m²] (isotropic link 9) or both "
+                             "link_polar_inertia and link_diametral_inertia")
+        else:
+            for key, value in (("link_polar_inertia", polar),
+                               ("link_diametral_inertia", diametral)):
+                if value is None:
+                    raise SceneError(s.key(key), "is missing; link_polar_inertia and "
+                                                 "link_diametral_inertia go together (or give "
+                                                 "link_inertia alone for an isotropic link 9)")
+        cross = s.number("cross_inertia", default=0.0, ge=0.0)
+        rod = s.sub("rod", required=True)
+        model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
+        mech = cls(
+            swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell, bore=bore,
+            cylinders=z, halves=halves, hinge=hinge, piston_mass=piston_mass, rod_model=model,
+            rod_mass=rod.number("mass", ge=0.0),
+            rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0),
+            rod_inertia_cg=(rod.number("inertia_cg", default=0.0, ge=0.0) if model == "rigid"
+                            else 0.0),
+            link_polar_inertia=polar, link_diametral_inertia=diametral, cross_inertia=cross)
+        rod.finish()
+        try:
+            mech.validate()
+        except SceneError as exc:
+            if iso is not None and exc.key.startswith("mechanism.link_"):
+                exc.key = s.key("link_inertia")
+            raise rod.rename(s.rename(exc)) from None
+        return mech
 
     def validate(self) -> None:
         """Raise :class:`SceneError` for a geometry or mass set that cannot work."""
@@ -297,9 +376,9 @@ class SwashPlate:
 
     def toml_lines(self) -> list[str]:
         """The ``[mechanism]`` and ``[mechanism.rod]`` tables in SI (no unit suffixes), which
-        :func:`read_swash_plate` reads back to an equal object (the rod's ``inertia_cg`` is
+        :meth:`read` reads back to an equal object (the rod's ``inertia_cg`` is
         written, and read, for the rigid model only)."""
-        keys = {"type": "swash-plate", "swash": self.swash_angle, "joint_radius": self.joint_radius,
+        keys = {"type": self.name, "swash": self.swash_angle, "joint_radius": self.joint_radius,
                 "cylinder_radius": self.cylinder_radius, "rod_length": self.rod_length,
                 "bore": self.bore, "cylinders": self.cylinders, "halves": self.halves,
                 "hinge": self.hinge, "piston_mass": self.piston_mass,
@@ -311,6 +390,16 @@ class SwashPlate:
             rod["inertia_cg"] = self.rod_inertia_cg
         return (["[mechanism]"] + [f"{k} = {toml_value(v)}" for k, v in keys.items()]
                 + ["", "[mechanism.rod]"] + [f"{k} = {toml_value(v)}" for k, v in rod.items()])
+
+
+    def reference_terms(self) -> Callable[[float], tuple]:
+        """φ ↦ (J, dJ/dφ, u_k) for the reference path: the kernel's pure-Python code
+        (:class:`~.twins.KernelTwin`), there being no numpy twin of it."""
+        return KernelTwin(self, core.swash_terms).terms
+
+    def analysis_summary(self) -> dict[str, tuple[float, str]]:
+        """Figures of the mechanism itself for a result's ``/analysis``: none here."""
+        return {}
 
 
 def antonyuk_example(**changes) -> SwashPlate:
@@ -493,74 +582,3 @@ def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.f
     cols["dJ_dphi"] = JdJ[:, 1]
     return cols
 
-
-# ------------------------------------------------------------------------------------------------
-# Scene reading and writing
-
-
-#: Cylinders at most (a scene check: every per-cylinder array is sized by it).
-MAX_CYLINDERS = 64
-
-
-def read_swash_plate(s: "Section") -> SwashPlate:
-    """A :class:`SwashPlate` from the ``[mechanism]`` table (its ``type`` is read by the caller).
-
-    Keys (lengths plain in m or with ``_mm``, the angle plain in rad or with ``_deg``):
-    ``swash``, ``joint_radius``, ``cylinder_radius``, ``rod_length``, ``bore``, ``cylinders``
-    (default 1), ``halves`` (1 | 2, default 1), ``hinge`` (``"in-plane"`` default | ``"normal"``),
-    ``piston_mass`` [kg], link 9 either ``link_inertia`` (isotropic) or both ``link_polar_inertia``
-    and ``link_diametral_inertia`` [kg m²], ``cross_inertia`` [kg m²] (default 0); and the table
-    ``[mechanism.rod]``: ``model`` (``"two-mass"`` default | ``"rigid"``), ``mass`` [kg],
-    ``cg_from_pin`` (length, from the piston joint D), ``inertia_cg`` [kg m²] (rigid model only,
-    default 0). Unknown keys of the rod table are rejected here; the caller finishes ``s``.
-
-    Every error names the key as written in the file (``mechanism.swash_deg`` if the user wrote
-    ``swash_deg``, ``mechanism.swash`` if they wrote ``swash``): :meth:`SwashPlate.validate` reports
-    its canonical keys (angles as ``*_deg``, everything else by its SI name), which are mapped here.
-    """
-    swash = s.number("swash", "angle")
-    R = s.number("joint_radius", "length", gt=0.0)
-    r1 = s.number("cylinder_radius", "length", gt=0.0)
-    ell = s.number("rod_length", "length", gt=0.0)
-    bore = s.number("bore", "length", gt=0.0)
-    z = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
-    halves = s.integer("halves", 1, choices=(1, 2))
-    hinge = s.string("hinge", "in-plane", choices=tuple(HINGES))
-    piston_mass = s.number("piston_mass", ge=0.0)
-    iso = s.number("link_inertia", default=None, ge=0.0)
-    polar = s.number("link_polar_inertia", default=None, ge=0.0)
-    diametral = s.number("link_diametral_inertia", default=None, ge=0.0)
-    if iso is not None:
-        if polar is not None or diametral is not None:
-            raise SceneError(s.key("link_inertia"),
-                             "give either link_inertia (isotropic link 9) or both "
-                             "link_polar_inertia and link_diametral_inertia, not both forms")
-        polar = diametral = iso
-    elif polar is None and diametral is None:
-        raise SceneError(s.key("link_inertia"),
-                         "is missing; give link_inertia [kg m²] (isotropic link 9) or both "
-                         "link_polar_inertia and link_diametral_inertia")
-    else:
-        for key, value in (("link_polar_inertia", polar), ("link_diametral_inertia", diametral)):
-            if value is None:
-                raise SceneError(s.key(key), "is missing; link_polar_inertia and "
-                                             "link_diametral_inertia go together (or give "
-                                             "link_inertia alone for an isotropic link 9)")
-    cross = s.number("cross_inertia", default=0.0, ge=0.0)
-    rod = s.sub("rod", required=True)
-    model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
-    mech = SwashPlate(
-        swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell, bore=bore,
-        cylinders=z, halves=halves, hinge=hinge, piston_mass=piston_mass, rod_model=model,
-        rod_mass=rod.number("mass", ge=0.0),
-        rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0),
-        rod_inertia_cg=rod.number("inertia_cg", default=0.0, ge=0.0) if model == "rigid" else 0.0,
-        link_polar_inertia=polar, link_diametral_inertia=diametral, cross_inertia=cross)
-    rod.finish()
-    try:
-        mech.validate()
-    except SceneError as exc:
-        if iso is not None and exc.key.startswith("mechanism.link_"):
-            exc.key = s.key("link_inertia")
-        raise rod.rename(s.rename(exc)) from None
-    return mech

@@ -1,0 +1,121 @@
+"""Checks across the tables of a scene, run by :func:`~.read.scene_from_dict` once every table
+has been read and before any integration: what no single key can tell (J(φ) > 0 over the cycle,
+options that need a compiled method or a dynamic run, a gas model the mechanism supports, the
+signals an analysis asks for).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import SceneError
+from .reader import Section
+from .records import COMPILED_METHODS, Scene
+
+
+def check_consistency(scene: Scene) -> None:
+    """Checks across sections, done before any integration."""
+    # (18) divides by J(φ): it must stay positive over the whole cycle, dead centres included.
+    phi = np.linspace(0.0, scene.mechanism.cycle, 721)
+    with np.errstate(over="ignore", invalid="ignore"):
+        J = scene.mechanism.kinematics_table(phi)["J"] + scene.inertia.total
+    if not np.all(np.isfinite(J)):
+        raise SceneError("mechanism", "the reduced inertia J(φ) overflows (is not finite); "
+                                      "check the masses and lengths and their units")
+    try:
+        area = scene.mechanism.piston_area
+    except OverflowError:
+        area = math.inf
+    if not math.isfinite(area):
+        raise SceneError("mechanism.bore", f"the piston area overflows; check the bore and its "
+                                           f"unit (mm: 'bore_mm')")
+    if J.min() <= 0.0:
+        at = math.degrees(phi[int(np.argmin(J))])
+        raise SceneError("inertia", f"the reduced inertia J(φ) falls to {J.min():.3g} kg m² at "
+                                    f"φ = {at:g}°; give a shaft, flywheel or load inertia > 0")
+    sv = scene.solver
+    compiled = sv.method in COMPILED_METHODS
+    if scene.friction.pairs and scene.friction.policy == "paper" and not compiled:
+        raise SceneError("solver.method", "the reference path (scipy-*) follows the power-flow "
+                                          "policy only; use method = \"dop853\" or \"dopri5\" "
+                                          "with policy \"paper\"")
+    if sv.fixed_step > 0.0 and not compiled:
+        raise SceneError("solver.fixed_step", f"fixed steps need a compiled method "
+                                              f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")
+    if sv.kinematics == "tabulated" and not compiled:
+        raise SceneError("solver.kinematics", f"tables are for the compiled methods "
+                                              f"({', '.join(COMPILED_METHODS)}); the reference path "
+                                              f"{sv.method!r} is exact by design")
+    if sv.fixed_step > 0.0 and sv.domain == "time":
+        raise SceneError("solver.fixed_step", "fixed steps are crank-angle steps; use "
+                                              "domain = \"auto\" or fixed_step = 0")
+    if scene.run.mode == "prescribed-speed" and scene.load.inertia > 0.0:
+        raise SceneError("load.inertia", "a prescribed-speed run has no momentum to conserve when "
+                                         "an inertia is switched in; leave it out (0)")
+    if scene.gas.woschni is not None:
+        check_woschni(scene)
+    if scene.run.mode == "prescribed-speed" and scene.governor.model in ("pi", "flyweight"):
+        raise SceneError("governor.model", f"a prescribed-speed run integrates no governor state; "
+                                           f"use model = \"none\" or \"droop\", not "
+                                           f"{scene.governor.model!r}")
+    if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
+        if scene.gas.model == "none":
+            raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
+                                              "never moves; give omega or a starter")
+
+
+def check_woschni(scene: Scene) -> None:
+    """Wall heat transfer makes each cylinder's pressure a state of the ODE (built for the
+    crank-slider's exact cylinder volume, integrated by the compiled and the reference paths)."""
+    if not scene.mechanism.wall_heat_transfer:
+        raise SceneError("gas.woschni", f"wall heat transfer is built for crank-slider engines "
+                                        f"(their cylinder volume enters the ODE), not for the "
+                                        f"{scene.mechanism.name!r} mechanism; leave "
+                                        f"[gas.woschni] out")
+    if scene.run.mode == "prescribed-speed":
+        raise SceneError("gas.woschni", "with wall heat transfer the cylinder pressures are "
+                                        "states of the ODE, which a prescribed-speed run does not "
+                                        "integrate; run it dynamic (a large flywheel holds the "
+                                        "speed) or leave [gas.woschni] out")
+    if scene.gas.wiebe.m < 0.0:
+        raise SceneError("gas.wiebe.m", f"m = {scene.gas.wiebe.m:g}: with wall heat transfer the "
+                                        f"heat-release rate enters the ODE, and for m < 0 it is "
+                                        f"infinite at the combustion start; give m ≥ 0")
+    if scene.solver.kinematics == "tabulated":
+        raise SceneError("solver.kinematics", "the cylinder volumes of wall heat transfer use the "
+                                              "exact kinematics; use kinematics = \"exact\"")
+
+
+def check_gas_table(scene: Scene, section: Section) -> None:
+    """Build (and so validate) the pressure table; report under the key the user wrote."""
+    from ..assemble import gas_table
+
+    try:
+        gas_table(scene)
+    except SceneError as exc:
+        if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi"):
+            exc.key = "gas.file"
+        raise section.rename(exc) from None
+
+
+def check_analysis(scene: Scene) -> None:
+    """The [analysis] signals exist in this scene's trajectory and the orders fit the grid."""
+    from ..outputs import output_columns
+
+    a, mech = scene.analysis, scene.mechanism
+    columns = list(output_columns(scene))
+    derived = ([f"W_{k + 1}" for k in range(mech.n_cylinders)] if mech.slider_law
+               else [])
+    for name in a.orders:
+        if name not in columns + derived:
+            raise SceneError("analysis.orders", f"unknown signal {name!r}; allowed: "
+                                                f"{', '.join(columns + derived)}")
+    if len(set(a.orders)) != len(a.orders):
+        raise SceneError("analysis.orders", "a signal is named twice; name each once")
+    nyquist = (a.samples_per_cycle // 2) * 2.0 * math.pi / mech.cycle
+    if a.orders and a.max_order > nyquist:
+        raise SceneError("analysis.max_order", f"must be ≤ {nyquist:g} (the Nyquist order of "
+                                               f"samples_per_cycle = {a.samples_per_cycle} over "
+                                               f"a {math.degrees(mech.cycle):g}° cycle), got "
+                                               f"{a.max_order:g}")

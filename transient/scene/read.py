@@ -1,0 +1,426 @@
+"""Reading a scene: TOML text or a parsed dict → a validated :class:`~.records.Scene`.
+
+:func:`load_scene` parses the file; :func:`scene_from_dict` reads one table at a time through a
+:class:`~.reader.Section` (the ``[mechanism]`` table by the class that
+:data:`transient.mechanisms.MECHANISMS` names for its ``type``), then runs the checks across
+tables (:mod:`.checks`). Every error is one :class:`~transient.errors.SceneError` naming the file
+and the key as written.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import tomllib
+from dataclasses import replace
+from pathlib import Path
+
+from ..errors import SceneError
+from ..mechanisms import MECHANISMS
+from .checks import check_analysis, check_consistency, check_gas_table
+from .reader import MISSING, Section, show_value
+from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES,
+                      GOVERNOR_KEYS, Analysis, Friction, Gas, Governor, Inertia, Initial, Load,
+                      Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+
+
+def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
+    """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
+    path = Path(source)
+    if text is None:
+        try:
+            text = path.read_text(encoding="utf-8-sig")  # (a byte-order mark is not TOML)
+        except OSError as exc:
+            raise SceneError("(file)", f"cannot read: {exc.strerror}", file=str(path)) from None
+        except UnicodeDecodeError as exc:
+            raise SceneError("(file)", f"not UTF-8 text (byte {exc.start}); save the scene as "
+                                       f"UTF-8", file=str(path)) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError("(syntax)", f"not valid TOML: {exc}", file=str(path)) from None
+    return scene_from_dict(data, file=str(path), base_dir=path.parent)
+
+
+def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
+    """Build and validate a scene from parsed TOML. Raises :class:`SceneError`."""
+    base_dir = base_dir or Path.cwd()
+    try:
+        root = Section(data, "")
+        head = root.sub("scene")
+        name = head.string("name", Path(file).stem if file else "scene")
+        if not name.strip():
+            raise SceneError(head.key(head.written.get("name", "name")),
+                             "must not be empty; it names the result (leave it out to use the "
+                             "file's name)")
+        description = head.string("description", "")
+        head.finish()
+        ms = root.sub("mechanism", required=True)
+        kind = ms.string("type", choices=tuple(MECHANISMS))
+        mech = MECHANISMS[kind].read(ms)
+        ms.finish()
+        sections = {}
+        si = root.sub("inertia")
+        sections["inertia"] = Inertia(si.number("shaft", default=0.0, ge=0.0),
+                                      si.number("flywheel", default=0.0, ge=0.0),
+                                      si.number("load", default=0.0, ge=0.0))
+        si.finish()
+        sg = root.sub("gas")
+        sections["gas"] = _read_gas(sg, base_dir, mech.strokes)
+        sg.finish()
+        sl = root.sub("load")
+        sections["load"] = _read_load(sl)
+        sl.finish()
+        ss = root.sub("starter")
+        torque = ss.number("torque", default=0.0, ge=0.0)
+        noload = ss.number("noload_speed", "speed", 1.0, gt=0.0)
+        cutout = ss.number("cutout_speed", "speed", noload, gt=0.0, le=noload)
+        sections["starter"] = Starter(torque, noload, cutout)
+        ss.finish()
+        sgv = root.sub("governor")
+        sections["governor"] = _read_governor(sgv)
+        sgv.finish()
+        s0 = root.sub("initial")
+        sections["initial"] = Initial(s0.number("phi", "angle", 0.0),
+                                      s0.number("omega", "speed", 0.0))
+        s0.finish()
+        sr = root.sub("run", required=True)
+        sections["run"] = _read_run(sr)
+        sr.finish()
+        sv = root.sub("solver")
+        sections["solver"] = Solver(
+            method=sv.string("method", "dop853", choices=METHODS),
+            rtol=sv.number("rtol", default=1e-8, gt=0.0, lt=1.0),
+            atol=sv.number("atol", default=1e-10, gt=0.0),
+            switch_speed=sv.number("switch_speed", "speed", math.pi / 3.0, gt=0.0),
+            max_step=sv.number("max_step", "angle", math.pi, gt=0.0),
+            domain=sv.string("domain", "auto", choices=("auto", "time")),
+            fixed_step=sv.number("fixed_step", "angle", 0.0, ge=0.0),
+            kinematics=sv.string("kinematics", "exact", choices=("exact", "tabulated")),
+            table_tolerance=sv.number("table_tolerance", default=0.0, ge=0.0, lt=1.0))
+        sv.finish()
+        so = root.sub("output")
+        spr = so.integer("samples_per_rev", 72, ge=4)
+        if spr > MAX_SAMPLES_PER_REV:  # (every sample is written: a run must stay finite)
+            raise SceneError(so.key("samples_per_rev"), f"must be ≤ {MAX_SAMPLES_PER_REV}, got "
+                                                        f"{spr}")
+        dt = so.number("dt", default=0.0, ge=0.0)
+        if 0.0 < dt < MIN_OUTPUT_DT:  # (every sample is written: a run must stay finite)
+            raise SceneError(so.key("dt"), f"must be 0 (the default spacing) or ≥ "
+                                           f"{MIN_OUTPUT_DT:g} s, got {dt:g}")
+        sections["output"] = Output(spr, dt)
+        so.finish()
+        sf = root.sub("friction")
+        sections["friction"] = _read_friction(sf, mech.links)
+        sf.finish()
+        sa = root.sub("analysis")
+        sections["analysis"] = _read_analysis(sa)
+        sa.finish()
+        root.finish()
+        scene = Scene(name=name, description=description, mechanism=mech, **sections)
+        check_consistency(scene)
+        check_gas_table(scene, sg)
+        check_analysis(scene)
+        return scene
+    except SceneError as exc:
+        exc.file = exc.file or file
+        exc.args = (exc.line(),)
+        raise
+
+
+def _read_gas(s: Section, base_dir: Path, strokes: int) -> Gas:
+    gas = _read_gas_model(s, base_dir, strokes)
+    if gas.model == "none":
+        return gas
+    cycle = 2.0 * math.pi * strokes / 2
+    return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle))
+
+
+def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
+    model = s.string("model", "none",
+                     choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe"))
+    if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
+        return Gas(model="trapezoid", p0=0.0, amplitude=s.number("amplitude", ge=0.0),
+                   ramp=s.number("ramp", "angle", gt=0.0),
+                   duration=s.number("duration", "angle", math.pi, gt=0.0))
+    p0 = s.number("p0", "pressure", 1.0e5, ge=0.0)
+    if model == "none":
+        return Gas(model="none", p0=p0)
+    if model == "table":
+        if s.has("file"):
+            phi, p = _read_pressure_csv(s, base_dir)
+        else:
+            phi = s.numbers("phi", "angle")
+            p = s.numbers("p", "pressure")
+        corners = s.numbers("corners", "angle", ())
+        interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
+        return Gas(model="table", p0=p0, phi=phi, p=p, corners=corners, interpolation=interp)
+    if model == "wiebe":
+        return _read_wiebe(s, p0, strokes)
+    return Gas(
+        model="mixed-cycle", p0=p0,
+        compression_ratio=s.number("compression_ratio", gt=1.0),
+        p_a=s.number("p_a", "pressure", gt=0.0), n1=s.number("n1", gt=1.0),
+        p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
+        n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
+        p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+
+
+def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
+    """``model = "wiebe"``: the cycle's pressures in [gas], the combustion in [gas.wiebe].
+
+    Ranges of single keys are checked here; what needs several of them (the combustion inside
+    the closed part, γ(T) > 1 at intake closing) by :mod:`transient.forces.wiebe` when the table
+    is built, still inside :func:`load_scene` (:func:`~.checks.check_gas_table`).
+    """
+    d = Wiebe()
+    ratio = s.number("compression_ratio", gt=1.0)
+    p_a = s.number("p_a", "pressure", gt=0.0)
+    # A 2-stroke is scavenged to p_a: it has no intake or exhaust stroke.
+    need = MISSING if strokes == 4 else 0.0
+    p_in = s.number("p_intake", "pressure", need, ge=0.0)
+    p_ex = s.number("p_exhaust", "pressure", need, ge=0.0)
+    w = s.sub("wiebe", required=True)
+    wiebe = Wiebe(
+        start=w.number("start", "angle"), duration=w.number("duration", "angle", gt=0.0),
+        fuel_mass=w.number("fuel_mass", ge=0.0), a=w.number("a", default=d.a, gt=0.0),
+        m=w.number("m", default=d.m, gt=-1.0), lhv=w.number("lhv", default=d.lhv, gt=0.0),
+        efficiency=w.number("efficiency", default=d.efficiency, gt=0.0, le=1.0),
+        gamma=w.number("gamma", default=d.gamma, gt=1.0),
+        gamma_slope=w.number("gamma_slope", default=d.gamma_slope),
+        gamma_t_ref=w.number("gamma_t_ref", default=d.gamma_t_ref, gt=0.0),
+        t_a=w.number("t_a", default=d.t_a, gt=0.0),
+        intake_closing=w.number("intake_closing", "angle", None),
+        exhaust_opening=w.number("exhaust_opening", "angle", None),
+        step=w.number("step", "angle", d.step, gt=0.0),
+        tolerance=w.number("tolerance", default=d.tolerance, gt=0.0))
+    w.finish()
+    woschni = None
+    if s.has("woschni"):
+        h, dh = s.sub("woschni"), Woschni()
+        woschni = Woschni(c1=h.number("c1", default=dh.c1, ge=0.0),
+                          c2=h.number("c2", default=dh.c2, ge=0.0),
+                          wall_temperature=h.number("wall_temperature", default=dh.wall_temperature,
+                                                    gt=0.0))
+        h.finish()
+    return Gas(model="wiebe", p0=p0, compression_ratio=ratio, p_a=p_a, p_intake=p_in,
+               p_exhaust=p_ex, wiebe=wiebe, woschni=woschni)
+
+
+def _read_pressure_csv(s: Section, base_dir: Path):
+    """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
+    name = s.string("file")
+    path = (base_dir / name).resolve()
+    if not path.is_file():
+        raise SceneError(s.key("file"), f"no such file {str(path)!r}; give a CSV path relative "
+                                        f"to the scene")
+    angle_cols = {"phi_deg": math.pi / 180.0, "phi": 1.0}
+    p_cols = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:
+            rows = list(csv.reader(line for line in fh if not line.startswith("#")))
+    except UnicodeDecodeError as exc:
+        raise SceneError(s.key("file"), f"{path.name}: not UTF-8 text (byte {exc.start}); "
+                                        f"save the table as UTF-8 CSV") from None
+    header = [h.strip() for h in rows[0]] if rows else []
+    a = next((c for c in header if c in angle_cols), None)
+    b = next((c for c in header if c in p_cols), None)
+    if a is None or b is None:
+        raise SceneError(s.key("file"), f"{path.name}: needs an angle column ({', '.join(angle_cols)})"
+                                        f" and a pressure column ({', '.join(p_cols)}); "
+                                        f"header is {header}")
+    ia, ib = header.index(a), header.index(b)
+    try:
+        phi = tuple(float(r[ia]) * angle_cols[a] for r in rows[1:] if r)
+        p = tuple(float(r[ib]) * p_cols[b] for r in rows[1:] if r)
+    except (ValueError, IndexError) as exc:
+        raise SceneError(s.key("file"), f"{path.name}: a row is not numeric ({exc})") from None
+    return phi, p
+
+
+def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
+    """The [friction] table: a policy and an array of [[friction.pairs]] between neighbouring
+    links of the mechanism (shaft side first)."""
+    policy = s.string("policy", "power-flow", choices=POLICIES)
+    s.known.append("pairs")
+    raw = s.data.pop("pairs", [])
+    if not isinstance(raw, list):
+        raise SceneError(s.key("pairs"), "must be an array of tables ([[friction.pairs]])")
+    chain = " – ".join(links)
+    pairs, seen = [], {}
+    for i, item in enumerate(raw):
+        ps = Section(item, f"{s.key('pairs')}[{i}]")
+        ps.known.append("between")
+        between = ps.data.pop("between", None)
+        if (not isinstance(between, list) or len(between) != 2
+                or not all(isinstance(b, str) for b in between)):
+            raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
+                                                f"the links are {chain}")
+        for b in between:
+            if b not in links:
+                raise SceneError(ps.key("between"), f"unknown link {b!r}; the links are {chain}")
+        ia, ib = links.index(between[0]), links.index(between[1])
+        if abs(ia - ib) != 1:
+            raise SceneError(ps.key("between"),
+                             f"{between[0]!r} and {between[1]!r} are not neighbours; a pair joins "
+                             f"two adjacent links of the chain {chain}")
+        if ib < ia:
+            raise SceneError(ps.key("between"), f"give the shaft-side link first: "
+                                                f"[{between[1]!r}, {between[0]!r}]")
+        if ia in seen:
+            raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
+        seen[ia] = i
+        pair = Pair(between=(between[0], between[1]), eta_forward=_efficiency(ps, "eta_forward"),
+                    eta_backward=_efficiency(ps, "eta_backward"),
+                    name=ps.string("name", f"{between[0]}-{between[1]}"))
+        ps.finish()
+        twin = next((j for j, q in enumerate(pairs) if q.name == pair.name), None)
+        if twin is not None:
+            raise SceneError(ps.key("name"), f"{pair.name!r} names {s.key('pairs')}[{twin}] "
+                                             f"too; give each pair its own name (it labels the "
+                                             f"pair's result columns and reports)")
+        pairs.append(pair)
+    pairs.sort(key=lambda p: links.index(p.between[0]))
+    return Friction(policy, tuple(pairs))
+
+
+def _efficiency(s: Section, name: str) -> float:
+    """An efficiency in (0, 1]; η ≤ 0 would be a self-locking pair, which the model excludes."""
+    eta = s.number(name, le=1.0)
+    if eta <= 0.0:
+        raise SceneError(s.key(name), f"must be > 0, got {eta:g}; an efficiency ≤ 0 is a "
+                                      f"self-locking pair (the paper's ξ regime), not modelled")
+    return eta
+
+
+#: Distinct abscissae of a load schedule closer than this (relative to max(1, |x|)) are
+#: refused: a ramp that short is a step to the solver, and the event search could not tell its
+#: two corners apart (``transient.core.integrate.ON_LEVEL`` is 1e-12).
+SCHEDULE_MIN_GAP = 1e-9
+
+
+def _read_load(s: Section) -> Load:
+    """The [load] table: resisting torques, a generator and the schedule of their scale."""
+    torque = s.number("torque", default=0.0, ge=0.0)
+    linear = s.number("linear", default=0.0, ge=0.0)
+    fan = s.number("fan", default=0.0, ge=0.0)
+    power = s.number("generator_power", default=0.0, ge=0.0)
+    given = s.has("generator_min_speed", "speed")
+    w_min = s.number("generator_min_speed", "speed", 0.0, ge=0.0)
+    if power > 0.0 and w_min <= 0.0:
+        key = s.key(s.written.get("generator_min_speed", "generator_min_speed"))
+        what = "must be > 0" if given else "is missing"
+        raise SceneError(key, f"{what} with a generator_power: below it the torque −P/ω is held "
+                              f"at −P/ω_min (finite at rest); give 'generator_min_speed' or "
+                              f"'generator_min_speed_rpm' > 0")
+    times = s.numbers("schedule_time", default=())
+    revs = s.numbers("schedule_revolutions", default=())
+    scale = s.numbers("schedule_scale", default=())
+    if times and revs:
+        raise SceneError(s.key("schedule_revolutions"),
+                         "given together with 'schedule_time'; a schedule runs against time or "
+                         "against revolutions: give one of them")
+    name, x = ("schedule_time", times) if times else ("schedule_revolutions", revs)
+    if scale and not x:
+        raise SceneError(s.key("schedule_scale"), "has no abscissae; give 'schedule_time' [s] or "
+                                                  "'schedule_revolutions' with one entry per "
+                                                  "value")
+    if x and not scale:
+        raise SceneError(s.key(name), "has no values; give 'schedule_scale', the load's scale "
+                                      "at each entry")
+    if len(x) != len(scale):
+        raise SceneError(s.key("schedule_scale"), f"needs as many entries as {name!r}; got "
+                                                  f"{len(scale)} and {len(x)}")
+    for i in range(1, len(x)):
+        a, b = x[i - 1], x[i]
+        if b < a:
+            raise SceneError(s.key(name), f"must not decrease, but {b:g} follows {a:g} (entry "
+                                          f"{i + 1}); a step is two equal entries, a ramp two "
+                                          f"increasing ones")
+        if i >= 2 and x[i - 2] == a == b:
+            raise SceneError(s.key(name), f"{b:g} appears three times in a row (entries {i - 1} "
+                                          f"to {i + 1}); a step is two equal entries: the value "
+                                          f"before and the value after")
+        if 0.0 < b - a < SCHEDULE_MIN_GAP * max(1.0, abs(a), abs(b)):
+            raise SceneError(s.key(name), f"{a!r} and {b!r} (entries {i} and {i + 1}) are closer "
+                                          f"than {SCHEDULE_MIN_GAP:g} (relative); give equal "
+                                          f"entries for a step, or a longer ramp")
+    for i, v in enumerate(scale):
+        if v < 0.0:
+            raise SceneError(s.key("schedule_scale"), f"must be ≥ 0, got {v:g} (entry {i + 1}); "
+                                                      f"the scale multiplies a resisting load")
+    extra = s.number("inertia", default=0.0, ge=0.0)
+    at = s.number("inertia_time", default=MISSING if extra > 0.0 else 0.0, gt=0.0)
+    return Load(torque, linear, fan, power, w_min, times, revs, scale, extra, at)
+
+
+def _read_governor(s: Section) -> Governor:
+    model = s.string("model", "none", choices=tuple(GOVERNOR_KEYS))
+    if model == "none":
+        return Governor()
+    if model == "droop":
+        full = s.number("speed_full", "speed", gt=0.0)
+        zero = s.number("speed_zero", "speed", gt=full)
+        return Governor(model, full, zero)
+    d = Governor()
+    f_min = s.number("fuel_min", default=d.fuel_min, ge=0.0)
+    f_max = s.number("fuel_max", default=d.fuel_max, gt=f_min)
+    if model == "flyweight":
+        return Governor(
+            model, fuel_min=f_min, fuel_max=f_max, weights=s.integer("weights", d.weights, ge=1),
+            weight_mass=s.number("weight_mass", gt=0.0), radius=s.number("radius", "length", gt=0.0),
+            arm_ratio=s.number("arm_ratio", default=d.arm_ratio, gt=0.0),
+            gear_ratio=s.number("gear_ratio", default=d.gear_ratio, gt=0.0),
+            sleeve_mass=s.number("sleeve_mass", default=0.0, ge=0.0),
+            spring_rate=s.number("spring_rate", ge=0.0),
+            spring_preload=s.number("spring_preload", gt=0.0),
+            damping=s.number("damping", ge=0.0), travel=s.number("travel", "length", gt=0.0))
+    gain_p = s.number("gain_p", ge=0.0)
+    gain_i = s.number("gain_i", ge=0.0)
+    if gain_p == 0.0 and gain_i == 0.0:
+        raise SceneError(s.key("gain_i"), "gain_p and gain_i are both 0: the governor would never "
+                                          "move the rack; give gain_i > 0 (isochronous)")
+    return Governor(
+        model, speed=s.number("speed", "speed", gt=0.0), gain_p=gain_p, gain_i=gain_i,
+        gain_d=s.number("gain_d", default=0.0, ge=0.0),
+        derivative_time=s.number("derivative_time", default=d.derivative_time, gt=0.0),
+        actuator_time=s.number("actuator_time", default=d.actuator_time, gt=0.0),
+        rate_limit=s.number("rate_limit", default=0.0, ge=0.0),
+        fuel_min=f_min, fuel_max=f_max, anti_windup=s.flag("anti_windup", True),
+        tracking_time=s.number("tracking_time", default=0.0, ge=0.0),
+        fuel_initial=s.number("fuel_initial", default=f_max, ge=f_min, le=f_max))
+
+
+def _read_run(s: Section) -> Run:
+    mode = s.string("mode", "dynamic", choices=("dynamic", "prescribed-speed"))
+    t_end = s.number("t_end", default=math.inf, gt=0.0)
+    revs = s.number("revolutions", default=math.inf, gt=0.0)
+    if math.isinf(t_end) and math.isinf(revs):
+        raise SceneError(s.key("t_end"), "the run needs an end: give t_end [s] and/or revolutions")
+    if mode == "dynamic":
+        return Run(mode=mode, t_end=t_end, revolutions=revs)
+    if s.has("speed", "speed"):
+        speed = s.number("speed", "speed", gt=0.0)
+        return Run(mode=mode, t_end=t_end, revolutions=revs, speed=speed)
+    if not s.has("time") and not s.has("speed_table", "speed"):
+        raise SceneError(s.key("speed"), "is missing; a prescribed-speed run needs 'speed' (or "
+                                         "'speed_rpm'), or a table 'time' [s] with 'speed_table'")
+    time = s.numbers("time")
+    table = s.numbers("speed_table", "speed")
+    if len(time) != len(table) or len(time) < 2:
+        raise SceneError(s.key("speed_table"), f"needs as many entries as 'time' (≥ 2); got "
+                                               f"{len(table)} and {len(time)}")
+    if any(b <= a for a, b in zip(time, time[1:])):
+        raise SceneError(s.key("time"), "must increase strictly")
+    if min(table) <= 0:
+        raise SceneError(s.key("speed_table"), "speeds must be > 0 in a prescribed-speed run")
+    return Run(mode=mode, t_end=min(t_end, time[-1]), revolutions=revs, time=time,
+               speed_table=table)
+
+
+def _read_analysis(s: Section) -> Analysis:
+    return Analysis(loads=s.flag("loads", False), orders=s.strings("orders", ()),
+                    irregularity=s.flag("irregularity", False),
+                    max_order=s.number("max_order", default=12.0, gt=0.0),
+                    samples_per_cycle=s.integer("samples_per_cycle", 720, ge=16),
+                    detrend=s.string("detrend", "auto", choices=DETREND))
+

@@ -1,0 +1,395 @@
+"""The scene's records: frozen dataclasses in SI, one per TOML table, grouped by what they
+describe (inertia, gas, load, starter, governor, initial state, run, solver, output, friction,
+analysis), with the limits the reader checks them against. The mechanisms' records are the
+classes of :mod:`transient.mechanisms`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..mechanisms import Mechanism
+
+
+@dataclass(frozen=True)
+class Inertia:
+    """Constant inertias on the shaft [kg m²]."""
+
+    shaft: float = 0.0
+    flywheel: float = 0.0
+    load: float = 0.0
+
+    @property
+    def total(self) -> float:
+        return self.shaft + self.flywheel + self.load
+
+
+@dataclass(frozen=True)
+class Wiebe:
+    """Single-zone Wiebe combustion, the ``[gas.wiebe]`` table of ``model = "wiebe"``
+    (:func:`transient.forces.wiebe.wiebe_cycle`, whose parameters these are, in SI).
+
+    ``start`` [rad] (``start_deg``) and ``duration`` [rad] of the combustion, local angles as the
+    other gas models (4-stroke: 0 gas-exchange TDC, 2π firing TDC). ``fuel_mass`` [kg]: fuel
+    burned per cycle and cylinder at full load (governor fuel 1); 0 runs the engine motored.
+    ``a``, ``m`` [1]: Wiebe efficiency parameter and shape exponent. ``lhv`` [J/kg]: lower heating
+    value; ``efficiency`` [1]: combustion efficiency η_c, the share of m_f·LHV released.
+    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K].
+    ``t_a`` [K]: gas temperature at intake closing. ``intake_closing``, ``exhaust_opening`` [rad]:
+    ends of the closed part (None: the BDCs around the firing TDC). ``step`` [rad] and
+    ``tolerance`` [1]: largest knot spacing and target relative error of the tables.
+    """
+
+    start: float = 0.0
+    duration: float = 0.0
+    fuel_mass: float = 0.0
+    a: float = 6.908
+    m: float = 0.5
+    lhv: float = 42.5e6
+    efficiency: float = 1.0
+    gamma: float = 1.35
+    gamma_slope: float = 0.0
+    gamma_t_ref: float = 300.0
+    t_a: float = 330.0
+    intake_closing: float | None = None
+    exhaust_opening: float | None = None
+    step: float = math.radians(0.125)
+    tolerance: float = 1e-10
+
+
+@dataclass(frozen=True)
+class Woschni:
+    """Wall heat transfer of the closed part, Woschni's correlation: the ``[gas.woschni]`` table
+    of ``model = "wiebe"`` (equations in :mod:`transient.forces.woschni`). With it the cylinder
+    pressure depends on the shaft speed and on its own history, so the closed part of each
+    cylinder is a state of the ODE instead of a table (``transient.core.cylinder``).
+
+    ``c1`` [1] multiplies the mean piston speed, ``c2`` [m/(s K)] the pressure rise combustion
+    causes (from the combustion start on; Woschni's direct-injection value by default);
+    ``wall_temperature`` [K]: the mean temperature of head, piston crown and liner.
+    """
+
+    c1: float = 2.28
+    c2: float = 3.24e-3
+    wall_temperature: float = 450.0
+
+
+@dataclass(frozen=True)
+class Gas:
+    """Cylinder pressure model (angle-only in this version).
+
+    ``model``: ``"none"``, ``"table"`` (indicator diagram: absolute pressures ``p`` [Pa] at the
+    local angles ``phi`` [rad] over one cycle, local angle 0 = gas-exchange TDC for a 4-stroke,
+    firing TDC for a 2-stroke; ``corners`` [rad] where the curve has a kink, made breakpoints;
+    ``interpolation`` ``"pchip"``, ``"spline"`` or ``"linear"``), ``"mixed-cycle"`` (Gots App. 2,
+    Trinkler–Sabathé: ``compression_ratio`` [1], ``p_a`` [Pa] at the start of compression,
+    polytropic exponents ``n1`` and ``n2`` [1], peak pressure ``p_z`` [Pa], pre-expansion ratio
+    ``rho`` [1], ``p_intake`` and ``p_exhaust`` [Pa]), ``"trapezoid"`` (the swash-plate paper's
+    force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]) or
+    ``"wiebe"`` (single-zone Wiebe combustion, :class:`Wiebe`; with ``compression_ratio``, ``p_a``
+    [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]). ``p0`` is the
+    crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33).
+
+    **Fuel command.** The governor's fuel f ∈ [0, 1] (1 without a governor) sets the cylinder
+    pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot). For
+    ``"table"`` and ``"mixed-cycle"`` the motored curve is the constant p0, so the gas force is
+    f·(p − p0)·F_p (for ``"trapezoid"``, f times the force). For ``"wiebe"`` it is the cycle with
+    no fuel and p_full the cycle with ``fuel_mass``: with a constant γ the single-zone pressure is
+    linear in the fuel mass, so this is exactly the cycle burning f·fuel_mass. With
+    ``gamma_slope`` ≠ 0 (γ(T)) it is not, and the pressure at part load is only approximately
+    that cycle's: the author of :mod:`transient.forces.wiebe` reports up to about 2.5 % of p_max
+    for fuel levels 0.02 g apart; ``tests/validation/test_wiebe_runs.py`` measures, on the Gots
+    engine of ``cases/gots_diesel_wiebe.toml`` with γ = 1.38 − 1e-4·(T − 300 K), 1.1 % of the
+    full-load p_max between 0 and 0.02 g and 2.1 % between 0 and 0.031 g (at f = 0.5; the
+    indicated work at f = 0.25 is then 7.6 % low). Use a constant γ where part load matters.
+    The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"``).
+
+    **Fuel latching.** With ``injection`` [rad] (a local angle, as the tables'), each cylinder
+    takes the governor's command at its start of injection and burns that fuel until its next
+    one, so that the governor acts with the real per-cylinder delay (event ``injection``);
+    without it every cylinder follows the command at once.
+    """
+
+    model: str = "none"
+    p0: float = 1.0e5
+    phi: tuple[float, ...] = ()
+    p: tuple[float, ...] = ()
+    corners: tuple[float, ...] = ()
+    interpolation: str = "pchip"
+    compression_ratio: float = 0.0
+    p_a: float = 0.0
+    n1: float = 0.0
+    p_z: float = 0.0
+    rho: float = 0.0
+    n2: float = 0.0
+    p_intake: float = 0.0
+    p_exhaust: float = 0.0
+    amplitude: float = 0.0
+    ramp: float = 0.0
+    duration: float = math.pi
+    wiebe: Wiebe | None = None
+    injection: float | None = None
+    woschni: Woschni | None = None
+
+
+@dataclass(frozen=True)
+class Load:
+    """Resisting moment M_load = −s·(torque + linear·ω + fan·ω|ω| + P/max(ω, ω_min)) [N m]
+    (signs as Gots §1: + with rotation).
+
+    ``torque`` [N m], ``linear`` [N m s], ``fan`` [N m s²]. ``generator_power`` P [W]: an
+    electrical load, M·ω = −s·P; below ``generator_min_speed`` ω_min [rad/s] its torque is held
+    at −s·P/ω_min, so that it stays finite at a start from rest (like ``torque``, it does not
+    change sign with ω). ω_min must be > 0 when P > 0.
+
+    The scale s [1] (1 without a schedule) is piecewise linear in time (``schedule_time`` [s])
+    or in shaft revolutions from the initial angle (``schedule_revolutions`` [1]) through the
+    points (abscissa, ``schedule_scale``), constant before the first and after the last. The
+    abscissae do not decrease; two equal ones are a step (value before, value after). The
+    corners are state events (``load_schedule``): a step changes s exactly there.
+
+    ``inertia`` J_x [kg m²] switched in at ``inertia_time`` [s]: a load's inertia, at rest, that
+    a clutch couples to the shaft at that instant (an inelastic engagement: the angular momentum
+    J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the kinetic energy lost, ½Jω₋²·J_x/(J + J_x), is
+    counted in ``W_load``; event ``inertia_switch``).
+    """
+
+    torque: float = 0.0
+    linear: float = 0.0
+    fan: float = 0.0
+    generator_power: float = 0.0
+    generator_min_speed: float = 0.0
+    schedule_time: tuple[float, ...] = ()
+    schedule_revolutions: tuple[float, ...] = ()
+    schedule_scale: tuple[float, ...] = ()
+    inertia: float = 0.0
+    inertia_time: float = 0.0
+
+
+@dataclass(frozen=True)
+class Starter:
+    """Starter: M = torque·(1 − ω/noload_speed) until ω first reaches cutout_speed [N m, rad/s]."""
+
+    torque: float = 0.0
+    noload_speed: float = 1.0
+    cutout_speed: float = 1.0
+
+
+@dataclass(frozen=True)
+class Governor:
+    """Speed governor, setting the fuel command f (see :class:`Gas`); equations in
+    :mod:`transient.core.governor`.
+
+    ``droop``: the static characteristic of the swash-plate paper (§4): f = 1 below
+    ``speed_full`` (ω_a), linearly down to 0 at ``speed_zero`` (ω_1c), 0 above [rad/s].
+
+    ``pi``: isochronous PI(D) at ``speed`` ω_ref [rad/s]: ``gain_p`` K_p [1] and ``gain_i`` K_i
+    [1/s] per unit relative speed error, ``gain_d`` K_d [s] with its filter ``derivative_time``
+    τ_D [s]; the rack follows the clipped demand with the lag ``actuator_time`` τ_A [s], at most
+    ``rate_limit`` [1/s] (0: none), between ``fuel_min`` and ``fuel_max``; ``anti_windup`` back-calculation
+    with ``tracking_time`` T_t [s] (0: K_p/K_i); the rack and the integrator start at
+    ``fuel_initial``.
+
+    ``flyweight``: a centrifugal governor: ``weights`` n_w of ``weight_mass`` m_w [kg] at
+    ``radius`` ρ₀ [m] with the sleeve on its low stop, bell cranks of ``arm_ratio`` a/b [1],
+    turning at ``gear_ratio`` i_g times the shaft; ``sleeve_mass`` [kg], ``spring_rate`` k [N/m],
+    ``spring_preload`` F₀ [N], ``damping`` c [N s/m], sleeve ``travel`` z_max [m]; the rack gives
+    ``fuel_max`` on the low stop, ``fuel_min`` on the high one, linear between.
+    """
+
+    model: str = "none"
+    speed_full: float = 0.0
+    speed_zero: float = 0.0
+    speed: float = 0.0
+    gain_p: float = 0.0
+    gain_i: float = 0.0
+    gain_d: float = 0.0
+    derivative_time: float = 0.01
+    actuator_time: float = 0.02
+    rate_limit: float = 0.0
+    fuel_min: float = 0.0
+    fuel_max: float = 1.0
+    anti_windup: bool = True
+    tracking_time: float = 0.0
+    fuel_initial: float = 1.0
+    weights: int = 2
+    weight_mass: float = 0.0
+    radius: float = 0.0
+    arm_ratio: float = 1.0
+    gear_ratio: float = 1.0
+    sleeve_mass: float = 0.0
+    spring_rate: float = 0.0
+    spring_preload: float = 0.0
+    damping: float = 0.0
+    travel: float = 0.0
+
+
+#: The keys of each governor model (the resolved scene writes these).
+GOVERNOR_KEYS = {
+    "none": ("model",),
+    "droop": ("model", "speed_full", "speed_zero"),
+    "pi": ("model", "speed", "gain_p", "gain_i", "gain_d", "derivative_time", "actuator_time",
+           "rate_limit", "fuel_min", "fuel_max", "anti_windup", "tracking_time", "fuel_initial"),
+    "flyweight": ("model", "weights", "weight_mass", "radius", "arm_ratio", "gear_ratio",
+                  "sleeve_mass", "spring_rate", "spring_preload", "damping", "travel", "fuel_min",
+                  "fuel_max"),
+}
+
+
+@dataclass(frozen=True)
+class Initial:
+    """Initial shaft angle [rad] and speed [rad/s]."""
+
+    phi: float = 0.0
+    omega: float = 0.0
+
+
+@dataclass(frozen=True)
+class Run:
+    """What to run: ``dynamic`` (integrate (18)) or ``prescribed-speed`` (inverse dynamics).
+
+    The run ends at ``t_end`` [s] or after ``revolutions`` of the shaft, whichever comes first
+    (``inf`` = not set). For prescribed speed: ``speed`` [rad/s] constant, or a table ``time`` [s],
+    ``speed_table`` [rad/s] interpolated by a cubic spline.
+    """
+
+    mode: str = "dynamic"
+    t_end: float = math.inf
+    revolutions: float = math.inf
+    speed: float = 0.0
+    time: tuple[float, ...] = ()
+    speed_table: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Solver:
+    """Integration settings. ``method``: one of :data:`METHODS`; ``rtol`` [1] and ``atol`` (in the
+    units of each state) as scipy's; ``max_step`` [rad] in crank angle.
+    ``switch_speed`` [rad/s]: below it time is the independent variable;
+    ``domain``: ``"auto"`` (crank angle above the switch speed) or ``"time"`` (time throughout,
+    for comparison; the maximum step is then bounded by the output spacing only).
+    ``fixed_step`` [rad]: 0 for adaptive steps; > 0 for steps of that crank angle (compiled
+    methods; the last step before a breakpoint ends on it), with no error control, for periodic
+    steady runs. Time-domain stretches (below the switch speed) stay adaptive.
+    ``kinematics``: ``"exact"`` (the mechanism kernel at every evaluation) or ``"tabulated"``
+    (periodic quintic splines of J(φ) and u_k(φ), :mod:`transient.tabulate`), whose relative error
+    is kept ≤ ``table_tolerance`` (0: 0.01·rtol); if no table reaches it the run uses the exact
+    kernel and says so."""
+
+    method: str = "dop853"
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    switch_speed: float = math.pi / 3.0  # 10 rpm
+    max_step: float = math.pi
+    domain: str = "auto"
+    fixed_step: float = 0.0
+    kinematics: str = "exact"
+    table_tolerance: float = 0.0
+
+
+@dataclass(frozen=True)
+class Output:
+    """Output sampling: ``samples_per_rev`` in crank angle; in time mode every ``dt`` [s]."""
+
+    samples_per_rev: int = 72
+    dt: float = 0.0  # 0: Δφ / switch_speed
+
+
+#: Output samples per revolution at most (0.00036° apart).
+MAX_SAMPLES_PER_REV = 1_000_000
+
+#: Smallest time-mode output spacing [s]: 10⁸ samples per second of engine time, already
+#: 0.8 GB per column and second before compression.
+MIN_OUTPUT_DT = 1e-8
+
+#: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
+COMPILED_METHODS = ("dop853", "dopri5")
+METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
+
+
+def runs_compiled(scene) -> bool:
+    """Whether ``scene`` runs on the compiled stepper (a dynamic run by a compiled method): its
+    results stream to the file, and its kernels load from numba's cache, or compile."""
+    return scene.run.mode == "dynamic" and scene.solver.method in COMPILED_METHODS
+
+
+@dataclass(frozen=True)
+class Pair:
+    """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).
+
+    ``between``: the link on the shaft side first (a), then the far one (b), names from the
+    mechanism's ``links``. ``eta_forward`` = η_ba, the efficiency while a (the shaft side) drives;
+    ``eta_backward`` = η_ab, while b drives; both in (0, 1] [1].
+    """
+
+    between: tuple[str, str]
+    eta_forward: float
+    eta_backward: float
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Non-ideal pairs and how their modes are chosen (``transient.core.chain``).
+
+    ``policy``: ``"power-flow"`` (each pair's mode agrees with the power it transmits) or
+    ``"paper"`` (criterion (25), the sign of the shaft-side moments' power).
+    """
+
+    policy: str = "power-flow"
+    pairs: tuple[Pair, ...] = ()
+
+
+POLICIES = ("power-flow", "paper")
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Derived results computed after the run and stored under ``/analysis`` only when asked
+    (:mod:`transient.analysis.requested` lists the names and units).
+
+    ``loads``: forces, pin and journal loads and torques over the last cycle, as the mechanism's
+    loads analysis gives them. ``orders``: signals whose order spectrum is stored per whole cycle
+    — trajectory columns (``omega``, ``M_gas``, ``p_1`` …) or ``W_<k>``, the piston acceleration
+    of cylinder k (crank-slider). ``irregularity``: δ and the mean speed of every cycle.
+    ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
+    engine cycle.
+    ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
+    (:func:`transient.analysis.orders.order_spectrum`).
+    """
+
+    loads: bool = False
+    orders: tuple[str, ...] = ()
+    irregularity: bool = False
+    max_order: float = 12.0
+    samples_per_cycle: int = 720
+    detrend: str = "auto"
+
+    @property
+    def requested(self) -> bool:
+        return self.loads or bool(self.orders) or self.irregularity
+
+
+DETREND = ("auto", "ramp", "none")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene: what :func:`transient.scene.load_scene` returns, one record per TOML
+    table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
+    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`."""
+
+    name: str
+    description: str
+    mechanism: Mechanism
+    inertia: Inertia = field(default_factory=Inertia)
+    gas: Gas = field(default_factory=Gas)
+    load: Load = field(default_factory=Load)
+    starter: Starter = field(default_factory=Starter)
+    governor: Governor = field(default_factory=Governor)
+    initial: Initial = field(default_factory=Initial)
+    run: Run = field(default_factory=Run)
+    solver: Solver = field(default_factory=Solver)
+    output: Output = field(default_factory=Output)
+    friction: Friction = field(default_factory=Friction)
+    analysis: Analysis = field(default_factory=Analysis)

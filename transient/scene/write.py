@@ -1,0 +1,82 @@
+"""Writing a scene back: the resolved scene as TOML in SI (no unit suffixes, every default
+filled in), which :func:`~.read.load_scene` reads back to an equal scene. A result file stores
+it (``/scene/toml``) so that it can be rerun.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import fields, is_dataclass
+from typing import Any
+
+from ..tomlout import toml_value
+from .records import GOVERNOR_KEYS, Gas, Load, Scene
+
+
+def to_toml(scene: Scene) -> str:
+    """The resolved scene as TOML in SI units (no suffixes), round-tripping through load_scene."""
+    lines = ["# resolved scene: SI units, every default filled in (written by transient)",
+             "[scene]", f"name = {toml_value(scene.name)}", f"description = {toml_value(scene.description)}"]
+    lines += [""] + scene.mechanism.toml_lines()
+    lines += _section("inertia", scene.inertia)
+    lines += _gas_section(scene.gas)
+    lines += _load_section(scene.load)
+    lines += _section("starter", scene.starter)
+    lines += ["", "[governor]"] + [f"{k} = {toml_value(getattr(scene.governor, k))}"
+                                   for k in GOVERNOR_KEYS[scene.governor.model]]
+    lines += _section("initial", scene.initial)
+    run = {"mode": scene.run.mode}
+    for k in ("t_end", "revolutions"):
+        if math.isfinite(getattr(scene.run, k)):
+            run[k] = getattr(scene.run, k)
+    if scene.run.mode == "prescribed-speed":
+        if scene.run.time:
+            run.update(time=list(scene.run.time), speed_table=list(scene.run.speed_table))
+        else:
+            run["speed"] = scene.run.speed
+    lines += ["", "[run]"] + [f"{k} = {toml_value(v)}" for k, v in run.items()]
+    lines += _section("solver", scene.solver)
+    lines += _section("output", scene.output)
+    if scene.analysis.requested:  # (a scene that asks for nothing reads back the same without)
+        lines += _section("analysis", scene.analysis)
+    lines += ["", "[friction]", f"policy = {toml_value(scene.friction.policy)}"]
+    for pair in scene.friction.pairs:
+        lines += ["", "[[friction.pairs]]", f"name = {toml_value(pair.name)}",
+                  f"between = {toml_value(list(pair.between))}",
+                  f"eta_forward = {toml_value(pair.eta_forward)}",
+                  f"eta_backward = {toml_value(pair.eta_backward)}"]
+    return "\n".join(lines) + "\n"
+
+
+def _gas_section(gas: Gas) -> list[str]:
+    keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation"),
+            "trapezoid": ("model", "amplitude", "ramp", "duration"),
+            "wiebe": ("model", "p0", "compression_ratio", "p_a", "p_intake", "p_exhaust")}
+    names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
+                                 "n2", "p_intake", "p_exhaust"))
+    if gas.injection is not None:
+        names = (*names, "injection")
+    lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
+    if gas.model == "wiebe":  # unset optional angles (None) are left out: they read back as None
+        lines += ["", "[gas.wiebe]"] + [f"{f.name} = {toml_value(getattr(gas.wiebe, f.name))}"
+                                        for f in fields(gas.wiebe)
+                                        if getattr(gas.wiebe, f.name) is not None]
+    if gas.woschni is not None:
+        lines += ["", "[gas.woschni]"] + [f"{f.name} = {toml_value(getattr(gas.woschni, f.name))}"
+                                          for f in fields(gas.woschni)]
+    return lines
+
+
+def _load_section(load: Load) -> list[str]:
+    """[load] with the schedule's keys only when there is one (and only its abscissa)."""
+    names = ["torque", "linear", "fan", "generator_power", "generator_min_speed"]
+    if load.inertia > 0.0:
+        names += ["inertia", "inertia_time"]
+    if load.schedule_scale:
+        names += ["schedule_revolutions" if load.schedule_revolutions else "schedule_time",
+                  "schedule_scale"]
+    return ["", "[load]"] + [f"{k} = {toml_value(getattr(load, k))}" for k in names]
+
+
+def _section(name: str, obj: Any) -> list[str]:
+    assert is_dataclass(obj)
+    return ["", f"[{name}]"] + [f"{f.name} = {toml_value(getattr(obj, f.name))}" for f in fields(obj)]
