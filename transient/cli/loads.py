@@ -27,12 +27,9 @@ def register(sub) -> None:
 
 def _loads_scene(res):
     """The result's scene, or a one-line error (exit 2) if ``transient loads`` draws nothing for
-    its mechanism: crank-slider and articulated engines only."""
-    from ..mechanisms.articulated import Articulated
-    from ..mechanisms.crank_slider import CrankSlider
-
+    its mechanism (:data:`DRAWERS`)."""
     scene = res.scene()
-    if not isinstance(scene.mechanism, (CrankSlider, Articulated)):
+    if scene.mechanism.name not in DRAWERS:
         raise SceneError("mechanism.type", f"load diagrams are drawn for crank-slider and "
                                            f"articulated engines, not "
                                            f"{type(scene.mechanism).__name__} (its forces are "
@@ -52,13 +49,16 @@ def _diagrams(compute, res, *args):
 
 
 def cmd_loads(args) -> int:
-    from ..analysis.loads.diagrams import crank_slider_diagrams
-    from ..mechanisms.articulated import Articulated
-
     res = read_result(args.result)
     scene = _loads_scene(res)
-    if isinstance(scene.mechanism, Articulated):
-        return _radial_loads(args, res, scene)
+    return DRAWERS[scene.mechanism.name](args, res, scene)
+
+
+def _crank_slider_loads(args, res, scene) -> int:
+    """``transient loads`` of a crank-slider engine: the chosen cylinder's crankpin (polar), the
+    most loaded main journal, the wear diagram, running torques, and a CSV."""
+    from ..analysis.loads.diagrams import crank_slider_diagrams
+
     mech = scene.mechanism
     n_cyl = mech.n_cylinders
     if not 1 <= args.cylinder <= n_cyl:
@@ -222,3 +222,9 @@ def _radial_loads(args, res, scene) -> int:
     for path in written:
         print(f"  wrote {path}")
     return EXIT_OK
+
+
+#: What ``transient loads`` draws, by the mechanism's name in
+#: :data:`transient.mechanisms.MECHANISMS`; other mechanisms store their forces through
+#: ``[analysis] loads = true`` instead.
+DRAWERS = {"crank-slider": _crank_slider_loads, "articulated": _radial_loads}

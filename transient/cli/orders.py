@@ -36,7 +36,6 @@ def register(sub) -> None:
 def cmd_orders(args) -> int:
     from ..analysis.irregularity import NoWholeCycle
     from ..analysis.orders import orders_up_to, run_orders, strongest_orders
-    from ..mechanisms.crank_slider import CrankSlider
 
     res = read_result(args.result)
     scene = res.scene()
@@ -50,7 +49,7 @@ def cmd_orders(args) -> int:
     cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
     try:
         ro = run_orders(scene, traj, n, cuts=cuts, detrend=args.detrend,
-                        piston_cylinder=1 if isinstance(mech, CrankSlider) else None)
+                        piston_cylinder=1 if mech.slider_law else None)
     except NoWholeCycle as exc:
         raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
     spec_w, spec_m, rep = ro.omega, ro.gas_torque, ro.piston

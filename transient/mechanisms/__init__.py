@@ -16,7 +16,9 @@ Adding a mechanism takes
    the kernel, written back to TOML);
 3. its loads analysis: a module of :mod:`transient.analysis` and its line in
    ``transient.analysis.requested.LOADS`` (without one, ``[analysis] loads = true`` is refused
-   for it: the analyses sit above the mechanisms, so a mechanism cannot name them itself);
+   for it: the analyses sit above the mechanisms, so a mechanism cannot name them itself),
+   and, if ``transient loads`` is to draw its diagrams, a line in
+   ``transient.cli.loads.DRAWERS``;
 4. one line in :data:`MECHANISMS` below.
 """
 from __future__ import annotations
