@@ -83,7 +83,7 @@ def test_spin_up_is_detrended():
 def test_piston_acceleration_of_a_central_crank_slider_at_constant_speed():
     r, l = 0.05, 0.2
     mech = SimpleNamespace(cycle=2 * math.pi, crank_radius=r, rod_length=l, offset=0.0,
-                           firing_angles=(0.0,))
+                           firing_angles=(0.0,), slider_law=True)
     phi = np.linspace(0.0, 3 * 2 * math.pi, 3 * 720 + 1)
     traj = {"t": phi / W0, "phi": phi, "omega": np.full_like(phi, W0),
             "epsilon": np.zeros_like(phi)}
