@@ -50,10 +50,22 @@ class NotWritable(PermissionError):
     (the CLI prints the one-line message and exits 2 when this happens before integrating)."""
 
 
+def partial_path(path: Path) -> Path:
+    """The temporary name a result is written under until its run ends: hidden, beside it."""
+    return path.with_name(f".{path.name}.part")
+
+
 def check_writable(path: Path, force: bool) -> None:
-    """Fail before any work if the result exists (without force) or its folder is not writable."""
+    """Fail before any work if the result, or the partial result of an interrupted run, exists
+    (without force), if the name is a folder, or if its folder is not writable."""
+    if path.is_dir():
+        raise NotWritable(f"{path}: is a folder, not a result file; remove it or write the "
+                          f"result elsewhere (-o)")
     if path.exists() and not force:
         raise ResultExists(f"{path}: exists; use --force to overwrite it")
+    if os.path.lexists(partial_path(path)) and not force:
+        raise ResultExists(f"{partial_path(path)}: the partial result of an interrupted run; "
+                           f"use --force to replace it")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:  # a file in the way, a read-only or missing file system, …
@@ -66,7 +78,7 @@ def check_writable(path: Path, force: bool) -> None:
     # objects cannot be closed cleanly once its writes fail.
     probe = path.with_name(f".{path.name}.probe")
     try:
-        with open(probe, "wb") as fh:
+        with create_exclusive(probe, replace=True) as fh:
             fh.write(bytes(PROBE_BYTES))
             fh.flush()
             os.fsync(fh.fileno())
@@ -75,6 +87,16 @@ def check_writable(path: Path, force: bool) -> None:
                           f" is the disk full?") from None
     finally:
         probe.unlink(missing_ok=True)
+
+
+def create_exclusive(path: Path, replace: bool = False):
+    """A new file at ``path`` open for binary writing, created by this call and never through a
+    link planted at the name (``O_EXCL | O_NOFOLLOW``). ``replace`` first removes what is there
+    (a link itself, not its target); otherwise an existing name raises FileExistsError."""
+    if replace:
+        Path(path).unlink(missing_ok=True)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o666)
+    return os.fdopen(fd, "wb")
 
 
 #: Size of the write probe of :func:`check_writable` [bytes]: a result's header and first blocks.
@@ -102,7 +124,7 @@ def create_file(path: Path) -> h5py.File:
     then refuses to open it elsewhere, while the run writes it or for good after the run was
     killed (until ``h5clear --status``), which would lose what a killed run computed. Reopened
     with the 1.10 bounds, the file keeps its superblock."""
-    h5py.File(path, "w").close()
+    h5py.File(path, "x").close()  # (exclusive: fails on any name there, a planted link too)
     return reopen_file(path)
 
 
@@ -194,7 +216,10 @@ class ResultWriter:
                  columns: dict[str, str], force: bool = False) -> None:
         self.path = Path(path)
         check_writable(self.path, force)
-        self.tmp = self.path.with_name(f".{self.path.name}.part")
+        self.force = force
+        self.tmp = partial_path(self.path)
+        if force:
+            self.tmp.unlink(missing_ok=True)  # (a kept partial result, or a link planted there)
         try:
             self.f = create_file(self.tmp)
             self._start(scene_name, scene_toml, columns)
@@ -289,8 +314,28 @@ class ResultWriter:
         if message:
             self.f.attrs["message"] = message
         self.f.close()
-        os.replace(self.tmp, self.path)
+        _publish(self.tmp, self.path, self.force)
         return self.path
+
+
+def _publish(tmp: Path, path: Path, force: bool) -> None:
+    """Give the finished file its name: replacing what is there only with ``force``; without it,
+    a file that appeared at the name during the run is kept, and so is ours, under ``tmp``."""
+    if force:
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)  # (fails if the name exists, even as a link)
+    except FileExistsError:
+        raise ResultExists(f"{path}: appeared during the run; the result is kept as {tmp}") \
+            from None
+    except OSError:  # a file system without hard links: as close as it allows
+        if os.path.lexists(path):
+            raise ResultExists(f"{path}: appeared during the run; the result is kept as "
+                               f"{tmp}") from None
+        os.replace(tmp, path)
+        return
+    tmp.unlink()
 
 
 @dataclass

@@ -358,6 +358,50 @@ def test_sigkill_during_writing_leaves_an_incomplete_file(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert code.returncode == 0, code.stderr
     assert "complete = False" in code.stdout
+    # a rerun without --force refuses, in one line, and leaves the partial result as it was
+    before = part.read_bytes()
+    again = subprocess.run([sys.executable, "-m", "transient", "run", str(scene), "-o", str(out),
+                            "-q"], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert again.returncode == 2 and again.stderr.count("\n") == 1, again.stderr
+    assert str(part) in again.stderr and "--force" in again.stderr
+    assert part.read_bytes() == before
+
+
+def _run_until_a_block(scene: Path, out: Path) -> subprocess.Popen:
+    """``transient run scene -o out`` in a new process, once its result holds a block."""
+    proc = subprocess.Popen([sys.executable, "-m", "transient", "run", str(scene), "-o", str(out),
+                             "-q"], cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    part = out / f".{scene.stem}.h5.part"
+    deadline = time.monotonic() + 600.0  # (a cold cache compiles the stepper first)
+    while proc.poll() is None and not _holds_a_block(part):
+        assert time.monotonic() < deadline, "no trajectory block written in 600 s"
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.stderr.read().decode()
+    return proc
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_terminate_and_hangup_end_a_run_as_ctrl_c_does(tmp_path, signame):
+    """``timeout``, a scheduler's preemption (SIGTERM) or a closed terminal (SIGHUP): the run
+    stops between blocks, the result gets its name and says complete = false, exit 1 with one
+    line."""
+    scene = tmp_path / "long.toml"
+    scene.write_text(LONG, encoding="utf-8")
+    out = tmp_path / "out"
+    proc = _run_until_a_block(scene, out)
+    try:
+        os.kill(proc.pid, getattr(signal, signame))
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    err = err.decode()
+    assert proc.returncode == 1 and err.count("\n") == 1 and "interrupted" in err, err
+    assert not (out / ".long.h5.part").exists()
+    with h5py.File(out / "long.h5", "r") as f:
+        assert bool(f.attrs["complete"]) is False
+        assert f["trajectory/t"].shape[0] > 0
 
 
 @pytest.mark.parametrize("where", ["under-a-file", "is-a-file"])

@@ -12,6 +12,9 @@ from __future__ import annotations
 
 import argparse
 import gc
+import signal
+import threading
+from contextlib import contextmanager
 import os
 import sys
 
@@ -56,7 +59,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        with _signals_interrupt():
+            return args.func(args)
     except SceneError as exc:
         print(exc.line(), file=sys.stderr)
         return EXIT_INVALID
@@ -73,6 +77,30 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("transient: interrupted", file=sys.stderr)
         return EXIT_FAILED
+
+
+#: Signals that end a command as Ctrl-C does, so that a run stopped by ``timeout``, a batch
+#: scheduler's preemption or a closed terminal keeps its partial result marked incomplete.
+INTERRUPTING_SIGNALS = ("SIGTERM", "SIGHUP")
+
+
+@contextmanager
+def _signals_interrupt():
+    """While a command runs, :data:`INTERRUPTING_SIGNALS` raise KeyboardInterrupt as SIGINT
+    does (in the main thread only: elsewhere Python cannot install handlers)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    kept = {}
+    for name in INTERRUPTING_SIGNALS:
+        sig = getattr(signal, name, None)
+        if sig is not None:
+            kept[sig] = signal.signal(sig, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        for sig, handler in kept.items():
+            signal.signal(sig, handler)
 
 
 def _parser() -> argparse.ArgumentParser:

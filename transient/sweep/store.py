@@ -54,7 +54,7 @@ class SweepStore:
 
     def __init__(self, path: Path, sweep: Sweep, force: bool = False) -> None:
         self.path, self.sweep = Path(path), sweep
-        self.part = self.path.with_name(f".{self.path.name}.part")
+        self.part = results.partial_path(self.path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         if not os.access(self.path.parent, os.W_OK):
             raise PermissionError(f"{self.path.parent}: folder is not writable")
