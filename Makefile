@@ -23,7 +23,7 @@ install: $(STAMP)
 # Re-running `make run` replaces the default result on purpose (--force).
 run: $(STAMP)
 	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
-	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results
+	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results --force
 
 # The import contracts first (pyproject.toml, [tool.importlinter]), then the suite: one pytest
 # worker per core, at most 4 (a process compiling the stepper holds about a gigabyte); worksteal

@@ -93,9 +93,15 @@ def create_exclusive(path: Path, replace: bool = False):
     """A new file at ``path`` open for binary writing, created by this call and never through a
     link planted at the name (``O_EXCL | O_NOFOLLOW``). ``replace`` first removes what is there
     (a link itself, not its target); otherwise an existing name raises FileExistsError."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink():
+        raise NotWritable(f"{path}: is a folder; give a file name")
     if replace:
-        Path(path).unlink(missing_ok=True)
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o666)
+        path.unlink(missing_ok=True)
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o666)
+    except FileExistsError:
+        raise ResultExists(f"{path}: exists; use --force to replace it") from None
     return os.fdopen(fd, "wb")
 
 

@@ -78,3 +78,42 @@ def test_a_result_name_that_is_a_folder_is_refused_before_any_work(tmp_path, cap
         assert code == 2 and stdout == "" and err.count("\n") == 1, err
         assert "small.h5" in err and "is a folder" in err and "Traceback" not in err
     assert not os.path.lexists(out / ".small.h5.part")
+
+
+def test_every_file_writing_command_refuses_to_replace_without_force(tmp_path, capsys):
+    """plot, kinematics: a second run into the same names is one line, exit 2, the first files
+    untouched; with --force they are written again."""
+    out = tmp_path / "out"
+    assert run(capsys, "run", scene(tmp_path), "-o", out, "-q")[0] == 0
+    result = out / "small.h5"
+    commands = {
+        "plot": (["plot", result, "-o", out], out / "small_speed.png"),
+        "kinematics": (["kinematics", scene(tmp_path), "-o", out / "k.csv", "--plot",
+                        out / "k.png"], out / "k.csv"),
+    }
+    for name, (argv, first_file) in commands.items():
+        assert run(capsys, *argv)[0] == 0, name
+        stamp = first_file.read_bytes()
+        code, stdout, err = run(capsys, *argv)
+        assert code == 2 and err.count("\n") == 1 and "--force" in err, (name, err)
+        assert first_file.read_bytes() == stamp
+        assert run(capsys, *argv, "--force")[0] == 0, name
+
+
+def test_a_link_planted_at_an_output_name_is_not_followed(tmp_path, capsys):
+    victim = tmp_path / "victim.csv"
+    victim.write_text("not yours")
+    os.symlink(victim, tmp_path / "k.csv")
+    code, _, err = run(capsys, "kinematics", scene(tmp_path), "-o", tmp_path / "k.csv")
+    assert code == 2 and "--force" in err
+    assert run(capsys, "kinematics", scene(tmp_path), "-o", tmp_path / "k.csv", "--force")[0] == 0
+    assert victim.read_text() == "not yours"
+    assert not (tmp_path / "k.csv").is_symlink()
+
+
+def test_option_values_that_would_do_nothing_or_run_forever_are_refused(tmp_path, capsys):
+    for argv, key in ((["kinematics", scene(tmp_path), "--points", "-5"], "--points"),
+                      (["efficiency", scene(tmp_path), "--rpm", "inf"], "--rpm"),
+                      (["efficiency", scene(tmp_path), "--rpm", "nan"], "--rpm")):
+        code, stdout, err = run(capsys, *argv)
+        assert code == 2 and stdout == "" and err.count("\n") == 1 and key in err, (argv, err)

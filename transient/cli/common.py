@@ -21,14 +21,15 @@ KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
 
 
 def number_list(text: str, option: str, low: float, high: float = math.inf) -> list[float]:
-    """Comma-separated numbers in (low, high], or a one-line error (exit 2)."""
+    """Comma-separated finite numbers in (low, high], or a one-line error (exit 2)."""
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise SceneError(option, f"must be comma-separated numbers, got {text!r}") from None
-    bad = [v for v in values if not (low < v <= high)]
+    bad = [v for v in values if not (low < v <= high and math.isfinite(v))]
     if not values or bad:
-        raise SceneError(option, f"values must lie in ({low:g}, {high:g}], got {text!r}")
+        raise SceneError(option, f"values must be finite and lie in ({low:g}, {high:g}], "
+                                 f"got {text!r}")
     return values
 
 
@@ -62,16 +63,38 @@ def pyplot():
     return plt
 
 
-def save(fig, path):
-    """Write ``fig`` as a PNG at ``path`` and close it (a long command draws many); returns
-    ``path``."""
+def add_force(parser) -> None:
+    """The ``--force`` option of a command that writes files."""
+    parser.add_argument("--force", action="store_true",
+                        help="replace files that exist (default: refuse, exit 2)")
+
+
+def output_file(path, force: bool):
+    """``path`` opened for writing text, created by this call: an existing file is a one-line
+    error (exit 2) unless ``force``, and a link planted at the name is never followed."""
+    import io
+
+    from ..results import create_exclusive
+
+    return io.TextIOWrapper(create_exclusive(Path(path), replace=force), encoding="utf-8",
+                            newline="")
+
+
+def save(fig, path, force: bool):
+    """Write ``fig`` as a PNG at ``path`` (as :func:`output_file` creates files) and close it
+    (a long command draws many); returns ``path``."""
+    from ..results import create_exclusive
+
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with create_exclusive(Path(path), replace=force) as fh:
+        fig.savefig(fh, format="png", dpi=110)
     pyplot().close(fig)
     return path
 
 
-def write_columns(path, cols: dict) -> None:
-    """A CSV of equal-length columns, named by the keys (12 significant digits)."""
-    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols),
-               comments="", fmt="%.12g")
+def write_columns(path, cols: dict, force: bool) -> None:
+    """A CSV of equal-length columns, named by the keys (12 significant digits), created as
+    :func:`output_file` creates files."""
+    with output_file(path, force) as fh:
+        np.savetxt(fh, np.column_stack(list(cols.values())), delimiter=",",
+                   header=",".join(cols), comments="", fmt="%.12g")

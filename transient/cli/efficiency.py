@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 
 from ..errors import SceneError
-from .common import EXIT_OK, number_list, output_folder, pyplot, save
+from .common import EXIT_OK, add_force, number_list, output_file, output_folder, pyplot, save
 
 
 def register(sub) -> None:
@@ -20,6 +20,7 @@ def register(sub) -> None:
                    help="mode policies to compare, e.g. power-flow,paper (default: the scene's)")
     e.add_argument("--samples-per-rev", type=int, default=1440)
     e.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    add_force(e)
     e.set_defaults(func=cmd_efficiency)
 
 
@@ -42,7 +43,8 @@ def cmd_efficiency(args) -> int:
     rows = efficiency_study(scene, rpm, fuels, policies, args.samples_per_rev)
     out = output_folder(args.output, Path("results"))
     stem = Path(args.scene).stem
-    write_csv(rows, out / f"{stem}_efficiency.csv")
+    with output_file(out / f"{stem}_efficiency.csv", args.force) as fh:
+        write_csv(rows, fh)
     names = [p.name for p in scene.friction.pairs]
     print(f"{'policy':>10} {'fuel':>5} {'rpm':>7} {'η_work':>9} {'η (30)':>9}  "
           + "  ".join(f"loss {n} [J/cycle] (circulated)" for n in names))
@@ -56,5 +58,5 @@ def cmd_efficiency(args) -> int:
     plot_study(a1, a2, rows, len(names), names)
     a1.set_title(f"{scene.name}: mechanical efficiency at constant speed")
     print(f"wrote {out / f'{stem}_efficiency.csv'}")
-    print(f"wrote {save(fig, out / f'{stem}_efficiency.png')}")
+    print(f"wrote {save(fig, out / f'{stem}_efficiency.png', args.force)}")
     return EXIT_OK

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import EXIT_OK, pyplot, save
+from ..errors import SceneError
+from .common import EXIT_OK, add_force, output_file, pyplot, save
 
 
 def register(sub) -> None:
@@ -15,12 +16,15 @@ def register(sub) -> None:
     k.add_argument("-o", "--output", default=None, help="CSV file (default: standard output)")
     k.add_argument("--points", type=int, default=361, help="points over one cycle")
     k.add_argument("--plot", default=None, help="also write a PNG of the transfer functions and J")
+    add_force(k)
     k.set_defaults(func=cmd_kinematics)
 
 
 def cmd_kinematics(args) -> int:
     from ..scene import load_scene
 
+    if args.points < 2:
+        raise SceneError("--points", f"must be ≥ 2 (points over one cycle), got {args.points}")
     scene = load_scene(args.scene)
     mech = scene.mechanism
     phi = np.linspace(0.0, mech.cycle, args.points)
@@ -28,7 +32,8 @@ def cmd_kinematics(args) -> int:
     header = ",".join(table)
     data = np.column_stack(list(table.values()))
     if args.output:
-        np.savetxt(args.output, data, delimiter=",", header=header, comments="", fmt="%.12g")
+        with output_file(args.output, args.force) as fh:
+            np.savetxt(fh, data, delimiter=",", header=header, comments="", fmt="%.12g")
         print(f"wrote {args.output}")
     else:
         np.savetxt(sys.stdout, data, delimiter=",", header=header, comments="", fmt="%.12g")
@@ -42,5 +47,5 @@ def cmd_kinematics(args) -> int:
         plots.reduced_inertia(a2, table)
         a1.set_title(f"{scene.name}: transfer functions and reduced inertia")
         # (a table on standard output stays a clean CSV: the message goes to standard error)
-        print(f"wrote {save(fig, Path(args.plot))}", file=sys.stderr if not args.output else sys.stdout)
+        print(f"wrote {save(fig, Path(args.plot), args.force)}", file=sys.stderr if not args.output else sys.stdout)
     return EXIT_OK

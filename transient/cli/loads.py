@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
-from .common import EXIT_OK, output_folder, pyplot, read_result, save, write_columns
+from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, save, write_columns
 
 
 def register(sub) -> None:
@@ -22,6 +22,7 @@ def register(sub) -> None:
     lo.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
     lo.add_argument("--cylinder", type=int, default=1,
                     help="cylinder (1-based, from the nose) whose crankpin is drawn (default 1)")
+    add_force(lo)
     lo.set_defaults(func=cmd_loads)
 
 
@@ -87,14 +88,14 @@ def _crank_slider_loads(args, res, scene) -> int:
         axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
                              f"(split beam, (58))", fontsize=9)
     fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle")
-    written.append(save(fig, out / f"{stem}_loads_polar.png"))
+    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force))
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for j in range(n_cyl):
         plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin {j + 1}")
     ax.legend(fontsize=8)
     ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
-    written.append(save(fig, out / f"{stem}_loads_crankpin.png"))
+    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force))
 
     rays, sums = d.crankpin_wear
     fig, axes = plt.subplots(1, ncols, figsize=(5.5 * ncols, 5.5), squeeze=False)
@@ -105,13 +106,13 @@ def _crank_slider_loads(args, res, scene) -> int:
         axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
     fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6: each load wears ±60° around its "
                  f"direction)", fontsize=10)
-    written.append(save(fig, out / f"{stem}_loads_wear.png"))
+    written.append(save(fig, out / f"{stem}_loads_wear.png", args.force))
 
     if d.inline:
         fig, ax = plt.subplots(figsize=(8, 4.5))
         plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
         ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
-        written.append(save(fig, out / f"{stem}_loads_running_torques.png"))
+        written.append(save(fig, out / f"{stem}_loads_running_torques.png", args.force))
 
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
@@ -128,7 +129,7 @@ def _crank_slider_loads(args, res, scene) -> int:
         for j in range(d.main_journals.x.shape[0]):
             cols[f"R_main_{j + 1}_N"] = d.main_journals.magnitude[j]
     csv = out / f"{stem}_loads.csv"
-    write_columns(csv, cols)
+    write_columns(csv, cols, args.force)
     written.append(csv)
 
     area = loads.area
@@ -188,7 +189,7 @@ def _radial_loads(args, res, scene) -> int:
         plots.crankpin_polar(axes[0, j], loads.R_K[j], loads.R_T[j])
         axes[0, j].set_title(f"master crankpin of row {j + 1}, crank frame", fontsize=9)
     fig.suptitle(f"{scene.name}: polar load diagram over the last cycle")
-    written.append(save(fig, out / f"{stem}_loads_polar.png"))
+    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force))
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for j in range(rows):
         plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin, row {j + 1}")
@@ -196,7 +197,7 @@ def _radial_loads(args, res, scene) -> int:
         plots.load_against_angle(ax, deg, d.link_load[i], label=f"link pin {i + 1}")
     ax.legend(fontsize=8)
     ax.set_title(f"{scene.name}: crankpin and link-pin loads over the last cycle (dashed: mean)")
-    written.append(save(fig, out / f"{stem}_loads_crankpin.png"))
+    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force))
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
     for k in range(loads.P.shape[0]):
@@ -208,7 +209,7 @@ def _radial_loads(args, res, scene) -> int:
         for name in ("K", "T", "R_K", "R_T", "R"):
             cols[f"{name}_row{j + 1}_N"] = getattr(loads, name)[j]
     csv = out / f"{stem}_loads.csv"
-    write_columns(csv, cols)
+    write_columns(csv, cols, args.force)
     written.append(csv)
     start = d.window.start
     print(f"{res.path}: loads over the last cycle (φ = {start:.6g} … "

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..errors import SceneError
-from .common import EXIT_OK, output_folder, pyplot, read_result, save, write_columns
+from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, save, write_columns
 
 
 def register(sub) -> None:
@@ -30,6 +30,7 @@ def register(sub) -> None:
     od.add_argument("--detrend", choices=("auto", "ramp", "none"), default="auto",
                     help="remove each cycle's ramp from ω before its DFT (default auto: for a "
                          "spin-up, a run starting below 90 %% of its final speed)")
+    add_force(od)
     od.set_defaults(func=cmd_orders)
 
 
@@ -73,7 +74,7 @@ def cmd_orders(args) -> int:
         cols_csv["W_relative_constant"] = rep.relative_constant[-1]
         cols_csv["W_relative_added"] = rep.relative_added[-1]
     csv = out / f"{stem}_orders.csv"
-    write_columns(csv, cols_csv)
+    write_columns(csv, cols_csv, args.force)
     written.append(csv)
 
     plt = pyplot()
@@ -97,7 +98,7 @@ def cmd_orders(args) -> int:
         plots.order_bars(axes[i], orders, rep.relative_constant[-1], "W / W₁ (cylinder 1)", top,
                          width=0.2, offset=0.1, label="constant ω̄", log=True)
         axes[i].legend(fontsize=8)
-    written.append(save(fig, out / f"{stem}_orders.png"))
+    written.append(save(fig, out / f"{stem}_orders.png", args.force))
 
     if n_cyc >= 2:
         amp = spec_w.amplitude
@@ -112,13 +113,13 @@ def cmd_orders(args) -> int:
         plots.order_tracks(a2, means * rpm, tracks, "ω amplitude [rad/s]")
         a2.set_title("order tracks of ω against the cycle-mean speed", fontsize=9)
         fig.suptitle(f"{scene.name}: run-up orders of ω")
-        written.append(save(fig, out / f"{stem}_orders_runup.png"))
+        written.append(save(fig, out / f"{stem}_orders_runup.png", args.force))
         run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": starts,
                "omega_mean_rad_s": means}
         run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j]
                     for j in orders_up_to(orders, top)})
         csv = out / f"{stem}_orders_runup.csv"
-        write_columns(csv, run)
+        write_columns(csv, run, args.force)
         written.append(csv)
 
     print(f"{res.path}: orders over the last whole cycle (φ = {starts[-1]:.6g} … "

@@ -1,13 +1,14 @@
 """``transient plot``: PNG figures of a result, or of several side by side."""
 from __future__ import annotations
 
-from .common import EXIT_OK, output_folder, pyplot, read_result, save
+from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, save
 
 
 def register(sub) -> None:
     pl = sub.add_parser("plot", help="write PNG figures of a result, or compare several")
     pl.add_argument("result", nargs="+", help="one result, or several to compare side by side")
     pl.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    add_force(pl)
     pl.set_defaults(func=cmd_plot)
 
 
@@ -29,21 +30,21 @@ def cmd_plot(args) -> int:
     plots.speed(a1, traj)
     plots.acceleration(a2, traj)
     a1.set_title(f"{scene.name}: speed and acceleration")
-    written.append(save(fig, out / f"{stem}_speed.png"))
+    written.append(save(fig, out / f"{stem}_speed.png", args.force))
     fig, ax = plt.subplots(figsize=(8, 4.5))
     plots.torques(ax, traj, scene.mechanism.cycle)
     ax.set_title(f"{scene.name}: moments over the last cycle")
-    written.append(save(fig, out / f"{stem}_torques.png"))
+    written.append(save(fig, out / f"{stem}_torques.png", args.force))
     if "load_change_1_t_s" in res.analysis:
         fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
         plots.load_response(axes, traj, scene.mechanism.cycle, res.analysis)
         axes[0].set_title(f"{scene.name}: load steps (ISO 8528-5 band around the new speed)")
-        written.append(save(fig, out / f"{stem}_response.png"))
+        written.append(save(fig, out / f"{stem}_response.png", args.force))
     if scene.friction.pairs:
         fig, ax = plt.subplots(figsize=(8, 4.5))
         plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)
         ax.set_title(f"{scene.name}: power through the non-ideal pairs ({scene.friction.policy})")
-        written.append(save(fig, out / f"{stem}_pairs.png"))
+        written.append(save(fig, out / f"{stem}_pairs.png", args.force))
     table = gas_table(scene)
     if table is not None and not gas_is_force(scene):
         mech = scene.mechanism
@@ -55,7 +56,7 @@ def cmd_plot(args) -> int:
             plots.indicator_pv(a2, table, mech.volume_function(0.0), log=False)
             a2.set_xlabel("swept volume F_p·s [dm³]")
         a1.set_title(f"{scene.name}: indicator diagram")
-        written.append(save(fig, out / f"{stem}_indicator.png"))
+        written.append(save(fig, out / f"{stem}_indicator.png", args.force))
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
@@ -79,5 +80,5 @@ def _plot_comparison(args) -> int:
         plots.piston_force(axes[2, j], res.trajectory, scene)
         axes[0, j].set_title(f"{scene.name}\n{scene.mechanism.n_cylinders} cylinder(s)", fontsize=9)
     path = out / ("compare_" + "_".join(r.path.stem for r in results) + ".png")
-    print(f"wrote {save(fig, path)}")
+    print(f"wrote {save(fig, path, args.force)}")
     return EXIT_OK

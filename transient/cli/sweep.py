@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..errors import SceneError
-from .common import EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, output_folder, pyplot, save
+from .common import EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, add_force, output_folder, pyplot, save
 
 
 def register(sub) -> None:
@@ -33,6 +33,7 @@ def register(sub) -> None:
     sp.add_argument("-o", "--output", default=None, help="folder (default: beside the file)")
     sp.add_argument("--quantity", action="append", default=None,
                     help="a collected quantity to plot (repeatable; default: all)")
+    add_force(sp)
     sp.set_defaults(func=cmd_sweep_plot)
 
 
@@ -125,7 +126,7 @@ def cmd_sweep_plot(args) -> int:
             plots.sweep_scatter(ax, tab.columns[a["key"]], tab.columns[b["key"]], tab.columns[q],
                                 _axis_label(a, tab), _axis_label(b, tab), label)
         ax.set_title(f"{tab.name}: {q}", fontsize=10)
-        written.append(save(fig, out / f"{tab.path.stem.lstrip('.')}_{q}.png"))
+        written.append(save(fig, out / f"{tab.path.stem.lstrip('.')}_{q}.png", args.force))
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK

@@ -53,8 +53,9 @@ def efficiency_study(scene, rpm, fuels=(1.0,), policies=None, samples_per_rev: i
     return rows
 
 
-def write_csv(rows: list[dict], path) -> None:
-    """The study as CSV, one row per point; columns STUDY_COLUMNS then the per-pair ones."""
+def write_csv(rows: list[dict], fh) -> None:
+    """The study as CSV into the text file ``fh``, one row per point; columns STUDY_COLUMNS then
+    the per-pair ones."""
     extra = sorted({k for r in rows for k in r} - set(STUDY_COLUMNS) - {"steady_phi_start",
                                                                         "steady_cycles"})
     cols = list(STUDY_COLUMNS) + extra
@@ -62,7 +63,7 @@ def write_csv(rows: list[dict], path) -> None:
     for r in rows:
         lines.append(",".join(str(r.get(c, "")) if isinstance(r.get(c), str)
                               else f"{r.get(c, math.nan):.10g}" for c in cols))
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    fh.write("\n".join(lines) + "\n")
 
 
 def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
