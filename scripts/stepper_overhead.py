@@ -14,7 +14,8 @@ from pathlib import Path
 from transient.bench import BENCH_SCENES
 from transient.bench_targets import (CALLS_PER_STEP, per_call, rhs_arguments, stepper_overhead,
                                      timed_scene)
-from transient.core import model as cm
+from transient.core import layout
+from transient.core import rhs
 from transient.core.jit import kernel
 from transient.scene import load_scene
 
@@ -30,9 +31,9 @@ def margins_loop(m, states, y, out, sw, wk):
     unused (the arguments of ``rhs_loop``)."""
     acc = 0.0
     for i in range(states.shape[0]):
-        sel = states[i - i % CALLS_PER_STEP, cm.PHI]
-        cm.margins_at(m, True, states[i], sel, sw, wk)
-        acc += wk[cm.WK_G, 0]
+        sel = states[i - i % CALLS_PER_STEP, layout.PHI]
+        rhs.margins_at(m, True, states[i], sel, sw, wk)
+        acc += wk[layout.WK_G, 0]
     return acc
 
 

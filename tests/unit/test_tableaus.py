@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import DOP853, RK45
 
-from transient.core.integrate import _dense_eval
+from transient.core.rk import _dense_eval
 from transient.core.tableaus import TABLEAUS
 
 SCIPY = {"dopri5": RK45, "dop853": DOP853}

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import articulated as core
-from ..core.model import ARTICULATED
+from ..core.layout import ARTICULATED
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value

@@ -50,7 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import swash_plate as core
-from ..core.model import SWASH_PLATE
+from ..core.layout import SWASH_PLATE
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
