@@ -2,7 +2,7 @@
 transient's side (``scripts/handwritten_kernel.py`` builds up from the hand-written side).
 
 The bare single cylinder (``cases/coasting_single.toml``) takes none of the branches that
-``model.derivative`` has for other scenes: gas forces, a generator, pairs, governor states, wall
+``rhs.derivative`` has for other scenes: gas forces, a generator, pairs, governor states, wall
 heat, other mechanisms. This script times a copy of ``derivative``'s crank-angle path with those
 branches, then with each of them removed (compiled out: a closure constant), then with all
 removed, each checked against transient's own right-hand side first (the same checksum to 1e-9
@@ -27,7 +27,7 @@ from transient.scene import load_scene
 
 
 def derivative_without(kind=True, gas=True, generator=True, others=True):
-    """A loop over states calling ``model.derivative``'s crank-angle path, without pairs (the
+    """A loop over states calling ``rhs.derivative``'s crank-angle path, without pairs (the
     bare scene's), keeping only the branches whose flag is set: ``kind`` the dispatch on the
     mechanism's kind (else the crank slider's terms directly), ``gas`` the gas forces,
     ``generator`` the generator's term, ``others`` the pairs', governor's and wall heat's."""

@@ -27,7 +27,7 @@ SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
 @kernel
 def margins_loop(m, states, y, out, sw, wk):
     """The mode margins at every state as the stepper evaluates them outside its root finder: a
-    call to ``model.margins_at`` (not inlined; it passes the Model by value). ``y``, ``out``
+    call to ``rhs.margins_at`` (not inlined; it passes the Model by value). ``y``, ``out``
     unused (the arguments of ``rhs_loop``)."""
     acc = 0.0
     for i in range(states.shape[0]):

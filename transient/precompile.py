@@ -1,6 +1,6 @@
 """Compile the stepper's callees in a helper process while this process compiles the stepper.
 
-On a cold cache, compiling the stepper (:func:`transient.core.integrate.advance`) takes
+On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) takes
 ~210–270 s on the slower test machine, on one core: while numba types the stepper it compiles,
 one after another, each callee that is not inlined (the dense output, the root finders, the
 output row, the start and the end of a run), ~110 s of it. A helper process started at the same

@@ -283,7 +283,7 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     cubics are blended, so the ``p_<k>`` columns hold the pressure applied."""
     model, _, _ = build_model(scene)
     coef = model.coef.copy()
-    if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.model.Model)
+    if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.layout.Model)
         coef[:, :4] = coef[:, 4:] + fuel * (coef[:, :4] - coef[:, 4:])
     else:
         coef *= fuel

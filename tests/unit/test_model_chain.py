@@ -1,4 +1,4 @@
-"""The serial chain inside the compiled model (``transient.core.model``): how a mechanism's links
+"""The serial chain inside the compiled model (``transient.core.rhs``): how a mechanism's links
 become sub-chains, the right-hand side with held pair modes, the forward/inverse consistency of the
 chain, and the choice of modes at a state (issue 4)."""
 from __future__ import annotations

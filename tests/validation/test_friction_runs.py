@@ -2,7 +2,7 @@
 reference path, and η_mech (``cases/gots_diesel_friction.toml``, ``swash_plate_4cyl_friction``).
 
 The balance checked everywhere is ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k
-with the work integrals integrated with the motion (``core.model.STATE``). In crank angle the
+with the work integrals integrated with the motion (``core.layout.STATE``). In crank angle the
 kinetic energy K is itself a state whose derivative is that sum, so there the balance checks the
 stepper's bookkeeping (events, mode switches, domain switches). The demanding test is in time:
 there the state is ω, φ̈ comes from the chain solve, and only a correct chain (its φ̈ and its pair

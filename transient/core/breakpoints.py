@@ -46,7 +46,6 @@ def next_breakpoint(bp, period, phi, upward):
     return -np.inf
 
 
-
 @kernel(inline="always")
 def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
     """Where the segment of the next step ends, and what bounds that step: ``(x_end, up, down,
@@ -169,4 +168,3 @@ def _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
     injected = _inject(m, y, sw, evbuf, ist, wk)
     closed = _close_intake(m, y)
     return injected or closed or _jumps_at(m, bp, y[PHI])
-

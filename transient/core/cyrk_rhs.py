@@ -1,5 +1,5 @@
 """transient's right-hand side as a C callback for CyRK's compiled solvers (the benchmark's
-compiled peer, issue 5; optional ``bench`` extra).
+compiled peer; optional ``bench`` extra).
 
 A generic solver holds no switches between calls, so each call picks the governor's branch and
 the pairs' modes for its own state (``rhs.choose_modes``), with time as the independent

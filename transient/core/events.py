@@ -103,7 +103,7 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
 
 
 #: A pair's mode margin can fall through zero and come back within one step, unseen at the
-#: step's ends. Every stage of the step evaluates it (``model.derivative`` keeps the least value);
+#: step's ends. Every stage of the step evaluates it (``rhs.derivative`` keeps the least value);
 #: when that dips to zero or below, the margin is sampled at these fractions of the step to find
 #: the first crossing.
 N_MARGIN_SAMPLES = 4
@@ -191,7 +191,6 @@ def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
     return 0.0, N_FINE_SAMPLES
 
 
-
 FIRST_PAIR_EVENT = 14
 N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
 
@@ -214,8 +213,8 @@ def _event_spec(m, cfg, e, angle_mode, sw):
 
     The load schedule's corners are levels of t or φ, watched one segment at a time: the corner
     above and, for corners in φ (the shaft may turn back in time mode), the one below. On the
-    independent variable the segment also ends on the corner (see ``_advance``), so the event is
-    found at the step's end exactly, as a breakpoint is in crank angle."""
+    independent variable the segment also ends on the corner (``breakpoints._segment_end``), so
+    the event is found at the step's end exactly, as a breakpoint is in crank angle."""
     if e == 0 and sw[SW_STARTER] == 1:
         return EV_STARTER_CUTOUT, OMEGA, m.starter_cutout, 1
     if e == 1 and angle_mode:
@@ -279,7 +278,6 @@ def _sleeve_stops(m, y, level, w):
     return gv.FREE
 
 
-
 @kernel(inline="always")
 def _crosses(g0, g1, direction):
     """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
@@ -290,7 +288,6 @@ def _crosses(g0, g1, direction):
     if direction < 0:
         return falling
     return rising or falling
-
 
 
 @kernel(inline="always")

@@ -43,8 +43,8 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
 def select_pieces(m, sel, wk):
     """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL) and the gas table's piece there
     (WK_PIECE). ``sel`` is one angle for a whole step, so they are computed when it changes and
-    kept, not in each of a step's right-hand sides (numba's float modulo alone was 4.4 % of the
-    diesel's samples under ``perf``)."""
+    kept, not recomputed in each of a step's right-hand sides, whose cost numba's float modulo
+    would otherwise add to noticeably."""
     if wk[WK_SEL, 0] != sel:
         for k in range(m.ncyl):
             local_sel = (sel - m.gas_phase[k]) % m.period
@@ -265,7 +265,7 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``, dJ possibly NaN without ``with_dJ``; the
     rows u, u′ of ``wk`` are left holding the transfer functions and, with gas, WK_LOCAL and
     WK_PIECE the cylinders' pieces at ``sel`` (:func:`select_pieces`), for :func:`cylinder_rates`
-    and :func:`output_row`.
+    and :func:`.outputs.output_row`.
 
     Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force of cylinder k is
     (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel f
@@ -306,4 +306,3 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     if sw[SW_STARTER]:
         M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
     return J, dJ, w, M_gas, M_load, M_starter
-

@@ -39,12 +39,12 @@ N_STATE_BASE = len(STATE)
 W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 
 #: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), the
-#: governor's branch (see :func:`governor_branch`), the modes of the non-ideal pairs (bit k set:
-#: pair k backward, its far side drives), the direction of motion σ = ±1 that the pair modes
-#: refer to (sign of ω; changed only at a speed reversal, where the modes are chosen afresh), the
-#: segment of the load schedule (:func:`load_segment`) and the generator's low-speed branch
-#: (:func:`generator_branch`), and the flyweight governor's sleeve, moving or on a stop
-#: (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``).
+#: governor's branch (see :func:`.forcing.governor_branch`), the modes of the non-ideal pairs
+#: (bit k set: pair k backward, its far side drives), the direction of motion σ = ±1 that the
+#: pair modes refer to (sign of ω; changed only at a speed reversal, where the modes are chosen
+#: afresh), the segment of the load schedule (:func:`.forcing.load_segment`) and the generator's
+#: low-speed branch (:func:`.forcing.generator_branch`), and the flyweight governor's sleeve,
+#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``).
 SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE = range(7)
 N_SWITCHES = 7
 
@@ -75,7 +75,7 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
 #: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
 #: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
-#: (:func:`select_pieces`).
+#: (:func:`.forcing.select_pieces`).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_SCRATCH) = range(17)
 N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
@@ -166,4 +166,3 @@ def work_array(m):
     wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
     wk[WK_SEL, 0] = np.nan  # no pieces selected yet
     return wk
-

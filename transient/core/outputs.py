@@ -28,7 +28,7 @@ def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
     (p_mot + f·(p_full − p_mot), see :func:`applied_value`), ``PAIR_OUTPUTS`` of each pair, the
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
-    samples (``integrate._emit_samples``): there a call would copy the Model for every sample."""
+    samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
     row[0] = y[T]
     row[1] = y[PHI]
@@ -64,4 +64,3 @@ def pair_rows(m, w, w_loss, wk, out):
         out[np_ * k + 1] = wk[WK_ETA, k]
         out[np_ * k + 2] = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k] * w
         out[np_ * k + 3] = w_loss[k]
-

@@ -72,8 +72,8 @@ def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
 def derivative(m, angle_mode, y, sel, sw, wk, out):
     """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
 
-    Inlined into its callers: as a call, passing the Model (numba flattens it into ~130 scalar
-    arguments) cost ~40 ns of a ~75 ns right-hand side (``scripts/handwritten_kernel.py``).
+    Inlined into its callers, because as a call, passing the Model (numba flattens it into ~130
+    scalar arguments) would cost about as much as the right-hand side itself.
 
     In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
     (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
@@ -191,4 +191,3 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
             modes |= 1 << k
     sw[SW_MODES] = modes
     return status
-

@@ -89,8 +89,6 @@ def _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol):
     return abs(h) * np.sqrt(num / den)
 
 
-
-
 @kernel(inline="always")
 def _shrink(tab, err):
     """The factor on the step size after a step rejected with error norm ``err`` > 1."""
@@ -122,7 +120,7 @@ def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     n = y.shape[0]
     ns = tab.n_stages
     # Stage ns is the derivative at the new state (FSAL: row ns of A holds B). One call site, as
-    # ``model.derivative`` is inlined wherever it is called.
+    # ``rhs.derivative`` is inlined wherever it is called.
     for s in range(1, ns + 1):
         for i in range(n):
             acc = 0.0
@@ -184,4 +182,3 @@ def _dense_state(F, y, x, h, theta, ix, out):
     exactly x + θh."""
     _dense_eval(F, y, theta, out)
     out[ix] = x + theta * h
-

@@ -82,15 +82,15 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     tab : tableaus.Tableau
         The Runge–Kutta pair (DOP853, DOPRI5).
     cfg : float64[N_CFG]
-        Settings, indices ``C_*``.
+        Settings, indices ``C_*`` (:mod:`.stepper_io`, as the other layouts and codes).
     bp : float64[:]
         Sorted breakpoints in [0, m.period).
-    y : float64[model.n_state(m)]
+    y : float64[layout.n_state(m)]
         State, updated in place.
     fst, ist : float64[fst_size(m)], int64[N_IST]
         Stepper state kept between calls (zeros before the first call, except
         ``fst[F_PASSED_BP] = nan`` and ``ist[I_STARTER_ON]``).
-    outbuf : float64[nbuf, model.n_outputs(m)]
+    outbuf : float64[nbuf, layout.n_outputs(m)]
         Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
     evbuf : float64[nev, 4]
         Events (code, t, φ, ω); ``ist[I_NEV]`` rows filled.
@@ -100,7 +100,8 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     int
         RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED (the speed reached zero in a run
         that ends only by revolutions), LOCKED (at rest, the friction of the non-ideal pairs holds
-        the applied moments) or CHATTERING (pair modes switching without progress).
+        the applied moments), CHATTERING (pair modes switching without progress) or STIFF
+        (Hairer's stiffness test fired).
     """
     n = n_state(m)
     K = np.empty((tab.n_ext, n))
@@ -108,7 +109,6 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
     gs = np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1)))  # pair mode margins over a step
     return _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, np.empty(n), np.empty(n),
                     np.empty(n), np.empty(n), work_array(m), gs)
-
 
 
 @kernel
@@ -360,7 +360,6 @@ def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
     return False
 
 
-
 @kernel(inline="always")
 def _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F, tmp,
                        wk, outbuf, ist, fst, dense_ready):
@@ -556,4 +555,3 @@ def _start_modes(m, y, sel, ist, wk):
     if status == AMBIGUOUS or status == NONE_CONSISTENT:
         ist[I_NTIES] += 1
     return status
-

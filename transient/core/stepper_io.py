@@ -63,7 +63,6 @@ def fst_size(m):
     return N_FST + n_state(m) + max(m.n_pairs, 1)
 
 
-
 @kernel(inline="always")
 def _retake(fst, ist, h):
     """The step attempt is computed again with size ``h``, counted as a rejection."""
@@ -103,7 +102,7 @@ def _emit_event(m, evbuf, ist, code, y, wk):
 
 @kernel
 def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
-    """One output row at state ``y`` (an event's): a call into ``model.output_row``."""
+    """One output row at state ``y`` (an event's): a call into ``outputs.output_row``."""
     output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
     _count_row(y, ist, fst)
 
@@ -119,12 +118,10 @@ def _count_row(y, ist, fst):
 @kernel
 def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, tmp, wk):
     """The output samples of the grid (spacing ``d_out``) up to ``x_stop`` inside the last step
-    (from x, size h), from its dense output F. A call of its own, with the output row inlined:
-    from the stepper's loop, once the step was inlined there, each sample's call into the output
-    row copied the Model at three times the cost (``perf``), and the coasting cylinder's runs at
-    72 samples per turn were 10 % slower; from here a call per sample still copied it twice
-    (through ``_emit_row``), and inlining only ``_emit_row`` made those runs 17–22 % slower
-    (README, *Calls that copy the Model*)."""
+    (from x, size h), from its dense output F. A call of its own, with the output row inlined,
+    because every other arrangement copies the Model per sample: a call into the output row from
+    the stepper's loop copies it (and the loop, with the step inlined, is the costliest place to
+    copy it), and a call per sample through ``_emit_row`` copies it twice."""
     angle_mode = ist[I_ANGLE_MODE] == 1
     while fst[F_NEXT_OUT] <= x_stop:
         _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
@@ -151,7 +148,7 @@ def _reset_output_grid(cfg, ist, fst, y):
 
 @kernel
 def _locked(m, y, sel, outbuf, evbuf, ist, fst, wk):
-    """End a run at rest that the pairs' friction holds (``model.choose_modes``): φ̈ = 0 from here,
+    """End a run at rest that the pairs' friction holds (``rhs.choose_modes``): φ̈ = 0 from here,
     and nothing in the model depends on time explicitly, so the machine stays where it is."""
     _emit_event(m, evbuf, ist, EV_LOCKED, y, wk)
     if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI] or ist[I_NOUT] == 0:

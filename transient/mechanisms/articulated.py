@@ -104,7 +104,7 @@ class Articulated:
     row_cranks: tuple[float, ...] = (0.0,)
     firing: tuple[float, ...] = ()
 
-    #: Model.kind of the compiled kernel (transient.core.model.ARTICULATED).
+    #: Model.kind of the compiled kernel (transient.core.layout.ARTICULATED).
     kind = core_kind = ARTICULATED
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, then the
     #: rods with the pistons and gas forces.

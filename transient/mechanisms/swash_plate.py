@@ -21,7 +21,7 @@ Choices the paper leaves open (``reference/antonyuk-swashplate-dynamics.md``, [D
 
 The mechanism interface the rest of the package uses (as :class:`~.crank_slider.CrankSlider`):
 
-* ``kind = 1`` (``core.model.SWASH_PLATE``), ``strokes = 2`` (two-stroke, one power pulse per turn),
+* ``kind = 1`` (``core.layout.SWASH_PLATE``), ``strokes = 2`` (two-stroke, one power pulse per turn),
   ``cycle = 2π``; ``bank_angles`` are the cylinder angles ψ_Dk.
 * ``firing_angles``: the shaft angle at which cylinder k's gas table is at local angle 0 is its
   *inner dead centre* (x_D smallest: the piston nearest the plane I–I, end of compression), found
@@ -124,7 +124,7 @@ class SwashPlate:
     link_diametral_inertia: float
     cross_inertia: float
 
-    #: Model.kind of the compiled kernel (transient.core.model.SWASH_PLATE).
+    #: Model.kind of the compiled kernel (transient.core.layout.SWASH_PLATE).
     kind = core_kind = SWASH_PLATE
     #: Two-stroke: one gas pulse per cylinder and turn.
     strokes = 2
