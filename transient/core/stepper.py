@@ -10,12 +10,15 @@ it integrates in time, and a step that would cross a breakpoint is retaken so th
 (:mod:`.breakpoints`). The events (:mod:`.events`) truncate the step they fall in; acting on one
 changes the switches, the state or the independent variable (:func:`_switch_at_event`).
 
-Each turn of the loop in :func:`_advance` is: the segment's end (:func:`.breakpoints._segment_end`)
-and the step size (:func:`_step_size`), a step attempt (:func:`_attempt`), its acceptance or
-rejection and the next step size, the retake for a breakpoint crossed in time, the event location
+Each turn of the loop in :func:`_advance` is: the segment's end
+(:func:`.breakpoints._segment_end`) and the step size (:func:`_step_size`), a step attempt
+(:func:`_start_attempt`, the step, :func:`_judge_attempt`), its acceptance or rejection and the
+next step size, the retake for a breakpoint crossed in time, the event location
 (:func:`.events._locate_events`), the output samples inside the step (:func:`_emit_step_samples`),
 and either the step taken whole (:func:`_take_step`) or the state moved to the event and the event
-acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`).
+acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`). The step and
+the right-hand side at a restart are called in the loop itself, not inside a piece: inlined
+functions nested a level deeper cost numba's inliner noticeably more compile time.
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks
@@ -151,7 +154,11 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
             return STALLED
         if ist[I_F_VALID] == 0:
-            _restart(m, cfg, angle_mode, y, f, sw, wk, gs, fst, ist, evbuf)
+            # The derivative and the pairs' margins afresh (called here, not in a helper: an
+            # inlined right-hand side nested a level deeper costs numba's inliner much more).
+            ahead = _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf)
+            derivative(m, angle_mode, y, ahead, sw, wk, f)
+            _restarted(cfg, angle_mode, fst, ist)
 
         # The segment and the step size.
         x_end, up, down, h_max, tol_end, corner = _segment_end(m, cfg, bp, angle_mode, ix, x, y,
@@ -168,10 +175,14 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         else:
             sel = y[PHI] + 0.5 * h * y[OMEGA]
 
-        # The step attempt, its acceptance and the next step size.
-        finite, err, dip, w_lo, w_hi = _attempt(tab, m, angle_mode, ix, x, h, y, f, sel, sw, K,
-                                                y_new, tmp, wk, gs, ist, rtol, atol, g0, g1, c0,
-                                                at_segment_end and x_end == corner, corner)
+        # The step attempt (the step called here, not in a helper: its inlined right-hand side
+        # nested a level deeper costs numba's inliner much more), its acceptance and the next
+        # step size.
+        _start_attempt(f, K, wk)
+        _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
+                                                      rtol, atol, g0, g1, c0,
+                                                      at_segment_end and x_end == corner, corner)
         if not finite:
             # A trial step may leave the physical region (K < 0 in a stage): shrink it; only a
             # non-finite value that persists at small steps is a failure.
@@ -265,17 +276,23 @@ def _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk):
 
 
 @kernel(inline="always")
-def _restart(m, cfg, angle_mode, y, f, sw, wk, gs, fst, ist, evbuf):
-    """The derivative ``f`` and the pairs' margins ``gs[0]`` at the state, computed afresh where
-    the step before did not leave them valid (a start, an event, a breakpoint that changes the
-    state or where a pressure jumps); the first step's size if none is set."""
+def _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf):
+    """Where the step before did not leave the derivative and the margins valid (a start, an
+    event, a breakpoint that changes the state or where a pressure jumps): the pairs' margins
+    ``gs[0]`` at the state, with the modes settled; returns the angle that picks the table pieces
+    for the derivative there."""
     # (the table piece just ahead in the direction of motion: on a breakpoint, rounding of the
     # shaft angle must not pick the piece behind it)
     ahead = y[PHI] + (1e-9 if angle_mode or y[OMEGA] >= 0.0 else -1e-9)
     if m.n_pairs > 0:
         _settle_modes(m, angle_mode, y, ahead, sw, wk, gs, ist, evbuf)
         ist[I_NFEV] += 1
-    derivative(m, angle_mode, y, ahead, sw, wk, f)
+    return ahead
+
+
+@kernel(inline="always")
+def _restarted(cfg, angle_mode, fst, ist):
+    """The derivative at the state is valid again; the first step's size if none is set."""
     ist[I_NFEV] += 1
     ist[I_F_VALID] = 1
     if fst[F_H] <= 0.0:
@@ -297,25 +314,31 @@ def _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end):
 
 
 @kernel(inline="always")
-def _attempt(tab, m, angle_mode, ix, x, h, y, f, sel, sw, K, y_new, tmp, wk, gs, ist, rtol, atol,
-             g0, g1, c0, on_corner, corner):
-    """One step attempt from (x, y) with size h: ``(finite, err, dip, w_lo, w_hi)``.
-
-    Leaves the stages in K, the new state in y_new and the pairs' margins there in
-    ``gs[N_MARGIN_SAMPLES]``. ``err``: the error norm; ``finite``: it and y_new are finite;
-    ``dip``: some pair's margin reached zero in a stage (:func:`.events._locate_events` then
-    samples them); ``w_lo``, ``w_hi``: the speed's range over the stages, read before any dense
-    output adds its own stages to it. ``on_corner``: the step ends on a load-schedule corner.
-    """
-    n = y.shape[0]
-    for i in range(n):
+def _start_attempt(f, K, wk):
+    """Before a step attempt: its first stage is the derivative carried over, and the ranges
+    its stages record (the margins' least values, the speed's and the PI demand's ranges) are
+    reset."""
+    for i in range(f.shape[0]):
         K[0, i] = f[i]
     wk[WK_G_MIN, :] = np.inf
     wk[WK_SPEED, 0] = np.inf
     wk[WK_SPEED, 1] = -np.inf
     wk[WK_DEMAND, 0] = np.inf
     wk[WK_DEMAND, 1] = -np.inf
-    _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+
+
+@kernel(inline="always")
+def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, c0, on_corner,
+                   corner):
+    """After the step attempt of size h from y (stages in K, new state in y_new): ``(finite, err,
+    dip, w_lo, w_hi)``, with the pairs' margins at y_new into ``gs[N_MARGIN_SAMPLES]``.
+
+    ``err``: the error norm; ``finite``: it and y_new are finite; ``dip``: some pair's margin
+    reached zero in a stage (:func:`.events._locate_events` then samples them); ``w_lo``,
+    ``w_hi``: the speed's range over the stages, read before any dense output adds its own stages
+    to it. ``on_corner``: the step ends on a load-schedule corner.
+    """
+    n = y.shape[0]
     if on_corner:
         y_new[ix] = corner  # x + (corner − x) can miss it by an ulp: the event needs g = 0
     w_lo, w_hi = wk[WK_SPEED, 0], wk[WK_SPEED, 1]
