@@ -2,7 +2,7 @@
 transient's side (``tools/handwritten_kernel.py`` builds up from the hand-written side).
 
 The bare single cylinder (``cases/coasting_single.toml``) takes none of the branches that
-``model.derivative`` has for other scenes: gas forces, a generator, pairs, governor states, wall
+``rhs.derivative`` has for other scenes: gas forces, a generator, pairs, governor states, wall
 heat, other mechanisms. This script times a copy of ``derivative``'s crank-angle path with those
 branches, then with each of them removed (compiled out: a closure constant), then with all
 removed, each checked against transient's own right-hand side first (the same checksum to 1e-9
@@ -16,7 +16,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-import transient.core.model as cm
+import transient.core.forcing as forcing
+import transient.core.layout as layout
+import transient.core.rhs as rhs
 from transient.verify.targets import (BARE_SCENE, CALLS_PER_STEP, per_call, rhs_arguments,
                                      rhs_loop)
 from transient.core import governor as gv
@@ -25,59 +27,60 @@ from transient.scene import load_scene
 
 
 def derivative_without(kind=True, gas=True, generator=True, others=True):
-    """A loop over states calling ``model.derivative``'s crank-angle path, without pairs (the
+    """A loop over states calling ``rhs.derivative``'s crank-angle path, without pairs (the
     bare scene's), keeping only the branches whose flag is set: ``kind`` the dispatch on the
     mechanism's kind (else the crank slider's terms directly), ``gas`` the gas forces,
     ``generator`` the generator's term, ``others`` the pairs', governor's and wall heat's."""
 
     @njit(inline="always", _nrt=False)
     def derivative(m, y, sel, sw, wk, out):
-        u = wk[cm.WK_U]
+        u = wk[layout.WK_U]
         with_dJ = m.n_pairs > 0
         if kind:
-            J, _ = cm.mechanism_terms(m.kind, m.mech, m.kin_coef, y[cm.PHI], u, wk[cm.WK_DU],
-                                      with_dJ)
+            J, _ = forcing.mechanism_terms(m.kind, m.mech, m.kin_coef, y[layout.PHI], u,
+                                           wk[layout.WK_DU], with_dJ)
         else:
-            J, _ = crank_slider_terms(m.mech, y[cm.PHI], u, wk[cm.WK_DU], with_dJ)
+            J, _ = crank_slider_terms(m.mech, y[layout.PHI], u, wk[layout.WK_DU], with_dJ)
         J += m.J0
-        w = np.sqrt(2.0 * y[cm.KINETIC] / J)
+        w = np.sqrt(2.0 * y[layout.KINETIC] / J)
         M_gas = 0.0
         if gas and m.has_gas:
-            f = cm.command(m, w, y, sw)
-            cm.select_pieces(m, sel, wk)
+            f = forcing.command(m, w, y, sw)
+            forcing.select_pieces(m, sel, wk)
             for k in range(m.ncyl):
-                M_gas += m.gas_scale[k] * (cm.gas_value(m, k, y[cm.PHI], sel, wk)
+                M_gas += m.gas_scale[k] * (forcing.gas_value(m, k, y[layout.PHI], sel, wk)
                                            - m.gas_offset) * u[k]
             M_gas *= f
-        s = cm.load_scale(m, y, sw[cm.SW_LOAD])
+        s = forcing.load_scale(m, y, sw[layout.SW_LOAD])
         M_load = -s * (m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
         if generator and m.gen_power != 0.0:
-            M_load -= s * m.gen_power / (m.gen_min if sw[cm.SW_GENERATOR] else w)
+            M_load -= s * m.gen_power / (m.gen_min if sw[layout.SW_GENERATOR] else w)
         M_starter = 0.0
-        if sw[cm.SW_STARTER]:
+        if sw[layout.SW_STARTER]:
             M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
-        wk[cm.WK_SPEED, 0] = min(wk[cm.WK_SPEED, 0], w)
-        wk[cm.WK_SPEED, 1] = max(wk[cm.WK_SPEED, 1], w)
-        out[cm.W_GAS] = M_gas
-        out[cm.W_LOAD] = M_load
-        out[cm.W_STARTER] = M_starter
+        wk[layout.WK_SPEED, 0] = min(wk[layout.WK_SPEED, 0], w)
+        wk[layout.WK_SPEED, 1] = max(wk[layout.WK_SPEED, 1], w)
+        out[layout.W_GAS] = M_gas
+        out[layout.W_LOAD] = M_load
+        out[layout.W_STARTER] = M_starter
         if others:
             if m.n_pairs != 0:
-                out[cm.W_LOSS0] = np.nan  # (the bare scene has none: this copy does not solve them)
+                # (the bare scene has none: this copy does not solve them)
+                out[layout.W_LOSS0] = np.nan
             if m.gov_dyn != gv.NONE or m.latch:
-                cm.governor_rates(m, w, y, 1.0 / w, sw, wk, out)
+                forcing.governor_rates(m, w, y, 1.0 / w, sw, wk, out)
             if m.woschni:
-                cm.cylinder_rates(m, True, y, sel, w, cm.command(m, w, y, sw), wk, out)
-        out[cm.PHI] = 1.0
-        out[cm.T] = 1.0 / w
-        out[cm.KINETIC] = M_gas + M_load + M_starter
+                forcing.cylinder_rates(m, True, y, sel, w, forcing.command(m, w, y, sw), wk, out)
+        out[layout.PHI] = 1.0
+        out[layout.T] = 1.0 / w
+        out[layout.KINETIC] = M_gas + M_load + M_starter
 
     @njit(_nrt=False)
     def loop(m, states, y, out, sw, wk, chained):
         acc = 0.0
         for i in range(states.shape[0]):
-            derivative(m, states[i], states[i - i % CALLS_PER_STEP, cm.PHI], sw, wk, out)
-            acc += out[cm.KINETIC]
+            derivative(m, states[i], states[i - i % CALLS_PER_STEP, layout.PHI], sw, wk, out)
+            acc += out[layout.KINETIC]
         return acc
 
     return loop
@@ -87,8 +90,8 @@ def derivative_without(kind=True, gas=True, generator=True, others=True):
 def transient_in_this_loop(m, states, y, out, sw, wk, chained):
     acc = 0.0
     for i in range(states.shape[0]):
-        cm.derivative(m, True, states[i], states[i - i % CALLS_PER_STEP, cm.PHI], sw, wk, out)
-        acc += out[cm.KINETIC]
+        rhs.derivative(m, True, states[i], states[i - i % CALLS_PER_STEP, layout.PHI], sw, wk, out)
+        acc += out[layout.KINETIC]
     return acc
 
 

@@ -16,7 +16,8 @@ from pathlib import Path
 
 os.environ["NUMBA_DISABLE_JIT"] = "1"
 
-import transient.core.integrate as ig  # noqa: E402
+import transient.core.events as events  # noqa: E402
+import transient.core.rhs as rhs  # noqa: E402
 from transient.scene import load_scene  # noqa: E402
 from transient.run import integrate  # noqa: E402
 
@@ -40,15 +41,15 @@ def margin_call(caller, args, result):
 
 def root_call(caller, args, result):
     comp = args[4]
-    name = f"pair {comp - ig.PAIR_COMP}" if comp >= ig.PAIR_COMP else f"component {comp}"
+    name = f"pair {comp - events.PAIR_COMP}" if comp >= events.PAIR_COMP else f"component {comp}"
     roots[name] += 1
     iterations[name] += result[1]
 
 
 # (the kernels look these names up in the module at each call when run as Python)
-ig.margins_at = counted(ig.margins_at, margin_call)
-ig.margins_inline = counted(ig.margins_inline, margin_call)
-ig._root = counted(ig._root, root_call)
+rhs.margins_at = counted(rhs.margins_at, margin_call)
+rhs.margins_inline = counted(rhs.margins_inline, margin_call)
+events._root = counted(events._root, root_call)
 
 name, revolutions = sys.argv[1], float(sys.argv[2])
 scene = load_scene(CASES / f"{name}.toml")

@@ -79,7 +79,7 @@ def run(name: str, repeats: int = 20, samples_per_rev: int = 1) -> None:
 
 
 def _short(mangled: str) -> str:
-    """``transient.core.integrate._advance`` from numba's mangled name."""
+    """``transient.core.stepper._advance`` from numba's mangled name."""
     parts, i = [], mangled.find("_ZN") + 3
     while i < len(mangled) and mangled[i].isdigit():
         j = i

@@ -14,7 +14,8 @@ from pathlib import Path
 from transient.verify.bench import BENCH_SCENES
 from transient.verify.targets import (CALLS_PER_STEP, per_call, rhs_arguments, stepper_overhead,
                                      timed_scene)
-from transient.core import model as cm
+from transient.core import layout
+from transient.core import rhs
 from transient.core.jit import kernel
 from transient.scene import load_scene
 
@@ -26,13 +27,13 @@ SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",
 @kernel
 def margins_loop(m, states, y, out, sw, wk):
     """The mode margins at every state as the stepper evaluates them outside its root finder: a
-    call to ``model.margins_at`` (not inlined; it passes the Model by value). ``y``, ``out``
+    call to ``rhs.margins_at`` (not inlined; it passes the Model by value). ``y``, ``out``
     unused (the arguments of ``rhs_loop``)."""
     acc = 0.0
     for i in range(states.shape[0]):
-        sel = states[i - i % CALLS_PER_STEP, cm.PHI]
-        cm.margins_at(m, True, states[i], sel, sw, wk)
-        acc += wk[cm.WK_G, 0]
+        sel = states[i - i % CALLS_PER_STEP, layout.PHI]
+        rhs.margins_at(m, True, states[i], sel, sw, wk)
+        acc += wk[layout.WK_G, 0]
     return acc
 
 

@@ -13,8 +13,8 @@ from numpy.typing import NDArray
 
 from .core import cylinder as cyl
 from .core import governor as gv
-from .core.model import (PAPER, PHI, POWER_FLOW, TABULATED, T, Model, applied_value, fuel,
-                         governor_branch, mechanism_terms, select_pieces, work_array)
+from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core.layout import PAPER, PHI, POWER_FLOW, TABULATED, Model, T, work_array
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .forces.trapezoid import trapezoid_table
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from .assemble import gas_is_force, governor_kind
 from .core import governor as gv
-from .core.model import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
+from .core.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
 
 
 def output_columns(scene) -> dict[str, str]:

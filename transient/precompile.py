@@ -1,6 +1,6 @@
 """Compile the stepper's callees in a helper process while this process compiles the stepper.
 
-On a cold cache, compiling the stepper (:func:`transient.core.integrate.advance`) takes
+On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) takes
 ~210–270 s on the slower test machine, on one core: while numba types the stepper it compiles,
 one after another, each callee that is not inlined (the dense output, the root finders, the
 output row, the start and the end of a run), ~110 s of it. A helper process started at the same
@@ -27,31 +27,31 @@ import sys
 
 from numba import config, typeof, types
 
-from .core import integrate as ci
-from .core import model as cm
+from .core import breakpoints, events, forcing, rhs, rk, stepper
+from .core import stepper_io as sio
 
 #: The stepper's callees compiled apart (not inlined), in the reverse of the order in which the
 #: stepper's compile first calls for them (recorded with numba's "numba:compile" events), so
 #: that the helper and the stepper's compile meet in the middle.
 CALLEES = (
-    ci._to_time_mode,
-    ci._sleeve_stops,
-    ci._at_breakpoint,
-    ci._emit_samples,
-    ci._crossing_inside,
-    ci._fall_after_rise,
-    ci._crossing,
-    ci._dense,
-    ci._finish,
-    ci.next_breakpoint,
-    cm.margins_at,
-    ci._reset_output_grid,
-    ci._to_angle_mode,
-    ci._locked,
-    ci._start_modes,
-    cm.generator_branch,
-    cm.load_segment,
-    cm.start_branch,
+    stepper._to_time_mode,
+    events._sleeve_stops,
+    breakpoints._at_breakpoint,
+    sio._emit_samples,
+    events._crossing_inside,
+    events._fall_after_rise,
+    events._crossing,
+    rk._dense,
+    sio._finish,
+    breakpoints.next_breakpoint,
+    rhs.margins_at,
+    sio._reset_output_grid,
+    stepper._to_angle_mode,
+    sio._locked,
+    stepper._start_modes,
+    forcing.generator_branch,
+    forcing.load_segment,
+    forcing.start_branch,
 )
 
 
@@ -82,8 +82,8 @@ def compile_callees(model, tab, callees=CALLEES) -> None:
         fn.compile(signature(fn, model, tab))
 
 
-#: The stepper, whose compile the helper joins (taken at import: tests wrap ``ci.advance``).
-STEPPER = ci.advance
+#: The stepper, whose compile the helper joins (taken at import: tests wrap ``stepper.advance``).
+STEPPER = stepper.advance
 
 
 def stepper_is_cached() -> bool:

@@ -16,9 +16,10 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from .assemble import build_model, gas_tables, initial_governor
-from .core.integrate import next_breakpoint
+from .core.breakpoints import next_breakpoint
 from .core import governor as gv
-from .core.model import T, generator_branch, load_segment
+from .core.forcing import generator_branch, load_segment
+from .core.layout import T
 from .errors import SimulationError
 
 

@@ -15,10 +15,11 @@ from typing import Callable
 import numpy as np
 
 from .assemble import build_model, initial_governor
-from .core import integrate as ci
-from .core import model as cm
+from .core import forcing, layout, stepper
+from .core import stepper_io as sio
+from .core.inverse import inverse_dynamics
+from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
-from .core.model import inverse_dynamics, n_outputs, n_state
 from .errors import SimulationError
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
@@ -33,22 +34,22 @@ SUMMARY_SAMPLES = 500_000
 
 def _config(scene) -> np.ndarray:
     sv, out, run = scene.solver, scene.output, scene.run
-    cfg = np.zeros(ci.N_CFG)
-    cfg[ci.C_RTOL] = sv.rtol
-    cfg[ci.C_ATOL] = sv.atol
-    cfg[ci.C_T_END] = run.t_end
-    cfg[ci.C_PHI_END] = scene.initial.phi + 2.0 * math.pi * run.revolutions
-    cfg[ci.C_W_LO] = sv.switch_speed
-    cfg[ci.C_W_HI] = 1.5 * sv.switch_speed  # hysteresis: no chatter around the switch speed
-    cfg[ci.C_DPHI_OUT] = 2.0 * math.pi / out.samples_per_rev
-    cfg[ci.C_DT_OUT] = out.dt if out.dt > 0 else cfg[ci.C_DPHI_OUT] / cfg[ci.C_W_HI]
-    cfg[ci.C_MAX_STEP_PHI] = sv.max_step
-    cfg[ci.C_MAX_STEP_T] = sv.max_step / sv.switch_speed
+    cfg = np.zeros(sio.N_CFG)
+    cfg[sio.C_RTOL] = sv.rtol
+    cfg[sio.C_ATOL] = sv.atol
+    cfg[sio.C_T_END] = run.t_end
+    cfg[sio.C_PHI_END] = scene.initial.phi + 2.0 * math.pi * run.revolutions
+    cfg[sio.C_W_LO] = sv.switch_speed
+    cfg[sio.C_W_HI] = 1.5 * sv.switch_speed  # hysteresis: no chatter around the switch speed
+    cfg[sio.C_DPHI_OUT] = 2.0 * math.pi / out.samples_per_rev
+    cfg[sio.C_DT_OUT] = out.dt if out.dt > 0 else cfg[sio.C_DPHI_OUT] / cfg[sio.C_W_HI]
+    cfg[sio.C_MAX_STEP_PHI] = sv.max_step
+    cfg[sio.C_MAX_STEP_T] = sv.max_step / sv.switch_speed
     if sv.domain == "time":  # never to crank angle; steps bounded by the output spacing only
-        cfg[ci.C_W_LO] = cfg[ci.C_W_HI] = math.inf
-        cfg[ci.C_MAX_STEP_T] = math.inf
-    cfg[ci.C_CHUNK_STEPS] = 20000
-    cfg[ci.C_FIXED_STEP] = sv.fixed_step
+        cfg[sio.C_W_LO] = cfg[sio.C_W_HI] = math.inf
+        cfg[sio.C_MAX_STEP_T] = math.inf
+    cfg[sio.C_CHUNK_STEPS] = 20000
+    cfg[sio.C_FIXED_STEP] = sv.fixed_step
     return cfg
 
 
@@ -58,12 +59,12 @@ def _initial_state(scene, model):
     y[2] = scene.initial.omega
     governor, sleeve = initial_governor(scene, model)
     y[y.size - governor.size:] = governor
-    fst = np.zeros(ci.fst_size(model))
-    fst[ci.F_PASSED_BP] = np.nan
-    ist = np.zeros(ci.N_IST, dtype=np.int64)
+    fst = np.zeros(sio.fst_size(model))
+    fst[sio.F_PASSED_BP] = np.nan
+    ist = np.zeros(sio.N_IST, dtype=np.int64)
     st = scene.starter
-    ist[ci.I_STARTER_ON] = int(st.torque > 0 and scene.initial.omega < st.cutout_speed)
-    ist[ci.I_SLEEVE] = sleeve
+    ist[sio.I_STARTER_ON] = int(st.torque > 0 and scene.initial.omega < st.cutout_speed)
+    ist[sio.I_SLEEVE] = sleeve
     return y, fst, ist
 
 
@@ -80,15 +81,15 @@ def _compile(model, tab, cfg, bp) -> float:
     compiling its callees (:mod:`.precompile`); return the seconds it took."""
     t0 = time.perf_counter()
     warm = cfg.copy()
-    warm[ci.C_T_END] = 1e-6
-    warm[ci.C_PHI_END] = 1e-6
+    warm[sio.C_T_END] = 1e-6
+    warm[sio.C_PHI_END] = 1e-6
     y = np.zeros(n_state(model))
     y[2] = 1.0
     helper = start_helper(model, tab)
     try:
-        ci.advance(model, tab, warm, bp, y, np.zeros(ci.fst_size(model)),
-                   np.zeros(ci.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
-                   np.empty((64, 4)))
+        stepper.advance(model, tab, warm, bp, y, np.zeros(sio.fst_size(model)),
+                        np.zeros(sio.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
+                        np.empty((64, 4)))
     finally:
         stop_helper(helper)
     return time.perf_counter() - t0
@@ -101,7 +102,7 @@ def _events_by_name(rows, switching: bool) -> dict[str, np.ndarray]:
     codes = rows[:, 0].astype(np.int64)
     ev = {}
     for code in np.unique(codes):
-        name = ci.EVENT_NAMES[code]
+        name = sio.EVENT_NAMES[code]
         ev["inertia_switch" if switching and name == "end" else name] = rows[codes == code, 1:3]
     return ev
 
@@ -123,26 +124,26 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     y, fst, ist = _initial_state(scene, model)
     outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
     evbuf = np.empty((EVENT_ROWS, 4))
-    blocks, events = [], {name: [] for name in ci.EVENT_NAMES}  # events kept only with keep
-    status, message = ci.RUNNING, ""
+    blocks, events = [], {name: [] for name in sio.EVENT_NAMES}  # events kept only with keep
+    status, message = sio.RUNNING, ""
     # An inertia switched in: the run stops at that time (as at its end), the shaft's inertia and
     # speed jump (switch_inertia), and the run goes on.
     switch_at = scene.load.inertia_time if 0.0 < scene.load.inertia and (
         scene.load.inertia_time < scene.run.t_end) else math.inf
     run_cfg = cfg.copy()
-    run_cfg[ci.C_T_END] = min(cfg[ci.C_T_END], switch_at)
+    run_cfg[sio.C_T_END] = min(cfg[sio.C_T_END], switch_at)
     t0 = time.perf_counter()
     try:
-        while status == ci.RUNNING:
-            status = ci.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf)
-            switching = status == ci.FINISHED and y[cm.T] == switch_at
-            block = {name: outbuf[: ist[ci.I_NOUT], j].copy() for j, name in enumerate(names)}
-            ev = _events_by_name(evbuf[: ist[ci.I_NEV]], switching)
-            ist[ci.I_NOUT] = 0
-            ist[ci.I_NEV] = 0
+        while status == sio.RUNNING:
+            status = stepper.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf)
+            switching = status == sio.FINISHED and y[layout.T] == switch_at
+            block = {name: outbuf[: ist[sio.I_NOUT], j].copy() for j, name in enumerate(names)}
+            ev = _events_by_name(evbuf[: ist[sio.I_NEV]], switching)
+            ist[sio.I_NOUT] = 0
+            ist[sio.I_NEV] = 0
             if switching:
                 model = switch_inertia(model, scene.load.inertia, y, ist)
-                run_cfg, switch_at, status = cfg, math.inf, ci.RUNNING
+                run_cfg, switch_at, status = cfg, math.inf, sio.RUNNING
             if keep or not blocks or block["t"].size:
                 blocks = (blocks if keep else []) + [block]
             if keep:
@@ -163,42 +164,42 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
              f"ω = {last['omega']:.9g} rad/s")
     if message:
         message = f"interrupted; last sample at {where}"
-    if status == ci.STALLED:
+    if status == sio.STALLED:
         how = "the shaft turned backwards" if y[2] < 0.0 else "the speed reached zero"
         message = (f"stalled: {how} at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) before the {scene.run.revolutions:g} revolutions "
                    f"the run ends by; give run.t_end to follow the motion after a stall")
     at = f"t = {y[1]:.9g} s, φ = {y[0]:.9g} rad ({math.degrees(y[0]):.6g}°)"
-    if status == ci.LOCKED:
+    if status == sio.LOCKED:
         message = (f"locked: at rest at {at} the friction of the non-ideal pairs holds the "
                    f"applied moments in both directions (nothing changes them later, so the "
                    f"machine stays there)")
-    if status == ci.CHATTERING:
-        event = ci.EVENT_NAMES[int(ist[ci.I_CHATTER_CODE])]
-        message = (f"chattering: {ci.CHATTER_COUNT} state events in a row ({event}) without "
+    if status == sio.CHATTERING:
+        event = sio.EVENT_NAMES[int(ist[sio.I_CHATTER_CODE])]
+        message = (f"chattering: {stepper.CHATTER_COUNT} state events in a row ({event}) without "
                    f"progress at {at} (last sample {where})"
                    + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
                       f"sliding mode), the power-flow policy has one at every state"
                       if event == "pair_mode" and scene.friction.policy != "power-flow" else ""))
-    if status == ci.STIFF:
-        message = (f"stiff at {at}: in {ci.STIFF_COUNT} steps the estimate h·λ of the dominant "
-                   f"eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
+    if status == sio.STIFF:
+        message = (f"stiff at {at}: in {stepper.STIFF_COUNT} steps the estimate h·λ of the "
+                   f"dominant eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
                    f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
                    f"the step (a governor or actuator far faster than the engine?)")
-    if status in (ci.FAIL_NONFINITE, ci.FAIL_STEP):
+    if status in (sio.FAIL_NONFINITE, sio.FAIL_STEP):
         cause = ("a non-finite value in the state or its error estimate"
-                 if status == ci.FAIL_NONFINITE else "the step size fell below 10 ulp")
+                 if status == sio.FAIL_NONFINITE else "the step size fell below 10 ulp")
         message = (f"integration failed at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
     solver = {"method": scene.solver.method, "fixed_step": scene.solver.fixed_step,
               "rtol": scene.solver.rtol, "atol": scene.solver.atol,
-              "nfev": int(ist[ci.I_NFEV]), "nsteps": int(ist[ci.I_NSTEPS]),
-              "nreject": int(ist[ci.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
-              "mode_switches": int(ist[ci.I_NSWITCH]), "mode_ties": int(ist[ci.I_NTIES]),
+              "nfev": int(ist[sio.I_NFEV]), "nsteps": int(ist[sio.I_NSTEPS]),
+              "nreject": int(ist[sio.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
+              "mode_switches": int(ist[sio.I_NSWITCH]), "mode_ties": int(ist[sio.I_NTIES]),
               **_kinematics_attrs(scene)}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
-                   solver, complete=status == ci.FINISHED, message=message)
+                   solver, complete=status == sio.FINISHED, message=message)
 
 
 def switch_inertia(model, extra: float, y, ist):
@@ -208,18 +209,18 @@ def switch_inertia(model, extra: float, y, ist):
     the switches that depend on the speed, which jumped across their levels without an event
     (the governor's branch, the generator's); returns the model with the extra inertia on the
     shaft (``J0``)."""
-    angle_mode = ist[ci.I_ANGLE_MODE] == 1
-    J = cm.inertia(model, y[cm.PHI], cm.work_array(model))
-    w = cm.speed(J, angle_mode, y)
+    angle_mode = ist[sio.I_ANGLE_MODE] == 1
+    J = forcing.inertia(model, y[layout.PHI], layout.work_array(model))
+    w = forcing.speed(J, angle_mode, y)
     w_new = J * w / (J + extra)
-    y[cm.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new
+    y[layout.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new
     if angle_mode:
-        y[cm.KINETIC] = 0.5 * (J + extra) * w_new * w_new
+        y[layout.KINETIC] = 0.5 * (J + extra) * w_new * w_new
     else:
-        y[cm.OMEGA] = w_new
-    ist[ci.I_GOV_BRANCH] = cm.start_branch(model, w_new, y)
-    ist[ci.I_GEN_LOW] = cm.generator_branch(model, w_new, True)
-    ist[ci.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
+        y[layout.OMEGA] = w_new
+    ist[sio.I_GOV_BRANCH] = forcing.start_branch(model, w_new, y)
+    ist[sio.I_GEN_LOW] = forcing.generator_branch(model, w_new, True)
+    ist[sio.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
     return model._replace(J0=model.J0 + extra)
 
 
@@ -247,7 +248,7 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     cubics are blended, so the ``p_<k>`` columns hold the pressure applied."""
     model, _, _ = build_model(scene)
     coef = model.coef.copy()
-    if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.model.Model)
+    if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.layout.Model)
         coef[:, :4] = coef[:, 4:] + fuel * (coef[:, :4] - coef[:, 4:])
     else:
         coef *= fuel

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import PPoly, make_interp_spline
 
-from .core.model import mechanism_terms
+from .core.forcing import mechanism_terms
 
 #: Table sizes tried: 64, 128, … intervals per revolution.
 MIN_INTERVALS, MAX_INTERVALS = 64, 1 << 15

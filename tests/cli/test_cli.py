@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 
 import transient
-import transient.core.integrate as ci
+import transient.core.stepper as stepper
+import transient.core.stepper_io as sio
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import to_toml
 
@@ -552,7 +553,7 @@ def interrupt_advance(monkeypatch, on_chunk: int):
     buffer of its own); only calls with the run's buffer of ``BUFFER_ROWS`` rows are counted.
     Returns the list of output rows each completed chunk produced.
     """
-    real = ci.advance
+    real = stepper.advance
     rows: list[int] = []
     calls = [0]
 
@@ -563,10 +564,10 @@ def interrupt_advance(monkeypatch, on_chunk: int):
                 raise KeyboardInterrupt
         status = real(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf)
         if outbuf.shape[0] == sim.BUFFER_ROWS:
-            rows.append(int(ist[ci.I_NOUT]))
+            rows.append(int(ist[sio.I_NOUT]))
         return status
 
-    monkeypatch.setattr(ci, "advance", advance)
+    monkeypatch.setattr(stepper, "advance", advance)
     return rows
 
 

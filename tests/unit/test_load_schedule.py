@@ -23,7 +23,8 @@ from scene_texts import SMALL
 
 from transient.assemble import build_model
 from transient.cli import main
-from transient.core import model as cm
+from transient.core import forcing
+from transient.core import layout
 from transient.scene import Load, load_scene, scene_from_dict, to_toml
 
 # the small scene from 30°, with the default output
@@ -78,13 +79,13 @@ def test_revolutions_are_angles_from_the_initial_angle(tmp_path):
     scene = scene_of(tmp_path, with_load("schedule_revolutions = [1, 2.5]\n"
                                          "schedule_scale = [1, 0]"))
     m = build_model(scene)[0]
-    assert m.load_comp == cm.PHI
+    assert m.load_comp == layout.PHI
     phi0 = math.radians(30)
     assert m.load_x.tolist() == [phi0 + 2 * math.pi * 1.0, phi0 + 2 * math.pi * 2.5]
     assert m.load_s.tolist() == [1.0, 0.0]
     time = build_model(scene_of(tmp_path, with_load("schedule_time = [1, 2.5]\n"
                                                     "schedule_scale = [1, 0]")))[0]
-    assert time.load_comp == cm.T and time.load_x.tolist() == [1.0, 2.5]
+    assert time.load_comp == layout.T and time.load_x.tolist() == [1.0, 2.5]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -184,9 +185,9 @@ def schedule_model(x, s, comp):
 
 
 def kernel_scale(m, x, rising):
-    y = np.zeros(cm.n_state(m))
+    y = np.zeros(layout.n_state(m))
     y[m.load_comp] = x
-    return cm.load_scale(m, y, cm.load_segment(m, x, rising))
+    return forcing.load_scale(m, y, forcing.load_segment(m, x, rising))
 
 
 def test_numpy_interp_takes_the_value_after_a_repeated_abscissa():
@@ -195,7 +196,7 @@ def test_numpy_interp_takes_the_value_after_a_repeated_abscissa():
     assert np.interp(-1.0, [-2, -1, -1, 0], [5, 5, 0, 0]) == 0.0
 
 
-@pytest.mark.parametrize("comp", [cm.T, cm.PHI], ids=["time", "angle"])
+@pytest.mark.parametrize("comp", [layout.T, layout.PHI], ids=["time", "angle"])
 @pytest.mark.parametrize("name", list(TABLES))
 def test_schedule_matches_numpy_interp(name, comp):
     xp, fp = (np.asarray(v) for v in TABLES[name])
@@ -221,7 +222,7 @@ def test_schedule_matches_numpy_interp(name, comp):
 def test_steps_differ_by_direction_exactly_on_the_corner():
     """The test above has teeth: on a step the two directions give the two values."""
     xp, fp = TABLES["steps-and-ramps"]
-    m = schedule_model(xp, fp, cm.T)
+    m = schedule_model(xp, fp, layout.T)
     assert (kernel_scale(m, 0.5, True), kernel_scale(m, 0.5, False)) == (0.0, 1.5)
     assert (kernel_scale(m, 1.2, True), kernel_scale(m, 1.2, False)) == (0.4, 1.0)
     assert (kernel_scale(m, 0.0, True), kernel_scale(m, 0.0, False)) == (1.0, 0.2)
@@ -229,10 +230,10 @@ def test_steps_differ_by_direction_exactly_on_the_corner():
 
 def test_segment_skips_a_step_empty_segment():
     """Two equal corners enclose no segment: the index lands past both, or before both."""
-    m = schedule_model([1.0, 2.0, 2.0, 3.0], [0, 1, 2, 3], cm.T)
-    assert [cm.load_segment(m, x, True) for x in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0)] == \
+    m = schedule_model([1.0, 2.0, 2.0, 3.0], [0, 1, 2, 3], layout.T)
+    assert [forcing.load_segment(m, x, True) for x in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0)] == \
         [0, 1, 1, 3, 3, 4, 4]
-    assert [cm.load_segment(m, x, False) for x in (1.0, 2.0, 3.0)] == [0, 1, 3]
+    assert [forcing.load_segment(m, x, False) for x in (1.0, 2.0, 3.0)] == [0, 1, 3]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -240,13 +241,13 @@ def test_segment_skips_a_step_empty_segment():
 
 
 def moments_load(m, w, seg=0, gen_low=0, x=0.0):
-    y = np.zeros(cm.n_state(m))
-    y[cm.OMEGA] = w
+    y = np.zeros(layout.n_state(m))
+    y[layout.OMEGA] = w
     y[m.load_comp] = x
-    sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-    sw[cm.SW_LOAD] = seg
-    sw[cm.SW_GENERATOR] = gen_low
-    return cm.moments(m, False, y, 0.0, sw, cm.work_array(m), True)[4]
+    sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
+    sw[layout.SW_LOAD] = seg
+    sw[layout.SW_GENERATOR] = gen_low
+    return forcing.moments(m, False, y, 0.0, sw, layout.work_array(m), True)[4]
 
 
 def test_default_load_moment_is_the_formula_bit_for_bit():
@@ -277,8 +278,9 @@ def test_generator_moment():
     # mid-ramp: s = 0.5 + (1.5 − 0.5)·0.25
     assert moments_load(m, 100.0, seg=1, x=1.25) == pytest.approx(-0.75 * (2.0 + 150.0),
                                                                   rel=1e-15)
-    assert cm.generator_branch(m, 49.0, True) == 1 and cm.generator_branch(m, 51.0, False) == 0
-    assert cm.generator_branch(m, 50.0, True) == 0 and cm.generator_branch(m, 50.0, False) == 1
+    branch = forcing.generator_branch
+    assert branch(m, 49.0, True) == 1 and branch(m, 51.0, False) == 0
+    assert branch(m, 50.0, True) == 0 and branch(m, 50.0, False) == 1
 
 
 @pytest.mark.parametrize("abscissa", ["time", "revolutions"])

@@ -1,4 +1,4 @@
-"""The serial chain inside the compiled model (``transient.core.model``): how a mechanism's links
+"""The serial chain inside the compiled model (``transient.core.rhs``): how a mechanism's links
 become sub-chains, the right-hand side with held pair modes, the forward/inverse consistency of the
 chain, and the choice of modes at a state."""
 from __future__ import annotations
@@ -11,7 +11,10 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core import model as cm
+from transient.core import forcing
+from transient.core import inverse
+from transient.core import layout
+from transient.core import rhs
 from transient.core.chain import LOCKED, UNIQUE
 from transient.scene import Friction, Pair, load_scene
 
@@ -25,18 +28,18 @@ def gots(pairs=None, policy="power-flow"):
 
 
 def state(model, phi, omega):
-    y = np.zeros(cm.N_STATE_BASE + model.n_pairs)
-    y[cm.PHI], y[cm.OMEGA] = phi, omega
+    y = np.zeros(layout.N_STATE_BASE + model.n_pairs)
+    y[layout.PHI], y[layout.OMEGA] = phi, omega
     return y
 
 
 def forward(model, phi, omega, modes):
     """φ̈, J, dJ and the per-sub-chain terms at a time-domain state with held ``modes``."""
-    wk = cm.work_array(model)
+    wk = layout.work_array(model)
     sw = np.array([0, 0, modes, 1 if omega >= 0 else -1])
     y = state(model, phi, omega)
-    J, dJ, w, Mg, Ml, Ms = cm.moments(model, False, y, phi, sw, wk, True)
-    a = cm.acceleration(model, J, dJ, w, Mg, Ml, Ms, sw, wk)
+    J, dJ, w, Mg, Ml, Ms = forcing.moments(model, False, y, phi, sw, wk, True)
+    a = rhs.acceleration(model, J, dJ, w, Mg, Ml, Ms, sw, wk)
     return a, J, dJ, Mg + Ml + Ms, wk, sw, y
 
 
@@ -54,10 +57,10 @@ def test_links_become_subchains_and_their_terms_add_up(links, expected):
     for phi in RNG.uniform(0, 4 * math.pi, 20):
         a, J, dJ, M, wk, _, _ = forward(model, phi, 300.0, 0)
         n = model.n_pairs
-        assert np.sum(wk[cm.WK_J, :n + 1]) == pytest.approx(J, rel=1e-14)
-        assert np.sum(wk[cm.WK_DJ, :n + 1]) == pytest.approx(dJ, rel=1e-14, abs=1e-15)
-        assert np.sum(wk[cm.WK_M, :n + 1]) == pytest.approx(M, rel=1e-14, abs=1e-12)
-        assert wk[cm.WK_J, 0] >= model.J0 and np.all(wk[cm.WK_J, :n + 1] > 0)
+        assert np.sum(wk[layout.WK_J, :n + 1]) == pytest.approx(J, rel=1e-14)
+        assert np.sum(wk[layout.WK_DJ, :n + 1]) == pytest.approx(dJ, rel=1e-14, abs=1e-15)
+        assert np.sum(wk[layout.WK_M, :n + 1]) == pytest.approx(M, rel=1e-14, abs=1e-12)
+        assert wk[layout.WK_J, 0] >= model.J0 and np.all(wk[layout.WK_J, :n + 1] > 0)
 
 
 def test_ideal_pairs_reduce_to_equation_18_in_the_model():
@@ -80,14 +83,15 @@ def test_energy_form_equals_the_acceleration_form(policy):
     for phi, omega, modes in zip(RNG.uniform(0, 4 * math.pi, 30), RNG.uniform(50, 500, 30),
                                  RNG.integers(0, 4, 30)):
         a, J, dJ, M, wk, sw, y = forward(model, phi, omega, modes)
-        y[cm.KINETIC] = 0.5 * J * omega ** 2
+        y[layout.KINETIC] = 0.5 * J * omega ** 2
         out = np.empty_like(y)
-        cm.derivative(model, True, y, phi, sw, wk, out)
-        assert out[cm.KINETIC] == pytest.approx(J * a + 0.5 * dJ * omega ** 2, rel=1e-12,
-                                                abs=1e-12 * abs(M))
-        losses = out[cm.W_LOSS0:cm.W_LOSS0 + model.n_pairs]
-        assert out[cm.W_GAS] + out[cm.W_LOAD] + out[cm.W_STARTER] - losses.sum() == pytest.approx(
-            out[cm.KINETIC], rel=1e-12, abs=1e-12 * abs(M))
+        rhs.derivative(model, True, y, phi, sw, wk, out)
+        assert out[layout.KINETIC] == pytest.approx(J * a + 0.5 * dJ * omega ** 2, rel=1e-12,
+                                                    abs=1e-12 * abs(M))
+        losses = out[layout.W_LOSS0:layout.W_LOSS0 + model.n_pairs]
+        work = out[layout.W_GAS] + out[layout.W_LOAD] + out[layout.W_STARTER]
+        assert work - losses.sum() == pytest.approx(out[layout.KINETIC], rel=1e-12,
+                                                    abs=1e-12 * abs(M))
 
 
 def test_inverse_chain_recovers_the_forward_motion():
@@ -97,18 +101,18 @@ def test_inverse_chain_recovers_the_forward_motion():
     model, _, _ = build_model(gots())
     n = model.n_pairs
     for phi, omega in zip(RNG.uniform(0, 4 * math.pi, 40), RNG.uniform(-500, 500, 40)):
-        wk = cm.work_array(model)
+        wk = layout.work_array(model)
         y = state(model, phi, omega)
-        sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-        assert cm.choose_modes(model, False, y, phi, sw, wk) == UNIQUE
-        a, J, dJ, M, wk, _, _ = forward(model, phi, omega, sw[cm.SW_MODES])
-        S, eta = wk[cm.WK_S, :n].copy(), wk[cm.WK_ETA, :n].copy()
-        drive, n_ok = cm.inverse_chain(model, a, omega, float(np.sign(omega)), wk)
+        sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
+        assert rhs.choose_modes(model, False, y, phi, sw, wk) == UNIQUE
+        a, J, dJ, M, wk, _, _ = forward(model, phi, omega, sw[layout.SW_MODES])
+        S, eta = wk[layout.WK_S, :n].copy(), wk[layout.WK_ETA, :n].copy()
+        drive, n_ok = inverse.inverse_chain(model, a, omega, float(np.sign(omega)), wk)
         assert n_ok == 1
-        scale = np.abs(wk[cm.WK_M, :n + 1]).sum() + J * abs(a) + abs(dJ) * omega ** 2
+        scale = np.abs(wk[layout.WK_M, :n + 1]).sum() + J * abs(a) + abs(dJ) * omega ** 2
         assert abs(drive) <= 1e-12 * scale
-        np.testing.assert_allclose(wk[cm.WK_S, :n], S, rtol=1e-10, atol=1e-12 * scale)
-        np.testing.assert_array_equal(wk[cm.WK_ETA, :n], eta)
+        np.testing.assert_allclose(wk[layout.WK_S, :n], S, rtol=1e-10, atol=1e-12 * scale)
+        np.testing.assert_array_equal(wk[layout.WK_ETA, :n], eta)
 
 
 @pytest.mark.parametrize("policy", ["power-flow", "paper"])
@@ -118,19 +122,19 @@ def test_modes_chosen_at_a_state_follow_the_policy(policy):
     model, _, _ = build_model(gots(policy=policy))
     n = model.n_pairs
     for phi, omega in zip(RNG.uniform(0, 4 * math.pi, 40), RNG.uniform(-500, 500, 40)):
-        wk = cm.work_array(model)
+        wk = layout.work_array(model)
         y = state(model, phi, omega)
-        sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-        cm.choose_modes(model, False, y, phi, sw, wk)
-        assert sw[cm.SW_DIRECTION] == np.sign(omega)
-        _, _, _, _, wk, _, _ = forward(model, phi, omega, sw[cm.SW_MODES])
-        cm.mode_margins(model, sw, wk)
-        upstream = np.cumsum(wk[cm.WK_M, :n])
+        sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
+        rhs.choose_modes(model, False, y, phi, sw, wk)
+        assert sw[layout.SW_DIRECTION] == np.sign(omega)
+        _, _, _, _, wk, _, _ = forward(model, phi, omega, sw[layout.SW_MODES])
+        rhs.mode_margins(model, sw, wk)
+        upstream = np.cumsum(wk[layout.WK_M, :n])
         for k in range(n):
-            backward = bool((sw[cm.SW_MODES] >> k) & 1)
-            driver = wk[cm.WK_S, k] if policy == "power-flow" else upstream[k]
+            backward = bool((sw[layout.SW_MODES] >> k) & 1)
+            driver = wk[layout.WK_S, k] if policy == "power-flow" else upstream[k]
             assert backward == (driver * omega < 0), (k, driver, omega)
-            assert wk[cm.WK_G, k] >= 0.0
+            assert wk[layout.WK_G, k] >= 0.0
 
 
 def test_locked_at_rest_when_friction_holds_starter_against_compression():
@@ -141,18 +145,18 @@ def test_locked_at_rest_when_friction_holds_starter_against_compression():
     model, _, _ = build_model(base)
     phi = 1.5  # cylinder 3 compressing (its firing TDC at 120°)
     y = state(model, phi, 0.0)
-    wk = cm.work_array(model)
-    sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-    _, _, _, Mg, _, _ = cm.moments(model, False, y, phi, sw, wk, True)
+    wk = layout.work_array(model)
+    sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
+    _, _, _, Mg, _, _ = forcing.moments(model, False, y, phi, sw, wk, True)
     assert Mg < 0  # the gas resists forward motion here
     for ratio, locked in ((1.0, True), (1 / 0.9, False), (0.9, False)):
         m = model._replace(starter_torque=-Mg * ratio)
         sw = np.array([1, 0, 0, 1])
-        status = cm.choose_modes(m, False, y, phi, sw, wk)
+        status = rhs.choose_modes(m, False, y, phi, sw, wk)
         assert (status == LOCKED) == locked, ratio
         if not locked:
-            assert sw[cm.SW_DIRECTION] == (1 if ratio > 1 else -1)
+            assert sw[layout.SW_DIRECTION] == (1 if ratio > 1 else -1)
     ideal, _, _ = build_model(gots(()))
     ideal = ideal._replace(starter_torque=-Mg * 1.001)
-    J, dJ, w, Mg2, Ml, Ms = cm.moments(ideal, False, y, phi, np.array([1, 0, 0, 1]), wk, True)
-    assert cm.acceleration(ideal, J, dJ, w, Mg2, Ml, Ms, np.array([1, 0, 0, 1]), wk) > 0
+    J, dJ, w, Mg2, Ml, Ms = forcing.moments(ideal, False, y, phi, np.array([1, 0, 0, 1]), wk, True)
+    assert rhs.acceleration(ideal, J, dJ, w, Mg2, Ml, Ms, np.array([1, 0, 0, 1]), wk) > 0

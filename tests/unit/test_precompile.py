@@ -9,7 +9,7 @@ from pathlib import Path
 
 from transient import precompile
 from transient.assemble import build_model
-from transient.core import integrate as ci
+from transient.core import breakpoints
 from transient.core.tableaus import TABLEAUS
 from transient.scene import load_scene
 
@@ -25,10 +25,10 @@ def test_a_helper_process_compiles_into_the_shared_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # (the helper's, inherited)
     monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
     monkeypatch.setattr(precompile, "_cores", lambda: 2)
-    helper = precompile.start_helper(*_model_and_tableau(), callees=(ci.next_breakpoint,))
+    helper = precompile.start_helper(*_model_and_tableau(), callees=(breakpoints.next_breakpoint,))
     assert helper is not None
     assert helper.wait(timeout=300) == 0
-    saved = {p.suffix for p in tmp_path.rglob("integrate.next_breakpoint-*")}
+    saved = {p.suffix for p in tmp_path.rglob("breakpoints.next_breakpoint-*")}
     assert {".nbi", ".nbc"} <= saved, sorted(tmp_path.rglob("*"))  # (index, machine code)
 
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from transient.core import swash_plate as core
-from transient.core.model import SWASH_PLATE
+from transient.core.layout import SWASH_PLATE
 from transient.errors import SceneError
 from transient.forces.gas import mixed_cycle
 from transient.mechanisms import swash_plate as sp

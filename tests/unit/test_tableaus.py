@@ -1,5 +1,5 @@
 """The Runge–Kutta pairs of :mod:`transient.core.tableaus` and the dense-output layout of
-:mod:`transient.core.integrate`, against SciPy's independent implementations (``RK45`` with its
+:mod:`transient.core.rk`, against SciPy's independent implementations (``RK45`` with its
 own interpolant matrix P, ``DOP853``): one step of the same size on a nonlinear system must give
 the same new state, the same error estimate's size and the same dense output.
 """
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import DOP853, RK45
 
-from transient.core.integrate import _dense_eval
+from transient.core.rk import _dense_eval
 from transient.core.tableaus import TABLEAUS
 
 SCIPY = {"dopri5": RK45, "dop853": DOP853}

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from transient.core import integrate as ci
+from transient.core import stepper
 from transient.run import _WriteBehind
 
 
@@ -59,7 +59,7 @@ def test_a_failed_write_is_raised_by_the_next_wait_and_only_once():
 
 def test_the_stepper_releases_the_gil():
     """The overlap needs the compiled stepper to run without the GIL."""
-    assert ci.advance.targetoptions.get("nogil") is True
+    assert stepper.advance.targetoptions.get("nogil") is True
 
 
 def test_result_files_hold_a_bounded_chunk_cache(tmp_path):

@@ -2,7 +2,7 @@
 reference path, and η_mech (``cases/gots_diesel_friction.toml``, ``swash_plate_4cyl_friction``).
 
 The balance checked everywhere is ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k
-with the work integrals integrated with the motion (``core.model.STATE``). In crank angle the
+with the work integrals integrated with the motion (``core.layout.STATE``). In crank angle the
 kinetic energy K is itself a state whose derivative is that sum, so there the balance checks the
 stepper's bookkeeping (events, mode switches, domain switches). The demanding test is in time:
 there the state is ω, φ̈ comes from the chain solve, and only a correct chain (its φ̈ and its pair
@@ -21,7 +21,9 @@ import pytest
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
 from transient.core.chain import LOCKED, modes_power_flow
-from transient.core.model import WK_DJ, WK_J, WK_M, moments, split_subchains, work_array
+from transient.core.forcing import moments
+from transient.core.layout import WK_DJ, WK_J, WK_M, work_array
+from transient.core.rhs import split_subchains
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 from transient.run import integrate, prescribed
 

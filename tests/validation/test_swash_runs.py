@@ -18,7 +18,8 @@ from scipy.integrate import quad
 
 from transient.analysis.irregularity import fluctuation
 from transient.assemble import build_model
-from transient.core.model import inertia, work_array
+from transient.core.forcing import inertia
+from transient.core.layout import work_array
 from transient.scene import load_scene
 from transient.run import integrate
 

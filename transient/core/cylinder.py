@@ -1,5 +1,5 @@
 """Cylinder pressures as states of the ODE: the closed part of the cycle with Woschni's wall heat
-transfer (``[gas.woschni]`` of ``model = "wiebe"``; issue 6).
+transfer (``[gas.woschni]`` of ``model = "wiebe"``).
 
 With heat transfer the pressure depends on the time spent per degree, i.e. on the shaft speed
 and on the cylinder's own history, so it cannot be an angle-only table. From intake closing (IVC)

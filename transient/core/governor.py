@@ -1,8 +1,8 @@
-"""Dynamic speed governors, whose states are integrated with the engine (issue 6).
+"""Dynamic speed governors, whose states are integrated with the engine.
 
 The static droop characteristic of the swash-plate paper (§4) has no state and lives in
-``transient.core.model`` (``fuel``). The two governors here move the fuel rack through states of
-their own, appended to the state vector after the pairs' work integrals (``model.gov_index``):
+``transient.core.forcing`` (``fuel``). The two governors here move the fuel rack through states of
+their own, appended to the state vector after the pairs' work integrals (``layout.gov_index``):
 
 **PI(D), isochronous.** Relative speed error e = (ω_ref − ω)/ω_ref. Controller output
 
@@ -51,7 +51,7 @@ from .jit import kernel
 #: and its filter state; a PI governor has no filter state to integrate).
 NONE, PI, FLYWEIGHT, PID = 0, 1, 2, 3
 
-#: States of the PI(D) governor (offsets from ``model.gov_index``) and their output columns.
+#: States of the PI(D) governor (offsets from ``layout.gov_index``) and their output columns.
 PI_INTEGRAL, PI_RACK, PI_FILTER = range(3)
 #: Parameters of the PI(D) governor (``Model.gov_par``, filled by ``transient.assemble``).
 (P_REF, P_KP, P_KI, P_KD, P_TAU_D, P_TAU_A, P_RATE, P_FMIN, P_FMAX, P_INV_TT) = range(10)
@@ -61,7 +61,7 @@ FW_LIFT, FW_RATE = range(2)
 #: Parameters of the flyweight governor. F_CENT = n_w m_w (a/b) i_g² [kg], F_ARM = a/b.
 (F_CENT, F_RHO0, F_ARM, F_PRELOAD, F_SPRING, F_DAMP, F_MASS, F_TRAVEL, F_FMAX, F_FMIN,
  F_W_LIFT, F_W_TOP) = range(12)
-#: The sleeve's switch (``model.SW_SLEEVE``): moving, on the low stop (z = 0), on the high stop.
+#: The sleeve's switch (``layout.SW_SLEEVE``): moving, on the low stop (z = 0), on the high stop.
 FREE, ON_LOW_STOP, ON_HIGH_STOP = range(3)
 
 #: Output columns (and units) of each governor's states.

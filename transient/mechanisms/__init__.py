@@ -9,8 +9,9 @@ for the stepper, in plain Python for the reference path.
 Adding a mechanism takes
 
 1. its compiled kernel, ``transient/core/<name>.py``: ``<name>_terms(mp, φ, u, du) -> (J, dJ/dφ)``
-   filling u_k and u′_k, a kind code in :mod:`transient.core.model` and its branch in
-   ``mechanism_terms`` (the stepper and the kinematics tables reach it there);
+   filling u_k and u′_k, a kind code in :mod:`transient.core.layout` and its branch in
+   ``transient.core.forcing.mechanism_terms`` (the stepper and the kinematics tables reach it
+   there);
 2. its mechanism file, ``transient/mechanisms/<name>.py``: a frozen dataclass in SI with the
    members of :class:`Mechanism` (read from its ``[mechanism]`` table, validated, packed for
    the kernel, written back to TOML);
@@ -46,7 +47,7 @@ class Mechanism(Protocol):
     #: Its ``type`` in the ``[mechanism]`` table and its key in :data:`MECHANISMS`; the resolved
     #: scene writes it back (:meth:`toml_lines`) and errors name it.
     name: ClassVar[str]
-    #: ``Model.kind`` of its kernel in the compiled core (:mod:`transient.core.model`), for
+    #: ``Model.kind`` of its kernel in the compiled core (:mod:`transient.core.layout`), for
     #: ``transient.assemble`` and the kinematics tables.
     kind: ClassVar[int]
     #: The links of its serial chain, shaft first: a friction pair joins two neighbours

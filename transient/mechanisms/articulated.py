@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import articulated as core
-from ..core.model import ARTICULATED
+from ..core.layout import ARTICULATED
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -120,7 +120,7 @@ class Articulated:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "articulated"
-    #: Model.kind of the compiled kernel (transient.core.model.ARTICULATED).
+    #: Model.kind of the compiled kernel (transient.core.layout.ARTICULATED).
     kind = ARTICULATED
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False

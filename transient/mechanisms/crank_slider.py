@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import crank_slider as core
-from ..core.model import CRANK_SLIDER
+from ..core.layout import CRANK_SLIDER
 from ..errors import SceneError
 from ..tomlout import toml_value
 from .twins import CrankSliderNumpy
@@ -77,7 +77,7 @@ class CrankSlider:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "crank-slider"
-    #: Model.kind of the compiled kernel (transient.core.model.CRANK_SLIDER).
+    #: Model.kind of the compiled kernel (transient.core.layout.CRANK_SLIDER).
     kind = CRANK_SLIDER
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
     wall_heat_transfer = True

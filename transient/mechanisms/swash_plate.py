@@ -21,7 +21,7 @@ Choices the paper leaves open (``reference/antonyuk-swashplate-dynamics.md``, [D
 
 How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 
-* ``kind = 1`` (``core.model.SWASH_PLATE``), ``strokes = 2`` (two-stroke, one power pulse per turn),
+* ``kind = 1`` (``core.layout.SWASH_PLATE``), ``strokes = 2`` (two-stroke, one power pulse per turn),
   ``cycle = 2π``; ``bank_angles`` are the cylinder angles ψ_Dk.
 * ``firing_angles``: the shaft angle at which cylinder k's gas table is at local angle 0 is its
   *inner dead centre* (x_D smallest: the piston nearest the plane I–I, end of compression), found
@@ -50,7 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import swash_plate as core
-from ..core.model import SWASH_PLATE
+from ..core.layout import SWASH_PLATE
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -130,7 +130,7 @@ class SwashPlate:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "swash-plate"
-    #: Model.kind of the compiled kernel (transient.core.model.SWASH_PLATE).
+    #: Model.kind of the compiled kernel (transient.core.layout.SWASH_PLATE).
     kind = SWASH_PLATE
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False

@@ -294,7 +294,7 @@ def _efficiency(s: Section, name: str) -> float:
 
 #: Distinct abscissae of a load schedule closer than this (relative to max(1, |x|)) are
 #: refused: a ramp that short is a step to the solver, and the event search could not tell its
-#: two corners apart (``transient.core.integrate.ON_LEVEL`` is 1e-12).
+#: two corners apart (``transient.core.events.ON_LEVEL`` is 1e-12).
 SCHEDULE_MIN_GAP = 1e-9
 
 

@@ -74,10 +74,10 @@ def worker_info() -> dict[str, str]:
 def kernel_loads() -> dict[str, int]:
     """How often this process compiled or loaded the stepper from numba's cache (its signatures
     and cache hits + misses): 1 after any number of runs of one kind of scene."""
-    from ..core import integrate as ci
+    from ..core import stepper
 
-    st = ci.advance.stats
-    return {"signatures": len(ci.advance.signatures),
+    st = stepper.advance.stats
+    return {"signatures": len(stepper.advance.signatures),
             "loads": sum(st.cache_hits.values()) + sum(st.cache_misses.values())}
 
 

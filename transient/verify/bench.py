@@ -233,7 +233,7 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     from CyRK import nbsolve2_ivp
 
     from ..assemble import build_model
-    from ..core import model as cm
+    from ..core import layout
     from .cyrk_rhs import make_rhs
 
     model, _, _ = build_model(base)
@@ -241,9 +241,9 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     if name not in rhs_cache:
         rhs_cache[name] = make_rhs(model)
     rhs = rhs_cache[name]
-    y0 = np.zeros(cm.n_state(model))
-    y0[cm.PHI], y0[cm.OMEGA] = base.initial.phi, base.initial.omega
-    args = cm.work_array(model).ravel()  # (as allocated: no gas table piece selected yet)
+    y0 = np.zeros(layout.n_state(model))
+    y0[layout.PHI], y0[layout.OMEGA] = base.initial.phi, base.initial.omega
+    args = layout.work_array(model).ravel()  # (as allocated: no gas table piece selected yet)
     span = (0.0, ref.t_end)
 
     def solve(dense=False):
@@ -268,9 +268,9 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
                          16 * SAMPLES_PER_REV)
     tail = sol.call_vectorize(t_tail)
     sol.free()
-    phase = abs(y_end[cm.PHI] - ref.phi_end)
-    w_err = _end_errors(ref, ref.t_end, y_end[cm.OMEGA])[1]
-    l2 = _l2_error(ref, tail[cm.PHI], tail[cm.OMEGA])
+    phase = abs(y_end[layout.PHI] - ref.phi_end)
+    w_err = _end_errors(ref, ref.t_end, y_end[layout.OMEGA])[1]
+    l2 = _l2_error(ref, tail[layout.PHI], tail[layout.OMEGA])
     return _row(name, "CyRK DOP853 (transient's compiled RHS)", rtol, statistics.median(walls),
                 compile_s, repeat, {"nfev": -1, "nsteps": steps, "nreject": -1},
                 (phase, w_err, l2))

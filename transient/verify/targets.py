@@ -34,10 +34,11 @@ from ..assemble import build_model
 from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS,
                     SAMPLES_PER_REV, TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight,
                     on_plateau, order_slope, read_record)
-from ..core import model as cm
+from ..core import layout
 from ..core.jit import kernel
-from ..scene import Governor, Starter, load_scene
+from ..core.rhs import derivative
 from ..run import SUMMARY_SAMPLES, integrate
+from ..scene import Governor, Starter, load_scene
 
 #: Right-hand sides per DOP853 step. The stepper picks each cylinder's gas table piece once per
 #: step (``model.select_pieces``, keyed by the step's ``sel``): the timing loop keeps ``sel`` for
@@ -75,9 +76,9 @@ def rhs_loop(m, states, y, out, sw, wk, chained):
             for j in range(y.shape[0]):
                 y[j] = states[i, j] + 0.0 * out[j]
             state = y
-        sel = states[i - i % CALLS_PER_STEP, cm.PHI]
-        cm.derivative(m, True, state, sel, sw, wk, out)
-        acc += out[cm.KINETIC]
+        sel = states[i - i % CALLS_PER_STEP, layout.PHI]
+        derivative(m, True, state, sel, sw, wk, out)
+        acc += out[layout.KINETIC]
     return acc
 
 
@@ -103,17 +104,17 @@ def rhs_arguments(scene, n_states=2000):
                               output=dc.replace(scene.output, samples_per_rev=SAMPLES_PER_REV))
                    ).trajectory
     phi = np.linspace(tr["phi"][-1] - model.period, tr["phi"][-1], n_states)
-    states = np.zeros((phi.size, cm.n_state(model)))
-    states[:, cm.PHI], states[:, cm.T] = phi, np.interp(phi, tr["phi"], tr["t"])
-    states[:, cm.KINETIC] = np.interp(phi, tr["phi"], 0.5 * tr["J"] * tr["omega"] ** 2)
-    n = cm.n_state(model)
-    return model, states, np.empty(n), np.zeros(n), _switches(), cm.work_array(model)
+    states = np.zeros((phi.size, layout.n_state(model)))
+    states[:, layout.PHI], states[:, layout.T] = phi, np.interp(phi, tr["phi"], tr["t"])
+    states[:, layout.KINETIC] = np.interp(phi, tr["phi"], 0.5 * tr["J"] * tr["omega"] ** 2)
+    n = layout.n_state(model)
+    return model, states, np.empty(n), np.zeros(n), _switches(), layout.work_array(model)
 
 
 def _switches():
     """The switch states of a run driven forward (the stepper's ``sw``)."""
-    sw = np.zeros(cm.N_SWITCHES, dtype=np.int64)
-    sw[cm.SW_DIRECTION] = 1
+    sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
+    sw[layout.SW_DIRECTION] = 1
     return sw
 
 
@@ -256,8 +257,8 @@ def hand_parameters(base) -> np.ndarray:
 def hand_arguments(base):
     """(p, states, out, rec) for a hand-written loop: 2000 states over 40 rad at K = 170 J."""
     states = np.zeros((2000, 6))
-    states[:, cm.PHI] = np.linspace(0.0, 40.0, 2000)
-    states[:, cm.KINETIC] = 170.0
+    states[:, layout.PHI] = np.linspace(0.0, 40.0, 2000)
+    states[:, layout.KINETIC] = 170.0
     return hand_parameters(base), states, np.empty(6), np.array([np.inf, -np.inf])
 
 
@@ -270,10 +271,10 @@ def hand_against_transient(base, rows, **flags) -> tuple[np.ndarray, np.ndarray]
     theirs = np.zeros(6)
     hand, transient = [], []
     for i in rows:
-        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), cm.work_array(m), False)
+        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), layout.work_array(m), False)
         rhs(p, states[i], out, rec)
-        hand.append((out[cm.T], out[cm.KINETIC]))
-        transient.append((theirs[cm.T], theirs[cm.KINETIC]))
+        hand.append((out[layout.T], out[layout.KINETIC]))
+        transient.append((theirs[layout.T], theirs[layout.KINETIC]))
     return np.array(hand), np.array(transient)
 
 
@@ -298,7 +299,7 @@ def bare_kernel(rounds=7) -> dict:
     for kin in ("exact", "tabulated"):
         m, _, _ = build_model(dc.replace(base, solver=dc.replace(base.solver, kinematics=kin)))
         costs[kin] = per_call(rhs_loop, m, states, np.empty(6), np.zeros(6), _switches(),
-                              cm.work_array(m), False, rounds=rounds)
+                              layout.work_array(m), False, rounds=rounds)
     return {"hand_written_s": hand, "exact_s": costs["exact"], "tabulated_s": costs["tabulated"]}
 
 

@@ -1,0 +1,170 @@
+"""Breakpoints: the shaft angles where a pressure table has a corner or a jump, or a cylinder
+starts its injection or closes its intake. The right-hand side is smooth only between them, so
+the stepper ends a segment on each: in crank angle a step stops on the next one exactly; in time
+a step that would cross one is retaken so that it ends on it (:func:`_aim_at_breakpoint`). On a
+breakpoint the state may change (a cylinder latches its fuel, or starts its closed part at p_a)
+and the derivative carried over from the last step may be stale (:func:`_at_breakpoint`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import kernel
+
+from . import cylinder as cyl
+from .events import _crossing, _dense_once, _load_corner
+from .forcing import command, inertia, speed
+from .layout import OMEGA, PHI, cyl_index, latch_index
+from .stepper_io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, C_T_END,
+                         EV_INJECTION, F_PASSED_BP, F_REDO_LEVEL, I_ANGLE_MODE, I_NREDO,
+                         _emit_event, _retake)
+
+# In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
+# (a retaken step lands on it only to the accuracy of the dense output).
+BP_LANDING = 1e-7
+
+
+@kernel
+def next_breakpoint(bp, period, phi, upward):
+    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle."""
+    tol = 1e-13 * max(1.0, abs(phi))
+    k = np.floor(phi / period)
+    if upward:
+        for c in range(2):
+            base = (k + c) * period
+            for j in range(bp.shape[0]):
+                v = base + bp[j]
+                if v > phi + tol:
+                    return v
+        return np.inf
+    for c in range(2):
+        base = (k - c) * period
+        for j in range(bp.shape[0] - 1, -1, -1):
+            v = base + bp[j]
+            if v < phi - tol:
+                return v
+    return -np.inf
+
+
+@kernel(inline="always")
+def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
+    """Where the segment of the next step ends, and what bounds that step: ``(x_end, up, down,
+    h_max, tol_end, corner)``.
+
+    ``x_end``: the next breakpoint (in crank angle), the end of the run, or a load-schedule corner
+    on the independent variable before them (the step lands on it and its event is found there,
+    θ = 1; one closer than ``tol_end`` is left to the event search, which finds it at once in the
+    next step). ``up``, ``down``: the breakpoints above and below the shaft. ``tol_end``: a step
+    that would end within rounding of ``x_end`` ends on it exactly, so that no later step of a
+    few ulp is needed (:func:`next_breakpoint` treats such a point as reached).
+    """
+    here = y[PHI]
+    if not angle_mode and abs(here - fst[F_PASSED_BP]) <= BP_LANDING:
+        here = fst[F_PASSED_BP]  # just landed on it: look beyond it, both ways
+    up = next_breakpoint(bp, m.period, here, True)
+    down = next_breakpoint(bp, m.period, here, False)
+    if angle_mode:
+        x_end = min(up, cfg[C_PHI_END])
+        h_max = min(cfg[C_MAX_STEP_PHI], 256.0 * cfg[C_DPHI_OUT])
+    else:
+        x_end = cfg[C_T_END]
+        h_max = min(cfg[C_MAX_STEP_T], 256.0 * cfg[C_DT_OUT])
+    tol_end = 1e-13 * max(1.0, abs(x))
+    corner = _load_corner(m, ix, sw)
+    if tol_end < corner - x and corner < x_end:
+        x_end = corner
+    return x_end, up, down, h_max, tol_end, corner
+
+
+@kernel(inline="always")
+def _aim_at_breakpoint(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, fst, ist, up,
+                       down, min_step):
+    """In time, a step must not cross a breakpoint: one that does is retaken so that it ends
+    there, at most four times in a row. Returns ``(retake, dense_ready)``: whether the step is
+    to be computed again (``fst[F_H]`` set), and whether its dense output is in F."""
+    if angle_mode:
+        return False, False
+    if y_new[PHI] > up or y_new[PHI] < down:
+        _dense_once(False, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
+        level = up if y_new[PHI] > up else down
+        theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, sel, sw, tmp, wk)
+        fst[F_REDO_LEVEL] = level
+        if theta * h > min_step and ist[I_NREDO] < 4:
+            _retake(fst, ist, theta * h)
+            ist[I_NREDO] += 1
+            return True, True
+        return False, True
+    if 0 < ist[I_NREDO] < 4:
+        # A retaken step lands on the breakpoint only to the accuracy of the dense output it was
+        # aimed with (at loose tolerances, up to ~1e-3 rad short): lengthen it by the time the
+        # rest of the angle takes at the speed reached (a secant step), rather than leaving a
+        # sliver that the next step would cross and retake again.
+        short = fst[F_REDO_LEVEL] - y_new[PHI]
+        rest = short / y_new[OMEGA] if y_new[OMEGA] != 0.0 else -1.0
+        if abs(short) > BP_LANDING and 0.0 < rest < h:
+            _retake(fst, ist, h + rest)
+            ist[I_NREDO] += 1
+            return True, False
+    return False, False
+
+
+@kernel(inline="always")
+def _on_angle(phi, angle, period):
+    """Whether the shaft angle phi is on ``angle`` of the cycle (to BP_LANDING)."""
+    d = (phi - angle) % period
+    return min(d, period - d) <= BP_LANDING
+
+
+@kernel
+def _jumps_at(m, bp, phi):
+    """Whether a pressure jumps at the breakpoint the shaft is on (``Model.bp_jump``): the
+    derivative carried over from the step that ended there (FSAL) used the piece before it."""
+    for j in range(bp.shape[0]):
+        if _on_angle(phi, bp[j], m.period):
+            return m.bp_jump[j]
+    return False
+
+
+@kernel
+def _inject(m, y, sw, evbuf, ist, wk):
+    """At a breakpoint, moving forward: each cylinder whose start of injection this is latches the
+    governor's command (``m.latch``). Returns whether any did (the derivative at y changes)."""
+    if not m.latch:
+        return False
+    J = inertia(m, y[PHI], wk)
+    w = speed(J, ist[I_ANGLE_MODE] == 1, y)
+    if w <= 0.0:
+        return False
+    c = latch_index(m)
+    hit = False
+    for k in range(m.ncyl):
+        if _on_angle(y[PHI], m.gas_phase[k] + m.inj_angle, m.period):
+            y[c + k] = command(m, w, y, sw)
+            hit = True
+            _emit_event(m, evbuf, ist, EV_INJECTION, y, wk)
+    return hit
+
+
+@kernel
+def _close_intake(m, y):
+    """At a breakpoint: each cylinder whose intake closes here starts its closed part at p_a
+    (``m.woschni``, :mod:`.cylinder`). Returns whether any did (the derivative at y changes)."""
+    if not m.woschni:
+        return False
+    c = cyl_index(m)
+    hit = False
+    for k in range(m.ncyl):
+        if _on_angle(y[PHI], m.gas_phase[k] + m.cyl_par[cyl.IVC], m.period):
+            y[c + k] = m.cyl_par[cyl.P_A]
+            hit = True
+    return hit
+
+
+@kernel
+def _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+    """What a breakpoint does to the state (injections, intake closings); returns whether the
+    derivative carried over from the last step (FSAL) is stale: the state changed, or a pressure
+    jumps here."""
+    injected = _inject(m, y, sw, evbuf, ist, wk)
+    closed = _close_intake(m, y)
+    return injected or closed or _jumps_at(m, bp, y[PHI])

@@ -1,0 +1,402 @@
+"""State events on a step: the event functions, their crossings located on the dense output
+(Illinois root finding, sampling for crossings that come and go inside a step), which events are
+watched in the current switches (:func:`_event_spec`), and the search for a step's earliest event
+(:func:`_locate_events`).
+
+The events are the switches between time and crank angle, starter cut-out, the governor
+characteristic's corners, the PI governor's limits, the flyweight governor's stops, the corners of
+the load schedule and the generator's minimum speed, speed reversals, the end of the run and the
+pairs' mode switches (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6). Locating them is kept
+apart from acting on them (:mod:`.stepper`), because location only reads the step and its dense
+output, while acting changes the state and the switches.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import kernel
+
+from .chain import MAX_PAIRS
+from . import governor as gv
+from .forcing import demand, inertia, is_pi, speed
+from .layout import (OMEGA, PHI, SW_LOAD, SW_SLEEVE, SW_STARTER, T, WK_DEMAND, WK_G, WK_G_MIN,
+                     gov_index)
+from .rhs import margins_at, margins_inline
+from .rk import _dense, _dense_eval, _dense_state
+from .stepper_io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR,
+                         EV_LOAD, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
+                         EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
+
+# Event "components" at and above PAIR_COMP are the mode margins of the pairs (rhs.mode_margins);
+# DEMAND_COMP is the PI governor's demand u (forcing.demand).
+PAIR_COMP = 100
+DEMAND_COMP = -1
+# A step that starts within this (relative) of the level of the event just handled starts on it:
+# the event has put it there, and rounding must not make it cross the level again at once.
+ON_LEVEL = 1e-12
+
+
+@kernel(inline="always")
+def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
+    """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
+    pair comp − PAIR_COMP, the PI demand u − level, else y[comp] − level."""
+    if comp >= PAIR_COMP:
+        margins_at(m, angle_mode, yv, sel, sw, wk)
+        return wk[WK_G, comp - PAIR_COMP]
+    if comp == OMEGA or comp == DEMAND_COMP:
+        J = inertia(m, yv[PHI], wk)
+        w = speed(J, angle_mode, yv)
+        return (w if comp == OMEGA else demand(m, w, yv)) - level
+    return yv[comp] - level
+
+
+@kernel
+def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
+    """θ ∈ (0, 1] where the event function crosses zero on the dense output.
+
+    The caller has checked that it changes sign between y and y_new. The bracket's right end is
+    y_new itself, not the dense output at θ = 1, which can differ from it by rounding and then
+    would not bracket a root that sits at the very end of the step.
+    """
+    ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
+    gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
+    return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)[0]
+
+
+@kernel
+def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
+    """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
+    (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations).
+
+    The θ returned is on the far side of the crossing (g there has gb's sign, or is 0): the
+    state at the event has crossed. Two pairs whose margins fall through zero at the same angle
+    (a massless link between them) then both see their crossing there, and a switch is never
+    undone because rounding left the event a hair before its own root."""
+    if gb == 0.0 or (ga > 0.0) == (gb > 0.0):
+        return b, 0
+    side = 0
+    for i in range(100):
+        if b - a < 1e-12:
+            return b, i
+        c = b - gb * (b - a) / (gb - ga)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        _dense_eval(F, y, c, tmp)
+        if comp >= PAIR_COMP:  # most iterations: the margins inlined, no copy of the Model
+            margins_inline(m, angle_mode, tmp, sel, sw, wk)
+            gc = wk[WK_G, comp - PAIR_COMP]
+        else:
+            gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
+        if gc == 0.0:
+            return c, i + 1
+        if (gc > 0.0) == (gb > 0.0):
+            b, gb = c, gc
+            if side == -1:
+                ga *= 0.5
+            side = -1
+        else:
+            a, ga = c, gc
+            if side == 1:
+                gb *= 0.5
+            side = 1
+    return b, 100
+
+
+#: A pair's mode margin can fall through zero and come back within one step, unseen at the
+#: step's ends. Every stage of the step evaluates it (``rhs.derivative`` keeps the least value);
+#: when that dips to zero or below, the margin is sampled at these fractions of the step to find
+#: the first crossing.
+N_MARGIN_SAMPLES = 4
+
+
+@kernel(inline="always")
+def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
+    """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
+    holds the step's start and row N its end already)."""
+    ix = PHI if angle_mode else T
+    for j in range(1, N_MARGIN_SAMPLES):
+        _dense_state(F, y, x, h, j / N_MARGIN_SAMPLES, ix, tmp)
+        margins_at(m, angle_mode, tmp, sel, sw, wk)
+        for k in range(m.n_pairs):
+            gs[j, k] = wk[WK_G, k]
+
+
+#: Samples of the fine search for a crossing that a step's stages show and its coarse samples
+#: miss (a pair's power reversing for a few degrees inside a long step); a crossing that these
+#: miss too makes the step be retaken shorter, at most MAX_UNSEEN times in a row.
+N_FINE_SAMPLES, MAX_UNSEEN = 64, 3
+
+
+@kernel
+def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp, wk,
+                     n_samples):
+    """θ where the speed, the PI demand or a pair's margin (``comp``) first crosses ``level``
+    (in ``direction``) inside a step whose ends are on the same side of it, sampled at
+    θ = j/n_samples on the dense output; 2 if the samples see no crossing (it was only in a
+    stage, or between samples). Returns (θ, evaluations)."""
+    ix = PHI if angle_mode else T
+    g_prev = ga
+    for j in range(1, n_samples + 1):
+        theta = j / n_samples
+        _dense_state(F, y, x, h, theta, ix, tmp)
+        g = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
+        if _crosses(g_prev, g, direction):
+            root, evals = _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
+                                (j - 1) / n_samples, theta, g_prev, g)
+            return root, j + evals
+        g_prev = g
+    return 2.0, n_samples
+
+
+@kernel(inline="always")
+def _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
+    """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
+    margin evaluations (right-hand sides) the root finding took.
+
+    A margin that starts at 0 (an event has just switched this pair's mode) and is below it a
+    sample on either fell at once — the power only touched zero there and turns back, and the
+    switch is undone at the step's start (θ = 0) — or first rose for less than a sample's span
+    (the power reversed for a few degrees): :func:`_fall_after_rise` tells which.
+    """
+    if gs[0, k] == 0.0 and gs[1, k] < 0.0:
+        return _fall_after_rise(m, angle_mode, F, y, x, h, k, 1.0 / N_MARGIN_SAMPLES, sel, sw,
+                                tmp, wk)
+    for j in range(N_MARGIN_SAMPLES):
+        if _crosses(gs[j, k], gs[j + 1, k], -1):
+            return _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
+                         j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
+    return 2.0, 0
+
+
+@kernel
+def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
+    """For a margin that starts at 0 and is below it at ``theta_end``: θ where it falls to zero
+    after rising above it (sampled at N_FINE_SAMPLES points up to ``theta_end``), or 0 if no
+    sample rises above zero (it fell at once). Returns (θ, evaluations)."""
+    ix = PHI if angle_mode else T
+    rose = False
+    g_prev = 0.0
+    th_prev = 0.0
+    for j in range(1, N_FINE_SAMPLES + 1):
+        theta = theta_end * j / N_FINE_SAMPLES
+        _dense_state(F, y, x, h, theta, ix, tmp)
+        g = _event_g(m, angle_mode, tmp, PAIR_COMP + k, 0.0, sel, sw, wk)
+        if rose and g <= 0.0:
+            root, evals = _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
+                                th_prev, theta, g_prev, g)
+            return root, j + evals
+        rose = rose or g > 0.0
+        g_prev = g
+        th_prev = theta
+    return 0.0, N_FINE_SAMPLES
+
+
+FIRST_PAIR_EVENT = 14
+N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
+
+
+@kernel(inline="always")
+def _load_corner(m, ix, sw):
+    """The load schedule's next corner on the independent variable ``ix`` (``inf`` if the
+    schedule runs against the other variable, or has no corner ahead)."""
+    seg = sw[SW_LOAD]
+    if m.load_comp != ix or seg >= m.load_x.shape[0]:
+        return np.inf
+    return m.load_x[seg]
+
+
+@kernel(inline="always")
+def _event_spec(m, cfg, e, angle_mode, sw):
+    """State event number e that applies now: (code, component, level, direction), code −1 if
+    none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
+    −1 falling, 0 either way.
+
+    The load schedule's corners are levels of t or φ, watched one segment at a time: the corner
+    above and, for corners in φ (the shaft may turn back in time mode), the one below. On the
+    independent variable the segment also ends on the corner (``breakpoints._segment_end``), so
+    the event is found at the step's end exactly, as a breakpoint is in crank angle."""
+    if e == 0 and sw[SW_STARTER] == 1:
+        return EV_STARTER_CUTOUT, OMEGA, m.starter_cutout, 1
+    if e == 1 and angle_mode:
+        return EV_TO_TIME, OMEGA, cfg[C_W_LO], -1
+    if e == 2 and not angle_mode:
+        return EV_TO_ANGLE, OMEGA, cfg[C_W_HI], 1
+    if e == 3 and not angle_mode:
+        return EV_REVERSAL, OMEGA, 0.0, 0
+    if e == 4:  # the end of the run by the variable that is not independent
+        if angle_mode:
+            return EV_END, T, cfg[C_T_END], 1
+        return EV_END, PHI, cfg[C_PHI_END], 1
+    if 5 <= e < 7 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
+        return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
+    if 5 <= e < 7 and is_pi(m):  # the PI demand reaching its upper or lower limit
+        return EV_GOVERNOR, DEMAND_COMP, m.gov_par[gv.P_FMAX if e == 5 else gv.P_FMIN], 0
+    if e == 7 and sw[SW_LOAD] < m.load_x.shape[0]:  # the schedule's corner ahead
+        return EV_LOAD, m.load_comp, m.load_x[sw[SW_LOAD]], 1
+    if e == 8 and m.load_comp == PHI and sw[SW_LOAD] > 0:  # behind, reached turning back
+        return EV_LOAD, PHI, m.load_x[sw[SW_LOAD] - 1], -1
+    if e == 9 and m.gen_power != 0.0:  # the generator's minimum speed
+        return EV_GENERATOR, OMEGA, m.gen_min, 0
+    if 10 <= e < 14 and m.gov_dyn == gv.FLYWEIGHT:
+        return _sleeve_event(m, e, sw)
+    if e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
+        # the mode margin of pair e − FIRST_PAIR_EVENT falls to zero
+        return EV_PAIR_MODE, PAIR_COMP + e - FIRST_PAIR_EVENT, 0.0, -1
+    return -1, OMEGA, 0.0, 0
+
+
+@kernel(inline="always")
+def _sleeve_event(m, e, sw):
+    """The flyweight governor's events (``_event_spec``, e = 10 … 13): a moving sleeve reaching
+    its low or high stop; on a stop, the speed at which the net force turns away from it."""
+    par = m.gov_par
+    z = gov_index(m) + gv.FW_LIFT
+    sleeve = sw[SW_SLEEVE]
+    if e == 10 and sleeve == gv.FREE:
+        return EV_SLEEVE_STOP, z, 0.0, -1
+    if e == 11 and sleeve == gv.FREE:
+        return EV_SLEEVE_STOP, z, par[gv.F_TRAVEL], 1
+    if e == 12 and sleeve == gv.ON_LOW_STOP:
+        return EV_SLEEVE_FREE, OMEGA, par[gv.F_W_LIFT], 1
+    if e == 13 and sleeve == gv.ON_HIGH_STOP:
+        return EV_SLEEVE_FREE, OMEGA, par[gv.F_W_TOP], -1
+    return -1, OMEGA, 0.0, 0
+
+
+@kernel
+def _sleeve_stops(m, y, level, w):
+    """The sleeve has reached a stop (lift ``level``): it stops there (ż = 0) unless the net force
+    already pulls it away, so that it stays free (returns the new switch)."""
+    g = gov_index(m)
+    y[g + gv.FW_RATE] = 0.0
+    low = level == 0.0
+    force = gv.sleeve_force(m.gov_par, w, level, 0.0)
+    if low and force <= 0.0:
+        return gv.ON_LOW_STOP
+    if not low and force >= 0.0:
+        return gv.ON_HIGH_STOP
+    return gv.FREE
+
+
+@kernel(inline="always")
+def _crosses(g0, g1, direction):
+    """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
+    rising = g0 < 0.0 <= g1
+    falling = g1 <= 0.0 < g0
+    if direction > 0:
+        return rising
+    if direction < 0:
+        return falling
+    return rising or falling
+
+
+@kernel(inline="always")
+def _dense_once(ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist):
+    """The last step's dense output into F, unless ``ready`` (it costs the pair's extra stages,
+    so a step computes it only when an event or an output sample needs it); returns True."""
+    if not ready:
+        _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+        ist[I_NFEV] += tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
+    return True
+
+
+@kernel(inline="always")
+def _locate_events(tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist,
+                   dip, dense_ready, w_lo, w_hi):
+    """The earliest state event in the last step (from x, size h; accepted, not yet taken):
+    ``(code, θ, component, level, rising, unseen, dense_ready)``, code −1 if there is none.
+
+    ``rising``: the event function crosses from below. ``unseen``: a pair's margin dipped below
+    zero in the step's stages only, which no sample found (the caller retakes the step shorter).
+    ``dip``: the stages saw some pair's margin reach zero; ``w_lo``, ``w_hi``: the speed's range
+    over the stages; ``gs[0]`` and ``gs[N_MARGIN_SAMPLES]`` hold the margins at the step's ends.
+    """
+    ev_code = -1
+    ev_theta = 2.0
+    unseen = False
+    ev_comp = 0
+    ev_level = 0.0
+    ev_rising = True
+    # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
+    w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
+    w1 = 1.0 / K[tab.n_stages, T] if angle_mode else y_new[OMEGA]
+    if dip:
+        dense_ready = _dense_once(dense_ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F,
+                                  tmp, wk, ist)
+        _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs)
+        ist[I_NFEV] += N_MARGIN_SAMPLES - 1
+    for e in range(N_EVENT_KINDS):
+        code, comp, level, direction = _event_spec(m, cfg, e, angle_mode, sw)
+        if code < 0:
+            continue
+        if comp >= PAIR_COMP:
+            if not dip:
+                continue
+            theta, only_stages = _pair_event(m, angle_mode, F, y, x, h, comp - PAIR_COMP, sel, sw,
+                                             tmp, wk, gs, ist)
+            unseen = unseen or only_stages
+            if theta < ev_theta:
+                ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
+            continue
+        theta, rising, dense_ready = _level_event(tab, m, angle_mode, x, h, y, y_new, K, F, code,
+                                                  comp, level, direction, w0, w1, w_lo, w_hi, sel,
+                                                  sw, tmp, wk, ist, dense_ready)
+        if theta < ev_theta:
+            ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
+            ev_rising = rising
+    return ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready
+
+
+@kernel(inline="always")
+def _pair_event(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
+    """θ where pair k's margin first falls to zero in the step (2 if it does not), and whether
+    only the stages saw it fall below zero (the samples, coarse and fine, did not)."""
+    theta, evals = _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs)
+    ist[I_NFEV] += evals
+    only_stages = False
+    if theta > 1.0 and wk[WK_G_MIN, k] < 0.0 <= gs[0, k]:
+        # the stages saw the margin fall below zero, the samples did not
+        theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, PAIR_COMP + k, 0.0, -1,
+                                        gs[0, k], sel, sw, tmp, wk, N_FINE_SAMPLES)
+        ist[I_NFEV] += evals
+        only_stages = theta > 1.0
+    return theta, only_stages
+
+
+@kernel(inline="always")
+def _level_event(tab, m, angle_mode, x, h, y, y_new, K, F, code, comp, level, direction, w0, w1,
+                 w_lo, w_hi, sel, sw, tmp, wk, ist, dense_ready):
+    """θ where the speed, the PI demand or the state ``comp`` first crosses ``level`` (in
+    ``direction``) in the step, 2 if it does not; whether it crosses from below; ``dense_ready``.
+    ``w0``, ``w1``: the speed at the step's ends."""
+    if comp == DEMAND_COMP:
+        ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
+        gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
+    else:
+        ga = (w0 if comp == OMEGA else y[comp]) - level
+        gb = (w1 if comp == OMEGA else y_new[comp]) - level
+    if code == ist[I_AT_EVENT] - 1 and abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
+        ga = 0.0
+    ends = _crosses(ga, gb, direction)
+    # The speed (the PI demand) can pass a level and come back within one step (its
+    # fluctuation within a cycle about a governor corner): the stages' range shows it.
+    inside = not ends and ((comp == OMEGA and w_lo < level < w_hi) or (
+        comp == DEMAND_COMP and wk[WK_DEMAND, 0] < level < wk[WK_DEMAND, 1]))
+    theta = 2.0
+    rising = True
+    if ends or inside:
+        dense_ready = _dense_once(dense_ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F,
+                                  tmp, wk, ist)
+        if ends:
+            theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
+        else:
+            for n_samples in (N_MARGIN_SAMPLES, N_FINE_SAMPLES):  # coarse, then fine
+                theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, level,
+                                                direction, ga, sel, sw, tmp, wk, n_samples)
+                ist[I_NFEV] += evals
+                if theta <= 1.0:
+                    break
+        # the crossing's direction: from below (an 'inside' crossing is the first one away from
+        # the step's start, so this holds for it too)
+        rising = ga < 0.0 or (ga == 0.0 and gb > 0.0)
+    return theta, rising, dense_ready

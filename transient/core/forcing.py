@@ -1,0 +1,308 @@
+"""The applied terms of the reduced model at a state: the mechanism's inertia and transfer
+functions, the cylinders' gas values (tables, or pressure states with wall heat transfer), the
+governors' fuel command and branches, the load with its schedule and generator, the starter, and
+their sum into the reduced moments (:func:`moments`).
+
+These are the physics the right-hand side (:mod:`.rhs`), the output rows (:mod:`.outputs`) and the
+inverse dynamics (:mod:`.inverse`) share; the discrete branches (governor, load segment,
+generator) are chosen here too, because each is the same formula the term evaluates, held fixed
+over a step so that the right-hand side is smooth inside it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import kernel
+
+from . import cylinder as cyl
+from . import governor as gv
+from .articulated import articulated_terms
+from .crank_slider import crank_slider_terms
+from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, OMEGA, PHI, SW_GENERATOR, SW_GOVERNOR,
+                     SW_LOAD, SW_SLEEVE, SW_STARTER, TABULATED, WK_DEMAND, WK_DU, WK_LOCAL,
+                     WK_PIECE, WK_SEL, WK_U, cyl_index, gov_index, latch_index)
+from .swash_plate import swash_terms
+from .tabulated import tabulated_terms
+from .tables import find_piece, table_eval, table_eval_pair
+
+
+@kernel(inline="always")
+def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
+    """J(φ) and dJ/dφ of the mechanism's moving parts; fills ``u[k]``, ``du[k]`` per cylinder.
+    Without ``with_dJ`` dJ and ``du`` may be left NaN (the exact crank-slider skips them)."""
+    if kind == TABULATED:
+        return tabulated_terms(kin_coef, phi, u, du)
+    if kind == CRANK_SLIDER:
+        return crank_slider_terms(mech, phi, u, du, with_dJ)
+    if kind == ARTICULATED:
+        return articulated_terms(mech, phi, u, du)
+    return swash_terms(mech, phi, u, du)
+
+
+@kernel(inline="always")
+def select_pieces(m, sel, wk):
+    """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL) and the gas table's piece there
+    (WK_PIECE). ``sel`` is one angle for a whole step, so they are computed when it changes and
+    kept, not recomputed in each of a step's right-hand sides, whose cost numba's float modulo
+    would otherwise add to noticeably."""
+    if wk[WK_SEL, 0] != sel:
+        for k in range(m.ncyl):
+            local_sel = (sel - m.gas_phase[k]) % m.period
+            wk[WK_LOCAL, k] = local_sel
+            wk[WK_PIECE, k] = find_piece(m.knots, m.piece_knot, local_sel)
+        wk[WK_SEL, 0] = sel
+
+
+@kernel(inline="always")
+def gas_value(m, k, phi, sel, wk):
+    """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
+
+    ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
+    ends exactly on a corner keeps using the piece it integrates over (DESIGN §2, breakpoints).
+    The piece is the one :func:`select_pieces` left in ``wk`` for it.
+    """
+    local_sel = wk[WK_LOCAL, k]
+    value, _ = table_eval(m.knots, m.coef, m.piece_knot, int(wk[WK_PIECE, k]),
+                          local_sel + (phi - sel))
+    return value
+
+
+@kernel(inline="always")
+def gas_pair(m, k, phi, sel, wk):
+    """Full-load and motored table values of cylinder k at shaft angle ``phi`` (``m.has_motored``
+    only: ``m.coef`` pairs the two curves on common knots); ``sel``, ``wk`` as in
+    :func:`gas_value`."""
+    local_sel = wk[WK_LOCAL, k]
+    return table_eval_pair(m.knots, m.coef, m.piece_knot, int(wk[WK_PIECE, k]),
+                           local_sel + (phi - sel))
+
+
+@kernel(inline="always")
+def applied_value(m, k, phi, sel, f, wk):
+    """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot).
+
+    Without a motored table the motored curve is the constant ``gas_offset`` (p0), and at f = 1
+    the value is the table's to the last bit.
+    """
+    if m.has_motored:
+        p, p_mot = gas_pair(m, k, phi, sel, wk)
+        return p_mot + f * (p - p_mot)
+    p = gas_value(m, k, phi, sel, wk)
+    if f == 1.0:
+        return p
+    return m.gas_offset + f * (p - m.gas_offset)
+
+
+@kernel(inline="always")
+def cylinder_value(m, k, y, sel, f, wk):
+    """The pressure on piston k: its state in the closed part with wall heat transfer
+    (``m.woschni``, :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
+    if m.woschni:
+        if cyl.closed_angle(m.cyl_par, wk[WK_LOCAL, k], m.period) >= 0.0:
+            return y[cyl_index(m) + k]
+    return applied_value(m, k, y[PHI], sel, f, wk)
+
+
+@kernel(inline="always")
+def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
+    """dp_k/dφ (crank angle) or dp_k/dt (time) of the cylinder pressure states (``m.woschni``):
+    the first law with Wiebe's heat release and Woschni's wall heat (:mod:`.cylinder`); zero
+    outside the closed part. dV/dφ = F_p·u_k from the row u of ``wk``, the cylinders' angles in
+    their cycles from WK_LOCAL (both left by :func:`moments`)."""
+    c = cyl_index(m)
+    lc = latch_index(m)
+    for k in range(m.ncyl):
+        local_sel = wk[WK_LOCAL, k]
+        x_sel = cyl.closed_angle(m.cyl_par, local_sel, m.period)
+        if x_sel < 0.0:
+            out[c + k] = 0.0
+            continue
+        shift = y[PHI] - sel  # the angles at y, continued from the step's piece
+        f_k = y[lc + k] if m.latch else f
+        A, B = cyl.pressure_rate(m.mech, m.cyl_par, x_sel + shift, x_sel, local_sel + shift,
+                                 y[c + k], m.gas_scale[k] * wk[WK_U, k], w, f_k)
+        out[c + k] = A - B / w if angle_mode else w * A - B
+
+
+@kernel(inline="always")
+def inertia(m, phi, wk):
+    """Total reduced inertia J(φ), (19); fills the row u of ``wk``."""
+    J, _ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, wk[WK_U], wk[WK_DU], False)
+    return J + m.J0
+
+
+@kernel(inline="always")
+def speed(J, angle_mode, y):
+    """ω from the state: y[2] itself in time mode, √(2K/J) in crank-angle mode (ω > 0 there)."""
+    if angle_mode:
+        return np.sqrt(2.0 * y[KINETIC] / J)
+    return y[OMEGA]
+
+
+@kernel
+def governor_branch(m, w, rising):
+    """Branch of the droop characteristic at speed w: 0 full fuel (ω ≤ ω_a), 1 the droop line,
+    2 no fuel (ω ≥ ω₁c); on a corner, the branch the motion enters (``rising``: ω increasing)."""
+    if w < m.gov_full or (w == m.gov_full and not rising):
+        return 0
+    if w > m.gov_zero or (w == m.gov_zero and rising):
+        return 2
+    return 1
+
+
+@kernel(inline="always")
+def fuel(m, w, branch):
+    """Fuel command f of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
+    to 0 at ω_1c, 0 above; 1 without a governor. The cylinder pressure is p_mot + f·(p_full −
+    p_mot) (:func:`applied_value`), i.e. f scales the gas force (p − p0)·F_p when the motored curve
+    is p0. The branch is fixed for a whole step (a state event stops on each corner), so that the
+    right-hand side is smooth inside every step."""
+    if not m.gov_on or branch == 0:
+        return 1.0
+    if branch == 2:
+        return 0.0
+    return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
+
+
+@kernel(inline="always")
+def command(m, w, y, sw):
+    """The governor's fuel command at state ``y``: the rack of a dynamic governor (PI(D): its
+    position state; flyweight: linked to the sleeve), else the droop characteristic (:func:`fuel`)."""
+    if is_pi(m):
+        return y[gov_index(m) + gv.PI_RACK]
+    if m.gov_dyn == gv.FLYWEIGHT:
+        return gv.rack_of_lift(m.gov_par, y[gov_index(m) + gv.FW_LIFT])
+    return fuel(m, w, sw[SW_GOVERNOR])
+
+
+@kernel(inline="always")
+def is_pi(m):
+    """Whether the governor is a PI(D) one (its demand's clipping is a switch, ``SW_GOVERNOR``)."""
+    return m.gov_dyn == gv.PI or m.gov_dyn == gv.PID
+
+
+@kernel(inline="always")
+def demand(m, w, y):
+    """The PI(D) governor's demand u at state y (before clipping)."""
+    return gv.pi_demand(m.gov_dyn, m.gov_par, w, y, gov_index(m))[1]
+
+
+@kernel
+def start_branch(m, w, y):
+    """``SW_GOVERNOR`` at the start of a run: the PI demand's clipping branch, or the droop
+    characteristic's branch (:func:`governor_branch`)."""
+    if is_pi(m):
+        return gv.demand_branch(m.gov_par, demand(m, w, y), True)
+    return governor_branch(m, w, True)
+
+
+@kernel(inline="always")
+def governor_rates(m, w, y, scale, sw, wk, out):
+    """Derivatives of the dynamic governor's states (× ``scale``: 1/ω in crank angle) and zero
+    for the latched fuels, into ``out``; the PI demand's range over a step into ``wk``."""
+    g = gov_index(m)
+    if is_pi(m):
+        u = gv.pi_rates(m.gov_dyn, m.gov_par, w, y, g, sw[SW_GOVERNOR], scale, out)
+        wk[WK_DEMAND, 0] = min(wk[WK_DEMAND, 0], u)
+        wk[WK_DEMAND, 1] = max(wk[WK_DEMAND, 1], u)
+    elif m.gov_dyn == gv.FLYWEIGHT:
+        gv.flyweight_rates(m.gov_par, w, y, g, sw[SW_SLEEVE], scale, out)
+    if m.latch:
+        c = latch_index(m)
+        for k in range(m.ncyl):
+            out[c + k] = 0.0
+
+
+@kernel
+def load_segment(m, x, rising):
+    """Segment of the load schedule at abscissa ``x`` (a time or a shaft angle, as ``m.load_comp``).
+
+    Segment j lies between corners j − 1 and j (segment 0 before the first, n after the last,
+    n corners): the number of corners below x, and on a corner the segment the motion enters
+    (``rising``: x increasing), so that a step (two equal corners) takes its value after the
+    step in the direction of motion. A step's empty segment is never the result.
+    """
+    j = 0
+    n = m.load_x.shape[0]
+    while j < n and (m.load_x[j] < x or (m.load_x[j] == x and rising)):
+        j += 1
+    return j
+
+
+@kernel(inline="always")
+def load_scale(m, y, seg):
+    """Scale s of the load at state ``y`` in schedule segment ``seg``: 1 without a schedule, the
+    first (last) value before (after) the corners, linear between two of them.
+
+    The segment is held for a whole step (a state event stops on each corner and moves it on),
+    so that the right-hand side is smooth inside every step and a step changes s exactly at its
+    event; inside a step the segment's line is extrapolated, as the governor's branch is.
+    """
+    n = m.load_x.shape[0]
+    if n == 0:
+        return 1.0
+    if seg <= 0:
+        return m.load_s[0]
+    if seg >= n:
+        return m.load_s[n - 1]
+    x0 = m.load_x[seg - 1]
+    s0 = m.load_s[seg - 1]
+    return s0 + (m.load_s[seg] - s0) * (y[m.load_comp] - x0) / (m.load_x[seg] - x0)
+
+
+@kernel
+def generator_branch(m, w, rising):
+    """1 while the generator's torque is held at −s·P/ω_min (ω < ω_min, or on it falling), else 0."""
+    if w < m.gen_min or (w == m.gen_min and not rising):
+        return 1
+    return 0
+
+
+@kernel(inline="always")
+def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
+    """Reduced inertia, speed and moments at state ``y``.
+
+    Returns ``(J, dJ, w, M_gas, M_load, M_starter)``, dJ possibly NaN without ``with_dJ``; the
+    rows u, u′ of ``wk`` are left holding the transfer functions and, with gas, WK_LOCAL and
+    WK_PIECE the cylinders' pieces at ``sel`` (:func:`select_pieces`), for :func:`cylinder_rates`
+    and :func:`.outputs.output_row`.
+
+    Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force of cylinder k is
+    (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel f
+    (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
+    P/max(ω, ω_min)), s from the schedule's segment ``sw[SW_LOAD]`` and the max from the
+    generator's branch ``sw[SW_GENERATOR]``. With fuel latching cylinder k burns the fuel it
+    took at its last injection, else every cylinder the governor's command (:func:`command`).
+    """
+    phi = y[PHI]
+    u = wk[WK_U]
+    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, u, wk[WK_DU], with_dJ)
+    J += m.J0
+    w = speed(J, angle_mode, y)
+    M_gas = 0.0
+    if m.has_gas:
+        f = command(m, w, y, sw)
+        select_pieces(m, sel, wk)
+        if m.latch or m.has_motored:  # p = p_mot + f_k·(p_full − p_mot), per cylinder
+            c = latch_index(m)
+            for k in range(m.ncyl):
+                f_k = y[c + k] if m.latch else f
+                p_k = cylinder_value(m, k, y, sel, f_k, wk)
+                M_gas += m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
+        else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
+            for k in range(m.ncyl):
+                M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel, wk) - m.gas_offset) * u[k]
+            M_gas *= f
+    # (with s = 1 exactly the formula without a schedule, to the last bit)
+    s = load_scale(m, y, sw[SW_LOAD])
+    M_load = -s * (m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
+    if m.gen_power != 0.0:
+        # An electrical load of power s·P: M ω = −s·P. Below ω_min (a start from rest) the
+        # torque is held at its value there, so that it stays finite; a state event switches
+        # the branch at ω_min, as at the governor's corners, keeping each step smooth.
+        w_gen = m.gen_min if sw[SW_GENERATOR] else w
+        M_load -= s * m.gen_power / w_gen
+    M_starter = 0.0
+    if sw[SW_STARTER]:
+        M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
+    return J, dJ, w, M_gas, M_load, M_starter

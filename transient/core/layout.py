@@ -1,0 +1,168 @@
+"""The layout of the compiled reduced model: the :data:`Model` tuple, the state vector, the
+switches, the output columns and the work array, with the index helpers that place the optional
+states (governor, latched fuels, cylinder pressures) after the fixed ones.
+
+Every other module of the model and the stepper indexes its arrays by these names, so they are
+defined once here, apart from the terms that fill them. The model is equation (18) of the
+swash-plate paper with variable ω, J(φ) φ̈ + ½ J′(φ) φ̇² = M(φ, φ̇, t), unit-free (SI); the scene
+classes build a :data:`Model` with ``transient.assemble``. In time as independent variable the
+third state is ω; in crank angle it is the kinetic energy K = ½ J(φ) ω², for which (18) is the
+work–energy law dK/dφ = M(φ, ω, t) and ω = √(2K/J): the same equation multiplied by ω, but an
+integration error in it is an error in the energy budget only, never a spurious exchange between
+J(φ) and ω, so coasting keeps K exactly.
+"""
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+from .jit import compiled, kernel
+
+from . import governor as gv
+
+#: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode). The first
+#: three are the dynamics; then work integrals (quadratures that do not feed back): the work
+#: of the gas forces, of the load and of the starter [J], then the energy lost in each non-ideal
+#: pair k (``W_loss_<k+1>``). Integrated with the motion, the work–energy balance
+#: ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k holds to the solver's accuracy.
+#: After them the dynamic governor's states (:mod:`.governor`, from :func:`gov_index`), then, with
+#: fuel latching, the fuel each cylinder took at its last injection (:func:`latch_index`; held
+#: constant between injections: their derivative is zero and the stepper sets them), then, with
+#: wall heat transfer, each cylinder's pressure in its closed part (:func:`cyl_index`,
+#: :mod:`.cylinder`; the ``p_<k>`` columns show it there).
+STATE = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
+PHI, T, OMEGA, W_GAS, W_LOAD, W_STARTER = range(6)
+KINETIC = OMEGA
+N_DYNAMIC = 3
+N_STATE_BASE = len(STATE)
+W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
+
+#: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), the
+#: governor's branch (see :func:`.forcing.governor_branch`), the modes of the non-ideal pairs
+#: (bit k set: pair k backward, its far side drives), the direction of motion σ = ±1 that the
+#: pair modes refer to (sign of ω; changed only at a speed reversal, where the modes are chosen
+#: afresh), the segment of the load schedule (:func:`.forcing.load_segment`) and the generator's
+#: low-speed branch (:func:`.forcing.generator_branch`), and the flyweight governor's sleeve,
+#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``).
+SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE = range(7)
+N_SWITCHES = 7
+
+#: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
+CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
+
+#: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
+POWER_FLOW, PAPER = 0, 1
+
+#: Columns written for every output sample; then one gas column per cylinder, then
+#: ``PAIR_OUTPUTS`` for each non-ideal pair, then the dynamic governor's states
+#: (``governor.STATE_NAMES``) and, with fuel latching, the fuel latched by each cylinder.
+OUTPUTS = ("t", "phi", "omega", "epsilon", "J", "dJ_dphi", "M_gas", "M_load", "M_starter", "fuel",
+           "W_gas", "W_load", "W_starter")
+OUTPUT_UNITS = ("s", "rad", "rad/s", "rad/s^2", "kg m^2", "kg m^2/rad", "N m", "N m", "N m", "1",
+                "J", "J", "J")
+N_OUT_FIXED = len(OUTPUTS)
+COL_EPS, COL_J, COL_DJ = OUTPUTS.index("epsilon"), OUTPUTS.index("J"), OUTPUTS.index("dJ_dphi")
+COL_M_GAS, COL_M_LOAD = OUTPUTS.index("M_gas"), OUTPUTS.index("M_load")
+#: Per pair k: S_k, the moment it takes out of its shaft side (reduced to φ; the far side receives
+#: η*_k S_k), η*_k in use, the power lost (1 − η*_k) S_k ω and the energy lost so far.
+PAIR_OUTPUTS = ("S", "eta", "P_loss", "W_loss")
+PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
+
+#: Rows of the work array ``wk`` (see :func:`work_array`): transfer functions u, u′ per cylinder;
+#: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, their least value
+#: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
+#: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
+#: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
+#: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
+#: (:func:`.forcing.select_pieces`).
+(WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
+ WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_SCRATCH) = range(17)
+N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
+
+Model = namedtuple(
+    "Model",
+    [
+        "kind",  # int: CRANK_SLIDER, SWASH_PLATE, ARTICULATED or TABULATED
+        "mech",  # float64[:]: the mechanism's packed parameters
+        "kin_coef",  # float64[1 + ncyl, n, 6]: the TABULATED kind's splines (transient.core.tabulated)
+        "ncyl",  # int: number of cylinders (gas force points)
+        "J0",  # float: constant inertia of shaft, flywheel and load [kg m²]
+        "has_gas",  # bool
+        "gas_phase",  # float64[ncyl]: shaft angle at which cylinder k is at local angle 0 [rad]
+        "gas_scale",  # float64[ncyl]: force per unit table value (piston area [m²], or 1 for forces)
+        "gas_offset",  # float: table value of zero force (crankcase pressure p0 [Pa], or 0)
+        "period",  # float: cycle length in local angle [rad] (4π four-stroke, 2π two-stroke)
+        "knots",  # float64[:], piecewise-cubic table (transient.core.tables)
+        "coef",  # float64[:, 4], or [:, 8] with has_motored (full-load, then motored cubic)
+        "piece_knot",  # int64[:]
+        "has_motored",  # bool: coef pairs a motored curve; else it is the constant gas_offset
+        "breakpoints",  # float64[:]: sorted shaft angles in [0, period) where a table has a corner
+        "bp_jump",  # bool[:]: whether a cylinder's pressure jumps at each breakpoint
+        "load_const",  # float: constant resisting torque [N m]
+        "load_linear",  # float: c in −c·ω [N m s]
+        "load_fan",  # float: K in −K·ω|ω| [N m s²]
+        "load_x",  # float64[:]: corners of the load schedule, non-decreasing (empty: s ≡ 1)
+        "load_s",  # float64[:]: the load's scale s at each corner (piecewise linear between)
+        "load_comp",  # int: state component the corners are values of, T [s] or PHI [rad]
+        "gen_power",  # float: generator power P in −s·P/max(ω, ω_min) [W] (0: none)
+        "gen_min",  # float: ω_min, below it the generator's torque is held at −s·P/ω_min [rad/s]
+        "starter_torque",  # float: starter stall torque [N m]
+        "starter_noload",  # float: speed at which the starter characteristic reaches zero [rad/s]
+        "starter_cutout",  # float: speed at which the starter disengages for good [rad/s]
+        "gov_on",  # bool: a static droop governor scales the gas forces
+        "gov_full",  # float: ω_a, full fuel at and below it [rad/s]
+        "gov_zero",  # float: ω_1c, no fuel at and above it [rad/s]
+        "gov_dyn",  # int: governor with states (transient.core.governor: NONE, PI, PID, FLYWEIGHT)
+        "gov_par",  # float64[:]: its parameters (governor.P_* or governor.F_*)
+        "latch",  # bool: each cylinder's fuel is latched at its start of injection
+        "inj_angle",  # float: local angle of the start of injection [rad] (with latch)
+        "woschni",  # bool: the closed part's pressures are states (wall heat transfer, .cylinder)
+        "cyl_par",  # float64[cylinder.N_PAR]: their parameters (transient.core.cylinder)
+        "n_pairs",  # int: number of non-ideal pairs (0: ideal constraints, equation (18))
+        "eta_fwd",  # float64[n_pairs]: efficiency of pair k when its shaft side drives
+        "eta_bwd",  # float64[n_pairs]: efficiency of pair k when its far side drives
+        "policy",  # int: POWER_FLOW or PAPER
+        "link_sub",  # int64[n_links]: sub-chain of each link (shaft first, gas-carrying link last)
+        "link_J",  # float64[n_links]: constant reduced inertia of the middle links [kg m²]
+    ],
+)
+
+
+@kernel(inline="always")
+def gov_index(m):
+    """Index of the dynamic governor's first state."""
+    return N_STATE_BASE + m.n_pairs
+
+
+@kernel(inline="always")
+def latch_index(m):
+    """Index of cylinder 0's latched fuel (with ``m.latch``)."""
+    return N_STATE_BASE + m.n_pairs + gv.n_states(m.gov_dyn)
+
+
+@kernel(inline="always")
+def cyl_index(m):
+    """Index of cylinder 0's pressure state (with ``m.woschni``), after the latched fuels."""
+    return latch_index(m) + (m.ncyl if m.latch else 0)
+
+
+@kernel
+def n_state(m):
+    """Length of the state vector of model ``m``."""
+    return cyl_index(m) + (m.ncyl if m.woschni else 0)
+
+
+@kernel
+def n_outputs(m):
+    """Columns of an output row of model ``m``."""
+    return (N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs + gv.n_states(m.gov_dyn)
+            + (m.ncyl if m.latch else 0))
+
+
+@compiled
+def work_array(m):
+    """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
+    wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
+    wk[WK_SEL, 0] = np.nan  # no pieces selected yet
+    return wk

@@ -1,0 +1,193 @@
+"""The right-hand side of the reduced model and what the non-ideal pairs add to it: the serial
+chain's acceleration (:mod:`.chain`) from the sub-chains' inertias and moments, the pairs' mode
+margins that the stepper watches, and the choice of the modes afresh at a start or a reversal.
+
+:func:`derivative` is what the stepper integrates; it is inlined into each of its few call sites,
+because a call would copy the Model's flattened fields at every stage. The margins come as an
+inlined form for the root finder's iterations and as a call for the rare sites.
+"""
+from __future__ import annotations
+
+from .jit import kernel
+
+from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
+from . import governor as gv
+from .forcing import command, cylinder_rates, governor_rates, moments
+from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T, W_GAS, W_LOAD,
+                     W_LOSS0, W_STARTER, WK_DJ, WK_ETA, WK_G, WK_G_MIN, WK_J, WK_M, WK_S,
+                     WK_SCRATCH, WK_SPEED)
+
+
+@kernel(inline="always")
+def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
+    """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
+
+    Links in order: the shaft (J0 with flywheel and load; load and starter act on it), middle links
+    of constant reduced inertia ``link_J`` (the crank), and the last link with the rest of the
+    mechanism's inertia and the gas forces. Links between ideal pairs share a sub-chain.
+    """
+    for k in range(m.n_pairs + 1):
+        wk[WK_J, k] = 0.0
+        wk[WK_DJ, k] = 0.0
+        wk[WK_M, k] = 0.0
+    last = m.link_sub.shape[0] - 1
+    J_rest = J
+    for i in range(last):
+        c = m.J0 if i == 0 else m.link_J[i]
+        wk[WK_J, m.link_sub[i]] += c
+        J_rest -= c
+    wk[WK_M, m.link_sub[0]] += M_shaft
+    wk[WK_J, m.link_sub[last]] += J_rest
+    wk[WK_DJ, m.link_sub[last]] += dJ
+    wk[WK_M, m.link_sub[last]] += M_gas
+
+
+@kernel(inline="always")
+def pair_etas(m, modes, eta_out):
+    """η*_k of (25) for the mode bit mask ``modes`` (bit k set: pair k backward)."""
+    for k in range(m.n_pairs):
+        eta_out[k] = eta_star(m.eta_fwd[k], m.eta_bwd[k], ((modes >> k) & 1) == 0)
+
+
+@kernel(inline="always")
+def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
+    """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)."""
+    if m.n_pairs == 0:
+        return (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J
+    return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+
+
+@kernel(inline="always")
+def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
+    """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
+    and the pairs' η*, S in the rows of ``wk``."""
+    n = m.n_pairs
+    split_subchains(m, J, dJ, M_gas, M_shaft, wk)
+    pair_etas(m, sw[SW_MODES], wk[WK_ETA])
+    return chain_solve(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], wk[WK_ETA, :n], w,
+                       wk[WK_S, :n])
+
+
+@kernel(inline="always")
+def derivative(m, angle_mode, y, sel, sw, wk, out):
+    """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
+
+    Inlined into its callers, because as a call, passing the Model (numba flattens it into ~130
+    scalar arguments) would cost about as much as the right-hand side itself.
+
+    In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
+    (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
+    """
+    # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
+    with_dJ = not angle_mode or m.n_pairs > 0
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, with_dJ)
+    # the speed's range over a step's stages: a speed event inside the step shows here
+    wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w)
+    wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w)
+    M = M_gas + M_load + M_starter
+    loss = 0.0  # Σ (1 − η*) S, the moment equivalent of the pairs' losses
+    q = 1.0 if angle_mode else w  # work per unit of the independent variable
+    if m.n_pairs == 0:  # equation (18); no chain to solve (a scene without pairs pays nothing)
+        a = (M - 0.5 * dJ * w * w) / J  # read in time mode only (in crank angle dJ may be NaN)
+    else:
+        a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+        mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
+        for k in range(m.n_pairs):
+            lk = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
+            out[W_LOSS0 + k] = lk * q
+            loss += lk
+            wk[WK_G_MIN, k] = min(wk[WK_G_MIN, k], wk[WK_G, k])
+    out[W_GAS] = M_gas * q
+    out[W_LOAD] = M_load * q
+    out[W_STARTER] = M_starter * q
+    if m.gov_dyn != gv.NONE or m.latch:
+        governor_rates(m, w, y, 1.0 / w if angle_mode else 1.0, sw, wk, out)
+    if m.woschni:
+        cylinder_rates(m, angle_mode, y, sel, w, command(m, w, y, sw), wk, out)
+    if angle_mode:
+        out[PHI] = 1.0
+        out[T] = 1.0 / w
+        out[KINETIC] = M - loss
+    else:
+        out[PHI] = w
+        out[T] = 1.0
+        out[OMEGA] = a
+
+
+@kernel(inline="always")
+def mode_margins(m, sw, wk):
+    """How far each pair's held mode is from switching, into ``wk[WK_G]`` (after
+    :func:`acceleration`); a mode switch is due where a margin falls to zero.
+
+    ``power-flow``: the power the pair transmits must have the mode's sign, S_k σ ≥ 0 forward,
+    S_k σ < 0 backward. ``paper``: criterion (25) on the moments of everything on the shaft side,
+    (Σ_{j≤k} M_j) σ ≥ 0 forward (``transient.core.chain.modes_paper``).
+    """
+    sigma = sw[SW_DIRECTION]
+    upstream = 0.0
+    for k in range(m.n_pairs):
+        upstream += wk[WK_M, k]
+        v = wk[WK_S, k] if m.policy == POWER_FLOW else upstream
+        if (sw[SW_MODES] >> k) & 1:
+            wk[WK_G, k] = -v * sigma
+        else:
+            wk[WK_G, k] = v * sigma
+
+
+@kernel(inline="always")
+def margins_inline(m, angle_mode, y, sel, sw, wk):
+    """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``; inlined into the
+    stepper's root finder, whose iterations evaluate them most: there a call would copy the Model
+    at every iteration."""
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
+    acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
+    mode_margins(m, sw, wk)
+
+
+@kernel
+def margins_at(m, angle_mode, y, sel, sw, wk):
+    """:func:`margins_inline` as a call: one compiled copy of the model's terms for the sites
+    that evaluate the margins rarely."""
+    margins_inline(m, angle_mode, y, sel, sw, wk)
+
+
+@kernel
+def choose_modes(m, angle_mode, y, sel, sw, wk):
+    """Choose σ and the pair modes afresh at state ``y`` (start of a run, speed reversal).
+
+    With ω ≠ 0, σ = sign ω; ``power-flow`` takes the unique consistent mode vector
+    (``chain.modes_power_flow``), ``paper`` criterion (25). At rest, the incipient motion decides:
+    σ is the direction the chain starts to move in; if the pairs' friction holds the applied
+    moments in both directions the chain is locked. Sets ``sw[SW_DIRECTION]`` and
+    ``sw[SW_MODES]``. Returns the status of ``chain.modes_power_flow``: UNIQUE, LOCKED, or (a
+    rounding tie S_k ≈ 0, resolved by its documented rule) AMBIGUOUS or NONE_CONSISTENT.
+    """
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
+    n = m.n_pairs
+    if n == 0:
+        sw[SW_DIRECTION] = -1 if w < 0.0 else 1
+        sw[SW_MODES] = 0
+        return UNIQUE
+    split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
+    a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
+                                         wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,
+                                         wk[WK_ETA, :n], wk[WK_S, :n],
+                                         wk[WK_SCRATCH: WK_SCRATCH + 4, :n])
+    if status == LOCKED:
+        return status
+    if w != 0.0:
+        sw[SW_DIRECTION] = 1 if w > 0.0 else -1
+    else:
+        sw[SW_DIRECTION] = 1 if a > 0.0 else -1
+    modes = 0
+    upstream = 0.0
+    for k in range(n):
+        upstream += wk[WK_M, k]
+        if m.policy == POWER_FLOW:
+            backward = wk[WK_ETA, k] != m.eta_fwd[k]
+        else:
+            backward = upstream * sw[SW_DIRECTION] < 0.0
+        if backward:
+            modes |= 1 << k
+    sw[SW_MODES] = modes
+    return status

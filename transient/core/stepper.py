@@ -1,0 +1,580 @@
+"""The compiled stepper: an embedded Runge–Kutta pair with dense output, driven segment by segment
+between breakpoints, with state events located on the dense output (DESIGN §2; Hairer, Nørsett &
+Wanner, *Solving ODEs I*, §II.6 and §II.10).
+
+One loop for every pair in :mod:`.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
+fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).
+While ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint,
+so the right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal)
+it integrates in time, and a step that would cross a breakpoint is retaken so that it ends on it
+(:mod:`.breakpoints`). The events (:mod:`.events`) truncate the step they fall in; acting on one
+changes the switches, the state or the independent variable (:func:`_switch_at_event`).
+
+Each turn of the loop in :func:`_advance` is: the segment's end
+(:func:`.breakpoints._segment_end`) and the step size (:func:`_step_size`), a step attempt
+(:func:`_start_attempt`, the step, :func:`_judge_attempt`), its acceptance or rejection and the
+next step size, the retake for a breakpoint crossed in time, the event location
+(:func:`.events._locate_events`), the output samples inside the step (:func:`_emit_step_samples`),
+and either the step taken whole (:func:`_take_step`) or the state moved to the event and the event
+acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`). The step and
+the right-hand side at a restart are called in the loop itself, not inside a piece: inlined
+functions nested a level deeper cost numba's inliner noticeably more compile time.
+
+:func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
+the Python caller can stream results, show progress and react to Ctrl-C between chunks
+(:mod:`.stepper_io`).
+
+The pieces of the loop, and the helpers called once per step or per root-finding iteration that
+take the Model, are inlined (``inline="always"``), each at its one call site or at a few where it
+is small: a call that is not inlined copies the Model's ~150 flattened words onto the stack
+(:mod:`.jit`). Calls that run rarely, or whose callee is too large to copy at several sites (the
+dense output, the margins, the output row), stay calls. The margins and the output row are
+inlined at one site each, into a small function: the margins into the root finder, whose
+iterations evaluate them most (``rhs.margins_inline``), the output row into the writing of the
+grid's samples (``outputs.output_row_inline``); inlining the margins into the step's samples too
+would cost much cold compile for little.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import compiled, kernel
+
+from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
+from .chain import AMBIGUOUS, NONE_CONSISTENT
+from .chain import LOCKED as LOCKED_STATUS
+from .events import (DEMAND_COMP, MAX_UNSEEN, N_MARGIN_SAMPLES, PAIR_COMP, _dense_once, _event_g,
+                     _locate_events, _sleeve_stops)
+from . import governor as gv
+from .forcing import (generator_branch, governor_branch, inertia, load_segment, speed,
+                      start_branch)
+from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_MODES, T, WK_DEMAND, WK_G, WK_G_MIN,
+                     WK_SPEED, cyl_index, gov_index, n_state, work_array)
+from .rhs import choose_modes, derivative, margins_at
+from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
+from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
+                         C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR,
+                         EV_GOVERNOR, EV_LOAD, EV_PAIR_MODE, EV_REVERSAL,
+                         EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_TO_ANGLE,
+                         EV_TO_TIME, F_ERR_OLD, F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T,
+                         F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
+                         I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_F_VALID, I_FLIPPED,
+                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_MODES, I_NBAD, I_NCHATTER, I_NEV,
+                         I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS, I_NSWITCH,
+                         I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED, I_STARTER_ON,
+                         I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event, _emit_row,
+                         _emit_samples, _finish, _locked, _out_spacing, _reset_output_grid,
+                         _retake)
+
+# Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
+# tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
+# not accuracy, sets the step: the problem is stiff for an explicit method.
+STIFF_COUNT, NONSTIFF_RESET = 15, 6
+# State events closer together than this (rad in crank angle; × the output spacing in time) count
+# as no progress; this many in a row is chattering, which is reported, never looped on.
+CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
+
+
+@compiled(nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
+def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
+    """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
+
+    Parameters
+    ----------
+    m : Model
+    tab : tableaus.Tableau
+        The Runge–Kutta pair (DOP853, DOPRI5).
+    cfg : float64[N_CFG]
+        Settings, indices ``C_*`` (:mod:`.stepper_io`, as the other layouts and codes).
+    bp : float64[:]
+        Sorted breakpoints in [0, m.period).
+    y : float64[layout.n_state(m)]
+        State, updated in place.
+    fst, ist : float64[fst_size(m)], int64[N_IST]
+        Stepper state kept between calls (zeros before the first call, except
+        ``fst[F_PASSED_BP] = nan`` and ``ist[I_STARTER_ON]``).
+    outbuf : float64[nbuf, layout.n_outputs(m)]
+        Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
+    evbuf : float64[nev, 4]
+        Events (code, t, φ, ω); ``ist[I_NEV]`` rows filled.
+
+    Returns
+    -------
+    int
+        RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED (the speed reached zero in a run
+        that ends only by revolutions), LOCKED (at rest, the friction of the non-ideal pairs holds
+        the applied moments), CHATTERING (pair modes switching without progress) or STIFF
+        (Hairer's stiffness test fired).
+    """
+    n = n_state(m)
+    K = np.empty((tab.n_ext, n))
+    F = np.empty((3 + tab.D.shape[0], n))
+    gs = np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1)))  # pair mode margins over a step
+    return _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, np.empty(n), np.empty(n),
+                    np.empty(n), np.empty(n), work_array(m), gs)
+
+
+@kernel
+def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk, gs):
+    """:func:`advance` in buffers allocated by it, compiled as a kernel (no reference counting,
+    :mod:`.jit`): the stepper loop passes arrays to its helpers at every step."""
+    rtol = cfg[C_RTOL]
+    atol = cfg[C_ATOL]
+    margin = 300  # rows kept free: a step never spans more than 256 output intervals
+    g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics,
+    g1 = g0 + gv.n_states(m.gov_dyn)
+    c0 = cyl_index(m)  # and so are the cylinder pressures y[c0:]
+
+    if ist[I_STARTED] == 0:
+        status = _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk)
+        if status != RUNNING:
+            return status
+    # As the last chunk left them: its derivative and margins (F_DERIV), if valid, and the
+    # counters of the retaken attempts; kept again where this chunk ends.
+    if ist[I_F_VALID] == 1:
+        _carry(fst, f, gs, m.n_pairs, False)
+    n_bad = ist[I_NBAD]  # consecutive non-finite step attempts
+    n_unseen = ist[I_NUNSEEN]  # consecutive attempts retaken for a crossing no sample found
+    rejected = ist[I_REJECTED] == 1  # the last attempt was rejected by the error test
+    steps_here = 0
+    while True:
+        if (ist[I_NOUT] + margin >= outbuf.shape[0] or ist[I_NEV] + 8 >= evbuf.shape[0]
+                or steps_here >= cfg[C_CHUNK_STEPS]):
+            _carry(fst, f, gs, m.n_pairs, True)
+            ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
+            return RUNNING
+        angle_mode = ist[I_ANGLE_MODE] == 1
+        sw = ist[:N_SWITCHES]
+        ix = PHI if angle_mode else T
+        x = y[ix]
+        if not angle_mode and y[OMEGA] < 0.0 and not np.isfinite(cfg[C_T_END]):
+            # A run that ends only by revolutions, turning backwards (from rest, or given a
+            # negative speed), would never reach them: report it as a stall, with what was
+            # computed, instead of integrating on.
+            _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+            return STALLED
+        if ist[I_F_VALID] == 0:
+            # The derivative and the pairs' margins afresh (called here, not in a helper: an
+            # inlined right-hand side nested a level deeper costs numba's inliner much more).
+            ahead = _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf)
+            derivative(m, angle_mode, y, ahead, sw, wk, f)
+            _restarted(cfg, angle_mode, fst, ist)
+
+        # The segment and the step size.
+        x_end, up, down, h_max, tol_end, corner = _segment_end(m, cfg, bp, angle_mode, ix, x, y,
+                                                               sw, fst)
+        if x_end - x <= tol_end:
+            return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
+        fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
+        h, h_planned, at_segment_end = _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end)
+        min_step = 10.0 * (np.nextafter(abs(x), np.inf) - abs(x))
+        if h < min_step:
+            return FAIL_STEP
+        if angle_mode:
+            sel = x + 0.5 * h
+        else:
+            sel = y[PHI] + 0.5 * h * y[OMEGA]
+
+        # The step attempt (the step called here, not in a helper: its inlined right-hand side
+        # nested a level deeper costs numba's inliner much more), its acceptance and the next
+        # step size.
+        _start_attempt(f, K, wk)
+        _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
+                                                      rtol, atol, g0, g1, c0,
+                                                      at_segment_end and x_end == corner, corner)
+        if not finite:
+            # A trial step may leave the physical region (K < 0 in a stage): shrink it; only a
+            # non-finite value that persists at small steps is a failure.
+            n_bad += 1
+            if n_bad > 30:
+                return FAIL_NONFINITE
+            _retake(fst, ist, 0.2 * h)
+            steps_here += 1
+            continue
+        n_bad = 0
+        if fixed:
+            err = 0.0  # every step is accepted; the step size alone sets the accuracy
+        if err > 1.0:
+            _retake(fst, ist, h * _shrink(tab, err))
+            ist[I_NREDO] = 0  # a shorter step no longer ends on the breakpoint it aimed at
+            steps_here += 1
+            rejected = True
+            continue
+        h_next = _accepted_size(tab, err, h, h_planned, at_segment_end, rejected, fst)
+        rejected = False
+        if not fixed and _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
+            # the run so far is kept; the state is the accepted step's start
+            if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
+                _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+            return STIFF
+        retake, dense_ready = _aim_at_breakpoint(tab, m, angle_mode, y, y_new, h, sel, sw, K, F,
+                                                 tmp, wk, fst, ist, up, down, min_step)
+        if retake:
+            steps_here += 1
+            continue
+        redo_hit_breakpoint = ist[I_NREDO] > 0 or dense_ready
+        ist[I_NREDO] = 0
+
+        # State events on this step: the earliest one truncates it.
+        ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready = _locate_events(
+            tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist, dip,
+            dense_ready, w_lo, w_hi)
+        if unseen and ev_code < 0 and n_unseen < MAX_UNSEEN:
+            _retake(fst, ist, 0.5 * h)  # computed again, shorter
+            n_unseen += 1
+            steps_here += 1
+            continue
+        n_unseen = 0
+        x_stop = x + h if ev_code < 0 else x + ev_theta * h
+        _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F,
+                           tmp, wk, outbuf, ist, fst, dense_ready)
+        ist[I_NSTEPS] += 1
+        steps_here += 1
+        fst[F_H] = h_next
+        fst[F_SEL] = sel
+        if ev_code < 0:
+            status = _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up,
+                                redo_hit_breakpoint, y, y_new, f, K, gs, sel, sw, outbuf, evbuf,
+                                ist, fst, wk)
+            if status != RUNNING:
+                return status
+            continue
+
+        # Truncate the step at the event, act on it and restart from there.
+        x_stop, on_breakpoint = _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp,
+                                               ev_level, at_segment_end and x_end == up, x_end,
+                                               tol_end, F, y, y_evt, sel, sw, wk, ist)
+        status = _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw,
+                               outbuf, evbuf, ist, fst, wk)
+        if status != RUNNING:
+            return status
+        _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y,
+                         ist, fst, wk)
+
+
+@kernel(inline="always")
+def _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk):
+    """The first chunk's start: the switches chosen at the initial state, the independent
+    variable, the output grid and the first row. Returns RUNNING, or LOCKED where the pairs'
+    friction holds the machine at rest."""
+    ist[I_STARTED] = 1
+    fst[F_ERR_OLD] = 1e-4
+    ist[I_GOV_BRANCH] = start_branch(m, y[OMEGA], y)
+    # (time only increases; the shaft angle as ω's sign says, forward from rest)
+    ist[I_LOAD_SEG] = load_segment(m, y[m.load_comp], m.load_comp == T or y[OMEGA] >= 0.0)
+    ist[I_GEN_LOW] = generator_branch(m, y[OMEGA], True)
+    fst[F_LAST_SWITCH] = np.nan
+    if _start_modes(m, y, y[PHI], ist, wk) == LOCKED_STATUS:
+        return _locked(m, y, y[PHI], outbuf, evbuf, ist, fst, wk)
+    if y[OMEGA] >= cfg[C_W_HI]:
+        _to_angle_mode(m, y, ist, wk)
+    fst[F_SEL] = y[PHI]
+    _reset_output_grid(cfg, ist, fst, y)
+    _emit_row(m, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, wk)
+    return RUNNING
+
+
+@kernel(inline="always")
+def _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf):
+    """Where the step before did not leave the derivative and the margins valid (a start, an
+    event, a breakpoint that changes the state or where a pressure jumps): the pairs' margins
+    ``gs[0]`` at the state, with the modes settled; returns the angle that picks the table pieces
+    for the derivative there."""
+    # (the table piece just ahead in the direction of motion: on a breakpoint, rounding of the
+    # shaft angle must not pick the piece behind it)
+    ahead = y[PHI] + (1e-9 if angle_mode or y[OMEGA] >= 0.0 else -1e-9)
+    if m.n_pairs > 0:
+        _settle_modes(m, angle_mode, y, ahead, sw, wk, gs, ist, evbuf)
+        ist[I_NFEV] += 1
+    return ahead
+
+
+@kernel(inline="always")
+def _restarted(cfg, angle_mode, fst, ist):
+    """The derivative at the state is valid again; the first step's size if none is set."""
+    ist[I_NFEV] += 1
+    ist[I_F_VALID] = 1
+    if fst[F_H] <= 0.0:
+        # Initial step: a fixed fraction of a revolution (angle) or of the output spacing.
+        fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
+
+
+@kernel(inline="always")
+def _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end):
+    """The size of the next attempt, the size planned before a cut to the segment's end, and
+    whether the attempt ends on the segment's end: ``(h, h_planned, at_segment_end)``."""
+    h = cfg[C_FIXED_STEP] if fixed else min(fst[F_H], h_max)
+    h_planned = h
+    at_segment_end = False
+    if x + h >= x_end - tol_end:
+        h = x_end - x
+        at_segment_end = True
+    return h, h_planned, at_segment_end
+
+
+@kernel(inline="always")
+def _start_attempt(f, K, wk):
+    """Before a step attempt: its first stage is the derivative carried over, and the ranges
+    its stages record (the margins' least values, the speed's and the PI demand's ranges) are
+    reset."""
+    for i in range(f.shape[0]):
+        K[0, i] = f[i]
+    wk[WK_G_MIN, :] = np.inf
+    wk[WK_SPEED, 0] = np.inf
+    wk[WK_SPEED, 1] = -np.inf
+    wk[WK_DEMAND, 0] = np.inf
+    wk[WK_DEMAND, 1] = -np.inf
+
+
+@kernel(inline="always")
+def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, c0, on_corner,
+                   corner):
+    """After the step attempt of size h from y (stages in K, new state in y_new): ``(finite, err,
+    dip, w_lo, w_hi)``, with the pairs' margins at y_new into ``gs[N_MARGIN_SAMPLES]``.
+
+    ``err``: the error norm; ``finite``: it and y_new are finite; ``dip``: some pair's margin
+    reached zero in a stage (:func:`.events._locate_events` then samples them); ``w_lo``,
+    ``w_hi``: the speed's range over the stages, read before any dense output adds its own stages
+    to it. ``on_corner``: the step ends on a load-schedule corner.
+    """
+    n = y.shape[0]
+    if on_corner:
+        y_new[ix] = corner  # x + (corner − x) can miss it by an ulp: the event needs g = 0
+    w_lo, w_hi = wk[WK_SPEED, 0], wk[WK_SPEED, 1]
+    # (the step's last right-hand side is at y_new: WK_G holds the margins there)
+    dip = False
+    for k in range(m.n_pairs):
+        gs[N_MARGIN_SAMPLES, k] = wk[WK_G, k]
+        # a margin that starts at or above zero and dips below, or above and reaches it
+        g_min = wk[WK_G_MIN, k]
+        dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
+    ist[I_NFEV] += tab.n_stages
+    err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0)
+    finite = np.isfinite(err)
+    for i in range(n):
+        finite = finite and np.isfinite(y_new[i])
+    return finite, err, dip, w_lo, w_hi
+
+
+@kernel(inline="always")
+def _accepted_size(tab, err, h, h_planned, at_segment_end, after_rejection, fst):
+    """The next step's size after a step of size h accepted with error norm ``err``; keeps the
+    error for the next step's PI control."""
+    factor = _grow(tab, err, fst[F_ERR_OLD], after_rejection)
+    fst[F_ERR_OLD] = max(err, 1e-4)
+    h_next = h * factor
+    if at_segment_end and not after_rejection:
+        # a step cut short to end on a breakpoint says nothing against the step planned
+        h_next = max(h_next, min(h_planned, h_planned * factor))
+    return h_next
+
+
+@kernel(inline="always")
+def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
+    """Count an accepted step in Hairer's stiffness test (``STIFF_COUNT``); True when stiff."""
+    if _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol) > tab.stiff_bound:
+        ist[I_NONSTIFF] = 0
+        ist[I_STIFF] += 1
+        return ist[I_STIFF] >= STIFF_COUNT
+    ist[I_NONSTIFF] += 1
+    if ist[I_NONSTIFF] >= NONSTIFF_RESET:
+        ist[I_STIFF] = 0
+    return False
+
+
+@kernel(inline="always")
+def _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F, tmp,
+                       wk, outbuf, ist, fst, dense_ready):
+    """The output grid's samples inside the step, up to ``x_stop`` (its end, or its event), from
+    the dense output."""
+    if fst[F_NEXT_OUT] <= x_stop:
+        _dense_once(dense_ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
+        _emit_samples(m, F, y, x, h, x_stop, ix, _out_spacing(cfg, angle_mode), sel, sw, outbuf,
+                      ist, fst, tmp, wk)
+
+
+@kernel(inline="always")
+def _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_breakpoint, y,
+               y_new, f, K, gs, sel, sw, outbuf, evbuf, ist, fst, wk):
+    """The accepted step, without an event in it, becomes the state (with its derivative and
+    margins carried over); a breakpoint it ends on acts. Returns RUNNING, or FINISHED where the
+    run ends with it."""
+    n = y.shape[0]
+    ist[I_AT_EVENT] = 0
+    for i in range(n):
+        y[i] = y_new[i]
+        f[i] = K[tab.n_stages, i]
+    for k in range(gs.shape[1]):
+        gs[0, k] = gs[N_MARGIN_SAMPLES, k]
+        if gs[0, k] < 0.0:
+            # A margin that the step's end leaves below zero (a root on the step's end, by
+            # rounding on its far side) would never be seen falling: the next step settles the
+            # modes first (_settle_modes).
+            ist[I_F_VALID] = 0
+    if angle_mode and at_segment_end and x_end == up:
+        _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
+        if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+            ist[I_F_VALID] = 0
+    elif redo_hit_breakpoint:
+        fst[F_PASSED_BP] = fst[F_REDO_LEVEL]
+        _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
+        if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+            ist[I_F_VALID] = 0
+    if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
+        return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
+    if not angle_mode and at_segment_end and x_end == cfg[C_T_END]:
+        return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
+    return RUNNING
+
+
+@kernel(inline="always")
+def _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level, ends_on_breakpoint,
+                   x_end, tol_end, F, y, y_evt, sel, sw, wk, ist):
+    """The state at the event (at θ = ``ev_theta`` of the step, independent variable
+    ``x_stop``), put exactly on the event's level, becomes the state. Returns ``(x_stop,
+    on_breakpoint)``: an event within rounding of the breakpoint the step ends on (a pair whose
+    power changes sign at a pressure corner, a load corner there) is on it, and the state goes
+    exactly there, so that both are recorded (else the next step would take the breakpoint as
+    passed, unseen)."""
+    _dense_eval(F, y, ev_theta, y_evt)
+    on_breakpoint = angle_mode and ends_on_breakpoint and x_end - x_stop <= tol_end
+    if on_breakpoint:
+        x_stop = x_end
+    y_evt[ix] = x_stop
+    if ev_comp >= PAIR_COMP:
+        pass  # the margin is zero here to the root finder's accuracy; nothing to put on a level
+    elif ev_comp == DEMAND_COMP:
+        # the demand onto the limit exactly, by its integrator (a shift of the root finder's
+        # accuracy), so that the next step starts on the level and does not cross it again
+        y_evt[gov_index(m) + gv.PI_INTEGRAL] -= _event_g(m, angle_mode, y_evt, ev_comp,
+                                                         ev_level, sel, sw, wk)
+    elif ev_comp != OMEGA:
+        y_evt[ev_comp] = ev_level
+    elif angle_mode:  # put the speed exactly on the level: K = ½ J ω²
+        J = inertia(m, y_evt[PHI], wk)
+        y_evt[KINETIC] = 0.5 * J * ev_level * ev_level
+    else:
+        y_evt[OMEGA] = ev_level
+    for i in range(y.shape[0]):
+        y[i] = y_evt[i]
+    ist[I_F_VALID] = 0
+    return x_stop, on_breakpoint
+
+
+@kernel(inline="always")
+def _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw, outbuf,
+                  evbuf, ist, fst, wk):
+    """The event (and a breakpoint it sits on) into the event buffer, and the ends of a run it
+    may bring: the end, a stall, the pairs locking at rest, chattering. Returns RUNNING, or the
+    code the run ends with."""
+    if on_breakpoint:
+        _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
+        _at_breakpoint(m, bp, y, sw, evbuf, ist, wk)
+    _emit_event(m, evbuf, ist, ev_code, y, wk)
+    if ev_code == EV_END:
+        return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
+    if ev_code == EV_REVERSAL and not np.isfinite(cfg[C_T_END]):
+        # A run that ends only by revolutions would never end once the shaft stops: report
+        # the stall (with what was computed) instead of integrating on.
+        _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+        return STALLED
+    if ev_code == EV_REVERSAL and m.n_pairs > 0:
+        # At rest the pairs may hold the applied moments; else the modes start afresh.
+        if _start_modes(m, y, sel, ist, wk) == LOCKED_STATUS:
+            return _locked(m, y, sel, outbuf, evbuf, ist, fst, wk)
+    gap = CHATTER_GAP * (1.0 if angle_mode else cfg[C_DT_OUT])
+    ist[I_NCHATTER] = ist[I_NCHATTER] + 1 if abs(x_stop - fst[F_LAST_SWITCH]) < gap else 0
+    fst[F_LAST_SWITCH] = x_stop
+    if ist[I_NCHATTER] >= CHATTER_COUNT:
+        ist[I_CHATTER_CODE] = ev_code
+        _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+        return CHATTERING
+    ist[I_AT_EVENT] = ev_code + 1
+    return RUNNING
+
+
+@kernel(inline="always")
+def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y, ist,
+                     fst, wk):
+    """What the event switches: a pair's mode, the starter, the governor's branch, the load
+    schedule's segment, the generator's branch, the sleeve on or off a stop, or the independent
+    variable (with the next step's size converted by ω = level and the output grid of the new
+    variable)."""
+    if ev_code == EV_PAIR_MODE:
+        ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
+        ist[I_NSWITCH] += 1
+        ist[I_FLIPPED] = ev_comp - PAIR_COMP + 1
+    elif ev_code == EV_STARTER_CUTOUT:
+        ist[I_STARTER_ON] = 0
+    elif ev_code == EV_GOVERNOR and ev_comp == DEMAND_COMP:
+        ist[I_GOV_BRANCH] = gv.demand_branch(m.gov_par, ev_level, ev_rising)
+    elif ev_code == EV_GOVERNOR:
+        ist[I_GOV_BRANCH] = governor_branch(m, ev_level, ev_rising)
+    elif ev_code == EV_LOAD:
+        # past the corner (and past its twin, for a step) in the direction of motion
+        ist[I_LOAD_SEG] = load_segment(m, ev_level, ev_rising)
+    elif ev_code == EV_GENERATOR:
+        ist[I_GEN_LOW] = generator_branch(m, ev_level, ev_rising)
+    elif ev_code == EV_SLEEVE_STOP:
+        J = inertia(m, y[PHI], wk)
+        ist[I_SLEEVE] = _sleeve_stops(m, y, ev_level, speed(J, angle_mode, y))
+    elif ev_code == EV_SLEEVE_FREE:
+        ist[I_SLEEVE] = gv.FREE
+    elif ev_code == EV_TO_TIME:
+        _to_time_mode(m, y, ist, wk)
+        fst[F_H] = h_next / ev_level
+        _reset_output_grid(cfg, ist, fst, y)
+    elif ev_code == EV_TO_ANGLE:
+        _to_angle_mode(m, y, ist, wk)
+        fst[F_H] = h_next * ev_level
+        _reset_output_grid(cfg, ist, fst, y)
+
+
+@kernel
+def _to_angle_mode(m, y, ist, wk):
+    """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
+    J = inertia(m, y[PHI], wk)
+    y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
+    ist[I_ANGLE_MODE] = 1
+
+
+@kernel
+def _to_time_mode(m, y, ist, wk):
+    """Time becomes the independent variable; the third state becomes ω."""
+    J = inertia(m, y[PHI], wk)
+    y[OMEGA] = speed(J, True, y)
+    ist[I_ANGLE_MODE] = 0
+
+
+@kernel(inline="always")
+def _settle_modes(m, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
+    """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
+    just switched sits on its level (margin 0). Any other pair already past its level here (two
+    pairs switching within the event location's accuracy) is switched now, so that no step starts
+    with a mode against its criterion: the stepper watches a margin only while it is positive."""
+    margins_at(m, angle_mode, y, sel, sw, wk)
+    flipped = ist[I_FLIPPED] - 1
+    ist[I_FLIPPED] = 0
+    changed = False
+    for k in range(m.n_pairs):
+        if k != flipped and wk[WK_G, k] < 0.0:
+            sw[SW_MODES] ^= 1 << k
+            ist[I_NSWITCH] += 1
+            changed = True
+            _emit_event(m, evbuf, ist, EV_PAIR_MODE, y, wk)
+    if changed:
+        margins_at(m, angle_mode, y, sel, sw, wk)
+        ist[I_NFEV] += 1
+    for k in range(m.n_pairs):
+        gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]
+
+
+@kernel
+def _start_modes(m, y, sel, ist, wk):
+    """Choose σ and the pair modes afresh (start, speed reversal; time domain); a rounding tie
+    that the kernel had to resolve by its rule is counted (``I_NTIES``)."""
+    status = choose_modes(m, False, y, sel, ist[:N_SWITCHES], wk)
+    if status == AMBIGUOUS or status == NONE_CONSISTENT:
+        ist[I_NTIES] += 1
+    return status
