@@ -230,45 +230,61 @@ def test_registry_free_cache_sets_up_what_the_refresh_would_for_loaded_code():
 
 LOAD_PROBE = """
 import importlib.util, sys
-import numpy as np
+import llvmlite.binding as ll
 from transient.core.jit import compiled
 spec = importlib.util.spec_from_file_location("kern", sys.argv[1])
 module = sys.modules["kern"] = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(module)
-fn = compiled(module.allocate_and_hash)
+double, allocate, hash_new = (compiled(getattr(module, name))
+                              for name in ("double", "allocate", "hash_new"))
+assert double(2.5) == 5.0  # (loading it imports none of numba's string or array code)
+secrets = [bool(ll.address_of_symbol(f"_numba_hashsecret_{name}"))
+           for name in ("djbx33a_suffix", "siphash_k0", "siphash_k1")]
+assert allocate(5) == 7.0
 s = "piston" * 3
-assert fn(5, s) == (7.0, hash(s)), (fn(5, s), hash(s))
-print(sum(fn.stats.cache_hits.values()), sum(fn.stats.cache_misses.values()),
-      "numba.np.arraymath" in sys.modules)
+assert hash_new(s) == hash(s + "!"), (hash_new(s), hash(s + "!"))
+print(*(sum(sum(f.stats.cache_hits.values()) for f in (double, allocate, hash_new)),
+        sum(sum(f.stats.cache_misses.values()) for f in (double, allocate, hash_new))),
+      "numba.np.arraymath" in sys.modules, *secrets)
 """
 
-
-ALLOCATE_AND_HASH = """
+KERNELS = """
 import numpy as np
 
 
-def allocate_and_hash(n, s):
+def double(x):
+    return 2 * x
+
+
+def allocate(n):
     a = np.empty(n)
     for i in range(n):
         a[i] = i
-    return a[n - 1] + a[n - 2], hash(s)
+    return a[n - 1] + a[n - 2]
+
+
+def hash_new(s):
+    return hash(s + "!")  # (a new string: its hash computed in machine code)
 """
 
 
 def test_registry_free_cache_loads_code_that_allocates_and_hashes(tmp_path):
     """Compiled in one process, loaded in another (with another hash seed) without the
-    registries: a function that allocates (the NRT) and hashes a string (the hash secrets)."""
+    registries: once the first function is loaded the hash secrets are there (before any of
+    numba's string code is loaded, which would set them up too); a function that allocates
+    (the NRT); one that hashes a new string (the hash secrets)."""
     source = tmp_path / "kern.py"
-    source.write_text(ALLOCATE_AND_HASH)
+    source.write_text(KERNELS)
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
     out = [subprocess.run([sys.executable, "-c", LOAD_PROBE, str(source)], cwd=REPO,
                           env={**env, "PYTHONHASHSEED": seed}, capture_output=True, text=True,
                           timeout=300) for seed in ("1", "2")]
     assert out[0].returncode == 0, out[0].stderr
-    assert out[0].stdout.split() == ["0", "1", "True"]  # compiled, with the registries
-    assert out[1].returncode == 0, f"{REGISTRY_FREE}: {out[1].stderr}"
-    assert out[1].stdout.split() == ["1", "0", "False"], (
-        f"{REGISTRY_FREE} should load without numba's compiler registries: {out[1].stdout}")
+    assert out[0].stdout.split() == ["0", "3", "True", "True", "True", "True"]  # compiled
+    assert out[1].returncode == 0, f"{REGISTRY_FREE}: exit {out[1].returncode}, {out[1].stderr}"
+    assert out[1].stdout.split() == ["3", "0", "False", "True", "True", "True"], (
+        f"{REGISTRY_FREE} should load without numba's compiler registries, with the NRT and "
+        f"the hash secrets set up (cache hits, misses, registries, secrets): {out[1].stdout}")
 
 
 # ----------------------------------------------------------------------------------------------
