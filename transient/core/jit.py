@@ -14,9 +14,9 @@ caller allocated); the few that allocate (the stepper's ``advance``, work arrays
 The replacements rely on numba internals, so they are on only under the numba release they were
 checked against (:data:`NUMBA_CHECKED`, pinned in pyproject.toml;
 ``tests/unit/test_numba_internals.py`` checks each internal they rely on). Under any other
-release ``compiled`` is plain ``njit(cache=True)``, with a warning at import: correct, slower to
-start and to compile, because a replacement running on internals that changed could load wrong
-code or deadlock instead of failing.
+release ``compiled`` is plain ``njit(cache=True)``, with a warning at import: correct, if slower
+to start and to compile, because a replacement running on changed internals could misbehave
+without failing.
 """
 from __future__ import annotations
 
@@ -62,7 +62,7 @@ class _RegistryFreeCache(FunctionCache):
 
     numba's ``load_overload`` begins with ``target_context.refresh()``, which imports and
     installs the typing and lowering registries of everything numba compiles (its numpy, typed
-    containers, random generators; ``numba.np.arraymath`` imports scipy.linalg): most of a warm
+    containers, random generators; ``numba.np.arraymath`` imports scipy.linalg): much of a warm
     start's time, and needed only to compile. Running loaded machine code needs two things that
     refresh would have set up, so they are set up here: the reference-counting runtime (NRT),
     which the allocating functions call, and the hash secrets that numba's hashing code reads as
