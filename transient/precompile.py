@@ -1,20 +1,23 @@
 """Compile the stepper's callees in a helper process while this process compiles the stepper.
 
-On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) takes
-~210–270 s on the slower test machine, on one core: while numba types the stepper it compiles,
-one after another, each callee that is not inlined (the dense output, the root finders, the
-output row, the start and the end of a run), ~110 s of it. A helper process started at the same
-time compiles those callees in the reverse order, each under its compile lock
-(:func:`transient.core.jit._compile_once_across_processes`). The stepper's compile loads each
-callee the helper has saved, waits for the one the helper is compiling, and compiles the others
-itself; nothing is compiled twice. Measured on the coasting cylinder: 141–142 s against 219–242 s
-(README *Start-up*, *A helper compiles the stepper's callees*).
+On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) is the bulk of
+a first run, on one core: while numba types the stepper it compiles, one after another, each
+callee that is not inlined (the dense output, the root finders, the output row, the start and
+the end of a run). A helper process started at the same time compiles those callees in the
+reverse order, each under its compile lock
+(:func:`transient.core.jit._compile_once_across_processes`), so that the two use two cores. The
+stepper's compile loads each callee the helper has saved, waits for the one the helper is
+compiling, and compiles the others itself; nothing is compiled twice.
 
 The helper needs each callee's argument types before the stepper's compile has found them: they
-are named by the callees' parameters (:func:`_types_by_parameter`). Were one wrong, the helper
-would compile a signature the stepper does not call and the stepper would compile its own; the
-test ``test_helper_compiles_the_signatures_the_stepper_calls`` checks each callee's cache. A
-helper that fails costs only its help: the stepper's compile compiles what is missing itself.
+are named by the callees' parameters (:func:`_types_by_parameter`), plain types, because
+:func:`transient.core.jit._compile_per_type` widens the constants the stepper passes. Were one
+wrong, the helper would compile a signature the stepper does not call and the stepper would
+compile its own; the test ``test_helper_compiles_the_signatures_the_stepper_calls`` checks each
+callee's cache. A helper that fails costs only its help: the stepper's compile compiles what is
+missing itself. Without transient's replacements of numba internals (another numba release,
+:data:`transient.core.jit.REPLACEMENTS_ON`) no helper is started, because without the compile
+lock it would compile what the stepper's compile compiles too.
 """
 from __future__ import annotations
 
@@ -27,7 +30,7 @@ import sys
 
 from numba import config, typeof, types
 
-from .core import breakpoints, events, forcing, rhs, rk, stepper
+from .core import breakpoints, events, forcing, jit, rhs, rk, stepper
 from .core import stepper_io as sio
 
 #: The stepper's callees compiled apart (not inlined), in the reverse of the order in which the
@@ -100,8 +103,9 @@ def _cores() -> int:
 
 def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
     """A helper process compiling ``callees`` (:func:`compile_callees`), or None where it would
-    not help: the stepper is cached, the JIT is off, or this process has one core."""
-    if config.DISABLE_JIT or _cores() < 2 or stepper_is_cached():
+    not help: the stepper is cached, the JIT is off, numba runs without transient's replacements,
+    or this process has one core."""
+    if config.DISABLE_JIT or not jit.REPLACEMENTS_ON or _cores() < 2 or stepper_is_cached():
         return None
     helper = None
     try:

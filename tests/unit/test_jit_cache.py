@@ -19,6 +19,7 @@ from transient.core import jit
 from transient.core.jit import COMPILE_LOCK, compiled
 
 KERNEL = "def double(x):\n    return 2 * x\n"
+ACROSS_PROCESSES = "transient.core.jit._compile_once_across_processes"
 
 
 def _fresh_function(tmp_path, monkeypatch):
@@ -71,8 +72,8 @@ def _wait_until_blocked(path, pid, running):
     waiting thread or process) turns false first, or if nothing blocks within 300 s."""
     deadline = time.monotonic() + 300.0
     while not _waits_for_lock(path, pid):
-        assert running(), "it did not wait for the lock"
-        assert time.monotonic() < deadline, "nothing reached the lock"
+        assert running(), f"{ACROSS_PROCESSES}: it did not wait for the lock"
+        assert time.monotonic() < deadline, f"{ACROSS_PROCESSES}: nothing reached the lock"
         time.sleep(0.01)
 
 
@@ -132,4 +133,5 @@ def test_constants_passed_to_a_kernel_share_its_machine_code(tmp_path, monkeypat
         return double(3) + double(4) + double(x) + double(True)
 
     assert caller(5) == 2 * (3 + 4 + 5 + 1)
-    assert [str(sig) for sig in double.signatures] == ["(int64,)", "(bool,)"]
+    assert [str(sig) for sig in double.signatures] == ["(int64,)", "(bool,)"], (
+        f"transient.core.jit._compile_per_type: {double.signatures} (compiled once per constant?)")

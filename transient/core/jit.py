@@ -1,28 +1,55 @@
 """The compile decorators of transient's numba functions.
 
-``compiled`` is ``numba.njit(cache=True)`` whose cache loads without numba's compiler registries
-(:class:`_RegistryFreeCache`); ``kernel`` is ``compiled`` without numba's reference counting
-(``_nrt=False``). With reference counting, every call that passes arrays — the
+``compiled`` is ``numba.njit`` with numba's on-disk cache and three replacements of numba
+internals, each for its gain: the cache loads without numba's compiler registries
+(:class:`_RegistryFreeCache`), constants passed between kernels share one compile
+(:func:`_compile_per_type`), and processes compiling the same function take turns
+(:func:`_compile_once_across_processes`). ``kernel`` is ``compiled`` without numba's reference
+counting (``_nrt=False``), because with it every call that passes arrays — the
 :data:`transient.core.model.Model` tuple holds a dozen — increfs and decrefs each of them through
-an indirect call: measured on the single cylinder (a throwaway loop timing one small kernel),
-passing the Model to it cost 130 ns of 260 ns; without reference counting the same call took
-72 ns. The whole right-hand side went from 0.512 µs per call (the previous record of
-``tools/stepper_overhead.py``) to 0.036 µs. Kernels under ``kernel`` must not allocate arrays
-(they work in buffers their caller allocated); the few that allocate (the stepper's ``advance``,
-work arrays) are ``compiled``.
+an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
+caller allocated); the few that allocate (the stepper's ``advance``, work arrays) are
+``compiled``.
+
+The replacements rely on numba internals, so they are on only under the numba release they were
+checked against (:data:`NUMBA_CHECKED`, pinned in pyproject.toml;
+``tests/unit/test_numba_internals.py`` checks each internal they rely on). Under any other
+release ``compiled`` is plain ``njit(cache=True)``, with a warning at import: correct, if slower
+to start and to compile, because a replacement running on changed internals could misbehave
+without failing.
 """
 from __future__ import annotations
 
 import fcntl
 import os
+import warnings
 from contextlib import contextmanager
 
+import numba
 from numba import config, njit, types
 from numba.core import sigutils
 from numba.core.caching import FunctionCache
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
 
+#: The numba release whose internals the replacements were checked against.
+NUMBA_CHECKED = "0.68.1"
+
+
+def _replacements_apply(version: str) -> bool:
+    """Whether the replacements may run under numba ``version``: only the checked release."""
+    return version == NUMBA_CHECKED
+
+
+#: Whether ``compiled`` uses the replacements (decided once, at import).
+REPLACEMENTS_ON = _replacements_apply(numba.__version__)
+
+if not REPLACEMENTS_ON:
+    warnings.warn(
+        f"transient.core.jit: numba {numba.__version__} is not {NUMBA_CHECKED}, the release its "
+        "replacements of numba internals were checked against; compiling with plain "
+        "njit(cache=True) instead (correct, slower to start and to compile)",
+        RuntimeWarning, stacklevel=2)
 
 #: The name of a function's compile lock in its cache folder, after numba's base name of its
 #: cache files (:func:`_compile_once_across_processes`).
@@ -33,19 +60,14 @@ class _RegistryFreeCache(FunctionCache):
     """numba's on-disk cache of a function, loading its machine code without first loading
     numba's compiler registries.
 
-    numba's ``load_overload`` begins with ``target_context.refresh()``: it imports and installs
-    the typing and lowering registries of everything numba compiles (its numpy, its typed
-    containers, its random generators; ``numba.np.arraymath`` imports scipy.linalg to find BLAS):
-    timed around ``load_overload`` in a diesel run, 0.35–0.38 s for the first function loaded,
-    0.003–0.05 s for each of the others (README *Start-up*). Those registries serve only
-    compiling. Running loaded machine code needs two things they would have set up: the
-    reference-counting runtime (NRT), which the allocating functions call, and the hash secrets
-    that numba's hashing code reads as symbols; both are set up here. A function that is not in
-    the cache is compiled as usual, and numba's compiler loads the registries itself
-    (``CompilerBase.__init__``). numba is pinned in pyproject.toml; the test
-    ``test_warm_run_loads_no_compiler_registries`` checks in a fresh process that this path is
-    the one taken and that its results are bit-identical.
-    """
+    numba's ``load_overload`` begins with ``target_context.refresh()``, which imports and
+    installs the typing and lowering registries of everything numba compiles (its numpy, typed
+    containers, random generators; ``numba.np.arraymath`` imports scipy.linalg): much of a warm
+    start's time, and needed only to compile. Running loaded machine code needs two things that
+    refresh would have set up, so they are set up here: the reference-counting runtime (NRT),
+    which the allocating functions call, and the hash secrets that numba's hashing code reads as
+    symbols. A function that is not in the cache is compiled as usual, and numba's compiler
+    loads the registries itself (``CompilerBase.__init__``)."""
 
     def load_overload(self, sig, target_context):
         from numba.cpython import hashing  # noqa: F401 (its import registers the hash secrets)
@@ -59,6 +81,8 @@ def compiled(fn=None, **options):
     """``@compiled`` or ``@compiled(nogil=True)``: njit, cached (:class:`_RegistryFreeCache`)."""
     if fn is None:
         return lambda f: compiled(f, **options)
+    if not REPLACEMENTS_ON:
+        return njit(fn, cache=True, **options)
     dispatcher = njit(fn, **options)
     if not config.DISABLE_JIT:  # (then njit returns fn itself)
         dispatcher._cache = _RegistryFreeCache(dispatcher.py_func)  # (what cache=True sets)
@@ -71,9 +95,9 @@ def _compile_once_across_processes(dispatcher):
     """A process about to compile ``dispatcher`` first waits for any other process compiling
     it, then loads what that one saved instead of compiling it again.
 
-    Processes started together on a cold cache — the test suite's workers, ``transient sweep``'s
-    — otherwise all compile the same stepper at once (~210–240 s each on the slower test machine,
-    README *Start-up*). numba's ``compile`` tries the cache before compiling, so it runs under an
+    Processes started together on a cold cache — the test suite's workers, ``transient sweep``'s,
+    the compile helper of :mod:`transient.precompile` — would otherwise each compile the same
+    functions. numba's ``compile`` tries the cache before compiling, so it runs under an
     exclusive ``flock`` on the function's lock file in its cache folder: the second process takes
     the lock once the first has saved, and loads. The lock is per function, not per signature,
     because numba saves a new signature by a read-modify-write of the function's index (it takes
@@ -133,11 +157,10 @@ def _compile_per_type(dispatcher):
 
     numba types a constant argument (an event code, a state index, ``True``) as a literal, and
     a call from compiled code compiles the callee for exactly the argument types it is given
-    (``Dispatcher.get_call_template``): one machine-code copy per constant. The stepper reports
-    its events with seven different codes (seven copies of ``_emit_event``, 1.6–2.8 s of
-    compiling each), and ``_crossing`` took both a constant and a variable state index (two
-    copies of it, and of the root finder ``_root`` it calls, ~12 s per copy of ``_root``). No
-    kernel of transient branches on an argument's value at compile time, so the literal types
+    (``Dispatcher.get_call_template``): one machine-code copy per constant, each compiled
+    separately. The stepper passes its event codes and state indices as constants, and the
+    compile helper (:mod:`transient.precompile`) can compile the callees only for plain types.
+    No kernel of transient branches on an argument's value at compile time, so the literal types
     are widened to their plain types before numba compiles."""
     per_constant = dispatcher.get_call_template
 
@@ -154,6 +177,6 @@ def kernel(fn=None, **options):
     Without ``inline="always"`` a kernel is a call in machine code, and numba passes a tuple
     argument flattened, by value: each array as its pointers, sizes, shape and strides. The
     Model tuple is ~150 words, copied onto the stack at every such call. numba's inlining copies
-    the callee's IR at every call site (a third of a cold compile), so inline what runs per step
-    at one or two sites, not everything (:mod:`.integrate` says what and what it measured)."""
+    the callee's IR at every call site, which lengthens a cold compile, so inline what runs per
+    step at one or two sites, not everything (:mod:`.integrate` says what)."""
     return compiled(fn, _nrt=False, **options)

@@ -1,0 +1,414 @@
+"""The numba internals that transient's replacements (:mod:`transient.core.jit`) and its compile
+helper (:mod:`transient.precompile`) rely on, each checked as it is in the pinned numba release.
+
+A numba release that changes one of them fails here, with a message naming the replacement and
+the internal: review the replacement against the new release before setting
+``jit.NUMBA_CHECKED`` to it. Under a release other than ``NUMBA_CHECKED`` the replacements are
+off (plain ``njit(cache=True)``); that fallback is tested here too."""
+from __future__ import annotations
+
+import ast
+import importlib.util
+import inspect
+import os
+import subprocess
+import sys
+import textwrap
+import threading
+import tomllib
+from pathlib import Path
+
+import llvmlite.binding as ll
+import numba
+from numba.core import caching, cpu, dispatcher, sigutils, types
+from numba.core.base import BaseContext
+from numba.core.compiler_lock import global_compiler_lock
+from numba.core.runtime import rtsys
+from numba.core.types import functions as type_functions
+
+from transient.core import jit
+
+REPO = Path(__file__).resolve().parents[2]
+REVIEW = f"numba {numba.__version__} changed it: review the replacement"
+
+REGISTRY_FREE = "transient.core.jit._RegistryFreeCache"
+PER_TYPE = "transient.core.jit._compile_per_type"
+ACROSS_PROCESSES = "transient.core.jit._compile_once_across_processes"
+HELPER = "transient.precompile (the compile helper)"
+
+
+def _statements(fn) -> list[str]:
+    """The lines of ``fn``'s body as ``ast.unparse`` writes them, stripped: numba's code without
+    its docstring, comments and line breaks, so that only a change in what it does changes
+    them."""
+    node = ast.parse(textwrap.dedent(inspect.getsource(fn))).body[0]
+    body = node.body[1:] if ast.get_docstring(node) is not None else node.body
+    return [line.strip() for stmt in body for line in ast.unparse(stmt).splitlines()]
+
+
+def _code(text: str) -> list[str]:
+    """``text`` as :func:`_statements` writes a body."""
+    return [line.strip() for line in ast.unparse(ast.parse(textwrap.dedent(text))).splitlines()]
+
+
+def _in_order(lines: list[str], wanted: list[str]) -> bool:
+    """Whether ``wanted`` are among ``lines``, in that order."""
+    rest = iter(lines)
+    return all(any(line == w for line in rest) for w in wanted)
+
+
+def _parameters(fn) -> list[str]:
+    return list(inspect.signature(fn).parameters)
+
+
+def _relies(replacement: str, internal: str) -> str:
+    return f"{replacement} relies on {internal}; {REVIEW}"
+
+
+# ----------------------------------------------------------------------------------------------
+# the numba release
+
+
+def test_the_pinned_numba_is_the_checked_one():
+    pin = [d for d in tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+           ["dependencies"] if d.replace(" ", "").startswith("numba==")]
+    assert pin == [f"numba=={jit.NUMBA_CHECKED}"], (
+        f"pyproject.toml pins {pin}, transient.core.jit.NUMBA_CHECKED is {jit.NUMBA_CHECKED}: "
+        "the replacements of numba internals are off under any other release; review them "
+        "against the pinned release (this file's tests), then set NUMBA_CHECKED to it")
+    assert numba.__version__ == jit.NUMBA_CHECKED and jit.REPLACEMENTS_ON, (
+        f"numba {numba.__version__} is installed, transient.core.jit's replacements were checked "
+        f"against {jit.NUMBA_CHECKED}: they are off (plain njit(cache=True))")
+
+
+def test_replacements_apply_only_under_the_checked_release():
+    assert jit._replacements_apply(jit.NUMBA_CHECKED)
+    for other in ("0.68.0", "0.68.2", "0.69.0", "0.68.1rc1", "0.68.1+local", ""):
+        assert not jit._replacements_apply(other), other
+
+
+FALLBACK_PROBE = """
+import importlib.util, sys, warnings
+import numba
+numba.__version__ = "0.0.0"  # as if another release were installed
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    from transient.core import jit
+from numba.core.caching import FunctionCache
+from transient import precompile
+from transient.assemble import build_model
+from transient.core.tableaus import TABLEAUS
+from transient.scene import load_scene
+
+assert not jit.REPLACEMENTS_ON
+assert [str(w.message).split(";")[0] for w in caught if w.category is RuntimeWarning] == [
+    f"transient.core.jit: numba 0.0.0 is not {jit.NUMBA_CHECKED}, the release its "
+    "replacements of numba internals were checked against"], [str(w.message) for w in caught]
+
+spec = importlib.util.spec_from_file_location("kern", sys.argv[1])
+module = sys.modules["kern"] = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+double, kernel, caller = module.double, module.triple, module.caller
+
+assert caller(5) == 16 and kernel(2.5) == 7.5
+for d in (double, kernel, caller):
+    assert type(d._cache) is FunctionCache, type(d._cache)  # numba's own cache, on
+    assert "compile" not in vars(d) and "get_call_template" not in vars(d)  # numba's own
+scene = load_scene(sys.argv[2])
+model, tab = build_model(scene)[0], TABLEAUS[scene.solver.method]
+precompile._cores = lambda: 2
+precompile.stepper_is_cached = lambda: False
+assert precompile.start_helper(model, tab) is None  # no helper without the compile lock
+print(";".join(str(s) for s in double.signatures))  # (none where caller was loaded)
+print(sum(caller.stats.cache_hits.values()), sum(caller.stats.cache_misses.values()))
+"""
+
+
+FALLBACK_KERNELS = """
+from transient.core.jit import compiled, kernel
+
+
+@compiled
+def double(x):
+    return 2 * x
+
+
+@kernel
+def triple(x):
+    return 3 * x
+
+
+@compiled
+def caller(x):
+    return double(3) + double(x)
+"""
+
+
+def test_under_another_numba_release_compiled_is_plain_njit_with_a_warning(tmp_path):
+    """The fallback: a numba release other than the checked one gets numba's own cache, compile
+    and call templates (constants compiled as literals), a warning at import, no helper; a
+    second process loads what the first saved."""
+    source = tmp_path / "kern.py"
+    source.write_text(FALLBACK_KERNELS)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    runs = [subprocess.run([sys.executable, "-c", FALLBACK_PROBE, str(source),
+                            str(REPO / "cases" / "coasting_single.toml")], cwd=REPO, env=env,
+                           capture_output=True, text=True, timeout=300) for _ in range(2)]
+    for run in runs:
+        assert run.returncode == 0, run.stderr
+    # compiled, double once per constant; then loaded from numba's cache
+    assert runs[0].stdout.splitlines() == ["(Literal[int](3),);(int64,)", "0 1"], runs[0].stdout
+    assert runs[1].stdout.splitlines() == ["", "1 0"], runs[1].stdout
+
+
+# ----------------------------------------------------------------------------------------------
+# _RegistryFreeCache
+
+
+def test_registry_free_cache_replaces_what_cache_true_sets():
+    assert _statements(dispatcher.Dispatcher.enable_caching) == _code(
+        "self._cache = FunctionCache(self.py_func)"), _relies(
+        REGISTRY_FREE, "numba.core.dispatcher.Dispatcher.enable_caching (cache=True) setting "
+        "self._cache = FunctionCache(self.py_func), which transient.core.jit.compiled replaces")
+    assert caching.FunctionCache.load_overload is caching.Cache.load_overload, _relies(
+        REGISTRY_FREE, "numba.core.caching.FunctionCache inheriting Cache.load_overload")
+
+
+def test_registry_free_cache_is_numbas_load_overload_without_the_refresh():
+    assert _parameters(caching.Cache.load_overload) == ["self", "sig", "target_context"], \
+        _relies(REGISTRY_FREE, "numba.core.caching.Cache.load_overload(sig, target_context)")
+    assert _statements(caching.Cache.load_overload) == _code("""
+        target_context.refresh()
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+        """), _relies(REGISTRY_FREE, "numba.core.caching.Cache.load_overload being refresh(), "
+                      "then _load_overload under _guard_against_spurious_io_errors (it is that "
+                      "without the refresh)")
+    assert _parameters(caching.Cache._load_overload) == ["self", "sig", "target_context"], \
+        _relies(REGISTRY_FREE, "numba.core.caching.Cache._load_overload(sig, target_context)")
+    assert _parameters(caching.Cache._guard_against_spurious_io_errors) == ["self"], _relies(
+        REGISTRY_FREE, "numba.core.caching.Cache._guard_against_spurious_io_errors()")
+    assert _in_order(_statements(dispatcher.Dispatcher.compile), _code("""
+        cres = self._cache.load_overload(sig, self.targetctx)
+        if cres is not None:
+            self._cache_hits[sig] += 1
+        """)), _relies(REGISTRY_FREE, "numba.core.dispatcher.Dispatcher.compile loading through "
+                       "self._cache.load_overload(sig, self.targetctx)")
+
+
+def test_registry_free_cache_sets_up_what_the_refresh_would_for_loaded_code():
+    """What refresh sets up that loaded machine code uses: symbols it links against. numba
+    registers symbols (``llvmlite.binding.add_symbol``) in these modules only: the NRT's when it
+    is initialized, the hash secrets when ``numba.cpython.hashing`` is imported, the rest when
+    the target context is made (before any load) or by the parallel backend."""
+    assert _statements(BaseContext.refresh) == _code("""
+        self.load_additional_registries()
+        self.install_registry(builtin_registry)
+        self.typing_context.refresh()
+        """), _relies(REGISTRY_FREE, "numba.core.base.BaseContext.refresh doing only "
+                      "load_additional_registries, install_registry, typing_context.refresh")
+    loads = _statements(cpu.CPUContext.load_additional_registries)
+    assert loads[0] == "rtsys.initialize(self)", _relies(
+        REGISTRY_FREE, "numba.core.cpu.CPUContext.load_additional_registries initializing the "
+        "NRT by rtsys.initialize(self)")
+    assert _parameters(rtsys.initialize) == ["ctx"], _relies(
+        REGISTRY_FREE, "numba.core.runtime.rtsys.initialize(ctx)")
+    root = Path(numba.__file__).parent
+    registering = sorted(str(p.relative_to(root)) for p in root.rglob("*.py")
+                         if "tests" not in p.relative_to(root).parts
+                         and "add_symbol(" in p.read_text())
+    assert registering == ["core/base.py", "core/externals.py", "core/runtime/nrt.py",
+                           "cpython/hashing.py", "np/ufunc/parallel.py"], _relies(
+        REGISTRY_FREE, "numba registering LLVM symbols only in these modules (it sets up the "
+                       f"NRT's and the hash secrets itself; found {registering})")
+    from numba.cpython import hashing  # noqa: F401
+
+    for name in ("djbx33a_suffix", "siphash_k0", "siphash_k1"):
+        assert ll.address_of_symbol(f"_numba_hashsecret_{name}"), _relies(
+            REGISTRY_FREE, f"numba.cpython.hashing registering _numba_hashsecret_{name}")
+
+
+LOAD_PROBE = """
+import importlib.util, sys
+import llvmlite.binding as ll
+from transient.core.jit import compiled
+spec = importlib.util.spec_from_file_location("kern", sys.argv[1])
+module = sys.modules["kern"] = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+double, allocate, hash_new = (compiled(getattr(module, name))
+                              for name in ("double", "allocate", "hash_new"))
+assert double(2.5) == 5.0  # (loading it imports none of numba's string or array code)
+secrets = [bool(ll.address_of_symbol(f"_numba_hashsecret_{name}"))
+           for name in ("djbx33a_suffix", "siphash_k0", "siphash_k1")]
+assert allocate(5) == 7.0
+s = "piston" * 3
+assert hash_new(s) == hash(s + "!"), (hash_new(s), hash(s + "!"))
+print(*(sum(sum(f.stats.cache_hits.values()) for f in (double, allocate, hash_new)),
+        sum(sum(f.stats.cache_misses.values()) for f in (double, allocate, hash_new))),
+      "numba.np.arraymath" in sys.modules, *secrets)
+"""
+
+KERNELS = """
+import numpy as np
+
+
+def double(x):
+    return 2 * x
+
+
+def allocate(n):
+    a = np.empty(n)
+    for i in range(n):
+        a[i] = i
+    return a[n - 1] + a[n - 2]
+
+
+def hash_new(s):
+    return hash(s + "!")  # (a new string: its hash computed in machine code)
+"""
+
+
+def test_registry_free_cache_loads_code_that_allocates_and_hashes(tmp_path):
+    """Compiled in one process, loaded in another (with another hash seed) without the
+    registries: once the first function is loaded the hash secrets are there (before any of
+    numba's string code is loaded, which would set them up too); a function that allocates
+    (the NRT); one that hashes a new string (the hash secrets)."""
+    source = tmp_path / "kern.py"
+    source.write_text(KERNELS)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    out = [subprocess.run([sys.executable, "-c", LOAD_PROBE, str(source)], cwd=REPO,
+                          env={**env, "PYTHONHASHSEED": seed}, capture_output=True, text=True,
+                          timeout=300) for seed in ("1", "2")]
+    assert out[0].returncode == 0, out[0].stderr
+    assert out[0].stdout.split() == ["0", "3", "True", "True", "True", "True"]  # compiled
+    assert out[1].returncode == 0, f"{REGISTRY_FREE}: exit {out[1].returncode}, {out[1].stderr}"
+    assert out[1].stdout.split() == ["3", "0", "False", "True", "True", "True"], (
+        f"{REGISTRY_FREE} should load without numba's compiler registries, with the NRT and "
+        f"the hash secrets set up (cache hits, misses, registries, secrets): {out[1].stdout}")
+
+
+# ----------------------------------------------------------------------------------------------
+# _compile_per_type
+
+
+def test_per_type_compile_widens_what_dispatcher_get_call_template_compiles():
+    template = dispatcher._DispatcherBase.get_call_template
+    assert dispatcher.Dispatcher.get_call_template is template, _relies(
+        PER_TYPE, "numba.core.dispatcher.Dispatcher inheriting _DispatcherBase.get_call_template")
+    assert _parameters(template) == ["self", "args", "kws"], _relies(
+        PER_TYPE, "numba.core.dispatcher.Dispatcher.get_call_template(args, kws)")
+    assert _in_order(_statements(template), _code("""
+        pysig, args = self._compiler.fold_argument_types(args, kws)
+        self.compile(tuple(args))
+        """)), _relies(PER_TYPE, "numba.core.dispatcher.Dispatcher.get_call_template compiling "
+                       "exactly the argument types it is given, self.compile(tuple(args))")
+    assert "self.dispatcher.get_call_template(args, kws)" in inspect.getsource(
+        type_functions.Dispatcher.get_call_type), _relies(
+        PER_TYPE, "numba.core.types.functions.Dispatcher.get_call_type typing a call from "
+        "compiled code by the dispatcher's get_call_template, looked up on the dispatcher")
+    assert types.unliteral(types.literal(3)) == types.int64, _relies(
+        PER_TYPE, "numba.types.unliteral(Literal[int](3)) being int64")
+    assert types.unliteral(types.literal(True)) == types.boolean, _relies(
+        PER_TYPE, "numba.types.unliteral(Literal[bool](True)) being bool")
+
+
+# ----------------------------------------------------------------------------------------------
+# _compile_once_across_processes
+
+
+def test_compile_lock_wraps_dispatcher_compile_which_tries_the_cache_first():
+    assert _parameters(dispatcher.Dispatcher.compile) == ["self", "sig"], _relies(
+        ACROSS_PROCESSES, "numba.core.dispatcher.Dispatcher.compile(sig)")
+    assert _in_order(_statements(dispatcher.Dispatcher.compile), _code("""
+        scope.enter_context(global_compiler_lock)
+        args, return_type = sigutils.normalize_signature(sig)
+        existing = self.overloads.get(tuple(args))
+        cres = self._cache.load_overload(sig, self.targetctx)
+        cres = self._compiler.compile(args, return_type)
+        self._cache.save_overload(sig, cres)
+        """)), _relies(ACROSS_PROCESSES, "numba.core.dispatcher.Dispatcher.compile, under "
+                       "numba's compiler lock, looking up self.overloads[tuple(args)], then "
+                       "the cache, then compiling and saving")
+    calls = [line for fn in (dispatcher._DispatcherBase._compile_for_args,
+                             dispatcher._DispatcherBase.get_call_template)
+             for line in inspect.getsource(fn).splitlines() if ".compile(" in line]
+    assert [c.split("=")[-1].strip() for c in calls] == [
+        "self.compile(tuple(argtypes))", "self.compile(tuple(args))"], _relies(
+        ACROSS_PROCESSES, "numba compiling for a call from Python (_compile_for_args) and "
+        f"from compiled code (get_call_template) through self.compile (found {calls})")
+    assert sigutils.normalize_signature((types.float64,)) == ((types.float64,), None), _relies(
+        ACROSS_PROCESSES, "numba.core.sigutils.normalize_signature returning (args, return)")
+
+
+def test_compile_lock_runs_under_numbas_reentrant_compiler_lock():
+    done = threading.Event()
+
+    def nested():
+        with global_compiler_lock:
+            with global_compiler_lock:
+                done.set()
+
+    worker = threading.Thread(target=nested, daemon=True)
+    worker.start()
+    worker.join(10.0)
+    assert done.is_set(), _relies(
+        ACROSS_PROCESSES, "numba.core.compiler_lock.global_compiler_lock being reentrant")
+
+
+def test_compile_lock_is_per_function_because_numba_saves_by_read_modify_write(tmp_path,
+                                                                               monkeypatch):
+    assert _statements(caching.IndexDataCacheFile.save) == _code("""
+        overloads = self._load_index()
+        try:
+            data_name = overloads[key]
+        except KeyError:
+            existing = set(overloads.values())
+            for i in itertools.count(1):
+                data_name = self._data_name(i)
+                if data_name not in existing:
+                    break
+            overloads[key] = data_name
+            self._save_index(overloads)
+        self._save_data(data_name, data)
+        """), _relies(ACROSS_PROCESSES, "numba.core.caching.IndexDataCacheFile.save being a "
+                      "read-modify-write of the function's index (why the lock is per function)")
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba"))
+    source = tmp_path / "kern.py"
+    source.write_text("def double(x):\n    return 2 * x\n")
+    spec = importlib.util.spec_from_file_location("kern", source)
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "kern", module)
+    spec.loader.exec_module(module)
+    cache = caching.FunctionCache(module.double)
+    assert isinstance(cache._cache_path, str) and isinstance(cache._impl.filename_base, str), \
+        _relies(ACROSS_PROCESSES, "numba.core.caching.Cache._cache_path and "
+                "_impl.filename_base (where the lock file goes, and its name)")
+    assert _parameters(cache._impl.locator.ensure_cache_path) == [], _relies(
+        ACROSS_PROCESSES, "numba.core.caching's locator.ensure_cache_path()")
+    cache._impl.locator.ensure_cache_path()
+    assert os.path.isdir(cache._cache_path), _relies(
+        ACROSS_PROCESSES, "locator.ensure_cache_path() making the cache folder")
+
+
+# ----------------------------------------------------------------------------------------------
+# transient.precompile
+
+
+def test_compile_helper_reads_numbas_cache_index(tmp_path, monkeypatch):
+    """``precompile.stepper_is_cached`` (and the helper's tests) read a function's saved
+    signatures from its index."""
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba"))
+    source = tmp_path / "kern.py"
+    source.write_text("def double(x):\n    return 2 * x\n")
+    spec = importlib.util.spec_from_file_location("kern", source)
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "kern", module)
+    spec.loader.exec_module(module)
+    double = jit.compiled(module.double)
+    assert double._cache._cache_file._load_index() == {}, _relies(
+        HELPER, "numba.core.caching.IndexDataCacheFile._load_index() ({} when nothing is saved)")
+    assert double(2) == 4
+    keys = list(double._cache._cache_file._load_index())
+    assert [key[0] for key in keys] == [(types.int64,)], _relies(
+        HELPER, "numba.core.caching.IndexDataCacheFile._load_index() keyed by (signature, ...)"
+        f" (found {keys})")
