@@ -6,7 +6,7 @@ internals, each for its gain: the cache loads without numba's compiler registrie
 (:func:`_compile_per_type`), and processes compiling the same function take turns
 (:func:`_compile_once_across_processes`). ``kernel`` is ``compiled`` without numba's reference
 counting (``_nrt=False``), because with it every call that passes arrays — the
-:data:`transient.core.model.Model` tuple holds a dozen — increfs and decrefs each of them through
+:data:`transient.core.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
 an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
 caller allocated); the few that allocate (the stepper's ``advance``, work arrays) are
 ``compiled``.
