@@ -1,7 +1,7 @@
 """Master and articulated rods (radial and V engines): exact kinematics and reduced inertia.
 
-Frame of one row (Semenov §0, ``reference/semenov-aircraft-kinematics.md``): origin O on the crank
-axis, x along the master cylinder from O toward its piston pin B, y a quarter-turn on in the
+Frame of one row (Semenov's notation, §1–§2; his clockwise, left-handed frame is numerically
+this one): origin O on the crank axis, x along the master cylinder from O toward its piston pin B, y a quarter-turn on in the
 direction of rotation; the row's local crank angle α is measured from x toward y (α = 0 at the
 master's TDC). Crankpin A = r(cos α, sin α); the master rod is a central crank-slider, sin β = λ sin α
 (Semenov (31)), its axis A → B along e = (cos β, −sin β), and n = (sin β, cos β) across it.

@@ -6,7 +6,8 @@ kept, and what differs is that the master rod carries the slave rods' link pins,
 two-force member. The kinematics are the mechanism's own exact ones
 (:mod:`transient.core.articulated`, Semenov (8), (31), (40)–(41) solved exactly), evaluated by the
 compiled kernels sample by sample; Semenov's text is pure kinematics at constant ω (Semenov §1,
-(17) and p. 22): the forces below follow from d'Alembert's principle on that geometry with the actual ω and ε.
+(17) and p. 22): the forces below follow from d'Alembert's principle on that geometry with the
+actual ω and ε.
 
 Frame and signs
 ---------------
