@@ -159,8 +159,8 @@ def test_psi_equal_delta_has_no_odd_harmonics_above_the_first():
 def test_psi_unequal_delta_has_a_third_harmonic_beside_semenov():
     """Rickert's case ψ_i ≠ δ_i: the 3rd harmonic appears. At δ = 72°, ψ = 67° the independently
     computed values (not in the text) for x_Bi = S cos δ: exact A₃ = −0.0249 mm, (45) −0.0088 mm;
-    here on S itself: exact (a₃, b₃) = (−0.0806, 0.0135) mm, (45) (−0.0286, 0.0021) mm, and (45) with the sin⁴β_i term
-    (:func:`third_harmonic`) (−0.0725, 0.0120) mm."""
+    here on S itself: exact (a₃, b₃) = (−0.0806, 0.0135) mm, (45) (−0.0286, 0.0021) mm, and (45)
+    with the sin⁴β_i term (:func:`third_harmonic`) (−0.0725, 0.0120) mm."""
     h = art.harmonics(radial([72], [67]))[0]
     exact, series = h.exact[0][3], h.series[0][3]
     print(f"3rd harmonic of S: exact {exact * 1e3} mm, Semenov (45) {series * 1e3} mm, "
