@@ -112,7 +112,7 @@ def test_mechanism_is_dinns(engine):
 
 
 def test_P4_1_inertia_force(engine, tables):
-    """p'_j: the package's exact P_j equals Gots' exact closed form (exact form of (6)) to 1e-12; the
+    """p'_j: the package's exact P_j equals Gots' exact closed form of (6) to 1e-12; the
     table follows the 2nd-order (6) within 2e-3 MPa (the data README's 0.0010); the gap between
     exact and 2nd order is 0.03…0.07 MPa (0.057 at 90°)."""
     scene, mech = engine
