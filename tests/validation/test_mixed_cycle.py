@@ -150,7 +150,7 @@ def test_interpolation_error(cycles):
           f"8 points per interval {err:.2e}")
 
 
-# Gots App. 2, table П2.1, as printed (reference/data/gots_P2_1_indicator.csv):
+# Gots App. 2, table П2.1, as printed (tests/data/gots_P2_1_indicator.csv):
 # φ [deg], V [dm³], p [MPa, absolute], T [K].
 P21 = np.array("""
     180 0.6053 0.1645 332.2    190 0.6024 0.1655 332.8    200 0.5934 0.1475 334.7
