@@ -1,9 +1,9 @@
 """Master and articulated rods (Semenov): the kernel against finite differences and against the
 plain-numpy geometry (:func:`positions`, complex numbers), and the Semenov identities and numbers.
 
-Semenov's dimensions (digest ``reference/semenov-aircraft-kinematics.md``, Table A): r = 95,
-l = 313, r_i = 75, l_i = 238 mm (r_i + l_i = l). The digest's [C] numbers (exact geometry, FFT)
-are checked where it gives them.
+Semenov's dimensions (the worked example of §4, fig. 19): r = 95, l = 313, r_i = 75,
+l_i = 238 mm (r_i + l_i = l). Numbers that are not in the text were computed independently
+(exact geometry, FFT) and are checked where available.
 """
 from __future__ import annotations
 
@@ -157,10 +157,10 @@ def test_psi_equal_delta_has_no_odd_harmonics_above_the_first():
 
 
 def test_psi_unequal_delta_has_a_third_harmonic_beside_semenov():
-    """Rickert's case ψ_i ≠ δ_i: the 3rd harmonic appears. At δ = 72°, ψ = 67° the digest's [C]
-    values for x_Bi = S cos δ: exact A₃ = −0.0249 mm, (45) −0.0088 mm; here on S itself: exact
-    (a₃, b₃) = (−0.0806, 0.0135) mm, (45) (−0.0286, 0.0021) mm, and (45) with the sin⁴β_i term
-    (:func:`third_harmonic`) (−0.0725, 0.0120) mm."""
+    """Rickert's case ψ_i ≠ δ_i: the 3rd harmonic appears. At δ = 72°, ψ = 67° the independently
+    computed values (not in the text) for x_Bi = S cos δ: exact A₃ = −0.0249 mm, (45) −0.0088 mm;
+    here on S itself: exact (a₃, b₃) = (−0.0806, 0.0135) mm, (45) (−0.0286, 0.0021) mm, and (45)
+    with the sin⁴β_i term (:func:`third_harmonic`) (−0.0725, 0.0120) mm."""
     h = art.harmonics(radial([72], [67]))[0]
     exact, series = h.exact[0][3], h.series[0][3]
     print(f"3rd harmonic of S: exact {exact * 1e3} mm, Semenov (45) {series * 1e3} mm, "
@@ -170,7 +170,7 @@ def test_psi_unequal_delta_has_a_third_harmonic_beside_semenov():
     assert series[0] * math.cos(math.radians(72)) == pytest.approx(-0.0088e-3, abs=0.00005e-3)
     np.testing.assert_allclose(exact, [-0.08061e-3, 0.01351e-3], atol=1e-8)
     np.testing.assert_allclose(h.third_corrected, [-0.07254e-3, 0.01201e-3], atol=1e-8)
-    # the digest: first-order coefficients of (45) within ~0.4 mm, second within ~4–7 %
+    # found by exact geometry: first-order coefficients of (45) within ~0.4 mm, second within ~4–7 %
     assert np.max(np.abs(h.exact[0][1] - h.series[0][1])) < 0.4e-3
     assert abs(math.hypot(*h.series[0][2]) / math.hypot(*h.exact[0][2]) - 1) < 0.07
 
@@ -192,7 +192,7 @@ def test_series_truncation_errors_are_reported_and_small():
 def test_slave_dynamic_parameter():
     """(61) at δ = 0° equals λ (errata: 0.304) and at 180° gives the text's 0.686; the exact
     2nd-harmonic amplitudes are 0.3108 and 0.7304 (the λ² truncation of (61) is 6 % at 180°).
-    max|W| at 180° over the master's: exact 1.2935 (digest [C]; the text prints 1.27)."""
+    max|W| at 180° over the master's: exact 1.2935 (computed; the text prints 1.27)."""
     h0, h180 = art.harmonics(radial([0, 180]))
     assert h0.lam_semenov == pytest.approx(LAM, rel=1e-12)
     assert h180.lam_semenov == pytest.approx(0.686, abs=5e-4)

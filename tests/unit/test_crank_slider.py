@@ -1,4 +1,4 @@
-"""Crank-slider kinematics and reduced inertia (reference/gots-crank-dynamics.md §2, §3, §6).
+"""Crank-slider kinematics and reduced inertia (Gots ch. 1, §2.2, §2.5).
 
 Three independent checks of ``transient.core.crank_slider``:
 
@@ -54,7 +54,8 @@ def rel_err(approx, exact):
 
 
 def gots_mech(**changes) -> CrankSlider:
-    """The Gots example cylinder (digest §11): r 47, L 148 mm, D 88 mm, two-mass rod 0.275/0.725."""
+    """The Gots example cylinder (Gots §2.9, App. 1): r 47, L 148 mm, D 88 mm, two-mass rod
+    0.275/0.725."""
     base = CrankSlider(crank_radius=0.047, rod_length=0.148, offset=0.0, bore=0.088,
                        piston_mass=1.520, crank_mass=0.912, rod_model="two-mass", rod_mass=1.752,
                        rod_cg_from_pin=0.725 * 0.148, rod_inertia_cg=0.0, strokes=4,

@@ -1,5 +1,5 @@
-"""Forces along a trajectory, :mod:`transient.analysis.loads.crank_slider` (reference/gots-crank-dynamics.md
-§4–§9): identities that hold exactly, so the bounds are round-off bounds.
+"""Forces along a trajectory, :mod:`transient.analysis.loads.crank_slider` (Gots
+§2.3–§2.8): identities that hold exactly, so the bounds are round-off bounds.
 
 * the vectorised kinematics against the compiled :func:`transient.core.crank_slider.slider`;
 * **the ε term**: P_j = −m_j d²s/dt² against a finite difference of the piston velocity
@@ -37,7 +37,7 @@ D6 = (np.array([-3, -2, -1, 1, 2, 3], dtype=float),
 
 
 def gots_mech(**changes) -> CrankSlider:
-    """The Gots example engine (digest §11): 3 cylinders, firing 1-2-3, two-mass rod."""
+    """The Gots example engine (Gots §2.9, App. 1): 3 cylinders, firing 1-2-3, two-mass rod."""
     base = CrankSlider(crank_radius=0.047, rod_length=0.148, offset=0.0, bore=0.088,
                        piston_mass=1.520, crank_mass=0.912, rod_model="two-mass", rod_mass=1.752,
                        rod_cg_from_pin=0.725 * 0.148, rod_inertia_cg=0.0, strokes=4,
@@ -156,7 +156,7 @@ def test_crankpin_and_big_end_as_vectors(name):
     assert rel(np.sum(load * u_hat, axis=0), ld.R_axial) <= RTOL
     assert rel(np.sum(load * n_hat, axis=0), ld.R_normal) <= RTOL
     if name == "two-mass":
-        # The book's scalar |R| = √(S² + K_rш²) (40)/(41) is not the vector sum (digest §7).
+        # The book's scalar |R| = √(S² + K_rш²) (40)/(41) is not the vector sum (a misprint).
         book = np.hypot(ld.S, ld.K_rod)
         assert rel(book, ld.R) > 0.1
 
@@ -250,7 +250,7 @@ def test_rigid_rod_virtual_work():
 
 
 def test_constant_speed_reduces_to_gots():
-    """ε = 0: P_j = −m_j r ω² [cos(α+β)/cos β + λ cos²α/cos³β] (digest §2.3, exact), no
+    """ε = 0: P_j = −m_j r ω² [cos(α+β)/cos β + λ cos²α/cos³β] (exact form of Gots (6)), no
     tangential inertia, throw torque = cylinder torque."""
     mech = gots_mech()
     w = 460.77

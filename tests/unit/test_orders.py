@@ -245,10 +245,10 @@ def test_rod_angle_only_odd_orders():
 
 
 def test_semenov_printed_fft_numbers():
-    """Semenov digest §5, oracles 7 and 9, to the printed digits. λ = 0.304: W amplitudes in units
+    """Semenov §2, series (9) and (31)–(35), to the digits below. λ = 0.304: W amplitudes in units
     of rω² 1, 0.3113, 0.0075, 0.0002 (orders 1, 2, 4, 6); β = 0.30764 sin φ − 0.001235 sin 3φ + …
-    r = 95, l = 313 mm: x_B = r cos φ + l cos β has the mean 305.662 mm and the coefficients
-    95, 7.3821, −0.0446, 0.0005 mm (orders 1, 2, 4, 6); s = (l + r) − x_B."""
+    r = 95, l = 313 mm: x_B = r cos φ + l cos β has the mean 305.662 mm and the coefficients 95,
+    7.3821, −0.0446, 0.0005 mm (orders 1, 2, 4, 6); s = (l + r) − x_B."""
     n = 720
     phi = grid(n)
     a = order_spectrum(piston_acceleration(phi, 1.0, 0.0, 0.304, 1.0), n, TWO_PI).amplitude[0]

@@ -1,4 +1,4 @@
-"""Swash-plate kinematics and reduced inertia (reference/antonyuk-swashplate-dynamics.md §2).
+"""Swash-plate kinematics and reduced inertia (Antonyuk et al. §2).
 
 Everything is checked against positions: the kernel's analytic derivatives against finite differences
 of the 3-D positions and rotation matrices given by ``positions``, and the paper's closed forms (13)

@@ -1,4 +1,4 @@
-"""The trapezoidal gas-force pulse of the swash-plate example (Antonyuk et al. §4, digest §4)."""
+"""The trapezoidal gas-force pulse of the swash-plate example (Antonyuk et al. §4)."""
 from __future__ import annotations
 
 import math

@@ -1,12 +1,13 @@
-"""Mean indicated torque from the book's printed indicator diagram П2.1 (digest §12.4).
+"""Mean indicated torque from the book's printed indicator diagram П2.1 (Gots App. 2, §2.9).
 
 The printed pressure column is not one consistent curve (data README), yet its loop carries about
 p_e-level work: rebuilt with intake 0.165 MPa (0–180°), the printed points 180–540° (linear between
 them) and exhaust 0.182 MPa (540–720°), three cylinders at 4400 rpm give a mean torque of about
-151.7 N m (the digest's 0.25° rebuild), against 205.77 N m from the ideal polytropes of the same
-cycle (cases/gots_diesel_4400.toml). That is why the book compares its "dynamic" 149.1 N m with
-M_e = 153.05 N m and not with M_i = 193.8 N m. The mean of −M_drive over a cycle (inverse dynamics,
-inertia included) must equal 3·∮p dV/(4π) of the same table: inertia does no net work per cycle.
+151.7 N m (an independent 0.25° rebuild, not in the book), against 205.77 N m from the ideal
+polytropes of the same cycle (cases/gots_diesel_4400.toml). That is why the book compares its
+"dynamic" 149.1 N m with M_e = 153.05 N m and not with M_i = 193.8 N m. The mean of −M_drive over a
+cycle (inverse dynamics, inertia included) must equal 3·∮p dV/(4π) of the same table: inertia does
+no net work per cycle.
 """
 from __future__ import annotations
 
@@ -54,4 +55,4 @@ def test_mean_torque_of_the_printed_diagram(gots_data):
     print(f"mean indicated torque of the printed П2.1 diagram, 3 cylinders: {mean:.2f} N m "
           f"(3·W/4π = {3 * work / cycle:.2f} N m)")
     assert abs(mean - 3 * work / cycle) <= 2e-3 * abs(mean)  # both sampled at 0.25° or finer
-    assert abs(mean - 151.7) <= 0.1  # the digest's 0.25° rebuild, printed to 0.1 N m
+    assert abs(mean - 151.7) <= 0.1  # the independent 0.25° rebuild, given to 0.1 N m

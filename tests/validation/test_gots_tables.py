@@ -1,4 +1,4 @@
-"""The Gots worked example at constant 4400 rpm (reference/gots-crank-dynamics.md §2.9, §11, §12):
+"""The Gots worked example at constant 4400 rpm (Gots §2.9, App. 1):
 tables П4.1 (forces and torque of one cylinder) and П4.2 (three cylinders) reproduced by a
 prescribed-speed run (inverse dynamics), and the mean indicated torque of the ideal mixed cycle.
 
@@ -9,8 +9,8 @@ gauge pressures of П4.1 (+ p0 = 0.1 MPa) as a ``table`` with linear interpolati
 split so that m_j = m_п + m₁ = 1.520 + 0.480 = 2.0 kg (Dinn's VJ1, App. 1), λ = 0.047/0.148.
 
 **Inertia: exact versus the book's 2nd order.** The simulator uses the exact crank-slider
-(digest §14), but П4.1's p'_j is −m_j r ω²(cos φ + λ cos 2φ)/F_p, the 2nd-order (6) (data
-README, "П4.1"); only the force resolution N, S, K, T is exact. The two differ by up to
+(Gots ch. 1, exact forms), but П4.1's p'_j is −m_j r ω²(cos φ + λ cos 2φ)/F_p, the 2nd-order (6)
+(data README, "П4.1"); only the force resolution N, S, K, T is exact. The two differ by up to
 m_j ω² |j_exact − j_2nd|/ω²·u ≈ 17 N·m (0.058 MPa in T, at 90°/270°/450°/630°), so the printed
 rows cannot be met to 1 N·m by the exact model. The test therefore *adds* the closed-form
 difference m_j ω² u (u′_exact − r(cos φ + λ cos 2φ)) to the simulated torque — u, u′ from Gots'
@@ -169,7 +169,7 @@ def test_mean_indicated_torque_of_the_ideal_cycle(p42, sample_integral):
     cycle (``MixedCycle.work``), to 1e-6: the inertia torque ½J′ω² averages to zero over a turn
     and ∮p0 dV = 0: 205.766 N·m (tables to 1e-9, quadrature ~1e-13).
 
-    Why this is not the book's 149.1 N·m (digest §12.4): the mean of the printed 30°-sampled
+    Why this is not the book's 149.1 N·m (Gots §2.9): the mean of the printed 30°-sampled
     П4.2 sum is only 104.1 N·m, because a 30° grid misses the combustion peak near 360–390°;
     rebuilding the torque finely from the printed П2.1 pressures gives 151.7 N·m, i.e. a loop
     of 635 J (~p_e, 1.11 MPa, not p_i = 1.42 MPa) — so the book's "dynamic" 149.1 compares with

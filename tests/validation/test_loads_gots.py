@@ -1,5 +1,5 @@
 """Crank-slider forces of :mod:`transient.analysis.loads.crank_slider` against the Gots worked example at
-constant 4400 rpm (reference/gots-crank-dynamics.md §2.9, §11, §12; data/README.md): table П4.1
+constant 4400 rpm (Gots §2.9, App. 1; data/README.md): table П4.1
 (p'_j, N, S, K, T of one cylinder), П4.2 (three cylinders and their sum), П4.4/П4.5 (running
 torques on the main journals and crankpins), K′_rш = 2.08 MPa and R′_шш,max = 6.33 MPa.
 
@@ -112,7 +112,7 @@ def test_mechanism_is_dinns(engine):
 
 
 def test_P4_1_inertia_force(engine, tables):
-    """p'_j: the package's exact P_j equals Gots' exact closed form (digest §2.3) to 1e-12; the
+    """p'_j: the package's exact P_j equals Gots' exact closed form of (6) to 1e-12; the
     table follows the 2nd-order (6) within 2e-3 MPa (the data README's 0.0010); the gap between
     exact and 2nd order is 0.03…0.07 MPa (0.057 at 90°)."""
     scene, mech = engine
@@ -225,7 +225,7 @@ def test_rod_centrifugal_force(engine):
 
 def test_crankpin_load_maximum(engine, tables):
     """R′_шш = |(K + K_rш, T)|/F_p: maximum 6.32 (П4.1 grid) … 6.33 MPa (text), at the
-    gas-exchange TDC where only inertia acts (digest §12.6). At 0° the exact and 2nd-order
+    gas-exchange TDC where only inertia acts (Gots §2.6, §2.9). At 0° the exact and 2nd-order
     inertia agree (j = rω²(1 + λ)), so no correction is needed there. Also on a 0.25° grid with
     the gauge pressures interpolated linearly between the printed rows."""
     scene, mech = engine
@@ -337,8 +337,8 @@ def test_P4_3_is_not_derived_from_P4_1(gots_data, tables):
     can do is the least-squares fit R ≈ Σ_k (a_k T_k + b_k K_k) + c, 7 free numbers per
     component, on the 25 rows where П4.1 gives T and K. It leaves an rms residual of
     0.11/0.12 MPa — ~60× the table's print resolution — spread over most rows (11 of 25 off by
-    more than 0.1 MPa), so no short list of misprinted rows explains it (digest §12.5: (58) with
-    a constant offset leaves 0.59 MPa). The table comes from another calculation, like
+    more than 0.1 MPa), so no short list of misprinted rows explains it (an independent fit of (58)
+    with a constant offset leaves 0.59 MPa). The table comes from another calculation, like
     Table 14; the test fails if the data ever become consistent, so this is revisited then.
     It also confirms the text's quotes from the table (§2.9): |R| max 2.596 MPa at 130°, min
     0.415 MPa at 570°."""

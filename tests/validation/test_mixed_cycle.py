@@ -1,8 +1,8 @@
 """The ideal mixed cycle of Gots App. 2 tabulated on the exact crank-slider volume.
 
-Sources (``reference/gots-crank-dynamics.md``): §10 (App. 2 cycle printout and how table П2.1
-is built), §11 (geometry), §12.4 (mean torque), §14 (the synthetic indicator diagram), and
-``tests/data/README.md`` (misprints in П2.1). Angles follow the Gots tables: 0° is the
+Sources: Gots App. 2 (the DIZDN cycle printout and table П2.1), §2.9 and App. 1 (geometry),
+§2.9 (mean torque, 149.1 N·m against M_e = 153.05 N·m), and ``tests/data/README.md`` (misprints
+in П2.1). Angles follow the Gots tables: 0° is the
 gas-exchange TDC and 360° the firing TDC. Run with ``-s`` to see the numbers.
 """
 from __future__ import annotations
@@ -150,7 +150,7 @@ def test_interpolation_error(cycles):
           f"8 points per interval {err:.2e}")
 
 
-# Gots App. 2, table П2.1, as printed (reference/data/gots_P2_1_indicator.csv):
+# Gots App. 2, table П2.1, as printed (tests/data/gots_P2_1_indicator.csv):
 # φ [deg], V [dm³], p [MPa, absolute], T [K].
 P21 = np.array("""
     180 0.6053 0.1645 332.2    190 0.6024 0.1655 332.8    200 0.5934 0.1475 334.7

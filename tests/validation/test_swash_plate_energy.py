@@ -1,5 +1,5 @@
 """Swash-plate engine under equation (18): energy is conserved when coasting, and a constant gas force
-does exactly the work F·Δx on its piston(s) (reference/antonyuk-swashplate-dynamics.md (18), (19)).
+does exactly the work F·Δx on its piston(s) (Antonyuk et al. (18), (19)).
 
 The kernel's J, dJ/dφ and u_k are integrated with scipy's DOP853 at tight tolerance; a wrong dJ/dφ
 or a sign slip between u_k and the piston positions would show as an energy drift.

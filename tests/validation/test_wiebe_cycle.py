@@ -1,6 +1,6 @@
 """Single-zone Wiebe cycle on the Gots diesel geometry, against closed forms and the first law.
 
-Geometry (``cases/gots_diesel_4400.toml``, ``reference/gots-crank-dynamics.md`` §10–§11):
+Geometry (``cases/gots_diesel_4400.toml``; Gots §2.9, App. 1, App. 2):
 r = 47 mm, L = 148 mm, D = 88 mm, ε = 18. Cycle: p_a = 0.1436 MPa and T_a = 329.9 K at intake
 closing (App. 2), intake 0.165 MPa and exhaust 0.182 MPa (П4.1), combustion from 358° (injection
 advance 15°, ignition delay 13°, App. 1) for 50°, m = 0.5, a = 6.908, 0.05 g of diesel fuel

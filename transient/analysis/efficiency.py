@@ -1,6 +1,7 @@
 """Mechanical efficiency over whole cycles in steady state (Antonyuk (30)) and where the power goes.
 
-Two forms are reported, and named apart (digest [!] at (30)):
+Two forms are reported, and named apart (as printed, (30) averages an
+instantaneous ratio whose denominator crosses zero):
 
 * ``eta_mech_work`` — the ratio of the work integrals over the same whole cycles,
   η = W_out / W_in, W_in = ∫(M_gas + M_starter) ω dt, W_out = −∫(M_load + M_drive) ω dt. This is

@@ -1,5 +1,4 @@
-"""The conventional wear diagram of a crankpin or journal (Gots §2.6, Table 14;
-reference/gots-crank-dynamics.md §7).
+"""The conventional wear diagram of a crankpin or journal (Gots §2.6, Table 14).
 
 Wear is taken proportional to the load, and each load vector wears the arc of ±60° around its
 direction; a ray of the diagram sums the loads whose direction lies within that arc of it. The

@@ -1,10 +1,11 @@
 """Master and articulated rods (radial and V engines): exact kinematics and reduced inertia.
 
-Frame of one row (Semenov §0, ``reference/semenov-aircraft-kinematics.md``): origin O on the crank
-axis, x along the master cylinder from O toward its piston pin B, y a quarter-turn on in the
-direction of rotation; the row's local crank angle α is measured from x toward y (α = 0 at the
-master's TDC). Crankpin A = r(cos α, sin α); the master rod is a central crank-slider, sin β = λ sin α
-(Semenov (31)), its axis A → B along e = (cos β, −sin β), and n = (sin β, cos β) across it.
+Frame of one row (Semenov's notation, §1–§2; his clockwise, left-handed frame is numerically
+this one): origin O on the crank axis, x along the master cylinder from O toward its piston pin
+B, y a quarter-turn on in the direction of rotation; the row's local crank angle α is measured
+from x toward y (α = 0 at the master's TDC). Crankpin A = r(cos α, sin α); the master rod is
+a central crank-slider, sin β = λ sin α (Semenov (31)), its axis A → B along e = (cos β, −sin β),
+and n = (sin β, cos β) across it.
 
 The master rod is a rigid body carrying the link pin of slave i at radius r_i and angle ψ_i from its
 axis, toward n: A_i = A + a_i e + q_i n, a_i = r_i cos ψ_i, q_i = r_i sin ψ_i (Semenov (8)). Slave

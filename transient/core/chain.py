@@ -33,20 +33,23 @@ acceleration explicitly:
 
 All η* = 1 is (18) with J = Σ J_k, M = Σ M_k; one pair (c_1 = 1/η*) is (22) multiplied out; two
 pairs are (27)–(28) with I_np = Σ c_j J_j, M_np = Σ c_j M_j and A = Σ c_j ½J′_j, which carries
-the inertia factors the printed A lacks (digest [!]). Summing the sub-chain equations times ω,
+the inertia factors the printed A lacks (a misprint in (28): the printed A lacks (I_b + I_c) on
+its first term and I_d on its second, so it is not an inertia). Summing the sub-chain equations
+times ω,
 
     Σ_k (J_k φ̈ + ½ J′_k ω²) ω = Σ_k M_k ω − Σ_k (1 − η*_k) S_k ω,
 
 so the loss in pair k is (1 − η*_k) S_k ω, ≥ 0 whenever the mode agrees with the sign of S_k ω.
 The reactions (29) follow from the same S_k: M_ba = −S_0 = (I_a/I_np)(M_np − A ω²) − M_a (the
-printed + A ω² is the misprint flagged in the digest).
+printed + A ω² in (29) is a sign misprint, found by re-deriving from a's own equation and (27)).
 
 Mode selection
 --------------
 ``paper`` (:func:`modes_paper`): criterion (25), M_a φ̇_a ≥ 0 → forward, generalized to a chain
 by taking for M_a the moment of everything on the shaft side of pair k reduced ideally to φ,
 Σ_{j≤k} M_j. It looks at the applied moments only, not at the power actually transmitted, so
-when inertia dominates it can pick a mode whose loss is negative (digest [!] at (25)).
+when inertia dominates it can pick a mode whose loss is negative (a gap in (25) as printed: it
+uses the sign of the external moment's power on a, not of the power flowing through the pair).
 
 ``power-flow`` (:func:`modes_power_flow`): the mode of pair k must agree with the power it
 transmits — forward requires S_k ω ≥ 0, backward S_k ω < 0. Equivalently S′_k = g_k(S_k) with

@@ -1,6 +1,6 @@
 """Swash-plate mechanism: Hooke-joint angle, joint and piston positions, reduced inertia.
 
-Frame and motion (``reference/antonyuk-swashplate-dynamics.md`` §2, worked in the fixed frame with
+Frame and motion (Antonyuk et al. §2, worked in the fixed frame with
 the real motion, not the inverted one): ``Ox`` along shaft 1 toward plate 3, ``O`` where the shaft
 axis meets the plate, the shaft turns by φ about ``Ox`` from ``Oy`` toward ``Oz``. At φ = 0 the plate
 contains ``Oz`` and the line ``m = (−sin α, cos α, 0)`` (eq. (6) at argument 0), so its normal is

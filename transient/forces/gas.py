@@ -7,8 +7,8 @@ builds the tables:
 
 * :func:`table_from_points`: from user points (a measured or printed indicator diagram);
 * :func:`table_from_function`: from closed forms, piece by piece, with an error estimate;
-* :func:`mixed_cycle`: the ideal mixed (Trinkler–Sabathé) cycle of Gots App. 2, digest §10 and
-  §14 (``reference/gots-crank-dynamics.md``), with its closed-form loop work.
+* :func:`mixed_cycle`: the ideal mixed (Trinkler–Sabathé) cycle of Gots App. 2 (the DIZDN
+  printout and table П2.1), with its closed-form loop work.
 
 Angles are local crank angles in radians and pressures are absolute, in Pa. The gas force on
 the piston is ``(p - p0)*F_p`` (Gots eq. (33)); the crankcase pressure ``p0`` is applied by the
@@ -643,8 +643,9 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                 step: float = DEFAULT_STEP) -> MixedCycle:
     """Ideal mixed (Trinkler–Sabathé) cycle tabulated against the local crank angle.
 
-    The indicator diagram of Gots App. 2 (digest §10 steps 1–5, §14 "a good synthetic
-    indicator diagram"), with the volume supplied by the mechanism. For a **4-stroke** the
+    The indicator diagram of Gots App. 2 (table П2.1: travel and volume by (1), the compression
+    polytrope n₁, the isobar p_z, the expansion polytrope n₂, constant gas-exchange pressures as
+    in table П4.1), with the volume supplied by the mechanism. For a **4-stroke** the
     angle convention is the Gots tables' one: x = 0 is the gas-exchange TDC and x = 2π (360°)
     the firing TDC; the period is 4π. With V_a = V(π) and V_c = V(2π):
 

@@ -1,10 +1,11 @@
 """The trapezoidal gas-force pulse of the swash-plate example (Antonyuk et al. §4).
 
-Digest ``reference/antonyuk-swashplate-dynamics.md`` §4: the force on a piston is zero until its
-pulse starts, rises linearly over φ₁* (``ramp``) to the plateau k·φ₁* (``amplitude``), stays
-there and falls linearly (slope −k, the cleaned 4th branch) to zero half a turn after the start
-(``duration``), then stays zero to the end of the period. One pulse per turn: the table's local angle 0 is the start
-of the pulse, which the mechanism's ``firing_angles`` place at each cylinder's inner dead centre.
+Antonyuk et al. §4: the force on a piston is zero until its pulse starts, rises linearly over φ₁*
+(``ramp``) to the plateau k·φ₁* (``amplitude``), stays there and falls linearly with slope −k to
+zero half a turn after the start (``duration``), then stays zero to the end of the period. (The
+printed 4th branch is garbled and goes negative; the fall is k[π((i+1)/2 + 2n) − φ₁].) One pulse
+per turn: the table's local angle 0 is the start of the pulse, which the mechanism's
+``firing_angles`` place at each cylinder's inner dead centre.
 
 The table holds a **force per piston** [N], not a pressure: the model must apply it with scale 1 and
 offset 0 (no piston area, no crankcase pressure). Thermodynamics are not modelled, as in the paper.

@@ -4,7 +4,7 @@ The compiled kinematics and the frame are described in :mod:`transient.core.swas
 holds the scene-side description (SI units), packs it for the kernel and gives numpy-level positions
 of every body for plots and checks.
 
-Choices the paper leaves open (``reference/antonyuk-swashplate-dynamics.md``, [D]):
+Choices the paper (Antonyuk et al. §2, §4) leaves open:
 
 * Cylinder k (k = 0 … z−1; tables label it k + 1 like the paper's i) sits at ψ_Dk = 2πk/z (the
   even spacing meant by "2π/i"), and its joint on link 9 at the same angle, ψ_k = ψ_Dk. In the

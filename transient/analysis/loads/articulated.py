@@ -1,13 +1,13 @@
 """Forces in a master-and-articulated-rod engine (radial; V with fork-and-blade rods) along a
 trajectory φ(t), ω(t), ε(t): pistons, rods, link pins and the master crankpin.
 
-The crank-slider counterpart is :mod:`.crank_slider` (Gots §2.3–§2.6,
-``reference/gots-crank-dynamics.md`` §4–§7); its conventions are kept, and what differs is that the
-master rod carries the slave rods' link pins, so it is not a two-force member. The kinematics are
-the mechanism's own exact ones (:mod:`transient.core.articulated`, Semenov (8), (31), (40)–(41)
-solved exactly, ``reference/semenov-aircraft-kinematics.md``), evaluated by the compiled kernels
-sample by sample; Semenov's text is pure kinematics at constant ω (digest §4): the forces below
-follow from d'Alembert's principle on that geometry with the actual ω and ε.
+The crank-slider counterpart is :mod:`.crank_slider` (Gots §2.3–§2.6); its conventions are
+kept, and what differs is that the master rod carries the slave rods' link pins, so it is not a
+two-force member. The kinematics are the mechanism's own exact ones
+(:mod:`transient.core.articulated`, Semenov (8), (31), (40)–(41) solved exactly), evaluated by the
+compiled kernels sample by sample; Semenov's text is pure kinematics at constant ω (Semenov §1,
+(17) and p. 22): the forces below follow from d'Alembert's principle on that geometry with the
+actual ω and ε.
 
 Frame and signs
 ---------------

@@ -1,6 +1,5 @@
 """Forces in a crank-slider engine along a trajectory φ(t), ω(t), ε(t): piston, rod, crankpin,
-big-end bearing, main journals and the running torques (Gots §2.3–§2.8,
-``reference/gots-crank-dynamics.md`` §4–§9).
+big-end bearing, main journals and the running torques (Gots §2.3–§2.8).
 
 The textbook assumes a constant speed; here ω and ε are arbitrary, so every inertia force has a
 term in ε besides the one in ω². Everything is plain numpy over arrays of samples (this is the
@@ -44,12 +43,14 @@ rotation), û = (A − B)/l = (sin β, −cos β) (along the rod, from the pin t
   **T_rш = −m₂ r ε** (tangential, the term that the constant-speed textbook does not have). The
   same for the crank's unbalanced mass m_k (28): K_rk = −m_k r ω², T_rk = −m_k r ε.
 * **Crankpin load** (40)/(41) as a vector: R = (K + K_rш) along −ĉ and (T + T_rш) along t̂, and
-  |R| = √((K + K_rш)² + (T + T_rш)²). The book's scalar "√(S² + K_rш²)" is wrong (digest §7).
+  |R| = √((K + K_rш)² + (T + T_rш)²). The book's scalar "√(S² + K_rш²)" in (40)/(41) is wrong:
+  it holds only for perpendicular vectors (found by re-deriving; the vector sum is what
+  reproduces the example's R_max = 6.33 MPa).
 * **Big-end bearing, rod frame.** The crankpin load rotated by (α + β): the axial component
   R_a = (K+K_rш) cos(α+β) + (T+T_rш) sin(α+β) along û (equal to S plus the m₂ inertia's share),
   and the normal one R_n = −(K+K_rш) sin(α+β) + (T+T_rш) cos(α+β) along (cos β, sin β) (the
   direction that is t̂ at α + β = 0). The force on the bearing shell is the opposite vector: Gots'
-  polar of the big-end bearing, "rotate by 180° + (φ + β)" (digest §7), plots it.
+  polar of the big-end bearing, "rotate by 180° + (φ + β)" (Gots §2.6), plots it.
 * **Rigid rod.** A rigid rod (mass m at G, l₁ from the pin, inertia I_G) is the two-mass rod
   (m₁ = m(l − l₁)/l, m₂ = m l₁/l, whose own inertia about G is m l₁(l − l₁)) plus a couple from
   the difference ΔI = I_G − m l₁(l − l₁): C = −ΔI β̈ with β̈ = β″ω² + β′ε (in the sense of β).

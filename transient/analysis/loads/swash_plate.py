@@ -2,8 +2,7 @@
 joints on link 9 and the torque each cylinder puts on the shaft.
 
 The counterpart of :mod:`.crank_slider` for the mechanism of Antonyuk et
-al. (``reference/antonyuk-swashplate-dynamics.md``; exact kinematics of
-:mod:`transient.core.swash_plate`).
+al. (§2, exact kinematics of :mod:`transient.core.swash_plate`).
 The paper gives the reduced equation (18) with M_П = Σ P_q u_q1 (19)–(20) and no piston or rod
 forces: they follow here from d'Alembert's principle on the same geometry with the actual ω and ε.
 
