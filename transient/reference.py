@@ -1,4 +1,6 @@
-"""The reference path: the same model in plain numpy, integrated by ``scipy.integrate.solve_ivp``.
+"""The reference path: the same model in plain numpy, integrated by ``scipy.integrate.solve_ivp``
+(one idea: a second, independent implementation of the whole model, kept together so that it
+shares nothing with the compiled one but the scene).
 
 Slow and independent of the compiled stepper: time is always the independent variable, the state
 is (φ, ω), and (18) is written out again here; the mechanism's J(φ), dJ/dφ and transfer functions

@@ -1,5 +1,6 @@
 """Order analysis: signals on a uniform crank-angle grid, per-cycle spectra in engine orders, the
-piston acceleration with a variable shaft speed, and the odd-harmonic report.
+piston acceleration with a variable shaft speed, and the odd-harmonic report: one idea, the
+orders of a run, from the grid to the report.
 
 **Engine order.** A component of order ν varies as cos(ν φ + θ): ν harmonics per revolution of the
 shaft. Over an engine cycle of angle Φ (2π for a 2-stroke, 4π for a 4-stroke engine) the DFT of

@@ -1,4 +1,5 @@
-"""Transient speed response to load changes and spin-up, in the terms of ISO 8528-5.
+"""Transient speed response to load changes and spin-up, in the terms of ISO 8528-5 (one idea:
+the standard's measures, each defined below against its ISO term).
 
 ISO 8528-5 (generating sets driven by reciprocating engines) judges a set by its *frequency*
 after a sudden load change; the shaft speed stands for it here (the frequency is proportional to

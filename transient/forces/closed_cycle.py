@@ -1,4 +1,5 @@
-"""The closed part of a cycle — compression, combustion, expansion — as one ideal-gas zone.
+"""The closed part of a cycle — compression, combustion, expansion — as one ideal-gas zone (one
+idea: that zone's first law, integrated, and what is read from its solution).
 
 Shared by the tabulated Wiebe cycle (:mod:`transient.forces.wiebe`) and the cycle with Woschni
 wall heat transfer (:mod:`transient.forces.woschni`): from intake closing (IVC, p = p_a) to

@@ -1,7 +1,8 @@
 """Cylinder gas pressure against the local crank angle, as periodic piecewise-cubic tables.
 
 The gas force of a cylinder with a prescribed indicator diagram depends on the crank angle only,
-so it is tabulated once per scene and evaluated in the compiled right-hand side by
+so it is tabulated once per scene (one idea: the periodic pressure table, built from points,
+from a function or from the mixed cycle) and evaluated in the compiled right-hand side by
 :func:`transient.core.tables.table_eval` (layout in :mod:`transient.core.tables`). This module
 builds the tables:
 

@@ -1,4 +1,5 @@
-"""Single-zone closed cycle with Wiebe heat release and Woschni wall heat transfer.
+"""Single-zone closed cycle with Wiebe heat release and Woschni wall heat transfer (one idea: the
+wall heat loss and the cycle it changes).
 
 The numpy definition of the physics that the compiled in-ODE gas model is checked against. The
 closed part of the cycle (intake closing IVC → exhaust opening EVO) is the one ideal-gas zone of

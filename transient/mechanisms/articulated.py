@@ -1,4 +1,5 @@
-"""Radial and V engines with a master rod and articulated (slave) rods (Semenov §§1, 3, 4).
+"""Radial and V engines with a master rod and articulated (slave) rods (Semenov §§1, 3, 4): one
+idea, the articulated mechanism, as each mechanism has its one module.
 
 The compiled kinematics and the frame are described in :mod:`transient.core.articulated`; this
 module holds the scene-side description (SI units), packs it for the kernel, and gives the numpy

@@ -1,5 +1,7 @@
 """The stress suite: hostile scenes, each run with a hard time bound, each checked against an
-invariant or an expected diagnosis; the report ``results/stress.md``.
+invariant or an expected diagnosis; the report ``results/stress.md``. One idea, kept in one
+module: the catalogue's cases and the harness that bounds and judges them read each other's
+fields throughout.
 
 Every case ends in one of three ways, and the report says which:
 
