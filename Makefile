@@ -37,7 +37,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m pip install -q -e '.[test,bench]'
 	$(BYTECODE)
-	$(VENV)/bin/transient bench -o results/benchmarks
+	$(VENV)/bin/transient bench -o results/benchmarks --force
 
 clean:
 	rm -rf $(VENV) results/*.h5 results/*.png

@@ -831,9 +831,11 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
                            "**not measured**")
         assert f"| {target} | {case} | {measured} | {verdict} |" in targets
         assert "|" not in target + case + measured  # (a cell's pipe would split the table)
-    # --report rewrites both reports from the stored measurements, unchanged
+    # --report rewrites both reports from the stored measurements, unchanged; only with --force
     (tmp_path / "targets.md").write_text("stale")
-    assert main(["bench", "--report", "-o", str(tmp_path)]) == 0
+    assert main(["bench", "--report", "-o", str(tmp_path)]) == 2
+    assert (tmp_path / "targets.md").read_text() == "stale"
+    assert main(["bench", "--report", "-o", str(tmp_path), "--force"]) == 0
     assert (tmp_path / "targets.md").read_text() == targets
 
 

@@ -117,3 +117,19 @@ def test_option_values_that_would_do_nothing_or_run_forever_are_refused(tmp_path
                       (["efficiency", scene(tmp_path), "--rpm", "nan"], "--rpm")):
         code, stdout, err = run(capsys, *argv)
         assert code == 2 and stdout == "" and err.count("\n") == 1 and key in err, (argv, err)
+
+
+def test_bench_and_stress_refuse_to_replace_a_record_before_any_work(tmp_path, capsys):
+    """A benchmark or stress run into a folder that holds a record refuses at once (one line,
+    exit 2) unless --force: a long run never ends by replacing a record unasked."""
+    for argv, name in ((["bench", "--quick"], "work_precision.csv"),
+                       (["bench", "--quick"], "targets.md"),
+                       (["stress", "--quick"], "stress.md")):
+        out = tmp_path / name
+        out.mkdir()
+        (out / name).write_text("the record")
+        code, stdout, err = run(capsys, *argv, "-o", out)
+        assert code == 2 and stdout == "" and err.count("\n") == 1, (argv, err)
+        assert name in err and "--force" in err
+        assert (out / name).read_text() == "the record"
+        assert sorted(p.name for p in out.iterdir()) == [name]  # nothing else written

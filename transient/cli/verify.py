@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import SceneError
-from .common import EXIT_FAILED, EXIT_OK
+from .common import EXIT_FAILED, EXIT_OK, add_force
 
 
 def register_bench(sub) -> None:
@@ -27,6 +27,7 @@ def register_bench(sub) -> None:
                    help="only measure the benchmark's other targets against the record "
                         "(targets.md)")
     b.add_argument("-o", "--output", default="results/benchmarks", help="folder of the record")
+    add_force(b)
     b.set_defaults(func=cmd_bench)
 
 
@@ -42,6 +43,7 @@ def register_stress(sub) -> None:
     st.add_argument("--case", action="append", default=None,
                     help="run only this case (repeatable)")
     st.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    add_force(st)
     st.set_defaults(func=cmd_stress)
 
 
@@ -54,7 +56,7 @@ def cmd_stress(args) -> int:
         if name not in names:
             raise SceneError("--case", f"unknown case {name!r}; allowed: {', '.join(names)}")
     out = Path(args.output)
-    check_writable(out / "stress.md", force=True)  # before any work (exit 2)
+    check_writable(out / "stress.md", force=args.force)  # before any work (exit 2)
     rows, path = run_stress(args.quick, out, only=args.case)
     failed = [case.name for case, o in rows if o.outcome == "FAIL"]
     print(f"wrote {path}" + (f"; FAILED: {', '.join(failed)}" if failed else ""))
@@ -72,11 +74,13 @@ def cmd_bench(args) -> int:
             raise SceneError(f"bench {flag}", f"no work_precision.csv in {args.output}; run "
                                               f"transient bench first")
     if args.report:
+        _refuse_to_replace(args, ["work_precision.md", *TARGETS])
         rewrite_report(Path(args.output), args.revolutions)
         also = ", targets.md" if rewrite_targets(args.output) else ""
         print(f"rewrote {Path(args.output) / 'work_precision.md'}{also} and figures")
         return EXIT_OK
     if args.targets:
+        _refuse_to_replace(args, TARGETS)
         run_targets(args.output, args.quick)
         print(f"wrote {Path(args.output) / 'targets.md'} and targets.json")
         return EXIT_OK
@@ -84,6 +88,7 @@ def cmd_bench(args) -> int:
     scenes = {Path(p).stem: p for p in args.scenes} if args.scenes else BENCH_SCENES
     for path in scenes.values():
         load_scene(path)  # an invalid scene fails here, before any work (exit 2)
+    _refuse_to_replace(args, [*RECORD, *TARGETS, *(f"work_precision_{s}.png" for s in scenes)])
     if args.quick:
         run_bench(scenes, revolutions=10.0, tolerances=(1e-4, 1e-6, 1e-8), repeat=1,
                   baselines=not args.no_baselines, out=args.output, baseline_budget=5.0,
@@ -96,3 +101,21 @@ def cmd_bench(args) -> int:
     print(f"wrote {Path(args.output) / 'work_precision.csv'}, work_precision.md, figures, "
           f"targets.md and targets.json")
     return EXIT_OK
+
+
+#: The files of a work–precision record, and of its targets (:mod:`transient.verify`).
+RECORD = ("work_precision.csv", "work_precision.md", "work_precision_references.json")
+TARGETS = ("targets.md", "targets.json")
+
+
+def _refuse_to_replace(args, names) -> None:
+    """Before any work: a record file already in ``-o`` is a one-line error (exit 2) unless
+    ``--force``, so that a long benchmark never ends by replacing a record unasked."""
+    from ..results import ResultExists
+
+    if args.force:
+        return
+    for name in names:
+        path = Path(args.output) / name
+        if path.exists():
+            raise ResultExists(f"{path}: exists; use --force to replace the record")
