@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import csv
 import math
+import os
+import stat
 import tomllib
 from dataclasses import replace
 from pathlib import Path
@@ -23,10 +25,29 @@ from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLI
                       Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
 
 
+def not_a_regular_file(path: Path) -> str:
+    """What ``path`` is if it is there but not a regular file ("a folder", "a FIFO", …), else
+    "": a FIFO or a device would be read forever, and a folder is no file to read."""
+    try:
+        mode = os.stat(path).st_mode  # (does not open it: a FIFO does not block here)
+    except OSError:
+        return ""
+    for test, kind in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return kind
+    return ""
+
+
 def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
     path = Path(source)
     if text is None:
+        kind = not_a_regular_file(path)
+        if kind:
+            raise SceneError("(file)", f"is {kind}, not a scene file; give a TOML file",
+                             file=str(path))
         try:
             text = path.read_text(encoding="utf-8-sig")  # (a byte-order mark is not TOML)
         except OSError as exc:
@@ -38,6 +59,9 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError("(syntax)", f"not valid TOML: {exc}", file=str(path)) from None
+    except RecursionError:
+        raise SceneError("(syntax)", "arrays or tables nested too deeply to read",
+                         file=str(path)) from None
     return scene_from_dict(data, file=str(path), base_dir=path.parent)
 
 
@@ -210,6 +234,9 @@ def _read_pressure_csv(s: Section, base_dir: Path):
     """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
     name = s.string("file")
     path = (base_dir / name).resolve()
+    kind = not_a_regular_file(path)
+    if kind:
+        raise SceneError(s.key("file"), f"{str(path)!r} is {kind}, not a CSV file")
     if not path.is_file():
         raise SceneError(s.key("file"), f"no such file {str(path)!r}; give a CSV path relative "
                                         f"to the scene")
