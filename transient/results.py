@@ -5,9 +5,15 @@ The layout of a run — header attributes, ``scene/toml``, ``trajectory/<column>
 functions below and nowhere else, so that a result file and each run of a sweep file
 (:mod:`transient.sweep.store`) hold the same thing in the same form and read back alike.
 
-The writer works on a temporary name beside the final one, flushes after every block so that a
-killed run leaves a readable file, and renames it when the run ends — ``complete = True`` after a
-finished run, ``False`` after a failure or an interrupt.
+The writer works on a temporary name beside the final one and renames it when the run ends —
+``complete = True`` after a finished run, ``False`` after a failure or an interrupt. While the run
+goes on the file is in HDF5's single-writer/multiple-reader (SWMR) mode, whose ordered flushes keep
+what is on disk a consistent file at every instant: killed by any signal at any instant, a run
+leaves a file that opens (read in SWMR mode, :func:`open_file`). After each block the writer
+appends a *checkpoint* — the trajectory's and the events' lengths and the stepper's state — once
+the block's data are flushed; a reader of an unfinished file takes the trajectory up to the last
+checkpoint only (every block completed before it, never a torn tail), and a run resumes from it
+bit-identically (:func:`read_checkpoint`, :meth:`ResultWriter.resume`).
 """
 from __future__ import annotations
 
@@ -64,8 +70,8 @@ def check_writable(path: Path, force: bool) -> None:
     if path.exists() and not force:
         raise ResultExists(f"{path}: exists; use --force to overwrite it")
     if os.path.lexists(partial_path(path)) and not force:
-        raise ResultExists(f"{partial_path(path)}: the partial result of an interrupted run; "
-                           f"use --force to replace it")
+        raise ResultExists(f"{partial_path(path)}: the partial result of an interrupted or "
+                           f"killed run; continue it with --resume, or replace it with --force")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:  # a file in the way, a read-only or missing file system, …
@@ -179,6 +185,8 @@ def append_events(events_group: h5py.Group, events: dict[str, np.ndarray]) -> No
     Extendable datasets, so that a long run streams its events too."""
     for name, rows in events.items():
         rows = np.asarray(rows, dtype=float).reshape(-1, 2)
+        if not rows.size:
+            continue  # (events that occurred only, as a streamed result keeps them)
         g = events_group.require_group(name)
         for j, (col, unit) in enumerate((("t", "s"), ("phi", "rad"))):
             if col not in g:
@@ -215,74 +223,205 @@ def write_run(node: h5py.Group, scene_name: str, scene_toml: str, data: RunData,
         write_analysis(node["analysis"], name, value, unit)
 
 
+#: The return code in the checkpoint of a run written whole (the reference path, a stiff rerun):
+#: it marks the end of what was written, with no stepper state to resume from.
+NOT_RESUMABLE = -1
+#: The group of a streamed result's checkpoints (:class:`Checkpoint`), kept in an incomplete
+#: result so that its run can be resumed.
+CHECKPOINTS = "checkpoint"
+
+
+@dataclass
+class Checkpoint:
+    """Where a streamed run stood after one of its blocks: the trajectory's length, each event
+    name's count, whether the extra inertia had been switched in, the stepper's return code, and
+    its state (its float state ``y`` and ``fst`` laid end to end in ``floats``, its integer state
+    ``ist``)."""
+
+    rows: int
+    events: dict[str, int]
+    switched: bool
+    code: int
+    floats: np.ndarray
+    ints: np.ndarray
+
+
+def _checkpoint_datasets(node: h5py.Group, event_names) -> None:
+    """The empty, extendable datasets of the checkpoints: ``index`` holds a row per checkpoint
+    (rows, switched, the stepper's return code, the float and integer state's lengths, then a
+    count per event name, named in its ``events`` attribute); ``floats`` and ``ints`` hold the
+    states one after another."""
+    g = node.create_group(CHECKPOINTS)
+    width = 5 + len(event_names)
+    g.create_dataset("index", shape=(0, width), maxshape=(None, width), dtype="i8",
+                     chunks=(64, width)).attrs["events"] = list(event_names)
+    g.create_dataset("floats", shape=(0,), maxshape=(None,), dtype="f8", chunks=(4096,))
+    g.create_dataset("ints", shape=(0,), maxshape=(None,), dtype="i8", chunks=(1024,))
+
+
+def _last_checkpoint(node: h5py.Group) -> Checkpoint | None:
+    """The last checkpoint under ``node`` whose data are all there, or None."""
+    if CHECKPOINTS not in node:
+        return None
+    g = node[CHECKPOINTS]
+    index = g["index"]
+    k = index.shape[0]
+    if k == 0:
+        return None
+    row = index[k - 1]
+    nf, ni = int(row[3]), int(row[4])
+    names = [str(n) for n in index.attrs["events"]]
+    return Checkpoint(rows=int(row[0]), switched=bool(row[1]), code=int(row[2]),
+                      events={name: int(c) for name, c in zip(names, row[5:])},
+                      floats=g["floats"][(k - 1) * nf:k * nf], ints=g["ints"][(k - 1) * ni:k * ni])
+
+
+def _extend(ds: h5py.Dataset, values) -> None:
+    """Append ``values`` along the first axis of ``ds`` and flush it (data before extent, in SWMR
+    mode)."""
+    values = np.asarray(values)
+    n = ds.shape[0]
+    ds.resize(n + values.shape[0], axis=0)
+    ds[n:] = values
+    ds.flush()
+
+
 class ResultWriter:
-    """Streams trajectory blocks into ``/trajectory``; see the module docstring."""
+    """Streams a run into its result file; see the module docstring.
+
+    The run is written to :func:`partial_path` in SWMR mode (:meth:`block` after each block).
+    :meth:`finish` copies it into a file of the usual layout beside it — its objects copied
+    whole, compressed chunks as they are — adds the solver statistics, the analysis and the
+    status, and gives that file the result's name; the partial file is removed only then, so
+    that a kill at any instant leaves one of the two whole."""
 
     def __init__(self, path: Path, scene_name: str, scene_toml: str,
-                 columns: dict[str, str], force: bool = False) -> None:
+                 columns: dict[str, str], event_names=(), force: bool = False,
+                 resume: bool = False) -> None:
         self.path = Path(path)
-        check_writable(self.path, force)
         self.force = force
         self.tmp = partial_path(self.path)
-        if force:
-            self.tmp.unlink(missing_ok=True)  # (a kept partial result, or a link planted there)
+        self.done = self.tmp.with_name(f".{self.path.name}.done")
+        self.scene_name, self.scene_toml = scene_name, scene_toml
+        self.columns, self.event_names = columns, tuple(event_names)
+        self.checkpoint: Checkpoint | None = None
+        if resume:
+            source = resumable(self.path)
+            self.checkpoint = _resume_point(source, scene_toml)
+            if source != self.tmp:
+                self.force = True  # (the published incomplete result is what this run replaces)
+        else:
+            check_writable(self.path, force)
+        self._create()
+        if self.checkpoint is not None:  # (else stopped before its first block: start afresh)
+            self._copy_upto(source, self.checkpoint)
+        self._go_live()
+        self.done.unlink(missing_ok=True)  # (a copy a kill interrupted; the partial file is whole)
+
+    def _create(self) -> None:
+        """The partial file, its header and its empty datasets (SWMR creates no objects), made
+        under a name of its own until :meth:`_go_live`: until SWMR mode is on, a kill leaves a
+        file that HDF5 will not open."""
+        self.broken = ""  # why a write failed, if one did
+        name = self.tmp.with_name(self.tmp.name + ".new")
+        name.unlink(missing_ok=True)  # (one a kill left, or a link planted there)
         try:
-            self.f = create_file(self.tmp)
-            self._start(scene_name, scene_toml, columns)
+            self.f = h5py.File(name, "x", libver=FILE_FORMAT, rdcc_nbytes=CHUNK_CACHE_BYTES)
+            write_header(self.f, scene=self.scene_name, complete=False, status="running")
+            # The columns' datasets stay open for the file's life: a dataset object freed after
+            # a failed write would make HDF5 retry it (and print its failure) on closing.
+            self.datasets = write_layout(self.f, self.scene_toml, self.columns)
+            for name_ in self.event_names:
+                _event_datasets(self.f["events"], name_)
+            _checkpoint_datasets(self.f, self.event_names)
+            self.f.flush()
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
-            self._abandon()
-            raise NotWritable(f"{self.tmp}: cannot write the result file "
+            self._abandon(name)
+            raise NotWritable(f"{name}: cannot write the result file "
                               f"({str(exc).splitlines()[0]}); is the disk full?") from None
 
-    def _abandon(self) -> None:
+    def _go_live(self) -> None:
+        """SWMR mode on, then the file takes the partial file's name (replacing what a resumed
+        run had there): from now on a kill leaves a file that opens."""
+        self.f.swmr_mode = True
+        os.replace(self.f.filename, self.tmp)
+
+    def _abandon(self, name: Path) -> None:
         """Close what can be closed of a file whose writes failed, and remove it."""
         try:
             self.f.close()
         except Exception:  # noqa: BLE001 — the file is broken already
             pass
-        self.tmp.unlink(missing_ok=True)
+        Path(name).unlink(missing_ok=True)
 
-    def _start(self, scene_name: str, scene_toml: str, columns: dict[str, str]) -> None:
-        self.broken = ""  # why a write failed, if one did
-        write_header(self.f, scene=scene_name, complete=False)
-        self.columns = columns
-        # The columns' datasets stay open for the file's life: a dataset object freed after a
-        # failed write would make HDF5 retry it (and print its failure) on closing.
-        self.datasets = write_layout(self.f, scene_toml, columns)
+    def _copy_upto(self, source: Path, cp: Checkpoint) -> None:
+        """The trajectory, events and checkpoints of ``source`` up to checkpoint ``cp``."""
+        with open_file(source) as src:
+            for name, ds in self.datasets.items():
+                _extend(ds, src["trajectory"][name][:cp.rows])
+            for name_, count in cp.events.items():
+                if name_ in src["events"] and count:
+                    for col in ("t", "phi"):
+                        _extend(self.f["events"][name_][col], src["events"][name_][col][:count])
+            k = src[CHECKPOINTS]["index"].shape[0]
+            g = self.f[CHECKPOINTS]
+            _extend(g["floats"], src[CHECKPOINTS]["floats"][:k * cp.floats.size])
+            _extend(g["ints"], src[CHECKPOINTS]["ints"][:k * cp.ints.size])
+            _extend(g["index"], src[CHECKPOINTS]["index"][:k])
         self.f.flush()
+
+    def block(self, block: dict[str, np.ndarray], events: dict[str, np.ndarray],
+              floats: np.ndarray, ints: np.ndarray, switched: bool, code: int) -> None:
+        """A block of the run, its events, then the checkpoint after it (the stepper's state):
+        a reader sees the checkpoint only once the data it counts are on disk."""
+        self.append(block)
+        self.events(events)
+        try:
+            g = self.f[CHECKPOINTS]
+            _extend(g["floats"], floats)
+            _extend(g["ints"], ints)
+            counts = [self.f["events"][n]["t"].shape[0] for n in self.event_names]
+            _extend(g["index"], [[self.datasets["t"].shape[0], int(switched), code,
+                                  floats.size, ints.size, *counts]])
+        except (OSError, RuntimeError) as exc:
+            self._failed(exc)
+
+    def _failed(self, exc: Exception):
+        self.broken = (f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); "
+                       f"is the disk full?")
+        raise WriteFailed(self.broken) from None
 
     def append(self, block: dict[str, np.ndarray]) -> None:
         """Append equal-length columns (every column of the file)."""
-        n = len(next(iter(block.values())))
-        if n == 0:
+        if len(next(iter(block.values()))) == 0:
             return
         try:
             for name, ds in self.datasets.items():
-                ds.resize(ds.shape[0] + n, axis=0)
-                ds[-n:] = block[name]
-            self.f.flush()
+                _extend(ds, block[name])
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
-            self.broken = f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); is the disk full?"
-            raise WriteFailed(self.broken) from None
+            self._failed(exc)
+
+    def events(self, events: dict[str, np.ndarray]) -> None:
+        """Append events (name → (n, 2) of t, φ) to the datasets made for their names."""
+        for name, rows in events.items():
+            rows = np.asarray(rows, dtype=float).reshape(-1, 2)
+            if rows.size:
+                g = self.f["events"][name]
+                _extend(g["t"], rows[:, 0])
+                _extend(g["phi"], rows[:, 1])
 
     def restart(self) -> None:
-        """Drop the trajectory and events written so far (a run started again from the
-        beginning, e.g. a stiff scene by an implicit method)."""
-        for ds in self.f["trajectory"].values():
-            ds.resize(0, axis=0)
-        del self.f["events"]
-        self.f.create_group("events")
-        self.f.flush()
+        """Start the file afresh (a run started again from the beginning, e.g. a stiff scene by
+        an implicit method)."""
+        self.f.close()
+        self._create()
+        self._go_live()
 
     def read_trajectory(self, last: int | None = None) -> dict[str, np.ndarray]:
         """The trajectory written so far (its ``last`` samples only, if given), read back."""
-        n = self.f["trajectory"]["t"].shape[0]
+        n = self.datasets["t"].shape[0]
         start = 0 if last is None else max(0, n - last)
-        return {name: self.f["trajectory"][name][start:] for name in self.columns}
-
-    def events(self, events: dict[str, np.ndarray]) -> None:
-        """Append events (:func:`append_events`)."""
-        append_events(self.f["events"], events)
+        return {name: ds[start:] for name, ds in self.datasets.items()}
 
     def read_events(self, t_from: float = -np.inf) -> dict[str, np.ndarray]:
         """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ). Events are
@@ -298,30 +437,128 @@ class ResultWriter:
                     lo = mid + 1
                 else:
                     hi = mid
-            out[name] = np.column_stack([t[lo:], g["phi"][lo:]])
+            if lo < t.shape[0]:
+                out[name] = np.column_stack([t[lo:], g["phi"][lo:]])
         return out
 
-    def solver(self, attrs: dict[str, Any]) -> None:
-        write_solver(self.f["solver"], attrs)
-
-    def analysis(self, name: str, value: Any, unit: str) -> None:
-        write_analysis(self.f["analysis"], name, value, unit)
-
-    def close(self, complete: bool, message: str = "") -> Path:
-        """Mark the file complete or not, close it and move it to its final name. After a failed
-        write the file is left as it is under its temporary name (it says complete = false if
-        its header reached the disk) and :class:`~transient.errors.WriteFailed` (a
+    def finish(self, complete: bool, message: str = "", status: str = "",
+               solver: dict[str, Any] | None = None,
+               analysis: dict[str, tuple[Any, str]] | None = None) -> Path:
+        """Write the result under its name: the run so far, ``solver``'s statistics,
+        ``analysis`` (name → (value, unit)), ``complete``, ``status`` and ``message``. An
+        incomplete result keeps its checkpoints (it can be resumed). After a failed write the
+        partial file is left as it is, and :class:`~transient.errors.WriteFailed` (a
         SimulationError) says so."""
         if self.broken:
             # (not closed: HDF5 would retry the failed writes, print and crash; cli.entry exits
             # without freeing it)
-            raise WriteFailed(f"{self.broken}; the partial file {self.tmp} may be unreadable")
-        self.f.attrs["complete"] = bool(complete)
-        if message:
-            self.f.attrs["message"] = message
+            raise WriteFailed(f"{self.broken}; the partial file {self.tmp} holds the run up to "
+                              f"its last checkpoint")
         self.f.close()
-        _publish(self.tmp, self.path, self.force)
+        status = status or ("finished" if complete else "failed")
+        try:
+            with h5py.File(self.tmp, "r") as src:
+                _copy_result(src, self.done, keep_checkpoints=not complete)
+            with reopen_file(self.done) as f:
+                f.attrs.update(complete=bool(complete), status=status)
+                if message:
+                    f.attrs["message"] = message
+                write_solver(f["solver"], solver or {})
+                for name, (value, unit) in (analysis or {}).items():
+                    write_analysis(f["analysis"], name, value, unit)
+        except (OSError, RuntimeError) as exc:
+            self.done.unlink(missing_ok=True)
+            raise WriteFailed(f"writing {self.done} failed ({str(exc).splitlines()[0]}); is "
+                              f"the disk full? The partial file {self.tmp} holds the run") from None
+        _publish(self.done, self.path, self.force)
+        self.tmp.unlink()
         return self.path
+
+    def abandon_swmr(self) -> None:
+        """Close the partial file as it is (after an exception the finish could not handle)."""
+        try:
+            self.f.close()
+        except Exception:  # noqa: BLE001 — the file is broken already
+            pass
+
+
+def _event_datasets(events_group: h5py.Group, name: str) -> h5py.Group:
+    """The empty, extendable ``t`` and ``phi`` datasets of the event ``name``."""
+    g = events_group.require_group(name)
+    for col, unit in (("t", "s"), ("phi", "rad")):
+        if col not in g:
+            g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
+                             chunks=(1024,)).attrs["unit"] = unit
+    return g
+
+
+def _copy_result(src: h5py.File, dest: Path, keep_checkpoints: bool) -> None:
+    """A new result file at ``dest`` holding what ``src`` holds: its attributes, its objects
+    copied whole (HDF5 copies a compressed chunk as it is), events that occurred only."""
+    with create_file(dest) as f:
+        f.attrs.update(dict(src.attrs))
+        for name in ("scene", "trajectory", "solver", "analysis"):
+            src.copy(src[name], f, name=name)
+        events = f.create_group("events")
+        for name, g in src["events"].items():
+            if g["t"].shape[0]:
+                src.copy(g, events, name=name)
+        if keep_checkpoints:
+            src.copy(src[CHECKPOINTS], f, name=CHECKPOINTS)
+
+
+def open_file(path: Path) -> h5py.File:
+    """A result file open for reading: finished, or the partial file of a run that was killed
+    (or still runs), which HDF5 opens in SWMR mode only."""
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        if "already open for" not in str(exc):
+            raise
+        return h5py.File(path, "r", swmr=True)
+
+
+#: The statuses of a run that ``--resume`` continues: killed while running, or interrupted.
+RESUMABLE = ("running", "interrupted")
+
+
+def resumable(path: Path) -> Path:
+    """The file a run of ``path`` resumes from: its partial file (a killed run), else the result
+    itself if it is incomplete; a one-line error if there is neither."""
+    for source in (partial_path(path), path):
+        if source.is_file():
+            try:
+                with open_file(source) as f:
+                    status = str(f.attrs.get("status", ""))
+                    complete = bool(f.attrs.get("complete", False))
+            except OSError as exc:
+                raise NotWritable(f"{source}: not a readable result ({str(exc).splitlines()[0]});"
+                                  f" use --force to start afresh") from None
+            if complete:
+                raise ResultExists(f"{source}: the run is complete; nothing to resume")
+            if status not in RESUMABLE:
+                raise NotWritable(f"{source}: the run ended {status or 'failed'}; resuming would "
+                                  f"end the same way (resume continues interrupted or killed runs)")
+            return source
+    raise NotWritable(f"{path}: no partial or incomplete result to resume; run without --resume")
+
+
+def _resume_point(source: Path, scene_toml: str) -> Checkpoint | None:
+    """The last checkpoint of ``source`` (None if it has none yet), after checking that it is a
+    run of the same scene."""
+    with open_file(source) as f:
+        toml = f["scene"]["toml"][()]
+        if (toml.decode() if isinstance(toml, bytes) else str(toml)) != scene_toml:
+            raise NotWritable(f"{source}: written from another scene (its /scene/toml differs); "
+                              f"resume with the same scene, or use --force to start afresh")
+        if CHECKPOINTS not in f:
+            raise NotWritable(f"{source}: not the result of a streamed run (no checkpoints); "
+                              f"use --force to start afresh")
+        cp = _last_checkpoint(f)
+    if cp is not None and cp.code == NOT_RESUMABLE:
+        raise NotWritable(f"{source}: a run written whole (not by the compiled stepper), which "
+                          f"cannot be resumed; use --force to start afresh")
+    return cp
 
 
 def _publish(tmp: Path, path: Path, force: bool) -> None:
@@ -369,9 +606,10 @@ class Result:
 
 
 def open_result(path: str | Path) -> Result:
-    """Read a result file (complete or not) into a :class:`Result`."""
+    """Read a result file into a :class:`Result`: complete, incomplete, or the partial file
+    (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint."""
     path = Path(path)
-    with h5py.File(path, "r") as f:
+    with open_file(path) as f:
         if f.attrs.get("creator") != CREATOR:
             raise ValueError(f"{path}: not a transient result file")
         return read_run(f, path)
@@ -379,16 +617,42 @@ def open_result(path: str | Path) -> Result:
 
 def read_run(node: h5py.Group, path: Path) -> Result:
     """The result laid out under ``node`` (a file's root or a sweep's run), read into memory;
-    ``path`` names the file it came from."""
-    traj = {k: node["trajectory"][k][()] for k in node["trajectory"]}
+    ``path`` names the file it came from. An incomplete streamed run is read up to its last
+    checkpoint: the blocks completed before it, never what a kill left half-written after it."""
+    attrs = dict(node.attrs)
+    complete = attrs.get("complete", True)
+    cp = None if complete else _last_checkpoint(node)
+    if cp is not None:
+        rows = slice(cp.rows)
+    elif not complete and CHECKPOINTS in node:  # a partial file killed before its first block
+        rows = slice(0)
+    else:  # complete, or a run written whole
+        rows = slice(None)
+    traj = {k: node["trajectory"][k][rows] for k in node["trajectory"]}
     units = {k: str(node["trajectory"][k].attrs.get("unit", "")) for k in node["trajectory"]}
-    events = {k: {c: g[c][()] for c in g} for k, g in node["events"].items()}
+    events = {}
+    for k, g in node["events"].items():
+        n = g["t"].shape[0] if cp is None or k not in cp.events else cp.events[k]
+        if n:
+            events[k] = {c: g[c][:n] for c in g}
     analysis = {}
     for k, ds in node["analysis"].items():
         value = ds[()]
         analysis[k] = (value.decode() if isinstance(value, bytes) else value,
                        str(ds.attrs.get("unit", "")))
     toml = node["scene"]["toml"][()]
-    return Result(path=path, attrs=dict(node.attrs), trajectory=traj, units=units, events=events,
+    if attrs.get("status") == "running":
+        attrs["message"] = _stopped_message(traj)
+    return Result(path=path, attrs=attrs, trajectory=traj, units=units, events=events,
                   solver=dict(node["solver"].attrs), analysis=analysis,
                   scene_toml=toml.decode() if isinstance(toml, bytes) else str(toml))
+
+
+def _stopped_message(traj: dict[str, np.ndarray]) -> str:
+    """What a partial file says of its run: it stopped (killed) or still runs, and where its
+    last checkpoint is."""
+    if not traj["t"].size:
+        return "stopped (killed?) or still running, before its first block was written"
+    return (f"stopped (killed?) or still running; holds the run up to its last checkpoint, "
+            f"t = {traj['t'][-1]:.9g} s, φ = {traj['phi'][-1]:.9g} rad, ω = "
+            f"{traj['omega'][-1]:.9g} rad/s; `transient run SCENE --resume` continues it")

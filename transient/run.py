@@ -20,10 +20,10 @@ from .core import stepper_io as sio
 from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
-from .errors import SimulationError
+from .errors import SceneError, SimulationError
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
-from .results import RunData
+from .results import NOT_RESUMABLE, RunData
 from .scene.records import COMPILED_METHODS, runs_compiled
 
 BUFFER_ROWS = 8192
@@ -107,14 +107,23 @@ def _events_by_name(rows, switching: bool) -> dict[str, np.ndarray]:
     return ev
 
 
-def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
-                 progress: Callable[[float], None] | None = None, keep: bool = True) -> RunData:
+#: The names of the events a compiled run can write (a result file makes their datasets first).
+EVENT_NAMES = (*sio.EVENT_NAMES, "inertia_switch")
+
+
+def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = None,
+                 progress: Callable[[float], None] | None = None, keep: bool = True,
+                 start=None) -> RunData:
     """Integrate a dynamic scene with the compiled stepper (``scene.solver.method``: DOP853 or
-    DOPRI5, adaptive or fixed-step); blocks go to ``on_block`` as they come.
+    DOPRI5, adaptive or fixed-step); blocks go to ``on_block(block, events, state)`` as they
+    come, ``state`` the stepper's after the block (the arguments of
+    :meth:`transient.results.ResultWriter.block` after the events).
 
     With ``keep = False`` the trajectory is not kept in memory (only its last block), so that a
     long run streamed to a file needs bounded memory. A Ctrl-C between chunks ends the run with
-    ``complete = False`` and what was computed so far.
+    ``complete = False`` and what was computed so far. ``start``, a
+    :class:`~transient.results.Checkpoint` of this scene's run, continues that run from it: the
+    stepper carries nothing else from a block to the next, so the run goes on bit-identically.
     """
     model, bp, _ = build_model(scene)
     cfg = _config(scene)
@@ -130,6 +139,11 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     # speed jump (switch_inertia), and the run goes on.
     switch_at = scene.load.inertia_time if 0.0 < scene.load.inertia and (
         scene.load.inertia_time < scene.run.t_end) else math.inf
+    switched = False
+    if start is not None:
+        status, switched = _restore(start, y, fst, ist)
+        if switched:
+            model, switch_at = model._replace(J0=model.J0 + scene.load.inertia), math.inf
     run_cfg = cfg.copy()
     run_cfg[sio.C_T_END] = min(cfg[sio.C_T_END], switch_at)
     t0 = time.perf_counter()
@@ -143,14 +157,14 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
             ist[sio.I_NEV] = 0
             if switching:
                 model = switch_inertia(model, scene.load.inertia, y, ist)
-                run_cfg, switch_at, status = cfg, math.inf, sio.RUNNING
+                run_cfg, switch_at, status, switched = cfg, math.inf, sio.RUNNING, True
             if keep or not blocks or block["t"].size:
                 blocks = (blocks if keep else []) + [block]
             if keep:
                 for k, v in ev.items():
                     events.setdefault(k, []).append(v)
             if on_block:
-                on_block(block, ev)
+                on_block(block, ev, (np.concatenate([y, fst]), ist.copy(), switched, status))
             if progress:
                 progress(_fraction_done(scene, y))
     except KeyboardInterrupt:
@@ -200,6 +214,19 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
                    solver, complete=status == sio.FINISHED, message=message)
+
+
+def _restore(start, y, fst, ist) -> tuple[int, bool]:
+    """The stepper's state ``y``, ``fst``, ``ist`` set from the checkpoint ``start``; returns its
+    return code and whether the extra inertia was in."""
+    if start.floats.size != y.size + fst.size or start.ints.size != ist.size:
+        raise SimulationError(f"the checkpoint holds a state of {start.floats.size} + "
+                              f"{start.ints.size} numbers, this scene's stepper {y.size + fst.size}"
+                              f" + {ist.size}: it was written by another version of transient")
+    y[:] = start.floats[:y.size]
+    fst[:] = start.floats[y.size:]
+    ist[:] = start.ints
+    return start.code, start.switched
 
 
 def switch_inertia(model, extra: float, y, ist):
@@ -308,13 +335,13 @@ def _work_columns(traj: dict, n_pairs: int) -> None:
         traj[name] = np.concatenate([[0.0], np.cumsum(dt * (power[1:] + power[:-1]) / 2.0)])
 
 
-def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
+def integrate(scene, on_block=None, progress=None, keep=True, start=None) -> RunData:
     """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
-    for ``keep``."""
+    for ``keep`` and ``start``."""
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
-        data = run_compiled(scene, on_block, progress, keep)
+        data = run_compiled(scene, on_block, progress, keep, start)
         if data.message.startswith("stiff"):
             data = _implicit_rerun(scene, data, on_block, progress)
     else:
@@ -335,7 +362,7 @@ def _implicit_rerun(scene, stiff: RunData, on_block, progress) -> RunData:
     radau = dataclasses.replace(scene, solver=dataclasses.replace(scene.solver,
                                                                   method="scipy-Radau"))
     if on_block:  # (what the explicit run streamed is superseded: start the file afresh)
-        on_block(None, None)
+        on_block(None, None, None)
     data = run_reference(radau, None, progress)
     data.solver["stiff_rerun"] = note
     data.solver["explicit_nsteps"] = stiff.solver["nsteps"]
@@ -379,9 +406,12 @@ class _WriteBehind:
         self._pool.shutdown(wait=True)
 
 
-def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> RunData:
+def simulate(scene, path: str | Path, *, force: bool = False, resume: bool = False,
+             progress=None) -> RunData:
     """Run ``scene`` and write the result file ``path`` (streamed; see :mod:`transient.results`).
 
+    ``resume`` continues the run that an interrupt or a kill stopped, from the last checkpoint of
+    its partial file (or of its incomplete result), bit-identically to a run never stopped.
     Raises :class:`transient.errors.SimulationError` after writing the partial result when the run
     fails or is interrupted.
     """
@@ -389,29 +419,28 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
     from .results import ResultWriter
     from .scene import to_toml
 
-    writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene), force)
+    streamed = runs_compiled(scene)
+    if resume and not streamed:
+        raise SceneError("solver.method", f"{scene.solver.method!r}: only runs of the compiled "
+                         f"stepper (DOP853, DOPRI5) can be resumed; run it again with --force")
+    writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene),
+                          EVENT_NAMES, force=force, resume=resume)
     writes = _WriteBehind()
     data = None
     try:
-        streamed = runs_compiled(scene)
-
-        def write_block(block, ev):
-            writer.append(block)
-            writer.events(ev)
-
-        def on_block(block, ev):
+        def on_block(block, ev, state):
             writes.wait()
             if block is None:  # the run starts again (a stiff scene, by an implicit method)
                 writer.restart()
                 return
-            writes.start(write_block, block, ev)
+            writes.start(writer.block, block, ev, *state)
 
-        data = integrate(scene, on_block=on_block, progress=progress, keep=False)
+        data = integrate(scene, on_block=on_block, progress=progress, keep=False,
+                         start=writer.checkpoint)
         writes.wait()
-        if not streamed or "stiff_rerun" in data.solver:
-            writer.append(data.trajectory)
-            writer.events(data.events)
-        writer.solver(data.solver)
+        if not streamed or "stiff_rerun" in data.solver:  # written whole, not resumable
+            writer.block(data.trajectory, data.events, np.zeros(0), np.zeros(0, np.int64), False,
+                         NOT_RESUMABLE)
         # The summary looks at the end of the run: its last SUMMARY_SAMPLES samples, so that
         # memory stays bounded however long the run (steady state, efficiency are found there).
         data.trajectory = writer.read_trajectory(last=SUMMARY_SAMPLES)
@@ -419,17 +448,23 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
                                          if data.trajectory["t"].size else -math.inf)
         summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
                    else {})
-        for name, (value, unit) in summary.items():
-            writer.analysis(name, value, unit)
         data.extra["summary"] = summary
     except BaseException as exc:
         writes.settle()
         msg = data.message if data is not None and data.message else f"{type(exc).__name__}: {exc}"
-        writer.close(False, msg)
+        writer.finish(False, msg, "interrupted" if isinstance(exc, KeyboardInterrupt) else "",
+                      data.solver if data is not None else None)
         raise
     finally:
         writes.shutdown()
-    writer.close(data.complete, data.message)
+    writer.finish(data.complete, data.message, _status(data), data.solver, summary)
     if not data.complete:
         raise SimulationError(f"{data.message}; partial result kept in {path} (complete = false)")
     return data
+
+
+def _status(data: RunData) -> str:
+    """The result's ``status``: ``finished``, ``interrupted`` or the failure's first word."""
+    if data.complete:
+        return "finished"
+    return data.message.split(":")[0].split(";")[0].strip() or "failed"

@@ -21,7 +21,7 @@ import pytest
 from scene_texts import SMALL
 
 from transient.cli import main
-from transient.results import PROBE_BYTES
+from transient.results import PROBE_BYTES, open_file
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -316,9 +316,9 @@ LONG = sub("revolutions = 2", "revolutions = 1000000", VALID)  # ~50 s, killed l
 def _holds_a_block(part):
     """Whether the result file being written at ``part`` holds a trajectory block yet."""
     try:
-        with h5py.File(part, "r", locking=False) as f:
-            return f["trajectory/t"].shape[0] > 0
-    except (OSError, KeyError):  # not there yet, or being written
+        with open_file(part) as f:
+            return f["checkpoint/index"].shape[0] > 0
+    except (OSError, KeyError):  # not there yet
         return False
 
 
@@ -348,7 +348,7 @@ def test_sigkill_during_writing_leaves_an_incomplete_file(tmp_path):
             proc.wait()
     assert proc.returncode == -signal.SIGKILL
     assert not (out / "long.h5").exists()  # never renamed: the run did not end
-    with h5py.File(part, "r") as f:
+    with open_file(part) as f:
         assert f.attrs["creator"] == "transient"
         assert bool(f.attrs["complete"]) is False
         n = f["trajectory/t"].shape[0]
@@ -472,5 +472,6 @@ def test_full_disk_mid_run_fails_with_one_line(tmp_path):
     assert r.returncode == 1, r.stderr
     assert r.stderr.count("\n") == 1, r.stderr
     assert r.stderr.startswith(f"transient: writing {part} failed (")
-    assert r.stderr.endswith(f"is the disk full?; the partial file {part} may be unreadable\n")
+    assert r.stderr.endswith(f"is the disk full?; the partial file {part} holds the run up to "
+                             f"its last checkpoint\n")
     assert list(out.iterdir()) == [part]

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import SceneError
 from .common import EXIT_OK, KERNELS_NOTICE, read_result
 
 
@@ -15,6 +16,9 @@ def register(sub) -> None:
     r.add_argument("scene")
     r.add_argument("-o", "--output", default="results", help="output folder (default results/)")
     r.add_argument("--force", action="store_true", help="overwrite an existing result")
+    r.add_argument("--resume", action="store_true",
+                   help="continue the interrupted or killed run of this scene from its last "
+                        "checkpoint (bit-identical to a run never stopped)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
     r.set_defaults(func=cmd_run)
     c = sub.add_parser("check", help="validate a scene only")
@@ -45,7 +49,10 @@ def cmd_run(args) -> int:
 
     scene = load_scene(args.scene)
     path = Path(args.output) / f"{Path(args.scene).stem}.h5"
-    check_writable(path, args.force)
+    if args.resume and args.force:
+        raise SceneError("--resume", "continues a run, --force replaces it: give one of them")
+    if not args.resume:
+        check_writable(path, args.force)
     bar = None
     if not args.quiet and sys.stderr.isatty():
         from tqdm import tqdm
@@ -59,7 +66,7 @@ def cmd_run(args) -> int:
                 bar.set_description(scene.name)  # (shown at once, however short the run)
             bar.update(int(1000 * fraction) - bar.n)
     try:
-        data = simulate(scene, path, force=args.force, progress=progress)
+        data = simulate(scene, path, force=args.force, resume=args.resume, progress=progress)
     finally:
         if bar:
             bar.close()

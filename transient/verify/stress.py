@@ -648,7 +648,7 @@ def million_revolutions(driven: bool):
         n_pairs = len(scene.friction.pairs)
         stats = {"drift": 0.0, "bal": 0.0, "scale": 0.0, "K0": None, "n": 0, "bad": 0}
 
-        def on_block(block, _ev):
+        def on_block(block, _ev, _state):
             if not block["t"].size:
                 return
             K = 0.5 * block["J"] * block["omega"] ** 2

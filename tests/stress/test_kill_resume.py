@@ -1,0 +1,121 @@
+"""Runs killed at random instants: the partial file opens, holds an exact prefix of the run that
+was never stopped (so it is monotone and finite), says it is incomplete, and ``--resume`` ends in
+a file bit-identical to that run's.
+
+Each scene is run once uninterrupted in this process, then again and again in a child process
+(``python -m transient run``) that is killed (SIGKILL, and SIGTERM for the interrupted path) at a
+random instant after its partial file appears; each kill is followed by a resume in this process.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from transient import load_scene, open_result
+from transient.results import partial_path
+from transient.run import simulate
+from transient.scene import to_toml
+
+REPO = Path(__file__).resolve().parents[2]
+#: (case, its [run] changed to, kills): long enough for many blocks (about a second), short
+#: enough for the suite; three scenes × 17 SIGKILLs = 51, with pairs switching modes, four
+#: cylinders and a governor.
+CASES = [("coasting_single", {"revolutions": 6_000}, 17),
+         ("gots_diesel_friction", {"revolutions": 1_500}, 17),
+         ("swash_plate_4cyl", {"t_end": 750.0}, 17)]
+#: SIGTERMs per scene besides: a run ended as Ctrl-C ends it, resumed from its published file.
+TERMS = 2
+
+
+def _scene_file(tmp: Path, case: str, run: dict) -> Path:
+    scene = load_scene(REPO / "cases" / f"{case}.toml")
+    scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, **run))
+    path = tmp / f"{case}.toml"
+    path.write_text(to_toml(scene))
+    return path
+
+
+def _start(scene_file: Path, out: Path) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "transient", "run", str(scene_file), "-o",
+                             str(out), "-q"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+def _wait_for(path: Path, proc: subprocess.Popen) -> bool:
+    """Whether ``path`` appeared while ``proc`` still ran."""
+    while proc.poll() is None:
+        if path.exists():
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def _same(a, b, what: str) -> None:
+    assert sorted(a.trajectory) == sorted(b.trajectory)
+    for name, x in a.trajectory.items():
+        assert np.array_equal(x, b.trajectory[name]), f"{what}: column {name} differs"
+    assert sorted(a.events) == sorted(b.events), what
+    for name, ev in a.events.items():
+        for col in ("t", "phi"):
+            assert np.array_equal(ev[col], b.events[name][col]), f"{what}: event {name} differs"
+
+
+def _check_prefix(part, full, what: str) -> None:
+    """``part`` holds the first samples of ``full`` exactly: monotone and finite as it is."""
+    assert not part.complete, what
+    n = part.trajectory["t"].size
+    for name, x in part.trajectory.items():
+        assert np.array_equal(x, full.trajectory[name][:n]), f"{what}: column {name} differs"
+    for name, ev in part.events.items():
+        k = ev["t"].size
+        assert np.array_equal(ev["t"], full.events[name]["t"][:k]), f"{what}: event {name}"
+    t = part.trajectory["t"]
+    assert np.all(np.diff(t) > 0) and np.all(np.isfinite(t)), what
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case, run, kills", CASES)
+def test_killed_runs_keep_a_prefix_and_resume_bit_identically(tmp_path, case, run, kills):
+    scene_file = _scene_file(tmp_path, case, run)
+    scene = load_scene(scene_file)
+    t0 = time.perf_counter()
+    simulate(scene, tmp_path / "full" / f"{case}.h5")
+    span = time.perf_counter() - t0
+    full = open_result(tmp_path / "full" / f"{case}.h5")
+    rng = np.random.default_rng(sum(map(ord, case)))
+    killed = terms = resumed_from_middle = 0
+    for k in range(2 * (kills + TERMS)):
+        if killed == kills and terms == TERMS:
+            break
+        sig = signal.SIGKILL if killed < kills else signal.SIGTERM
+        out = tmp_path / f"run{k}"
+        result = out / f"{case}.h5"
+        proc = _start(scene_file, out)
+        if not _wait_for(partial_path(result), proc):
+            pytest.fail(f"{case}: the run ended before its partial file appeared: "
+                        f"{proc.stderr.read().decode()}")
+        time.sleep(rng.uniform(0.0, 0.8 * span))
+        proc.send_signal(sig)
+        rc = proc.wait()
+        what = f"{case}, kill {k} ({sig.name}, rc {rc})"
+        if result.exists() and open_result(result).complete:
+            continue  # it finished first: nothing to check
+        killed += sig == signal.SIGKILL
+        terms += sig == signal.SIGTERM
+        left = partial_path(result) if sig == signal.SIGKILL else result
+        part = open_result(left)
+        _check_prefix(part, full, what)
+        assert part.attrs["status"] == ("running" if sig == signal.SIGKILL else "interrupted")
+        resumed_from_middle += 0 < part.trajectory["t"].size
+        simulate(scene, result, resume=True)
+        assert not partial_path(result).exists()
+        _same(open_result(result), full, what)
+    assert (killed, terms) == (kills, TERMS)  # every one landed while the run ran
+    assert resumed_from_middle >= kills // 2  # most after some blocks, not before the first
