@@ -6,6 +6,7 @@ that does not need them starts without them.
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -41,9 +42,30 @@ def read_result(path):
     if not Path(path).is_file():
         raise FileNotFoundError(f"{path}: no such result file")
     try:
-        return open_result(path)
+        res = open_result(path)
     except (OSError, ValueError) as exc:
         raise SceneError("(file)", f"not a readable transient result: {exc}", file=str(path)) from None
+    if not res.complete:
+        print(f"warning: {path}: {incomplete_note(res)}", file=sys.stderr)
+    return res
+
+
+def result_stem(path: Path) -> str:
+    """The name a result's figures and tables start with: its file's stem, also for the partial
+    file of a killed run (``.NAME.h5.part`` → ``NAME``)."""
+    name = Path(path).name
+    if name.startswith(".") and name.endswith(".h5.part"):
+        name = name[1:-len(".part")]
+    return Path(name).stem
+
+
+def incomplete_note(res) -> str:
+    """What a figure or a table of the incomplete result ``res`` covers, in one line."""
+    t = res.trajectory["t"]
+    status = str(res.attrs.get("status", "failed"))
+    how = "stopped while running (killed?)" if status == "running" else status
+    return (f"an incomplete run ({how}): covers t ≤ {t[-1]:.6g} s only" if t.size
+            else f"an incomplete run ({how}): no samples")
 
 
 def output_folder(option: str | None, default: Path) -> Path:
@@ -80,12 +102,17 @@ def output_file(path, force: bool):
                             newline="")
 
 
-def save(fig, path, force: bool):
+def save(fig, path, force: bool, source=None):
     """Write ``fig`` as a PNG at ``path`` (as :func:`output_file` creates files) and close it
-    (a long command draws many); returns ``path``."""
+    (a long command draws many); returns ``path``. A figure of an incomplete result ``source``
+    says so across its top."""
     from ..results import create_exclusive
 
     fig.tight_layout()
+    if source is not None and not source.complete:
+        fig.subplots_adjust(top=0.9)
+        fig.text(0.5, 0.995, incomplete_note(source), ha="center", va="top", color="crimson",
+                 fontsize="medium", fontweight="bold")
     with create_exclusive(Path(path), replace=force) as fh:
         fig.savefig(fh, format="png", dpi=110)
     pyplot().close(fig)

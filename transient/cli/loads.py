@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
-from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, save, write_columns
+from .common import (EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save,
+                     write_columns)
 
 
 def register(sub) -> None:
@@ -68,7 +69,7 @@ def _crank_slider_loads(args, res, scene) -> int:
     win, deg, loads = d.window.columns, d.window.angle_deg, d.loads
     k = args.cylinder - 1
     out = output_folder(args.output, res.path.parent)
-    stem = res.path.stem
+    stem = result_stem(res.path)
     plt = pyplot()
 
     from .. import plots
@@ -88,14 +89,14 @@ def _crank_slider_loads(args, res, scene) -> int:
         axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
                              f"(split beam, (58))", fontsize=9)
     fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle")
-    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force))
+    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force, res))
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for j in range(n_cyl):
         plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin {j + 1}")
     ax.legend(fontsize=8)
     ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
-    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force))
+    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force, res))
 
     rays, sums = d.crankpin_wear
     fig, axes = plt.subplots(1, ncols, figsize=(5.5 * ncols, 5.5), squeeze=False)
@@ -106,13 +107,13 @@ def _crank_slider_loads(args, res, scene) -> int:
         axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
     fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6: each load wears ±60° around its "
                  f"direction)", fontsize=10)
-    written.append(save(fig, out / f"{stem}_loads_wear.png", args.force))
+    written.append(save(fig, out / f"{stem}_loads_wear.png", args.force, res))
 
     if d.inline:
         fig, ax = plt.subplots(figsize=(8, 4.5))
         plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
         ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
-        written.append(save(fig, out / f"{stem}_loads_running_torques.png", args.force))
+        written.append(save(fig, out / f"{stem}_loads_running_torques.png", args.force, res))
 
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
@@ -181,7 +182,7 @@ def _radial_loads(args, res, scene) -> int:
     win, deg, loads = d.window.columns, d.window.angle_deg, d.loads
     rows, n_links = loads.R.shape[0], loads.link_x.shape[0]
     out = output_folder(args.output, res.path.parent)
-    stem = res.path.stem
+    stem = result_stem(res.path)
     plt = pyplot()
     written = []
     fig, axes = plt.subplots(1, rows, figsize=(6 * rows, 5.5), squeeze=False)
@@ -189,7 +190,7 @@ def _radial_loads(args, res, scene) -> int:
         plots.crankpin_polar(axes[0, j], loads.R_K[j], loads.R_T[j])
         axes[0, j].set_title(f"master crankpin of row {j + 1}, crank frame", fontsize=9)
     fig.suptitle(f"{scene.name}: polar load diagram over the last cycle")
-    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force))
+    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force, res))
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for j in range(rows):
         plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin, row {j + 1}")
@@ -197,7 +198,7 @@ def _radial_loads(args, res, scene) -> int:
         plots.load_against_angle(ax, deg, d.link_load[i], label=f"link pin {i + 1}")
     ax.legend(fontsize=8)
     ax.set_title(f"{scene.name}: crankpin and link-pin loads over the last cycle (dashed: mean)")
-    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force))
+    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force, res))
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
     for k in range(loads.P.shape[0]):

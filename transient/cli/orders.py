@@ -7,7 +7,8 @@ import math
 import numpy as np
 
 from ..errors import SceneError
-from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, save, write_columns
+from .common import (EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save,
+                     write_columns)
 
 
 def register(sub) -> None:
@@ -60,7 +61,7 @@ def cmd_orders(args) -> int:
     top = args.max_order
 
     out = output_folder(args.output, res.path.parent)
-    stem = res.path.stem
+    stem = result_stem(res.path)
     written = []
     cols_csv = {"order": orders, "omega_amplitude_rad_s": spec_w.amplitude[-1],
                 "omega_phase_rad": spec_w.phase[-1]}
@@ -98,7 +99,7 @@ def cmd_orders(args) -> int:
         plots.order_bars(axes[i], orders, rep.relative_constant[-1], "W / W₁ (cylinder 1)", top,
                          width=0.2, offset=0.1, label="constant ω̄", log=True)
         axes[i].legend(fontsize=8)
-    written.append(save(fig, out / f"{stem}_orders.png", args.force))
+    written.append(save(fig, out / f"{stem}_orders.png", args.force, res))
 
     if n_cyc >= 2:
         amp = spec_w.amplitude
@@ -113,7 +114,7 @@ def cmd_orders(args) -> int:
         plots.order_tracks(a2, means * rpm, tracks, "ω amplitude [rad/s]")
         a2.set_title("order tracks of ω against the cycle-mean speed", fontsize=9)
         fig.suptitle(f"{scene.name}: run-up orders of ω")
-        written.append(save(fig, out / f"{stem}_orders_runup.png", args.force))
+        written.append(save(fig, out / f"{stem}_orders_runup.png", args.force, res))
         run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": starts,
                "omega_mean_rad_s": means}
         run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j]

@@ -1,7 +1,7 @@
 """``transient plot``: PNG figures of a result, or of several side by side."""
 from __future__ import annotations
 
-from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, save
+from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save
 
 
 def register(sub) -> None:
@@ -23,28 +23,28 @@ def cmd_plot(args) -> int:
     res = read_result(args.result[0])
     scene = res.scene()
     out = output_folder(args.output, res.path.parent)
-    stem = res.path.stem
+    stem = result_stem(res.path)
     traj = res.trajectory
     written = []
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     plots.speed(a1, traj)
     plots.acceleration(a2, traj)
     a1.set_title(f"{scene.name}: speed and acceleration")
-    written.append(save(fig, out / f"{stem}_speed.png", args.force))
+    written.append(save(fig, out / f"{stem}_speed.png", args.force, res))
     fig, ax = plt.subplots(figsize=(8, 4.5))
     plots.torques(ax, traj, scene.mechanism.cycle)
     ax.set_title(f"{scene.name}: moments over the last cycle")
-    written.append(save(fig, out / f"{stem}_torques.png", args.force))
+    written.append(save(fig, out / f"{stem}_torques.png", args.force, res))
     if "load_change_1_t_s" in res.analysis:
         fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
         plots.load_response(axes, traj, scene.mechanism.cycle, res.analysis)
         axes[0].set_title(f"{scene.name}: load steps (ISO 8528-5 band around the new speed)")
-        written.append(save(fig, out / f"{stem}_response.png", args.force))
+        written.append(save(fig, out / f"{stem}_response.png", args.force, res))
     if scene.friction.pairs:
         fig, ax = plt.subplots(figsize=(8, 4.5))
         plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)
         ax.set_title(f"{scene.name}: power through the non-ideal pairs ({scene.friction.policy})")
-        written.append(save(fig, out / f"{stem}_pairs.png", args.force))
+        written.append(save(fig, out / f"{stem}_pairs.png", args.force, res))
     table = gas_table(scene)
     if table is not None and not gas_is_force(scene):
         mech = scene.mechanism
@@ -56,7 +56,7 @@ def cmd_plot(args) -> int:
             plots.indicator_pv(a2, table, mech.volume_function(0.0), log=False)
             a2.set_xlabel("swept volume F_p·s [dm³]")
         a1.set_title(f"{scene.name}: indicator diagram")
-        written.append(save(fig, out / f"{stem}_indicator.png", args.force))
+        written.append(save(fig, out / f"{stem}_indicator.png", args.force, res))
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
@@ -79,6 +79,7 @@ def _plot_comparison(args) -> int:
         plots.acceleration(axes[1, j], res.trajectory)
         plots.piston_force(axes[2, j], res.trajectory, scene)
         axes[0, j].set_title(f"{scene.name}\n{scene.mechanism.n_cylinders} cylinder(s)", fontsize=9)
-    path = out / ("compare_" + "_".join(r.path.stem for r in results) + ".png")
-    print(f"wrote {save(fig, path, args.force)}")
+    path = out / ("compare_" + "_".join(result_stem(r.path) for r in results) + ".png")
+    incomplete = next((r for r in results if not r.complete), None)
+    print(f"wrote {save(fig, path, args.force, incomplete)}")
     return EXIT_OK

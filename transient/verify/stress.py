@@ -711,6 +711,57 @@ def _coast_period(scene) -> float:
     return value
 
 
+def kill_and_resume(quick: bool, ctx: Context) -> Outcome:
+    """The governed diesel with friction pairs run by ``transient run`` in child processes, each
+    killed (SIGKILL) at a random instant and resumed in this one: the partial file must hold an
+    exact prefix of the run never stopped, and the resumed file that run, bit for bit."""
+    import signal
+    import subprocess
+    import sys
+
+    from ..results import open_result, partial_path
+    from ..run import simulate
+    from ..scene import to_toml
+
+    scene = scene_of(put(base("gots_diesel_friction"), "run", revolutions=600 if quick else 3000),
+                     "kill-and-resume")
+    scene_file = ctx.out / "kill-and-resume.toml"
+    scene_file.write_text(to_toml(scene), encoding="utf-8")
+    t0 = time.perf_counter()
+    simulate(scene, ctx.out / "kill-and-resume-whole.h5", force=True)
+    span = time.perf_counter() - t0
+    whole = open_result(ctx.out / "kill-and-resume-whole.h5")
+    o, rng = Outcome(status="complete", error=0.0, tolerance=0.0), np.random.default_rng(1)
+    for k in range(3 if quick else 20):
+        out = ctx.out / f"kill-and-resume-{k}"
+        result = out / "kill-and-resume.h5"
+        for stale in (result, partial_path(result)):
+            stale.unlink(missing_ok=True)
+        proc = subprocess.Popen([sys.executable, "-m", "transient", "run", str(scene_file), "-o",
+                                 str(out), "-q"], stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        while proc.poll() is None and not partial_path(result).exists():
+            time.sleep(0.01)
+        time.sleep(rng.uniform(0.0, span))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        if result.exists():
+            o.notes.append(f"kill {k}: the run had finished")
+            continue
+        part = open_result(partial_path(result))
+        n = part.trajectory["t"].size
+        prefix = all(np.array_equal(v, whole.trajectory[c][:n]) for c, v in part.trajectory.items())
+        simulate(scene, result, resume=True)
+        again = open_result(result)
+        same = all(np.array_equal(v, again.trajectory[c]) for c, v in whole.trajectory.items())
+        o.steps += 1
+        if not (prefix and same and not part.complete):
+            o.ok = False
+            o.notes.append(f"kill {k} after {n} samples: prefix {prefix}, resumed identical {same}")
+    o.notes.append(f"{o.steps} runs killed and resumed")
+    return o
+
+
 def catalogue() -> list[Case]:
     """Every case, in report order."""
     return [
@@ -785,6 +836,9 @@ def catalogue() -> list[Case]:
                                           "backwards and can never reach them",
              single(backward_from_rest, "stalled|locked", name="backward-revolutions-only"),
              time_limit=10.0),
+        Case("kill-and-resume", "runs killed (SIGKILL) at random instants, then --resume: "
+                                "a prefix of the run kept, the resumed run bit-identical",
+             kill_and_resume, time_limit=120.0, full_time_limit=600.0),
         Case("million-revolutions-coasting", "10⁶ revolutions coasting: energy drift, phase "
                                              "drift, memory", million_revolutions(False),
              quick=False, time_limit=900.0),
