@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -246,7 +247,7 @@ class Checkpoint:
     ints: np.ndarray
 
 
-def _checkpoint_datasets(node: h5py.Group, event_names) -> None:
+def _checkpoint_datasets(node: h5py.Group, event_names) -> dict[str, h5py.Dataset]:
     """The empty, extendable datasets of the checkpoints: ``index`` holds a row per checkpoint
     (rows, switched, the stepper's return code, the float and integer state's lengths, then a
     count per event name, named in its ``events`` attribute); ``floats`` and ``ints`` hold the
@@ -257,6 +258,7 @@ def _checkpoint_datasets(node: h5py.Group, event_names) -> None:
                      chunks=(64, width)).attrs["events"] = list(event_names)
     g.create_dataset("floats", shape=(0,), maxshape=(None,), dtype="f8", chunks=(4096,))
     g.create_dataset("ints", shape=(0,), maxshape=(None,), dtype="i8", chunks=(1024,))
+    return {name: g[name] for name in ("index", "floats", "ints")}
 
 
 def _last_checkpoint(node: h5py.Group) -> Checkpoint | None:
@@ -277,13 +279,11 @@ def _last_checkpoint(node: h5py.Group) -> Checkpoint | None:
 
 
 def _extend(ds: h5py.Dataset, values) -> None:
-    """Append ``values`` along the first axis of ``ds`` and flush it (data before extent, in SWMR
-    mode)."""
+    """Append ``values`` along the first axis of ``ds``."""
     values = np.asarray(values)
     n = ds.shape[0]
     ds.resize(n + values.shape[0], axis=0)
     ds[n:] = values
-    ds.flush()
 
 
 class ResultWriter:
@@ -331,9 +331,10 @@ class ResultWriter:
             # The columns' datasets stay open for the file's life: a dataset object freed after
             # a failed write would make HDF5 retry it (and print its failure) on closing.
             self.datasets = write_layout(self.f, self.scene_toml, self.columns)
-            for name_ in self.event_names:
-                _event_datasets(self.f["events"], name_)
-            _checkpoint_datasets(self.f, self.event_names)
+            # Opened once: a lookup by path per block would cost more than writing the block.
+            self.event_datasets = {n: _event_datasets(self.f["events"], n)
+                                   for n in self.event_names}
+            self.checkpoints = _checkpoint_datasets(self.f, self.event_names)
             self.f.flush()
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
             self._abandon(name)
@@ -362,9 +363,10 @@ class ResultWriter:
             for name_, count in cp.events.items():
                 if name_ in src["events"] and count:
                     for col in ("t", "phi"):
-                        _extend(self.f["events"][name_][col], src["events"][name_][col][:count])
+                        _extend(self.event_datasets[name_][col],
+                                src["events"][name_][col][:count])
             k = src[CHECKPOINTS]["index"].shape[0]
-            g = self.f[CHECKPOINTS]
+            g = self.checkpoints
             _extend(g["floats"], src[CHECKPOINTS]["floats"][:k * cp.floats.size])
             _extend(g["ints"], src[CHECKPOINTS]["ints"][:k * cp.ints.size])
             _extend(g["index"], src[CHECKPOINTS]["index"][:k])
@@ -372,41 +374,54 @@ class ResultWriter:
 
     def block(self, block: dict[str, np.ndarray], events: dict[str, np.ndarray],
               floats: np.ndarray, ints: np.ndarray, switched: bool, code: int) -> None:
-        """A block of the run, its events, then the checkpoint after it (the stepper's state):
-        a reader sees the checkpoint only once the data it counts are on disk."""
-        self.append(block)
-        self.events(events)
-        try:
-            g = self.f[CHECKPOINTS]
+        """A block of the run and its events, flushed; then the checkpoint after it (the
+        stepper's state), flushed: a reader sees the checkpoint only once the data it counts are
+        on disk (SWMR keeps each dataset consistent in itself, the flushes order them)."""
+        with self._writing():
+            self._columns(block)
+            self._events(events)
+            self.f.flush()
+            g = self.checkpoints
             _extend(g["floats"], floats)
             _extend(g["ints"], ints)
-            counts = [self.f["events"][n]["t"].shape[0] for n in self.event_names]
+            counts = [self.event_datasets[n]["t"].shape[0] for n in self.event_names]
             _extend(g["index"], [[self.datasets["t"].shape[0], int(switched), code,
                                   floats.size, ints.size, *counts]])
-        except (OSError, RuntimeError) as exc:
-            self._failed(exc)
+            self.f.flush()
 
-    def _failed(self, exc: Exception):
-        self.broken = (f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); "
-                       f"is the disk full?")
-        raise WriteFailed(self.broken) from None
+    @contextmanager
+    def _writing(self):
+        """Writes whose failure (h5py reports one as OSError or RuntimeError) breaks the file:
+        remembered, and raised as :class:`~transient.errors.WriteFailed`."""
+        try:
+            yield
+        except (OSError, RuntimeError) as exc:
+            self.broken = (f"writing {self.tmp} failed ({str(exc).splitlines()[0]}); "
+                           f"is the disk full?")
+            raise WriteFailed(self.broken) from None
 
     def append(self, block: dict[str, np.ndarray]) -> None:
-        """Append equal-length columns (every column of the file)."""
-        if len(next(iter(block.values()))) == 0:
-            return
-        try:
-            for name, ds in self.datasets.items():
-                _extend(ds, block[name])
-        except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
-            self._failed(exc)
+        """Append equal-length columns (every column of the file), flushed."""
+        with self._writing():
+            self._columns(block)
+            self.f.flush()
 
     def events(self, events: dict[str, np.ndarray]) -> None:
-        """Append events (name → (n, 2) of t, φ) to the datasets made for their names."""
+        """Append events (name → (n, 2) of t, φ) to the datasets made for their names, flushed."""
+        with self._writing():
+            self._events(events)
+            self.f.flush()
+
+    def _columns(self, block: dict[str, np.ndarray]) -> None:
+        if len(next(iter(block.values()))):
+            for name, ds in self.datasets.items():
+                _extend(ds, block[name])
+
+    def _events(self, events: dict[str, np.ndarray]) -> None:
         for name, rows in events.items():
             rows = np.asarray(rows, dtype=float).reshape(-1, 2)
             if rows.size:
-                g = self.f["events"][name]
+                g = self.event_datasets[name]
                 _extend(g["t"], rows[:, 0])
                 _extend(g["phi"], rows[:, 1])
 
@@ -482,14 +497,15 @@ class ResultWriter:
             pass
 
 
-def _event_datasets(events_group: h5py.Group, name: str) -> h5py.Group:
+def _event_datasets(events_group: h5py.Group, name: str) -> dict[str, h5py.Dataset]:
     """The empty, extendable ``t`` and ``phi`` datasets of the event ``name``."""
     g = events_group.require_group(name)
+    out = {}
     for col, unit in (("t", "s"), ("phi", "rad")):
-        if col not in g:
-            g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
-                             chunks=(1024,)).attrs["unit"] = unit
-    return g
+        out[col] = g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
+                                    chunks=(1024,))
+        out[col].attrs["unit"] = unit
+    return out
 
 
 def _copy_result(src: h5py.File, dest: Path, keep_checkpoints: bool) -> None:
