@@ -27,11 +27,16 @@ result → analysis, and each layer imports only those below it (the contracts i
 - ``verify``         the work–precision benchmark, its targets, the stress catalogue
 - ``cli``            the ``transient`` command
 
-Public API: :func:`load_scene`, :func:`simulate`, :func:`open_result`.
+Public API: :func:`load_scene` and :class:`Scene` (``Scene.from_dict``, ``scene.replace``,
+``scene.to_toml``), :func:`simulate` → :class:`Result`, :func:`open_result`, and the errors
+:class:`SceneError` (invalid input) and :class:`SimulationError` (a run that failed).
 """
-from .results import open_result  # noqa: E402
+from . import errors  # noqa: E402
+from .errors import SceneError, SimulationError  # noqa: E402
+from .results import Result, open_result  # noqa: E402
 from .run import simulate  # noqa: E402
-from .scene import load_scene  # noqa: E402
+from .scene import Scene, load_scene  # noqa: E402
 from .version import __version__
 
-__all__ = ["load_scene", "simulate", "open_result", "__version__"]
+__all__ = ["load_scene", "Scene", "simulate", "Result", "open_result", "SceneError",
+           "SimulationError", "errors", "__version__"]

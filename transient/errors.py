@@ -27,7 +27,12 @@ class SceneError(ValueError):
 
 
 class SimulationError(RuntimeError):
-    """The integration failed; carries where (time, angle, state)."""
+    """The integration failed; carries where (time, angle, state), and ``result``, the run up to
+    there (a :class:`transient.results.Result`, when there is one)."""
+
+    def __init__(self, message: str, result=None) -> None:
+        super().__init__(message)
+        self.result = result
 
 
 class WriteFailed(SimulationError):

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
+from collections.abc import Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -597,28 +598,116 @@ def _publish(tmp: Path, path: Path, force: bool) -> None:
     tmp.unlink()
 
 
+class _Columns(Mapping):
+    """A result file's trajectory columns (its first ``rows`` samples), each read from the file
+    when first used: a long run's result opens without reading gigabytes."""
+
+    def __init__(self, path: Path, node: str, names: list[str], rows: slice) -> None:
+        self._path, self._node, self._names, self._rows = path, node, names, rows
+        self._read: dict[str, np.ndarray] = {}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._read:
+            if name not in self._names:
+                raise KeyError(name)
+            with open_file(self._path) as f:
+                self._read[name] = f[self._node]["trajectory"][name][self._rows]
+        return self._read[name]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+
 @dataclass
 class Result:
-    """A result file read back into memory."""
+    """A run's result, from its file (:func:`open_result`, or :func:`transient.simulate` with a
+    path) or in memory (:func:`transient.simulate` without one); the same either way.
 
-    path: Path
+    Attributes
+    ----------
+    path
+        The result file, or None for a run held in memory.
+    attrs
+        The header: ``scene`` (name), ``complete``, ``status``, ``message``, ``version``, …
+    trajectory
+        Column name → samples (a file's columns are read when first used); units in ``units``.
+    units
+        Column name → unit (SI).
+    events
+        Event name → ``{"t": [s], "phi": [rad]}`` of its occurrences.
+    solver
+        The solver's settings and statistics (``method``, ``rtol``, ``nfev``, ``nsteps``,
+        ``wall_s``, …).
+    analysis
+        Name → (value, unit) of the end-of-run summary and the analyses the scene asked for.
+    scene_toml
+        The resolved scene (every default filled in); :meth:`scene` rebuilds it.
+    """
+
+    path: Path | None
     attrs: dict[str, Any]
-    trajectory: dict[str, np.ndarray]
+    trajectory: Mapping[str, np.ndarray]
     units: dict[str, str]
     events: dict[str, dict[str, np.ndarray]]
     solver: dict[str, Any]
-    analysis: dict[str, tuple[Any, str]]  # name -> (value, unit)
+    analysis: dict[str, tuple[Any, str]]
     scene_toml: str
 
     @property
     def complete(self) -> bool:
+        """Whether the run ended as its scene describes."""
         return bool(self.attrs.get("complete", False))
+
+    @property
+    def status(self) -> str:
+        """``finished``, ``interrupted``, the failure's first word (``stalled``, ``locked``, …),
+        or ``running`` for the partial file of a run killed (or still running)."""
+        return str(self.attrs.get("status", "finished" if self.complete else "failed"))
+
+    @property
+    def message(self) -> str:
+        """What happened, with time, angle and speed, if the run did not finish."""
+        return str(self.attrs.get("message", ""))
 
     def scene(self):
         """Rebuild the scene from ``/scene/toml``."""
         from .scene import load_scene
 
-        return load_scene(f"{self.path}:/scene/toml", text=self.scene_toml)
+        return load_scene(f"{self.path or '(in memory)'}:/scene/toml", text=self.scene_toml)
+
+    def summary(self) -> dict[str, Any]:
+        """The end-of-run summary's values by name (units in ``analysis``): final and mean speed,
+        δ, steady state, spin-up and ISO 8528-5 measures, η_mech where the scene has pairs."""
+        return {name: value for name, (value, _) in self.analysis.items() if np.ndim(value) == 0}
+
+    def to_dataframe(self):
+        """The trajectory as a pandas DataFrame, one column per name, units in ``df.attrs``
+        (pandas is the optional extra ``transient[pandas]``)."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("to_dataframe needs pandas: pip install 'transient[pandas]'") \
+                from None
+        df = pd.DataFrame({name: self.trajectory[name] for name in self.trajectory})
+        df.attrs["units"] = dict(self.units)
+        return df
+
+
+def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dict[str, str],
+                     status: str, analysis: dict[str, tuple[Any, str]]) -> Result:
+    """The :class:`Result` of a run held in memory, as its file would read back."""
+    attrs = {"creator": CREATOR, "version": __version__, "format": FORMAT, "created": now(),
+             "scene": scene_name, "complete": bool(data.complete), "status": status}
+    if data.message:
+        attrs["message"] = data.message
+    events = {name: {"t": rows[:, 0], "phi": rows[:, 1]}
+              for name, rows in data.events.items() if rows.size}
+    return Result(path=None, attrs=attrs, trajectory=dict(data.trajectory),
+                  units={c: units.get(c, "") for c in data.trajectory}, events=events,
+                  solver=dict(data.solver), analysis=dict(analysis), scene_toml=scene_toml)
 
 
 def open_result(path: str | Path) -> Result:
@@ -644,7 +733,7 @@ def read_run(node: h5py.Group, path: Path) -> Result:
         rows = slice(0)
     else:  # complete, or a run written whole
         rows = slice(None)
-    traj = {k: node["trajectory"][k][rows] for k in node["trajectory"]}
+    traj = _Columns(Path(path), node.name, list(node["trajectory"]), rows)
     units = {k: str(node["trajectory"][k].attrs.get("unit", "")) for k in node["trajectory"]}
     events = {}
     for k, g in node["events"].items():
@@ -658,17 +747,19 @@ def read_run(node: h5py.Group, path: Path) -> Result:
                        str(ds.attrs.get("unit", "")))
     toml = node["scene"]["toml"][()]
     if attrs.get("status") == "running":
-        attrs["message"] = _stopped_message(traj)
+        attrs["message"] = _stopped_message(node["trajectory"], rows)
     return Result(path=path, attrs=attrs, trajectory=traj, units=units, events=events,
                   solver=dict(node["solver"].attrs), analysis=analysis,
                   scene_toml=toml.decode() if isinstance(toml, bytes) else str(toml))
 
 
-def _stopped_message(traj: dict[str, np.ndarray]) -> str:
+def _stopped_message(columns: h5py.Group, rows: slice) -> str:
     """What a partial file says of its run: it stopped (killed) or still runs, and where its
     last checkpoint is."""
-    if not traj["t"].size:
+    n = len(range(*rows.indices(columns["t"].shape[0])))
+    if not n:
         return "stopped (killed?) or still running, before its first block was written"
+    t, phi, w = (float(columns[c][n - 1]) for c in ("t", "phi", "omega"))
     return (f"stopped (killed?) or still running; holds the run up to its last checkpoint, "
-            f"t = {traj['t'][-1]:.9g} s, φ = {traj['phi'][-1]:.9g} rad, ω = "
-            f"{traj['omega'][-1]:.9g} rad/s; `transient run SCENE --resume` continues it")
+            f"t = {t:.9g} s, φ = {phi:.9g} rad, ω = {w:.9g} rad/s; `transient run SCENE "
+            f"--resume` continues it")

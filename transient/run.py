@@ -1,7 +1,8 @@
 """Drive a run: the compiled stepper chunk by chunk (or the reference path), streaming to HDF5.
 
-:func:`integrate` returns the run in memory; :func:`simulate` writes the result file and returns
-the same :class:`RunData`. Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
+:func:`integrate` returns the run as :class:`RunData`; :func:`simulate`, the public entry,
+returns a :class:`~transient.results.Result`, of a run kept in memory or written to a file.
+Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from .core.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
-from .results import NOT_RESUMABLE, RunData
+from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
 from .scene.records import COMPILED_METHODS, runs_compiled
 
 BUFFER_ROWS = 8192
@@ -406,15 +407,62 @@ class _WriteBehind:
         self._pool.shutdown(wait=True)
 
 
-def simulate(scene, path: str | Path, *, force: bool = False, resume: bool = False,
-             progress=None) -> RunData:
-    """Run ``scene`` and write the result file ``path`` (streamed; see :mod:`transient.results`).
+def simulate(scene, path: str | Path | None = None, *, force: bool = False, resume: bool = False,
+             progress: Callable[[float], None] | None = None) -> Result:
+    """Run ``scene``: in memory without ``path``, streamed to the result file ``path`` with it
+    (see :mod:`transient.results`); the :class:`~transient.results.Result` is the same either
+    way (a file's columns are read when first used).
 
-    ``resume`` continues the run that an interrupt or a kill stopped, from the last checkpoint of
-    its partial file (or of its incomplete result), bit-identically to a run never stopped.
-    Raises :class:`transient.errors.SimulationError` after writing the partial result when the run
-    fails or is interrupted.
+    Parameters
+    ----------
+    scene
+        A scene from :func:`transient.load_scene` or :meth:`Scene.from_dict`.
+    path
+        The result file; none keeps the run in memory.
+    force
+        Replace an existing result (and a partial one) at ``path``.
+    resume
+        Continue the run that an interrupt or a kill stopped, from the last checkpoint of its
+        partial file (or of its incomplete result), bit-identically to a run never stopped.
+    progress
+        Called with the fraction done after each block.
+
+    Raises
+    ------
+    transient.errors.SimulationError
+        The run failed or was interrupted; its ``result`` holds the run up to there (written
+        to ``path``, marked incomplete, when one was given).
     """
+    if path is None:
+        if force or resume:
+            raise SceneError("path", "force and resume apply to a result file: give its path")
+        return _in_memory(scene, progress)
+    _write(scene, Path(path), force, resume, progress)
+    res = open_result(path)
+    if not res.complete:
+        raise SimulationError(f"{res.message}; partial result kept in {path} (complete = false)",
+                              res)
+    return res
+
+
+def _in_memory(scene, progress) -> Result:
+    """A run kept in memory, with its summary, as a Result."""
+    from .analysis.summary import summarize
+    from .scene import to_toml
+
+    data = integrate(scene, progress=progress)
+    summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
+               else {})
+    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene),
+                           _status(data), summary)
+    if not data.complete:
+        raise SimulationError(data.message, res)
+    return res
+
+
+def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
+    """Stream a run into the result file ``path`` (:class:`~transient.results.ResultWriter`),
+    its summary from the end of the run."""
     from .analysis.summary import summarize
     from .results import ResultWriter
     from .scene import to_toml
@@ -423,7 +471,7 @@ def simulate(scene, path: str | Path, *, force: bool = False, resume: bool = Fal
     if resume and not streamed:
         raise SceneError("solver.method", f"{scene.solver.method!r}: only runs of the compiled "
                          f"stepper (DOP853, DOPRI5) can be resumed; run it again with --force")
-    writer = ResultWriter(Path(path), scene.name, to_toml(scene), output_columns(scene),
+    writer = ResultWriter(path, scene.name, to_toml(scene), output_columns(scene),
                           EVENT_NAMES, force=force, resume=resume)
     writes = _WriteBehind()
     data = None
@@ -443,12 +491,9 @@ def simulate(scene, path: str | Path, *, force: bool = False, resume: bool = Fal
                          NOT_RESUMABLE)
         # The summary looks at the end of the run: its last SUMMARY_SAMPLES samples, so that
         # memory stays bounded however long the run (steady state, efficiency are found there).
-        data.trajectory = writer.read_trajectory(last=SUMMARY_SAMPLES)
-        data.events = writer.read_events(t_from=data.trajectory["t"][0]
-                                         if data.trajectory["t"].size else -math.inf)
-        summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
-                   else {})
-        data.extra["summary"] = summary
+        tail = writer.read_trajectory(last=SUMMARY_SAMPLES)
+        events = writer.read_events(t_from=tail["t"][0] if tail["t"].size else -math.inf)
+        summary = summarize(scene, tail, events) if tail["t"].size else {}
     except BaseException as exc:
         writes.settle()
         msg = data.message if data is not None and data.message else f"{type(exc).__name__}: {exc}"
@@ -458,9 +503,6 @@ def simulate(scene, path: str | Path, *, force: bool = False, resume: bool = Fal
     finally:
         writes.shutdown()
     writer.finish(data.complete, data.message, _status(data), data.solver, summary)
-    if not data.complete:
-        raise SimulationError(f"{data.message}; partial result kept in {path} (complete = false)")
-    return data
 
 
 def _status(data: RunData) -> str:

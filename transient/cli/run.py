@@ -66,13 +66,13 @@ def cmd_run(args) -> int:
                 bar.set_description(scene.name)  # (shown at once, however short the run)
             bar.update(int(1000 * fraction) - bar.n)
     try:
-        data = simulate(scene, path, force=args.force, resume=args.resume, progress=progress)
+        res = simulate(scene, path, force=args.force, resume=args.resume, progress=progress)
     finally:
         if bar:
             bar.close()
     if not args.quiet:
         print(f"wrote {path}")
-        _print_summary(data.extra["summary"], data.solver)
+        _print_summary(res.analysis, res.solver)
     return EXIT_OK
 
 

@@ -18,11 +18,13 @@ from pathlib import Path
 
 from ..errors import SceneError
 from ..mechanisms import MECHANISMS
+from ..units import ALL_SUFFIXES
 from .checks import check_analysis, check_consistency, check_gas_table
 from .reader import MISSING, Section, show_value
 from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES,
                       GOVERNOR_KEYS, Analysis, Friction, Gas, Governor, Inertia, Initial, Load,
                       Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+from .write import to_toml
 
 
 def not_a_regular_file(path: Path) -> str:
@@ -63,6 +65,41 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
         raise SceneError("(syntax)", "arrays or tables nested too deeply to read",
                          file=str(path)) from None
     return scene_from_dict(data, file=str(path), base_dir=path.parent)
+
+
+def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
+    """A copy of ``scene`` with keys of its tables changed, validated exactly as a scene file is
+    (the same one-line :class:`SceneError`, naming the key).
+
+    Each keyword names a table (``scene``, ``mechanism``, ``inertia``, ``load``, …) and gives
+    its keys as a TOML file would, unit suffixes included, sub-tables as nested dicts:
+    ``scene.replace(inertia={"flywheel": 0.5}, initial={"omega_rpm": 1500})``. A key given with
+    another unit replaces the scene's own (``omega_rpm`` replaces ``omega``).
+    """
+    data = tomllib.loads(to_toml(scene))
+    for table, keys in tables.items():
+        if not isinstance(keys, dict):
+            raise SceneError(table, f"give the table's keys as a dict, got {type(keys).__name__}")
+        _merge(data.setdefault(table, {}), keys)
+    return scene_from_dict(data, file="(replace)")
+
+
+def _merge(base: dict, changes: dict) -> None:
+    """``changes`` into the TOML table ``base``, sub-tables merged key by key; a key replaces
+    the same quantity written with another unit suffix (or none)."""
+    for key, value in changes.items():
+        if isinstance(value, dict) and isinstance(base.get(key), dict):
+            _merge(base[key], value)
+            continue
+        stem = _unsuffixed(key)
+        for other in [k for k in base if k != key and _unsuffixed(k) == stem]:
+            del base[other]
+        base[key] = value
+
+
+def _unsuffixed(key: str) -> str:
+    head, _, suffix = key.rpartition("_")
+    return head if head and suffix in ALL_SUFFIXES else key
 
 
 def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
