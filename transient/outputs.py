@@ -27,3 +27,51 @@ def output_columns(scene) -> dict[str, str]:
         cols["M_drive"] = "N m"
         cols["W_drive"] = "J"
     return cols
+
+
+#: What each trajectory column holds, with its sign convention (torques and speeds positive in
+#: the direction of rotation, forces toward the crank axis: DESIGN §4, after Gots §1). ``{k}`` is
+#: a cylinder's or a pair's number.
+DESCRIPTIONS = {
+    "t": "time since the start of the run",
+    "phi": "crank angle, unwrapped: it grows with forward rotation and is not reduced to a cycle",
+    "omega": "shaft speed dφ/dt, positive in the direction of rotation",
+    "epsilon": "shaft acceleration dω/dt, positive when speeding up in the direction of rotation",
+    "J": "reduced moment of inertia J(φ) of the whole machine about the shaft, the [inertia] "
+         "constants included",
+    "dJ_dphi": "dJ/dφ, the rate of change of the reduced inertia with the crank angle",
+    "M_gas": "moment of the gas forces on the shaft, positive driving the shaft forward",
+    "M_load": "moment of the load on the shaft, positive driving it forward (a brake is negative)",
+    "M_starter": "moment of the starter on the shaft, positive driving it forward",
+    "fuel": "fuel command between the motored (0) and the full-load (1) pressure curve",
+    "W_gas": "work of M_gas on the shaft since the start, ∫M_gas ω dt",
+    "W_load": "work of M_load on the shaft since the start (negative: taken by the load)",
+    "W_starter": "work of M_starter on the shaft since the start",
+    "p_{k}": "pressure in cylinder {k} (for force-pulse models the force on piston {k}), pushing "
+             "the piston toward the crank axis",
+    "S_{k}": "moment that non-ideal pair {k} takes from its shaft side, reduced to φ; the far "
+             "side receives eta_{k}·S_{k}",
+    "eta_{k}": "efficiency in use in pair {k}: η_forward (< 1) when power flows forward, "
+               "1/η_backward (> 1) when it flows back",
+    "P_loss_{k}": "power lost in pair {k}, (1 − eta_{k})·S_{k}·ω",
+    "W_loss_{k}": "energy lost in pair {k} since the start, ∫P_loss_{k} dt",
+    "gov_integral": "the PI(D) governor's integral state",
+    "gov_rack": "the PI(D) governor's rack (actuator) position",
+    "gov_filter": "the PID governor's filtered speed",
+    "sleeve_lift": "the flyweight governor's sleeve lift",
+    "sleeve_speed": "the flyweight governor's sleeve speed, d(sleeve_lift)/dt",
+    "fuel_{k}": "fuel command latched by cylinder {k} at its last injection",
+    "M_drive": "drive moment the prescribed speed needs on the shaft, positive driving it forward",
+    "W_drive": "work of M_drive on the shaft since the start (trapezoidal over the samples)",
+}
+
+
+def describe(column: str) -> str:
+    """The description of a trajectory column (:data:`DESCRIPTIONS`), for numbered ones too."""
+    if column in DESCRIPTIONS:
+        return DESCRIPTIONS[column]
+    head, _, k = column.rpartition("_")
+    pattern = f"{head}_{{k}}"
+    if k.isdigit() and pattern in DESCRIPTIONS:
+        return DESCRIPTIONS[pattern].replace("{k}", k)
+    raise KeyError(f"{column}: no description; add one to transient.outputs.DESCRIPTIONS")

@@ -18,6 +18,7 @@ bit-identically (:func:`read_checkpoint`, :meth:`ResultWriter.resume`).
 from __future__ import annotations
 
 import datetime as _dt
+import functools
 import os
 from collections.abc import Mapping
 from contextlib import contextmanager
@@ -28,8 +29,9 @@ from typing import Any
 import h5py
 import numpy as np
 
-from .version import __version__
 from .errors import WriteFailed
+from .outputs import describe
+from .version import __version__
 
 #: Root attribute ``creator`` of every file written here (result or sweep).
 CREATOR = "transient"
@@ -155,8 +157,54 @@ def now() -> str:
 
 def write_header(node: h5py.Group, **attrs: Any) -> None:
     """The attributes that open a result (a file's root, or a run's group in a sweep file): who
-    wrote it, in which format and when, then ``attrs`` (``scene``, ``complete``, …)."""
-    node.attrs.update(creator=CREATOR, version=__version__, format=FORMAT, created=now(), **attrs)
+    wrote it, in which format and when, how (:func:`provenance`), then ``attrs`` (``scene``,
+    ``complete``, …)."""
+    node.attrs.update(creator=CREATOR, version=__version__, format=FORMAT, created=now(),
+                      **provenance(), **attrs)
+
+
+@functools.cache
+def provenance() -> dict[str, str]:
+    """How a result was made: transient's git commit when it runs from a checkout (``+dirty``
+    with uncommitted changes; empty otherwise), the versions of Python and the numerical
+    libraries, the command or call, the CPU."""
+    import platform
+    import sys
+
+    import numba
+    import scipy
+
+    return {"git_commit": _git_commit(), "python": platform.python_version(),
+            "numpy": np.__version__, "scipy": scipy.__version__, "numba": numba.__version__,
+            "h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
+            "command": " ".join([Path(sys.argv[0]).name, *sys.argv[1:]]) if sys.argv else "",
+            "cpu": _cpu_name(), "platform": platform.platform()}
+
+
+def _git_commit() -> str:
+    import subprocess
+
+    src = Path(__file__).resolve().parent
+    try:
+        out = subprocess.run(["git", "-C", str(src), "describe", "--always", "--dirty=+dirty",
+                              "--abbrev=40", "--exclude=*"], capture_output=True, text=True,
+                             timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return ""
+    return out.stdout.strip() if out.returncode == 0 else ""
+
+
+def _cpu_name() -> str:
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    import platform
+
+    return platform.processor() or platform.machine()
 
 
 def write_layout(node: h5py.Group, scene_toml: str, units: dict[str, str],
@@ -177,6 +225,7 @@ def write_layout(node: h5py.Group, scene_toml: str, units: dict[str, str],
                                                  chunks=(CHUNK_ROWS,), compression="gzip",
                                                  compression_opts=1, shuffle=True)
         ds.attrs["unit"] = unit
+        ds.attrs["description"] = describe(name)
     for name in ("events", "solver", "analysis"):
         node.create_group(name)
     return columns

@@ -81,3 +81,34 @@ def test_scenes_from_code_vary_a_parameter_without_files(small):
     swings = [np.ptp(w) for w in finals]
     assert swings[0] > swings[1] > swings[2] > 0.0
     assert load_scene("text.toml", text=scene.to_toml()) == scene
+
+
+def test_a_result_says_how_it_was_made_and_what_each_column_is(small, tmp_path):
+    import re
+
+    import h5py
+    import numba
+
+    simulate(small, tmp_path / "small.h5")
+    with h5py.File(tmp_path / "small.h5") as f:
+        a = f.attrs
+        assert (a["numpy"], a["numba"], a["h5py"]) == (np.__version__, numba.__version__,
+                                                       h5py.__version__)
+        assert re.fullmatch(r"([0-9a-f]{40}(\+dirty)?)?", a["git_commit"])
+        assert a["cpu"] and a["python"] and "command" in a
+        for name, ds in f["trajectory"].items():
+            assert ds.attrs["description"] and ds.attrs["unit"] is not None, name
+
+
+def test_every_column_a_run_can_write_is_described():
+    from transient.core import governor
+    from transient.core.layout import OUTPUTS, PAIR_OUTPUTS
+    from transient.outputs import describe
+
+    names = [*OUTPUTS, *(f"{c}_3" for c in PAIR_OUTPUTS), "p_2", "fuel_4", "M_drive", "W_drive",
+             *(n for kind in governor.STATE_NAMES for n in kind)]
+    for name in names:
+        assert len(describe(name)) > 10, name
+    assert "pair 3" in describe("S_3") and "cylinder 2" in describe("p_2")
+    with pytest.raises(KeyError, match="no description"):
+        describe("nonsense_1")
