@@ -505,8 +505,27 @@ def test_kinematics_to_stdout(tmp_path, capsys):
     code, out, err = cli(capsys, "kinematics", scene, "--points", 7)
     assert (code, err) == (0, "")
     lines = out.splitlines()
-    assert lines[0].split(",")[:5] == ["phi_deg", "J", "dJ_dphi", "s_1", "u_1"]
+    assert lines[0].split(",")[:6] == ["phi_deg", "J", "J_mechanism", "dJ_dphi", "s_1", "u_1"]
     assert len(lines) == 1 + 7
+
+
+def test_kinematics_J_is_the_result_J(tmp_path, capsys):
+    """One vocabulary: the J of ``kinematics`` is the J a run writes (the constant inertias
+    included), at the same angles."""
+    scene = write(tmp_path, "coast", COASTING.format(revolutions=1, samples=8))
+    code, _, err = cli(capsys, "kinematics", scene, "-o", tmp_path / "k.csv", "--points", 9)
+    assert code == 0, err
+    k = np.genfromtxt(tmp_path / "k.csv", delimiter=",", names=True)
+    assert cli(capsys, "run", scene, "-o", tmp_path, "-q")[0] == 0
+    res = transient.open_result(tmp_path / "coast.h5")
+    J = np.interp(np.radians(k["phi_deg"]), res.trajectory["phi"], res.trajectory["J"])
+    inside = np.radians(k["phi_deg"]) <= res.trajectory["phi"][-1]
+    at = np.isin(np.round(np.radians(k["phi_deg"]), 12), np.round(res.trajectory["phi"], 12))
+    assert np.count_nonzero(inside & at) >= 3
+    # (the CSV holds 12 significant digits)
+    np.testing.assert_allclose(J[inside & at], k["J"][inside & at], rtol=1e-11)
+    total = transient.load_scene(scene).inertia.total
+    assert total > 0 and np.allclose(k["J"] - k["J_mechanism"], total, rtol=1e-9)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -28,7 +28,7 @@ def cmd_kinematics(args) -> int:
     scene = load_scene(args.scene)
     mech = scene.mechanism
     phi = np.linspace(0.0, mech.cycle, args.points)
-    table = mech.kinematics_table(phi)
+    table = _with_constant_inertia(mech.kinematics_table(phi), scene.inertia.total)
     header = ",".join(table)
     data = np.column_stack(list(table.values()))
     if args.output:
@@ -49,3 +49,16 @@ def cmd_kinematics(args) -> int:
         # (a table on standard output stays a clean CSV: the message goes to standard error)
         print(f"wrote {save(fig, Path(args.plot), args.force)}", file=sys.stderr if not args.output else sys.stdout)
     return EXIT_OK
+
+
+def _with_constant_inertia(table: dict, constant: float) -> dict:
+    """The mechanism's table with ``J`` as a result's ``J`` is — the whole machine's reduced
+    inertia, the ``[inertia]`` constants included — and the linkage's own as ``J_mechanism``."""
+    out = {}
+    for name, values in table.items():
+        if name == "J":
+            out["J"] = values + constant
+            out["J_mechanism"] = values
+        else:
+            out[name] = values
+    return out
