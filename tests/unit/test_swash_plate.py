@@ -239,6 +239,19 @@ def test_kernel_equals_its_python_twin():
             np.testing.assert_allclose(du1, du2, rtol=1e-14, atol=1e-17)
 
 
+@pytest.mark.parametrize("halves", [1, 2])
+def test_the_table_u_is_the_derivative_of_its_x(halves):
+    """One vocabulary: ``u_k`` and ``du_k`` of the table are those of the piston ``x_k`` is, for
+    one piston per cylinder and for two (whose generalized force the kernel sums)."""
+    g = sp.antonyuk_example(halves=halves)
+    table = sp.kinematics_table(g, PHI)
+    for k in range(1, g.cylinders + 1):
+        x = lambda p: sp.kinematics_table(g, p)[f"x_{k}"]  # noqa: E731
+        u = lambda p: sp.kinematics_table(g, p)[f"u_{k}"]  # noqa: E731
+        np.testing.assert_allclose(table[f"u_{k}"], derivative(x, PHI, 1e-2, D6), atol=1e-10)
+        np.testing.assert_allclose(table[f"du_{k}"], derivative(u, PHI, 1e-2, D6), atol=1e-9)
+
+
 def test_pack_and_properties():
     mp = EX.pack()
     assert mp.dtype == np.float64 and mp.size == core.CYL0 + core.CYL_STRIDE * EX.cylinders

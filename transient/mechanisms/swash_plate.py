@@ -556,8 +556,9 @@ def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.f
 
     Columns: ``phi_deg``; ``u9`` = |ω₉|/φ̇ and ``u13`` = ω₁₃/φ̇ (eq. (13), derived from positions);
     per cylinder k = 1 … z: ``x_<k>`` x of piston joint D [m] (negative: the pistons lie on the −x side
-    of the plate centre O), ``u_<k>`` [m/rad] and ``du_<k>`` [m/rad²] as filled by the kernel (summed
-    over both pistons when halves = 2), ``rod_tilt_<k>_deg`` angle between rod and cylinder axis;
+    of the plate centre O), ``u_<k>`` = dx_<k>/dφ [m/rad] and ``du_<k>`` [m/rad²] of that one
+    piston (the kernel's sum over both pistons when halves = 2, divided by halves: the same
+    piston as ``x_<k>``), ``rod_tilt_<k>_deg`` angle between rod and cylinder axis;
     ``J`` [kg m²], ``dJ_dphi`` [kg m²/rad]: the kernel's parts (all but shaft and plates).
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=np.float64))
@@ -575,8 +576,8 @@ def kinematics_table(geom: SwashPlate, phi: ArrayLike) -> dict[str, NDArray[np.f
     tilt = np.degrees(np.arctan2(np.hypot(rod[..., 1], rod[..., 2]), rod[..., 0]))
     for k in range(z):
         cols[f"x_{k + 1}"] = D[:, k, 0]
-        cols[f"u_{k + 1}"] = u[:, k]
-        cols[f"du_{k + 1}"] = du[:, k]
+        cols[f"u_{k + 1}"] = u[:, k] / geom.halves
+        cols[f"du_{k + 1}"] = du[:, k] / geom.halves
         cols[f"rod_tilt_{k + 1}_deg"] = tilt[:, k]
     cols["J"] = JdJ[:, 0]
     cols["dJ_dphi"] = JdJ[:, 1]
