@@ -39,7 +39,17 @@ def cmd_check(args) -> int:
     print(f"{args.scene}: ok ({scene.name}: {type(scene.mechanism).__name__}, "
           f"{scene.mechanism.n_cylinders} cylinder(s), gas {scene.gas.model}, "
           f"run {scene.run.mode}{friction})")
+    _print_mechanism(scene.mechanism)
     return EXIT_OK
+
+
+def _print_mechanism(mech) -> None:
+    """What the mechanism's geometry implies, without a run: stroke, displacement, and its own
+    figures (for master and articulated rods: each slave's λ_i, stroke excess, dead centre)."""
+    print(f"  stroke {mech.stroke() * 1e3:.6g} mm, swept volume {mech.swept_volume() * 1e6:.6g} "
+          f"cm³ per cylinder, {mech.n_cylinders * mech.swept_volume() * 1e3:.6g} l in all")
+    for name, (value, unit) in mech.analysis_summary().items():
+        print(f"  {name} = {value:.9g} {unit}")
 
 
 def cmd_run(args) -> int:
