@@ -238,14 +238,9 @@ def append_events(events_group: h5py.Group, events: dict[str, np.ndarray]) -> No
         rows = np.asarray(rows, dtype=float).reshape(-1, 2)
         if not rows.size:
             continue  # (events that occurred only, as a streamed result keeps them)
-        g = events_group.require_group(name)
-        for j, (col, unit) in enumerate((("t", "s"), ("phi", "rad"))):
-            if col not in g:
-                g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
-                                 chunks=(1024,)).attrs["unit"] = unit
-            ds = g[col]
-            ds.resize(ds.shape[0] + rows.shape[0], axis=0)
-            ds[ds.shape[0] - rows.shape[0]:] = rows[:, j]
+        ds = _event_datasets(events_group, name)
+        _extend(ds["t"], rows[:, 0])
+        _extend(ds["phi"], rows[:, 1])
 
 
 def write_solver(solver_group: h5py.Group, attrs: dict[str, Any]) -> None:
@@ -548,13 +543,14 @@ class ResultWriter:
 
 
 def _event_datasets(events_group: h5py.Group, name: str) -> dict[str, h5py.Dataset]:
-    """The empty, extendable ``t`` and ``phi`` datasets of the event ``name``."""
+    """The extendable ``t`` and ``phi`` datasets of the event ``name``, made empty if missing."""
     g = events_group.require_group(name)
     out = {}
     for col, unit in (("t", "s"), ("phi", "rad")):
-        out[col] = g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
-                                    chunks=(1024,))
-        out[col].attrs["unit"] = unit
+        if col not in g:
+            g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
+                             chunks=(1024,)).attrs["unit"] = unit
+        out[col] = g[col]
     return out
 
 
