@@ -22,7 +22,7 @@ import functools
 import os
 from collections.abc import Mapping
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -48,7 +48,6 @@ class RunData:
     solver: dict[str, float | int | str]
     complete: bool = True
     message: str = ""
-    extra: dict = field(default_factory=dict)
 
 
 class ResultExists(FileExistsError):
