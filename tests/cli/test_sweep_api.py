@@ -1,0 +1,46 @@
+"""Sweeps from code (``transient.sweep.api.sweep``): the engine of ``transient sweep`` on a scene
+held in memory; its runs are the runs ``simulate`` gives."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scene_texts import SMALL
+
+from transient import SceneError, load_scene, simulate
+from transient.sweep.api import sweep
+
+
+@pytest.fixture
+def small():
+    return load_scene("small.toml", text=SMALL)
+
+
+def test_a_sweep_from_code_runs_what_simulate_runs(small):
+    flywheels = [0.0, 0.1, 1.0]
+    done = sweep(small, {"inertia.flywheel": flywheels}, collect=["delta", "final_speed_rpm"],
+                 scheduler="serial")
+    df = done.to_dataframe()
+    assert list(df["inertia.flywheel"]) == flywheels and list(df["status"]) == ["ok"] * 3
+    assert df.attrs["units"]["delta"] == "1"
+    assert np.all(np.diff(df["delta"]) < 0)  # more flywheel, less swing
+    for i, J in enumerate(flywheels):
+        alone = simulate(small.replace(inertia={"flywheel": J}))
+        run = done.run(i)
+        assert np.array_equal(run.trajectory["omega"], alone.trajectory["omega"])
+        assert df["delta"][i] == alone.summary()["delta_last_cycle"]
+    assert done.computed == [0, 1, 2] and done.reused == []
+
+
+def test_a_sweep_in_a_folder_is_mended_when_run_again(small, tmp_path):
+    first = sweep(small, {"load.torque": [0.0, 1.0]}, output=tmp_path, scheduler="serial")
+    again = sweep(small, {"load.torque": [0.0, 1.0, 2.0]}, output=tmp_path, scheduler="serial")
+    assert first.path == again.path == tmp_path / "small.h5"
+    assert sorted(again.computed) == [2] and sorted(again.reused) == [0, 1]
+    assert (tmp_path / "small.sweep.toml").is_file()
+
+
+def test_axes_must_be_given_as_a_dict_of_values(small):
+    with pytest.raises(SceneError, match="give a dict of dotted scene keys"):
+        sweep(small, [("load.torque", [1.0])], scheduler="serial")
+    with pytest.raises(SceneError, match=r"axes\['load.torque'\]: values must be numbers"):
+        sweep(small, {"load.torque": [{"a": 1}]}, scheduler="serial")
