@@ -1,5 +1,6 @@
-"""``transient sweep`` on a real Dask cluster (issue 10): the file, the summary, a failing run,
-resuming, never overwriting another sweep, the sweep file's one-line errors, the summary plots.
+"""``transient sweep`` on a real Dask cluster: the file, the summary, a failing run, resuming,
+mending (a changed value, an added point, retried failures, an interrupted mending), never
+overwriting another sweep, the sweep file's one-line errors, the summary plots.
 
 One LocalCluster (2 worker processes, loopback only) serves the module through ``--scheduler``;
 one test starts the default cluster of ``run_sweep`` itself. Every run is a few revolutions of
@@ -20,7 +21,7 @@ from transient.analysis.summary import summarize
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import load_scene
 from transient.run import integrate
-from transient.sweep import kernel_loads, load_sweep, run_sweep
+from transient.sweep import kernel_loads, load_sweep, open_run, run_sweep
 
 from terminal import terminal_run
 
@@ -127,7 +128,7 @@ def test_resume_recomputes_nothing_finished(sweep_file, tmp_path, cluster):
     [(name, attrs)] = first.items()
 
     again = run_sweep(sweep, out, scheduler=cluster)
-    assert again.skipped == [attrs["index"]]
+    assert again.reused == [attrs["index"]]
     assert sorted(again.computed) == sorted({0, 1, 2, 3} - {attrs["index"]})
     assert _groups(out / "small.h5")[name]["created"] == attrs["created"]  # not rewritten
 
@@ -136,7 +137,7 @@ def test_resume_recomputes_nothing_finished(sweep_file, tmp_path, cluster):
         del f["runs/run_0002"]
     before = _groups(out / "small.h5")
     third = run_sweep(sweep, out, scheduler=cluster)
-    assert third.computed == [2] and third.skipped == [0, 1, 3]
+    assert third.computed == [2] and third.reused == [0, 1, 3]
     after = _groups(out / "small.h5")
     assert all(after[n]["created"] == a["created"] for n, a in before.items())
     assert len(third.rows) == 4 and len(third.failed) == 2
@@ -145,18 +146,134 @@ def test_resume_recomputes_nothing_finished(sweep_file, tmp_path, cluster):
 def test_another_sweep_is_never_overwritten(sweep_file, tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["sweep", str(sweep_file), "-o", str(out), "--scheduler", "serial", "-q"]) == 1
-    changed = tmp_path / "small.toml"  # same name, other values: another sweep
-    changed.write_text(SWEEP.replace("[5e-4, 1e-3]", "[5e-4, 2e-3]"))
+    other = tmp_path / "other" / "small.toml"  # the same file name, another sweep
+    other.parent.mkdir()
+    other.write_text(SWEEP.replace('"small"', '"big"').replace("[5e-4, 1e-3]", "[5e-4, 2e-3]"))
     capsys.readouterr()
-    assert main(["sweep", str(changed), "-o", str(out), "--scheduler", "serial", "-q"]) == 2
+    assert main(["sweep", str(other), "-o", str(out), "--scheduler", "serial", "-q"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "holds another sweep" in err and "--force" in err and len(err.splitlines()) == 1
+    assert "holds another sweep ('small', not 'big')" in err and "--force" in err
+    assert len(err.splitlines()) == 1
     with h5py.File(out / "small.h5", "r") as f:  # untouched
         assert json.loads(f["runs/run_0002"].attrs["params"])["load.fan"] == 1e-3
-    assert main(["sweep", str(changed), "-o", str(out), "--scheduler", "serial", "-q",
+    assert main(["sweep", str(other), "-o", str(out), "--scheduler", "serial", "-q",
                  "--force"]) == 1
     with h5py.File(out / "small.h5", "r") as f:
+        assert f.attrs["sweep"] == "big"
         assert json.loads(f["runs/run_0002"].attrs["params"])["load.fan"] == 2e-3
+
+
+def _mark(path):
+    """Mark every stored run with an attribute no run writes: a run computed again lacks it."""
+    with h5py.File(path, "r+") as f:
+        for g in f["runs"].values():
+            g.attrs["mark"] = True
+
+
+def _unused(path):
+    """The ``created`` of each stored run the sweep no longer holds."""
+    with h5py.File(path, "r") as f:
+        return sorted(g.attrs["created"] for g in f["unused"].values())
+
+
+def test_mending_after_changing_an_axis_value(sweep_file, tmp_path, capsys):
+    out, path = tmp_path / "out", tmp_path / "out" / "small.h5"
+    args = ["sweep", str(sweep_file), "-o", str(out), "--scheduler", "serial"]
+    assert main(args) == 1  # (runs 1 and 3 fail on purpose, in every sweep below)
+    _mark(path)
+    before = _groups(path)
+    sweep_file.write_text(SWEEP.replace("[5e-4, 1e-3]", "[5e-4, 2e-3]"))
+    capsys.readouterr()
+    assert main(args) == 1
+    said = capsys.readouterr().out
+    assert ("2 run(s) reused, 0 recomputed, 2 new, 2 failed; 2 stored run(s) no longer in the "
+            "sweep kept in the file (--prune deletes them)") in said
+    after = _groups(path)
+    assert [n for n, a in after.items() if "mark" in a] == ["run_0000", "run_0001"]
+    assert [after[n]["created"] for n in ("run_0000", "run_0001")] == [
+        before[n]["created"] for n in ("run_0000", "run_0001")]
+    assert [json.loads(a["params"])["load.fan"] for a in after.values()] == [5e-4, 5e-4, 2e-3,
+                                                                            2e-3]
+    assert _unused(path) == sorted(before[n]["created"] for n in ("run_0002", "run_0003"))
+    with open(out / "small_summary.csv", newline="") as fh:
+        assert [float(r["load.fan"]) for r in csv.DictReader(fh)] == [5e-4, 5e-4, 2e-3, 2e-3]
+
+    sweep_file.write_text(SWEEP)  # back: every run reused, two from where they were kept
+    assert main(args) == 1
+    assert "4 run(s) reused, 0 recomputed, 0 new, 2 failed; 2 stored" in capsys.readouterr().out
+    back = _groups(path)
+    assert all(a["mark"] for a in back.values())
+    assert {n: a["created"] for n, a in back.items()} == {
+        n: a["created"] for n, a in before.items()}
+    assert main(args + ["--prune"]) == 1
+    said = capsys.readouterr().out
+    assert "4 run(s) reused, 0 recomputed, 0 new, 2 failed\n" in said and "kept" not in said
+    assert _unused(path) == [] and len(_groups(path)) == 4
+
+
+def test_mending_after_adding_a_point(sweep_file, tmp_path):
+    out = tmp_path / "out"
+    first = run_sweep(load_sweep(sweep_file), out, scheduler="serial")
+    _mark(first.path)
+    before = _groups(first.path)
+    omega = open_run(first.path, 3).trajectory["omega"]
+    sweep_file.write_text(SWEEP.replace("[0.0, 400.0]", "[0.0, 10.0, 400.0]"))
+    done = run_sweep(load_sweep(sweep_file), out, scheduler="serial")
+    assert done.reused == [0, 2, 3, 5] and done.computed == [1, 4] and done.new == [1, 4]
+    assert done.recomputed == [] and done.unused == 0
+    after = _groups(done.path)
+    for old, new in (("run_0000", "run_0000"), ("run_0001", "run_0002"),
+                     ("run_0002", "run_0003"), ("run_0003", "run_0005")):  # moved, not rewritten
+        assert after[new]["mark"] and after[new]["created"] == before[old]["created"], new
+        assert after[new]["scene_toml"] == before[old]["scene_toml"], new
+        assert after[new]["index"] == int(new[-1]), new
+    assert "mark" not in after["run_0001"] and "mark" not in after["run_0004"]
+    assert [r["status"] for r in done.rows] == ["ok", "ok", "failed", "ok", "ok", "failed"]
+    assert [r["load.torque"] for r in done.rows] == [0.0, 10.0, 400.0] * 2
+    assert np.array_equal(open_run(done.path, 5).trajectory["omega"], omega)
+
+
+def test_retry_failed_recomputes_only_the_failed_runs(sweep_file, tmp_path, capsys):
+    path = tmp_path / "out" / "small.h5"
+    args = ["sweep", str(sweep_file), "-o", str(tmp_path / "out"), "--scheduler", "serial"]
+    assert main(args) == 1
+    _mark(path)
+    before = _groups(path)
+    capsys.readouterr()
+    assert main(args + ["--retry-failed"]) == 1  # (they fail again)
+    said = capsys.readouterr().out
+    assert "2 run(s) reused, 2 recomputed, 0 new, 2 failed\n" in said and "kept" not in said
+    after = _groups(path)
+    assert sorted(n for n, a in after.items() if "mark" not in a) == ["run_0001", "run_0003"]
+    assert after["run_0000"] == before["run_0000"] and after["run_0002"] == before["run_0002"]
+    assert all("stalled" in after[n]["message"] for n in ("run_0001", "run_0003"))
+    assert _unused(path) == []  # the failed runs' first copies went with their replacement
+
+
+def test_interrupted_mending_keeps_every_finished_run(sweep_file, tmp_path):
+    out, path = tmp_path / "out", tmp_path / "out" / "small.h5"
+    run_sweep(load_sweep(sweep_file), out, scheduler="serial")
+    _mark(path)
+    created = sorted(a["created"] for a in _groups(path).values())
+    sweep_file.write_text(SWEEP.replace("[0.0, 400.0]", "[0.0, 10.0, 400.0]"))
+    mended = load_sweep(sweep_file)
+
+    def interrupt(spec, res, done, total):
+        raise KeyboardInterrupt  # as a Ctrl-C after the first new run is written
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(mended, out, scheduler="serial", on_result=interrupt)
+    part = out / ".small.h5.part"
+    assert part.is_file() and not path.exists()
+    held = _groups(part)
+    assert sorted(held) == ["run_0000", "run_0001", "run_0002", "run_0003", "run_0005"]
+    assert sorted(a["created"] for a in held.values() if "mark" in a) == created
+    with h5py.File(part, "r") as f:
+        assert not f.attrs["complete"] and "summary" not in f["analysis"]
+    done = run_sweep(mended, out, scheduler="serial")
+    assert done.computed == [4] and done.reused == [0, 1, 2, 3, 5]
+    assert {n: a["created"] for n, a in _groups(path).items() if n != "run_0004"} == {
+        n: a["created"] for n, a in held.items()}
 
 
 def test_sweep_in_a_terminal_says_kernels_load_until_the_first_run(sweep_file, tmp_path):

@@ -5,8 +5,10 @@ before the runs had that layout still resumes and summarises. No run is integrat
 runs are made up, so no kernel is compiled."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
+import shutil
 from pathlib import Path
 
 import h5py
@@ -15,6 +17,7 @@ import pytest
 
 from transient import results
 from transient.sweep import SweepStore, load_sweep, open_run, read_summary
+from transient.sweep.store import Stored, match_runs
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -197,3 +200,178 @@ def test_a_file_in_the_earlier_layout_resumes(sweep, tmp_path):
     assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
     assert rows[0]["mean_speed_rpm"] == pytest.approx(301.5 * 30 / math.pi, rel=1e-15)
     assert read_summary(tmp_path / "small.h5").columns["final_t"][0] == res["summary"]["final_t"][0]
+
+
+# ------------------------------------------------------------------------------------------------
+# Mending: runs reused by their resolved scene
+
+
+def _sweep_of(tmp_path, values: str, name: str = "small"):
+    """The sweep of SWEEP with the torque axis ``values``, in a file named small.toml (so that
+    it writes small.h5) under a folder of its own."""
+    folder = tmp_path / values.replace(" ", "").strip("[]")
+    folder.mkdir(exist_ok=True)
+    path = folder / "small.toml"
+    path.write_text(SWEEP.replace("[0.0, 400.0, 10.0]", values)
+                    .replace('name = "small"', f'name = "{name}"'))
+    return load_sweep(path)
+
+
+def _finished(out: Path, sweep) -> Path:
+    """A finished sweep file of ``sweep``; the torque of 400 N m failed."""
+    store = SweepStore(out / "small.h5", sweep)
+    for spec in sweep.runs:
+        store.write_run(spec, _res(spec.params["load.torque"] != 400.0, seed=spec.index))
+    store.write_summary(out / "small_summary.csv")
+    return store.close(True)
+
+
+def _stored_runs(path: Path) -> dict[str, tuple[str, str]]:
+    """Every finished run of a sweep file by where it is: (its scene, its ``created``)."""
+    with h5py.File(path, "r") as f:
+        return {f"{top}/{n}": (g.attrs["scene_toml"], g.attrs["created"])
+                for top in ("runs", "unused") if top in f for n, g in f[top].items()
+                if "status" in g.attrs}
+
+
+def test_match_runs_prefers_ok_runs_in_place_and_retries_failed_ones(sweep):
+    a, b, c = (s.toml for s in sweep.runs)
+    targets = [f"runs/run_000{i}" for i in range(3)]
+    stored = [Stored("unused/x", a, True, {}), Stored("runs/run_0000", a, True, {}),
+              Stored("runs/run_0001", b, False, {}), Stored("unused/y", c, False, {}),
+              Stored("unused/z", c, True, {})]
+    got = match_runs(stored, sweep.runs, targets)
+    assert {i: s.path for i, s in got.items()} == {0: "runs/run_0000", 1: "runs/run_0001",
+                                                    2: "unused/z"}
+    got = match_runs(stored, sweep.runs, targets, retry_failed=True)
+    assert {i: s.path for i, s in got.items()} == {0: "runs/run_0000", 2: "unused/z"}
+    # one stored run serves one run: a sweep holding a scene twice computes the second
+    twice = (sweep.runs[0], dataclasses.replace(sweep.runs[0], index=1))
+    assert list(match_runs(stored[1:2], twice, targets)) == [0]
+
+
+def test_mending_reuses_moves_and_parks_runs(tmp_path):
+    out = tmp_path / "out"
+    path = _finished(out, _sweep_of(tmp_path, "[0.0, 400.0, 10.0]"))
+    before = _stored_runs(path)
+    mended = _sweep_of(tmp_path, "[10.0, 0.0, 5.0]")  # reordered, 400 dropped, 5 added
+    store = SweepStore(path, mended)
+    assert store.finished == {0, 1} and store.recomputed == set()
+    assert not path.exists() and store.part.exists()  # mended as a part
+    runs = {n: (g.attrs["scene_toml"], g.attrs["created"]) for n, g in store.f["runs"].items()}
+    assert runs == {"run_0000": before["runs/run_0002"], "run_0001": before["runs/run_0000"]}
+    assert [store.f[f"runs/run_000{i}"].attrs["index"] for i in (0, 1)] == [0, 1]
+    assert json.loads(store.f["runs/run_0000"].attrs["params"]) == {"load.torque": 10.0}
+    [parked] = store.f["unused"].values()
+    assert (parked.attrs["scene_toml"], parked.attrs["created"]) == before["runs/run_0001"]
+    assert "summary" not in store.f["analysis"] and not store.f.attrs["complete"]
+    store.write_run(mended.runs[2], _res(True, seed=5))
+    assert store.tidy() == 1  # the dropped point is kept
+    rows = store.write_summary(out / "small_summary.csv")
+    store.close(True)
+    assert [r["load.torque"] for r in rows] == [10.0, 0.0, 5.0]
+    tab = read_summary(path)
+    assert tab.axes[0]["values"] == [10.0, 0.0, 5.0]
+    with h5py.File(path, "r") as f:
+        assert f.attrs["n_runs"] == 3 and f["sweep/toml"][()].decode() == mended.text
+    # the dropped point again: reused from where it was kept; --prune deletes what is left over
+    again = SweepStore(path, _sweep_of(tmp_path, "[0.0, 400.0, 10.0]"))
+    assert again.finished == {0, 1, 2}
+    assert again.f["runs/run_0001"].attrs["created"] == before["runs/run_0001"][1]
+    assert again.tidy(prune=True) == 0 and len(again.f["unused"]) == 0
+    again.close(True)
+
+
+def test_changed_scenes_and_retried_failures_are_recomputed(tmp_path):
+    out = tmp_path / "out"
+    sweep = _sweep_of(tmp_path, "[0.0, 400.0, 10.0]")
+    path = _finished(out, sweep)
+    before = _stored_runs(path)
+    store = SweepStore(path, sweep, retry_failed=True)
+    assert store.finished == {0, 2} and store.recomputed == {1}
+    assert list(store.f["runs"]) == ["run_0000", "run_0002"]  # the failed one parked, not lost
+    store.write_run(sweep.runs[1], _res(False, seed=9))
+    assert store.tidy() == 0  # (the retried run's old copy is gone once it is replaced)
+    store.close(True)
+    after = _stored_runs(path)
+    assert after["runs/run_0000"] == before["runs/run_0000"]
+    assert after["runs/run_0002"] == before["runs/run_0002"]
+    assert set(after) == {"runs/run_0000", "runs/run_0001", "runs/run_0002"}
+    # the same points with another constant change: every run is another scene, recomputed
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "small.toml").write_text(SWEEP.replace('"run.revolutions" = 12',
+                                                    '"run.revolutions" = 13'))
+    store = SweepStore(path, load_sweep(other / "small.toml"))
+    assert store.finished == set() and store.recomputed == {0, 1, 2}
+    assert len(store.f["unused"]) == 3
+    store.close(False)
+
+
+def test_another_sweep_is_refused_unchanged(tmp_path):
+    out = tmp_path / "out"
+    path = _finished(out, _sweep_of(tmp_path, "[0.0, 400.0, 10.0]"))
+    before = path.read_bytes()
+    with pytest.raises(FileExistsError, match="holds another sweep \\('small', not 'big'\\)"):
+        SweepStore(path, _sweep_of(tmp_path, "[1.0]", name="big"))
+    assert path.read_bytes() == before
+
+
+class _Interrupt:
+    """Raise KeyboardInterrupt before the ``at``-th change of an HDF5 file (a group moved or
+    deleted, an attribute or a dataset written), as a Ctrl-C between two of them would."""
+
+    PATCHED = ((h5py.Group, "move"), (h5py.Group, "__delitem__"),
+               (h5py.AttributeManager, "__setitem__"), (h5py.Dataset, "__setitem__"))
+
+    def __init__(self, monkeypatch, at: int) -> None:
+        self.at, self.count = at, 0
+        for cls, name in self.PATCHED:
+            monkeypatch.setattr(cls, name, self._wrap(getattr(cls, name)))
+
+    def _wrap(self, method):
+        def changed(*args, **kwargs):
+            self.count += 1
+            if self.count == self.at:
+                raise KeyboardInterrupt
+            return method(*args, **kwargs)
+        return changed
+
+
+def test_interrupted_mending_loses_no_run(tmp_path, monkeypatch):
+    """Interrupted before each change it makes in turn, mending leaves a file that the next
+    mending completes: every run finished before is there once, reused or parked."""
+    out = tmp_path / "out"
+    template = tmp_path / "template.h5"
+    shutil.copy(_finished(out, _sweep_of(tmp_path, "[0.0, 400.0, 10.0]")), template)
+    before = sorted(_stored_runs(template).values())
+    mended = _sweep_of(tmp_path, "[10.0, 0.0, 5.0]")
+    at = 0
+    while True:
+        at += 1
+        for p in out.iterdir():
+            p.unlink()
+        shutil.copy(template, out / "small.h5")
+        store = None
+        with monkeypatch.context() as m:
+            trap = _Interrupt(m, at)
+            try:
+                store = SweepStore(out / "small.h5", mended)
+                store.write_run(mended.runs[2], _res(True, seed=5))
+                interrupted = False
+            except KeyboardInterrupt:
+                interrupted = True
+                if store is not None:  # (as run_sweep does)
+                    store.close(False)
+        if not interrupted:
+            store.close(False)
+            break
+        store = SweepStore(out / "small.h5", mended)
+        done = store.finished
+        assert done in ({0, 1}, {0, 1, 2}), at  # run 2 only if its status was written
+        store.close(False)
+        stored = _stored_runs(store.part)
+        old = sorted(v for v in stored.values() if v[0] != mended.runs[2].toml)
+        assert old == before, at  # each run finished before: there, once
+        assert stored["runs/run_0000"] == _stored_runs(template)["runs/run_0002"], at
+    assert at > 10 and trap.count == at - 1  # (every change was interrupted once)

@@ -13,8 +13,9 @@ def register(sub) -> None:
     sw = sub.add_parser(
         "sweep", help="run a parameter sweep on Dask → DIR/<stem>.h5 and <stem>_summary.csv",
         description="A base scene, parameter axes and quantities to collect (transient.sweep). "
-                    "Every scene is validated before any work; an interrupted sweep resumes "
-                    "where it stopped when the same command is run again.")
+                    "Every scene is validated before any work. Run again, the command mends "
+                    "its file: a stored run whose resolved scene is unchanged is reused, "
+                    "changed and new points are computed (an interrupted sweep resumes).")
     sw.add_argument("sweep")
     sw.add_argument("-o", "--output", default="results", help="output folder (default results/)")
     sw.add_argument("--scheduler", default=None,
@@ -23,8 +24,11 @@ def register(sub) -> None:
     sw.add_argument("--workers", type=int, default=None,
                     help="processes of the local cluster (default: one per core)")
     sw.add_argument("--force", action="store_true",
-                    help="replace an existing sweep file instead of resuming it")
-    sw.add_argument("--retry-failed", action="store_true", help="run the failed runs again")
+                    help="replace an existing sweep file instead of mending it")
+    sw.add_argument("--retry-failed", action="store_true",
+                    help="compute the failed runs again (the others are reused)")
+    sw.add_argument("--prune", action="store_true",
+                    help="delete the stored runs the sweep no longer holds (kept by default)")
     sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
     sw.set_defaults(func=cmd_sweep)
     sp = sub.add_parser("sweep-plot", help="plot a sweep's summary: lines (one axis), heat maps "
@@ -63,8 +67,8 @@ def cmd_sweep(args) -> int:
             bar.set_postfix_str(f"run {spec.index}: {res['status']}", refresh=True)
 
     try:
-        out = run_sweep(sweep, args.output, args.scheduler, args.workers, args.force,
-                        args.retry_failed, on_result)
+        out = run_sweep(sweep, args.output, args.scheduler, args.workers, force=args.force,
+                        retry_failed=args.retry_failed, on_result=on_result, prune=args.prune)
     except KeyboardInterrupt:
         # (not main's generic line: the finished runs are kept, and saying so tells how to resume)
         print(f"transient: interrupted; the finished runs are kept in {args.output}/."
@@ -75,8 +79,7 @@ def cmd_sweep(args) -> int:
         if bar is not None:
             bar.close()
     if not args.quiet:
-        print(f"wrote {out.path} and {out.csv}: {len(out.computed)} run(s) computed, "
-              f"{len(out.skipped)} found finished, {len(out.failed)} failed")
+        print(f"wrote {out.path} and {out.csv}: {_counts(out)}")
         for r in out.failed:
             print(f"  run {r['run']} failed: {r['message']}")
     if out.failed:
@@ -84,6 +87,16 @@ def cmd_sweep(args) -> int:
               f"{out.path}; --retry-failed runs them again)", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
+
+
+def _counts(out) -> str:
+    """What the sweep did with each run, and the stored runs it no longer holds."""
+    text = (f"{len(out.reused)} run(s) reused, {len(out.recomputed)} recomputed, "
+            f"{len(out.new)} new, {len(out.failed)} failed")
+    if out.unused:
+        text += (f"; {out.unused} stored run(s) no longer in the sweep kept in the file "
+                 f"(--prune deletes them)")
+    return text
 
 
 def cmd_sweep_plot(args) -> int:

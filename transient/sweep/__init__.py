@@ -5,7 +5,8 @@
 - :mod:`.execute` runs them: :func:`run_one` on Dask workers (or in this process), the client
   and its local cluster, Ctrl-C handling;
 - :mod:`.store` writes the one sweep file: each run in a result file's layout
-  (:mod:`transient.results`), the sweep's axes, run index and status, and the summary table.
+  (:mod:`transient.results`), the sweep's axes, run index and status, and the summary table;
+  run again, it mends the file, reusing every stored run whose resolved scene is unchanged.
 """
 from .execute import Outcome, kernel_loads, run_one, run_sweep, worker_info
 from .spec import (DEFAULT_COLLECT, METHODS, QUANTITIES, SPACINGS, Axis, RunSpec, Sweep,

@@ -87,13 +87,23 @@ def kernel_loads() -> dict[str, int]:
 
 @dataclass
 class Outcome:
-    """What a sweep did: the file, the runs computed now, those found finished, and the rows."""
+    """What a sweep did: the file, the runs computed now (in the order they arrived), those
+    reused from the file, those of the computed that replaced a stored run of the same axis
+    values (another scene, or failed and retried), the stored runs the sweep no longer holds
+    that the file keeps, and the rows."""
 
     path: Path
     csv: Path
     computed: list[int]
-    skipped: list[int]
+    reused: list[int]
+    recomputed: list[int]
+    unused: int
     rows: list[dict[str, Any]]
+
+    @property
+    def new(self) -> list[int]:
+        """The computed runs that replaced nothing stored: new points, or not reached before."""
+        return [i for i in self.computed if i not in self.recomputed]
 
     @property
     def failed(self) -> list[dict[str, Any]]:
@@ -102,21 +112,24 @@ class Outcome:
 
 def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | None = None,
               workers: int | None = None, force: bool = False, retry_failed: bool = False,
-              on_result: Callable[[RunSpec, dict, int, int], None] | None = None) -> Outcome:
-    """Run the sweep's unfinished runs and write the file and the summary (module docstring).
+              on_result: Callable[[RunSpec, dict, int, int], None] | None = None,
+              prune: bool = False) -> Outcome:
+    """Run the runs of the sweep the file does not hold and write the file and the summary
+    (module docstring).
 
-    ``scheduler``: None for a LocalCluster of ``workers`` processes (default one per core), a
-    ``tcp://host:port`` address of a running Dask scheduler, or ``"serial"`` (this process, no
-    Dask: debugging and the benchmark's baseline). ``on_result(spec, result, done, total)`` is
-    called after each run is written (the progress bar). On KeyboardInterrupt the file keeps the
-    finished runs (``complete = false``) and the interrupt goes on.
+    An existing file of the sweep is mended (:class:`~transient.sweep.store.SweepStore`): a
+    stored run whose resolved scene is unchanged is reused, failed ones too unless
+    ``retry_failed``; stored runs the sweep no longer holds are kept apart, or deleted at the end
+    with ``prune``. ``scheduler``: None for a LocalCluster of ``workers`` processes (default one
+    per core), a ``tcp://host:port`` address of a running Dask scheduler, or ``"serial"`` (this
+    process, no Dask: debugging and the benchmark's baseline). ``on_result(spec, result, done,
+    total)`` is called after each run is written (the progress bar). On KeyboardInterrupt the
+    file keeps the finished runs (``complete = false``) and the interrupt goes on.
     """
     out_dir = Path(out_dir)
     stem = sweep.path.stem
-    store = SweepStore(out_dir / f"{stem}.h5", sweep, force)
-    if retry_failed:
-        store.drop_failed()
-    skipped = sorted(store.finished)
+    store = SweepStore(out_dir / f"{stem}.h5", sweep, force, retry_failed)
+    reused = sorted(store.finished)
     todo = [s for s in sweep.runs if s.index not in store.finished]
     computed: list[int] = []
     try:
@@ -128,13 +141,14 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
                 computed.append(spec.index)
                 if on_result:
                     on_result(spec, res, len(store.finished), len(sweep.runs))
+        unused = store.tidy(prune)
     except BaseException:
         store.close(False)
         raise
     csv_path = out_dir / f"{stem}_summary.csv"
     rows = store.write_summary(csv_path)
     path = store.close(True)
-    return Outcome(path, csv_path, computed, skipped, rows)
+    return Outcome(path, csv_path, computed, reused, sorted(store.recomputed), unused, rows)
 
 
 def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int | None

@@ -10,6 +10,7 @@ written here.
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import os
@@ -32,6 +33,41 @@ def group_name(index: int, n_runs: int) -> str:
     return f"run_{index:0{max(4, len(str(n_runs - 1)))}d}"
 
 
+#: The group of the finished runs a sweep no longer holds.
+UNUSED = "unused"
+
+
+@dataclass(frozen=True)
+class Stored:
+    """A finished run found in a sweep file: where it is, its resolved scene, whether it ended
+    ``ok``, and its axis values (which identify a point of the sweep)."""
+
+    path: str
+    toml: str
+    ok: bool
+    params: dict[str, Any]
+
+
+def match_runs(stored: list[Stored], runs: tuple[RunSpec, ...], targets: list[str],
+               retry_failed: bool = False) -> dict[int, Stored]:
+    """The stored run each run of the sweep reuses (by index): one with the same resolved scene,
+    an ``ok`` one before a failed one and the one already at ``targets[index]`` before another,
+    so that nothing moves without need; never a failed one with ``retry_failed``. Each stored
+    run serves one run at most (a list sweep may hold one scene twice)."""
+    by_scene: dict[str, list[Stored]] = {}
+    for s in stored:
+        if s.ok or not retry_failed:
+            by_scene.setdefault(s.toml, []).append(s)
+    out = {}
+    for spec in runs:
+        pool = by_scene.get(spec.toml)
+        if pool:
+            best = min(pool, key=lambda s: (not s.ok, s.path != targets[spec.index]))
+            pool.remove(best)
+            out[spec.index] = best
+    return out
+
+
 class SweepStore:
     """The sweep file (HDF5), written by the client only.
 
@@ -42,17 +78,23 @@ class SweepStore:
     (:func:`transient.results.write_run`: header attributes with ``scene``, ``complete`` and
     ``message``; ``scene/toml``; ``trajectory/<col>`` with ``unit``; ``events/<name>/{t,phi}``;
     ``solver`` attributes; ``analysis/<name>``, the run's summary, with ``unit``), with the
-    sweep's attributes ``index``, ``params`` (JSON), ``scene_toml`` (the resolved scene, which a
-    resumed sweep compares), ``worker``, ``wall_s`` and ``status`` (``ok`` or ``failed``, written
-    last: a group without it is unfinished); ``/analysis/summary`` the table of collected
-    quantities (attribute ``units``, JSON).
+    sweep's attributes ``index``, ``params`` (JSON), ``scene_toml`` (the resolved scene, by which
+    a run is reused), ``worker``, ``wall_s`` and ``status`` (``ok`` or ``failed``, written last: a
+    group without it is unfinished); ``/unused/scene_<hash>`` finished runs the sweep no longer
+    holds, in the same form (kept, so that no computed run is lost, and reused if the sweep
+    holds their scene again); ``/analysis/summary`` the table of collected quantities
+    (attribute ``units``, JSON).
 
     While the sweep runs the file is ``.<name>.h5.part``; it is renamed when every run is done.
-    An existing file of the same sweep is resumed (finished runs are kept); one of another sweep
-    is never overwritten without ``force``.
+    An existing file of the same sweep (by name) is mended: a stored run whose resolved scene a
+    run of the sweep has is reused, at that run's place; the others are parked in ``/unused``.
+    Runs only ever move by renaming a group, and a run is written under a free name with its
+    ``status`` last, so that an interrupt at any instant loses no finished run and counts no
+    half-written one. A file of another sweep is never overwritten without ``force``.
     """
 
-    def __init__(self, path: Path, sweep: Sweep, force: bool = False) -> None:
+    def __init__(self, path: Path, sweep: Sweep, force: bool = False,
+                 retry_failed: bool = False) -> None:
         self.path, self.sweep = Path(path), sweep
         self.part = results.partial_path(self.path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -66,31 +108,28 @@ class SweepStore:
             self.f = self._create(self.part)
         else:
             self._check(found)  # raises, changing nothing, if it is another sweep
-            os.replace(found, self.part)  # a finished file being resumed is a part again
+            os.replace(found, self.part)  # a finished file being mended is a part again
             self.f = results.reopen_file(self.part)
-        self.finished = self._prepare()
+        try:
+            self.finished, self.recomputed = self._prepare(retry_failed)
+        except BaseException:
+            self.f.close()  # (what was done so far is consistent: see the class docstring)
+            raise
 
     def _check(self, path: Path) -> None:
-        """An existing file must hold this sweep: every stored run's scene equal to ours."""
-        other = (f"{path}: exists and holds another sweep ({{}}); use --force to replace it or "
-                 f"-o another folder")
+        """An existing file must hold this sweep: a sweep file of the same name."""
         try:
             with h5py.File(path, "r") as f:
-                if f.attrs.get("kind") != "sweep" or int(f.attrs.get("n_runs", -1)) != len(
-                        self.sweep.runs):
-                    raise FileExistsError(other.format(f"not {len(self.sweep.runs)} runs"))
-                for name, g in f["runs"].items():
-                    i = int(g.attrs.get("index", -1))
-                    same = (0 <= i < len(self.sweep.runs)
-                            and g.attrs["scene_toml"] == self.sweep.runs[i].toml)
-                    if "status" in g.attrs and not same:
-                        raise FileExistsError(other.format(f"the scene of {name} differs from "
-                                                           f"run {i} of {self.sweep.path}"))
+                kind, name = f.attrs.get("kind"), f.attrs.get("sweep")
         except OSError as exc:
-            if isinstance(exc, FileExistsError):
-                raise
             raise SceneError("(file)", f"cannot open to resume: {exc}; use --force to start "
                                        f"afresh", file=str(path)) from None
+        if kind == "sweep" and name == self.sweep.name:
+            return
+        what = (f"holds another sweep ({name!r}, not {self.sweep.name!r})" if kind == "sweep"
+                else "is not a sweep file")
+        raise FileExistsError(f"{path}: exists and {what}; use --force to replace it or -o "
+                              f"another folder")
 
     def _create(self, path: Path) -> h5py.File:
         f = results.create_file(path)
@@ -98,44 +137,85 @@ class SweepStore:
                              n_runs=len(self.sweep.runs))
         f.create_group("sweep").create_dataset("toml", data=self.sweep.text)
         f.create_group("runs")
+        f.create_group(UNUSED)
         f.create_group("analysis")
         return f
 
-    def _prepare(self) -> set[int]:
-        """Indices of the finished runs; groups left half-written by an interrupt are removed
-        (they run again). The sweep's text and axes are (re)written: a resumed sweep may collect
-        other quantities."""
-        runs = self.f["runs"]
-        for name in [n for n, g in runs.items() if "status" not in g.attrs]:
-            del runs[name]
-        done = {int(g.attrs["index"]) for g in runs.values()}
+    def _prepare(self, retry_failed: bool) -> tuple[set[int], set[int]]:
+        """Put every stored run the sweep reuses at its place, park the others in ``/unused``;
+        returns the indices of the reused runs and of the runs computed again (a stored run of
+        the same axis values had another scene, or failed and ``retry_failed``). The summary of
+        an earlier sweep is dropped: it is rewritten when this one ends."""
+        self.f.attrs["complete"] = False
+        self.f.require_group(UNUSED)
+        if "summary" in self.f["analysis"]:
+            del self.f["analysis/summary"]
+        stored = self._stored()
+        targets = [f"runs/{self.group_name(s.index)}" for s in self.sweep.runs]
+        reuse = match_runs(stored, self.sweep.runs, targets, retry_failed)
+        wanted = {s.path: targets[i] for i, s in reuse.items()}
+        for s in stored:  # (out of the way first: a target may hold another run)
+            if s.path.startswith("runs/") and wanted.get(s.path) != s.path:
+                parked = self._park(s.path)
+                if s.path in wanted:
+                    wanted[parked] = wanted.pop(s.path)
+        for src, dst in wanted.items():
+            if src != dst:
+                self.f.move(src, dst)
+        for i in reuse:
+            self.f[targets[i]].attrs.update(index=i, params=json.dumps(self.sweep.runs[i].params))
+        self.f.attrs["n_runs"] = len(self.sweep.runs)
+        self._write_sweep()
+        self.f.flush()
+        seen = [s.params for s in stored]
+        again = {spec.index for spec in self.sweep.runs
+                 if spec.index not in reuse and spec.params in seen}
+        return set(reuse), again
+
+    def _stored(self) -> list[Stored]:
+        """The finished runs in ``/runs`` and ``/unused``; groups left half-written by an
+        interrupt (no ``status``) are removed: they run again."""
+        out = []
+        for top in ("runs", UNUSED):
+            node = self.f[top]
+            for name in list(node):
+                g = node[name]
+                if "status" not in g.attrs:
+                    del node[name]
+                    continue
+                params = json.loads(g.attrs.get("params", "{}"))
+                out.append(Stored(f"{top}/{name}", str(g.attrs["scene_toml"]),
+                                  g.attrs["status"] == "ok", params))
+        return out
+
+    def _park(self, path: str) -> str:
+        """Move a stored run into ``/unused`` under a free name (its scene's hash); returns it."""
+        toml = str(self.f[path].attrs["scene_toml"])
+        stem = f"{UNUSED}/scene_{hashlib.sha256(toml.encode()).hexdigest()[:16]}"
+        name, k = stem, 1
+        while name in self.f:
+            name, k = f"{stem}_{k}", k + 1
+        self.f.move(path, name)
+        return name
+
+    def _write_sweep(self) -> None:
+        """The sweep's text and axes, (re)written: a mended sweep may differ in both."""
         g = self.f["sweep"]
-        del g["toml"]
-        g.create_dataset("toml", data=self.sweep.text)
+        g["toml"][()] = self.sweep.text
         g.attrs.update(method=self.sweep.method, collect=json.dumps(self.sweep.collect),
                        axes=json.dumps([{"key": a.key, "group": a.group, "values": list(a.values)}
                                         for a in self.sweep.axes]))
-        self.f.flush()
-        return done
 
     def group_name(self, index: int) -> str:
         return group_name(index, len(self.sweep.runs))
-
-    def drop_failed(self) -> None:
-        """Forget the failed runs so that they run again (``--retry-failed``)."""
-        for spec in self.sweep.runs:
-            name = self.group_name(spec.index)
-            if spec.index in self.finished and self.f["runs"][name].attrs["status"] != "ok":
-                del self.f["runs"][name]
-                self.finished.discard(spec.index)
 
     def write_run(self, spec: RunSpec, res: dict[str, Any]) -> None:
         """One run's group (``res`` from :func:`~transient.sweep.execute.run_one`); ``status``
         is written last and flushed, marking it finished."""
         runs = self.f["runs"]
         name = self.group_name(spec.index)
-        if name in runs:
-            del runs[name]
+        if name in runs:  # (never a finished run lost: parked)
+            self._park(f"runs/{name}")
         g = runs.create_group(name)
         g.attrs.update(index=spec.index, params=json.dumps(spec.params), scene_toml=spec.toml,
                        worker=res["worker"], wall_s=res["wall_s"])
@@ -145,6 +225,18 @@ class SweepStore:
         g.attrs["status"] = res["status"]
         self.f.flush()
         self.finished.add(spec.index)
+
+    def tidy(self, prune: bool = False) -> int:
+        """When every run is done: delete the parked runs whose scene the sweep holds again (a
+        failed run retried, a repeated point), and with ``prune`` every parked run; returns how
+        many are kept."""
+        scenes = {s.toml for s in self.sweep.runs}
+        unused = self.f[UNUSED]
+        for name in list(unused):
+            if prune or unused[name].attrs["scene_toml"] in scenes:
+                del unused[name]
+        self.f.flush()
+        return len(unused)
 
     def summary(self) -> tuple[list[dict[str, Any]], dict[str, str]]:
         """The summary rows (run order) and the units of their columns, from the stored runs."""
