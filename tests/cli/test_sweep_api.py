@@ -34,7 +34,7 @@ def test_a_sweep_from_code_runs_what_simulate_runs(small):
 def test_a_sweep_in_a_folder_is_mended_when_run_again(small, tmp_path):
     first = sweep(small, {"load.torque": [0.0, 1.0]}, output=tmp_path, scheduler="serial")
     again = sweep(small, {"load.torque": [0.0, 1.0, 2.0]}, output=tmp_path, scheduler="serial")
-    assert first.path == again.path == tmp_path / "small.h5"
+    assert first.path == again.path == tmp_path / "small.sweep.h5"
     assert sorted(again.computed) == [2] and sorted(again.reused) == [0, 1]
     assert (tmp_path / "small.sweep.toml").is_file()
 
@@ -44,3 +44,15 @@ def test_axes_must_be_given_as_a_dict_of_values(small):
         sweep(small, [("load.torque", [1.0])], scheduler="serial")
     with pytest.raises(SceneError, match=r"axes\['load.torque'\]: values must be numbers"):
         sweep(small, {"load.torque": [{"a": 1}]}, scheduler="serial")
+
+
+def test_a_sweep_on_a_given_dask_client(small):
+    from dask.distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        before = cluster.scheduler.transition_counter
+        done = sweep(small, {"inertia.flywheel": [0.0, 0.5]}, client=client)
+        moved = cluster.scheduler.transition_counter - before
+    assert list(done.to_dataframe()["status"]) == ["ok", "ok"]
+    assert moved >= 2 * 3  # each run's task went through that scheduler (at least 3 states)

@@ -1,6 +1,7 @@
 """Sweeps from code: :func:`sweep` runs a scene over parameter axes with the engine of
-``transient sweep``, from a sweep file it writes beside its results (validated, stored and mended
-exactly as a sweep file given to the command is).
+``transient sweep``, from a sweep file it writes beside its results, ``<name>.sweep.toml``
+(validated, stored and mended exactly as a sweep file given to the command is), into
+``<name>.sweep.h5`` and ``<name>.sweep_summary.csv``.
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError
+from ..results import create_exclusive
 from ..tomlout import toml_value
 from .execute import run_sweep
 from .spec import DEFAULT_COLLECT, load_sweep
@@ -91,15 +93,15 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
     folder = Path(output if output is not None else tmp.name)
     folder.mkdir(parents=True, exist_ok=True)
     name = name or base.name
-    spec_file = folder / f"{name}.sweep.toml"
-    spec_file.write_text(sweep_toml(base, axes, collect, method, name, columns),
-                         encoding="utf-8")
+    spec_file = folder / f"{name}.sweep.toml"  # (the sweep's own definition: rewritten each time)
+    with create_exclusive(spec_file, replace=True) as fh:
+        fh.write(sweep_toml(base, axes, collect, method, name, columns).encode("utf-8"))
     spec = load_sweep(spec_file)
     if client is not None:
         scheduler = client.scheduler.address
     done = run_sweep(spec, folder, scheduler, workers, force,
                      on_result=(lambda _s, _r, n, total: progress(n, total)) if progress else None)
-    return SweepResult(done.path, read_summary(done.path), done.computed, done.skipped, tmp)
+    return SweepResult(done.path, read_summary(done.path), done.computed, done.reused, tmp)
 
 
 def sweep_toml(base, axes: dict[str, Sequence], collect: Sequence[str], method: str, name: str,
