@@ -1,4 +1,7 @@
-"""Plot helpers: each takes an ``ax`` and returns the artists; callers make and save figures."""
+"""Plot helpers: each takes an ``ax`` and returns the artists; callers make and save figures.
+
+Where a helper plots a run, ``traj`` is a :class:`~transient.results.Result` or its trajectory
+(a mapping of column name to samples)."""
 from __future__ import annotations
 
 import math
@@ -6,8 +9,14 @@ import math
 import numpy as np
 
 
+def _columns(traj):
+    """The trajectory of a Result, or ``traj`` itself."""
+    return getattr(traj, "trajectory", traj)
+
+
 def speed(ax, traj, label=None):
     """ω(t) [rpm]."""
+    traj = _columns(traj)
     artists = ax.plot(traj["t"], traj["omega"] * 30.0 / math.pi, lw=1.0, label=label)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("ω [rpm]")
@@ -17,6 +26,7 @@ def speed(ax, traj, label=None):
 
 def acceleration(ax, traj, label=None):
     """ε(t) [rad/s²]."""
+    traj = _columns(traj)
     artists = ax.plot(traj["t"], traj["epsilon"], lw=0.6, label=label)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("ε [rad/s²]")
@@ -28,6 +38,7 @@ def piston_force(ax, traj, scene, cylinder=1):
     """Gas force on one piston of ``cylinder`` against time [kN]: the table value times the
     pressure applied (the governor's fuel included) for force models, (p − p0)·F_p for pressure
     models."""
+    traj = _columns(traj)
     from .assemble import gas_is_force
 
     value = traj[f"p_{cylinder}"]
@@ -41,12 +52,14 @@ def piston_force(ax, traj, scene, cylinder=1):
 
 def last_cycle(traj, cycle):
     """Boolean mask of the samples in the last whole cycle of crank angle."""
+    traj = _columns(traj)
     phi = traj["phi"]
     return phi >= phi[-1] - cycle
 
 
 def torques(ax, traj, cycle):
     """Moments over the last cycle against the crank angle in that cycle [deg]."""
+    traj = _columns(traj)
     sel = last_cycle(traj, cycle)
     phi = np.degrees(traj["phi"][sel] - traj["phi"][sel][0])
     inertia = -0.5 * traj["dJ_dphi"][sel] * traj["omega"][sel] ** 2
@@ -121,6 +134,7 @@ def reduced_inertia(ax, table):
 def pair_power(ax, traj, names, cycle):
     """Power each non-ideal pair transmits, S_k ω [kW] (> 0: the shaft side drives), and the
     power it loses, over the last cycle against the crank angle in that cycle."""
+    traj = _columns(traj)
     sel = last_cycle(traj, cycle)
     phi = np.degrees(traj["phi"][sel] - traj["phi"][sel][0])
     w = traj["omega"][sel]
@@ -142,6 +156,7 @@ def load_response(axes, traj, cycle, analysis):
     """Speed (as run, and its one-cycle mean), fuel command and load torque against time, with
     each load step's ±band around its new steady speed (``analysis``: the run's ``/analysis``
     entries, name → (value, unit)). ``axes``: three axes sharing t. Returns the artists."""
+    traj = _columns(traj)
     from .analysis.transient_response import cycle_mean_speed
 
     rpm = 30.0 / math.pi

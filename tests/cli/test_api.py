@@ -130,3 +130,20 @@ def test_check_says_what_the_geometry_implies_without_a_run(capsys):
     for name, (value, unit) in mech.analysis_summary().items():
         assert figures[name] == f"{value:.9g} {unit}"
     assert "cyl_2_lambda" in figures and "cyl_3_stroke_excess" in figures
+
+
+def test_plot_helpers_take_a_result(small):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from transient import plots
+
+    res = simulate(small)
+    fig, (a, b) = plt.subplots(2)
+    (line,) = plots.speed(a, res)
+    (same,) = plots.speed(b, res.trajectory)
+    assert np.array_equal(line.get_ydata(), same.get_ydata())
+    assert np.array_equal(line.get_ydata(), res.trajectory["omega"] * 30.0 / np.pi)
+    plt.close(fig)
