@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import h5py
 import matplotlib
+import numpy as np
 import pytest
 from scene_texts import SMALL
 
@@ -118,3 +119,27 @@ def test_figures_and_output_of_an_incomplete_result_say_so(tmp_path, small, caps
 def test_the_partial_file_of_a_killed_run_names_its_figures_as_the_result():
     assert result_stem(".engine.h5.part") == "engine"
     assert result_stem("dir/engine.h5") == "engine"
+
+
+def test_a_run_killed_while_finishing_resumes_to_the_same_file(tmp_path, small, monkeypatch):
+    """Killed after its last block, before its file got its name: the partial file holds the
+    whole run, and --resume only finishes it (no block computed again, no event twice)."""
+    from transient import load_scene, simulate
+    from transient.results import ResultWriter, partial_path
+
+    scene = load_scene(small)
+    whole = simulate(scene, tmp_path / "whole.h5")
+    with monkeypatch.context() as m:
+        m.setattr(ResultWriter, "finish", lambda self, *a, **k: self.f.close())  # the "kill"
+        with pytest.raises(FileNotFoundError):
+            simulate(scene, tmp_path / "small.h5")
+    part = partial_path(tmp_path / "small.h5")
+    assert part.is_file() and not (tmp_path / "small.h5").exists()
+    assert open_result(part).trajectory["t"].size == whole.trajectory["t"].size
+    again = simulate(scene, tmp_path / "small.h5", resume=True)
+    assert again.complete and not part.exists()
+    for name, x in whole.trajectory.items():
+        assert np.array_equal(again.trajectory[name], x), name
+    assert {k: v["t"].size for k, v in again.events.items()} == \
+        {k: v["t"].size for k, v in whole.events.items()}
+    assert again.solver["nsteps"] == whole.solver["nsteps"]
