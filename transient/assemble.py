@@ -48,7 +48,8 @@ def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
         return tables[-1], tables[0]
     return mixed_cycle(mech.volume_function(clearance_volume(scene)), compression_ratio=gas.compression_ratio,
                        p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
-                       p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes), None
+                       p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes,
+                       dead_centres=mech.dead_centre_angles()), None
 
 
 @lru_cache(maxsize=8)

@@ -1,5 +1,24 @@
-"""Errors that reach the user, each with what the CLI needs to print it."""
+"""Errors that reach the user, each with what the CLI needs to print it, and :func:`show_value`,
+the one way a message quotes what the user gave."""
 from __future__ import annotations
+
+from typing import Any
+
+#: Longest quotation of a user's value or key in a message: a message names the offending token,
+#: never a whole line of a file, and stays one line on a terminal.
+QUOTE_LIMIT = 40
+
+
+def clip(text: str, limit: int = QUOTE_LIMIT) -> str:
+    """``text`` with control characters escaped and cut to ``limit`` characters ("..." marks the
+    cut), so that a quoted token can neither break the line nor fill the screen."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def show_value(value: Any) -> str:
+    """``repr(value)`` as a message quotes it (:func:`clip`)."""
+    return clip(repr(value))
 
 
 class SceneError(ValueError):
@@ -22,8 +41,11 @@ class SceneError(ValueError):
         super().__init__(self.line())
 
     def line(self) -> str:
+        """The one line the CLI prints; a key the user wrote is quoted as :func:`clip` does
+        (a TOML key may hold any character), and no part may start a second line."""
         prefix = f"{self.file}: " if self.file else ""
-        return f"{prefix}{self.key}: {self.message}"
+        line = f"{prefix}{clip(self.key, 4 * QUOTE_LIMIT)}: {self.message}"
+        return line.replace("\n", "\\n").replace("\r", "\\r")
 
 
 class SimulationError(RuntimeError):

@@ -20,7 +20,7 @@ import sys
 
 from ..errors import SceneError, SimulationError, WriteFailed
 from . import efficiency, kinematics, loads, orders, plot, run, sweep, verify
-from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE
+from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE, OptionParser
 
 __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", "main"]
 
@@ -55,10 +55,9 @@ def main(argv: list[str] | None = None) -> int:
     code. Every command's errors are turned into exit codes here, so that each prints as one
     line: invalid input (a :class:`~transient.errors.SceneError`, a file that is missing, exists
     or may not be written) → 2; a failed simulation (:class:`~transient.errors.SimulationError`)
-    or an interrupt → 1."""
-    parser = _parser()
-    args = parser.parse_args(argv)
+    or an interrupt → 1. Options are checked as scene keys are, each error one line."""
     try:
+        args = _parser().parse_args(argv)
         with _signals_interrupt():
             return args.func(args)
     except SceneError as exc:
@@ -104,7 +103,7 @@ def _signals_interrupt():
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="transient", description=__doc__.splitlines()[0])
+    p = OptionParser(prog="transient", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
     for register in _COMMANDS:
         register(sub)

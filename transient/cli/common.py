@@ -5,13 +5,17 @@ that does not need them starts without them.
 """
 from __future__ import annotations
 
+import argparse
 import math
+import re
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import QUOTE_LIMIT, SceneError, clip, show_value
+from ..scene.files import not_a_regular_file
+from ..scene.records import MAX_SAMPLES_PER_REV
 
 EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
 
@@ -21,16 +25,72 @@ EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
 KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
 
 
+#: Most points of a grid over one cycle an option may ask for, as many as a scene may write per
+#: revolution: every point is computed and written.
+MAX_POINTS = MAX_SAMPLES_PER_REV
+#: Highest shaft speed an option may give [rpm]: beyond it no piston machine runs, and the
+#: inertia forces (∝ ω²) would overflow long before.
+MAX_RPM = 1e6
+#: Most processes of a local Dask cluster (``sweep --workers``): more would only fork the machine
+#: to a halt.
+MAX_WORKERS = 256
+
+
+class OptionParser(argparse.ArgumentParser):
+    """argparse whose errors are one line, ``option: what is wrong, what is allowed``, raised as a
+    :class:`~transient.errors.SceneError` for :func:`transient.cli.main` to print (exit 2) as it
+    prints a scene's, instead of a usage block; a value it quotes is cut to a token's length."""
+
+    def error(self, message: str):
+        message = re.sub(r"'([^']*)'", lambda m: show_value(m.group(1)), message)
+        head, _, rest = message.partition(": ")
+        if head.startswith("argument ") and rest:
+            raise SceneError(head.removeprefix("argument "), rest)
+        if head == "unrecognized arguments":
+            message = f"{head}: {clip(rest, 2 * QUOTE_LIMIT)}"
+        raise SceneError(self.prog, f"{message}; see '{self.prog} --help'")
+
+
+def whole(low: int, high: int):
+    """An option's type: a whole number in [low, high]; argparse names the option in the error."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a whole number {low} … {high}, got "
+                                             f"{show_value(text)}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be {low} … {high}, got {value}")
+        return value
+    return parse
+
+
+def real(gt: float, le: float = math.inf):
+    """An option's type: a finite number in (gt, le]; argparse names the option in the error."""
+    allowed = f"> {gt:g}" + (f" and ≤ {le:g}" if le < math.inf else "")
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a number {allowed}, got "
+                                             f"{show_value(text)}") from None
+        if not (math.isfinite(value) and gt < value <= le):
+            raise argparse.ArgumentTypeError(f"must be finite and {allowed}, got {value:g}")
+        return value
+    return parse
+
+
 def number_list(text: str, option: str, low: float, high: float = math.inf) -> list[float]:
     """Comma-separated finite numbers in (low, high], or a one-line error (exit 2)."""
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
-        raise SceneError(option, f"must be comma-separated numbers, got {text!r}") from None
+        raise SceneError(option, f"must be comma-separated numbers, got "
+                                 f"{show_value(text)}") from None
     bad = [v for v in values if not (low < v <= high and math.isfinite(v))]
     if not values or bad:
         raise SceneError(option, f"values must be finite and lie in ({low:g}, {high:g}], "
-                                 f"got {text!r}")
+                                 f"got {show_value(text)}")
     return values
 
 
@@ -39,8 +99,7 @@ def read_result(path):
     one-line error (exit 2), not a traceback."""
     from ..results import open_result
 
-    if not Path(path).is_file():
-        raise FileNotFoundError(f"{path}: no such result file")
+    check_result_path(path, "result file")
     try:
         res = open_result(path)
     except (OSError, ValueError) as exc:
@@ -68,10 +127,27 @@ def incomplete_note(res) -> str:
             else f"an incomplete run ({how}): no samples")
 
 
+def check_result_path(path, what: str) -> None:
+    """A file transient wrote (``what``: "result file", "sweep file") must be there and be a
+    regular file; else a one-line error (exit 2) saying what it is."""
+    kind = not_a_regular_file(Path(path))
+    if kind:
+        raise SceneError("(file)", f"is {kind}, not a {what}; give the .h5 file transient wrote",
+                         file=str(path))
+    if not Path(path).is_file():
+        raise FileNotFoundError(f"{path}: no such {what}")
+
+
 def output_folder(option: str | None, default: Path) -> Path:
     """The folder given by ``-o`` (else ``default``), created if missing."""
+    from ..results import NotWritable
+
     out = Path(option) if option else default
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # a file in the way, a read-only file system, …
+        raise NotWritable(f"{out}: cannot create the output folder ({exc.strerror or exc}); "
+                          f"give a writable folder") from None
     return out
 
 
@@ -96,24 +172,45 @@ def output_file(path, force: bool):
     error (exit 2) unless ``force``, and a link planted at the name is never followed."""
     import io
 
+    return io.TextIOWrapper(_created(path, force), encoding="utf-8", newline="")
+
+
+def check_output_file(path, force: bool) -> None:
+    """Before any work, what :func:`output_file` would refuse: a folder at the name, a file
+    there without ``force``, a folder that is not there."""
+    from ..results import NotWritable, ResultExists
+
+    path = Path(path)
+    if path.is_dir():
+        raise NotWritable(f"{path}: is a folder; give a file name")
+    if path.exists() and not force:
+        raise ResultExists(f"{path}: exists; use --force to replace it")
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"{path}: cannot create the file (no folder {path.parent}); "
+                                f"give a path in an existing folder")
+
+
+def _created(path, force: bool):
+    """``create_exclusive(path)``; a name in a folder that is not there is a one-line error."""
     from ..results import create_exclusive
 
-    return io.TextIOWrapper(create_exclusive(Path(path), replace=force), encoding="utf-8",
-                            newline="")
+    try:
+        return create_exclusive(Path(path), replace=force)
+    except (FileNotFoundError, NotADirectoryError) as exc:
+        raise FileNotFoundError(f"{path}: cannot create the file ({exc.strerror}); give a path "
+                                f"in an existing folder") from None
 
 
 def save(fig, path, force: bool, source=None):
     """Write ``fig`` as a PNG at ``path`` (as :func:`output_file` creates files) and close it
     (a long command draws many); returns ``path``. A figure of an incomplete result ``source``
     says so across its top."""
-    from ..results import create_exclusive
-
     fig.tight_layout()
     if source is not None and not source.complete:
         fig.subplots_adjust(top=0.9)
         fig.text(0.5, 0.995, incomplete_note(source), ha="center", va="top", color="crimson",
                  fontsize="medium", fontweight="bold")
-    with create_exclusive(Path(path), replace=force) as fh:
+    with _created(path, force) as fh:
         fig.savefig(fh, format="png", dpi=110)
     pyplot().close(fig)
     return path

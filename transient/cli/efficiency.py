@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..errors import SceneError
-from .common import EXIT_OK, add_force, number_list, output_file, output_folder, pyplot, save
+from ..errors import SceneError, show_value
+from .common import (EXIT_OK, MAX_POINTS, MAX_RPM, add_force, number_list, output_file,
+                     output_folder, pyplot, save, whole)
 
 
 def register(sub) -> None:
@@ -18,7 +19,8 @@ def register(sub) -> None:
                                                 "(default 1, full load)")
     e.add_argument("--policies", default=None,
                    help="mode policies to compare, e.g. power-flow,paper (default: the scene's)")
-    e.add_argument("--samples-per-rev", type=int, default=1440)
+    e.add_argument("--samples-per-rev", type=whole(36, MAX_POINTS), default=1440,
+                   help="crank-angle samples per revolution of each steady run (default 1440)")
     e.add_argument("-o", "--output", default="results", help="output folder (default results/)")
     add_force(e)
     e.set_defaults(func=cmd_efficiency)
@@ -29,20 +31,19 @@ def cmd_efficiency(args) -> int:
     from ..study.efficiency import efficiency_study, plot_study, write_csv
 
     scene = load_scene(args.scene)
-    rpm = number_list(args.rpm, "--rpm", 0.0)
+    rpm = number_list(args.rpm, "--rpm", 0.0, MAX_RPM)
     fuels = number_list(args.fuel, "--fuel", 0.0, 1.0)
     policies = tuple(args.policies.split(",")) if args.policies else None
     for p in policies or ():
         if p not in POLICIES:
-            raise SceneError("--policies", f"unknown policy {p!r}; allowed: {', '.join(POLICIES)}")
+            raise SceneError("--policies", f"unknown policy {show_value(p)}; allowed: "
+                                           f"{', '.join(POLICIES)}")
     if scene.gas.model == "none":
         raise SceneError("gas.model", "an efficiency study needs gas forces (the input power)",
                          file=args.scene)
-    if args.samples_per_rev < 36:
-        raise SceneError("--samples-per-rev", f"must be ≥ 36, got {args.samples_per_rev}")
-    rows = efficiency_study(scene, rpm, fuels, policies, args.samples_per_rev)
-    out = output_folder(args.output, Path("results"))
+    out = output_folder(args.output, Path("results"))  # (before the study: -o is checked first)
     stem = Path(args.scene).stem
+    rows = efficiency_study(scene, rpm, fuels, policies, args.samples_per_rev)
     with output_file(out / f"{stem}_efficiency.csv", args.force) as fh:
         write_csv(rows, fh)
     names = [p.name for p in scene.friction.pairs]

@@ -6,15 +6,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
-from .common import EXIT_OK, add_force, output_file, pyplot, save
+from .common import (EXIT_OK, MAX_POINTS, add_force, check_output_file, output_file, pyplot,
+                     save, whole)
 
 
 def register(sub) -> None:
     k = sub.add_parser("kinematics", help="tabulate positions, transfer functions, J and dJ/dφ")
     k.add_argument("scene")
     k.add_argument("-o", "--output", default=None, help="CSV file (default: standard output)")
-    k.add_argument("--points", type=int, default=361, help="points over one cycle")
+    k.add_argument("--points", type=whole(2, MAX_POINTS), default=361,
+                   help="points over one cycle (default 361)")
     k.add_argument("--plot", default=None, help="also write a PNG of the transfer functions and J")
     add_force(k)
     k.set_defaults(func=cmd_kinematics)
@@ -23,9 +24,9 @@ def register(sub) -> None:
 def cmd_kinematics(args) -> int:
     from ..scene import load_scene
 
-    if args.points < 2:
-        raise SceneError("--points", f"must be ≥ 2 (points over one cycle), got {args.points}")
     scene = load_scene(args.scene)
+    for path in filter(None, (args.output, args.plot)):
+        check_output_file(path, args.force)
     mech = scene.mechanism
     phi = np.linspace(0.0, mech.cycle, args.points)
     table = _with_constant_inertia(mech.kinematics_table(phi), scene.inertia.total)

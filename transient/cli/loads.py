@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
+from ..mechanisms.crank_slider import MAX_CYLINDERS
 from .common import (EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save,
-                     write_columns)
+                     whole, write_columns)
 
 
 def register(sub) -> None:
@@ -21,7 +22,7 @@ def register(sub) -> None:
                     "written as files into DIR, never into the HDF5 result (read only here).")
     lo.add_argument("result")
     lo.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
-    lo.add_argument("--cylinder", type=int, default=1,
+    lo.add_argument("--cylinder", type=whole(1, MAX_CYLINDERS), default=1,
                     help="cylinder (1-based, from the nose) whose crankpin is drawn (default 1)")
     add_force(lo)
     lo.set_defaults(func=cmd_loads)

@@ -7,8 +7,8 @@ import math
 import numpy as np
 
 from ..errors import SceneError
-from .common import (EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save,
-                     write_columns)
+from .common import (EXIT_OK, MAX_POINTS, add_force, output_folder, pyplot, read_result, real,
+                     result_stem, save, whole, write_columns)
 
 
 def register(sub) -> None:
@@ -23,10 +23,10 @@ def register(sub) -> None:
                     "written as files into DIR, never into the HDF5 result (read only here).")
     od.add_argument("result")
     od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
-    od.add_argument("--samples-per-cycle", type=int, default=720,
+    od.add_argument("--samples-per-cycle", type=whole(16, MAX_POINTS), default=720,
                     help="crank-angle grid points per engine cycle (default 720); orders up to "
                          "half of it per cycle")
-    od.add_argument("--max-order", type=float, default=12.0,
+    od.add_argument("--max-order", type=real(gt=0.0), default=12.0,
                     help="highest order in the tables and figures (default 12)")
     od.add_argument("--detrend", choices=("auto", "ramp", "none"), default="auto",
                     help="remove each cycle's ramp from ω before its DFT (default auto: for a "
@@ -43,10 +43,6 @@ def cmd_orders(args) -> int:
     scene = res.scene()
     mech = scene.mechanism
     n = args.samples_per_cycle
-    if n < 16:
-        raise SceneError("--samples-per-cycle", f"must be ≥ 16, got {n}")
-    if not args.max_order > 0:
-        raise SceneError("--max-order", f"must be > 0, got {args.max_order:g}")
     traj = res.trajectory
     cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
     try:

@@ -5,8 +5,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..errors import SceneError
-from .common import EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, add_force, output_folder, pyplot, save
+from ..errors import SceneError, show_value
+from .common import (EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, MAX_WORKERS, add_force,
+                     check_result_path, output_folder, pyplot, save, whole)
 
 
 def register(sub) -> None:
@@ -21,7 +22,7 @@ def register(sub) -> None:
     sw.add_argument("--scheduler", default=None,
                     help="tcp://host:port of a running Dask scheduler (default: a local cluster "
                          "of one process per core); 'serial' runs in this process without Dask")
-    sw.add_argument("--workers", type=int, default=None,
+    sw.add_argument("--workers", type=whole(1, MAX_WORKERS), default=None,
                     help="processes of the local cluster (default: one per core)")
     sw.add_argument("--force", action="store_true",
                     help="replace an existing sweep file instead of mending it")
@@ -48,11 +49,12 @@ def cmd_sweep(args) -> int:
     sweep = load_sweep(args.sweep)  # every scene validated here, before any work (exit 2)
     s = args.scheduler
     if s is not None and s != "serial" and "://" not in s:
-        raise SceneError("--scheduler", f"{s!r} is not an address; give tcp://host:port of a "
-                                        f"running Dask scheduler, or 'serial'")
-    if args.workers is not None and (args.workers < 1 or s is not None):
-        raise SceneError("--workers", "must be ≥ 1, and only for the local cluster (no "
-                                      "--scheduler)")
+        raise SceneError("--scheduler", f"{show_value(s)} is not an address; give "
+                                        f"tcp://host:port of a running Dask scheduler, or "
+                                        f"'serial'")
+    if args.workers is not None and s is not None:
+        raise SceneError("--workers", "is for the local cluster only; leave it out with "
+                                      "--scheduler")
     bar = None
     if not args.quiet and sys.stderr.isatty():
         from tqdm import tqdm
@@ -103,8 +105,7 @@ def cmd_sweep_plot(args) -> int:
     from .. import plots
     from ..sweep import read_summary
 
-    if not Path(args.result).is_file():
-        raise FileNotFoundError(f"{args.result}: no such sweep file")
+    check_result_path(args.result, "sweep file")
     try:
         tab = read_summary(args.result)
     except (OSError, ValueError, KeyError) as exc:
@@ -113,7 +114,7 @@ def cmd_sweep_plot(args) -> int:
     quantities = args.quantity or tab.collect
     for q in quantities:
         if q not in tab.columns or q in ("run", "status", "message"):
-            raise SceneError("--quantity", f"{q!r} is not in the summary; allowed: "
+            raise SceneError("--quantity", f"{show_value(q)} is not in the summary; allowed: "
                                            f"{', '.join(tab.collect)}", file=str(args.result))
     out = output_folder(args.output, tab.path.parent)
     plt = pyplot()

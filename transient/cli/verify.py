@@ -4,18 +4,26 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import SceneError
-from .common import EXIT_FAILED, EXIT_OK, add_force
+from ..errors import SceneError, show_value
+from .common import EXIT_FAILED, EXIT_OK, add_force, real, whole
+
+
+#: Bounds of the benchmark's options: a record of 10⁶ revolutions per run, or of 100 runs per
+#: point, would take days on the benchmark scenes.
+MAX_BENCH_REVOLUTIONS = 1e6
+MAX_REPEAT = 100
 
 
 def register_bench(sub) -> None:
     b = sub.add_parser("bench", help="work-precision record: error against run time, transient "
                                      "against solve_ivp (and CyRK if installed)")
     b.add_argument("scenes", nargs="*", help="scene files (default: the three benchmark scenes)")
-    b.add_argument("--revolutions", type=float, default=1000.0)
-    b.add_argument("--repeat", type=int, default=5, help="timed runs per point (median)")
+    b.add_argument("--revolutions", type=real(gt=0.0, le=MAX_BENCH_REVOLUTIONS), default=1000.0,
+                   help="revolutions of each timed run (default 1000)")
+    b.add_argument("--repeat", type=whole(1, MAX_REPEAT), default=5,
+                   help="timed runs per point (median; default 5)")
     b.add_argument("--no-baselines", action="store_true", help="transient's paths only")
-    b.add_argument("--baseline-budget", type=float, default=None,
+    b.add_argument("--baseline-budget", type=real(gt=0.0), default=None,
                    help="stop a baseline run after this long, and its tighter tolerances [s] "
                         "(default: transient.verify.bench.BASELINE_BUDGET_S, 60 s)")
     b.add_argument("--quick", action="store_true",
@@ -54,7 +62,8 @@ def cmd_stress(args) -> int:
     names = [c.name for c in catalogue()]
     for name in args.case or ():
         if name not in names:
-            raise SceneError("--case", f"unknown case {name!r}; allowed: {', '.join(names)}")
+            raise SceneError("--case", f"unknown case {show_value(name)}; allowed: "
+                                       f"{', '.join(names)}")
     out = Path(args.output)
     check_writable(out / "stress.md", force=args.force)  # before any work (exit 2)
     rows, path = run_stress(args.quick, out, only=args.case)

@@ -641,7 +641,8 @@ def volume_at(volume: VolumeFunction, x: float) -> float:
 def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                 p_a: float, n1: float, p_z: float, rho: float, n2: float,
                 p_intake: float | None = None, p_exhaust: float | None = None, strokes: int = 4,
-                step: float = DEFAULT_STEP) -> MixedCycle:
+                step: float = DEFAULT_STEP,
+                dead_centres: tuple[float, float] = (0.0, math.pi)) -> MixedCycle:
     """Ideal mixed (Trinkler–Sabathé) cycle tabulated against the local crank angle.
 
     The indicator diagram of Gots App. 2 (table П2.1: travel and volume by (1), the compression
@@ -664,12 +665,17 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
     instantaneously to ``p_a`` (a jump, no pumping loop), then compression from π back to 2π.
     `p_intake` and `p_exhaust` are not used.
 
+    With an offset crank the dead centres lie off 0 and π (`dead_centres`, t and b): the
+    compression starts at b, the firing TDC is at 2π + t (4-stroke) or t (2-stroke), the
+    expansion ends at 2π + b (4-stroke) or b, so that V_a and V_c are the cylinder's largest and
+    least volume; the table keeps its angle 0 and the pieces wrap across it.
+
     Parameters
     ----------
     volume : callable
         Vectorised ``V(x)`` [m³] of the cylinder at local crank angle x [rad].
     compression_ratio : float
-        ε; must equal ``V_a/V_c`` of `volume` to 1e-9 relative.
+        ε; must equal ``V_a/V_c`` of `volume` (largest over least volume) to 1e-9 relative.
     p_a : float
         Pressure at the start of compression [Pa] (Gots App. 2: 0.1436 MPa).
     n1 : float
@@ -688,6 +694,9 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         Cycle type.
     step : float
         Knot spacing of the tabulation [rad], see :func:`table_from_function`.
+    dead_centres : (float, float)
+        Local angles [rad] of top and bottom dead centre, near 0 and π
+        (``Mechanism.dead_centre_angles``).
 
     Returns
     -------
@@ -717,22 +726,26 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
     if not (np.isfinite(compression_ratio) and compression_ratio > 1.0):
         raise SceneError("gas.compression_ratio", f"{compression_ratio!r}; it must be > 1")
 
-    # Angles of the firing TDC and of the BDC that ends the expansion (x_tdc + π).
-    x_tdc = 2.0 * math.pi if strokes == 4 else 0.0
-    x_bdc = x_tdc + math.pi
-    x_start = math.pi  # compression starts at a BDC in both cycles
+    # Angles of the firing TDC, of the BDC that ends the expansion and of the BDC where the
+    # compression starts (the same dead centre a cycle earlier).
+    tdc, bdc = dead_centres
+    shift = 2.0 * math.pi if strokes == 4 else 0.0
+    x_tdc, x_bdc, x_start = tdc + shift, bdc + shift, bdc
     v_c = volume_at(volume, x_tdc)
     v_a = volume_at(volume, x_start)
     v_b = volume_at(volume, x_bdc)
     if not (v_c > 0.0 and v_a > v_c):
         raise SceneError("gas.compression_ratio",
-                         f"the volume gives V({deg_text(x_start)}) = {v_a:.6g} m³ and "
-                         f"V({deg_text(x_tdc)}) = {v_c:.6g} m³; need V_a > V_c > 0")
+                         f"the volume gives V({deg_text(x_start)}) = {v_a:.6g} m³ at bottom and "
+                         f"V({deg_text(x_tdc)}) = {v_c:.6g} m³ at top dead centre; need "
+                         f"V_a > V_c > 0")
     ratio = v_a / v_c
     if abs(ratio - compression_ratio) > 1e-9 * compression_ratio:
         raise SceneError("gas.compression_ratio",
-                         f"the geometry gives V_a/V_c = {ratio:.10g} but compression_ratio = "
-                         f"{compression_ratio:.10g}; make them agree (to 1e-9)")
+                         f"the volumes at the dead centres ({deg_text(x_start)}, "
+                         f"{deg_text(x_tdc)}) give V_a/V_c = {ratio:.10g}, not the "
+                         f"compression_ratio {compression_ratio:.10g}; the clearance volume "
+                         f"must be the swept volume/(ε − 1)")
     p_c = p_a * ratio ** n1
     if p_z < p_c:
         raise SceneError("gas.p_z", f"p_z = {p_z / 1e6:.6g} MPa is below the compression end "
@@ -763,19 +776,35 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
     # Polytrope work (p1 V1 - p2 V2)/(n - 1) and the isobar p_z (V_z - V_c).
     work = ((p_a * v_a - p_c * v_c) / (n1 - 1.0) + p_z * (v_z - v_c)
             + (p_z * v_z - p_b * v_b) / (n2 - 1.0))
-    expansion_pieces: list[PieceFunction] = [p_z, expansion] if has_isobar else [expansion]
-    expansion_corners = [angle_z] if has_isobar else []
+    # Each piece from the angle where it starts; the exhaust ends at the period's end (4π ≡ 0).
+    starts: list[tuple[float, PieceFunction]] = [(x_start, compression), (x_tdc, p_z),
+                                                 (angle_z, expansion)]
+    if not has_isobar:
+        starts.pop(1)
     if strokes == 4:
-        funcs = [float(p_intake), compression, *expansion_pieces, float(p_exhaust)]
-        corners = [math.pi, x_tdc, *expansion_corners, x_bdc]
+        starts += [(0.0, float(p_intake)), (x_bdc, float(p_exhaust))]
         # Pumping loop, from the volumes at the same corners the table uses.
         v_0 = volume_at(volume, 0.0)
         v_end = volume_at(volume, period)
         work += p_intake * (v_a - v_0) + p_exhaust * (v_end - v_b)
-    else:
-        funcs = [*expansion_pieces, compression]
-        corners = [*expansion_corners, x_bdc]
+    funcs, corners = _wrapped_pieces(starts, period)
     table, err = table_from_function(funcs, period, corners, step)
     return MixedCycle(knots=table.knots, coef=table.coef, piece_knot=table.piece_knot,
                       period=period, work=work, p_c=p_c, p_b=p_b, angle_z=angle_z, v_c=v_c,
                       v_a=v_a, v_z=v_z, v_b=v_b, strokes=strokes, interpolation_error=err)
+
+
+def _wrapped_pieces(starts: list[tuple[float, PieceFunction]], period: float
+                    ) -> tuple[list[PieceFunction], list[float]]:
+    """Pieces given by the angles where they start, as :func:`table_from_function` takes them:
+    the functions in order over [0, period) and the interior corners. A start off [0, period)
+    is taken modulo the period, and the piece running at angle 0 is the last one begun before
+    it (a cycle whose dead centre lies before 0 wraps across it)."""
+    def wrapped(x: float) -> float:  # (within rounding of the period's ends: its start)
+        x = x % period
+        return 0.0 if x < 1e-12 * period or x > period * (1.0 - 1e-12) else x
+
+    ordered = sorted(((wrapped(x), f) for x, f in starts), key=lambda item: item[0])
+    if ordered[0][0] > 0.0:
+        ordered.insert(0, (0.0, ordered[-1][1]))
+    return [f for _, f in ordered], [x for x, _ in ordered[1:]]

@@ -101,6 +101,11 @@ class Mechanism(Protocol):
         """V(x) [m³] of a cylinder over its local angle x [rad] (vectorised), ``clearance`` [m³]
         the volume at top dead centre: what the cycle models (mixed, Wiebe, Woschni) compress."""
 
+    def dead_centre_angles(self) -> tuple[float, float]:
+        """Local angles [rad] of the top and bottom dead centre of that cylinder, where V is
+        least and greatest: a cycle compresses from one to the other, and an offset moves them
+        off 0 and π."""
+
     def pack(self) -> NDArray[np.float64]:
         """The parameter array of its compiled kernel."""
 

@@ -360,6 +360,10 @@ class Articulated:
         """V(x) of the master cylinder over its local angle x [rad] (vectorised)."""
         return self.master().volume_function(clearance)
 
+    def dead_centre_angles(self) -> tuple[float, float]:
+        """Dead centres [rad] of the master cylinder, a centred crank-slider: 0 and π."""
+        return self.master().dead_centre_angles()
+
     def reference_terms(self) -> Callable[[float], tuple]:
         """φ ↦ (J, dJ/dφ, u_k) for the reference path: the kernel's pure-Python code
         (:class:`~.twins.KernelTwin`), there being no numpy twin of it."""

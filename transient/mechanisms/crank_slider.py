@@ -231,6 +231,13 @@ class CrankSlider:
         """Local crank angle of the true top dead centre, Gots (9): sin φ₁ = e/(l + r)."""
         return asin(self.offset / (self.rod_length + self.crank_radius))
 
+    def dead_centre_angles(self) -> tuple[float, float]:
+        """Local angles [rad] of the true dead centres, where crank and rod are in line: at TDC
+        stretched (the pin at l + r from the piston, Gots (9): sin φ₁ = e/(l + r)), at BDC
+        folded (the crank pointing away from the piston at l − r: φ₂ = π + asin(e/(l − r)))."""
+        r, l, e = self.crank_radius, self.rod_length, self.offset
+        return asin(e / (l + r)), pi + asin(e / (l - r))
+
     def stroke(self) -> float:
         """Exact stroke, Gots (11)."""
         r, l, e = self.crank_radius, self.rod_length, self.offset

@@ -353,6 +353,10 @@ class SwashPlate:
         """Volume [m³] swept in cylinder 1 between its dead centres: halves·F_p·stroke()."""
         return self.halves * self.piston_area * self.stroke()
 
+    def dead_centre_angles(self) -> tuple[float, float]:
+        """Dead centres [rad] of cylinder 1, inner and outer: 0 and π (module docstring)."""
+        return 0.0, pi
+
     def volume_function(self, clearance: float) -> Callable[[ArrayLike], NDArray[np.float64]]:
         """V(x) [m³] of cylinder 1 over the local angle x [rad] (= shaft angle; vectorised).
 

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import SceneError, show_value
 from .reader import Section
 from .records import COMPILED_METHODS, Scene
 
@@ -109,7 +109,7 @@ def check_analysis(scene: Scene) -> None:
                else [])
     for name in a.orders:
         if name not in columns + derived:
-            raise SceneError("analysis.orders", f"unknown signal {name!r}; allowed: "
+            raise SceneError("analysis.orders", f"unknown signal {show_value(name)}; allowed: "
                                                 f"{', '.join(columns + derived)}")
     if len(set(a.orders)) != len(a.orders):
         raise SceneError("analysis.orders", "a signal is named twice; name each once")

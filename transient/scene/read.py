@@ -8,11 +8,7 @@ and the key as written.
 """
 from __future__ import annotations
 
-import csv
 import math
-import os
-import stat
-import tomllib
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,6 +16,7 @@ from ..errors import SceneError
 from ..mechanisms import MECHANISMS
 from ..units import ALL_SUFFIXES
 from .checks import check_analysis, check_consistency, check_gas_table
+from .files import parse_toml, read_text, table_number, table_rows
 from .reader import MISSING, Section, show_value
 from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES,
                       GOVERNOR_KEYS, Analysis, Friction, Gas, Governor, Inertia, Initial, Load,
@@ -27,44 +24,12 @@ from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLI
 from .write import to_toml
 
 
-def not_a_regular_file(path: Path) -> str:
-    """What ``path`` is if it is there but not a regular file ("a folder", "a FIFO", …), else
-    "": a FIFO or a device would be read forever, and a folder is no file to read."""
-    try:
-        mode = os.stat(path).st_mode  # (does not open it: a FIFO does not block here)
-    except OSError:
-        return ""
-    for test, kind in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"),
-                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-                       (stat.S_ISSOCK, "a socket")):
-        if test(mode):
-            return kind
-    return ""
-
-
 def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
     path = Path(source)
     if text is None:
-        kind = not_a_regular_file(path)
-        if kind:
-            raise SceneError("(file)", f"is {kind}, not a scene file; give a TOML file",
-                             file=str(path))
-        try:
-            text = path.read_text(encoding="utf-8-sig")  # (a byte-order mark is not TOML)
-        except OSError as exc:
-            raise SceneError("(file)", f"cannot read: {exc.strerror}", file=str(path)) from None
-        except UnicodeDecodeError as exc:
-            raise SceneError("(file)", f"not UTF-8 text (byte {exc.start}); save the scene as "
-                                       f"UTF-8", file=str(path)) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError("(syntax)", f"not valid TOML: {exc}", file=str(path)) from None
-    except RecursionError:
-        raise SceneError("(syntax)", "arrays or tables nested too deeply to read",
-                         file=str(path)) from None
-    return scene_from_dict(data, file=str(path), base_dir=path.parent)
+        text = read_text(path, "scene")
+    return scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
 
 
 def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
@@ -76,7 +41,7 @@ def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
     ``scene.replace(inertia={"flywheel": 0.5}, initial={"omega_rpm": 1500})``. A key given with
     another unit replaces the scene's own (``omega_rpm`` replaces ``omega``).
     """
-    data = tomllib.loads(to_toml(scene))
+    data = parse_toml(to_toml(scene), "(replace)")
     for table, keys in tables.items():
         if not isinstance(keys, dict):
             raise SceneError(table, f"give the table's keys as a dict, got {type(keys).__name__}")
@@ -267,38 +232,48 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
                p_exhaust=p_ex, wiebe=wiebe, woschni=woschni)
 
 
+#: Column names of a pressure table (CSV) and their factors to SI.
+ANGLE_COLUMNS = {"phi_deg": math.pi / 180.0, "phi": 1.0}
+PRESSURE_COLUMNS = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
+
+
 def _read_pressure_csv(s: Section, base_dir: Path):
     """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
     name = s.string("file")
-    path = (base_dir / name).resolve()
-    kind = not_a_regular_file(path)
-    if kind:
-        raise SceneError(s.key("file"), f"{str(path)!r} is {kind}, not a CSV file")
-    if not path.is_file():
-        raise SceneError(s.key("file"), f"no such file {str(path)!r}; give a CSV path relative "
-                                        f"to the scene")
-    angle_cols = {"phi_deg": math.pi / 180.0, "phi": 1.0}
-    p_cols = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
     try:
-        with path.open(newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(line for line in fh if not line.startswith("#")))
-    except UnicodeDecodeError as exc:
-        raise SceneError(s.key("file"), f"{path.name}: not UTF-8 text (byte {exc.start}); "
-                                        f"save the table as UTF-8 CSV") from None
-    header = [h.strip() for h in rows[0]] if rows else []
-    a = next((c for c in header if c in angle_cols), None)
-    b = next((c for c in header if c in p_cols), None)
-    if a is None or b is None:
-        raise SceneError(s.key("file"), f"{path.name}: needs an angle column ({', '.join(angle_cols)})"
-                                        f" and a pressure column ({', '.join(p_cols)}); "
-                                        f"header is {header}")
-    ia, ib = header.index(a), header.index(b)
+        path = (base_dir / name).resolve()
+        there = path.exists()
+    except (OSError, ValueError):  # a name too long for the system, or holding a NUL
+        there = False
+    if not there:
+        raise SceneError(s.key("file"), f"no such file {show_value(name)}; give a CSV path "
+                                        f"relative to the scene")
     try:
-        phi = tuple(float(r[ia]) * angle_cols[a] for r in rows[1:] if r)
-        p = tuple(float(r[ib]) * p_cols[b] for r in rows[1:] if r)
-    except (ValueError, IndexError) as exc:
-        raise SceneError(s.key("file"), f"{path.name}: a row is not numeric ({exc})") from None
+        rows = table_rows(read_text(path, "table"))
+        header = [h.strip() for h in rows[0][1]] if rows else []
+        a = next((c for c in header if c in ANGLE_COLUMNS), None)
+        b = next((c for c in header if c in PRESSURE_COLUMNS), None)
+        if a is None or b is None:
+            raise SceneError("(line)", f"needs an angle column ({', '.join(ANGLE_COLUMNS)}) and a "
+                                       f"pressure column ({', '.join(PRESSURE_COLUMNS)}); header "
+                                       f"is {show_value(header)}")
+        phi = _table_column(rows[1:], header.index(a), a, ANGLE_COLUMNS[a])
+        p = _table_column(rows[1:], header.index(b), b, PRESSURE_COLUMNS[b])
+    except SceneError as exc:  # (placed here: the message names the table, the key the scene's)
+        raise SceneError(s.key("file"), f"{path.name}: {exc.message}") from None
     return phi, p
+
+
+def _table_column(rows, index: int, column: str, factor: float) -> tuple[float, ...]:
+    """Column ``index`` of a table's data rows in SI; a short row or a field that is no finite
+    number is an error naming its line."""
+    out = []
+    for number, fields in rows:
+        if index >= len(fields):
+            raise SceneError("(line)", f"line {number} has {len(fields)} field(s); column "
+                                       f"{column} is field {index + 1}")
+        out.append(table_number(fields[index], number, column) * factor)
+    return tuple(out)
 
 
 def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
@@ -321,7 +296,8 @@ def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
                                                 f"the links are {chain}")
         for b in between:
             if b not in links:
-                raise SceneError(ps.key("between"), f"unknown link {b!r}; the links are {chain}")
+                raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links "
+                                                    f"are {chain}")
         ia, ib = links.index(between[0]), links.index(between[1])
         if abs(ia - ib) != 1:
             raise SceneError(ps.key("between"),
@@ -339,7 +315,8 @@ def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
         ps.finish()
         twin = next((j for j, q in enumerate(pairs) if q.name == pair.name), None)
         if twin is not None:
-            raise SceneError(ps.key("name"), f"{pair.name!r} names {s.key('pairs')}[{twin}] "
+            raise SceneError(ps.key("name"), f"{show_value(pair.name)} names "
+                                             f"{s.key('pairs')}[{twin}] "
                                              f"too; give each pair its own name (it labels the "
                                              f"pair's result columns and reports)")
         pairs.append(pair)

@@ -11,12 +11,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ..errors import SceneError
+from ..errors import SceneError, show_value
 from ..units import ALL_SUFFIXES, SUFFIXES
 
 #: The default of a required key: reading it when absent is an error (``None`` is a valid
 #: default, so it cannot mark one).
 MISSING = object()
+
+#: TOML integers are unbounded; one past a float's range could not be compared or converted.
+MAX_EXACT_INT = int(1.7976931348623157e308)
 
 
 class Section:
@@ -47,7 +50,7 @@ class Section:
                 found.append((f"{name}_{suffix}", factor))
         if len(found) > 1:
             raise SceneError(self.key(found[1][0]),
-                             f"given twice (also as {found[0][0]!r}); give one of them")
+                             f"given twice (also as {show_value(found[0][0])}); give one of them")
         if not found:
             self._check_suffixes(name)
             return MISSING, 1.0, name
@@ -79,6 +82,9 @@ class Section:
             return default
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise SceneError(self.key(written), f"must be a number, got {show_value(value)}")
+        if isinstance(value, int) and abs(value) > MAX_EXACT_INT:
+            raise SceneError(self.key(written), f"must be finite, got {show_value(value)} (beyond "
+                                                f"a float's range)")
         if not math.isfinite(value):
             raise SceneError(self.key(written), f"must be finite, got {value}")
         self._check_range(written, value, gt, ge, lt, le, factor)
@@ -102,12 +108,13 @@ class Section:
         if isinstance(value, bool) or not isinstance(value, int):
             raise SceneError(self.key(written), f"must be a whole number, got {show_value(value)}")
         if ge is not None and value < ge:
-            raise SceneError(self.key(written), f"must be ≥ {ge}, got {value}")
+            raise SceneError(self.key(written), f"must be ≥ {ge}, got {show_value(value)}")
         if le is not None and value > le:
-            raise SceneError(self.key(written), f"must be ≤ {le}, got {value}")
+            raise SceneError(self.key(written), f"must be ≤ {le}, got {show_value(value)}")
         if choices is not None and value not in choices:
             raise SceneError(self.key(written),
-                             f"must be one of {', '.join(map(str, choices))}, got {value}")
+                             f"must be one of {', '.join(map(str, choices))}, got "
+                             f"{show_value(value)}")
         return value
 
     def flag(self, name: str, default: bool) -> bool:
@@ -141,7 +148,8 @@ class Section:
             raise SceneError(self.key(written), f"must be a string, got {show_value(value)}")
         if choices is not None and value not in choices:
             raise SceneError(self.key(written),
-                             f"unknown value {value!r}; allowed: {', '.join(map(repr, choices))}")
+                             f"unknown value {show_value(value)}; allowed: "
+                             f"{', '.join(map(repr, choices))}")
         return value
 
     def numbers(self, name: str, kind: str | None = None, default: Any = MISSING) -> tuple:
@@ -150,9 +158,7 @@ class Section:
             if default is MISSING:
                 raise SceneError(self.key(name), f"is missing; {self._unit_hint(name, kind)} list")
             return default
-        if not isinstance(value, list) or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                for v in value):
+        if not isinstance(value, list) or not all(finite_number(v) for v in value):
             raise SceneError(self.key(written), f"must be a list of finite numbers, got "
                                                 f"{show_value(value)}")
         return tuple(float(v) * factor for v in value)
@@ -219,11 +225,12 @@ _UNIT_LIKE = {"in", "m", "cm", "km", "ft", "s", "ms", "min", "h", "rad", "rps", 
               "psi", "atm", "kg", "g", "lb", "n", "nm", "kw", "w", "k", "c", "l"}
 
 
+def finite_number(v: Any) -> bool:
+    """Whether ``v`` is a number (not a boolean) a float holds finitely."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    return abs(v) <= MAX_EXACT_INT if isinstance(v, int) else math.isfinite(v)
+
+
 def _looks_like_unit(suffix: str) -> bool:
     return suffix in ALL_SUFFIXES or suffix.lower() in _UNIT_LIKE
-
-
-def show_value(value: Any) -> str:
-    """``repr(value)`` cut to 40 characters, so that an error stays one line."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."

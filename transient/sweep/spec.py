@@ -33,7 +33,6 @@ import dataclasses
 import itertools
 import math
 import re
-import tomllib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,7 +40,9 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import QUOTE_LIMIT, SceneError, clip, show_value
+from ..scene.files import parse_toml, read_text
+from ..scene.reader import finite_number
 from ..units import ALL_SUFFIXES
 
 METHODS = ("grid", "list", "random")
@@ -77,6 +78,9 @@ QUANTITIES: dict[str, tuple[str, float, str, str, Callable | None]] = {
     "spin_up_t90_s": ("spin_up_t90_s", 1.0, "s", "time to 90 % of the final speed", None),
 }
 DEFAULT_COLLECT = ("mean_speed_rpm", "delta")
+#: Most runs one sweep file may ask for: every run's scene is resolved and validated before any
+#: work, so a grid of 10¹² points would never start; split a larger study into sweeps.
+MAX_RUNS = 100_000
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _KEY_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
 
@@ -139,7 +143,7 @@ class _Table:
             return default
         value = self.data.pop(key)
         if isinstance(value, bool) and bool not in types or not isinstance(value, types):
-            raise self.error(key, f"must be {what}, got {value!r}")
+            raise self.error(key, f"must be {what}, got {show_value(value)}")
         return value
 
     def finish(self) -> None:
@@ -151,13 +155,8 @@ def load_sweep(source: str | Path) -> Sweep:
     """Read and validate a sweep file and every scene it resolves to. Raises SceneError."""
     path = Path(source)
     file = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-        data = tomllib.loads(text)
-    except OSError as exc:
-        raise SceneError("(file)", f"cannot read: {exc.strerror}", file=file) from None
-    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise SceneError("(syntax)", f"not valid TOML (UTF-8): {exc}", file=file) from None
+    text = read_text(path, "sweep")
+    data = parse_toml(text, file)
     root = _Table(data, "", file)
     head = _Table(root.get("sweep", (dict,), None, "a table") or {}, "sweep", file)
     name = head.get("name", (str,), path.stem, "a string")
@@ -168,9 +167,12 @@ def load_sweep(source: str | Path) -> Sweep:
                                  "or inline as a [base] table, exactly one of them")
     method = head.get("method", (str,), "grid", "a string")
     if method not in METHODS:
-        raise head.error("method", f"unknown value {method!r}; allowed: {', '.join(METHODS)}")
+        raise head.error("method", f"unknown value {show_value(method)}; allowed: "
+                                   f"{', '.join(METHODS)}")
     samples = head.get("samples", (int,), None, "a whole number ≥ 1")
     seed = head.get("seed", (int,), None, "a whole number")
+    if samples is not None and samples > MAX_RUNS:
+        raise head.error("samples", f"must be ≤ {MAX_RUNS} (runs of one sweep), got {samples}")
     if method == "random" and (samples is None or samples < 1 or seed is None):
         raise head.error("samples" if samples is None or samples < 1 else "seed",
                          "method = \"random\" needs samples (≥ 1) and seed (a whole number)")
@@ -181,7 +183,7 @@ def load_sweep(source: str | Path) -> Sweep:
                                       "a list of quantity names"))
     columns = head.get("columns", (list,), None, "a list of trajectory column names")
     if columns is not None and not all(isinstance(c, str) for c in columns):
-        raise head.error("columns", f"must be a list of strings, got {columns!r}")
+        raise head.error("columns", f"must be a list of strings, got {show_value(columns)}")
     head.finish()
     changes = _flatten(root.get("set", (dict,), {}, "a table of dotted scene keys and values"))
     for key in changes:
@@ -194,7 +196,7 @@ def load_sweep(source: str | Path) -> Sweep:
         base, base_file, base_dir = inline, f"{file}:[base]", path.parent
     else:
         base_file = path.parent / base_path
-        base, base_dir = _read_base(base_file, file), base_file.parent
+        base, base_dir = _read_base(base_file, base_path, file), base_file.parent
     sweep = Sweep(name, path, text, method, axes, collect,
                   None if columns is None else tuple(columns), ())
     runs = tuple(_resolve(sweep, base, changes, params, i, str(base_file), base_dir)
@@ -218,8 +220,9 @@ def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
 def _collect(head: _Table, names: list) -> tuple[str, ...]:
     for n in names:
         if not isinstance(n, str) or not _NAME.match(n):
-            raise head.error("collect", f"{n!r} is not a quantity name; give names such as "
-                                        f"{', '.join(QUANTITIES)}, or any /analysis entry")
+            raise head.error("collect", f"{show_value(n)} is not a quantity name; give names "
+                                        f"such as {', '.join(QUANTITIES)}, or any /analysis "
+                                        f"entry")
     if len(set(names)) != len(names):
         raise head.error("collect", "names must not repeat")
     return tuple(names)
@@ -237,7 +240,7 @@ def _check_key(key: str, err: SceneError) -> list[tuple[str, int | None]]:
     """The parts of a dotted scene key, name and optional [index] each; err if malformed."""
     parts = [_KEY_PART.match(p) for p in key.split(".")]
     if not key or not all(parts):
-        err.message = (f"{key!r} is not a scene key; give dotted TOML keys such as "
+        err.message = (f"{show_value(key)} is not a scene key; give dotted TOML keys such as "
                        f"'load.torque' or 'friction.pairs[0].eta_forward'")
         err.args = (err.line(),)
         raise err
@@ -256,9 +259,9 @@ def _check_distinct(axes: tuple[Axis, ...], file: str) -> None:
     for i, a in enumerate(axes):
         j = seen.setdefault(_quantity_key(a.key), i)
         if j != i:
-            raise SceneError(f"axis[{i}].key", f"{a.key!r} sets the quantity of axis[{j}] "
-                                               f"({axes[j].key!r}) again; give each quantity one "
-                                               f"axis", file=file)
+            raise SceneError(f"axis[{i}].key", f"{show_value(a.key)} sets the quantity of "
+                                               f"axis[{j}] ({show_value(axes[j].key)}) again; "
+                                               f"give each quantity one axis", file=file)
 
 
 def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int) -> Axis:
@@ -274,8 +277,12 @@ def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int)
     num = t.get("num", (int,), None, "a whole number ≥ 2") if method != "random" else None
     spacing = t.get("spacing", (str,), "linear", "a string")
     t.finish()
+    for k, v in lo_hi.items():
+        if v is not None and not finite_number(v):
+            raise t.error(k, f"must be finite, got {show_value(v)}")
     if spacing not in SPACINGS:
-        raise t.error("spacing", f"unknown value {spacing!r}; allowed: {', '.join(SPACINGS)}")
+        raise t.error("spacing", f"unknown value {show_value(spacing)}; allowed: "
+                                 f"{', '.join(SPACINGS)}")
     given = [k for k, v in lo_hi.items() if v is not None] + (["num"] if num is not None else [])
     if values is not None and given:
         raise t.error(given[0], "given together with 'values'; give a list of values or a range, "
@@ -283,7 +290,7 @@ def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int)
     if values is not None:
         if not values or not all(isinstance(v, (int, float, str, bool)) for v in values):
             raise t.error("values", f"must be a non-empty list of numbers, strings or booleans, "
-                                    f"got {values!r}")
+                                    f"got {show_value(values)}")
         if method == "random":  # draw from the list
             picks = np.random.default_rng([seed, i]).integers(0, len(values), samples)
             values = [values[k] for k in picks]
@@ -299,8 +306,8 @@ def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int)
         if not a < b:
             raise t.error("high", f"must be > low ({a:g}), got {b:g}")
         return Axis(key, _draw(a, b, spacing, samples, seed, i), group)
-    if num < 2:
-        raise t.error("num", f"must be ≥ 2, got {num}")
+    if not 2 <= num <= MAX_RUNS:
+        raise t.error("num", f"must be 2 … {MAX_RUNS} (runs of one sweep), got {num}")
     grid = np.geomspace(a, b, num) if spacing == "log" else np.linspace(a, b, num)
     return Axis(key, tuple(float(v) for v in grid), group)
 
@@ -326,7 +333,7 @@ def _points(sweep: Sweep) -> Iterator[dict[str, Any]]:
     for g in (groups if moving is None else [moving]):
         lengths = {len(a.values) for a in g}
         if len(lengths) > 1:
-            what = "method = \"list\"" if moving else f"group {g[0].group!r}"
+            what = "method = \"list\"" if moving else f"group {show_value(g[0].group)}"
             raise SceneError(f"axis ({g[0].key})",
                              f"the axes of {what} move together and need equally many values; "
                              f"got {', '.join(f'{a.key}: {len(a.values)}' for a in g)}",
@@ -335,18 +342,22 @@ def _points(sweep: Sweep) -> Iterator[dict[str, Any]]:
         yield from (dict(zip((a.key for a in moving), row))
                     for row in zip(*(a.values for a in moving)))
         return
+    runs = math.prod(len(g[0].values) for g in groups)
+    if runs > MAX_RUNS:
+        raise SceneError("axis", f"the grid has {runs} points, more than the {MAX_RUNS} runs of "
+                                 f"one sweep; split it into sweeps or give fewer values",
+                         file=str(sweep.path))
     for combo in itertools.product(*(range(len(g[0].values)) for g in groups)):
         yield {a.key: a.values[k] for g, k in zip(groups, combo) for a in g}
 
 
-def _read_base(path: Path, sweep_file: str) -> dict:
+def _read_base(path: Path, written: str, sweep_file: str) -> dict:
+    """The base scene at ``path`` parsed (as ``written`` in the sweep file, which its errors
+    quote)."""
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise SceneError("sweep.base", f"cannot read the base scene {str(path)!r}: "
-                                       f"{exc.strerror}", file=sweep_file) from None
-    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise SceneError("sweep.base", f"the base scene {str(path)!r} is not valid TOML: {exc}",
+        return parse_toml(read_text(path, "scene"), str(path))
+    except SceneError as exc:  # (the sweep file's key names which file could not be read)
+        raise SceneError("sweep.base", f"the base scene {show_value(written)}: {exc.message}",
                          file=sweep_file) from None
 
 
@@ -364,7 +375,7 @@ def set_key(data: dict, key: str, value: Any) -> None:
                                       f"(an array of tables, indexed from 0)")
             node = node[index]
         if not isinstance(node, dict):
-            raise SceneError(key, f"{name!r} is a value in the base scene, not a table")
+            raise SceneError(key, f"{show_value(name)} is a value in the base scene, not a table")
     leaf, index = parts[-1]
     if index is not None:
         raise SceneError(key, "the last part must name a value, not an array entry")
@@ -380,13 +391,14 @@ def _resolve(sweep: Sweep, base: dict, changes: dict, params: dict, i: int, base
     from ..scene import scene_from_dict, to_toml
 
     data = copy.deepcopy(base)
-    shown = ", ".join(f"{k} = {v!r}" for k, v in params.items())
+    shown = ", ".join(f"{clip(k)} = {show_value(v)}" for k, v in params.items())
     try:
         for key, value in itertools.chain(changes.items(), params.items()):
             set_key(data, key, value)
         scene = scene_from_dict(data, file=base_file, base_dir=base_dir)
     except SceneError as exc:
-        raise SceneError(f"run {i} ({shown})", f"scene {exc.key}: {exc.message}",
+        raise SceneError(f"run {i} ({shown})", f"scene {clip(exc.key, 4 * QUOTE_LIMIT)}: "
+                                               f"{exc.message}",
                          file=str(sweep.path)) from None
     return RunSpec(i, params, scene, to_toml(scene))
 
@@ -400,12 +412,13 @@ def _check_columns(sweep: Sweep, runs: tuple[RunSpec, ...]) -> None:
             check = QUANTITIES.get(q, (None,) * 5)[4]
             if check is not None and not check(spec.scene):
                 what = "gas forces" if q == "eta_mech" else "load step"
-                raise SceneError("sweep.collect", f"{q!r} ({QUANTITIES[q][3]}) cannot be measured "
-                                                  f"in run {spec.index}: its scene has no {what}",
+                raise SceneError("sweep.collect", f"{show_value(q)} ({QUANTITIES[q][3]}) cannot "
+                                                  f"be measured in run {spec.index}: its scene "
+                                                  f"has no {what}",
                                  file=str(sweep.path))
         have = output_columns(spec.scene)
         for c in sweep.columns or ():
             if c not in have:
-                raise SceneError("sweep.columns", f"unknown column {c!r} in run {spec.index}; "
-                                                  f"allowed: {', '.join(have)}",
+                raise SceneError("sweep.columns", f"unknown column {show_value(c)} in run "
+                                                  f"{spec.index}; allowed: {', '.join(have)}",
                                  file=str(sweep.path))

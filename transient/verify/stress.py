@@ -359,8 +359,8 @@ def long_rod_ratio(lam: float, domain: str = "auto"):
 
 
 def offset_near_limit(fraction: float, domain: str = "auto"):
-    """The offset changes the stroke, so the mixed cycle (whose compression ratio must match the
-    geometry) gives way to a tabulated indicator diagram (:func:`firing_table`)."""
+    """The offset changes the stroke and moves the dead centres; a tabulated indicator diagram
+    (:func:`firing_table`) keeps the gas force the same at every offset."""
     def build(quick: bool) -> dict:
         d = gas_table_scene(quick, *firing_table(), domain=domain)
         return put(d, "mechanism", offset_mm=fraction * (148.0 - 47.0))
