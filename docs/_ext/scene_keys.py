@@ -72,14 +72,14 @@ class Recorder:
         table = _table(section.path)
         entry = self.keys[table].setdefault(name, {
             "type": method, "kind": kind, "defaults": set(), "required": set(),
-            "bounds": set(), "choices": choices, "when": set()})
+            "bounds": defaultdict(set), "choices": choices, "when": set()})
         variant = getattr(section, "_variant", None)
         if required:
             entry["required"].add(variant)
         elif method not in ("sub", "other"):
             entry["defaults"].add(_show_default(default))
-        if bounds:
-            entry["bounds"].add(bounds)
+        if method in ("number", "numbers", "integer"):
+            entry["bounds"][variant].add(bounds)
         entry["when"].add(variant)
         if method == "string" and name in SELECTORS and choices:
             self.selectors[table][name] = choices
@@ -260,18 +260,30 @@ def _when(entry: dict, all_variants: set) -> str:
     return _variants(variants)
 
 
+def _bounds(seen: set, unit: str) -> str:
+    """The bounds one variant of a table reads a key with; a bound whose value differs between
+    scenes is another key's value (``cutout_speed`` ≤ ``noload_speed``)."""
+    sets = [set(b) for b in seen]
+    common = set.intersection(*sets)
+    order = {w: i for i, w in enumerate((">", "≥", "<", "≤"))}
+    text = [f"{w} {b:g}" + (f" {unit}" if unit else "")
+            for w, b in sorted(common, key=lambda wb: order[wb[0]])]
+    text += [f"{w} another key" for w in sorted({w for s in sets for w, _ in s - common},
+                                                 key=order.get)]
+    return ", ".join(text)
+
+
 def _allowed(entry: dict) -> str:
     if entry["choices"]:
         return ", ".join(f"``{c!r}``".replace("'", '"') for c in entry["choices"])
     unit = SI_UNIT.get(entry["kind"], "")
-    if not entry["bounds"]:
-        return ""
-    seen = [set(bounds) for bounds in entry["bounds"]]
-    common = set.intersection(*seen)
-    text = [f"{w} {b:g}" + (f" {unit}" if unit else "") for w, b in sorted(common)]
-    # A bound that differs between scenes is another key's value (cutout ≤ noload speed).
-    text += [f"{w} another key" for w in sorted({w for s in seen for w, _ in s - common})]
-    return ", ".join(text)
+    by_text = defaultdict(set)
+    for variant, seen in entry["bounds"].items():
+        by_text[_bounds(seen, unit)].add(variant)
+    if len(by_text) == 1:
+        return next(iter(by_text))
+    return "; ".join(f"{text} ({_variants(v) if None not in v else 'otherwise'})"
+                     for text, v in by_text.items() if text)
 
 
 def _default(entry: dict) -> str:
@@ -341,7 +353,8 @@ def render(rec: Recorder) -> list[str]:
             lines += [f"     - {c}" for c in cells[1:]]
         lines.append("")
         for cls in classes.get(table, []):
-            lines += [f".. autoclass:: {cls.__module__}.{cls.__qualname__}", "   :no-index:", ""]
+            lines += [f".. autoclass:: {cls.__module__}.{cls.__qualname__}", "   :no-index:",
+                      "   :no-members:", ""]
         _check_fields(table, keys, classes.get(table, []))
     return lines
 
