@@ -39,8 +39,10 @@ bench: $(STAMP)
 	$(BYTECODE)
 	$(VENV)/bin/transient bench -o results/benchmarks --force
 
-# The documentation site into docs/_build/html; warnings are errors. The gallery's examples run
-# during the build (docs/examples), so a cold numba cache makes the first build take minutes.
+# The documentation site into docs/_build/html; warnings are errors. Every page is read afresh
+# (-E): the scene keys, the CLI and the API pages are generated from the code, which Sphinx does
+# not track. The gallery's examples run during the build (docs/examples; an unchanged example
+# is not run again), so a cold numba cache makes the first build take minutes.
 DOCS_STAMP := $(VENV)/.installed-docs
 
 $(DOCS_STAMP): $(STAMP) pyproject.toml
@@ -49,7 +51,7 @@ $(DOCS_STAMP): $(STAMP) pyproject.toml
 	touch $(DOCS_STAMP)
 
 docs: $(DOCS_STAMP)
-	$(VENV)/bin/sphinx-build -W --keep-going -b html docs docs/_build/html
+	$(VENV)/bin/sphinx-build -E -W --keep-going -b html docs docs/_build/html
 
 clean:
 	rm -rf $(VENV) results/*.h5 results/*.png docs/_build docs/generated docs/auto_examples \

@@ -12,7 +12,6 @@ import tomllib
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 import transient
 from transient.analysis.irregularity import fluctuation
@@ -40,12 +39,12 @@ scene = transient.load_scene(CASES / "gots_diesel_spinup.toml")
 sized = flywheel_for_delta(scene, 0.02)
 print(f"flywheel for δ = 0.02: {sized.flywheel:.4f} kg m²")
 
-fig, ax = plt.subplots(figsize=(6, 4))
-ax.loglog(flywheels, deltas, "o-", label="runs in memory")
+fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
+ax.plot(flywheels, deltas, "o-", label="runs in memory")
 ax.axhline(0.02, color="0.5", lw=0.8, ls=":")
 ax.plot([sized.flywheel], [0.02], "s", color="C3", label="flywheel_for_delta")
 ax.set_xlabel("flywheel [kg m²]")
 ax.set_ylabel("δ [1]")
-ax.grid(True, which="both", alpha=0.3)
+ax.grid(True, alpha=0.3)
 ax.legend()
 plt.show()

@@ -26,15 +26,15 @@ for h in articulated.harmonics(mech):
 
 phi = np.linspace(0.0, 2 * np.pi, 721)
 table = mech.kinematics_table(phi)
-fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True, layout="constrained")
 for k in range(1, mech.n_cylinders + 1):
     a1.plot(np.degrees(phi), 1e3 * table[f"u_{k}"], label=f"cylinder {k}")
 a1.set_ylabel("u_k = dx/dφ [mm/rad]")
-a1.legend(fontsize=8, ncol=3)
+fig.legend(loc="outside lower center", ncol=mech.n_cylinders, fontsize=8)
 a2.plot(np.degrees(phi), table["J"])
 a2.set_ylabel("J(φ) [kg m²]")
 a2.set_xlabel("φ [deg]")
 for ax in (a1, a2):
     ax.grid(True, alpha=0.3)
-a1.set_title("Transfer functions and reduced inertia over one turn")
+fig.suptitle("Transfer functions and reduced inertia over one turn")
 plt.show()
