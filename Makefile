@@ -5,7 +5,7 @@ STAMP := $(VENV)/.installed
 DEFAULT_SCENE := cases/swash_plate_4cyl.toml
 DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
-.PHONY: run test bench install clean
+.PHONY: run test bench docs install clean
 
 # Bytecode is written at install: where PYTHONDONTWRITEBYTECODE is set, each run would otherwise
 # compile transient's sources again, a noticeable part of a warm start.
@@ -39,5 +39,20 @@ bench: $(STAMP)
 	$(BYTECODE)
 	$(VENV)/bin/transient bench -o results/benchmarks --force
 
+# The documentation site into docs/_build/html; warnings are errors. Every page is read afresh
+# (-E): the scene keys, the CLI and the API pages are generated from the code, which Sphinx does
+# not track. The gallery's examples run during the build (docs/examples; an unchanged example
+# is not run again), so a cold numba cache makes the first build take minutes.
+DOCS_STAMP := $(VENV)/.installed-docs
+
+$(DOCS_STAMP): $(STAMP) pyproject.toml
+	$(PY) -m pip install -q -e '.[test,docs]'
+	$(BYTECODE)
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	$(VENV)/bin/sphinx-build -E -W --keep-going -b html docs docs/_build/html
+
 clean:
-	rm -rf $(VENV) results/*.h5 results/*.png
+	rm -rf $(VENV) results/*.h5 results/*.png docs/_build docs/generated docs/auto_examples \
+		docs/guide/_generated
