@@ -644,18 +644,19 @@ def _publish(tmp: Path, path: Path, force: bool) -> None:
 
 class _Columns(Mapping):
     """A result file's trajectory columns (its first ``rows`` samples), each read from the file
-    when first used: a long run's result opens without reading gigabytes."""
+    when first used: a long run's result opens without reading gigabytes. The file stays open
+    (read-only) while the columns are in use, so that they can be read after it was replaced or
+    deleted (a temporary folder gone)."""
 
     def __init__(self, path: Path, node: str, names: list[str], rows: slice) -> None:
-        self._path, self._node, self._names, self._rows = path, node, names, rows
+        self._file, self._node, self._names, self._rows = open_file(path), node, names, rows
         self._read: dict[str, np.ndarray] = {}
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self._read:
             if name not in self._names:
                 raise KeyError(name)
-            with open_file(self._path) as f:
-                self._read[name] = f[self._node]["trajectory"][name][self._rows]
+            self._read[name] = self._file[self._node]["trajectory"][name][self._rows]
         return self._read[name]
 
     def __iter__(self):

@@ -147,3 +147,11 @@ def test_plot_helpers_take_a_result(small):
     assert np.array_equal(line.get_ydata(), same.get_ydata())
     assert np.array_equal(line.get_ydata(), res.trajectory["omega"] * 30.0 / np.pi)
     plt.close(fig)
+
+
+def test_a_result_reads_its_columns_after_its_file_is_gone(small, tmp_path):
+    """Columns are read when used, from the file opened when the result was: a temporary folder
+    removed in between takes nothing away."""
+    res = simulate(small, tmp_path / "gone.h5")
+    (tmp_path / "gone.h5").unlink()
+    assert res.trajectory["omega"].size > 0 and res.trajectory["t"][0] == 0.0
