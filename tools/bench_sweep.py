@@ -26,7 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from transient.sweep import load_sweep, run_one, run_sweep, worker_info
+from transient.sweeps import load_sweep, run_one, run_sweep, worker_info
 
 SWEEP = Path(__file__).resolve().parents[1] / "cases" / "sweeps" / "gots_eta_speed_load.toml"
 

@@ -22,14 +22,15 @@ result → analysis, and each layer imports only those below it (the contracts i
 - ``run``            drives the compiled stepper in chunks (or the reference path), prescribed
                      speed, and :func:`simulate`
 - ``plots``          ax-first plotting helpers
-- ``study``, ``sweep``
+- ``study``, ``sweeps``
                      many runs: efficiency and flywheel studies; parameter sweeps on Dask
 - ``verify``         the work–precision benchmark, its targets, the stress catalogue
 - ``cli``            the ``transient`` command
 
 Public API: :func:`load_scene` and :class:`Scene` (``Scene.from_dict``, ``scene.replace``,
-``scene.to_toml``), :func:`simulate` → :class:`Result`, :func:`open_result`, and the errors
-:class:`SceneError` (invalid input) and :class:`SimulationError` (a run that failed).
+``scene.to_toml``), :func:`simulate` → :class:`Result`, :func:`open_result`, :func:`sweep`, and
+the errors :class:`SceneError` (invalid input) and :class:`SimulationError` (a run that
+failed).
 """
 from . import errors  # noqa: E402
 from .errors import SceneError, SimulationError  # noqa: E402
@@ -38,5 +39,15 @@ from .run import simulate  # noqa: E402
 from .scene import Scene, load_scene  # noqa: E402
 from .version import __version__
 
-__all__ = ["load_scene", "Scene", "simulate", "Result", "open_result", "SceneError",
+__all__ = ["load_scene", "Scene", "simulate", "Result", "open_result", "sweep", "SceneError",
            "SimulationError", "errors", "__version__"]
+
+
+def __getattr__(name: str):
+    """``transient.sweep``, imported when first used: the sweep machinery is not part of a
+    single run's start."""
+    if name == "sweep":
+        from .sweeps.api import sweep
+
+        return sweep
+    raise AttributeError(f"module 'transient' has no attribute {name!r}")

@@ -3,7 +3,7 @@
 The layout of a run — header attributes, ``scene/toml``, ``trajectory/<column>``,
 ``events/<name>/{t,phi}``, ``solver`` attributes, ``analysis/<name>`` — is written by the
 functions below and nowhere else, so that a result file and each run of a sweep file
-(:mod:`transient.sweep.store`) hold the same thing in the same form and read back alike.
+(:mod:`transient.sweeps.store`) hold the same thing in the same form and read back alike.
 
 The writer works on a temporary name beside the final one and renames it when the run ends —
 ``complete = True`` after a finished run, ``False`` after a failure or an interrupt. While the run

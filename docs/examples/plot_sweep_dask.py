@@ -2,7 +2,7 @@
 A sweep on Dask: η_mech against the load
 ========================================
 
-:func:`transient.sweep.api.sweep` runs a scene over parameter axes with the engine of
+:func:`transient.sweep` runs a scene over parameter axes with the engine of
 ``transient sweep``: here the governed Gots diesel with its main bearings and crankpins as
 non-ideal pairs (``cases/gots_diesel_governed.toml``, its fan load taken off) at four load
 torques, 300 revolutions each (steady after a few dozen), on the Dask client it is
@@ -17,7 +17,6 @@ import matplotlib.pyplot as plt
 from dask.distributed import Client, LocalCluster
 
 import transient
-from transient.sweep.api import sweep
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"
 base = transient.load_scene(CASES / "gots_diesel_governed.toml")
@@ -25,8 +24,8 @@ base = base.replace(load={"fan": 0.0}, run={"revolutions": 300})
 
 with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                   dashboard_address=None) as cluster, Client(cluster) as client:
-    done = sweep(base, {"load.torque": [40.0, 80.0, 120.0, 160.0]},
-                 collect=["mean_speed_rpm", "eta_mech"], client=client)
+    done = transient.sweep(base, {"load.torque": [40.0, 80.0, 120.0, 160.0]},
+                           collect=["mean_speed_rpm", "eta_mech"], client=client)
 df = done.to_dataframe()
 print(df[["load.torque", "mean_speed_rpm", "eta_mech", "status"]])
 

@@ -21,7 +21,7 @@ from transient.analysis.summary import summarize
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import load_scene
 from transient.run import integrate
-from transient.sweep import kernel_loads, load_sweep, open_run, run_sweep
+from transient.sweeps import kernel_loads, load_sweep, open_run, run_sweep
 
 from terminal import terminal_run
 

@@ -1,4 +1,4 @@
-"""Sweeps from code (``transient.sweep.api.sweep``): the engine of ``transient sweep`` on a scene
+"""Sweeps from code (``transient.sweep``): the engine of ``transient sweep`` on a scene
 held in memory; its runs are the runs ``simulate`` gives."""
 from __future__ import annotations
 
@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 from scene_texts import SMALL
 
-from transient import SceneError, load_scene, simulate
-from transient.sweep.api import sweep
+from transient import SceneError, load_scene, simulate, sweep
 
 
 @pytest.fixture

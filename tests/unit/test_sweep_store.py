@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from transient import results
-from transient.sweep import SweepStore, load_sweep, open_run, read_summary
-from transient.sweep.store import Stored, match_runs
+from transient.sweeps import SweepStore, load_sweep, open_run, read_summary
+from transient.sweeps.store import Stored, match_runs
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

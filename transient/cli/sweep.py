@@ -1,5 +1,5 @@
 """``transient sweep`` and ``transient sweep-plot``: parameter sweeps on Dask and figures of their
-summaries (:mod:`transient.sweep`)."""
+summaries (:mod:`transient.sweeps`)."""
 from __future__ import annotations
 
 import sys
@@ -13,7 +13,7 @@ from .common import (EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, MAX_WORKERS, add_forc
 def register(sub) -> None:
     sw = sub.add_parser(
         "sweep", help="run a parameter sweep on Dask → DIR/<stem>.h5 and <stem>_summary.csv",
-        description="A base scene, parameter axes and quantities to collect (transient.sweep). "
+        description="A base scene, parameter axes and quantities to collect (transient.sweeps). "
                     "Every scene is validated before any work. Run again, the command mends "
                     "its file: a stored run whose resolved scene is unchanged is reused, "
                     "changed and new points are computed (an interrupted sweep resumes).")
@@ -44,7 +44,7 @@ def register(sub) -> None:
 
 def cmd_sweep(args) -> int:
     from ..scene import runs_compiled
-    from ..sweep import load_sweep, run_sweep
+    from ..sweeps import load_sweep, run_sweep
 
     sweep = load_sweep(args.sweep)  # every scene validated here, before any work (exit 2)
     s = args.scheduler
@@ -103,7 +103,7 @@ def _counts(out) -> str:
 
 def cmd_sweep_plot(args) -> int:
     from .. import plots
-    from ..sweep import read_summary
+    from ..sweeps import read_summary
 
     check_result_path(args.result, "sweep file")
     try:
