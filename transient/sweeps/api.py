@@ -67,7 +67,7 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
         Dotted scene key → values, e.g. ``{"load.torque": [50, 100], "inertia.flywheel":
         [0.1, 0.2]}``; unit suffixes allowed (``"initial.omega_rpm"``).
     collect
-        Quantities of each run for the table (:data:`transient.sweep.QUANTITIES` or any
+        Quantities of each run for the table (:data:`transient.sweeps.QUANTITIES` or any
         ``/analysis`` entry).
     method
         ``"grid"``: every combination of the axes; ``"list"``: their i-th values together.

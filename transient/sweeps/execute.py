@@ -1,7 +1,7 @@
 """Running a sweep: the runs on Dask workers (or in this process), their results to the store.
 
 Workers (Dask processes, one thread each) run :func:`run_one` and return arrays; only the client
-writes, into one HDF5 file ``DIR/<stem>.h5`` (:class:`~transient.sweep.store.SweepStore`), run by
+writes, into one HDF5 file ``DIR/<stem>.h5`` (:class:`~transient.sweeps.store.SweepStore`), run by
 run as results arrive, so that an interrupted sweep resumes from what is there. The summary
 table goes to ``/analysis/summary`` and ``DIR/<stem>_summary.csv``.
 """
@@ -117,7 +117,7 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
     """Run the runs of the sweep the file does not hold and write the file and the summary
     (module docstring).
 
-    An existing file of the sweep is mended (:class:`~transient.sweep.store.SweepStore`): a
+    An existing file of the sweep is mended (:class:`~transient.sweeps.store.SweepStore`): a
     stored run whose resolved scene is unchanged is reused, failed ones too unless
     ``retry_failed``; stored runs the sweep no longer holds are kept apart, or deleted at the end
     with ``prune``. ``scheduler``: None for a LocalCluster of ``workers`` processes (default one

@@ -210,7 +210,7 @@ class SweepStore:
         return group_name(index, len(self.sweep.runs))
 
     def write_run(self, spec: RunSpec, res: dict[str, Any]) -> None:
-        """One run's group (``res`` from :func:`~transient.sweep.execute.run_one`); ``status``
+        """One run's group (``res`` from :func:`~transient.sweeps.execute.run_one`); ``status``
         is written last and flushed, marking it finished."""
         runs = self.f["runs"]
         name = self.group_name(spec.index)
