@@ -1,13 +1,16 @@
 """Energy gained per cycle by one cylinder with a pressure table, against ∮p dV, over rtol:
 tables from points (linear, pchip, spline; 21 angles, no corners declared) with every knot a
-breakpoint, and the Gots mixed cycle, whose 0.125° spline knots stay inside steps. With
+breakpoint; ``pulse``: the smooth pulse of ``tests/validation/test_energy.py`` on a 1° spline
+(every knot a breakpoint too); and the Gots mixed cycle, whose 0.125° spline knots stay inside
+steps. With
 ``--other`` each gets the other treatment of its knots, for comparison: the tables from points
 stepped across (as before every knot was a breakpoint), the mixed cycle stopped on every knot.
 
 The scene and the reference are those of ``tests/validation/test_table_knots.py``; ∮p dV here is
 Gauss–Legendre (20 points) of (p − p0)·dV/dx on every knot interval of the table the run uses
 (its numpy twin), dV/dx differentiated by hand from the crank slider's volume.
-Rerun: ``.venv/bin/python tools/table_knots_energy.py linear pchip spline mixed [--other]``.
+Rerun: ``.venv/bin/python tools/table_knots_energy.py linear pchip spline pulse mixed
+[--other]``.
 """
 import sys
 from dataclasses import replace
@@ -23,6 +26,7 @@ from transient.scene import load_scene
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "validation"))
 import test_table_knots as case  # noqa: E402
+from test_energy import smooth_gas  # noqa: E402
 
 RTOLS = (1e-6, 1e-8, 1e-10, 1e-12)
 
@@ -30,6 +34,8 @@ RTOLS = (1e-6, 1e-8, 1e-10, 1e-12)
 def scene_of(kind: str, rtol: float):
     if kind in ("linear", "pchip", "spline"):
         return case.scene_with_table(kind, rtol)
+    if kind == "pulse":
+        return replace(case.scene_with_table("spline", rtol), gas=smooth_gas())
     mixed = load_scene(ROOT / "cases" / "gots_diesel_governed.toml").gas
     return replace(case.scene_with_table("linear", rtol), gas=mixed)
 
