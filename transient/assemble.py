@@ -134,25 +134,31 @@ def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64
     ``tables``) jumps while its piston moves (u_k ≠ 0; a jump at a dead centre, as all of the
     crank-slider cycles' are, leaves the torque continuous). The stepper's first stage beyond such
     a breakpoint must be evaluated afresh, not carried over from the step that ended on it (which
-    used the table piece before the corner)."""
+    used the table piece before the corner). Vectorised over the corners, which a table from
+    points has at every knot."""
     out = np.zeros(bp.size, dtype=np.bool_)
     tol = 1e-12 * period
-    u, du = np.empty(mech.n_cylinders), np.empty(mech.n_cylinders)
-    packed, no_table = mech.pack(), np.zeros((1, 1, 6))
-    for j, angle in enumerate(bp):
-        mechanism_terms(int(mech.kind), packed, no_table, angle, u, du, False)
-        reach = 1e-9 * np.abs(u).max()  # u_k below it: a dead centre, to rounding
-        for table in (t for t in tables if t is not None):
-            corners = table.corners[:-1]
-            step = 1e-9 * np.abs(table.coef[:, 0]).max()  # a jump, not the rounding at a kink
-            for k, c in enumerate(np.mod(angle - phases, period)):
-                gap = np.abs(corners - c)
-                for i in np.flatnonzero(np.minimum(gap, period - gap) <= tol):
-                    right = table.evaluate(corners[i], i)[0]
-                    left = table.evaluate(corners[i] if i > 0 else period,
-                                          (i - 1) % table.n_pieces)[0]
-                    out[j] |= bool(abs(right - left) > step and abs(u[k]) > reach)
+    for table in (t for t in tables if t is not None):
+        corners = table.corners[:-1]
+        i = np.arange(corners.size)
+        right = table.evaluate(corners, i)[0]
+        left = table.evaluate(np.where(i > 0, corners, period), (i - 1) % table.n_pieces)[0]
+        step = 1e-9 * np.abs(table.coef[:, 0]).max()  # a jump, not the rounding at a kink
+        jumps = corners[np.abs(right - left) > step]
+        for k, phase in enumerate(phases):
+            for angle in np.mod(phase + jumps, period):
+                gap = np.abs(bp - angle)
+                j = np.flatnonzero(np.minimum(gap, period - gap) <= tol)
+                out[j] |= _piston_moves(mech, k, angle)
     return out
+
+
+def _piston_moves(mech, k: int, angle: float) -> bool:
+    """Whether piston k moves at the shaft angle (u_k above 1e-9 of the largest |u|, not a dead
+    centre to rounding)."""
+    u, du = np.empty(mech.n_cylinders), np.empty(mech.n_cylinders)
+    mechanism_terms(int(mech.kind), mech.pack(), np.zeros((1, 1, 6)), angle, u, du, False)
+    return bool(abs(u[k]) > 1e-9 * np.abs(u).max())
 
 
 def paired_table(full: PressureTable, motored: PressureTable

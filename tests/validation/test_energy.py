@@ -182,17 +182,18 @@ def driven_scene(domain, revs=20, samples_per_rev=720, rtol=1e-10):
                    output=output)
 
 
-def work_balance(data, sample_integral, domain):
+def work_balance(data, scene, sample_integral, table_end_events, domain):
     """(ΔK, {W_gas, W_load, W_starter}) of a run; the works by quadrature of the output samples.
 
     Why quadrature of the samples: the output M columns are the moments the stepper used, at the
     dense-output state, so ∫M dφ is the work done *in the run*, including any ω-dependence of the
-    load. Every M here is smooth between breakpoints (the gas table's ends), so a degree-6
+    load. Every M here is smooth between the gas table's ends (its other knots, breakpoints too,
+    are C²), so a degree-6
     local-polynomial rule on 0.25–0.5° samples between the breakpoint events (and the run's ends)
     is accurate to ~1e-11 of the work (see :func:`test_work_quadrature_is_converged`). In crank angle the integral is ∫M dφ over φ-samples; in time ∫M ω dt over t-samples.
     """
     tr = data.trajectory
-    bp = data.events.get("breakpoint", np.zeros((0, 2)))
+    bp = table_end_events(data, scene)
     if domain == "angle":
         x, w, cuts = tr["phi"], np.ones_like(tr["phi"]), bp[:, 1]
     else:
@@ -204,7 +205,7 @@ def work_balance(data, sample_integral, domain):
 
 
 @pytest.mark.parametrize("domain,revs", [("angle", 20), ("time", 20), ("time", 2)])
-def test_work_energy_balance_of_a_driven_run(domain, revs, sample_integral):
+def test_work_energy_balance_of_a_driven_run(domain, revs, sample_integral, table_end_events):
     """K(end) − K(0) = W_gas + W_load + W_starter to 1e-8 of |W_gas| + |W_load| + |W_starter| at
     rtol 1e-10. In crank angle K is the state, so this checks the moments written out against the
     state; in time it checks the integration of (18) with its ½J′ω² term.
@@ -227,7 +228,7 @@ def test_work_energy_balance_of_a_driven_run(domain, revs, sample_integral):
         "the final state does not follow from the last sample: Δφ = "
         f"{math.degrees(tr['phi'][-1] - tr['phi'][-2]):.6g}° over Δt = {dt:.6g} s at "
         f"ω = {tr['omega'][-1]:.6g} rad/s")
-    dK, works = work_balance(data, sample_integral, domain)
+    dK, works = work_balance(data, scene, sample_integral, table_end_events, domain)
     total = sum(abs(v) for v in works.values())
     residual = (dK - sum(works.values())) / total
     print(f"{domain} domain, {revs} rev: ΔK = {dK:.6f} J, W = {works}, residual {residual:.2e}")
@@ -235,33 +236,35 @@ def test_work_energy_balance_of_a_driven_run(domain, revs, sample_integral):
     assert abs(residual) <= 1e-8
 
 
-def test_work_quadrature_is_converged(sample_integral):
+def test_work_quadrature_is_converged(sample_integral, table_end_events):
     """The quadrature behind the balance: doubling the output sampling (720 → 1440 per revolution)
     changes the work by < 1e-10 of the total (4th-order convergence, set by the spline table's 1°
     knots), so the 1e-8 balance measures the integration, not the quadrature."""
     works = []
     for spr in (720, 1440):
-        data = integrate(driven_scene("angle", 20, samples_per_rev=spr))
-        works.append(work_balance(data, sample_integral, "angle")[1])
+        scene = driven_scene("angle", 20, samples_per_rev=spr)
+        works.append(work_balance(integrate(scene), scene, sample_integral, table_end_events,
+                                  "angle")[1])
     total = sum(abs(v) for v in works[0].values())
     for c in works[0]:
         assert abs(works[0][c] - works[1][c]) <= 1e-10 * total
 
 
 def test_time_domain_breakpoints_are_reported_once():
-    """In time, a step that would cross a table corner is retaken to end on it, and the corner is
-    reported as a ``breakpoint`` event. Each crossing must be reported once, at the corner: the
-    20-revolution driven run crosses a corner every 240° (3 cylinders, one corner per cycle each)
-    i.e. 30 times (the last one is the run's end)."""
+    """In time, a step that would cross a breakpoint is retaken to end on it, and the breakpoint
+    is reported as a ``breakpoint`` event. Each crossing must be reported once, on it: every knot
+    of the 1° table is a breakpoint, and the cylinders' phases (0°, 240°, 480°) put all of them on
+    the shaft's 1° grid, so the 20-revolution driven run crosses 7200 (the last one is the run's
+    end)."""
     data = integrate(driven_scene("time", 20))
     bp = data.events["breakpoint"]
-    step = math.radians(240.0)
+    step = math.radians(1.0)
     nearest = np.round(bp[:, 1] / step) * step
-    print(f"{len(bp)} breakpoint events; largest distance from a corner "
+    print(f"{len(bp)} breakpoint events; largest distance from a knot "
           f"{np.max(np.abs(bp[:, 1] - nearest)):.2e} rad")
     assert np.max(np.abs(bp[:, 1] - nearest)) <= 1e-12 * 2 * math.pi * 20
     assert np.unique(nearest).size == len(bp)
-    assert 29 <= len(bp) <= 30
+    assert 7199 <= len(bp) <= 7200
 
 
 @pytest.mark.parametrize("rtol", [1e-3, 1e-4, 1e-5])

@@ -130,10 +130,12 @@ REV_SCHEDULE = {"schedule_revolutions": (3.0, 3.0, 6.0, 9.0, 12.0, 12.0),
                 "schedule_scale": (1.0, 2.0, 2.0, 0.5, 0.5, 1.5)}
 
 
-def work_balance(data, sample_integral, domain):
-    """(ΔK, works from the W_* columns, works by quadrature of the M columns between events)."""
+def work_balance(data, scene, sample_integral, table_end_events, domain):
+    """(ΔK, works from the W_* columns, works by quadrature of the M columns between events: the
+    load schedule's and the gas table's ends, its only corners)."""
     tr = data.trajectory
-    cuts_ev = [data.events[k] for k in ("breakpoint", "load_schedule") if k in data.events]
+    cuts_ev = [table_end_events(data, scene)] + [data.events[k] for k in ("load_schedule",)
+                                                 if k in data.events]
     cuts_ev = np.concatenate(cuts_ev) if cuts_ev else np.zeros((0, 2))
     if domain == "angle":
         x, w, cuts = tr["phi"], np.ones_like(tr["phi"]), cuts_ev[:, 1]
@@ -148,14 +150,16 @@ def work_balance(data, sample_integral, domain):
 
 @pytest.mark.parametrize("domain", ["angle", "time"])
 @pytest.mark.parametrize("schedule", ["time", "revolutions"])
-def test_work_energy_balance_across_steps_and_ramps(domain, schedule, sample_integral):
+def test_work_energy_balance_across_steps_and_ramps(domain, schedule, sample_integral,
+                                                    table_end_events):
     """All four load terms scaled by the schedule (two steps and a ramp), 20 revolutions at
     rtol 1e-10: ΔK = ΣW to 1e-8 of Σ|W| from the state integrals and from the quadrature, and
     the two agree on W_load to 1e-8."""
     sched = TIME_SCHEDULE if schedule == "time" else REV_SCHEDULE
     load = Load(torque=10.0, linear=0.05, fan=2e-4, generator_power=5e3,
                 generator_min_speed=50.0, **sched)
-    data = run(engine(load, domain))
+    scene = engine(load, domain)
+    data = run(scene)
     assert data.events["load_schedule"].shape[0] == 4  # 4 corners (each step's two are one)
     if schedule == "time":
         assert np.all(np.abs(data.events["load_schedule"][:, 0] - [0.1, 0.2, 0.3, 0.35])
@@ -166,10 +170,10 @@ def test_work_energy_balance_across_steps_and_ramps(domain, schedule, sample_int
         if domain == "angle":
             # the table corners come every 240° (2/3 rev): the corners at 6 and 12 rev sit on
             # breakpoints, and the step that lands on both reports both
-            bp = data.events["breakpoint"][:, 1]
+            bp = table_end_events(data, scene)[:, 1]
             assert len(bp) == 30
             assert all(np.any(np.abs(bp - 2 * np.pi * r) <= 1e-12 * 80) for r in (6.0, 12.0))
-    dK, state, quad = work_balance(data, sample_integral, domain)
+    dK, state, quad = work_balance(data, scene, sample_integral, table_end_events, domain)
     total = sum(abs(v) for v in quad.values())
     res_state = (dK - sum(state.values())) / total
     res_quad = (dK - sum(quad.values())) / total
@@ -182,13 +186,14 @@ def test_work_energy_balance_across_steps_and_ramps(domain, schedule, sample_int
     assert abs(state["load"] - quad["load"]) <= 1e-8 * total
 
 
-def test_quadrature_sees_a_misplaced_step(sample_integral):
+def test_quadrature_sees_a_misplaced_step(sample_integral, table_end_events):
     """The quadrature check has teeth: without the step's event among the cuts (as if the load
     jumped where no event says), the balance misses by far more than 1e-8."""
     load = Load(generator_power=5e3, generator_min_speed=50.0, **TIME_SCHEDULE)
-    data = run(engine(load, "angle"))
+    scene = engine(load, "angle")
+    data = run(scene)
     tr = data.trajectory
-    bp = data.events["breakpoint"][:, 1]
+    bp = table_end_events(data, scene)[:, 1]
     x = tr["phi"]
     full = sample_integral(x, tr["M_load"], np.concatenate([[x[0], x[-1]], bp,
                                                            data.events["load_schedule"][:, 1]]))

@@ -26,24 +26,41 @@ BP_LANDING = 1e-7
 
 @kernel
 def next_breakpoint(bp, period, phi, upward):
-    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle."""
+    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle; by
+    bisection, as a table from points makes every knot of every cylinder a breakpoint."""
     tol = 1e-13 * max(1.0, abs(phi))
     k = np.floor(phi / period)
+    n = bp.shape[0]
     if upward:
         for c in range(2):
             base = (k + c) * period
-            for j in range(bp.shape[0]):
-                v = base + bp[j]
-                if v > phi + tol:
-                    return v
+            j = _count_below(bp, base, phi + tol, True)
+            if j < n:
+                return base + bp[j]
         return np.inf
     for c in range(2):
         base = (k - c) * period
-        for j in range(bp.shape[0] - 1, -1, -1):
-            v = base + bp[j]
-            if v < phi - tol:
-                return v
+        j = _count_below(bp, base, phi - tol, False) - 1
+        if j >= 0:
+            return base + bp[j]
     return -np.inf
+
+
+@kernel(inline="always")
+def _count_below(bp, base, level, inclusive):
+    """How many of the angles ``base + bp[j]`` lie below ``level`` (or on it, ``inclusive``).
+    They are a leading run of j: bp is sorted and rounded addition is monotone, so bisection
+    finds what a scan from j = 0 would."""
+    lo = 0
+    hi = bp.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        v = base + bp[mid]
+        if v < level or (inclusive and v == level):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
 
 
 @kernel(inline="always")
@@ -117,11 +134,18 @@ def _on_angle(phi, angle, period):
 
 @kernel
 def _jumps_at(m, bp, phi):
-    """Whether a pressure jumps at the breakpoint the shaft is on (``Model.bp_jump``): the
-    derivative carried over from the step that ended there (FSAL) used the piece before it."""
-    for j in range(bp.shape[0]):
-        if _on_angle(phi, bp[j], m.period):
-            return m.bp_jump[j]
+    """Whether a pressure jumps at a breakpoint the shaft is on (``Model.bp_jump``): the
+    derivative carried over from the step that ended there (FSAL) used the piece before it.
+    Only the breakpoints near φ in its cycle (and across the cycle's ends) are looked at."""
+    y = phi % m.period
+    reach = 2.0 * BP_LANDING  # (wider than _on_angle's test, which decides)
+    for shift in (-m.period, 0.0, m.period):
+        c = y + shift
+        j = _count_below(bp, 0.0, c - reach, False)
+        while j < bp.shape[0] and bp[j] <= c + reach:
+            if m.bp_jump[j] and _on_angle(phi, bp[j], m.period):
+                return True
+            j += 1
     return False
 
 

@@ -38,6 +38,7 @@ __all__ = [
     "assemble_table",
     "cycle_period",
     "deg_text",
+    "every_knot_a_corner",
     "gas_exchange_pressures",
     "mixed_cycle",
     "not_a_knot_coef",
@@ -401,6 +402,7 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
     Returns
     -------
     PressureTable
+        With every knot a corner (:func:`every_knot_a_corner`), declared or not.
 
     Raises
     ------
@@ -483,7 +485,24 @@ def table_from_points(phi: ArrayLike, p: ArrayLike, period: float, corners: Arra
                              f"{max(e - s + 1, 0)} point(s); each piece between corners needs "
                              "at least 2")
         pieces.append(_piece_coef(phi[s:e + 1], p[s:e + 1], ends[j], ends[j + 1], interpolation))
-    return assemble_table(pieces, period)
+    return every_knot_a_corner(assemble_table(pieces, period))
+
+
+def every_knot_a_corner(table: PressureTable) -> PressureTable:
+    """The same curve with every knot a corner, hence a breakpoint of the stepper.
+
+    Sparse user points leave a derivative that jumps at each knot, below the order the stepper
+    relies on (DOP853: 8): the slope for ``"linear"`` (C⁰), the second derivative for
+    ``"pchip"`` (C¹) and the third for ``"spline"`` (C², whose jump is of the size of the curve's
+    own third derivative where knots are sparse). A step across a jump in the k-th derivative
+    has a local error ∝ jump·h^(k+1), which an order-8 pair's error control follows poorly: a
+    run's error stayed far above rtol (README, *How it integrates*). Stopping on every knot
+    costs one segment per knot and cylinder. (The dense knots of :func:`table_from_function`
+    approximate a smooth curve, their jumps are O(step) small, and they stay inside steps.)
+    """
+    n = table.knots.size - 1
+    return PressureTable(knots=table.knots, coef=table.coef,
+                         piece_knot=np.arange(n + 1, dtype=np.int64), period=table.period)
 
 
 def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: float,

@@ -80,8 +80,9 @@ class Gas:
 
     ``model``: ``"none"``, ``"table"`` (indicator diagram: absolute pressures ``p`` [Pa] at the
     local angles ``phi`` [rad] over one cycle, local angle 0 = gas-exchange TDC for a 4-stroke,
-    firing TDC for a 2-stroke; ``corners`` [rad] where the curve has a kink, made breakpoints;
-    ``interpolation`` ``"pchip"``, ``"spline"`` or ``"linear"``), ``"mixed-cycle"`` (Gots App. 2,
+    firing TDC for a 2-stroke; ``corners`` [rad] where the curve may jump or kink, also between
+    samples; ``interpolation`` ``"pchip"``, ``"spline"`` or ``"linear"``; every angle of the
+    table and every corner is a breakpoint), ``"mixed-cycle"`` (Gots App. 2,
     Trinkler–Sabathé: ``compression_ratio`` [1], ``p_a`` [Pa] at the start of compression,
     polytropic exponents ``n1`` and ``n2`` [1], peak pressure ``p_z`` [Pa], pre-expansion ratio
     ``rho`` [1], ``p_intake`` and ``p_exhaust`` [Pa]), ``"trapezoid"`` (the swash-plate paper's

@@ -791,7 +791,8 @@ def catalogue() -> list[Case]:
         Case("swash-rod-reach", "swash-plate rods 0.1 % longer than the offset they bridge",
              single(swash_rod_at_reach, name="swash-rod-reach")),
         Case("pressure-rise-1e-6", "1 → 120 bar over 1e-6 rad, declared corners (crank angle, "
-                                   "time) and undeclared (kinks inside steps)",
+                                   "time) and undeclared (every knot a breakpoint all the "
+                                   "same)",
              several({"rise-1e-6": pressure_rise(1e-6, True),
                       "rise-1e-6-time": pressure_rise(1e-6, True, "time"),
                       "rise-1e-6-undeclared": pressure_rise(1e-6, False)})),
