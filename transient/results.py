@@ -31,7 +31,9 @@ FORMAT = 1
 
 @dataclass
 class RunData:
-    """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics."""
+    """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics;
+    ``status`` says what the run did (:data:`transient.outcome.STATUSES`; "" until judged) and
+    ``warnings`` what a finished run must not be read without."""
 
     trajectory: dict[str, np.ndarray]
     events: dict[str, np.ndarray]
@@ -39,6 +41,8 @@ class RunData:
     complete: bool = True
     message: str = ""
     extra: dict = field(default_factory=dict)
+    status: str = ""
+    warnings: list[str] = field(default_factory=list)
 
 
 class ResultExists(FileExistsError):
@@ -215,6 +219,11 @@ def write_run(node: h5py.Group, scene_name: str, scene_toml: str, data: RunData,
         write_analysis(node["analysis"], name, value, unit)
 
 
+def outcome_attrs(status: str, warnings: list[str]) -> dict[str, str]:
+    """The root attributes that say what a run did: ``status``, and ``warnings`` if any."""
+    return {"status": status, **({"warnings": "; ".join(warnings)} if warnings else {})}
+
+
 class ResultWriter:
     """Streams trajectory blocks into ``/trajectory``; see the module docstring."""
 
@@ -304,6 +313,11 @@ class ResultWriter:
     def solver(self, attrs: dict[str, Any]) -> None:
         write_solver(self.f["solver"], attrs)
 
+    def outcome(self, status: str, warnings: list[str]) -> None:
+        """What the run did (:func:`outcome_attrs`), written before :meth:`close`."""
+        if not self.broken:
+            self.f.attrs.update(outcome_attrs(status, warnings))
+
     def analysis(self, name: str, value: Any, unit: str) -> None:
         write_analysis(self.f["analysis"], name, value, unit)
 
@@ -360,6 +374,13 @@ class Result:
     @property
     def complete(self) -> bool:
         return bool(self.attrs.get("complete", False))
+
+    @property
+    def status(self) -> str:
+        """What the run did (:data:`transient.outcome.STATUSES`); a file written before
+        statuses were stored says ``finished`` if complete, else ``failed``."""
+        default = "finished" if self.complete else "failed"
+        return str(self.attrs.get("status", default))
 
     def scene(self):
         """Rebuild the scene from ``/scene/toml``."""

@@ -21,6 +21,7 @@ from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
 from .errors import SimulationError
+from .outcome import RunStopped, Watch, code_status, judge, status_of
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import RunData
@@ -199,7 +200,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
               **_kinematics_attrs(scene)}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
-                   solver, complete=status == sio.FINISHED, message=message)
+                   solver, complete=status == sio.FINISHED, message=message,
+                   status=code_status(status))
 
 
 def switch_inertia(model, extra: float, y, ist):
@@ -310,18 +312,21 @@ def _work_columns(traj: dict, n_pairs: int) -> None:
 
 def integrate(scene, on_block=None, progress=None, keep=True) -> RunData:
     """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
-    for ``keep``."""
+    for ``keep``. The run comes back judged (:func:`transient.outcome.judge`); a run that
+    outgrows its output budget or stops advancing raises :class:`~transient.outcome.RunStopped`
+    after its blocks so far went to ``on_block``."""
+    watch = Watch(scene, len(output_columns(scene)))
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
-        data = run_compiled(scene, on_block, progress, keep)
+        data = run_compiled(scene, watch.wrap(on_block), progress, keep)
         if data.message.startswith("stiff"):
-            data = _implicit_rerun(scene, data, on_block, progress)
+            data = _implicit_rerun(scene, data, watch.wrap(on_block), progress)
     else:
         from .reference import run_reference
 
         data = run_reference(scene, on_block, progress)
-    return data
+    return judge(data, watch)
 
 
 def _implicit_rerun(scene, stiff: RunData, on_block, progress) -> RunData:
@@ -424,11 +429,17 @@ def simulate(scene, path: str | Path, *, force: bool = False, progress=None) -> 
         data.extra["summary"] = summary
     except BaseException as exc:
         writes.settle()
-        msg = data.message if data is not None and data.message else f"{type(exc).__name__}: {exc}"
+        msg = data.message if data is not None and data.message else (
+            str(exc) if isinstance(exc, SimulationError) else f"{type(exc).__name__}: {exc}")
+        writer.outcome(status_of(exc), [])
         writer.close(False, msg)
+        if isinstance(exc, RunStopped):
+            raise RunStopped(exc.status, f"{exc}; partial result kept in {path} "
+                                         f"(complete = false)") from None
         raise
     finally:
         writes.shutdown()
+    writer.outcome(data.status, data.warnings)
     writer.close(data.complete, data.message)
     if not data.complete:
         raise SimulationError(f"{data.message}; partial result kept in {path} (complete = false)")

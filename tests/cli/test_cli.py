@@ -437,7 +437,7 @@ def test_info_prints_the_summary(tmp_path, capsys):
     lines = out.splitlines()
     assert lines[0].startswith(f"{path}: scene 'small-spinup', transient {transient.__version__}, "
                                f"format 1, created ")
-    assert lines[0].endswith("complete = True")
+    assert lines[0].endswith("complete = True, status = finished")
     assert lines[1].startswith(f"  trajectory: {4 * 24 + 1} samples; ")
     for column in ("t [s]", "phi [rad]", "omega [rad/s]", "epsilon [rad/s^2]", "p_3 [Pa]"):
         assert column in lines[1]
@@ -584,7 +584,7 @@ def test_interrupted_run_keeps_the_partial_result(tmp_path, capsys, monkeypatch)
 
     assert sorted(p.name for p in tmp_path.glob("*.h5*")) == ["long.h5"]
     res = transient.open_result(path)
-    assert res.complete is False
+    assert res.complete is False and res.status == "interrupted"
     assert "interrupted" in res.attrs["message"]
     tr = res.trajectory
     assert tr["t"].size == rows[0]
