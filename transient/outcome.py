@@ -20,8 +20,10 @@ from .errors import SimulationError
 STATUSES = {
     "finished": "ran to its end as the scene describes",
     "interrupted": "stopped by Ctrl-C, SIGTERM or SIGHUP",
-    "stalled": "the speed fell to zero and the shaft did not run again",
-    "reversed": "the shaft was driven backwards and turned backwards at the end",
+    "stalled": "the speed fell to zero and the shaft did not run again (it ends slower than "
+               "the switch speed)",
+    "reversed": "the shaft was driven backwards and turned backwards at the end (faster than "
+                "the switch speed)",
     "locked": "at rest, the friction of the non-ideal pairs holds the machine",
     "chattering": "pair modes or other switches flip without progress",
     "runaway": "the speed grew beyond RUNAWAY_SPEED",
@@ -59,6 +61,20 @@ def code_status(code: int) -> str:
     return {sio.RUNNING: "interrupted", sio.FINISHED: FINISHED, sio.STALLED: "stalled",
             sio.LOCKED: "locked", sio.CHATTERING: "chattering", sio.STIFF: "stiff",
             sio.FAIL_NONFINITE: "failed", sio.FAIL_STEP: "failed"}[code]
+
+
+def failure_cause(step: bool, finite: bool, rtol: float, atol: float) -> str:
+    """Why the stepper gave up: the step fell below 10 ulp (``step``), or no attempt had a
+    finite error estimate and state. From a finite state the tolerance is named as a cause, so
+    that a tolerance no step can meet is not taken for a state gone non-finite."""
+    tolerance = f"the tolerance rtol = {rtol:g}, atol = {atol:g}"
+    if step:
+        return f"the step size fell below 10 ulp (no step meets {tolerance} here)"
+    if finite:
+        return (f"from a finite state, 30 attempts at steps shrinking to 10⁻²¹ of the first had "
+                f"a non-finite error estimate or new state (a force singular here, or "
+                f"{tolerance}, against which the error norm overflows)")
+    return "a non-finite value in the state"
 
 
 def where(t: float, phi: float, omega: float) -> str:
@@ -171,11 +187,11 @@ class Watch:
         if self.fastest > RUNAWAY_SPEED:
             return "runaway", (f"runaway: the speed reached {self.fastest:.3g} rad/s (beyond "
                                f"{RUNAWAY_SPEED:g}); at the end {end}")
-        omega = self.last["omega"]
-        if omega < 0.0:
+        omega, ws = self.last["omega"], self.scene.solver.switch_speed
+        if omega <= -ws:  # (slower than the switch speed, either way, is rocking at rest)
             return "reversed", (f"reversed: the shaft was driven backwards{self._stopped()} "
                                 f"and turned backwards at the end, {end}")
-        if self.stop is not None and omega < self.scene.solver.switch_speed:
+        if (self.stop is not None or omega < 0.0) and omega < ws:
             return "stalled", (f"stalled: the speed reached zero{self._stopped()} and the "
                                f"shaft did not run again; at the end {end}")
         return status, message

@@ -21,7 +21,7 @@ from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
 from .errors import SimulationError
-from .outcome import RunStopped, Watch, code_status, judge, status_of
+from .outcome import RunStopped, Watch, code_status, failure_cause, judge, status_of
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import RunData
@@ -188,8 +188,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict], None] | None = None,
                    f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
                    f"the step (a governor or actuator far faster than the engine?)")
     if status in (sio.FAIL_NONFINITE, sio.FAIL_STEP):
-        cause = ("a non-finite value in the state or its error estimate"
-                 if status == sio.FAIL_NONFINITE else "the step size fell below 10 ulp")
+        cause = failure_cause(status == sio.FAIL_STEP, bool(np.all(np.isfinite(y))),
+                              scene.solver.rtol, scene.solver.atol)
         message = (f"integration failed at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
     solver = {"method": scene.solver.method, "fixed_step": scene.solver.fixed_step,

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from transient.errors import SimulationError
-from transient.outcome import (IDLE_CHUNKS, STATUSES, RunStopped, Watch, code_status, status_in,
-                               status_of)
+from transient.outcome import (IDLE_CHUNKS, STATUSES, RunStopped, Watch, code_status,
+                               failure_cause, status_in, status_of)
 
 
 def scene(omega0=100.0, budget=4e9, policy="power-flow", pairs=()):
@@ -61,6 +61,12 @@ def test_a_shaft_that_stopped_and_rocks_at_rest_is_stalled():
     status, message = w.verdict("finished", "")
     assert status == "stalled"
     assert message.startswith("stalled: the speed reached zero (it stopped at t = 1 s, ")
+
+
+def test_a_shaft_held_near_rest_by_friction_is_stalled_not_reversed():
+    """Pairs of efficiency 0.01 brake the shaft to a creep backwards of a few µrad/s."""
+    w = watched(block([0, 1, 2], [100, 0.0, -3.7e-6]))
+    assert w.verdict("finished", "")[0] == "stalled"
 
 
 def test_a_start_that_rocks_back_once_and_then_runs_is_finished():
@@ -146,3 +152,13 @@ def test_statuses_from_codes_messages_and_exceptions():
     assert status_of(RunStopped("no-progress", "no progress: …")) == "no-progress"
     assert status_of(SimulationError("stalled: the speed reached zero")) == "stalled"
     assert {code_status(c) for c in range(8)} - {"stiff"} <= set(STATUSES)
+
+
+def test_a_failure_from_a_finite_state_names_the_tolerance():
+    assert failure_cause(True, True, 1e-13, 1e-300) == (
+        "the step size fell below 10 ulp (no step meets the tolerance rtol = 1e-13, "
+        "atol = 1e-300 here)")
+    assert "a non-finite value in the state" not in failure_cause(False, True, 1e-13, 1e-300)
+    assert "atol = 1e-300, against which the error norm overflows" in failure_cause(
+        False, True, 1e-13, 1e-300)
+    assert failure_cause(False, False, 1e-8, 1e-10) == "a non-finite value in the state"

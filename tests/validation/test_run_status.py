@@ -14,6 +14,7 @@ from transient.results import open_result
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 COASTING = (CASES / "coasting_single.toml").read_text()
+FRICTION = (CASES / "gots_diesel_friction.toml").read_text()
 
 
 def write(tmp_path, name: str, text: str) -> Path:
@@ -65,3 +66,37 @@ def test_a_run_beyond_its_output_budget_is_stopped_and_kept(tmp_path, capsys):
     with h5py.File(tmp_path / "budget.h5") as f:
         assert not f.attrs["complete"] and f.attrs["status"] == "over-budget"
         assert f["trajectory/t"].size > 0 and np.all(np.diff(f["trajectory/t"][()]) > 0)
+
+
+def test_pairs_of_efficiency_near_zero_brake_the_engine_to_a_stall_exit_1(tmp_path, capsys):
+    """η = 0.01 in both pairs: the engine cannot turn its own crank; with t_end the run goes on
+    to its end, the shaft creeping at a few µrad/s around where it stopped."""
+    text = FRICTION.replace("eta_forward = 0.985", "eta_forward = 0.01").replace(
+        "eta_backward = 0.98\n", "eta_backward = 0.01\n").replace(
+        "revolutions = 600", "revolutions = 20\nt_end = 2")
+    scene = write(tmp_path, "braked", text)
+    assert main(["run", str(scene), "-o", str(tmp_path), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert re.fullmatch(r"transient: stalled: the speed reached zero \(it stopped at t = \S+ s, "
+                        r"φ = \S+ rad \(\S+°\)\) and the shaft did not run again; at the end "
+                        r"t = 2 s, φ = \S+ rad \(\S+°\), ω = \S+ rad/s \(\S+ rpm\); result in "
+                        r"\S+braked\.h5 \(status = stalled\)\n", err), err
+    res = open_result(tmp_path / "braked.h5")
+    assert res.complete and res.status == "stalled"
+    assert abs(res.trajectory["omega"][-1]) < 1e-3
+
+
+def test_negative_losses_of_the_papers_criterion_are_a_warning(tmp_path, capsys):
+    """The Gots diesel with policy "paper": both pairs report negative losses (their modes stand
+    against the power); the run did what the scene asked, exit 0, with a warning per pair."""
+    text = FRICTION.replace('policy = "power-flow"', 'policy = "paper"').replace(
+        "revolutions = 600", "revolutions = 5")
+    scene = write(tmp_path, "paper", text)
+    assert main(["run", str(scene), "-o", str(tmp_path), "-q"]) == 0
+    lines = capsys.readouterr().err.splitlines()
+    assert [line.split(" (P_loss")[0] for line in lines] == [
+        "transient: warning: pair 1 (main bearings) reported negative losses",
+        "transient: warning: pair 2 (crankpins) reported negative losses"]
+    res = open_result(tmp_path / "paper.h5")
+    assert res.status == "finished"
+    assert res.attrs["warnings"].count("reported negative losses") == 2
