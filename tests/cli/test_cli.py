@@ -398,9 +398,13 @@ def test_scene_toml_round_trips(tmp_path, capsys, name, text):
     scene_path = write(tmp_path, name, text)
     original = transient.load_scene(scene_path)
     code, out, err = cli(capsys, "run", scene_path, "-o", tmp_path / "res", "-q")
-    assert (code, err) == (0, "")
     result = transient.open_result(tmp_path / "res" / f"{name}.h5")
     assert result.complete
+    # (the V-twin's starter is weaker than its gas torque at rest: the shaft is driven backwards,
+    # which the run says; the scene round-trips all the same)
+    assert (code, result.status) == ((1, "reversed") if name == "table_starter" else
+                                     (0, "finished"))
+    assert len(err.splitlines()) == code
     assert_same_scene(result.scene(), original)
 
 

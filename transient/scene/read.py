@@ -21,9 +21,10 @@ from ..mechanisms import MECHANISMS
 from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table
 from .reader import MISSING, Section, show_value
-from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND,
-                      MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES, GOVERNOR_KEYS, Analysis, Friction, Gas, Governor, Inertia, Initial, Load,
-                      Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
+                      MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES, Analysis, Friction,
+                      Gas, Governor, Inertia, Initial, Load, Output, Pair, Run, Scene, Solver,
+                      Starter, Wiebe, Woschni)
 
 
 def not_a_regular_file(path: Path) -> str:
