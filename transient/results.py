@@ -22,7 +22,7 @@ import functools
 import os
 from collections.abc import Mapping
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -41,13 +41,17 @@ FORMAT = 1
 
 @dataclass
 class RunData:
-    """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics."""
+    """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics;
+    ``status`` says what the run did (:data:`transient.outcome.STATUSES`; "" until judged) and
+    ``warnings`` what a finished run must not be read without."""
 
     trajectory: dict[str, np.ndarray]
     events: dict[str, np.ndarray]
     solver: dict[str, float | int | str]
     complete: bool = True
     message: str = ""
+    status: str = ""
+    warnings: list[str] = field(default_factory=list)
 
 
 class ResultExists(FileExistsError):
@@ -266,6 +270,11 @@ def write_run(node: h5py.Group, scene_name: str, scene_toml: str, data: RunData,
     write_solver(node["solver"], data.solver)
     for name, (value, unit) in analysis.items():
         write_analysis(node["analysis"], name, value, unit)
+
+
+def outcome_attrs(status: str, warnings: list[str]) -> dict[str, str]:
+    """The root attributes that say what a run did: ``status``, and ``warnings`` if any."""
+    return {"status": status, **({"warnings": "; ".join(warnings)} if warnings else {})}
 
 
 #: The return code in the checkpoint of a run written whole (the reference path, a stiff rerun):
@@ -502,9 +511,11 @@ class ResultWriter:
 
     def finish(self, complete: bool, message: str = "", status: str = "",
                solver: dict[str, Any] | None = None,
-               analysis: dict[str, tuple[Any, str]] | None = None) -> Path:
+               analysis: dict[str, tuple[Any, str]] | None = None,
+               warnings: list[str] | None = None) -> Path:
         """Write the result under its name: the run so far, ``solver``'s statistics,
-        ``analysis`` (name → (value, unit)), ``complete``, ``status`` and ``message``. An
+        ``analysis`` (name → (value, unit)), ``complete``, ``status`` (with ``warnings``:
+        :func:`outcome_attrs`) and ``message``. An
         incomplete result keeps its checkpoints (it can be resumed). After a failed write the
         partial file is left as it is, and :class:`~transient.errors.WriteFailed` (a
         SimulationError) says so."""
@@ -519,7 +530,7 @@ class ResultWriter:
             with h5py.File(self.tmp, "r") as src:
                 _copy_result(src, self.done, keep_checkpoints=not complete)
             with reopen_file(self.done) as f:
-                f.attrs.update(complete=bool(complete), status=status)
+                f.attrs.update(complete=bool(complete), **outcome_attrs(status, warnings or []))
                 if message:
                     f.attrs["message"] = message
                 write_solver(f["solver"], solver or {})
@@ -532,13 +543,6 @@ class ResultWriter:
         _publish(self.done, self.path, self.force)
         self.tmp.unlink()
         return self.path
-
-    def abandon_swmr(self) -> None:
-        """Close the partial file as it is (after an exception the finish could not handle)."""
-        try:
-            self.f.close()
-        except Exception:  # noqa: BLE001 — the file is broken already
-            pass
 
 
 def _event_datasets(events_group: h5py.Group, name: str) -> dict[str, h5py.Dataset]:
@@ -717,6 +721,11 @@ class Result:
         """What happened, with time, angle and speed, if the run did not finish."""
         return str(self.attrs.get("message", ""))
 
+    @property
+    def warnings(self) -> list[str]:
+        """What a finished run must not be read without (negative losses, …), one per item."""
+        return [w for w in str(self.attrs.get("warnings", "")).split("; ") if w]
+
     def scene(self):
         """Rebuild the scene from ``/scene/toml``."""
         from .scene import load_scene
@@ -742,10 +751,12 @@ class Result:
 
 
 def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dict[str, str],
-                     status: str, analysis: dict[str, tuple[Any, str]]) -> Result:
-    """The :class:`Result` of a run held in memory, as its file would read back."""
+                     analysis: dict[str, tuple[Any, str]]) -> Result:
+    """The :class:`Result` of a run held in memory (judged: ``data.status``), as its file would
+    read back."""
     attrs = {"creator": CREATOR, "version": __version__, "format": FORMAT, "created": now(),
-             "scene": scene_name, "complete": bool(data.complete), "status": status}
+             **provenance(), "scene": scene_name, "complete": bool(data.complete),
+             **outcome_attrs(data.status, data.warnings)}
     if data.message:
         attrs["message"] = data.message
     events = {name: {"t": rows[:, 0], "phi": rows[:, 1]}

@@ -22,6 +22,7 @@ from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
+from .outcome import FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
@@ -202,8 +203,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
                    f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
                    f"the step (a governor or actuator far faster than the engine?)")
     if status in (sio.FAIL_NONFINITE, sio.FAIL_STEP):
-        cause = ("a non-finite value in the state or its error estimate"
-                 if status == sio.FAIL_NONFINITE else "the step size fell below 10 ulp")
+        cause = failure_cause(status == sio.FAIL_STEP, bool(np.all(np.isfinite(y))),
+                              scene.solver.rtol, scene.solver.atol)
         message = (f"integration failed at t = {y[1]:.9g} s, φ = {y[0]:.9g} rad "
                    f"({math.degrees(y[0]):.6g}°) (last good sample {where}): {cause}")
     solver = {"method": scene.solver.method, "fixed_step": scene.solver.fixed_step,
@@ -214,7 +215,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
               **_kinematics_attrs(scene)}
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
-                   solver, complete=status == sio.FINISHED, message=message)
+                   solver, complete=status == sio.FINISHED, message=message,
+                   status=code_status(status))
 
 
 def _restore(start, y, fst, ist) -> tuple[int, bool]:
@@ -338,18 +340,21 @@ def _work_columns(traj: dict, n_pairs: int) -> None:
 
 def integrate(scene, on_block=None, progress=None, keep=True, start=None) -> RunData:
     """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
-    for ``keep`` and ``start``."""
+    for ``keep`` and ``start``. The run comes back judged (:func:`transient.outcome.judge`); a
+    run that outgrows its output budget or stops advancing raises
+    :class:`~transient.outcome.RunStopped` after its blocks so far went to ``on_block``."""
+    watch = Watch(scene, len(output_columns(scene)))
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
-        data = run_compiled(scene, on_block, progress, keep, start)
+        data = run_compiled(scene, watch.wrap(on_block), progress, keep, start)
         if data.message.startswith("stiff"):
-            data = _implicit_rerun(scene, data, on_block, progress)
+            data = _implicit_rerun(scene, data, watch.wrap(on_block), progress)
     else:
         from .reference import run_reference
 
         data = run_reference(scene, on_block, progress)
-    return data
+    return judge(data, watch)
 
 
 def _implicit_rerun(scene, stiff: RunData, on_block, progress) -> RunData:
@@ -437,12 +442,22 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
         if force or resume:
             raise SceneError("path", "force and resume apply to a result file: give its path")
         return _in_memory(scene, progress)
-    _write(scene, Path(path), force, resume, progress)
+    try:
+        _write(scene, Path(path), force, resume, progress)
+    except RunStopped as exc:  # (written as far as it went)
+        raise _said(exc, open_result(path), path) from None
     res = open_result(path)
-    if not res.complete:
-        raise SimulationError(f"{res.message}; partial result kept in {path} (complete = false)",
-                              res)
+    if res.status != FINISHED:
+        raise _said(SimulationError(res.message), res, path)
     return res
+
+
+def _said(exc: SimulationError, res: Result, path: Path) -> SimulationError:
+    """``exc`` carrying the result ``res``, its message saying where the result is."""
+    exc.args = (f"{exc}; result in {path} (status = {res.status})" if res.complete else
+                f"{exc}; partial result kept in {path} (complete = false)",)
+    exc.result = res
+    return exc
 
 
 def _in_memory(scene, progress) -> Result:
@@ -453,10 +468,9 @@ def _in_memory(scene, progress) -> Result:
     data = integrate(scene, progress=progress)
     summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
                else {})
-    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene),
-                           _status(data), summary)
-    if not data.complete:
-        raise SimulationError(data.message, res)
+    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary)
+    if res.status != FINISHED:
+        raise SimulationError(f"{data.message} (status = {res.status})", res)
     return res
 
 
@@ -496,17 +510,10 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         summary = summarize(scene, tail, events) if tail["t"].size else {}
     except BaseException as exc:
         writes.settle()
-        msg = data.message if data is not None and data.message else f"{type(exc).__name__}: {exc}"
-        writer.finish(False, msg, "interrupted" if isinstance(exc, KeyboardInterrupt) else "",
-                      data.solver if data is not None else None)
+        msg = data.message if data is not None and data.message else (
+            str(exc) if isinstance(exc, SimulationError) else f"{type(exc).__name__}: {exc}")
+        writer.finish(False, msg, status_of(exc), data.solver if data is not None else None)
         raise
     finally:
         writes.shutdown()
-    writer.finish(data.complete, data.message, _status(data), data.solver, summary)
-
-
-def _status(data: RunData) -> str:
-    """The result's ``status``: ``finished``, ``interrupted`` or the failure's first word."""
-    if data.complete:
-        return "finished"
-    return data.message.split(":")[0].split(";")[0].strip() or "failed"
+    writer.finish(data.complete, data.message, data.status, data.solver, summary, data.warnings)

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
-from .common import EXIT_OK, KERNELS_NOTICE, read_result
+from ..errors import SceneError, SimulationError
+from ..outcome import FINISHED
+from .common import EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, read_result
 
 
 def register(sub) -> None:
@@ -75,15 +76,33 @@ def cmd_run(args) -> int:
             if KERNELS_NOTICE in bar.desc:
                 bar.set_description(scene.name)  # (shown at once, however short the run)
             bar.update(int(1000 * fraction) - bar.n)
+    failed = None
     try:
         res = simulate(scene, path, force=args.force, resume=args.resume, progress=progress)
+    except SimulationError as exc:
+        if exc.result is None or not exc.result.complete:
+            raise  # (one line: where it stopped, where the partial result is)
+        res, failed = exc.result, exc  # ran to its end, but not as the scene describes
     finally:
         if bar:
             bar.close()
     if not args.quiet:
         print(f"wrote {path}")
+        if res.status != FINISHED:
+            print(f"  status: {res.message}")
         _print_summary(res.analysis, res.solver)
-    return EXIT_OK
+    return _said(res, failed)
+
+
+def _said(res, failed) -> int:
+    """Warnings and a run that did not do what its scene describes, one line each on standard
+    error; the exit code (1 for any status but finished)."""
+    for warning in res.warnings:
+        print(f"transient: warning: {warning}", file=sys.stderr)
+    if failed is None:
+        return EXIT_OK
+    print(f"transient: {failed}", file=sys.stderr)
+    return EXIT_FAILED
 
 
 def _print_summary(summary, solver) -> None:
@@ -91,8 +110,11 @@ def _print_summary(summary, solver) -> None:
     v = {k: val for k, (val, _) in summary.items()}
     print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
           f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
-    print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
-          f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
+    if math.isfinite(v["mean_omega_last_cycle"]):
+        print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
+              f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
+    else:
+        print("  last cycle: none (the run holds no whole cycle turned forwards)")
     ss = v.get("steady_state_t")
     if ss is not None:
         print("  steady state: " + (f"reached at t = {ss:.6g} s" if math.isfinite(ss) else
@@ -165,9 +187,11 @@ def cmd_info(args) -> int:
     res = read_result(args.result)
     a = res.attrs
     print(f"{res.path}: scene {a['scene']!r}, transient {a['version']}, format {a['format']}, "
-          f"created {a['created']}, complete = {bool(a['complete'])}")
+          f"created {a['created']}, complete = {bool(a['complete'])}, status = {res.status}")
     if a.get("message"):
         print(f"  message: {a['message']}")
+    if a.get("warnings"):
+        print(f"  warnings: {a['warnings']}")
     n = res.trajectory["t"].size
     print(f"  trajectory: {n} samples; " + ", ".join(f"{k} [{u}]" for k, u in res.units.items()))
     for name, ev in res.events.items():

@@ -15,12 +15,14 @@ from pathlib import Path
 from ..errors import SceneError
 from ..mechanisms import MECHANISMS
 from ..units import ALL_SUFFIXES
+from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table
 from .files import parse_toml, read_text, table_number, table_rows
 from .reader import MISSING, Section, show_value
-from .records import (DETREND, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES,
-                      GOVERNOR_KEYS, Analysis, Friction, Gas, Governor, Inertia, Initial, Load,
-                      Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
+                      MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES, Analysis, Friction,
+                      Gas, Governor, Inertia, Initial, Load, Output, Pair, Run, Scene, Solver,
+                      Starter, Wiebe, Woschni)
 from .write import to_toml
 
 
@@ -146,6 +148,12 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         check_consistency(scene)
         check_gas_table(scene, sg)
         check_analysis(scene)
+        try:
+            check_work(scene)
+        except SceneError as exc:  # (reported under the key as written: max_step_deg, …)
+            for section in (s0, sr, sv, so, sa):
+                section.rename(exc)
+            raise
         return scene
     except SceneError as exc:
         exc.file = exc.file or file
@@ -437,11 +445,14 @@ def _read_run(s: Section) -> Run:
     revs = s.number("revolutions", default=math.inf, gt=0.0)
     if math.isinf(t_end) and math.isinf(revs):
         raise SceneError(s.key("t_end"), "the run needs an end: give t_end [s] and/or revolutions")
+    budgets = {"max_output_bytes": s.number("max_output_bytes", default=DEFAULT_MAX_OUTPUT_BYTES,
+                                            gt=0.0),
+               "max_steps": s.number("max_steps", default=DEFAULT_MAX_STEPS, ge=1.0)}
     if mode == "dynamic":
-        return Run(mode=mode, t_end=t_end, revolutions=revs)
+        return Run(mode=mode, t_end=t_end, revolutions=revs, **budgets)
     if s.has("speed", "speed"):
         speed = s.number("speed", "speed", gt=0.0)
-        return Run(mode=mode, t_end=t_end, revolutions=revs, speed=speed)
+        return Run(mode=mode, t_end=t_end, revolutions=revs, speed=speed, **budgets)
     if not s.has("time") and not s.has("speed_table", "speed"):
         raise SceneError(s.key("speed"), "is missing; a prescribed-speed run needs 'speed' (or "
                                          "'speed_rpm'), or a table 'time' [s] with 'speed_table'")
@@ -455,7 +466,7 @@ def _read_run(s: Section) -> Run:
     if min(table) <= 0:
         raise SceneError(s.key("speed_table"), "speeds must be > 0 in a prescribed-speed run")
     return Run(mode=mode, t_end=min(t_end, time[-1]), revolutions=revs, time=time,
-               speed_table=table)
+               speed_table=table, **budgets)
 
 
 def _read_analysis(s: Section) -> Analysis:

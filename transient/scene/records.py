@@ -245,6 +245,13 @@ class Initial:
     omega: float = 0.0
 
 
+#: Default of ``[run] max_output_bytes``: 4 GB, more than any scene of ``cases/`` writes by far
+#: and less than a laptop's free disk.
+DEFAULT_MAX_OUTPUT_BYTES = 4e9
+#: Default of ``[run] max_steps``: 10⁹ step attempts, hours of stepping.
+DEFAULT_MAX_STEPS = 1e9
+
+
 @dataclass(frozen=True)
 class Run:
     """What to run: ``dynamic`` (integrate (18)) or ``prescribed-speed`` (inverse dynamics).
@@ -252,6 +259,11 @@ class Run:
     The run ends at ``t_end`` [s] or after ``revolutions`` of the shaft, whichever comes first
     (``inf`` = not set). For prescribed speed: ``speed`` [rad/s] constant, or a table ``time`` [s],
     ``speed_table`` [rad/s] interpolated by a cubic spline.
+
+    Budgets (:mod:`.budget`), so that a mistyped end or limit is refused before any work instead
+    of filling the disk or running for ever: ``max_output_bytes`` [bytes], the trajectory a run
+    may write (8 bytes a value before compression) and the analysis grid it may hold;
+    ``max_steps`` [1], the step attempts its limits may imply and it may take.
     """
 
     mode: str = "dynamic"
@@ -260,6 +272,8 @@ class Run:
     speed: float = 0.0
     time: tuple[float, ...] = ()
     speed_table: tuple[float, ...] = ()
+    max_output_bytes: float = DEFAULT_MAX_OUTPUT_BYTES
+    max_steps: float = DEFAULT_MAX_STEPS
 
 
 @dataclass(frozen=True)

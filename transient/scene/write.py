@@ -33,6 +33,7 @@ def to_toml(scene: Scene) -> str:
             run.update(time=list(scene.run.time), speed_table=list(scene.run.speed_table))
         else:
             run["speed"] = scene.run.speed
+    run.update(max_output_bytes=scene.run.max_output_bytes, max_steps=scene.run.max_steps)
     lines += ["", "[run]"] + [f"{k} = {toml_value(v)}" for k, v in run.items()]
     lines += _section("solver", scene.solver)
     lines += _section("output", scene.output)
