@@ -124,8 +124,8 @@ def test_events_further_along_are_progress():
 def test_a_restarted_run_is_watched_afresh():
     w = Watch(scene(), columns=3)
     watch_block = w.wrap(None)
-    watch_block(block([0, 1], [100, -1]), {})
-    watch_block(None, None)
+    watch_block(block([0, 1], [100, -1]), {}, None)
+    watch_block(None, None, None)
     assert w.stop is None and w.samples == 0 and not w.seen
 
 
