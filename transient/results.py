@@ -273,8 +273,9 @@ def write_run(node: h5py.Group, scene_name: str, scene_toml: str, data: RunData,
 
 
 def outcome_attrs(status: str, warnings: list[str]) -> dict[str, str]:
-    """The root attributes that say what a run did: ``status``, and ``warnings`` if any."""
-    return {"status": status, **({"warnings": "; ".join(warnings)} if warnings else {})}
+    """The root attributes that say what a run did: ``status``, and ``warnings`` if any (one a
+    line)."""
+    return {"status": status, **({"warnings": "\n".join(warnings)} if warnings else {})}
 
 
 #: The return code in the checkpoint of a run written whole (the reference path, a stiff rerun):
@@ -724,7 +725,7 @@ class Result:
     @property
     def warnings(self) -> list[str]:
         """What a finished run must not be read without (negative losses, …), one per item."""
-        return [w for w in str(self.attrs.get("warnings", "")).split("; ") if w]
+        return [w for w in str(self.attrs.get("warnings", "")).splitlines() if w]
 
     def scene(self):
         """Rebuild the scene from ``/scene/toml``."""

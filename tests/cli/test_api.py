@@ -57,7 +57,7 @@ def test_a_failed_run_raises_with_the_run_up_to_there(small):
         simulate(stalls)
     res = info.value.result
     assert isinstance(res, Result) and not res.complete and res.status == "stalled"
-    assert res.message == str(info.value) and "t = " in res.message
+    assert str(info.value) == f"{res.message} (status = stalled)" and "t = " in res.message
     assert res.trajectory["t"].size > 0 and res.trajectory["omega"][0] > 0.0
 
 

@@ -190,8 +190,8 @@ def cmd_info(args) -> int:
           f"created {a['created']}, complete = {bool(a['complete'])}, status = {res.status}")
     if a.get("message"):
         print(f"  message: {a['message']}")
-    if a.get("warnings"):
-        print(f"  warnings: {a['warnings']}")
+    for warning in res.warnings:
+        print(f"  warning: {warning}")
     n = res.trajectory["t"].size
     print(f"  trajectory: {n} samples; " + ", ".join(f"{k} [{u}]" for k, u in res.units.items()))
     for name, ev in res.events.items():
