@@ -711,6 +711,49 @@ def _coast_period(scene) -> float:
     return value
 
 
+#: Runaway inputs: (section, keys) that would write or step without bound, each refused before
+#: any work with a one-line error naming the key.
+RUNAWAY_INPUTS = [("run", "t_end", 1e30), ("run", "revolutions", 1e30),
+                  ("solver", "switch_speed_rpm", 1e30), ("solver", "max_step_deg", 1e-9),
+                  ("solver", "fixed_step_deg", 1e-12), ("initial", "phi", 1e20),
+                  ("solver", "rtol", 1e-16)]
+
+
+def runaway(quick: bool, ctx: Context) -> Outcome:
+    """Inputs that would run without bound are refused before any work, naming their key; and a
+    run that outgrows its output budget all the same is stopped where it is, the partial result
+    kept readable and marked (``over-budget``)."""
+    from ..errors import SceneError
+
+    o = Outcome(status="complete", error=0.0, tolerance=0.0)
+    for section, key, value in RUNAWAY_INPUTS:
+        d = put(base("coasting_single"), section, **{key: value})
+        if key == "t_end":
+            del d["run"]["revolutions"]  # (which would end the run first)
+        try:
+            scene_of(d, "runaway")
+            o.ok = False
+            o.notes.append(f"{section}.{key} = {value:g} was accepted")
+        except SceneError as exc:
+            if exc.key != f"{section}.{key}" or "\n" in str(exc):
+                o.ok = False
+                o.notes.append(f"{section}.{key}: the error names {exc.key!r}: {exc}")
+        o.steps += 1
+    d = put(put(base("coasting_single"), "run", t_end=100.0, max_output_bytes=3e5),
+            "solver", rtol=1e-6)
+    d["run"].pop("revolutions", None)
+    run = run_scene(d, "runaway-budget", ctx)
+    t = run.trajectory["t"]
+    kept = t.size > 0 and bool(np.all(np.diff(t) > 0)) and not nonfinite(run.trajectory)
+    if run.complete or not run.message.startswith("over budget") or not kept:
+        o.ok = False
+        o.notes.append(f"over budget: complete {run.complete}, {t.size} samples kept "
+                       f"(monotone and finite: {kept}): {run.message}")
+    o.notes.append(f"{len(RUNAWAY_INPUTS)} runaway inputs refused; a run over its budget stopped "
+                   f"after {t.size} samples")
+    return o
+
+
 def kill_and_resume(quick: bool, ctx: Context) -> Outcome:
     """The governed diesel with friction pairs run by ``transient run`` in child processes, each
     killed (SIGKILL) at a random instant and resumed in this one: the partial file must hold an
@@ -723,14 +766,17 @@ def kill_and_resume(quick: bool, ctx: Context) -> Outcome:
     from ..run import simulate
     from ..scene import to_toml
 
-    scene = scene_of(put(base("gots_diesel_friction"), "run", revolutions=600 if quick else 3000),
-                     "kill-and-resume")
+    scene = scene_of(put(base("gots_diesel_friction"), "run",
+                         revolutions=3000 if quick else 10000), "kill-and-resume")
     scene_file = ctx.out / "kill-and-resume.toml"
     scene_file.write_text(to_toml(scene), encoding="utf-8")
     whole = simulate(scene, ctx.out / "kill-and-resume-whole.h5", force=True)
-    span = whole.solver["wall_s"] + 0.5  # (a child loads the kernels first; no compile here)
+    span = whole.solver["wall_s"] + 0.2  # (a child loads the kernels first; no compile here)
     o, rng = Outcome(status="complete", error=0.0, tolerance=0.0), np.random.default_rng(1)
-    for k in range(3 if quick else 20):
+    kills = 3 if quick else 20
+    for k in range(4 * kills):  # (a run may finish before its kill: another is started)
+        if o.steps == kills:
+            break
         out = ctx.out / f"kill-and-resume-{k}"
         result = out / "kill-and-resume.h5"
         for stale in (result, partial_path(result)):
@@ -744,8 +790,7 @@ def kill_and_resume(quick: bool, ctx: Context) -> Outcome:
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         if result.exists():
-            o.notes.append(f"kill {k}: the run had finished")
-            continue
+            continue  # it had finished
         part = open_result(partial_path(result))
         n = part.trajectory["t"].size
         prefix = all(np.array_equal(v, whole.trajectory[c][:n]) for c, v in part.trajectory.items())
@@ -835,6 +880,9 @@ def catalogue() -> list[Case]:
                                           "backwards and can never reach them",
              single(backward_from_rest, "stalled|locked", name="backward-revolutions-only"),
              time_limit=10.0),
+        Case("runaway", "inputs that would run without bound (t_end, revolutions 1e30, …) "
+                        "refused naming their key; a run over its output budget stopped, kept",
+             runaway, time_limit=60.0),
         Case("kill-and-resume", "runs killed (SIGKILL) at random instants, then --resume: "
                                 "a prefix of the run kept, the resumed run bit-identical",
              kill_and_resume, time_limit=120.0, full_time_limit=600.0),
