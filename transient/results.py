@@ -288,13 +288,13 @@ CHECKPOINTS = "checkpoint"
 
 @dataclass
 class Checkpoint:
-    """Where a streamed run stood after one of its blocks: the trajectory's length, each event
-    name's count, whether the extra inertia had been switched in, the stepper's return code, and
+    """Where a streamed run stood after one of its blocks: the trajectory's length, the event
+    log's length, whether the extra inertia had been switched in, the stepper's return code, and
     its state (its float state ``y`` and ``fst`` laid end to end in ``floats``, its integer state
     ``ist``)."""
 
     rows: int
-    events: dict[str, int]
+    events: int
     switched: bool
     code: int
     floats: np.ndarray
@@ -303,16 +303,18 @@ class Checkpoint:
 
 def _checkpoint_datasets(node: h5py.Group, event_names) -> dict[str, h5py.Dataset]:
     """The empty, extendable datasets of the checkpoints: ``index`` holds a row per checkpoint
-    (rows, switched, the stepper's return code, the float and integer state's lengths, then a
-    count per event name, named in its ``events`` attribute); ``floats`` and ``ints`` hold the
-    states one after another."""
+    (rows, switched, the stepper's return code, the float and integer state's lengths, the event
+    log's length); ``floats`` and ``ints`` hold the states one after another; ``events``, the
+    event log, a row (name, t, φ) per event in time order, the name an index into its
+    ``names`` attribute (one dataset, not one per name: a result's objects are made before it
+    streams, and each costs its start)."""
     g = node.create_group(CHECKPOINTS)
-    width = 5 + len(event_names)
-    g.create_dataset("index", shape=(0, width), maxshape=(None, width), dtype="i8",
-                     chunks=(64, width)).attrs["events"] = list(event_names)
+    g.create_dataset("index", shape=(0, 6), maxshape=(None, 6), dtype="i8", chunks=(64, 6))
     g.create_dataset("floats", shape=(0,), maxshape=(None,), dtype="f8", chunks=(4096,))
     g.create_dataset("ints", shape=(0,), maxshape=(None,), dtype="i8", chunks=(1024,))
-    return {name: g[name] for name in ("index", "floats", "ints")}
+    g.create_dataset("events", shape=(0, 3), maxshape=(None, 3), dtype="f8",
+                     chunks=(1024, 3)).attrs["names"] = list(event_names)
+    return {name: g[name] for name in ("index", "floats", "ints", "events")}
 
 
 def _last_checkpoint(node: h5py.Group) -> Checkpoint | None:
@@ -326,10 +328,29 @@ def _last_checkpoint(node: h5py.Group) -> Checkpoint | None:
         return None
     row = index[k - 1]
     nf, ni = int(row[3]), int(row[4])
-    names = [str(n) for n in index.attrs["events"]]
     return Checkpoint(rows=int(row[0]), switched=bool(row[1]), code=int(row[2]),
-                      events={name: int(c) for name, c in zip(names, row[5:])},
-                      floats=g["floats"][(k - 1) * nf:k * nf], ints=g["ints"][(k - 1) * ni:k * ni])
+                      events=int(row[5]), floats=g["floats"][(k - 1) * nf:k * nf],
+                      ints=g["ints"][(k - 1) * ni:k * ni])
+
+
+def _logged_events(g: h5py.Group, count: int | None = None, t_from: float = -np.inf
+                   ) -> dict[str, np.ndarray]:
+    """The event log of the checkpoint group ``g`` (its first ``count`` rows; from the first
+    event at t ≥ ``t_from``, found by bisection: the log is in time order), name → (n, 2) of
+    (t, φ) in the order they occurred."""
+    log = g["events"]
+    n = log.shape[0] if count is None else count
+    lo, hi = 0, n
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if log[mid, 1] < t_from:
+            lo = mid + 1
+        else:
+            hi = mid
+    rows = log[lo:n]
+    names = [str(name) for name in log.attrs["names"]]
+    codes = rows[:, 0].astype(np.int64)
+    return {names[c]: rows[codes == c, 1:] for c in np.unique(codes)}
 
 
 def _extend(ds: h5py.Dataset, values) -> None:
@@ -386,8 +407,6 @@ class ResultWriter:
             # a failed write would make HDF5 retry it (and print its failure) on closing.
             self.datasets = write_layout(self.f, self.scene_toml, self.columns)
             # Opened once: a lookup by path per block would cost more than writing the block.
-            self.event_datasets = {n: _event_datasets(self.f["events"], n)
-                                   for n in self.event_names}
             self.checkpoints = _checkpoint_datasets(self.f, self.event_names)
             self.f.flush()
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
@@ -414,13 +433,9 @@ class ResultWriter:
         with open_file(source) as src:
             for name, ds in self.datasets.items():
                 _extend(ds, src["trajectory"][name][:cp.rows])
-            for name_, count in cp.events.items():
-                if name_ in src["events"] and count:
-                    for col in ("t", "phi"):
-                        _extend(self.event_datasets[name_][col],
-                                src["events"][name_][col][:count])
             k = src[CHECKPOINTS]["index"].shape[0]
             g = self.checkpoints
+            _extend(g["events"], src[CHECKPOINTS]["events"][:cp.events])
             _extend(g["floats"], src[CHECKPOINTS]["floats"][:k * cp.floats.size])
             _extend(g["ints"], src[CHECKPOINTS]["ints"][:k * cp.ints.size])
             _extend(g["index"], src[CHECKPOINTS]["index"][:k])
@@ -438,9 +453,8 @@ class ResultWriter:
             g = self.checkpoints
             _extend(g["floats"], floats)
             _extend(g["ints"], ints)
-            counts = [self.event_datasets[n]["t"].shape[0] for n in self.event_names]
             _extend(g["index"], [[self.datasets["t"].shape[0], int(switched), code,
-                                  floats.size, ints.size, *counts]])
+                                  floats.size, ints.size, g["events"].shape[0]]])
             self.f.flush()
 
     @contextmanager
@@ -461,7 +475,7 @@ class ResultWriter:
             self.f.flush()
 
     def events(self, events: dict[str, np.ndarray]) -> None:
-        """Append events (name → (n, 2) of t, φ) to the datasets made for their names, flushed."""
+        """Append events (name → (n, 2) of t, φ) to the event log, flushed."""
         with self._writing():
             self._events(events)
             self.f.flush()
@@ -472,12 +486,13 @@ class ResultWriter:
                 _extend(ds, block[name])
 
     def _events(self, events: dict[str, np.ndarray]) -> None:
-        for name, rows in events.items():
-            rows = np.asarray(rows, dtype=float).reshape(-1, 2)
-            if rows.size:
-                g = self.event_datasets[name]
-                _extend(g["t"], rows[:, 0])
-                _extend(g["phi"], rows[:, 1])
+        """A block's events into the log, in time order (the log is, block after block)."""
+        rows = [np.column_stack([np.full(len(v), self.event_names.index(name), float),
+                                 np.asarray(v, dtype=float).reshape(-1, 2)])
+                for name, v in events.items() if len(v)]
+        if rows:
+            rows = np.concatenate(rows)
+            _extend(self.checkpoints["events"], rows[np.argsort(rows[:, 1], kind="stable")])
 
     def restart(self) -> None:
         """Start the file afresh (a run started again from the beginning, e.g. a stiff scene by
@@ -493,22 +508,9 @@ class ResultWriter:
         return {name: ds[start:] for name, ds in self.datasets.items()}
 
     def read_events(self, t_from: float = -np.inf) -> dict[str, np.ndarray]:
-        """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ). Events are
-        written in time order, so the first one is found by bisection in the file and only the
-        tail is read (a long run has millions of breakpoint events)."""
-        out = {}
-        for name, g in self.f["events"].items():
-            t = g["t"]
-            lo, hi = 0, t.shape[0]
-            while lo < hi:
-                mid = (lo + hi) // 2
-                if t[mid] < t_from:
-                    lo = mid + 1
-                else:
-                    hi = mid
-            if lo < t.shape[0]:
-                out[name] = np.column_stack([t[lo:], g["phi"][lo:]])
-        return out
+        """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ); only the
+        log's tail is read (a long run has millions of breakpoint events)."""
+        return _logged_events(self.f[CHECKPOINTS], t_from=t_from)
 
     def finish(self, complete: bool, message: str = "", status: str = "",
                solver: dict[str, Any] | None = None,
@@ -565,10 +567,7 @@ def _copy_result(src: h5py.File, dest: Path, keep_checkpoints: bool) -> None:
         f.attrs.update(dict(src.attrs))
         for name in ("scene", "trajectory", "solver", "analysis"):
             src.copy(src[name], f, name=name)
-        events = f.create_group("events")
-        for name, g in src["events"].items():
-            if g["t"].shape[0]:
-                src.copy(g, events, name=name)
+        append_events(f.create_group("events"), _logged_events(src[CHECKPOINTS]))
         if keep_checkpoints:
             src.copy(src[CHECKPOINTS], f, name=CHECKPOINTS)
 
@@ -792,11 +791,11 @@ def read_run(node: h5py.Group, path: Path) -> Result:
         rows = slice(None)
     traj = _Columns(Path(path), node.name, list(node["trajectory"]), rows)
     units = {k: str(node["trajectory"][k].attrs.get("unit", "")) for k in node["trajectory"]}
-    events = {}
-    for k, g in node["events"].items():
-        n = g["t"].shape[0] if cp is None or k not in cp.events else cp.events[k]
-        if n:
-            events[k] = {c: g[c][:n] for c in g}
+    if len(node["events"]) or CHECKPOINTS not in node:  # (a finished file, a sweep's run)
+        logged = {k: np.column_stack([g["t"][()], g["phi"][()]]) for k, g in node["events"].items()}
+    else:  # a partial file: its event log, up to the last checkpoint
+        logged = _logged_events(node[CHECKPOINTS], cp.events if cp else 0)
+    events = {k: {"t": v[:, 0], "phi": v[:, 1]} for k, v in logged.items() if len(v)}
     analysis = {}
     for k, ds in node["analysis"].items():
         value = ds[()]
