@@ -89,7 +89,7 @@ def test_sweep_file_summary_and_failed_runs(sweep_file, tmp_path, cluster, capsy
             assert sorted(g["trajectory"]) == ["omega", "phi", "t"]
             assert g["trajectory/omega"].attrs["unit"] == "rad/s"
             failing = params["load.torque"] == 400.0
-            assert g.attrs["status"] == ("failed" if failing else "ok"), name
+            assert g.attrs["status"] == ("stalled" if failing else "finished"), name
             if failing:
                 assert "stalled" in g.attrs["message"]
                 assert g["trajectory/t"].size > 0  # the partial trajectory is kept
@@ -99,11 +99,11 @@ def test_sweep_file_summary_and_failed_runs(sweep_file, tmp_path, cluster, capsy
         units = json.loads(f["analysis/summary"].attrs["units"])
     assert units["mean_speed_rpm"] == "rpm" and units["final_t"] == "s"
     assert list(table["run"]) == [0, 1, 2, 3]
-    assert [s.decode() for s in table["status"]] == ["ok", "failed", "ok", "failed"]
+    assert [s.decode() for s in table["status"]] == ["finished", "stalled", "finished", "stalled"]
     assert np.isnan(table["mean_speed_rpm"][[1, 3]]).all()
     with open(out / "small_summary.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
-    assert [r["status"] for r in rows] == ["ok", "failed", "ok", "failed"]
+    assert [r["status"] for r in rows] == ["finished", "stalled", "finished", "stalled"]
     assert "stalled" in rows[1]["message"]
     # a worker's result is the run as computed in this process
     spec = load_sweep(sweep_file).runs[2]
@@ -228,7 +228,7 @@ def test_mending_after_adding_a_point(sweep_file, tmp_path):
         assert after[new]["scene_toml"] == before[old]["scene_toml"], new
         assert after[new]["index"] == int(new[-1]), new
     assert "mark" not in after["run_0001"] and "mark" not in after["run_0004"]
-    assert [r["status"] for r in done.rows] == ["ok", "ok", "failed", "ok", "ok", "failed"]
+    assert [r["status"] for r in done.rows] == ["finished", "finished", "stalled", "finished", "finished", "stalled"]
     assert [r["load.torque"] for r in done.rows] == [0.0, 10.0, 400.0] * 2
     assert np.array_equal(open_run(done.path, 5).trajectory["omega"], omega)
 
@@ -284,9 +284,9 @@ def test_sweep_in_a_terminal_says_kernels_load_until_the_first_run(sweep_file, t
     assert code == 1, terminal  # (runs 1 and 3 fail on purpose)
     assert out.startswith(f"wrote {tmp_path / 'out' / 'small.h5'}"), out
     notice = terminal.find(KERNELS_NOTICE)
-    status = terminal.find("run 0: ok", notice)
+    status = terminal.find("run 0: finished", notice)
     assert 0 <= notice < status, terminal
-    assert "run 3: failed" in terminal[status:], terminal
+    assert "run 3: stalled" in terminal[status:], terminal
 
 
 def test_default_local_cluster(tmp_path):

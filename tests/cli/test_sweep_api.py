@@ -19,7 +19,7 @@ def test_a_sweep_from_code_runs_what_simulate_runs(small):
     done = sweep(small, {"inertia.flywheel": flywheels}, collect=["delta", "final_speed_rpm"],
                  scheduler="serial")
     df = done.to_dataframe()
-    assert list(df["inertia.flywheel"]) == flywheels and list(df["status"]) == ["ok"] * 3
+    assert list(df["inertia.flywheel"]) == flywheels and list(df["status"]) == ["finished"] * 3
     assert df.attrs["units"]["delta"] == "1"
     assert np.all(np.diff(df["delta"]) < 0)  # more flywheel, less swing
     for i, J in enumerate(flywheels):
@@ -53,5 +53,5 @@ def test_a_sweep_on_a_given_dask_client(small):
         before = cluster.scheduler.transition_counter
         done = sweep(small, {"inertia.flywheel": [0.0, 0.5]}, client=client)
         moved = cluster.scheduler.transition_counter - before
-    assert list(done.to_dataframe()["status"]) == ["ok", "ok"]
+    assert list(done.to_dataframe()["status"]) == ["finished", "finished"]
     assert moved >= 2 * 3  # each run's task went through that scheduler (at least 3 states)

@@ -49,7 +49,7 @@ def _res(ok: bool, n: int = 5000, seed: int = 0) -> dict:
     """What run_one returns, made up: a complete run, or one that stopped with a message."""
     rng = np.random.default_rng(seed)
     t = np.cumsum(rng.uniform(1e-4, 2e-4, n))
-    return {"status": "ok" if ok else "failed", "complete": ok,
+    return {"status": "finished" if ok else "failed", "complete": ok,
             "message": "" if ok else "stalled at t = 0.1 s",
             "trajectory": {"t": t, "phi": 300.0 * t, "omega": 300.0 + rng.normal(size=n)},
             "events": {"breakpoint": np.column_stack([t[::700], 300.0 * t[::700]]),
@@ -155,10 +155,10 @@ def test_summary_round_trips_and_a_part_resumes(sweep, tmp_path):
     again.write_run(sweep.runs[2], _res(True, seed=2))
     rows = again.write_summary(tmp_path / "small_summary.csv")
     assert again.close(True) == path
-    assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
+    assert [r["status"] for r in rows] == ["finished", "failed", "finished"]
     tab = read_summary(path)
     assert list(tab.columns["run"]) == [0, 1, 2]
-    assert list(tab.columns["status"]) == ["ok", "failed", "ok"]
+    assert list(tab.columns["status"]) == ["finished", "failed", "finished"]
     assert tab.columns["mean_speed_rpm"][0] == pytest.approx(301.5 * 30 / math.pi, rel=1e-15)
     assert math.isnan(tab.columns["mean_speed_rpm"][1])
     assert tab.units["mean_speed_rpm"] == "rpm" and tab.units["final_t"] == "s"
@@ -190,14 +190,14 @@ def test_a_file_in_the_earlier_layout_resumes(sweep, tmp_path):
         g.create_group("solver").attrs.update(res["solver"])
         for name, (value, unit) in res["summary"].items():
             g.create_dataset(f"analysis/{name}", data=value).attrs["unit"] = unit
-        g.attrs["status"] = "ok"
+        g.attrs["status"] = "finished"
     store = SweepStore(tmp_path / "small.h5", sweep)
     assert store.finished == {0}
     store.write_run(sweep.runs[1], _res(False))
     store.write_run(sweep.runs[2], _res(True, seed=3))
     rows = store.write_summary(tmp_path / "small_summary.csv")
     store.close(True)
-    assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
+    assert [r["status"] for r in rows] == ["finished", "failed", "finished"]
     assert rows[0]["mean_speed_rpm"] == pytest.approx(301.5 * 30 / math.pi, rel=1e-15)
     assert read_summary(tmp_path / "small.h5").columns["final_t"][0] == res["summary"]["final_t"][0]
 

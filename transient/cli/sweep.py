@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import SceneError, show_value
 from .common import (EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, MAX_WORKERS, add_force,
                      check_result_path, output_folder, pyplot, save, whole)
@@ -103,7 +105,7 @@ def _counts(out) -> str:
 
 def cmd_sweep_plot(args) -> int:
     from .. import plots
-    from ..sweeps import read_summary
+    from ..sweeps.store import finished, read_summary
 
     check_result_path(args.result, "sweep file")
     try:
@@ -122,7 +124,7 @@ def cmd_sweep_plot(args) -> int:
     for a in tab.axes:
         if all(d["group"] != a["group"] for d in dims):
             dims.append(a)
-    failed = tab.columns["status"] != "ok"
+    failed = np.array([not finished(str(status)) for status in tab.columns["status"]])
     written = []
     for q in quantities:
         label = f"{q} [{tab.units.get(q, '')}]"

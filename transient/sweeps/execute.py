@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError
+from ..outcome import FINISHED
 from ..version import __version__
 from .spec import RunSpec, Sweep
 from .store import SweepStore
@@ -31,8 +32,9 @@ from .store import SweepStore
 
 
 def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
-    """Integrate one scene and summarise it (on a worker); never raises: a failure comes back
-    as ``status = "failed"`` with its message (and the partial trajectory, if any).
+    """Integrate one scene and summarise it (on a worker); never raises: its ``status`` is the
+    run's (:data:`transient.outcome.STATUSES`: ``finished``, or what stopped it, with its
+    message and the partial trajectory, if any), ``failed`` for an exception.
 
     The imports stay in this process (a Dask worker runs many tasks), so numba loads each kernel
     once per worker, from its on-disk cache; ``compile_s`` shows it (≈ 0 after the first run).
@@ -55,7 +57,7 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
         out["complete"] = data.complete
         if data.complete:
             out["summary"] = summarize(scene, data.trajectory, data.events)
-            out["status"] = "ok"
+        out["status"] = data.status
         out["message"] = data.message
     except Exception as exc:  # noqa: BLE001 (this run failed: say so, the sweep goes on)
         out["message"] = f"{type(exc).__name__}: {exc}"
@@ -107,7 +109,7 @@ class Outcome:
 
     @property
     def failed(self) -> list[dict[str, Any]]:
-        return [r for r in self.rows if r["status"] != "ok"]
+        return [r for r in self.rows if r["status"] != FINISHED]
 
 
 def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | None = None,

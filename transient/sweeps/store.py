@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import results
 from ..errors import SceneError
+from ..outcome import FINISHED
 from ..units import ALL_SUFFIXES
 from .spec import QUANTITIES, RunSpec, Sweep
 
@@ -37,10 +38,16 @@ def group_name(index: int, n_runs: int) -> str:
 UNUSED = "unused"
 
 
+def finished(status: str) -> bool:
+    """Whether a stored run's ``status`` (a result's: :data:`transient.outcome.STATUSES`) says
+    it did what its scene describes; ``ok`` is how files written before said it."""
+    return status in (FINISHED, "ok")
+
+
 @dataclass(frozen=True)
 class Stored:
-    """A finished run found in a sweep file: where it is, its resolved scene, whether it ended
-    ``ok``, and its axis values (which identify a point of the sweep)."""
+    """A stored run found in a sweep file: where it is, its resolved scene, whether it ended
+    ``finished``, and its axis values (which identify a point of the sweep)."""
 
     path: str
     toml: str
@@ -51,7 +58,7 @@ class Stored:
 def match_runs(stored: list[Stored], runs: tuple[RunSpec, ...], targets: list[str],
                retry_failed: bool = False) -> dict[int, Stored]:
     """The stored run each run of the sweep reuses (by index): one with the same resolved scene,
-    an ``ok`` one before a failed one and the one already at ``targets[index]`` before another,
+    a finished one before a failed one and the one already at ``targets[index]`` before another,
     so that nothing moves without need; never a failed one with ``retry_failed``. Each stored
     run serves one run at most (a list sweep may hold one scene twice)."""
     by_scene: dict[str, list[Stored]] = {}
@@ -79,8 +86,8 @@ class SweepStore:
     ``message``; ``scene/toml``; ``trajectory/<col>`` with ``unit``; ``events/<name>/{t,phi}``;
     ``solver`` attributes; ``analysis/<name>``, the run's summary, with ``unit``), with the
     sweep's attributes ``index``, ``params`` (JSON), ``scene_toml`` (the resolved scene, by which
-    a run is reused), ``worker``, ``wall_s`` and ``status`` (``ok`` or ``failed``, written last: a
-    group without it is unfinished); ``/unused/scene_<hash>`` finished runs the sweep no longer
+    a run is reused), ``worker``, ``wall_s`` and ``status`` (the run's, as a result's:
+    ``finished``, ``stalled``, …, ``failed``; written last: a group without it is unfinished); ``/unused/scene_<hash>`` finished runs the sweep no longer
     holds, in the same form (kept, so that no computed run is lost, and reused if the sweep
     holds their scene again); ``/analysis/summary`` the table of collected quantities
     (attribute ``units``, JSON).
@@ -185,7 +192,7 @@ class SweepStore:
                     continue
                 params = json.loads(g.attrs.get("params", "{}"))
                 out.append(Stored(f"{top}/{name}", str(g.attrs["scene_toml"]),
-                                  g.attrs["status"] == "ok", params))
+                                  finished(str(g.attrs["status"])), params))
         return out
 
     def _park(self, path: str) -> str:
@@ -250,7 +257,7 @@ class SweepStore:
             row = {"run": spec.index, "status": str(g.attrs["status"]), **spec.params}
             for q in self.sweep.collect:
                 value, unit = _quantity(g["analysis"], q)
-                row[q] = value if row["status"] == "ok" else math.nan
+                row[q] = value if finished(row["status"]) else math.nan
                 units[q] = units[q] or unit
             row["wall_s"] = float(g.attrs["wall_s"])
             row["compile_s"] = float(g["solver"].attrs.get("compile_s", math.nan))
