@@ -168,3 +168,25 @@ def test_loads_of_a_radial_engine(tmp_path, capsys):
                                atol=1e-10 * np.abs(loads.link_x[3]).max())
     peak = re.search(r"row 1: \|R\| max ([0-9.eE+-]+) kN", printed)
     assert peak and float(peak.group(1)) == pytest.approx(loads.R[0].max() / 1e3, rel=1e-6)
+
+
+def test_the_loads_csv_names_no_quantity_as_a_result_names_another(tmp_path, capsys):
+    """One vocabulary: a loads CSV column is a result column's name only for the same quantity
+    (Gots' rod force S is S_rod, not a result's pair moment S_k)."""
+    from pathlib import Path
+
+    import transient
+
+    case = Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_friction.toml"
+    scene = transient.load_scene(case).replace(run={"revolutions": 3})
+    res = transient.simulate(scene, tmp_path / "r.h5")
+    assert main(["loads", str(tmp_path / "r.h5"), "-o", str(tmp_path)]) == 0
+    capsys.readouterr()
+    header = (tmp_path / "r_loads.csv").read_text().splitlines()[0].split(",")
+    assert "S_rod_1_N" in header and "S_1" in res.trajectory
+    units = {"s": "s", "rad": "rad", "rad_s": "rad/s", "rad_s2": "rad/s^2", "N": "N", "Nm": "N m"}
+    for column in header:
+        for suffix, unit in units.items():
+            name = column.removesuffix(f"_{suffix}")
+            if name != column and name in res.units:
+                assert res.units[name] == unit, column

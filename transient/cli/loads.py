@@ -10,6 +10,11 @@ from .common import (EXIT_OK, add_force, output_folder, pyplot, read_result, res
                      whole, write_columns)
 
 
+#: The loads' names in the CSV where Gots' letter means something else in a result: Gots' S,
+#: the force along the rod, is ``S_rod`` (a result's ``S_k`` is the moment pair k transmits).
+CSV_NAMES = {"S": "S_rod"}
+
+
 def register(sub) -> None:
     lo = sub.add_parser(
         "loads", help="crankpin, main-journal loads and running torques along a crank-slider "
@@ -120,7 +125,7 @@ def _crank_slider_loads(args, res, scene) -> int:
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
     for j in range(n_cyl):
         for name in ("P_g", "P_j", "P", "N", "S", "K", "T", "R_K", "R_T", "R"):
-            cols[f"{name}_{j + 1}_N"] = getattr(loads, name)[j]
+            cols[f"{CSV_NAMES.get(name, name)}_{j + 1}_N"] = getattr(loads, name)[j]
         cols[f"M_{j + 1}_Nm"] = loads.torque[j]
     cols["M_engine_Nm"] = d.engine_torque
     if d.inline:
@@ -204,7 +209,8 @@ def _radial_loads(args, res, scene) -> int:
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
     for k in range(loads.P.shape[0]):
         for name in ("P_g", "P_j", "P", "N", "S", "torque"):
-            cols[f"{name}_{k + 1}_{'Nm' if name == 'torque' else 'N'}"] = getattr(loads, name)[k]
+            cols[f"{CSV_NAMES.get(name, name)}_{k + 1}_{'Nm' if name == 'torque' else 'N'}"] = \
+                getattr(loads, name)[k]
     for i in range(n_links):
         cols[f"link_x_{i + 1}_N"], cols[f"link_y_{i + 1}_N"] = loads.link_x[i], loads.link_y[i]
     for j in range(rows):
