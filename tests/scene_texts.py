@@ -36,3 +36,18 @@ atol = 1e-8
 [output]
 samples_per_rev = 12
 """
+
+#: The Gots diesel's ideal mixed cycle (App. 2) as a [gas] table, its compression ratio left as
+#: ``{cr}`` (appended to SMALL or another scene with no [gas] table).
+MIXED_CYCLE = """
+[gas]
+model = "mixed-cycle"
+compression_ratio = {cr}
+p_a_MPa = 0.1436
+n1 = 1.368
+p_z_MPa = 10.5
+rho = 1.671
+n2 = 1.228
+p_intake_MPa = 0.165
+p_exhaust_MPa = 0.182
+"""

@@ -241,9 +241,12 @@ def append_events(events_group: h5py.Group, events: dict[str, np.ndarray]) -> No
         rows = np.asarray(rows, dtype=float).reshape(-1, 2)
         if not rows.size:
             continue  # (events that occurred only, as a streamed result keeps them)
-        ds = _event_datasets(events_group, name)
-        _extend(ds["t"], rows[:, 0])
-        _extend(ds["phi"], rows[:, 1])
+        g = events_group.require_group(name)
+        for j, (col, unit) in enumerate((("t", "s"), ("phi", "rad"))):
+            if col not in g:
+                g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
+                                 chunks=(1024,)).attrs["unit"] = unit
+            _extend(g[col], rows[:, j])
 
 
 def write_solver(solver_group: h5py.Group, attrs: dict[str, Any]) -> None:
@@ -546,18 +549,6 @@ class ResultWriter:
         _publish(self.done, self.path, self.force)
         self.tmp.unlink()
         return self.path
-
-
-def _event_datasets(events_group: h5py.Group, name: str) -> dict[str, h5py.Dataset]:
-    """The extendable ``t`` and ``phi`` datasets of the event ``name``, made empty if missing."""
-    g = events_group.require_group(name)
-    out = {}
-    for col, unit in (("t", "s"), ("phi", "rad")):
-        if col not in g:
-            g.create_dataset(col, shape=(0,), maxshape=(None,), dtype="f8",
-                             chunks=(1024,)).attrs["unit"] = unit
-        out[col] = g[col]
-    return out
 
 
 def _copy_result(src: h5py.File, dest: Path, keep_checkpoints: bool) -> None:

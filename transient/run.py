@@ -445,14 +445,14 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
     try:
         _write(scene, Path(path), force, resume, progress)
     except RunStopped as exc:  # (written as far as it went)
-        raise _said(exc, open_result(path), path) from None
+        raise _with_result(exc, open_result(path), path) from None
     res = open_result(path)
     if res.status != FINISHED:
-        raise _said(SimulationError(res.message), res, path)
+        raise _with_result(SimulationError(res.message), res, path)
     return res
 
 
-def _said(exc: SimulationError, res: Result, path: Path) -> SimulationError:
+def _with_result(exc: SimulationError, res: Result, path: Path) -> SimulationError:
     """``exc`` carrying the result ``res``, its message saying where the result is."""
     exc.args = (f"{exc}; result in {path} (status = {res.status})" if res.complete else
                 f"{exc}; partial result kept in {path} (complete = false)",)

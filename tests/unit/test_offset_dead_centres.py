@@ -8,25 +8,14 @@ import math
 
 import numpy as np
 import pytest
-from scene_texts import SMALL
+from scene_texts import MIXED_CYCLE, SMALL
 
 from transient.assemble import clearance_volume, gas_table
 from transient.cli import main
 from transient.forces.gas import mixed_cycle
 from transient.scene import load_scene
 
-MIXED = """
-[gas]
-model = "mixed-cycle"
-compression_ratio = 18
-p_a_MPa = 0.1436
-n1 = 1.368
-p_z_MPa = 10.5
-rho = 1.671
-n2 = 1.228
-p_intake_MPa = 0.165
-p_exhaust_MPa = 0.182
-"""
+MIXED = MIXED_CYCLE.format(cr=18)
 
 GEOMETRIES = [  # (r, l, e) [m]: the Gots diesel, offsets both ways, one near the limit l − r
     (0.047, 0.148, 0.0), (0.047, 0.148, 0.010), (0.047, 0.148, -0.030), (0.047, 0.148, 0.100),

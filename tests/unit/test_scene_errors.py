@@ -13,26 +13,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from scene_texts import SMALL
+from scene_texts import MIXED_CYCLE, SMALL
 
 from transient.cli import main
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
 VALID = SMALL  # (every case below breaks one thing of it)
-
-MIXED_CYCLE = """
-[gas]
-model = "mixed-cycle"
-compression_ratio = {cr}
-p_a_MPa = 0.1436
-n1 = 1.368
-p_z_MPa = 10.5
-rho = 1.671
-n2 = 1.228
-p_intake_MPa = 0.165
-p_exhaust_MPa = 0.182
-"""
 
 
 def replace(old: str, new: str) -> str:

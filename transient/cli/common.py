@@ -121,8 +121,7 @@ def result_stem(path: Path) -> str:
 def incomplete_note(res) -> str:
     """What a figure or a table of the incomplete result ``res`` covers, in one line."""
     t = res.trajectory["t"]
-    status = str(res.attrs.get("status", "failed"))
-    how = "stopped while running (killed?)" if status == "running" else status
+    how = "stopped while running (killed?)" if res.status == "running" else res.status
     return (f"an incomplete run ({how}): covers t ≤ {t[-1]:.6g} s only" if t.size
             else f"an incomplete run ({how}): no samples")
 
