@@ -2,8 +2,8 @@
 
 On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) is the bulk of
 a first run, on one core: while numba types the stepper it compiles, one after another, each
-callee that is not inlined (the dense output, the root finders, the output row, the start and
-the end of a run). A helper process started at the same time compiles those callees in the
+of its callees (every kernel is a compile unit of its own, which LLVM inlines afterwards:
+:func:`transient.core.jit.kernel`). A helper process started at the same time compiles those callees in the
 reverse order, each under its compile lock
 (:func:`transient.core.jit._compile_once_across_processes`), so that the two use two cores. The
 stepper's compile loads each callee the helper has saved, waits for the one the helper is
@@ -30,41 +30,49 @@ import sys
 
 from numba import config, typeof, types
 
-from .core import breakpoints, events, forcing, jit, rhs, rk, stepper
+from .core import breakpoints, events, jit, rhs, rk, stepper
 from .core import stepper_io as sio
 
-#: The stepper's callees compiled apart (not inlined), in the reverse of the order in which the
-#: stepper's compile first calls for them (recorded with numba's "numba:compile" events), so
-#: that the helper and the stepper's compile meet in the middle.
+#: The stepper's callees, each compiled apart with its own callees (:func:`.core.jit.kernel`), in
+#: the reverse of the order in which the stepper's compile first calls for them (recorded with
+#: numba's "numba:compile" events), so that the helper and the stepper's compile meet in the
+#: middle.
 CALLEES = (
-    stepper._to_time_mode,
-    events._sleeve_stops,
-    breakpoints._at_breakpoint,
-    sio._emit_samples,
-    events._crossing_inside,
-    events._fall_after_rise,
-    events._crossing,
-    rk._dense,
+    stepper._switch_at_event,
+    stepper._record_event,
+    stepper._move_to_event,
+    stepper._take_step,
+    stepper._emit_step_samples,
+    events._locate_events,
+    breakpoints._aim_at_breakpoint,
+    stepper._stiff,
+    stepper._accepted_size,
+    stepper._judge_attempt,
+    rk._step,
     sio._finish,
-    breakpoints.next_breakpoint,
-    rhs.margins_at,
-    sio._reset_output_grid,
-    stepper._to_angle_mode,
-    sio._locked,
-    stepper._start_modes,
-    forcing.generator_branch,
-    forcing.load_segment,
-    forcing.start_branch,
+    breakpoints._segment_end,
+    stepper._settle_at_restart,
+    rhs.derivative,
+    sio._emit_row,
+    stepper._start_run,
 )
 
 
 def _types_by_parameter(model, tab) -> dict:
     """numba type of each parameter name the callees use, as the stepper passes it."""
-    scalar = {types.boolean: ("angle_mode", "upward", "rising"),
+    scalar = {types.boolean: ("angle_mode", "upward", "rising", "fixed", "on_corner",
+                              "at_segment_end", "after_rejection", "dip", "dense_ready",
+                              "redo_hit_breakpoint", "ends_on_breakpoint", "on_breakpoint",
+                              "ev_rising", "keep"),
               types.float64: ("h", "sel", "x", "level", "theta", "theta_end", "x_stop", "d_out",
-                              "ga", "gb", "a", "b", "phi", "period", "w"),
-              types.int64: ("comp", "k", "direction", "code", "ix", "n_samples")}
-    array = {types.float64[::1]: ("y", "y_new", "tmp", "out", "row", "cfg", "fst", "bp"),
+                              "ga", "gb", "a", "b", "phi", "period", "w", "x_end", "h_max",
+                              "tol_end", "rtol", "atol", "corner", "err", "h_planned", "up",
+                              "down", "min_step", "w_lo", "w_hi", "ev_theta", "ev_level",
+                              "h_next"),
+              types.int64: ("comp", "k", "direction", "code", "ix", "n_samples", "g0", "g1", "c0",
+                            "ev_code", "ev_comp", "n_pairs")}
+    array = {types.float64[::1]: ("y", "y_new", "tmp", "out", "row", "cfg", "fst", "bp", "f",
+                                  "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
              types.int64[::1]: ("ist", "sw")}
     by_name = {"m": typeof(model), "tab": typeof(tab)}

@@ -91,7 +91,7 @@ def _compile(model, tab, cfg, bp) -> float:
     try:
         stepper.advance(model, tab, warm, bp, y, np.zeros(sio.fst_size(model)),
                         np.zeros(sio.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
-                        np.empty((64, 4)))
+                        np.empty((64, 4)), *stepper.buffers(model, tab, y.shape[0]))
     finally:
         stop_helper(helper)
     return time.perf_counter() - t0
@@ -151,7 +151,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     t0 = time.perf_counter()
     try:
         while status == sio.RUNNING:
-            status = stepper.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf)
+            status = stepper.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf,
+                                     *stepper.buffers(model, tab, y.shape[0]))
             switching = status == sio.FINISHED and y[layout.T] == switch_at
             block = {name: outbuf[: ist[sio.I_NOUT], j].copy() for j, name in enumerate(names)}
             ev = _events_by_name(evbuf[: ist[sio.I_NEV]], switching)

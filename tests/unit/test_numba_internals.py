@@ -20,7 +20,7 @@ from pathlib import Path
 
 import llvmlite.binding as ll
 import numba
-from numba.core import caching, cpu, dispatcher, sigutils, types
+from numba.core import caching, codegen, cpu, dispatcher, sigutils, types
 from numba.core.base import BaseContext
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
@@ -412,3 +412,95 @@ def test_compile_helper_reads_numbas_cache_index(tmp_path, monkeypatch):
     assert [key[0] for key in keys] == [(types.int64,)], _relies(
         HELPER, "numba.core.caching.IndexDataCacheFile._load_index() keyed by (signature, ...)"
         f" (found {keys})")
+
+
+# ----------------------------------------------------------------------------------------------
+# _inlined_by_llvm
+
+INLINED = "transient.core.jit._inlined_by_llvm"
+
+
+def test_llvm_inlining_marks_the_module_numba_links_into_callers_and_caches():
+    link = codegen.CPUCodeLibrary.finalize
+    assert _in_order(_statements(link), _code("""
+        self._final_module.link_in(library._get_module_for_linking(), preserve=True)
+        self._optimize_final_module()
+        """)), _relies(INLINED, "numba.core.codegen.CPUCodeLibrary.finalize linking each callee's "
+                       "_get_module_for_linking() before optimizing the whole module")
+    assert _in_order(_statements(codegen.CPUCodeLibrary.serialize_using_object_code), _code("""
+        data = (self._get_compiled_object(), self._get_module_for_linking().as_bitcode())
+        """)), _relies(INLINED, "numba.core.codegen.CPUCodeLibrary.serialize_using_object_code "
+                       "caching the module for linking beside the machine code")
+    assert _parameters(ll.ValueRef.add_function_attribute) == ["self", "attr"], _relies(
+        INLINED, "llvmlite.binding.ValueRef.add_function_attribute(attr)")
+    assert jit._symbol_prefix(rhs_derivative()) == "_ZN9transient4core3rhs10derivativeB", _relies(
+        INLINED, "numba.core.itanium_mangler.mangle_identifier (numba names a function's "
+        "symbols after its mangled qualified name, then B and its ABI tags)")
+
+
+def rhs_derivative():
+    from transient.core.rhs import derivative
+
+    return derivative.py_func
+
+
+INLINE_KERNELS = """
+import numpy as np
+from transient.core.jit import kernel
+
+
+@kernel(inline=True)
+def scaled(t, x):
+    return t[0][1] * x + t[1]
+
+
+@kernel
+def offset(t, x):  # (recursive: LLVM's own heuristics leave it a call)
+    if x < 1.0:
+        return t[0][0] + x
+    return offset(t, x - 1.0) + offset(t, x - 2.0)
+
+
+@kernel
+def caller(t, x):
+    return scaled(t, x) + scaled(t, 2.0 * x) + offset(t, x)
+"""
+
+INLINE_PROBE = """
+import importlib.util, sys
+import numpy as np
+spec = importlib.util.spec_from_file_location("kern", sys.argv[1])
+module = sys.modules["kern"] = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+from transient.core.jit import _symbol_prefix
+t = (np.arange(3.0), 0.5)
+if sys.argv[2] == "callees":  # compiled and cached, as the compile helper does
+    print(module.scaled(t, 1.0))
+    module.offset(t, 1.0)
+else:
+    assert module.caller(t, 2.0) == (2.0 + 0.5) + (4.0 + 0.5) + module.offset.py_func(t, 2.0)
+    ir = module.caller.inspect_llvm(module.caller.signatures[0])
+    calls = [line for line in ir.splitlines() if " call " in line]
+    print(any(_symbol_prefix(module.scaled.py_func) in c for c in calls),
+          any(_symbol_prefix(module.offset.py_func) in c for c in calls),
+          sum(module.scaled.stats.cache_hits.values()))
+"""
+
+
+def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cache(tmp_path):
+    """``kernel(inline=True)``: no call to it is left in a caller's optimized code, whether the
+    callee was compiled with the caller or loaded from numba's cache (where the compile helper
+    saved it); a plain kernel stays a call, which shows the check sees calls."""
+    source = tmp_path / "kern.py"
+    source.write_text(INLINE_KERNELS)
+
+    def probe(cache: str, what: str) -> list[str]:
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / cache)}
+        run = subprocess.run([sys.executable, "-c", INLINE_PROBE, str(source), what], cwd=REPO,
+                             env=env, capture_output=True, text=True, timeout=300)
+        assert run.returncode == 0, run.stderr
+        return run.stdout.split()
+
+    assert probe("together", "caller") == ["False", "True", "0"]  # inlined, a call, compiled
+    assert probe("apart", "callees") == ["1.5"]
+    assert probe("apart", "caller") == ["False", "True", "1"]  # the same, loaded

@@ -46,7 +46,7 @@ def next_breakpoint(bp, period, phi, upward):
     return -np.inf
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _count_below(bp, base, level, inclusive):
     """How many of the angles ``base + bp[j]`` lie below ``level`` (or on it, ``inclusive``).
     They are a leading run of j: bp is sorted and rounded addition is monotone, so bisection
@@ -63,7 +63,7 @@ def _count_below(bp, base, level, inclusive):
     return lo
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
     """Where the segment of the next step ends, and what bounds that step: ``(x_end, up, down,
     h_max, tol_end, corner)``.
@@ -93,7 +93,7 @@ def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
     return x_end, up, down, h_max, tol_end, corner
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _aim_at_breakpoint(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, fst, ist, up,
                        down, min_step):
     """In time, a step must not cross a breakpoint: one that does is retaken so that it ends
@@ -125,7 +125,7 @@ def _aim_at_breakpoint(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, 
     return False, False
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _on_angle(phi, angle, period):
     """Whether the shaft angle phi is on ``angle`` of the cycle (to BP_LANDING)."""
     d = (phi - angle) % period

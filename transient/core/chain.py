@@ -102,7 +102,7 @@ MAX_PAIRS = 6
 UNIQUE, AMBIGUOUS, NONE_CONSISTENT, LOCKED = 0, 1, 2, 3
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def eta_star(eta_fwd, eta_bwd, forward):
     """η* of (25): η_fwd when the shaft side drives (``forward``), else 1/η_bwd."""
     if forward:
@@ -110,7 +110,7 @@ def eta_star(eta_fwd, eta_bwd, forward):
     return 1.0 / eta_bwd
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def chain_solve(J, dJ, M, eta_s, w, S_out):
     """φ̈ of the serial chain for given modes; fills the pair moments S_k.
 
@@ -169,7 +169,7 @@ def modes_paper(M, eta_fwd, eta_bwd, w, eta_out):
         eta_out[k] = eta_star(eta_fwd[k], eta_bwd[k], upstream * w >= 0.0)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _copy(dst, src):
     """dst[:] = src, as a loop (an array assignment needs reference counting, ``core.jit``)."""
     for i in range(src.shape[0]):

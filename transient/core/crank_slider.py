@@ -44,7 +44,7 @@ def slider(alpha, r, l, e):
     return s, ds, dds, asin(sb), db, ddb
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def rod_and_piston(sa, ca, r, l, e):
     """sin β, cos β, dβ/dα and the piston's ds/dα from sin α, cos α (Gots (2), (7), (12), (17))."""
     sb = (r * sa - e) / l
@@ -53,7 +53,7 @@ def rod_and_piston(sa, ca, r, l, e):
     return sb, cb, db, r * sa + l * sb * db
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def rod_and_piston_second(sa, ca, r, l, sb, cb, db):
     """d²β/dα² and d²s/dα² (Gots (8), (18)–(19) at ω = 1), from :func:`rod_and_piston`'s values."""
     ddb = (l * sb * db * db - r * sa) / (l * cb)
@@ -74,7 +74,7 @@ def cylinder_terms(alpha, mp):
     return cylinder_terms_sc(sin(alpha), cos(alpha), mp, True)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def cylinder_terms_sc(sa, ca, mp, with_dJ):
     """:func:`cylinder_terms` from sin α and cos α; without ``with_dJ`` only J and ds, dJ and dds
     NaN (the crank-angle right-hand side without pairs needs no dJ/dφ; README *Speed*, bare (18))."""
@@ -97,7 +97,7 @@ def cylinder_terms_sc(sa, ca, mp, with_dJ):
     return J, dJ, ds, dds
 
 
-@kernel(inline="always")  # inlined with the two above: README *Speed*, bare (18)
+@kernel(inline=True)
 def crank_slider_terms(mp, phi, u, du, with_dJ=True):
     """Reduced inertia J(φ), dJ/dφ of all cylinders; fills the piston transfer functions.
 

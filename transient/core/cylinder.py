@@ -42,7 +42,7 @@ from .jit import kernel
 N_PAR = 22
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def closed_angle(par, local, period):
     """Angle past intake closing [rad] if the local angle ``local`` is in the closed part, else
     −1."""
@@ -50,14 +50,14 @@ def closed_angle(par, local, period):
     return x if x < par[CLOSED] else -1.0
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def volume(mech, par, local):
     """Cylinder volume V = V_c + F_p·s at the local angle [m³] (s from the true TDC)."""
     s = slider(local, mech[R], mech[L], mech[E])[0]
     return par[V_C] + par[AREA] * s
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def release_rate(par, x, fuel):
     """dQ_b/dx [J/rad] at ``x`` past intake closing inside the combustion: Wiebe's rate times
     the cycle's heat (the normalised angle kept in [0, 1]: a step's stages may reach a hair past
@@ -67,7 +67,7 @@ def release_rate(par, x, fuel):
     return fuel * par[Q_FULL] * a * (m + 1.0) * y ** m * math.exp(-a * y ** (m + 1.0)) / par[DURATION]
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def wall_heat(par, burnt, p, V, T, w):
     """Q̇_w [W], the heat flow into the walls at gas temperature T (Woschni's h, see the module
     docstring); ``burnt``: past the combustion start (Woschni's combustion term on)."""
@@ -83,7 +83,7 @@ def wall_heat(par, burnt, p, V, T, w):
     return h * area * (T - par[T_WALL])
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def pressure_rate(mech, par, x, x_sel, local, p, dVdx, w, fuel):
     """(A, B) of dp/dx = A − B/ω at ``x`` past intake closing (module docstring). The combustion
     and Woschni's combustion term are on or off for the whole step, as the angle ``x_sel`` of

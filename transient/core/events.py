@@ -36,7 +36,7 @@ DEMAND_COMP = -1
 ON_LEVEL = 1e-12
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
     """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
     pair comp − PAIR_COMP, the PI demand u − level, else y[comp] − level."""
@@ -109,7 +109,7 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
 N_MARGIN_SAMPLES = 4
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
     """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
     holds the step's start and row N its end already)."""
@@ -148,7 +148,7 @@ def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel,
     return 2.0, n_samples
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
     margin evaluations (right-hand sides) the root finding took.
@@ -195,7 +195,7 @@ FIRST_PAIR_EVENT = 14
 N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _load_corner(m, ix, sw):
     """The load schedule's next corner on the independent variable ``ix`` (``inf`` if the
     schedule runs against the other variable, or has no corner ahead)."""
@@ -205,7 +205,7 @@ def _load_corner(m, ix, sw):
     return m.load_x[seg]
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _event_spec(m, cfg, e, angle_mode, sw):
     """State event number e that applies now: (code, component, level, direction), code −1 if
     none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
@@ -245,7 +245,7 @@ def _event_spec(m, cfg, e, angle_mode, sw):
     return -1, OMEGA, 0.0, 0
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _sleeve_event(m, e, sw):
     """The flyweight governor's events (``_event_spec``, e = 10 … 13): a moving sleeve reaching
     its low or high stop; on a stop, the speed at which the net force turns away from it."""
@@ -278,7 +278,7 @@ def _sleeve_stops(m, y, level, w):
     return gv.FREE
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _crosses(g0, g1, direction):
     """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
     rising = g0 < 0.0 <= g1
@@ -290,7 +290,7 @@ def _crosses(g0, g1, direction):
     return rising or falling
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _dense_once(ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist):
     """The last step's dense output into F, unless ``ready`` (it costs the pair's extra stages,
     so a step computes it only when an event or an output sample needs it); returns True."""
@@ -300,7 +300,7 @@ def _dense_once(ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, 
     return True
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _locate_events(tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist,
                    dip, dense_ready, w_lo, w_hi):
     """The earliest state event in the last step (from x, size h; accepted, not yet taken):
@@ -347,7 +347,7 @@ def _locate_events(tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tm
     return ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _pair_event(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
     """θ where pair k's margin first falls to zero in the step (2 if it does not), and whether
     only the stages saw it fall below zero (the samples, coarse and fine, did not)."""
@@ -363,7 +363,7 @@ def _pair_event(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
     return theta, only_stages
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _level_event(tab, m, angle_mode, x, h, y, y_new, K, F, code, comp, level, direction, w0, w1,
                  w_lo, w_hi, sel, sw, tmp, wk, ist, dense_ready):
     """θ where the speed, the PI demand or the state ``comp`` first crosses ``level`` (in

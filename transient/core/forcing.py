@@ -26,7 +26,7 @@ from .tabulated import tabulated_terms
 from .tables import find_piece, table_eval, table_eval_pair
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
     """J(φ) and dJ/dφ of the mechanism's moving parts; fills ``u[k]``, ``du[k]`` per cylinder.
     Without ``with_dJ`` dJ and ``du`` may be left NaN (the exact crank-slider skips them)."""
@@ -39,7 +39,7 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
     return swash_terms(mech, phi, u, du)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def select_pieces(m, sel, wk):
     """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL) and the gas table's piece there
     (WK_PIECE). ``sel`` is one angle for a whole step, so they are computed when it changes and
@@ -53,7 +53,7 @@ def select_pieces(m, sel, wk):
         wk[WK_SEL, 0] = sel
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def gas_value(m, k, phi, sel, wk):
     """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
@@ -67,7 +67,7 @@ def gas_value(m, k, phi, sel, wk):
     return value
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def gas_pair(m, k, phi, sel, wk):
     """Full-load and motored table values of cylinder k at shaft angle ``phi`` (``m.has_motored``
     only: ``m.coef`` pairs the two curves on common knots); ``sel``, ``wk`` as in
@@ -77,7 +77,7 @@ def gas_pair(m, k, phi, sel, wk):
                            local_sel + (phi - sel))
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def applied_value(m, k, phi, sel, f, wk):
     """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot).
 
@@ -93,7 +93,7 @@ def applied_value(m, k, phi, sel, f, wk):
     return m.gas_offset + f * (p - m.gas_offset)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def cylinder_value(m, k, y, sel, f, wk):
     """The pressure on piston k: its state in the closed part with wall heat transfer
     (``m.woschni``, :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
@@ -103,7 +103,7 @@ def cylinder_value(m, k, y, sel, f, wk):
     return applied_value(m, k, y[PHI], sel, f, wk)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
     """dp_k/dφ (crank angle) or dp_k/dt (time) of the cylinder pressure states (``m.woschni``):
     the first law with Wiebe's heat release and Woschni's wall heat (:mod:`.cylinder`); zero
@@ -124,14 +124,14 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
         out[c + k] = A - B / w if angle_mode else w * A - B
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def inertia(m, phi, wk):
     """Total reduced inertia J(φ), (19); fills the row u of ``wk``."""
     J, _ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, wk[WK_U], wk[WK_DU], False)
     return J + m.J0
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def speed(J, angle_mode, y):
     """ω from the state: y[2] itself in time mode, √(2K/J) in crank-angle mode (ω > 0 there)."""
     if angle_mode:
@@ -150,7 +150,7 @@ def governor_branch(m, w, rising):
     return 1
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def fuel(m, w, branch):
     """Fuel command f of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
     to 0 at ω_1c, 0 above; 1 without a governor. The cylinder pressure is p_mot + f·(p_full −
@@ -164,7 +164,7 @@ def fuel(m, w, branch):
     return (m.gov_zero - w) / (m.gov_zero - m.gov_full)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def command(m, w, y, sw):
     """The governor's fuel command at state ``y``: the rack of a dynamic governor (PI(D): its
     position state; flyweight: linked to the sleeve), else the droop characteristic (:func:`fuel`)."""
@@ -175,13 +175,13 @@ def command(m, w, y, sw):
     return fuel(m, w, sw[SW_GOVERNOR])
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def is_pi(m):
     """Whether the governor is a PI(D) one (its demand's clipping is a switch, ``SW_GOVERNOR``)."""
     return m.gov_dyn == gv.PI or m.gov_dyn == gv.PID
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def demand(m, w, y):
     """The PI(D) governor's demand u at state y (before clipping)."""
     return gv.pi_demand(m.gov_dyn, m.gov_par, w, y, gov_index(m))[1]
@@ -196,7 +196,7 @@ def start_branch(m, w, y):
     return governor_branch(m, w, True)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def governor_rates(m, w, y, scale, sw, wk, out):
     """Derivatives of the dynamic governor's states (× ``scale``: 1/ω in crank angle) and zero
     for the latched fuels, into ``out``; the PI demand's range over a step into ``wk``."""
@@ -229,7 +229,7 @@ def load_segment(m, x, rising):
     return j
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def load_scale(m, y, seg):
     """Scale s of the load at state ``y`` in schedule segment ``seg``: 1 without a schedule, the
     first (last) value before (after) the corners, linear between two of them.
@@ -258,7 +258,7 @@ def generator_branch(m, w, rising):
     return 0
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     """Reduced inertia, speed and moments at state ``y``.
 

@@ -70,7 +70,7 @@ STATE_NAMES = ((), ("gov_integral", "gov_rack"), ("sleeve_lift", "sleeve_speed")
 STATE_UNITS = ((), ("1", "1"), ("m", "m/s"), ("1", "1", "rad/s"))
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def n_states(kind):
     """Number of states of governor ``kind``."""
     if kind == PID:
@@ -85,7 +85,7 @@ def n_states(kind):
 AT_MAX, BETWEEN, AT_MIN = range(3)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def pi_demand(kind, par, w, y, g):
     """(e, u): relative speed error and the PI or PID demand; states from y[g]."""
     e = (par[P_REF] - w) / par[P_REF]
@@ -95,7 +95,7 @@ def pi_demand(kind, par, w, y, g):
     return e, u
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def clipped(par, u, branch):
     """u_s: the demand on the branch's side of the limits (u itself between them, extrapolated
     across a limit inside a step until its event switches the branch)."""
@@ -116,7 +116,7 @@ def demand_branch(par, u, rising):
     return BETWEEN
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def pi_rates(kind, par, w, y, g, branch, scale, out):
     """Time derivatives of the PI(D) states, times ``scale`` (1/ω in crank angle), into out[g:];
     returns the demand u."""
@@ -130,14 +130,14 @@ def pi_rates(kind, par, w, y, g, branch, scale, out):
     return u
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def sleeve_force(par, w, z, v):
     """Net axial force on the flyweight governor's sleeve [N] (the module's equation)."""
     rho = par[F_RHO0] + par[F_ARM] * z
     return par[F_CENT] * rho * w * w - (par[F_PRELOAD] + par[F_SPRING] * z) - par[F_DAMP] * v
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def flyweight_rates(par, w, y, g, sleeve, scale, out):
     """Time derivatives of (z, ż), times ``scale``; zero on a stop (``sleeve`` ≠ FREE)."""
     if sleeve != FREE:
@@ -149,7 +149,7 @@ def flyweight_rates(par, w, y, g, sleeve, scale, out):
     out[g + FW_RATE] = sleeve_force(par, w, y[g + FW_LIFT], v) / par[F_MASS] * scale
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def rack_of_lift(par, z):
     """Fuel command of the rack linked to the sleeve at lift z."""
     return par[F_FMAX] + (par[F_FMIN] - par[F_FMAX]) * z / par[F_TRAVEL]

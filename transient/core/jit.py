@@ -29,6 +29,8 @@ import numba
 from numba import config, njit, types
 from numba.core import sigutils
 from numba.core.caching import FunctionCache
+from numba.core.codegen import CPUCodeLibrary
+from numba.core.itanium_mangler import mangle_identifier
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
 
@@ -171,12 +173,58 @@ def _compile_per_type(dispatcher):
     dispatcher.get_call_template = get_call_template
 
 
-def kernel(fn=None, **options):
-    """``@kernel`` or ``@kernel(inline="always")``: compiled, no reference counting.
+def kernel(fn=None, *, inline=False, **options):
+    """``@kernel`` or ``@kernel(inline=True)``: compiled, no reference counting.
 
-    Without ``inline="always"`` a kernel is a call in machine code, and numba passes a tuple
-    argument flattened, by value: each array as its pointers, sizes, shape and strides. The
-    Model tuple is ~150 words, copied onto the stack at every such call. numba's inlining copies
-    the callee's IR at every call site, which lengthens a cold compile, so inline what runs per
-    step at one or two sites, not everything (:mod:`.integrate` says what)."""
+    A kernel is a compile unit of its own. As a plain call in machine code, numba passes a tuple
+    argument flattened, by value: each array as its pointers, sizes, shape and strides, so the
+    Model tuple's ~150 words would be copied onto the stack at every call. With ``inline=True``
+    LLVM inlines the kernel at every call site (:func:`_inlined_by_llvm`), where the copy
+    vanishes: the machine code is that of one function, while numba types and lowers each
+    kernel once. numba's own inlining (``inline="always"``) copies the callee's IR into every
+    caller before typing it, which made the cold compile grow with the nesting of calls."""
+    if fn is None:
+        return lambda f: kernel(f, inline=inline, **options)
+    if inline:
+        if REPLACEMENTS_ON:
+            _INLINED_BY_LLVM.add(_symbol_prefix(fn))
+        else:  # (numba's inliner: the same machine code, a slower compile)
+            options["inline"] = "always"
     return compiled(fn, _nrt=False, **options)
+
+
+#: The symbol prefixes of the kernels that LLVM inlines at their call sites.
+_INLINED_BY_LLVM: set[str] = set()
+
+
+def _symbol_prefix(fn) -> str:
+    """The start of the symbols numba gives ``fn``'s compiled versions: the Itanium-mangled
+    qualified name, then its ABI tags (``B…``) and argument types (which vary)."""
+    return "_ZN" + mangle_identifier(f"{fn.__module__}.{fn.__qualname__}")[1:-1] + "B"
+
+
+def _inlined_by_llvm(get_module_for_linking):
+    """numba's ``CPUCodeLibrary._get_module_for_linking``, with the kernels compiled with
+    ``inline=True`` marked ``alwaysinline``.
+
+    numba links the module of each callee into its caller's and optimizes the whole with LLVM,
+    whose inliner then takes every function so marked. The module for linking is also what
+    numba's cache stores beside the machine code, so a callee loaded from the cache is inlined
+    alike."""
+
+    def get_marked_module(library):
+        module = get_module_for_linking(library)
+        prefixes = tuple(_INLINED_BY_LLVM)
+        for fn in module.functions:
+            if fn.is_declaration or not fn.name.startswith(prefixes):
+                continue
+            if not {bytes(a) for a in fn.attributes} & {b"alwaysinline", b"noinline"}:
+                fn.add_function_attribute("alwaysinline")
+        return module
+
+    return get_marked_module
+
+
+if REPLACEMENTS_ON:
+    CPUCodeLibrary._get_module_for_linking = _inlined_by_llvm(
+        CPUCodeLibrary._get_module_for_linking)

@@ -129,19 +129,19 @@ Model = namedtuple(
 )
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def gov_index(m):
     """Index of the dynamic governor's first state."""
     return N_STATE_BASE + m.n_pairs
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def latch_index(m):
     """Index of cylinder 0's latched fuel (with ``m.latch``)."""
     return N_STATE_BASE + m.n_pairs + gv.n_states(m.gov_dyn)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def cyl_index(m):
     """Index of cylinder 0's pressure state (with ``m.woschni``), after the latched fuels."""
     return latch_index(m) + (m.ncyl if m.latch else 0)

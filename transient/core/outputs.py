@@ -23,7 +23,7 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
     output_row_inline(m, angle_mode, y, sel, sw, wk, row)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
     (p_mot + f·(p_full − p_mot), see :func:`applied_value`), ``PAIR_OUTPUTS`` of each pair, the
@@ -55,7 +55,7 @@ def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
         j += 1
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def pair_rows(m, w, w_loss, wk, out):
     """``PAIR_OUTPUTS`` of each pair from the rows η*, S of ``wk``; ``w_loss``: energy lost so far."""
     np_ = len(PAIR_OUTPUTS)

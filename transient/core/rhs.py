@@ -18,7 +18,7 @@ from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T,
                      WK_SCRATCH, WK_SPEED)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
     """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
 
@@ -42,14 +42,14 @@ def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
     wk[WK_M, m.link_sub[last]] += M_gas
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def pair_etas(m, modes, eta_out):
     """η*_k of (25) for the mode bit mask ``modes`` (bit k set: pair k backward)."""
     for k in range(m.n_pairs):
         eta_out[k] = eta_star(m.eta_fwd[k], m.eta_bwd[k], ((modes >> k) & 1) == 0)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)."""
     if m.n_pairs == 0:
@@ -57,7 +57,7 @@ def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
     and the pairs' η*, S in the rows of ``wk``."""
@@ -68,7 +68,7 @@ def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
                        wk[WK_S, :n])
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def derivative(m, angle_mode, y, sel, sw, wk, out):
     """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
 
@@ -114,7 +114,7 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
         out[OMEGA] = a
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def mode_margins(m, sw, wk):
     """How far each pair's held mode is from switching, into ``wk[WK_G]`` (after
     :func:`acceleration`); a mode switch is due where a margin falls to zero.
@@ -134,7 +134,7 @@ def mode_margins(m, sw, wk):
             wk[WK_G, k] = v * sigma
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def margins_inline(m, angle_mode, y, sel, sw, wk):
     """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``; inlined into the
     stepper's root finder, whose iterations evaluate them most: there a call would copy the Model

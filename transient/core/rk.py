@@ -6,8 +6,8 @@ One set of functions for every pair in :mod:`.tableaus` (DOP853, DOPRI5), passed
 know the state vector's layout only as far as the error control needs it (which components are
 controlled and how the accumulating ones are scaled), and nothing of events or of the stepper's
 bookkeeping, which :mod:`.stepper` keeps. The step, the error norm and the stiffness estimate
-run once per step attempt and are inlined into it: as calls they would copy the Model's flattened
-fields onto the stack (:mod:`.jit`).
+run once per step attempt and are inlined into it by LLVM: as calls they would copy the Model's
+flattened fields onto the stack (:func:`.jit.kernel`).
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 PI_BETA = 0.04
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _controlled(i, ix, g0, g1, c0):
     """Whether state component i is error-controlled: the dynamics' (but the independent
     variable ``ix``), the governor's y[g0:g1] and the cylinder pressures y[c0:]. The work
@@ -32,7 +32,7 @@ def _controlled(i, ix, g0, g1, c0):
     return i != ix and (i < N_DYNAMIC or g0 <= i < g1 or i >= c0)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0):
     """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
     the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5), over the components
@@ -64,7 +64,7 @@ def _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0):
     return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * (N_DYNAMIC - 1 + g1 - g0 + n - c0))
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol):
     """Estimate of h·λ over the step (Hairer, *Solving ODEs II*, §IV.2): the last main stage and
     the FSAL stage both sit at the step's end, and ‖f(y₁) − f(y_s)‖/‖y₁ − y_s‖ estimates the
@@ -89,13 +89,13 @@ def _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol):
     return abs(h) * np.sqrt(num / den)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _shrink(tab, err):
     """The factor on the step size after a step rejected with error norm ``err`` > 1."""
     return max(MIN_FACTOR, SAFETY * err ** -tab.exponent)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _grow(tab, err, err_old, after_rejection):
     """The factor on the step size after a step accepted with error norm ``err``; ``err_old`` is
     the last accepted step's.
@@ -111,7 +111,7 @@ def _grow(tab, err, err_old, after_rejection):
     return factor
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """One Runge–Kutta step of size h from (x, y) with f = y′; K[0] must hold f.
 
@@ -119,8 +119,8 @@ def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """
     n = y.shape[0]
     ns = tab.n_stages
-    # Stage ns is the derivative at the new state (FSAL: row ns of A holds B). One call site, as
-    # ``rhs.derivative`` is inlined wherever it is called.
+    # Stage ns is the derivative at the new state (FSAL: row ns of A holds B). One call site,
+    # because ``rhs.derivative`` is inlined wherever it is called.
     for s in range(1, ns + 1):
         for i in range(n):
             acc = 0.0
@@ -176,7 +176,7 @@ def _dense_eval(F, y, theta, out):
         out[i] = y[i] + acc
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _dense_state(F, y, x, h, theta, ix, out):
     """State at fraction θ of the last step (from x, size h), its independent variable ``ix``
     exactly x + θh."""

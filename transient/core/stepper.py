@@ -10,35 +10,32 @@ it integrates in time, and a step that would cross a breakpoint is retaken so th
 (:mod:`.breakpoints`). The events (:mod:`.events`) truncate the step they fall in; acting on one
 changes the switches, the state or the independent variable (:func:`_switch_at_event`).
 
-Each turn of the loop in :func:`_advance` is: the segment's end
+Each turn of the loop in :func:`advance` is: the segment's end
 (:func:`.breakpoints._segment_end`) and the step size (:func:`_step_size`), a step attempt
 (:func:`_start_attempt`, the step, :func:`_judge_attempt`), its acceptance or rejection and the
 next step size, the retake for a breakpoint crossed in time, the event location
 (:func:`.events._locate_events`), the output samples inside the step (:func:`_emit_step_samples`),
 and either the step taken whole (:func:`_take_step`) or the state moved to the event and the event
-acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`). The step and
-the right-hand side at a restart are called in the loop itself, not inside a piece: inlined
-functions nested a level deeper cost numba's inliner noticeably more compile time.
+acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`).
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks
 (:mod:`.stepper_io`).
 
-The pieces of the loop, and the helpers called once per step or per root-finding iteration that
-take the Model, are inlined (``inline="always"``), each at its one call site or at a few where it
-is small: a call that is not inlined copies the Model's ~150 flattened words onto the stack
-(:mod:`.jit`). Calls that run rarely, or whose callee is too large to copy at several sites (the
-dense output, the margins, the output row), stay calls. The margins and the output row are
-inlined at one site each, into a small function: the margins into the root finder, whose
-iterations evaluate them most (``rhs.margins_inline``), the output row into the writing of the
-grid's samples (``outputs.output_row_inline``); inlining the margins into the step's samples too
-would cost much cold compile for little.
+Every function here is a compile unit of its own (:func:`.jit.kernel`). The pieces of the loop,
+and the helpers called once per step or per root-finding iteration that take the Model, are
+inlined by LLVM (``kernel(inline=True)``) at each call site: a call that is not inlined copies
+the Model's ~150 flattened words onto the stack. Calls that run rarely, or whose callee is too
+large to copy at several sites (the dense output, the margins, the output row), stay calls. The
+margins and the output row are inlined at one site each, into a small function: the margins
+into the root finder, whose iterations evaluate them most (``rhs.margins_inline``), the output
+row into the writing of the grid's samples (``outputs.output_row_inline``).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .jit import compiled, kernel
+from .jit import kernel
 
 from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .chain import AMBIGUOUS, NONE_CONSISTENT
@@ -75,8 +72,19 @@ STIFF_COUNT, NONSTIFF_RESET = 15, 6
 CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
 
 
-@compiled(nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
-def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
+def buffers(m, tab, n: int) -> tuple:
+    """The work arrays of one call of :func:`advance`, after its first nine arguments: the
+    stages ``K``, the dense output ``F``, the derivative ``f``, three states, the right-hand
+    side's scratch ``wk`` and the pairs' margins over a step ``gs``. Allocated by the caller,
+    so that the stepper is one compile unit of its own, without reference counting. ``n``: the
+    length of the state."""
+    return (np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
+            np.empty(n), np.empty(n), np.empty(n), work_array(m),
+            np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))))
+
+
+@kernel(nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
+def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk, gs):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 
     Parameters
@@ -97,6 +105,8 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
         Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
     evbuf : float64[nev, 4]
         Events (code, t, φ, ω); ``ist[I_NEV]`` rows filled.
+    K, F, f, y_new, y_evt, tmp, wk, gs
+        Work arrays, fresh for each call (:func:`buffers`).
 
     Returns
     -------
@@ -106,18 +116,6 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf):
         the applied moments), CHATTERING (pair modes switching without progress) or STIFF
         (Hairer's stiffness test fired).
     """
-    n = n_state(m)
-    K = np.empty((tab.n_ext, n))
-    F = np.empty((3 + tab.D.shape[0], n))
-    gs = np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1)))  # pair mode margins over a step
-    return _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, np.empty(n), np.empty(n),
-                    np.empty(n), np.empty(n), work_array(m), gs)
-
-
-@kernel
-def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk, gs):
-    """:func:`advance` in buffers allocated by it, compiled as a kernel (no reference counting,
-    :mod:`.jit`): the stepper loop passes arrays to its helpers at every step."""
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     margin = 300  # rows kept free: a step never spans more than 256 output intervals
@@ -154,8 +152,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
             _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
             return STALLED
         if ist[I_F_VALID] == 0:
-            # The derivative and the pairs' margins afresh (called here, not in a helper: an
-            # inlined right-hand side nested a level deeper costs numba's inliner much more).
+            # The derivative and the pairs' margins afresh.
             ahead = _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf)
             derivative(m, angle_mode, y, ahead, sw, wk, f)
             _restarted(cfg, angle_mode, fst, ist)
@@ -175,9 +172,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
         else:
             sel = y[PHI] + 0.5 * h * y[OMEGA]
 
-        # The step attempt (the step called here, not in a helper: its inlined right-hand side
-        # nested a level deeper costs numba's inliner much more), its acceptance and the next
-        # step size.
+        # The step attempt, its acceptance and the next step size.
         _start_attempt(f, K, wk)
         _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
         finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
@@ -253,7 +248,7 @@ def _advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt,
                          ist, fst, wk)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk):
     """The first chunk's start: the switches chosen at the initial state, the independent
     variable, the output grid and the first row. Returns RUNNING, or LOCKED where the pairs'
@@ -275,7 +270,7 @@ def _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk):
     return RUNNING
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf):
     """Where the step before did not leave the derivative and the margins valid (a start, an
     event, a breakpoint that changes the state or where a pressure jumps): the pairs' margins
@@ -290,7 +285,7 @@ def _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf):
     return ahead
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _restarted(cfg, angle_mode, fst, ist):
     """The derivative at the state is valid again; the first step's size if none is set."""
     ist[I_NFEV] += 1
@@ -300,7 +295,7 @@ def _restarted(cfg, angle_mode, fst, ist):
         fst[F_H] = 0.05 if angle_mode else 0.05 * cfg[C_DT_OUT]
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end):
     """The size of the next attempt, the size planned before a cut to the segment's end, and
     whether the attempt ends on the segment's end: ``(h, h_planned, at_segment_end)``."""
@@ -313,7 +308,7 @@ def _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end):
     return h, h_planned, at_segment_end
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _start_attempt(f, K, wk):
     """Before a step attempt: its first stage is the derivative carried over, and the ranges
     its stages record (the margins' least values, the speed's and the PI demand's ranges) are
@@ -327,7 +322,7 @@ def _start_attempt(f, K, wk):
     wk[WK_DEMAND, 1] = -np.inf
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, c0, on_corner,
                    corner):
     """After the step attempt of size h from y (stages in K, new state in y_new): ``(finite, err,
@@ -357,7 +352,7 @@ def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, 
     return finite, err, dip, w_lo, w_hi
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _accepted_size(tab, err, h, h_planned, at_segment_end, after_rejection, fst):
     """The next step's size after a step of size h accepted with error norm ``err``; keeps the
     error for the next step's PI control."""
@@ -370,7 +365,7 @@ def _accepted_size(tab, err, h, h_planned, at_segment_end, after_rejection, fst)
     return h_next
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
     """Count an accepted step in Hairer's stiffness test (``STIFF_COUNT``); True when stiff."""
     if _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol) > tab.stiff_bound:
@@ -383,7 +378,7 @@ def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
     return False
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F, tmp,
                        wk, outbuf, ist, fst, dense_ready):
     """The output grid's samples inside the step, up to ``x_stop`` (its end, or its event), from
@@ -394,7 +389,7 @@ def _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel,
                       ist, fst, tmp, wk)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_breakpoint, y,
                y_new, f, K, gs, sel, sw, outbuf, evbuf, ist, fst, wk):
     """The accepted step, without an event in it, becomes the state (with its derivative and
@@ -428,7 +423,7 @@ def _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_
     return RUNNING
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level, ends_on_breakpoint,
                    x_end, tol_end, F, y, y_evt, sel, sw, wk, ist):
     """The state at the event (at θ = ``ev_theta`` of the step, independent variable
@@ -462,7 +457,7 @@ def _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level, ends_
     return x_stop, on_breakpoint
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw, outbuf,
                   evbuf, ist, fst, wk):
     """The event (and a breakpoint it sits on) into the event buffer, and the ends of a run it
@@ -494,7 +489,7 @@ def _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel
     return RUNNING
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y, ist,
                      fst, wk):
     """What the event switches: a pair's mode, the starter, the governor's branch, the load
@@ -547,7 +542,7 @@ def _to_time_mode(m, y, ist, wk):
     ist[I_ANGLE_MODE] = 0
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _settle_modes(m, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
     just switched sits on its level (margin 0). Any other pair already past its level here (two

@@ -63,14 +63,14 @@ def fst_size(m):
     return N_FST + n_state(m) + max(m.n_pairs, 1)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _retake(fst, ist, h):
     """The step attempt is computed again with size ``h``, counted as a rejection."""
     fst[F_H] = h
     ist[I_NREJECT] += 1
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _carry(fst, f, gs, n_pairs, keep):
     """The derivative ``f`` at the state and the pairs' margins there (``gs[0]``) into the stepper's
     state ``fst`` (``keep``) or back from it (F_DERIV): what a chunk leaves valid, the next takes
@@ -107,7 +107,7 @@ def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
     _count_row(y, ist, fst)
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _count_row(y, ist, fst):
     """The bookkeeping after a row is written at state ``y``."""
     ist[I_NOUT] += 1
@@ -131,7 +131,7 @@ def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, t
         fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _out_spacing(cfg, angle_mode):
     return cfg[C_DPHI_OUT] if angle_mode else cfg[C_DT_OUT]
 

@@ -63,7 +63,7 @@ def find_piece(knots, piece_knot, x):
     return lo
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _interval(knots, piece_knot, piece, x):
     """The knot interval of ``piece`` that holds x (bisection). Only the piece's own intervals
     are searched: the same result as a global search clamped into the piece, and fewer

@@ -19,7 +19,7 @@ from .jit import kernel
 TWO_PI = 2.0 * math.pi
 
 
-@kernel(inline="always")
+@kernel(inline=True)
 def _poly5(c, x):
     """Value and derivative of c[0] + c[1]x + … + c[5]x⁵ (Horner)."""
     v = c[5]
