@@ -846,8 +846,11 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert [s["revolutions"] for s in res["scale"]] == [10.0, 100.0]
     assert all(s["peak_mb"] > 10 and s["wall_per_1000_s"] > 0 for s in res["scale"])
     assert 0 < res["warm_start"]["python_alone_s"] < res["warm_start"]["median_s"]
+    cold = res["cold_start"]  # (quick: on warm caches, the harness only)
+    assert not cold["cold"] and cold["compile_s"] >= 0 and cold["run_wall_s"] > 0
+    assert "(quick: caches warm)" in targets and "## Cold compile profile" in targets
     lines = verdicts(res)
-    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 \
+    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 2 \
         + len(BENCH_SCENES) * len(ADAPTIVE) + 2
     for target, case, measured, verdict in lines:
         assert verdict in ("met", "met at the baseline's best error", "**missed**",

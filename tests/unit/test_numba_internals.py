@@ -504,3 +504,57 @@ def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cac
     assert probe("together", "caller") == ["False", "True", "0"]  # inlined, a call, compiled
     assert probe("apart", "callees") == ["1.5"]
     assert probe("apart", "caller") == ["False", "True", "1"]  # the same, loaded
+
+
+# ----------------------------------------------------------------------------------------------
+# _SharedLocator
+
+SHARED = "transient.core.jit._SharedLocator"
+
+SHARE_PROBE = """
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("kern", sys.argv[1])
+module = sys.modules["kern"] = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+from transient.core.jit import compiled
+double = compiled(module.double)
+assert double(2.5) == float(sys.argv[2])
+print(sum(double.stats.cache_hits.values()), sum(double.stats.cache_misses.values()))
+"""
+
+
+def test_copies_of_the_sources_at_other_paths_share_the_cache_and_other_sources_do_not(tmp_path):
+    """A cluster's nodes or a fresh clone: the same module at another path (another mtime too)
+    loads what the first saved; changed contents compile afresh."""
+    first, second, changed = (tmp_path / name / "kern.py" for name in ("a", "b", "c"))
+    for path, body in ((first, "2 * x"), (second, "2 * x"), (changed, "3 * x")):
+        path.parent.mkdir()
+        path.write_text(f"def double(x):\n    return {body}\n")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+
+    def probe(source, result) -> list[str]:
+        run = subprocess.run([sys.executable, "-c", SHARE_PROBE, str(source), result], cwd=REPO,
+                             env=env, capture_output=True, text=True, timeout=300)
+        assert run.returncode == 0, run.stderr
+        return run.stdout.split()
+
+    assert probe(first, "5.0") == ["0", "1"]  # compiled
+    assert probe(second, "5.0") == ["1", "0"], _relies(
+        SHARED, "numba's cache folder being the locator's get_cache_path()")
+    assert probe(changed, "7.5") == ["0", "1"], _relies(
+        SHARED, "numba's index keyed by a hash of the source's contents (get_source_stamp)")
+    assert [p.name for p in (tmp_path / "numba").iterdir() if "kern" in p.name] == ["kern"]
+
+
+def test_shared_locator_is_numbas_user_provided_locator_with_another_folder():
+    assert _parameters(caching.UserProvidedCacheLocator.__init__) == ["self", "py_func",
+                                                                     "py_file"], _relies(
+        SHARED, "numba.core.caching.UserProvidedCacheLocator(py_func, py_file)")
+    assert "self._cache_path = os.path.join(config.CACHE_DIR, cache_subpath)" in _statements(
+        caching.UserProvidedCacheLocator.__init__), _relies(
+        SHARED, "UserProvidedCacheLocator keeping its folder in self._cache_path")
+    assert caching.UserProvidedCacheLocator.get_cache_path(
+        type("L", (), {"_cache_path": "x"})()) == "x"
+    assert "_locator_classes" in vars(caching.CompileResultCacheImpl) or hasattr(
+        caching.CompileResultCacheImpl, "_locator_classes"), _relies(
+        SHARED, "numba.core.caching._CacheImpl._locator_classes")

@@ -1,4 +1,5 @@
-"""``transient run``, ``check`` and ``info``: simulate a scene, validate one, summarise a result."""
+"""``transient run``, ``check``, ``info`` and ``warmup``: simulate a scene, validate one, summarise
+a result, compile the kernels ahead of a first run."""
 from __future__ import annotations
 
 import math
@@ -28,6 +29,15 @@ def register(sub) -> None:
     i = sub.add_parser("info", help="summarise a result file")
     i.add_argument("result")
     i.set_defaults(func=cmd_info)
+    w = sub.add_parser("warmup", help="compile the kernels ahead of a first run",
+                       description="Compile (or load from the cache) every kernel a run needs, "
+                                   "by running built-in scenes and the scenes given for a "
+                                   "fraction of a revolution; one line per kernel compiled. "
+                                   "The cache folder is $TRANSIENT_CACHE_DIR, else "
+                                   "~/.cache/transient.")
+    w.add_argument("scenes", nargs="*", metavar="scene",
+                   help="scenes whose mechanisms' kinematics to compile too")
+    w.set_defaults(func=cmd_warmup)
 
 
 def cmd_check(args) -> int:
@@ -216,4 +226,21 @@ def cmd_info(args) -> int:
     if arrays:
         print(f"  analyses asked for by the scene ([analysis]; {len(arrays)} arrays): "
               + ", ".join(arrays))
+    return EXIT_OK
+
+
+def cmd_warmup(args) -> int:
+    from numba import config
+
+    from ..scene import load_scene
+    from ..warmup import warm_up
+
+    scenes = [load_scene(path) for path in args.scenes]  # (every scene valid before any work)
+
+    def report(kernel) -> None:
+        print(f"{'  ' * kernel.depth}compiled {kernel.name} in {kernel.wall_s:.2f} s", flush=True)
+
+    print(f"kernels in {config.CACHE_DIR}", flush=True)
+    compiled = warm_up(scenes, report)
+    print(f"{len(compiled)} kernel(s) compiled" if compiled else "all kernels were cached")
     return EXIT_OK

@@ -1,7 +1,7 @@
 """Every numba-compiled function of transient (kinematics, reduced model, stepper).
 
-Numba's on-disk cache checks only the timestamp of the file that defines a function, not of the
-kernels it calls from other files: after an edit to ``tables.py`` a cached ``model.gas_value``
+Numba's on-disk cache checks only the file that defines a function (a hash of its contents), not
+the kernels it calls from other files: after an edit to ``tables.py`` a cached ``model.gas_value``
 would keep the old code. So the cache lives in a folder named by a hash of all the sources in
 this package, unless the user sets ``NUMBA_CACHE_DIR`` (then that folder is used as it is).
 """
@@ -24,10 +24,17 @@ def source_hash(root: Path, pattern: str) -> str:
     return h.hexdigest()
 
 
+#: The environment variable naming transient's cache folder (a shared file system's folder lets
+#: the nodes of a cluster compile once per CPU model).
+CACHE_DIR_VARIABLE = "TRANSIENT_CACHE_DIR"
+
+
 def cache_root() -> Path:
-    """``$XDG_CACHE_HOME/transient`` (``~/.cache/transient`` when unset or empty), where
-    transient keeps what it computes once: numba's kernels here, the Wiebe cycles' tables
-    (:mod:`transient.forces.wiebe_cache`)."""
+    """``$TRANSIENT_CACHE_DIR``, else ``$XDG_CACHE_HOME/transient`` (``~/.cache/transient`` when
+    unset or empty), where transient keeps what it computes once: numba's kernels here, the Wiebe
+    cycles' tables (:mod:`transient.forces.wiebe_cache`)."""
+    if os.environ.get(CACHE_DIR_VARIABLE):
+        return Path(os.environ[CACHE_DIR_VARIABLE]).expanduser()
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "transient"
 
 

@@ -1,15 +1,16 @@
 """The compile decorators of transient's numba functions.
 
-``compiled`` is ``numba.njit`` with numba's on-disk cache and three replacements of numba
+``compiled`` is ``numba.njit`` with numba's on-disk cache and five replacements of numba
 internals, each for its gain: the cache loads without numba's compiler registries
-(:class:`_RegistryFreeCache`), constants passed between kernels share one compile
-(:func:`_compile_per_type`), and processes compiling the same function take turns
-(:func:`_compile_once_across_processes`). ``kernel`` is ``compiled`` without numba's reference
-counting (``_nrt=False``), because with it every call that passes arrays — the
+(:class:`_RegistryFreeCache`) from a folder that copies of the sources at other paths share
+(:class:`_SharedLocator`), constants passed between kernels share one compile
+(:func:`_compile_per_type`), processes compiling the same function take turns
+(:func:`_compile_once_across_processes`), and LLVM inlines the kernels marked so
+(:func:`_inlined_by_llvm`). ``kernel`` is ``compiled`` without numba's reference counting
+(``_nrt=False``), because with it every call that passes arrays — the
 :data:`transient.core.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
 an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
-caller allocated); the few that allocate (the stepper's ``advance``, work arrays) are
-``compiled``.
+caller allocated); the few that allocate (work arrays) are ``compiled``.
 
 The replacements rely on numba internals, so they are on only under the numba release they were
 checked against (:data:`NUMBA_CHECKED`, pinned in pyproject.toml;
@@ -28,7 +29,7 @@ from contextlib import contextmanager
 import numba
 from numba import config, njit, types
 from numba.core import sigutils
-from numba.core.caching import FunctionCache
+from numba.core.caching import CompileResultCacheImpl, FunctionCache, UserProvidedCacheLocator
 from numba.core.codegen import CPUCodeLibrary
 from numba.core.itanium_mangler import mangle_identifier
 from numba.core.compiler_lock import global_compiler_lock
@@ -58,9 +59,30 @@ if not REPLACEMENTS_ON:
 COMPILE_LOCK = "{}.compile.lock"
 
 
+class _SharedLocator(UserProvidedCacheLocator):
+    """numba's locator of a function's cache files in ``numba.config.CACHE_DIR``, with their
+    folder named by the function's module (``transient.core.rhs``) where numba names it by a hash
+    of the source file's absolute path: copies of the same sources at other paths (the nodes of a
+    cluster, a clone and its worktrees, a fresh virtual environment) share one cache. numba's
+    index keys each entry by a hash of the source's contents and by the CPU (its codegen's magic
+    tuple), so other sources or another CPU never load each other's code."""
+
+    def __init__(self, py_func, py_file):
+        super().__init__(py_func, py_file)
+        self._cache_path = os.path.join(config.CACHE_DIR, py_func.__module__)
+
+
+class _SharedCacheImpl(CompileResultCacheImpl):
+    """numba's cache of compile results, found by :class:`_SharedLocator` first."""
+
+    _locator_classes = [_SharedLocator, *CompileResultCacheImpl._locator_classes]
+
+
 class _RegistryFreeCache(FunctionCache):
-    """numba's on-disk cache of a function, loading its machine code without first loading
-    numba's compiler registries.
+    _impl_class = _SharedCacheImpl
+
+    """numba's on-disk cache of a function, in the folder :class:`_SharedLocator` names, loading
+    its machine code without first loading numba's compiler registries.
 
     numba's ``load_overload`` begins with ``target_context.refresh()``, which imports and
     installs the typing and lowering registries of everything numba compiles (its numpy, typed

@@ -10,7 +10,11 @@ measured, how, and whether it is met or by how much it is missed.
 * the bare scene (equation (18) alone) against a kernel written by hand for that equation
   (within 5 %), and the bare scene against itself carrying unused options (no measurable change);
 * warm start (≤ 1 s process wall of ``transient run``) and scale (wall time per revolution at 10⁶
-  revolutions within 10 % of 10³, peak memory independent of the length), each in new processes.
+  revolutions within 10 % of 10³, peak memory independent of the length), each in new processes;
+* cold start, each in new processes on an empty cache: the first ``transient run`` of the default
+  scene (its compile ≤ 20 s), ``transient warmup`` of every bench scene and a radial engine (≤ 60
+  s), and the profile of the default scene's compile, function by function
+  (:class:`transient.warmup.CompileLog`).
 
 Timings are medians after a warm-up; what is compared runs alternately, so that the machine's
 drift shows in both sides alike.
@@ -20,6 +24,7 @@ from __future__ import annotations
 import dataclasses as dc
 import json
 import math
+import os
 import statistics
 import subprocess
 import sys
@@ -31,12 +36,14 @@ import numpy as np
 from numba import njit
 
 from ..assemble import build_model
+from ..core import CACHE_DIR_VARIABLE
 from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS,
                     SAMPLES_PER_REV, TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight,
                     on_plateau, order_slope, read_record)
 from ..core import layout
 from ..core.jit import kernel
 from ..core.rhs import derivative
+from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
 
@@ -47,6 +54,14 @@ CALLS_PER_STEP = 12
 #: Settings of the overhead and bare-scene runs: 1000 revolutions at rtol 1e-8, atol 1e-11.
 RUN_RTOL, RUN_ATOL = 1e-8, 1e-11
 OVERHEAD_TARGET, BARE_TARGET, WARM_TARGET_S, SCALE_TARGET = 0.30, 0.05, 1.0, 0.10
+#: Cold start: the first run's compile [s], the compile of every kernel (``transient warmup``) [s].
+COLD_RUN_TARGET_S, COLD_ALL_TARGET_S = 20.0, 60.0
+#: The default scene (``make run``) and the radial engine the cold start compiles besides the
+#: bench scenes.
+DEFAULT_SCENE = BENCH_SCENES["swash_plate_4cyl"]
+RADIAL_SCENE = DEFAULT_SCENE.parent / "radial_5cyl.toml"
+#: Functions named in the profile's table, by their own compile time; the rest are summed.
+PROFILE_ROWS = 15
 #: Peak memory counts as independent of the run's length if it grows by at most this fraction.
 MEMORY_TARGET = 0.01
 #: Output of the scale runs [samples per turn].
@@ -374,6 +389,65 @@ def scale(lengths=(1e3, 2e5, 1e6), samples_per_rev=SCALE_SAMPLES_PER_REV, scene=
 
 
 # ------------------------------------------------------------------------------------------------
+# cold start
+
+
+def _cold_env(cache: Path | None) -> dict:
+    """The environment of a child process whose caches are in ``cache`` (None: this process's)."""
+    env = dict(os.environ)
+    if cache is not None:
+        env.pop("NUMBA_CACHE_DIR", None)
+        env[CACHE_DIR_VARIABLE] = str(cache)
+    return env
+
+
+_PROFILE_CHILD = """
+import dataclasses, json, sys
+from transient import run
+run.start_helper = lambda *args: None  # (every compile in this process, for the log)
+from transient.scene import load_scene
+from transient.warmup import CompileLog
+with CompileLog() as log:
+    run.simulate(load_scene(sys.argv[1]))
+print(json.dumps([dataclasses.asdict(c) for c in log.compiled]))
+"""
+
+
+def compile_profile(scene: Path, cache: Path | None) -> list[dict]:
+    """The functions compiled by a run of ``scene`` in one process (no compile helper), with
+    their CPU seconds (:class:`transient.warmup.Compiled`), on the caches in ``cache``."""
+    out = subprocess.run([sys.executable, "-c", _PROFILE_CHILD, str(scene)], check=True,
+                         capture_output=True, text=True, env=_cold_env(cache)).stdout
+    return json.loads(out.splitlines()[-1])
+
+
+def cold_start(quick=False) -> dict:
+    """On empty caches, each in a new process: the first ``transient run`` of the default scene
+    (process wall and the compile it reports), ``transient warmup`` of the bench scenes and a
+    radial engine, and the default scene's compile profile. ``quick``: on this process's caches
+    (the harness only; nothing is compiled where they are warm)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        def cache(name: str) -> Path | None:
+            return None if quick else Path(tmp) / name
+
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "transient", "run", str(DEFAULT_SCENE), "-q",
+                        "-o", tmp], check=True, stdout=subprocess.DEVNULL,
+                       env=_cold_env(cache("run")))
+        run_wall = time.perf_counter() - t0
+        compile_s = open_result(Path(tmp) / f"{DEFAULT_SCENE.stem}.h5").solver["compile_s"]
+        scenes = [*map(str, BENCH_SCENES.values()), str(RADIAL_SCENE)]
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "transient", "warmup", *scenes], check=True,
+                       stdout=subprocess.DEVNULL, env=_cold_env(cache("warmup")))
+        warmup_wall = time.perf_counter() - t0
+        profile = compile_profile(DEFAULT_SCENE, cache("profile"))
+    return {"scene": DEFAULT_SCENE.stem, "cold": not quick, "run_wall_s": run_wall,
+            "compile_s": compile_s, "warmup_scenes": [Path(p).stem for p in scenes],
+            "warmup_wall_s": warmup_wall, "profile": profile}
+
+
+# ------------------------------------------------------------------------------------------------
 # from the record's rows: speed at equal accuracy, the error's fall with the tolerance
 
 
@@ -450,6 +524,8 @@ def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     progress("targets: warm start")
     res["scale"] = scale((10.0, 100.0) if quick else (1e3, 2e5, 1e6))
     progress("targets: scale")
+    res["cold_start"] = cold_start(quick)
+    progress("targets: cold start")
     return res
 
 
@@ -488,6 +564,7 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
     lines.append((f"warm start ≤ {WARM_TARGET_S:g} s", w["scene"],
                   f"{w['median_s']:.2f} s (interpreter alone {w['python_alone_s']:.2f} s)",
                   _missed(w["median_s"], WARM_TARGET_S)))
+    lines += _cold_verdicts(res.get("cold_start"))
     for m in res["monotone"]:
         rises = ", ".join(f"rtol {r:.0e} ×{k:.3g}" for r, k in m["rises"]) or "none"
         flat = ", ".join(f"{r:.0e} ×{k:.4f}" for r, k in m.get("flat", []))
@@ -511,6 +588,39 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
                   f"(peak {full[-1]['peak_mb']:.0f} MB)",
                   _missed(peak / full[0]["peak_mb"], MEMORY_TARGET)))
     return lines
+
+
+def _cold_verdicts(c) -> list[tuple[str, str, str, str]]:
+    """The cold start's verdicts (none in a record from before it was measured)."""
+    if c is None:
+        return []
+    how = "" if c["cold"] else " (quick: caches warm)"
+    return [(f"cold first run: compile ≤ {COLD_RUN_TARGET_S:g} s", c["scene"] + how,
+             f"{c['compile_s']:.1f} s (process wall {c['run_wall_s']:.1f} s)",
+             _missed(c["compile_s"], COLD_RUN_TARGET_S)),
+            (f"cold compile of every kernel ≤ {COLD_ALL_TARGET_S:g} s",
+             f"transient warmup {' '.join(c['warmup_scenes'])}{how}",
+             f"{c['warmup_wall_s']:.1f} s", _missed(c["warmup_wall_s"], COLD_ALL_TARGET_S))]
+
+
+def _profile_section(c) -> list[str]:
+    """The cold compile's profile: the functions of longest own compile, the rest summed."""
+    if c is None:
+        return []
+    rows = sorted(c["profile"], key=lambda r: -r["own_cpu_s"])
+    total = sum(r["own_cpu_s"] for r in rows)
+    rest = rows[PROFILE_ROWS:]
+    md = ["", "## Cold compile profile", "",
+          f"A run of `{c['scene']}.toml` in one process without the compile helper, on "
+          + ("an empty cache" if c["cold"] else "warm caches (quick)")
+          + f": {len(rows)} functions compiled in {total:.1f} s of CPU. Own: without the "
+          "callees compiled inside it; with callees: including them.", "",
+          "| function | own CPU [s] | with callees [s] |", "|---|---|---|",
+          *(f"| `{r['name']}` | {r['own_cpu_s']:.2f} | {r['cpu_s']:.2f} |"
+            for r in rows[:PROFILE_ROWS])]
+    if rest:
+        md.append(f"| the other {len(rest)} | {sum(r['own_cpu_s'] for r in rest):.2f} | |")
+    return md
 
 
 def write_targets(res, out: Path) -> Path:
@@ -546,6 +656,7 @@ def write_targets(res, out: Path) -> Path:
            "|---|---|---|",
            *(f"| {s['revolutions']:g} | {s['wall_per_1000_s']:.4g} | {s['peak_mb']:.1f} |"
              for s in res["scale"])]
+    md += _profile_section(res.get("cold_start"))
     path = out / "targets.md"
     path.write_text("\n".join(md) + "\n", encoding="utf-8")
     return path
