@@ -408,3 +408,9 @@ class Scene:
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
     analysis: Analysis = field(default_factory=Analysis)
+
+    def geometry(self) -> dict[str, tuple[float, str]]:
+        """What the mechanism's geometry implies, without a run, name → (value, unit) in SI
+        (:meth:`transient.mechanisms.Mechanism.geometry`): stroke, swept volume, displacement,
+        dead-centre angles, λ, each piston's stroke; what ``transient check`` prints."""
+        return self.mechanism.geometry()
