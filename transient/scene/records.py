@@ -369,8 +369,9 @@ class Analysis:
     of cylinder k (crank-slider). ``irregularity``: δ and the mean speed of every cycle.
     ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
     engine cycle.
-    ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
-    (:func:`transient.analysis.orders.order_spectrum`).
+    ``detrend``: what is done to ω before each cycle's DFT, as ``transient orders --detrend``:
+    ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
+    (:func:`transient.analysis.orders.order_spectrum`); other signals are not detrended.
     """
 
     loads: bool = False
