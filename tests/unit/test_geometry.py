@@ -224,3 +224,20 @@ def test_check_prints_the_geometry_under_the_api_names_the_guide_lists(case, cap
     for name, (_, unit) in geometry.items():
         generic = re.sub(r"^cyl_[0-9]+_", "cyl_<c>_", name)
         assert table.get(generic) == unit, name
+
+
+def test_a_slave_whose_tdc_is_across_0_deg_from_its_bank_lags_it_by_a_small_angle():
+    """Slaves at δ = 0.005° and 359.995° whose link pins (ψ = 10°, 350°) put their TDCs about
+    0.01° on the other side of 0° (the TDC angle wraps, the bank does not) report the lag in
+    (−π, π], the searched TDC's distance from δ on the circle."""
+    radial = ARTICULATED["radial_5cyl"]
+    for bank, psi in ((0.005, 10.0), (359.995, 350.0)):
+        mech = replace(radial, slave_banks=(math.radians(bank),),
+                       link_angles=(math.radians(psi),), link_radii=radial.link_radii[:1],
+                       slave_lengths=radial.slave_lengths[:1], firing=())
+        g = mech.geometry()
+        X = lambda a: float(axial(mech, a, 1)[0])  # noqa: E731
+        _, tdc = extremes(X, -0.5, 2.0 * math.pi - 0.5, 1e-6)
+        assert abs(g["cyl_2_tdc"][0] - math.radians(bank)) > math.pi  # wrapped across 0°
+        lag = g["cyl_2_tdc_after_bank"][0]
+        assert abs(lag) < math.radians(0.1) and abs(lag - wrapped(tdc, math.radians(bank))) <= 1e-8

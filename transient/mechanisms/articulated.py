@@ -399,7 +399,7 @@ class Articulated:
         between them (:func:`piston_strokes`) and ``cyl_<c>_lambda`` its dynamic parameter
         (:func:`dynamic_parameters`, Semenov (61) solved exactly); per slave
         ``cyl_<c>_stroke_excess`` over the master's 2r and ``cyl_<c>_tdc_after_bank``, its TDC's
-        lag behind δ_i ((55)–(57) solved exactly); ``stroke`` and ``swept_volume`` of the
+        lag behind δ_i in (−π, π] ((55)–(57) solved exactly); ``stroke`` and ``swept_volume`` of the
         master cylinder, the gas cycle's, and ``displacement`` F_p·Σ strokes over every
         cylinder."""
         tdc, bdc = dead_centres(self)
@@ -414,7 +414,10 @@ class Articulated:
             out[c + "lambda"] = (float(lam[i]), "1")
             if i:
                 out[c + "stroke_excess"] = (float(strokes[i] - self.stroke()), "m")
-                out[c + "tdc_after_bank"] = (float(tdc[i] - self.slave_banks[i - 1]), "rad")
+                lag = float(tdc[i] - self.slave_banks[i - 1])
+                # in (−π, π]: a slave near 0° has its TDC just before 2π or just after 0
+                lag -= 2.0 * pi * ((lag > pi) - (lag <= -pi))
+                out[c + "tdc_after_bank"] = (lag, "rad")
         out["stroke"] = (self.stroke(), "m")
         out["swept_volume"] = (self.swept_volume(), "m^3")
         out["displacement"] = (float(self.rows * self.piston_area * strokes.sum()), "m^3")
