@@ -5,7 +5,8 @@ Slave-rod kinematics of a radial engine
 A five-cylinder radial with Semenov's dimensions: one master rod and four slave rods on link
 pins. The slave pistons do not follow the crank-slider law: their strokes exceed 2r, their dead
 centres lag their bank angles, and their second harmonic λ_i differs from cylinder to cylinder.
-No simulation is needed: the mechanism gives its exact kinematics and harmonics directly.
+No simulation is needed: ``scene.geometry()`` gives each piston's exact stroke, dead centres and
+λ_i (the names ``transient check`` prints), and the mechanism its kinematics and harmonics.
 """
 from pathlib import Path
 
@@ -17,12 +18,15 @@ from transient.mechanisms import articulated
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"
 
-mech = transient.load_scene(CASES / "radial_5cyl.toml").mechanism
-r = mech.crank_radius
+scene = transient.load_scene(CASES / "radial_5cyl.toml")
+mech = scene.mechanism
+geometry = scene.geometry()
 for h in articulated.harmonics(mech):
+    c = f"cyl_{h.cylinder}_"
     print(f"cylinder {h.cylinder} (bank {np.degrees(h.bank):5.1f}°): "
-          f"stroke − 2r = {1e3 * (h.stroke - 2 * r):6.3f} mm, "
-          f"λ exact {h.lam:.4f}, Semenov (61) {h.lam_semenov:.4f}")
+          f"TDC {np.degrees(geometry[c + 'tdc_after_bank'][0]):5.2f}° after its bank, "
+          f"stroke − 2r = {1e3 * geometry[c + 'stroke_excess'][0]:6.3f} mm, "
+          f"λ exact {geometry[c + 'lambda'][0]:.4f}, Semenov (61) {h.lam_semenov:.4f}")
 
 phi = np.linspace(0.0, 2 * np.pi, 721)
 table = mech.kinematics_table(phi)

@@ -114,24 +114,6 @@ def test_every_column_a_run_can_write_is_described():
         describe("nonsense_1")
 
 
-def test_check_says_what_the_geometry_implies_without_a_run(capsys):
-    from pathlib import Path
-
-    from transient.cli import main
-
-    case = Path(__file__).resolve().parents[2] / "cases" / "radial_5cyl.toml"
-    assert main(["check", str(case)]) == 0
-    out = capsys.readouterr().out.splitlines()
-    mech = load_scene(case).mechanism
-    assert out[1] == (f"  stroke {mech.stroke() * 1e3:.6g} mm, swept volume "
-                      f"{mech.swept_volume() * 1e6:.6g} cm³ per cylinder, "
-                      f"{5 * mech.swept_volume() * 1e3:.6g} l in all")
-    figures = dict(line.strip().split(" = ") for line in out[2:])
-    for name, (value, unit) in mech.analysis_summary().items():
-        assert figures[name] == f"{value:.9g} {unit}"
-    assert "cyl_2_lambda" in figures and "cyl_3_stroke_excess" in figures
-
-
 def test_plot_helpers_take_a_result(small):
     import matplotlib
 

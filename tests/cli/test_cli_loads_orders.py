@@ -112,11 +112,11 @@ def test_orders_files_and_delta(spinup, tmp_path, capsys):
     assert csv["M_gas_amplitude_Nm"][1:].max() > 0.0
     # the odd-harmonic table: first-order W relative to itself is 1
     k1 = int(np.argmin(np.abs(csv["order"] - 1.0)))
-    assert csv["W_relative"][k1] == pytest.approx(1.0)
+    assert csv["W_1_relative"][k1] == pytest.approx(1.0)
     assert "odd>=3" in printed and "fractional" in printed
     runup = _read_csv(out / f"{stem}_orders_runup.csv")
     assert runup["cycle"].size == 4
-    assert np.all(np.diff(runup["omega_mean_rad_s"]) > 0)  # spinning up
+    assert np.all(np.diff(runup["cycle_omega_mean_rad_s"]) > 0)  # spinning up
 
     res = open_result(spinup)
     scene = res.scene()
@@ -190,3 +190,67 @@ def test_the_loads_csv_names_no_quantity_as_a_result_names_another(tmp_path, cap
             name = column.removesuffix(f"_{suffix}")
             if name != column and name in res.units:
                 assert res.units[name] == unit, column
+
+
+#: Orders-CSV columns that no result stores (each is explained in the orders section of the
+#: user guide): a run-up row's cycle number and the odd-harmonic report's comparisons with the
+#: same engine at constant speed. Every other column is a stored quantity's name.
+ORDERS_ONLY_IN_CSV = {"cycle", "W_1_amplitude_constant_m_s2", "W_1_relative",
+                      "W_1_relative_constant", "W_1_relative_added"}
+
+#: Unit suffixes of CSV column names → the unit strings of result files.
+CSV_UNITS = {"s": "s", "rad": "rad", "rad_s": "rad/s", "rad_s2": "rad/s^2", "N": "N", "Nm": "N m",
+             "m_s2": "m/s^2"}
+
+
+def _without_unit(column: str) -> tuple[str, str | None]:
+    for suffix in sorted(CSV_UNITS, key=len, reverse=True):
+        if column.endswith(f"_{suffix}"):
+            return column.removesuffix(f"_{suffix}"), CSV_UNITS[suffix]
+    return column, None
+
+
+def test_the_orders_csvs_name_each_quantity_as_a_result_does(tmp_path, capsys):
+    """One vocabulary: an orders-CSV column named as a trajectory column has its unit, and one
+    named as a stored analysis ``orders_<name>`` (the scene's ``[analysis] orders``, same grid
+    and orders) is that quantity: the same unit and the same values (last cycle for the
+    per-order table, every cycle for the run-up table, to the CSV's 12 digits)."""
+    import transient
+
+    case = CASES / "gots_diesel_spinup.toml"
+    scene = transient.load_scene(case).replace(
+        run={"revolutions": 8},
+        analysis={"orders": ["omega", "M_gas", "W_1"], "samples_per_cycle": 720,
+                  "max_order": 12.0})
+    res = transient.simulate(scene, tmp_path / "r.h5")
+    assert main(["orders", str(tmp_path / "r.h5"), "-o", str(tmp_path),
+                 "--samples-per-cycle", "720", "--max-order", "12"]) == 0
+    capsys.readouterr()
+    stored = res.analysis
+    orders = stored["orders_order"][0]
+    k = orders.size
+    matched = set()
+    for csv_name, per_order in (("r_orders.csv", True), ("r_orders_runup.csv", False)):
+        csv = _read_csv(tmp_path / csv_name)
+        for column, values in csv.items():
+            name, unit = _without_unit(column)
+            if name in res.units:
+                assert res.units[name] == unit, column
+            order = re.fullmatch(r"(\w+)_order_([0-9.]+)", name)
+            if order:  # a run-up column: one order's amplitude over the cycles
+                signal, nu = order.group(1), float(order.group(2))
+                value, stored_unit = stored[f"orders_{signal}_amplitude"]
+                value = value[:, int(np.argmin(np.abs(orders - nu)))]
+            elif f"orders_{name}" in stored:
+                value, stored_unit = stored[f"orders_{name}"]
+                value = value[-1] if per_order and np.ndim(value) == 2 else value
+            else:
+                assert column in ORDERS_ONLY_IN_CSV, column
+                continue
+            matched.add(column)
+            assert (unit or "1/rev") == stored_unit, column
+            got = values[:k] if per_order else values
+            np.testing.assert_allclose(got, value, rtol=1e-10,
+                                       atol=1e-10 * np.abs(value).max(), err_msg=column)
+    assert {"omega_amplitude_rad_s", "M_gas_amplitude_Nm", "W_1_amplitude_m_s2",
+            "cycle_omega_mean_rad_s", "omega_order_1_rad_s"} <= matched

@@ -232,6 +232,32 @@ def test_two_pair_reactions_29_rederived():
         assert abs(M_cd * u_dc + c["e2"] * M_dc) <= tol / abs(u_ba)
 
 
+def test_reaction_M_cd_of_29_with_u_ba_where_the_print_has_u_bc():
+    """M_cd of (29) as derived (docs: *Theory*): the kernel's reaction on d is
+    (I_d/I_np){φ̇²[−A u_ba u_dc + I_np(u′_ba u_dc + u_ba u′_dc)] + u_ba u_dc M_np} − M_d; the
+    printed form, with u_bc (= 1, b and c one body) for u_ba and u′_bc (= 0) for u′_dc, is not,
+    and M_dc = −M_cd u_dc/η*_dc holds as printed."""
+    rng = np.random.default_rng(2929)
+    bad = 0
+    for _ in range(N_CASES):
+        c = two_pair_case(rng)
+        S = np.empty(2)
+        chain_solve(c["J"], c["dJ"], c["M"], np.array([c["e1"], c["e2"]]), c["w"], S)
+        _, _, M_dc, M_cd = two_pair_reactions(c["u_ba"], c["u_dc"], c["e1"], c["e2"], S[0], S[1])
+        I_np, M_np, A = terms_28(c)
+        w2, u_ba, u_dc, du_ba, du_dc = c["w"] ** 2, c["u_ba"], c["u_dc"], c["du_ba"], c["du_dc"]
+        derived = (c["I_d"] / I_np * (w2 * (-A * u_ba * u_dc + I_np * (du_ba * u_dc + u_ba * du_dc))
+                                      + u_ba * u_dc * M_np) - c["M_d"])
+        printed = (c["I_d"] / I_np * (w2 * (-A * 1.0 * u_dc + I_np * (du_ba * u_dc + u_ba * 0.0))
+                                      + 1.0 * u_dc * M_np) - c["M_d"])
+        scale = abs(c["I_d"]) * (abs(M_np) + abs(A) * w2 + I_np * w2 * (abs(du_ba) + abs(du_dc))
+                                 * max(1.0, abs(u_ba)) * max(1.0, abs(u_dc))) / I_np + abs(c["M_d"])
+        assert abs(M_cd - derived) <= 1e-11 * scale
+        assert abs(M_dc + M_cd * u_dc / c["e2"]) <= 1e-11 * scale * abs(u_dc) / c["e2"]
+        bad += abs(M_cd - printed) > 1e-6 * scale
+    assert bad >= 0.95 * N_CASES
+
+
 @pytest.mark.parametrize("n", [3, 4, 5])
 def test_general_chain_against_linear_solve_and_power_balance(n):
     rng = np.random.default_rng(100 + n)

@@ -12,7 +12,8 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   [rad/s] (cycle angle over cycle time), ``irregularity_cycle_delta`` [1]
   (δ = (ω_max − ω_min)/ω_mean over each cycle's samples, Gots §2.8), each (C,).
 * ``orders = [...]``: ``orders_order`` (K,) [1/rev]; ``orders_cycle_start`` (C,) [rad],
-  ``orders_cycle_omega_mean`` (C,) [rad/s]; ``orders_detrend`` ("ramp" or "none"); per signal s
+  ``orders_cycle_omega_mean`` (C,) [rad/s]; ``orders_detrend`` ("ramp" or "none": what was
+  done to ω, the only signal detrended, as ``transient orders`` does); per signal s
   ``orders_<s>_amplitude`` (C, K) [unit of s] and ``orders_<s>_phase`` (C, K) [rad]
   (:class:`transient.analysis.orders.OrderSpectrum`; order 0 is the mean of the detrended cycle).
   A signal is a trajectory column or ``W_<k>``, the piston acceleration of cylinder k,
@@ -120,7 +121,11 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
                                        "orders_detrend": (mode, "")}
     for s in req.orders:
         v = cols[s]
-        spec = order_spectrum(v[:-1], n, cycle, detrend=mode, end=v[-1])
+        # The ramp is ω's trend (a spin-up), as `transient orders` removes it: other signals'
+        # trends are not additive (W = ω²s″ + εs′ scales with ω²), and a ramp through their
+        # cycle ends would add spurious orders.
+        spec = order_spectrum(v[:-1], n, cycle, detrend=mode if s == "omega" else "none",
+                              end=v[-1])
         keep = spec.orders <= req.max_order + 1e-9
         out["orders_order"] = (spec.orders[keep], "1/rev")
         out[f"orders_{s}_amplitude"] = (spec.amplitude[:, keep], units[s])

@@ -11,6 +11,10 @@ from .common import (EXIT_OK, MAX_POINTS, add_force, output_folder, pyplot, read
                      result_stem, save, whole, write_columns)
 
 
+#: The cylinder whose piston acceleration W is reported (a crank-slider's).
+PISTON_CYLINDER = 1
+
+
 def register(sub) -> None:
     od = sub.add_parser(
         "orders", help="order spectra of ω, M_gas and the piston acceleration (PNG + CSV "
@@ -47,7 +51,7 @@ def cmd_orders(args) -> int:
     cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
     try:
         ro = run_orders(scene, traj, n, cuts=cuts, detrend=args.detrend,
-                        piston_cylinder=1 if mech.slider_law else None)
+                        piston_cylinder=PISTON_CYLINDER if mech.slider_law else None)
     except NoWholeCycle as exc:
         raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
     spec_w, spec_m, rep = ro.omega, ro.gas_torque, ro.piston
@@ -64,12 +68,13 @@ def cmd_orders(args) -> int:
     if spec_m is not None:
         cols_csv["M_gas_amplitude_Nm"] = spec_m.amplitude[-1]
         cols_csv["M_gas_phase_rad"] = spec_m.phase[-1]
-    if rep is not None:
-        cols_csv["W_amplitude_m_s2"] = rep.amplitude[-1]
-        cols_csv["W_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
-        cols_csv["W_relative"] = rep.relative[-1]
-        cols_csv["W_relative_constant"] = rep.relative_constant[-1]
-        cols_csv["W_relative_added"] = rep.relative_added[-1]
+    if rep is not None:  # W_1: the piston acceleration of cylinder 1, as [analysis] orders names it
+        w = f"W_{PISTON_CYLINDER}"
+        cols_csv[f"{w}_amplitude_m_s2"] = rep.amplitude[-1]
+        cols_csv[f"{w}_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
+        cols_csv[f"{w}_relative"] = rep.relative[-1]
+        cols_csv[f"{w}_relative_constant"] = rep.relative_constant[-1]
+        cols_csv[f"{w}_relative_added"] = rep.relative_added[-1]
     csv = out / f"{stem}_orders.csv"
     write_columns(csv, cols_csv, args.force)
     written.append(csv)
@@ -112,7 +117,7 @@ def cmd_orders(args) -> int:
         fig.suptitle(f"{scene.name}: run-up orders of ω")
         written.append(save(fig, out / f"{stem}_orders_runup.png", args.force, res))
         run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": starts,
-               "omega_mean_rad_s": means}
+               "cycle_omega_mean_rad_s": means}
         run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j]
                     for j in orders_up_to(orders, top)})
         csv = out / f"{stem}_orders_runup.csv"

@@ -55,11 +55,12 @@ def cmd_check(args) -> int:
 
 
 def _print_mechanism(mech) -> None:
-    """What the mechanism's geometry implies, without a run: stroke, displacement, and its own
-    figures (for master and articulated rods: each slave's λ_i, stroke excess, dead centre)."""
-    print(f"  stroke {mech.stroke() * 1e3:.6g} mm, swept volume {mech.swept_volume() * 1e6:.6g} "
-          f"cm³ per cylinder, {mech.n_cylinders * mech.swept_volume() * 1e3:.6g} l in all")
-    for name, (value, unit) in mech.analysis_summary().items():
+    """What the mechanism's geometry implies, without a run (``scene.geometry()``), then its
+    other figures a result stores (master and articulated rods: Semenov's series beside the
+    exact values), each as ``name = value unit`` under the name and SI unit the API gives it."""
+    figures = mech.geometry()
+    figures.update(mech.analysis_summary())
+    for name, (value, unit) in figures.items():
         print(f"  {name} = {value:.9g} {unit}")
 
 

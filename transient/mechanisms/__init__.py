@@ -126,6 +126,14 @@ class Mechanism(Protocol):
         """Its ``[mechanism]`` table (and sub-tables) in SI, which :meth:`read` reads back to an
         equal object."""
 
+    def geometry(self) -> dict[str, tuple[float, str]]:
+        """What the geometry implies, without a run, name → (value, unit) in SI: every
+        mechanism's ``stroke`` [m] and ``swept_volume`` [m³] of the cylinder
+        :meth:`volume_function` describes and the engine's ``displacement`` [m³] (every piston's
+        swept volume), and its own figures (dead-centre angles, λ, each piston's stroke); the
+        names are listed in the user guide's *Mechanisms* page, and ``transient check`` prints
+        them as they are named here."""
+
     def analysis_summary(self) -> dict[str, tuple[float, str]]:
         """Figures of the mechanism itself for a result's ``/analysis``, name → (value, unit);
         {} if it has none."""

@@ -5,8 +5,10 @@ The compiled kinematics and the frame are described in :mod:`transient.core.arti
 module holds the scene-side description (SI units), packs it for the kernel, and gives the numpy
 geometry of every body (:func:`positions`), the slave dimensions of Semenov (6)–(7)
 (:func:`slave_dimensions`), the exact dead centres and strokes that (55)–(58) approximate
-(:func:`dead_centres`), and the harmonics of the slave pistons from the exact geometry beside
-Semenov's series (45), (47), (50) and the slave dynamic parameter λ_i (61) (:func:`harmonics`).
+(:func:`dead_centres`, :func:`piston_strokes`), the exact dynamic parameter λ_i that (61)
+approximates (:func:`dynamic_parameters`), all of them by name in :meth:`Articulated.geometry`,
+and the harmonics of the slave pistons from the exact geometry beside Semenov's series (45),
+(47), (50) and (61) (:func:`harmonics`).
 
 A row is one crankpin with a master rod and z′ slaves; all rows share one geometry and differ by the
 angle of their master cylinder (``row_banks``) and of their crankpin (``row_cranks``). Cylinders
@@ -389,17 +391,51 @@ class Articulated:
                 cols[f"du_{k + 1}"] = du[:, k]
         return cols
 
+    def geometry(self) -> dict[str, tuple[float, str]]:
+        """What the geometry implies, name → (value, unit), for the pistons c = 1 … 1 + z′ of a
+        row (row j's cylinders are c + j(1 + z′), alike): ``lambda`` λ = r/l of the master rod;
+        per piston ``cyl_<c>_tdc``, ``cyl_<c>_bdc`` the local crank angles α of its exact outer
+        and inner dead centre (:func:`dead_centres`; the master's 0 and π), ``cyl_<c>_stroke``
+        between them (:func:`piston_strokes`) and ``cyl_<c>_lambda`` its dynamic parameter
+        (:func:`dynamic_parameters`, Semenov (61) solved exactly); per slave
+        ``cyl_<c>_stroke_excess`` over the master's 2r and ``cyl_<c>_tdc_after_bank``, its TDC's
+        lag behind δ_i in (−π, π] ((55)–(57) solved exactly); ``stroke`` and ``swept_volume`` of the
+        master cylinder, the gas cycle's, and ``displacement`` F_p·Σ strokes over every
+        cylinder."""
+        tdc, bdc = dead_centres(self)
+        strokes = piston_strokes(self)
+        lam = dynamic_parameters(self)
+        out = {"lambda": (self.lam, "1")}
+        for i in range(1 + self.n_slaves):
+            c = f"cyl_{i + 1}_"
+            out[c + "tdc"] = (float(tdc[i]), "rad")
+            out[c + "bdc"] = (float(bdc[i]), "rad")
+            out[c + "stroke"] = (float(strokes[i]), "m")
+            out[c + "lambda"] = (float(lam[i]), "1")
+            if i:
+                out[c + "stroke_excess"] = (float(strokes[i] - self.stroke()), "m")
+                lag = float(tdc[i] - self.slave_banks[i - 1])
+                # in (−π, π]: a slave near 0° has its TDC just before 2π or just after 0
+                lag -= 2.0 * pi * ((lag > pi) - (lag <= -pi))
+                out[c + "tdc_after_bank"] = (lag, "rad")
+        out["stroke"] = (self.stroke(), "m")
+        out["swept_volume"] = (self.swept_volume(), "m^3")
+        out["displacement"] = (float(self.rows * self.piston_area * strokes.sum()), "m^3")
+        return out
+
     def analysis_summary(self) -> dict[str, tuple[float, str]]:
         """Per slave of a row (cylinder c = 2 … 1 + z′), for a result's ``/analysis``: λ_i exact and
-        by (61), the stroke's excess over 2r, its TDC's lag behind δ_i, the 3rd harmonic of its
-        displacement exact and by (45), and the largest error of Semenov's acceleration series."""
+        by (61), the stroke's excess over 2r, its TDC's lag behind δ_i (those of
+        :meth:`geometry`), the 3rd harmonic of its displacement exact and by (45), and the largest
+        error of Semenov's acceleration series."""
         out = {}
+        geometry = self.geometry()
         for h in harmonics(self):
             c = f"cyl_{h.cylinder}_"
-            out[c + "lambda"] = (h.lam, "1")
+            out[c + "lambda"] = geometry[c + "lambda"]
             out[c + "lambda_semenov"] = (h.lam_semenov, "1")
-            out[c + "stroke_excess"] = (h.stroke - self.stroke(), "m")
-            out[c + "tdc_after_bank"] = (h.tdc - h.bank, "rad")
+            out[c + "stroke_excess"] = geometry[c + "stroke_excess"]
+            out[c + "tdc_after_bank"] = geometry[c + "tdc_after_bank"]
             out[c + "S3"] = (hypot(*h.exact[0][3]), "m")
             out[c + "S3_semenov"] = (hypot(*h.series[0][3]), "m")
             out[c + "series_error_W"] = (h.error[2], "m/rad^2")
@@ -514,6 +550,15 @@ def dead_centres(mech: Articulated) -> tuple[NDArray[np.float64], NDArray[np.flo
         for out, j in ((tdc, np.argmax(x[:, i])), (bdc, np.argmin(x[:, i]))):
             out[i] = bisect_root(lambda a: rate(a, i), grid[j] - h, grid[j] + h) % (2.0 * pi)
     return tdc, bdc
+
+
+def dynamic_parameters(mech: Articulated) -> NDArray[np.float64]:
+    """Exact dynamic parameter λ_i of each piston of a row (1 + z′,), the master first: the
+    amplitude of the 2nd harmonic of its acceleration d²X/dα² over r, four times that of its
+    displacement X (Semenov (61) from the truncated series, (51); for the master λ + λ³/4 + …)."""
+    alpha = np.linspace(0.0, 2.0 * pi, SAMPLES, endpoint=False)
+    second = fourier(axial_positions(mech, alpha)[0], 2)[2]  # (2, 1 + z′): a₂, b₂ of X
+    return 4.0 * np.hypot(second[0], second[1]) / mech.crank_radius
 
 
 def piston_strokes(mech: Articulated) -> NDArray[np.float64]:
@@ -664,6 +709,7 @@ def harmonics(mech: Articulated, orders: int = 6) -> list[SlaveHarmonics]:
     exact = fourier(np.stack(X, axis=1), orders)  # (orders + 1, 2, 3, 1 + z′)
     tdc, bdc = dead_centres(mech)
     stroke = piston_strokes(mech)
+    lam = dynamic_parameters(mech)
     r = mech.crank_radius
     out = []
     for i in range(mech.n_slaves):
@@ -677,7 +723,7 @@ def harmonics(mech: Articulated, orders: int = 6) -> list[SlaveHarmonics]:
                     for d in range(3))
         out.append(SlaveHarmonics(
             cylinder=i + 2, bank=mech.slave_banks[i], link_angle=mech.link_angles[i], exact=ex,
-            series=se, source=source, error=err, lam=4.0 * hypot(*ex[0][2]) / r,
+            series=se, source=source, error=err, lam=float(lam[1 + i]),
             lam_semenov=lambda_semenov(r, mech.rod_length, mech.link_radii[i],
                                        mech.link_angles[i], mech.slave_lengths[i],
                                        mech.slave_banks[i]),

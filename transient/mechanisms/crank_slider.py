@@ -247,6 +247,18 @@ class CrankSlider:
         """Swept volume of one cylinder, F_p·S [m³]."""
         return self.piston_area * self.stroke()
 
+    def geometry(self) -> dict[str, tuple[float, str]]:
+        """What the geometry implies, name → (value, unit), every cylinder alike: ``lambda``
+        λ = r/l and ``offset_ratio`` k = e/r (Gots §1.4), ``stroke`` S (11), ``tdc`` and ``bdc``
+        the local crank angles of the true dead centres (:meth:`dead_centre_angles`; 0 and π
+        without offset), ``swept_volume`` V_h = F_p·S and ``displacement`` i·V_h (Gots §2.2)."""
+        tdc, bdc = self.dead_centre_angles()
+        return {"lambda": (self.lam, "1"),
+                "offset_ratio": (self.offset / self.crank_radius, "1"),
+                "stroke": (float(self.stroke()), "m"), "tdc": (tdc, "rad"), "bdc": (bdc, "rad"),
+                "swept_volume": (float(self.swept_volume()), "m^3"),
+                "displacement": (float(self.n_cylinders * self.swept_volume()), "m^3")}
+
     def kinematics_table(self, phi: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
         """Positions, transfer functions and J(φ), dJ/dφ of the moving parts over ``phi`` [rad]."""
         mp = self.pack()

@@ -166,16 +166,7 @@ class SwashPlate:
         about the Hooke joint's largest non-uniformity of it otherwise. Validates the geometry.
         """
         tdc, _ = dead_centres(self)
-        out = []
-        for k, a in enumerate(tdc):
-            even = 2.0 * pi * k / self.cylinders
-            off = (a - even + pi) % (2.0 * pi) - pi
-            if abs(off) < 1e-9:  # exact by symmetry; the root is within a few ulp of it
-                out.append(even)
-            else:
-                w = float(a % (2.0 * pi))
-                out.append(0.0 if w >= 2.0 * pi else w)
-        return tuple(out)
+        return tuple(_snapped(a, 2.0 * pi * k / self.cylinders) for k, a in enumerate(tdc))
 
     @property
     def piston_area(self) -> float:
@@ -357,6 +348,26 @@ class SwashPlate:
         """Dead centres [rad] of cylinder 1, inner and outer: 0 and π (module docstring)."""
         return 0.0, pi
 
+    def geometry(self) -> dict[str, tuple[float, str]]:
+        """What the geometry implies, name → (value, unit): per cylinder c ``cyl_<c>_tdc`` and
+        ``cyl_<c>_bdc``, the shaft angles [rad] in [0, 2π) of its piston's inner dead centre
+        (the end of compression, its firing angle) and outer one (:func:`dead_centres`), and
+        ``cyl_<c>_stroke`` between them, per piston (:func:`stroke`); ``stroke`` and
+        ``swept_volume`` of cylinder 1, the gas cycle's (:meth:`stroke`), and ``displacement``
+        halves·F_p·Σ strokes, every piston's."""
+        _, outer = dead_centres(self)
+        strokes = stroke(self)
+        out = {}
+        for k in range(self.cylinders):
+            c = f"cyl_{k + 1}_"
+            out[c + "tdc"] = (self.firing_angles[k], "rad")
+            out[c + "bdc"] = (_snapped(outer[k], 2.0 * pi * k / self.cylinders + pi), "rad")
+            out[c + "stroke"] = (float(strokes[k]), "m")
+        out["stroke"] = (self.stroke(), "m")
+        out["swept_volume"] = (self.swept_volume(), "m^3")
+        out["displacement"] = (float(self.halves * self.piston_area * strokes.sum()), "m^3")
+        return out
+
     def volume_function(self, clearance: float) -> Callable[[ArrayLike], NDArray[np.float64]]:
         """V(x) [m³] of cylinder 1 over the local angle x [rad] (= shaft angle; vectorised).
 
@@ -423,6 +434,16 @@ def antonyuk_example(**changes) -> SwashPlate:
                 cross_inertia=0.3)
     base.update(changes)
     return SwashPlate(**base)
+
+
+def _snapped(angle: float, even: float) -> float:
+    """A dead centre's shaft angle wrapped to [0, 2π), and snapped onto the even spacing
+    ``even`` where it lies there by symmetry (module docstring): the root is within a few ulp
+    of it, far inside 1e-9 rad."""
+    if abs((angle - even + pi) % (2.0 * pi) - pi) < 1e-9:
+        angle = even
+    w = float(angle % (2.0 * pi))
+    return 0.0 if w >= 2.0 * pi else w
 
 
 def _points(mp: NDArray[np.float64], phi: NDArray[np.float64]):

@@ -369,8 +369,9 @@ class Analysis:
     of cylinder k (crank-slider). ``irregularity``: δ and the mean speed of every cycle.
     ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
     engine cycle.
-    ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
-    (:func:`transient.analysis.orders.order_spectrum`).
+    ``detrend``: what is done to ω before each cycle's DFT, as ``transient orders --detrend``:
+    ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
+    (:func:`transient.analysis.orders.order_spectrum`); other signals are not detrended.
     """
 
     loads: bool = False
@@ -408,3 +409,9 @@ class Scene:
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
     analysis: Analysis = field(default_factory=Analysis)
+
+    def geometry(self) -> dict[str, tuple[float, str]]:
+        """What the mechanism's geometry implies, without a run, name → (value, unit) in SI
+        (:meth:`transient.mechanisms.Mechanism.geometry`): stroke, swept volume, displacement,
+        dead-centre angles, λ, each piston's stroke; what ``transient check`` prints."""
+        return self.mechanism.geometry()
