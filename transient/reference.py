@@ -642,7 +642,7 @@ class JointForces:
 
     Arrays ``(n_cylinders, n)`` [N, N·m]; vectors as ``(2, n_cylinders, n)`` in each cylinder's
     frame (x to the side the crankpin moves at the top, y along the cylinder axis toward the
-    head, Gots §1), forces on the body named second.
+    head, Gots §1).
 
     Attributes
     ----------

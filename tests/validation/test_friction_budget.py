@@ -20,6 +20,7 @@ FMEP, the total, imep and bmep, checked against what holds independently of the 
   per cycle, fmep = (1 − η_bwd)·imep and η_mech = η_bwd (1e-9).
 * **Displacement**: V_d = n·(π D²/4)·2r for the central Gots diesel; an offset engine's stroke
   from its piston positions at the dead centres.
+* **Chen–Flynn**: the correlation in SI, and the Gots diesel's FMEP at rated speed of its order.
 """
 from __future__ import annotations
 
@@ -30,8 +31,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis.efficiency import displacement, mechanical_efficiency
+from transient.analysis.efficiency import (chen_flynn_fmep, displacement, mean_piston_speed,
+                                           mechanical_efficiency)
 from transient.analysis.loads.crank_slider import slider_arrays
+from transient.assemble import gas_table
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, load_scene
 from transient.study.efficiency import point_scene
@@ -198,3 +201,32 @@ def test_displacement():
     stroke = s[1] - s[0]
     assert stroke > 2 * offset.crank_radius  # an offset lengthens the stroke
     assert displacement(offset) == pytest.approx(3 * offset.piston_area * stroke, rel=1e-13)
+
+
+def test_chen_flynn_in_si():
+    """The correlation in SI against its usual units (bar, m/s): p_max = 100 bar, c_m = 10 m/s
+    give 0.4 + 0.005·100 + 0.09·10 + 0.0009·100 = 1.89 bar; c_m = 2 S n."""
+    assert chen_flynn_fmep(100e5, 10.0) == pytest.approx(1.89e5, rel=1e-14)
+    mech = load_scene(CASES / "gots_diesel_friction.toml").mechanism
+    assert mean_piston_speed(mech, 3000 * RPM) == pytest.approx(2 * 0.094 * 50.0, rel=1e-14)
+
+
+def test_gots_diesel_fmep_has_the_order_of_chen_flynn_at_rated_speed():
+    """A sanity check of the order of magnitude, not a fit: the Gots diesel at its rated
+    4400 rpm and full fuel (inverse dynamics), the peak pressure of its cycle (p_z = 10.5 MPa)
+    and c_m = 13.8 m/s. Its pairs are the main bearings and the crankpins only, while the
+    correlation counts all the engine's friction (piston and rings, valve train, auxiliaries
+    too), so the scene's FMEP must lie below the correlation's and, for efficiencies of a
+    plausible size, within a factor of five of it."""
+    scene = gots_friction()
+    sc = point_scene(scene, 4400 * RPM, "power-flow", 720)
+    eff = {k: v for k, (v, _) in mechanical_efficiency(sc, prescribed(sc).trajectory).items()}
+    x = np.linspace(0.0, scene.mechanism.cycle, 200_001)
+    p_max = float(np.max(gas_table(scene)(x)))
+    assert p_max == pytest.approx(10.5e6, rel=1e-12)
+    c_m = mean_piston_speed(scene.mechanism, 4400 * RPM)
+    cf = chen_flynn_fmep(p_max, c_m)
+    print(f"FMEP {eff['fmep'] / 1e5:.3f} bar (main bearings {eff['fmep_1'] / 1e5:.3f}, "
+          f"crankpins {eff['fmep_2'] / 1e5:.3f}); Chen–Flynn {cf / 1e5:.3f} bar at p_max "
+          f"{p_max / 1e5:.1f} bar, c_m {c_m:.2f} m/s; ratio {eff['fmep'] / cf:.2f}")
+    assert 0.2 * cf <= eff["fmep"] <= cf
