@@ -220,7 +220,8 @@ def cmd_info(args) -> int:
             print(f"  {s['stiff_rerun']}")
     values = {k: v for k, (v, _) in res.analysis.items()}
     _print_response(values)
-    _print_efficiency(values, pair_names(res.scene()))
+    # (the pairs' names are in the resolved scene, read only when there are pairs)
+    _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())
     arrays = []
     for k, (v, unit) in res.analysis.items():
         if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped
