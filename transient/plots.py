@@ -152,6 +152,26 @@ def pair_power(ax, traj, names, cycle):
     return artists
 
 
+def friction_budget(ax, labels, fmep, names):
+    """The friction budget as stacked bars: at each of ``labels`` (operating points, or one run)
+    the FMEP of each pair [kPa], ``fmep`` of shape (len(names), len(labels)) [Pa], the total on
+    top. Returns the bars."""
+    fmep = np.asarray(fmep, float).reshape(len(names), len(labels)) / 1e3
+    x = np.arange(len(labels))
+    bottom = np.zeros(len(labels))
+    artists = []
+    for name, row in zip(names, fmep):
+        artists.append(ax.bar(x, row, 0.6, bottom=bottom, label=name))
+        bottom = bottom + row
+    for xi, total in zip(x, bottom):
+        ax.annotate(f"{total:.4g}", (xi, total), ha="center", va="bottom", fontsize=8)
+    ax.set_xticks(x, [str(v) for v in labels])
+    ax.set_ylabel("FMEP [kPa]")
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize=8)
+    return artists
+
+
 def load_response(axes, traj, cycle, analysis):
     """Speed (as run, and its one-cycle mean), fuel command and load torque against time, with
     each load step's ±band around its new steady speed (``analysis``: the run's ``/analysis``

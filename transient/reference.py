@@ -7,13 +7,19 @@ is (φ, ω), and (18) is written out again here; the mechanism's J(φ), dJ/dφ a
 come from its plain-Python twin (``reference_terms``, :mod:`transient.mechanisms.twins`: the
 crank-slider's from the Gots relations, not from its kernel). Breakpoints and the starter
 cut-out are terminal events of solve_ivp, so every segment between them is smooth.
+
+The joint forces of a crank-slider (:func:`crank_slider_joint_forces`) are that model's
+reactions by Newton–Euler, body by body, for a prescribed motion: what the analyses' force
+relations and the reduced model's torque are checked against.
 """
 from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
@@ -624,3 +630,129 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
               "nsteps": nsteps, "nreject": -1, "wall_s": time.perf_counter() - t0, "compile_s": 0.0}
     return RunData(traj, {k: np.asarray(v).reshape(-1, 2) for k, v in events.items() if v}, solver,
                    complete=not message, message=message)
+
+
+# ------------------------------------------------------------------------------------------------
+# Joint forces of the crank-slider by Newton–Euler
+
+
+@dataclass(frozen=True)
+class JointForces:
+    """The joint forces of every cylinder of a crank-slider, from :func:`crank_slider_joint_forces`.
+
+    Arrays ``(n_cylinders, n)`` [N, N·m]; vectors as ``(2, n_cylinders, n)`` in each cylinder's
+    frame (x to the side the crankpin moves at the top, y along the cylinder axis toward the
+    head, Gots §1).
+
+    Attributes
+    ----------
+    main : force of the throw on the main bearing (the frame), the throw's share of the shaft's
+        journal load.
+    crankpin : force of the rod on the crankpin.
+    pin : force of the rod on the piston at the piston pin.
+    N : force of the cylinder wall on the piston along +x (Gots (34)'s N).
+    S : the rod force compression-positive as Gots splits the rod (35): the pin force plus the
+        force that accelerates the pin's share m₁ = m(l − l₁)/l of the rod mass, along the rod,
+        −(pin + m₁ a_B)·û with û = (A − B)/l.
+    throw_torque : moment of the throw on the shaft, positive in the direction of rotation.
+    """
+
+    main: NDArray[np.float64]
+    crankpin: NDArray[np.float64]
+    pin: NDArray[np.float64]
+    N: NDArray[np.float64]
+    S: NDArray[np.float64]
+    throw_torque: NDArray[np.float64]
+
+
+def crank_slider_joint_forces(mech, phi, omega, epsilon, gas_force=None,
+                              joint_moments=(0.0, 0.0, 0.0)) -> JointForces:
+    """Joint forces of a crank-slider for a prescribed motion φ, ω, ε by Newton–Euler: the
+    independent check of the analyses' force relations (Gots (34)–(41)) and of the reduced model.
+
+    Each cylinder is three bodies in its own plane — the throw (its unbalanced mass m_k at the
+    crankpin A, turning with the shaft), the rod (mass m at G, l₁ from the pin, inertia I_G about
+    G; a two-mass rod is the rigid one with I_G = m l₁(l − l₁), the inertia of its end masses),
+    the piston (mass m_p at the pin B, sliding along the axis at the offset e) — and the eight
+    unknowns: the bearing's force on the throw (2), the shaft's moment on the throw, the throw's
+    force on the rod at A (2), the rod's force on the piston at B (2) and the wall's force N. The
+    throw's and the rod's Newton and Euler equations and the piston's Newton equation are eight
+    linear equations, solved per sample (``numpy.linalg.solve``). The kinematics are written out
+    here from the loop x_B = e: sin β = (r sin α − e)/l, β̇ = r cos α ω/(l cos β), β̈ and ÿ_B by
+    differentiating once more.
+
+    Parameters
+    ----------
+    mech : transient.mechanisms.crank_slider.CrankSlider
+    phi, omega, epsilon : array_like (n,)
+        Shaft angle [rad], speed [rad/s], acceleration [rad/s²]; cylinder k is at the local angle
+        α = φ − ``firing_angles[k]``.
+    gas_force : array_like (n_cylinders, n), optional
+        Gas force on each piston toward the crank [N]; 0 if omitted.
+    joint_moments : three array_like (n_cylinders, n) or scalars
+        Known moments [N·m] in the main bearing, the crankpin and the piston pin, each on the
+        joint's outer body (throw, rod, rod) and opposite on the inner one (frame, throw, piston;
+        the wall holds the piston's), positive in the direction of rotation: where a friction
+        model's joint moments are checked against the chain's.
+
+    Returns
+    -------
+    JointForces
+    """
+    phi, omega, epsilon = (np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in
+                           np.broadcast_arrays(phi, omega, epsilon))
+    alpha = phi[None, :] - np.asarray(mech.firing_angles, dtype=np.float64)[:, None]
+    w = np.broadcast_to(omega, alpha.shape)
+    eps = np.broadcast_to(epsilon, alpha.shape)
+    shape = alpha.shape
+    r, l, e = mech.crank_radius, mech.rod_length, mech.offset
+    m, l1 = mech.rod_mass, mech.rod_cg_from_pin
+    i_g = mech.rod_inertia_cg if mech.rod_model == "rigid" else m * l1 * (l - l1)
+    p_g = np.zeros(shape) if gas_force is None else np.broadcast_to(gas_force, shape)
+    # The moments about +z (x × y): the shaft turns clockwise in this frame, so a moment in the
+    # direction of rotation is −z; the rod turns by +β̇ about z.
+    m_main, m_pin_a, m_pin_b = (-np.broadcast_to(np.asarray(v, dtype=np.float64), shape)
+                                for v in joint_moments)
+    sa, ca = np.sin(alpha), np.cos(alpha)
+    sb = (r * sa - e) / l
+    cb = np.sqrt(1.0 - sb * sb)
+    db = r * ca * w / (l * cb)  # β̇
+    ddb = (-r * sa * w**2 + r * ca * eps + l * sb * db**2) / (l * cb)  # β̈
+    pos_a = np.array([r * sa, r * ca])
+    pos_b = np.array([np.full(shape, e), r * ca + l * cb])
+    acc_a = np.array([r * (-sa * w**2 + ca * eps), r * (-ca * w**2 - sa * eps)])
+    acc_b = np.array([np.zeros(shape), -r * ca * w**2 - r * sa * eps - l * cb * db**2
+                      - l * sb * ddb])
+    f = l1 / l
+    pos_g = (1.0 - f) * pos_b + f * pos_a
+    acc_g = (1.0 - f) * acc_b + f * acc_a
+    ra, rb = pos_a - pos_g, pos_b - pos_g  # from G to the rod's ends
+    # Unknowns: F_O (x, y) bearing → throw, M the shaft's moment on the throw (z), F_A (x, y)
+    # throw → rod, F_B (x, y) rod → piston, N.
+    A = np.zeros(shape + (8, 8))
+    rhs = np.zeros(shape + (8,))
+    m_k, m_p = mech.crank_mass, mech.piston_mass
+    # Throw: F_O − F_A = m_k a_A; about O: M + A × (−F_A) − M_A = I_O·(−ε), I_O = m_k r².
+    A[..., 0, 0], A[..., 0, 3] = 1.0, -1.0
+    A[..., 1, 1], A[..., 1, 4] = 1.0, -1.0
+    rhs[..., 0], rhs[..., 1] = m_k * acc_a[0], m_k * acc_a[1]
+    A[..., 2, 2] = 1.0
+    A[..., 2, 3], A[..., 2, 4] = pos_a[1], -pos_a[0]  # A × (−F_A)
+    rhs[..., 2] = -m_k * r * r * eps - m_main + m_pin_a
+    # Rod: F_A − F_B = m a_G; about G: (A − G) × F_A + (B − G) × (−F_B) + M_A + M_B = I_G β̈.
+    A[..., 3, 3], A[..., 3, 5] = 1.0, -1.0
+    A[..., 4, 4], A[..., 4, 6] = 1.0, -1.0
+    rhs[..., 3], rhs[..., 4] = m * acc_g[0], m * acc_g[1]
+    A[..., 5, 3], A[..., 5, 4] = -ra[1], ra[0]
+    A[..., 5, 5], A[..., 5, 6] = rb[1], -rb[0]
+    rhs[..., 5] = i_g * ddb - m_pin_a - m_pin_b
+    # Piston: F_B + N x̂ − P_g ŷ = m_p a_B (its moment, −M_B, held by the wall).
+    A[..., 6, 5], A[..., 6, 7] = 1.0, 1.0
+    A[..., 7, 6] = 1.0
+    rhs[..., 6], rhs[..., 7] = m_p * acc_b[0], m_p * acc_b[1] + p_g
+    x = np.moveaxis(np.linalg.solve(A, rhs[..., None])[..., 0], -1, 0)
+    pin = x[5:7]
+    u_hat = (pos_a - pos_b) / l
+    m1 = m * (l - l1) / l
+    return JointForces(main=-x[0:2], crankpin=-x[3:5], pin=pin, N=x[7],
+                       S=-np.sum((pin + m1 * acc_b) * u_hat, axis=0), throw_torque=x[2])

@@ -736,14 +736,23 @@ def test_prescribed_run_with_pairs_reports_the_efficiency(tmp_path, capsys):
     assert (code, err) == (0, "")
     assert "mechanical efficiency over 1 steady cycle(s): η = W_out/W_in = " in out
     assert "(30) as printed, time average of P_out/P_in" in out
-    assert "pair 2: loss " in out and "circulated" in out
+    assert "pair 2 (crankpins): loss " in out and "circulated" in out
+    assert "mean effective pressures (V_d = 1.71516 L): imep " in out
+    assert "pair 2 (crankpins) loses most" in out  # (its efficiencies are the lower ones)
     res = transient.open_result(tmp_path / "gots_4400_pairs.h5")
     eta, unit = res.analysis["eta_mech_work"]
     assert unit == "1" and 0.85 < eta < 0.98
     losses = res.analysis["W_loss_1_per_cycle"][0] + res.analysis["W_loss_2_per_cycle"][0]
     assert eta == pytest.approx(1 - losses / res.analysis["W_in_per_cycle"][0], rel=1e-9)
+    for name in ("imep", "bmep", "fmep", "fmep_1", "fmep_2"):
+        assert res.analysis[name][1] == "Pa"
+    assert res.analysis["displacement"][1] == "m^3"
+    assert eta == pytest.approx(res.analysis["bmep"][0] / res.analysis["imep"][0], rel=1e-12)
     code, out, err = cli(capsys, "info", tmp_path / "gots_4400_pairs.h5")
     assert code == 0 and "mechanical efficiency over 1 steady cycle(s)" in out
+    assert "pair 1 (main bearings): loss " in out
+    code, out, err = cli(capsys, "plot", tmp_path / "gots_4400_pairs.h5", "-o", tmp_path)
+    assert code == 0 and (tmp_path / "gots_4400_pairs_budget.png").stat().st_size > 10_000
 
 
 def test_efficiency_study_writes_table_and_plot(tmp_path, capsys):
@@ -763,6 +772,25 @@ def test_efficiency_study_writes_table_and_plot(tmp_path, capsys):
     assert eta[("power-flow", 1.0, 5000.0)] < eta[("power-flow", 1.0, 1000.0)] - 0.01
     assert (tmp_path / "gots_diesel_friction_efficiency.png").stat().st_size > 10_000
     assert "wrote" in out and "power-flow" in out
+    # the friction budget per pair over speed, and η_mech over speed × load
+    for figure in ("friction_budget", "efficiency_map"):
+        assert (tmp_path / f"gots_diesel_friction_{figure}.png").stat().st_size > 10_000
+    fmep = {(r["policy"], float(r["fuel"]), float(r["rpm"])): float(r["fmep"]) for r in rows}
+    assert all(float(r["fmep"]) == pytest.approx(float(r["fmep_1"]) + float(r["fmep_2"]),
+                                                 rel=1e-9) for r in rows)
+    assert fmep[("power-flow", 1.0, 5000.0)] > fmep[("power-flow", 1.0, 1000.0)]
+
+
+def test_efficiency_study_refuses_a_figure_before_the_study(tmp_path, capsys, monkeypatch):
+    """A figure that exists is refused (exit 2) before any point is run, not after the study."""
+    import transient.study.efficiency as study
+
+    (tmp_path / "gots_diesel_friction_efficiency_map.png").write_bytes(b"keep")
+    monkeypatch.setattr(study, "prescribed", lambda *a, **k: pytest.fail("the study ran"))
+    code, out, err = cli(capsys, "efficiency", CASES / "gots_diesel_friction.toml", "--rpm",
+                         "1000,5000", "--fuel", "1,0.5", "-o", tmp_path)
+    assert code == 2 and "efficiency_map.png: exists; use --force" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gots_diesel_friction_efficiency_map.png"]
 
 
 @pytest.mark.parametrize("argv, key", [

@@ -259,8 +259,8 @@ SWEEP_CASES = [
      "sweep.method: must be a string, got ['grid']"),
     ("collect-long", SWEEP.replace("[sweep]\n", f'[sweep]\ncollect = ["{LONG}-"]\n'),
      "sweep.collect: '" + "x" * 36 + "... is not a quantity name; give names such as "
-     "mean_speed_rpm, final_speed_rpm, delta, eta_mech, speed_dip_pct, recovery_time_s, "
-     "droop_pct, spin_up_t90_s, or any /analysis entry"),
+     "mean_speed_rpm, final_speed_rpm, delta, eta_mech, fmep_kPa, speed_dip_pct, "
+     "recovery_time_s, droop_pct, spin_up_t90_s, or any /analysis entry"),
     ("columns-not-strings", SWEEP.replace("[sweep]\n", "[sweep]\ncolumns = [1, 2]\n"),
      "sweep.columns: must be a list of strings, got [1, 2]"),
     ("grid-num-huge", BASE + '[[axis]]\nkey = "load.torque"\nfrom = 0\nto = 1\nnum = '

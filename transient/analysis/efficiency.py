@@ -19,6 +19,32 @@ and comes back within the cycle (inertia driving part of the cycle), on which th
 This is why η_mech falls with speed. And how often the pair's mode runs against the power it
 transmits (negative loss): the share of the time and the number of such intervals per cycle — zero
 for the ``power-flow`` policy, the measure of disagreement for ``paper``.
+
+The friction budget
+-------------------
+A pair's loss follows from the chain's own quantities (:mod:`transient.core.chain`): summing the
+sub-chain equations ``J_k φ̈ + ½J′_k ω² = M_k + η*_{k−1} S_{k−1} − S_k`` times ω gives::
+
+    d/dt ½J(φ)ω² = Σ_k M_k ω − Σ_k (1 − η*_k) S_k ω,
+
+so pair k dissipates ``P_loss,k = (1 − η*_k) S_k ω`` (the ``P_loss_<k>`` column; its integral
+``W_loss_<k>`` is integrated with the motion). ``S_k ω`` is the power the shaft side sends into
+the pair and ``η*_k S_k ω`` what the far side receives. Forward (``η* = η_fwd``, ``S_k ω ≥ 0``)
+the loss is ``(1 − η_fwd) S_k ω``; backward (``η* = 1/η_bwd``, ``S_k ω < 0``) the far side sends
+``−S_k ω/η_bwd`` and the loss is ``(1 − η_bwd)(−S_k ω/η_bwd)``. In either mode the pair loses
+the share 1 − η of the power its driving side puts in, ≥ 0 whenever the mode agrees with the
+direction of that power (always, under ``power-flow``).
+
+Mean effective pressures refer the work per cycle to the engine's displacement V_d
+(:func:`displacement`): ``imep`` = W_in/V_d (gas and starter work), ``bmep`` = W_out/V_d (taken
+by load and drive), ``fmep_<k>`` = W_loss,k/V_d and ``fmep`` their sum. Over C whole cycles
+imep − fmep − bmep = ΔK/(C V_d), K = ½J(φ)ω², zero in steady state; the relative mismatch of
+this balance is ``energy_balance_residual``. η_mech = bmep/imep = 1 − fmep/imep. Every pair of
+the chains the mechanisms have joins links that all cylinders share (the main bearings of every
+throw, the crankpins of every rod, the plate bearing of every piston), so a pair's FMEP is
+referred to the whole displacement; for an engine whose cylinders work alike it is also each
+cylinder's. The correlation of Chen and Flynn (:func:`chen_flynn_fmep`) gives the order of a whole
+engine's FMEP to hold a scene's against.
 """
 from __future__ import annotations
 
@@ -57,6 +83,41 @@ def steady_window(scene, traj, rtol: float = 1e-4, cycles: int = 3):
     return float(marks[first]), float(marks[-1]), int(marks.size - 1 - first)
 
 
+def displacement(mech) -> float:
+    """The engine's displacement V_d [m³]: the number of cylinders times the volume each one
+    sweeps between its dead centres (crank-slider F_p·S, Gots (11);
+    swash plate both halves of a cylinder; articulated the master's, the slaves' strokes
+    differing from it by their ``stroke_excess``). A mean effective pressure is the work per
+    cycle over V_d, the cycle being ``mech.cycle`` (4π four-stroke, 2π two-stroke)."""
+    return mech.n_cylinders * mech.swept_volume()
+
+
+#: Coefficients (A [Pa], B [1], C [Pa s/m], D [Pa s²/m²]) of :func:`chen_flynn_fmep`: the
+#: generic four-stroke set quoted with Chen & Flynn's form, A = 0.4 bar, B = 0.005,
+#: C = 0.09 bar s/m, D = 0.0009 bar s²/m² (not a fit to any engine of this project).
+CHEN_FLYNN = (0.4e5, 0.005, 0.09e5, 0.0009e5)
+
+
+def chen_flynn_fmep(p_max: float, c_m: float, coefficients=CHEN_FLYNN) -> float:
+    """Friction mean effective pressure [Pa] by the correlation of Chen and Flynn (1965, SAE
+    650733), FMEP = A + B·p_max + C·c_m + D·c_m², from the peak cylinder pressure ``p_max``
+    [Pa] and the mean piston speed ``c_m`` [m/s] (:func:`mean_piston_speed`).
+
+    The whole engine's friction — piston and rings, bearings, valve train, auxiliaries — as a
+    regression over engines: an order of magnitude to compare a model's FMEP with, not a
+    prediction. The constant and the speed terms carry most of it at rated speed; the
+    coefficients differ from engine to engine (``coefficients``, default :data:`CHEN_FLYNN`).
+    """
+    a, b, c, d = coefficients
+    return a + b * p_max + c * c_m + d * c_m * c_m
+
+
+def mean_piston_speed(mech, omega: float) -> float:
+    """c_m = 2·S·n [m/s], S the stroke (the mechanism's ``stroke()``), n = ω/2π the speed in
+    revolutions per second: each piston travels 2S per revolution."""
+    return mech.stroke() * omega / math.pi
+
+
 def _at(traj, name: str, phi_marks) -> NDArray[np.float64]:
     """Column ``name`` at shaft angles ``phi_marks`` (linear in φ; exact on a sample)."""
     phi = traj["phi"]
@@ -89,6 +150,7 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
     W_out = -(_delta(traj, "W_load", a, b) + _delta(traj, "W_drive", a, b))
     losses = [_delta(traj, f"W_loss_{k + 1}", a, b) for k in range(n_pairs)]
     dK = _delta({"phi": traj["phi"], "K": 0.5 * traj["J"] * traj["omega"] ** 2}, "K", a, b)
+    v_d = displacement(scene.mechanism)
     out = {
         "steady_phi_start": (a, "rad"),
         "steady_cycles": (float(n_cyc), "1"),
@@ -97,6 +159,10 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         "eta_mech_work": (W_out / W_in if W_in > 0 else math.nan, "1"),
         "energy_balance_residual": ((dK - (W_in - W_out - sum(losses))) / max(abs(W_in), 1e-300),
                                     "1"),
+        "displacement": (v_d, "m^3"),
+        "imep": (W_in / n_cyc / v_d, "Pa"),
+        "bmep": (W_out / n_cyc / v_d, "Pa"),
+        "fmep": (sum(losses) / n_cyc / v_d, "Pa"),
     }
     if events is not None and n_pairs:
         switches = np.asarray(events.get("pair_mode", np.zeros((0, 2))))
@@ -110,6 +176,7 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         net = float(np.trapezoid(P, t))
         gross = float(np.trapezoid(np.abs(P), t))
         out[f"W_loss_{k + 1}_per_cycle"] = (losses[k] / n_cyc, "J")
+        out[f"fmep_{k + 1}"] = (losses[k] / n_cyc / v_d, "Pa")
         out[f"loss_share_{k + 1}"] = (losses[k] / W_in if W_in > 0 else math.nan, "1")
         out[f"W_transmitted_{k + 1}_per_cycle"] = (net / n_cyc, "J")
         out[f"W_circulated_{k + 1}_per_cycle"] = ((gross - abs(net)) / n_cyc, "J")

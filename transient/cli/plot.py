@@ -45,6 +45,14 @@ def cmd_plot(args) -> int:
         plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)
         ax.set_title(f"{scene.name}: power through the non-ideal pairs ({scene.friction.policy})")
         written.append(save(fig, out / f"{stem}_pairs.png", args.force, res))
+    if "fmep_1" in res.analysis:  # the friction budget of the steady cycles
+        names = [p.name for p in scene.friction.pairs]
+        fig, ax = plt.subplots(figsize=(5, 4.5))
+        plots.friction_budget(ax, ["steady cycles"], [res.analysis[f"fmep_{k + 1}"][0]
+                                                      for k in range(len(names))], names)
+        ax.set_title(f"{scene.name}: FMEP per pair (η_mech = "
+                     f"{res.analysis['eta_mech_work'][0]:.4f})")
+        written.append(save(fig, out / f"{stem}_budget.png", args.force, res))
     table = gas_table(scene)
     if table is not None and not gas_is_force(scene):
         mech = scene.mechanism

@@ -101,7 +101,7 @@ def cmd_run(args) -> int:
         print(f"wrote {path}")
         if res.status != FINISHED:
             print(f"  status: {res.message}")
-        _print_summary(res.analysis, res.solver)
+        _print_summary(res.analysis, res.solver, pair_names(scene))
     return _said(res, failed)
 
 
@@ -116,7 +116,7 @@ def _said(res, failed) -> int:
     return EXIT_FAILED
 
 
-def _print_summary(summary, solver) -> None:
+def _print_summary(summary, solver, names=()) -> None:
     rpm = 30.0 / math.pi
     v = {k: val for k, (val, _) in summary.items()}
     print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
@@ -138,7 +138,7 @@ def _print_summary(summary, solver) -> None:
         print(f"  mean drive torque required over the last cycle: "
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
     _print_response(v)
-    _print_efficiency(v)
+    _print_efficiency(v, names)
     asked = [k for k, val in v.items() if np.ndim(val) > 0]
     if asked:
         print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
@@ -170,8 +170,14 @@ def _print_response(v: dict) -> None:
               f"overshoot {v['spin_up_overshoot_pct']:.3g} %")
 
 
-def _print_efficiency(v: dict) -> None:
-    """η_mech in both forms and each pair's budget per cycle (``analysis.efficiency``)."""
+def pair_names(scene) -> list[str]:
+    """Each friction pair's label for the summary: its number and its name."""
+    return [f"pair {k} ({p.name})" for k, p in enumerate(scene.friction.pairs, start=1)]
+
+
+def _print_efficiency(v: dict, names=()) -> None:
+    """η_mech in both forms and each pair's budget per cycle (``analysis.efficiency``), the
+    pairs labelled by ``names`` (default: their numbers)."""
     if "eta_mech_work" not in v:
         return
     print(f"  mechanical efficiency over {v['steady_cycles']:.0f} steady cycle(s): "
@@ -182,14 +188,23 @@ def _print_efficiency(v: dict) -> None:
         print(f"    (30) as printed, time average of P_out/P_in: {v['eta_mech_printed']:.6g} "
               f"(ill-posed where P_in crosses zero; {100 * v['eta_mech_printed_excluded']:.3g} % "
               f"of the time left out)")
+    if "fmep" in v:
+        print(f"    mean effective pressures (V_d = {v['displacement'] * 1e3:.6g} L): imep "
+              f"{v['imep'] / 1e3:.6g} kPa, bmep {v['bmep'] / 1e3:.6g} kPa, fmep "
+              f"{v['fmep'] / 1e3:.6g} kPa")
     k = 1
+    label = dict(enumerate(names, start=1))
     while f"W_loss_{k}_per_cycle" in v:
-        print(f"    pair {k}: loss {v[f'W_loss_{k}_per_cycle']:.6g} J/cycle "
+        print(f"    {label.get(k, f'pair {k}')}: loss {v[f'W_loss_{k}_per_cycle']:.6g} "
+              f"J/cycle, fmep {v[f'fmep_{k}'] / 1e3:.6g} kPa "
               f"({100 * v[f'loss_share_{k}']:.4g} % of W_in), circulated "
               f"{v[f'W_circulated_{k}_per_cycle']:.6g} J/cycle, far side driving "
               f"{100 * v[f'backward_share_{k}']:.3g} % of the time, mode against the power "
               f"{100 * v[f'mode_against_power_share_{k}']:.3g} % of the time")
         k += 1
+    if k > 2:
+        most = max(range(1, k), key=lambda j: v[f"W_loss_{j}_per_cycle"])
+        print(f"    {label.get(most, f'pair {most}')} loses most")
     if "pair_mode_switches_per_cycle" in v:
         print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
 
@@ -216,7 +231,8 @@ def cmd_info(args) -> int:
             print(f"  {s['stiff_rerun']}")
     values = {k: v for k, (v, _) in res.analysis.items()}
     _print_response(values)
-    _print_efficiency(values)
+    # (the pairs' names are in the resolved scene, read only when there are pairs)
+    _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())
     arrays = []
     for k, (v, unit) in res.analysis.items():
         if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped

@@ -6,7 +6,9 @@ motion is periodic, so one cycle is the steady state. The load is the gas-force 
 ``fuel`` (1 full load), as the swash-plate paper's governor sets it. η_mech is the work ratio of
 :mod:`transient.analysis.efficiency`, and each pair's loss and circulated energy say why it falls
 with speed: the inertia torques ½J′(φ)ω² grow as ω², and the power they send back and forth
-through the pairs is lost on too.
+through the pairs is lost on too. Each row carries the friction budget of its point (imep, bmep,
+each pair's FMEP and the total); :func:`plot_budget` draws it against speed, :func:`plot_map`
+η_mech over speed × load.
 """
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import dataclasses
 import math
 
 from ..analysis.efficiency import mechanical_efficiency
+from ..plots import friction_budget, sweep_heatmap
 from ..scene import Friction, Initial, Output, Run
 from ..run import prescribed
 
@@ -97,3 +100,39 @@ def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
     twin.legend(loc="upper right", fontsize=8)
     ax_loss.grid(alpha=0.3)
     return artists
+
+
+def _first_policy(rows: list[dict]) -> tuple[str, list[float], list[float]]:
+    """The policy the figures show (the first), its fuels (largest first) and speeds."""
+    policy = rows[0]["policy"]
+    sel = [r for r in rows if r["policy"] == policy]
+    fuels = sorted({r["fuel"] for r in sel}, reverse=True)
+    rpm = sorted({r["rpm"] for r in sel})
+    return policy, fuels, rpm
+
+
+def _row(rows, policy, fuel, rpm) -> dict:
+    return next(r for r in rows if (r["policy"], r["fuel"], r["rpm"]) == (policy, fuel, rpm))
+
+
+def plot_budget(ax, rows: list[dict], names) -> list:
+    """Each pair's FMEP [kPa] stacked at every speed, for the first policy at its largest fuel
+    (:func:`transient.plots.friction_budget`). Returns the bars."""
+    policy, fuels, rpm = _first_policy(rows)
+    sel = [_row(rows, policy, fuels[0], n) for n in rpm]
+    fmep = [[r[f"fmep_{k + 1}"] for r in sel] for k in range(len(names))]
+    bars = friction_budget(ax, [f"{n:g}" for n in rpm], fmep, names)
+    ax.set_xlabel(f"speed [rpm] ({policy}, fuel {fuels[0]:g})")
+    return bars
+
+
+def plot_map(ax, rows: list[dict]):
+    """η_mech over speed × fuel for the first policy, each cell labelled
+    (:func:`transient.plots.sweep_heatmap`). Returns the mesh."""
+    policy, fuels, rpm = _first_policy(rows)
+    fuels = fuels[::-1]  # the lowest load at the bottom
+    eta = [[_row(rows, policy, f, n)["eta_mech_work"] for n in rpm] for f in fuels]
+    mesh = sweep_heatmap(ax, rpm, fuels, eta, "speed [rpm]", "fuel (gas-force fraction)",
+                         "η_mech = W_out / W_in")
+    ax.set_title(f"η_mech over speed and load ({policy})")
+    return mesh

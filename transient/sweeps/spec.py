@@ -67,6 +67,8 @@ QUANTITIES: dict[str, tuple[str, float, str, str, Callable | None]] = {
               "speed non-uniformity δ = (ω_max − ω_min)/ω_mean over the last cycle", None),
     "eta_mech": ("eta_mech_work", 1.0, "1", "mechanical efficiency W_out/W_in, steady cycles",
                  lambda s: s.gas.model != "none"),
+    "fmep_kPa": ("fmep", 1e-3, "kPa", "friction mean effective pressure Σ W_loss/V_d, steady "
+                 "cycles", lambda s: s.gas.model != "none"),
     "speed_dip_pct": ("load_change_1_dev_max_pct", 1.0, "%",
                       "ISO 8528-5 transient speed deviation after the first load step",
                       _has_load_step),
@@ -411,7 +413,7 @@ def _check_columns(sweep: Sweep, runs: tuple[RunSpec, ...]) -> None:
         for q in sweep.collect:
             check = QUANTITIES.get(q, (None,) * 5)[4]
             if check is not None and not check(spec.scene):
-                what = "gas forces" if q == "eta_mech" else "load step"
+                what = "gas forces" if q in ("eta_mech", "fmep_kPa") else "load step"
                 raise SceneError("sweep.collect", f"{show_value(q)} ({QUANTITIES[q][3]}) cannot "
                                                   f"be measured in run {spec.index}: its scene "
                                                   f"has no {what}",
