@@ -37,6 +37,9 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   ``loads_N_tangential`` (z, N) [N], ``loads_torque`` (z, N) [N m]; ``loads_engine_torque``
   (Σ torque) and ``loads_shaft_torque`` (with the rods' and link 9's inertia) (N,) [N m]. No
   crankpin.
+* ``thermodynamics = true``: per cylinder and whole cycle ``thermo_*`` — indicated work, IMEP,
+  BMEP, FMEP, the powers, the peak pressures and, for Wiebe combustion, the heat released and
+  the burned-fraction angles (:mod:`transient.analysis.thermo` lists the names and units).
 """
 from __future__ import annotations
 
@@ -48,6 +51,7 @@ import numpy as np
 from ..errors import SceneError
 from .irregularity import cycle_boundaries
 from .orders import order_spectrum, piston_acceleration, resolve_detrend, to_angle_grid
+from .thermo import cycle_thermodynamics
 
 #: A derived signal of ``orders``: the piston acceleration of cylinder k.
 PISTON_ACCELERATION = re.compile(r"W_([1-9][0-9]*)$")
@@ -61,7 +65,8 @@ def requested_analyses(scene, traj: dict[str, np.ndarray], events=None
     out: dict[str, tuple[Any, str]] = {}
     parts = (("irregularity", req.irregularity, lambda: cycle_irregularity(scene, traj)),
              ("orders", bool(req.orders), lambda: stored_orders(scene, traj, cuts)),
-             ("loads", req.loads, lambda: stored_loads(scene, traj, cuts)))
+             ("loads", req.loads, lambda: stored_loads(scene, traj, cuts)),
+             ("thermo", req.thermodynamics, lambda: cycle_thermodynamics(scene, traj, events)))
     for name, asked, compute in parts:
         if not asked:
             continue

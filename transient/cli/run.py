@@ -128,6 +128,7 @@ def _print_summary(summary, solver) -> None:
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
     _print_response(v)
     _print_efficiency(v)
+    _print_thermodynamics(v)
     asked = [k for k, val in v.items() if np.ndim(val) > 0]
     if asked:
         print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
@@ -183,6 +184,18 @@ def _print_efficiency(v: dict) -> None:
         print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
 
 
+def _print_thermodynamics(v: dict) -> None:
+    """The last whole cycle's mean effective pressures and powers (``analysis.thermo``)."""
+    if "thermo_last_imep_engine" not in v:
+        return
+    print(f"  last cycle: IMEP {v['thermo_last_imep_engine'] / 1e5:.5g} bar, BMEP "
+          f"{v['thermo_last_bmep'] / 1e5:.5g} bar, FMEP {v['thermo_last_fmep'] / 1e5:.5g} bar; "
+          f"indicated {v['thermo_last_P_indicated_engine'] / 1e3:.5g} kW, brake "
+          f"{v['thermo_last_P_brake'] / 1e3:.5g} kW, friction "
+          f"{v['thermo_last_P_friction'] / 1e3:.5g} kW; peak pressure "
+          f"{v['thermo_last_p_max'] / 1e6:.5g} MPa")
+
+
 def cmd_info(args) -> int:
     res = read_result(args.result)
     a = res.attrs
@@ -206,6 +219,7 @@ def cmd_info(args) -> int:
     values = {k: v for k, (v, _) in res.analysis.items()}
     _print_response(values)
     _print_efficiency(values)
+    _print_thermodynamics(values)
     arrays = []
     for k, (v, unit) in res.analysis.items():
         if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped

@@ -111,6 +111,10 @@ def check_analysis(scene: Scene) -> None:
         if name not in columns + derived:
             raise SceneError("analysis.orders", f"unknown signal {show_value(name)}; allowed: "
                                                 f"{', '.join(columns + derived)}")
+    if a.thermodynamics and scene.gas.model in ("none", "trapezoid"):
+        raise SceneError("analysis.thermodynamics",
+                         f"gas model {show_value(scene.gas.model)} applies no cylinder pressure "
+                         f"(∮p dV needs one); allowed with it: false")
     if len(set(a.orders)) != len(a.orders):
         raise SceneError("analysis.orders", "a signal is named twice; name each once")
     nyquist = (a.samples_per_cycle // 2) * 2.0 * math.pi / mech.cycle

@@ -370,19 +370,23 @@ class Analysis:
     ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
     engine cycle.
     ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
-    (:func:`transient.analysis.orders.order_spectrum`).
+    (:func:`transient.analysis.orders.order_spectrum`). ``thermodynamics``: per cylinder and
+    cycle the indicated work, IMEP, BMEP, FMEP, powers, peak pressures and, for Wiebe
+    combustion, the heat release and burned-fraction angles, from the pressure the run applied
+    (:mod:`transient.analysis.thermo`).
     """
 
     loads: bool = False
     orders: tuple[str, ...] = ()
     irregularity: bool = False
+    thermodynamics: bool = False
     max_order: float = 12.0
     samples_per_cycle: int = 720
     detrend: str = "auto"
 
     @property
     def requested(self) -> bool:
-        return self.loads or bool(self.orders) or self.irregularity
+        return self.loads or bool(self.orders) or self.irregularity or self.thermodynamics
 
 
 DETREND = ("auto", "ramp", "none")
