@@ -100,6 +100,154 @@ def indicator_pv(ax, table, volume, log=True):
     return artists
 
 
+def _cylinders(scene, cylinders):
+    """Cylinder numbers (1-based) to draw: all for None; ValueError for one out of range."""
+    n = scene.mechanism.n_cylinders
+    picked = list(range(1, n + 1)) if cylinders is None else [int(c) for c in cylinders]
+    bad = [c for c in picked if not 1 <= c <= n]
+    if bad:
+        raise ValueError(f"cylinder {bad[0]} is out of range; allowed: 1 … {n}")
+    return picked
+
+
+def _cycle_samples(traj, scene, cylinder, cycles):
+    """(label "i of n", sample mask, start angle) of each of ``cylinder``'s own whole cycles asked
+    for (indices as in a list: −1 the last); ValueError for an index the run does not hold."""
+    from .analysis.thermo import own_cycles
+
+    starts = own_cycles(scene, traj, cylinder)
+    phi = traj["phi"]
+    out = []
+    for c in cycles:
+        if not -starts.size <= c < starts.size:
+            raise ValueError(f"cycle {c} is out of range: cylinder {cylinder} has "
+                             f"{starts.size} whole cycle(s) in the run (allowed "
+                             f"{-starts.size} … {starts.size - 1})")
+        a = starts[c]
+        out.append((f"{c % starts.size + 1} of {starts.size}",
+                    (phi >= a) & (phi <= a + scene.mechanism.cycle), a))
+    return out
+
+
+def run_indicator_phi(ax, traj, scene, cylinders=None, cycles=(-1,), table=None):
+    """The pressure the run applied [MPa] against each cylinder's own (local) angle [deg], over
+    its whole cycles ``cycles`` (−1: the last), for ``cylinders`` (1-based; None: all).
+    ``table``: the input table (a :class:`~transient.forces.gas.PressureTable`) drawn dashed
+    for comparison. Returns the artists."""
+    traj = _columns(traj)
+    artists = []
+    for k in _cylinders(scene, cylinders):
+        for c, sel, a in _cycle_samples(traj, scene, k, cycles):
+            artists += ax.plot(np.degrees(traj["phi"][sel] - a), traj[f"p_{k}"][sel] / 1e6,
+                               lw=1.0, label=f"cylinder {k}, cycle {c}")
+    if table is not None:
+        x = np.linspace(0.0, table.period, 2881)
+        artists += ax.plot(np.degrees(x), table(x) / 1e6, lw=0.8, ls="--", color="0.5",
+                           label="input table, full fuel")
+    ax.set_xlabel("cylinder's own crank angle [deg]")
+    ax.set_ylabel("p [MPa]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    return artists
+
+
+def run_indicator_pv(ax, traj, scene, cylinders=None, cycles=(-1,), log=True):
+    """p–V diagram of the run: the pressure applied [MPa] against the cylinder's exact volume
+    [dm³] (:func:`transient.analysis.thermo.cylinder_volumes`; the swept part only where the gas
+    model gives no clearance), log-log unless ``log`` is False. Returns the artists."""
+    traj = _columns(traj)
+    from .analysis.thermo import cylinder_volumes
+
+    plot = ax.loglog if log else ax.plot
+    artists = []
+    for k in _cylinders(scene, cylinders):
+        for c, sel, _ in _cycle_samples(traj, scene, k, cycles):
+            V = cylinder_volumes(scene, traj["phi"][sel]).V[k - 1]
+            artists += plot(V * 1e3, traj[f"p_{k}"][sel] / 1e6, lw=1.0,
+                            label=f"cylinder {k}, cycle {c}")
+    ax.set_xlabel("V [dm³]")
+    ax.set_ylabel("p [MPa]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    return artists
+
+
+def speed_over_cycle(ax, traj, scene):
+    """ω(φ) [rpm] over the last whole cycle against the angle in it [deg], with its mean, its
+    extremes and δ = (ω_max − ω_min)/ω_mean (Gots §2.8) marked. Returns the artists."""
+    traj = _columns(traj)
+    from .analysis.irregularity import cycle_boundaries
+
+    cycle = scene.mechanism.cycle
+    tb, marks = cycle_boundaries(traj["t"], traj["phi"], cycle, scene.initial.phi)
+    if marks.size < 2:
+        raise ValueError("the run holds no whole cycle")
+    a, b = marks[-2], marks[-1]
+    sel = (traj["phi"] >= a) & (traj["phi"] <= b)
+    rpm = 30.0 / math.pi
+    x = np.degrees(traj["phi"][sel] - a)
+    w = traj["omega"][sel] * rpm
+    mean = cycle / (tb[-1] - tb[-2]) * rpm
+    artists = ax.plot(x, w, lw=1.2, label="ω")
+    i, j = int(np.argmax(w)), int(np.argmin(w))
+    artists.append(ax.axhline(mean, color="k", lw=0.6, ls="--", label="cycle mean"))
+    artists += ax.plot([x[i], x[j]], [w[i], w[j]], "o", color="C3", ms=4)
+    artists.append(ax.annotate("", xy=(x[i], w[j]), xytext=(x[i], w[i]),
+                               arrowprops={"arrowstyle": "<->", "color": "C3", "lw": 0.8}))
+    artists.append(ax.text(x[i], 0.5 * (w[i] + w[j]), f"  δ = {(w[i] - w[j]) / mean:.4g}",
+                           color="C3", va="center", fontsize=9))
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel("ω [rpm]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return artists
+
+
+def cylinder_torque_curves(ax, traj, scene):
+    """Each cylinder's gas torque and their sum M_gas [N m] over the last whole cycle against
+    the angle in it [deg] (:func:`transient.analysis.thermo.cylinder_torques`). Returns the
+    artists."""
+    traj = _columns(traj)
+    from .analysis.thermo import cylinder_torques
+
+    sel = last_cycle(traj, scene.mechanism.cycle)
+    part = {k: np.asarray(traj[k])[sel] for k in traj if k == "phi" or k.startswith("p_")}
+    x = np.degrees(part["phi"] - part["phi"][0])
+    torques = cylinder_torques(scene, part)
+    artists = [ax.plot(x, m, lw=0.9, label=f"cylinder {k + 1}")[0]
+               for k, m in enumerate(torques)]
+    artists += ax.plot(x, torques.sum(axis=0), lw=1.6, color="k", label="sum (M_gas)")
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel("M [N m]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return artists
+
+
+def inertia_and_gas(axes, traj, cycle):
+    """Over the last cycle against the angle in it [deg]: J(φ) [kg m²] on ``axes[0]``, and on
+    ``axes[1]`` the inertia moment ½J′(φ)ω² beside the gas and load moments [N m] — the terms
+    of (18), J φ̈ = M − ½J′φ̇², whose balance sets ε. Returns the artists."""
+    traj = _columns(traj)
+    sel = last_cycle(traj, cycle)
+    x = np.degrees(traj["phi"][sel] - traj["phi"][sel][0])
+    a_j, a_m = axes
+    artists = a_j.plot(x, traj["J"][sel], lw=1.2, color="C4")
+    a_j.set_ylabel("J [kg m²]")
+    artists += a_m.plot(x, 0.5 * traj["dJ_dphi"][sel] * traj["omega"][sel] ** 2, lw=1.2,
+                        color="C4", label="½J′ω²")
+    artists += a_m.plot(x, traj["M_gas"][sel], lw=1.0, color="C0", label="M_gas")
+    artists += a_m.plot(x, traj["M_load"][sel], lw=1.0, color="C3", label="M_load")
+    a_m.axhline(0.0, color="0.6", lw=0.5)
+    a_m.set_ylabel("M [N m]")
+    a_m.set_xlabel("crank angle in the last cycle [deg]")
+    a_m.legend(fontsize=8)
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    return artists
+
+
 def transfer_functions(ax, table):
     """Transfer functions of a kinematics table against the shaft angle: u₉,₁ and u₁₃,₁ of a
     swash plate (the paper's Fig. 4), the piston ones u_k [m/rad] on a second axis."""

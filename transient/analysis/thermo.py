@@ -436,3 +436,36 @@ def rate_of_heat_release(scene, phi: ArrayLike, p: ArrayLike, cylinder: int = 1
     vol = cylinder_volumes(scene, phi)
     dp = CubicSpline(phi, p, bc_type="not-a-knot")(phi, 1)
     return g / (g - 1.0) * p * vol.dV[cylinder - 1] + vol.V[cylinder - 1] * dp / (g - 1.0)
+
+
+# ------------------------------------------------------------------------------------------------
+# Per cylinder, for the plots
+
+
+def own_cycles(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int
+               ) -> NDArray[np.float64]:
+    """Shaft angles [rad] at which the whole cycles of ``cylinder`` (1-based) in the run start:
+    its local angle 0 (as its gas table counts it), cycles whose end the run reaches, after its
+    last backward motion. Raises ValueError for a cylinder out of range."""
+    from ..assemble import gas_phases
+
+    n = scene.mechanism.n_cylinders
+    if not 1 <= cylinder <= n:
+        raise ValueError(f"cylinder {cylinder} is out of range; allowed: 1 … {n}")
+    phi = np.asarray(traj["phi"], float)[_increasing_part(traj)]
+    return cycle_marks(phi, scene.mechanism.cycle, float(gas_phases(scene)[cylinder - 1]))[:-1]
+
+
+def cylinder_torques(scene, traj: Mapping[str, NDArray[np.float64]]) -> NDArray[np.float64]:
+    """Each cylinder's gas torque on the shaft at the stored samples, (n, samples) [N m]:
+    (p_k − p0)·dV_k/dφ for a pressure, the force times the piston's ds/dφ (both pistons of a
+    two-half swash plate) for a force model; their sum is ``M_gas``."""
+    from ..assemble import gas_is_force
+
+    phi = np.asarray(traj["phi"], float)
+    vol = cylinder_volumes(scene, phi)
+    p = np.array([np.asarray(traj[f"p_{k + 1}"], float)
+                  for k in range(scene.mechanism.n_cylinders)])
+    if gas_is_force(scene):
+        return p * vol.dV / scene.mechanism.piston_area
+    return (p - scene.gas.p0) * vol.dV
