@@ -62,6 +62,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .irregularity import NoWholeCycle
 from .orders import _increasing_part, cycle_marks, resample_angle
+from .pistons import piston_kinematics
 
 #: Degree of the interpolatory quadrature of the stored samples (error O(h^(d+1)) per interval).
 QUAD_DEGREE = 6
@@ -78,48 +79,6 @@ MFB_LEVELS = (0.1, 0.5, 0.9)
 
 # ------------------------------------------------------------------------------------------------
 # Cylinder volumes
-
-
-def _crank_slider_travel(mech, phi):
-    from .loads.crank_slider import slider_arrays
-
-    s, ds = [], []
-    for phase in mech.firing_angles:
-        a, b, *_ = slider_arrays(phi - phase, mech.crank_radius, mech.rod_length, mech.offset)
-        s.append(a)
-        ds.append(b)
-    n = mech.n_cylinders
-    return np.array(s), np.array(ds), np.full(n, mech.piston_area), np.full(n, mech.stroke())
-
-
-def _articulated_travel(mech, phi):
-    from ..mechanisms.articulated import piston_strokes
-
-    tab = mech.kinematics_table(phi)
-    n = mech.n_cylinders
-    s = np.array([tab[f"s_{k + 1}"] for k in range(n)])
-    u = np.array([tab[f"u_{k + 1}"] for k in range(n)])
-    strokes = np.tile(piston_strokes(mech), mech.rows)
-    return s, u, np.full(n, mech.piston_area), strokes
-
-
-def _swash_travel(mech, phi):
-    from ..mechanisms.swash_plate import dead_centres, kinematics_table, stroke
-
-    tab = kinematics_table(mech, phi)
-    inner = kinematics_table(mech, np.asarray(dead_centres(mech)[0], dtype=float))
-    n = mech.n_cylinders
-    # x of cylinder k's piston joint, from its value at its own inner dead centre
-    s = np.array([tab[f"x_{k + 1}"] - inner[f"x_{k + 1}"][k] for k in range(n)])
-    u = np.array([tab[f"u_{k + 1}"] for k in range(n)])
-    # opposed pistons (halves = 2) both bound the one volume: the area counts twice
-    return s, u, np.full(n, mech.halves * mech.piston_area), stroke(mech)
-
-
-#: Per mechanism: (mechanism, φ (m,)) → travel s_k from the top dead centre [m] and ds_k/dφ
-#: [m/rad], each (n, m), the area A_k [m²] and the stroke [m] of each cylinder (n,).
-TRAVEL = {"crank-slider": _crank_slider_travel, "articulated": _articulated_travel,
-          "swash-plate": _swash_travel}
 
 
 def clearance(scene) -> float:
@@ -152,15 +111,11 @@ class Volumes:
 def cylinder_volumes(scene, phi: ArrayLike) -> Volumes:
     """V_k(φ) = V_c + A_k s_k(φ) and dV_k/dφ of every cylinder at the shaft angles ``phi`` [rad].
 
-    Raises ValueError for a mechanism without a travel law in :data:`TRAVEL`."""
-    mech = scene.mechanism
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    travel = TRAVEL.get(mech.name)
-    if travel is None:
-        raise ValueError(f"no cylinder volumes for {type(mech).__name__}")
-    s, ds, area, stroke = travel(mech, phi)
+    Raises ValueError for a mechanism without piston kinematics (:mod:`.pistons`)."""
+    pk = piston_kinematics(scene.mechanism, phi)
     vc = clearance(scene)
-    return Volumes(vc + area[:, None] * s, area[:, None] * ds, area * stroke, vc)
+    return Volumes(vc + pk.area[:, None] * pk.s, pk.area[:, None] * pk.ds, pk.area * pk.stroke,
+                   vc)
 
 
 # ------------------------------------------------------------------------------------------------
