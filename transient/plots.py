@@ -205,10 +205,10 @@ def speed_over_cycle(ax, traj, scene):
 
 def cylinder_torque_curves(ax, traj, scene):
     """Each cylinder's gas torque and their sum M_gas [N m] over the last whole cycle against
-    the angle in it [deg] (:func:`transient.analysis.thermo.cylinder_torques`). Returns the
+    the angle in it [deg] (:func:`transient.analysis.pistons.cylinder_torques`). Returns the
     artists."""
     traj = _columns(traj)
-    from .analysis.thermo import cylinder_torques
+    from .analysis.pistons import cylinder_torques
 
     sel = last_cycle(traj, scene.mechanism.cycle)
     part = {k: np.asarray(traj[k])[sel] for k in traj if k == "phi" or k.startswith("p_")}
@@ -439,25 +439,74 @@ def order_bars(ax, orders, amplitude, ylabel, max_order=12.0, width=0.35, offset
     return artists
 
 
-def order_waterfall(ax, omega_mean_rpm, orders, amplitude, max_order=12.0):
-    """Run-up waterfall: each cycle's order spectrum [unit of the signal] as one line, raised by
-    its cycle-mean speed (the y axis reads speed at each line's base). ``amplitude``: (n_cycles,
-    n_orders). Returns the artists."""
+def order_waterfall(ax, omega_mean_rpm, orders, amplitude, max_order=12.0, label=None):
+    """Run-up waterfall as a colour map: the amplitude of each order (x) in each cycle, placed at
+    the cycle's mean speed (y), on a logarithmic colour scale over four decades below the
+    largest (weaker lines are drawn at its floor). ``amplitude``: (n_cycles, n_orders) in the
+    unit of the signal, ``label`` names it on the colour bar. Returns the mesh."""
+    from matplotlib.colors import LogNorm
+
     orders = np.asarray(orders)
     sel = (orders > 0.0) & (orders <= max_order + 1e-9)
-    amp = np.asarray(amplitude)[:, sel]
-    w = np.asarray(omega_mean_rpm)
-    step = np.ptp(w) / max(len(w) - 1, 1) if len(w) > 1 else 1.0
+    amp = np.asarray(amplitude, dtype=float)[:, sel]
+    w = np.asarray(omega_mean_rpm, dtype=float)
     top = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
-    scale = 3.0 * (step if step > 0 else 1.0) / top
-    artists = []
-    for c in range(amp.shape[0]):
-        artists += ax.plot(orders[sel], w[c] + scale * amp[c], lw=0.6,
-                           color=f"C{c % 10}" if amp.shape[0] <= 10 else "C0")
+    x = orders[sel]
+    dx = x[1] - x[0] if x.size > 1 else 1.0
+    x_edges = np.concatenate([x - dx / 2, [x[-1] + dx / 2]])
+    # each cycle's band reaches halfway to its neighbours' speeds
+    if w.size > 1:
+        mid = 0.5 * (w[1:] + w[:-1])
+        y_edges = np.concatenate([[w[0] - (mid[0] - w[0])], mid, [w[-1] + (w[-1] - mid[-1])]])
+    else:
+        y_edges = np.array([w[0] - 0.5, w[0] + 0.5]) if w.size else np.array([0.0, 1.0])
+    order = np.argsort(w)
+    if np.all(np.diff(w) > 0) or w.size < 2:
+        mesh = ax.pcolormesh(x_edges, y_edges, np.maximum(amp, top * 1e-4),
+                             norm=LogNorm(top * 1e-4, top), cmap="viridis", shading="flat")
+    else:  # not monotonic in speed (a run-down or a load step): one row per cycle, speed labels
+        mesh = ax.pcolormesh(x_edges, np.arange(w.size + 1), np.maximum(amp[order], top * 1e-4),
+                             norm=LogNorm(top * 1e-4, top), cmap="viridis", shading="flat")
+        ticks = np.linspace(0, w.size - 1, min(w.size, 8)).round().astype(int)
+        ax.set_yticks(ticks + 0.5, [f"{w[order][i]:.0f}" for i in ticks])
+    ax.figure.colorbar(mesh, ax=ax, label=label or "amplitude")
     ax.set_xlabel("engine order [1/rev]")
-    ax.set_ylabel("cycle-mean speed [rpm] (+ amplitude)")
+    ax.set_ylabel("cycle-mean speed [rpm]")
+    return mesh
+
+
+def campbell(ax, omega_mean_rpm, orders, amplitude, max_order=12.0, label=None):
+    """Campbell chart: each cycle's orders as points at (cycle-mean speed [rpm], frequency
+    ν·n/60 [Hz]), their colour and size the amplitude (logarithmic, four decades), over the
+    order lines ν = 1, 2, … (grey rays). ``amplitude``: (n_cycles, n_orders). Returns the
+    scatter."""
+    from matplotlib.colors import LogNorm
+
+    orders = np.asarray(orders)
+    sel = (orders > 0.0) & (orders <= max_order + 1e-9)
+    amp = np.asarray(amplitude, dtype=float)[:, sel]
+    w = np.asarray(omega_mean_rpm, dtype=float)
+    top = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
+    speed = np.repeat(w[:, None], sel.sum(), axis=1)
+    freq = speed * orders[sel][None, :] / 60.0
+    floor = top * 1e-4
+    shown = np.maximum(amp, floor)
+    size = 4.0 + 60.0 * (np.log10(shown / floor) / 4.0)
+    keep = amp >= floor
+    dots = ax.scatter(speed[keep], freq[keep], c=shown[keep], s=size[keep], cmap="viridis",
+                      norm=LogNorm(floor, top), edgecolors="none")
+    span = np.array([0.0, float(w.max()) * 1.05 if w.size else 1.0])
+    for nu in range(1, int(max_order) + 1):
+        ax.plot(span, span * nu / 60.0, color="0.8", lw=0.6, zorder=0)
+        ax.annotate(f"{nu}", (span[1], span[1] * nu / 60.0), fontsize=6, color="0.5")
+    ax.figure.colorbar(dots, ax=ax, label=label or "amplitude")
+    low = float(w.min()) if w.size else 0.0
+    ax.set_xlim(max(0.0, low - 0.1 * max(float(np.ptp(w)) if w.size else 0.0, low)),
+                span[1] * 1.04)
+    ax.set_xlabel("cycle-mean speed [rpm]")
+    ax.set_ylabel("frequency [Hz]")
     ax.grid(True, alpha=0.3)
-    return artists
+    return dots
 
 
 def order_tracks(ax, omega_mean_rpm, tracks, ylabel):

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis.thermo import cylinder_torques
+from transient.analysis.pistons import cylinder_torques
 from transient.cli import main
 from transient.results import open_result
 
@@ -84,3 +84,26 @@ def test_check_refuses_thermodynamics_without_a_pressure(tmp_path, capsys):
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1
     assert "analysis.thermodynamics: gas model 'trapezoid' applies no cylinder pressure" in err
+
+
+def test_cylinder_torque_orders_add_up_to_the_gas_torques(friction_result, capsys):
+    """The spectra of the cylinders' torques (``transient orders``) add up, order by order as
+    complex coefficients, to the spectrum of M_gas: the DFT is linear and the torques add up to
+    M_gas at every grid point."""
+    from transient.analysis.orders import run_orders
+
+    tmp, scene = friction_result
+    if not (tmp / "fr.h5").exists():
+        assert main(["run", str(scene), "-o", str(tmp), "-q"]) == 0
+    res = open_result(tmp / "fr.h5")
+    cuts = res.events["breakpoint"]["phi"]
+    ro = run_orders(res.scene(), res.trajectory, 720, cuts=cuts, piston_cylinder=2)
+    total = ro.cylinder_torques.coef.sum(axis=0)
+    scale = np.abs(ro.gas_torque.coef[-1]).max()
+    assert np.max(np.abs(total - ro.gas_torque.coef[-1])) <= 1e-9 * scale
+    assert main(["orders", str(tmp / "fr.h5"), "-o", str(tmp / "orders"), "--cylinder", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "piston acceleration W of cylinder 2" in out and "cylinder 3 torque" in out
+    code = main(["orders", str(tmp / "fr.h5"), "-o", str(tmp / "orders"), "--cylinder", "0"])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.splitlines()) == 1 and "allowed: 1 … 3" in err

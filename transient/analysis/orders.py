@@ -766,6 +766,10 @@ class RunOrders:
         M_gas over the last whole cycle, where the run has gas forces.
     piston : OddHarmonicReport or None
         The piston acceleration of one cylinder over the last whole cycle, where asked for.
+    cylinder_torques : OrderSpectrum or None
+        Each cylinder's gas torque over the last whole cycle
+        (:func:`transient.analysis.pistons.cylinder_torques`), one row per cylinder (where the
+        spectrum's rows are otherwise cycles), where the run has gas forces.
     """
 
     cycle_start: NDArray[np.float64]
@@ -775,6 +779,7 @@ class RunOrders:
     detrend: str
     gas_torque: OrderSpectrum | None = None
     piston: OddHarmonicReport | None = None
+    cylinder_torques: OrderSpectrum | None = None
 
     @property
     def orders(self) -> NDArray[np.float64]:
@@ -805,8 +810,8 @@ def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle
         For ω, as :func:`resolve_detrend`: a spin-up's trend would otherwise leak into every
         order of each cycle.
     piston_cylinder : int, optional
-        Cylinder (1-based) of a crank-slider whose piston acceleration is reported
-        (:func:`report_for_scene`); None: no report.
+        Cylinder (1-based) whose piston acceleration is reported (:func:`report_for_scene`,
+        any mechanism); None: no report.
 
     Raises :class:`~.irregularity.NoWholeCycle` if the run holds no whole cycle.
     """
@@ -815,10 +820,11 @@ def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle
     detrend = resolve_detrend(detrend, scene.initial.omega, float(traj["omega"][-1]))
     starts, omega = cycle_spectra(traj, "omega", n, cycle, phi0=phi0, cuts=cuts,
                                   detrend=detrend)
-    gas = None
+    gas = per_cylinder = None
     if "M_gas" in traj and scene.gas.model != "none":
         _, cm = to_angle_grid(traj, ("M_gas",), n, cycle, phi0=phi0, cycles=1, cuts=cuts)
         gas = order_spectrum(cm["M_gas"], n, cycle)
+        per_cylinder = _cylinder_torque_spectra(scene, traj, n, cuts)
     piston = None
     if piston_cylinder is not None:
         piston = report_for_scene(scene, traj, piston_cylinder, samples_per_cycle=n, cycles=1,
@@ -826,7 +832,32 @@ def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle
     t, phi = traj["t"], traj["phi"]
     delta = fluctuation(t, phi, traj["omega"], cycle, phi0)
     means, _ = cycle_means(t, phi, cycle, phi0)
-    return RunOrders(starts, omega, means[-starts.size:], delta, detrend, gas, piston)
+    return RunOrders(starts, omega, means[-starts.size:], delta, detrend, gas, piston,
+                     per_cylinder)
+
+
+def _cylinder_torque_spectra(scene, traj, n, cuts) -> OrderSpectrum | None:
+    """Each cylinder's gas torque over the last whole cycle, one spectrum row per cylinder: the
+    torques on the stored samples of the last two cycles (:func:`.pistons.cylinder_torques`,
+    adding up to M_gas there), resampled onto the grid as M_gas is, so that their spectra add up
+    to M_gas's (the resampling is linear in the samples). None without per-cylinder columns."""
+    from .pistons import cylinder_torques
+
+    count = getattr(scene.mechanism, "n_cylinders", 0)
+    names = [f"p_{k + 1}" for k in range(count)]
+    if not names or not all(c in traj for c in names):
+        return None
+    cycle = scene.mechanism.cycle
+    part = _increasing_part(traj)
+    phi = np.asarray(traj["phi"], dtype=float)[part]
+    recent = phi >= phi[-1] - 2.0 * cycle
+    cols = {"phi": phi[recent], **{c: np.asarray(traj[c], dtype=float)[part][recent]
+                                   for c in names}}
+    torques = cylinder_torques(scene, cols)
+    named = {"phi": cols["phi"], **{f"M_{k}": m for k, m in enumerate(torques)}}
+    _, grid_cols = to_angle_grid(named, list(named)[1:], n, cycle, phi0=scene.initial.phi,
+                                 cycles=1, cuts=cuts)
+    return order_spectrum(np.array([grid_cols[f"M_{k}"] for k in range(count)]), n, cycle)
 
 
 def orders_up_to(orders: ArrayLike, max_order: float) -> NDArray[np.intp]:

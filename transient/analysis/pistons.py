@@ -84,3 +84,17 @@ def piston_kinematics(mech, phi: ArrayLike) -> Pistons:
         raise ValueError(f"no piston kinematics for {type(mech).__name__}")
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     return Pistons(*law(mech, phi))
+
+
+def cylinder_torques(scene, traj) -> NDArray[np.float64]:
+    """Each cylinder's gas torque on the shaft at the samples of ``traj`` (``phi`` and
+    ``p_<k>``), (n, samples) [N m]: (p_k − p0)·A_k·s′_k for a pressure, the force times s′_k
+    (both pistons of a two-half swash plate) for a force model; their sum is ``M_gas``."""
+    from ..assemble import gas_is_force
+
+    mech = scene.mechanism
+    pk = piston_kinematics(mech, np.asarray(traj["phi"], dtype=float))
+    p = np.array([np.asarray(traj[f"p_{k + 1}"], dtype=float) for k in range(mech.n_cylinders)])
+    if gas_is_force(scene):
+        return p * pk.ds * (pk.area / mech.piston_area)[:, None]
+    return (p - scene.gas.p0) * pk.ds * pk.area[:, None]

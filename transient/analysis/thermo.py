@@ -409,18 +409,3 @@ def own_cycles(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int
         raise ValueError(f"cylinder {cylinder} is out of range; allowed: 1 … {n}")
     phi = np.asarray(traj["phi"], float)[_increasing_part(traj)]
     return cycle_marks(phi, scene.mechanism.cycle, float(gas_phases(scene)[cylinder - 1]))[:-1]
-
-
-def cylinder_torques(scene, traj: Mapping[str, NDArray[np.float64]]) -> NDArray[np.float64]:
-    """Each cylinder's gas torque on the shaft at the stored samples, (n, samples) [N m]:
-    (p_k − p0)·dV_k/dφ for a pressure, the force times the piston's ds/dφ (both pistons of a
-    two-half swash plate) for a force model; their sum is ``M_gas``."""
-    from ..assemble import gas_is_force
-
-    phi = np.asarray(traj["phi"], float)
-    vol = cylinder_volumes(scene, phi)
-    p = np.array([np.asarray(traj[f"p_{k + 1}"], float)
-                  for k in range(scene.mechanism.n_cylinders)])
-    if gas_is_force(scene):
-        return p * vol.dV / scene.mechanism.piston_area
-    return (p - scene.gas.p0) * vol.dV
