@@ -10,7 +10,8 @@
   keep their size; no half orders (the cycle is one turn).
 * A run (varying ω) of the radial and of the swash plate: :func:`report_for_scene` reports each
   piston against the same engine at constant mean speed; the run adds the orders the constant
-  speed lacks.
+  speed lacks; ``[analysis] orders = ["W_2"]`` stores a slave piston's orders as its report
+  computes them.
 """
 from __future__ import annotations
 
@@ -106,3 +107,23 @@ def test_report_for_every_piston_of_a_run(case, run, omega):
         assert rep.amplitude[-1][rep._k(1.0)] > 0.0
     with pytest.raises(ValueError, match="out of range"):
         report_for_scene(scene, data.trajectory, mech.n_cylinders + 1)
+
+
+def test_stored_piston_orders_of_a_slave_match_its_report():
+    """``[analysis] orders = ["W_2"]`` of a radial engine (a slave piston) stores what the
+    odd-harmonic report computes for that piston, cycle by cycle."""
+    from transient.analysis.requested import requested_analyses
+    from transient.scene import Analysis
+
+    scene = load_scene(CASES / "radial_5cyl.toml")
+    scene = replace(scene, run=Run(revolutions=8.0), output=Output(samples_per_rev=360),
+                    initial=Initial(phi=0.0, omega=177.7),
+                    analysis=Analysis(orders=("W_2",), samples_per_cycle=720, detrend="none"))
+    data = integrate(scene)
+    stored = requested_analyses(scene, data.trajectory, data.events)
+    cuts = np.asarray(data.events["breakpoint"])[:, 1]
+    rep = report_for_scene(scene, data.trajectory, 2, samples_per_cycle=720, cuts=cuts)
+    amp, unit = stored["orders_W_2_amplitude"]
+    assert unit == "m/s^2" and amp.shape[0] == rep.amplitude.shape[0] == 4  # 8 rev
+    k = amp.shape[1]
+    assert amp == pytest.approx(rep.amplitude[:, :k], rel=1e-12, abs=1e-9 * rep.first.max())

@@ -16,7 +16,7 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   ``orders_<s>_amplitude`` (C, K) [unit of s] and ``orders_<s>_phase`` (C, K) [rad]
   (:class:`transient.analysis.orders.OrderSpectrum`; order 0 is the mean of the detrended cycle).
   A signal is a trajectory column or ``W_<k>``, the piston acceleration of cylinder k,
-  W = ω²s″ + εs′ [m/s²] (crank-slider).
+  W = ω²s″ + εs′ [m/s²] (any mechanism, :mod:`transient.analysis.pistons`).
 * ``loads = true`` (crank-slider), over the last whole cycle on a uniform grid of N angles
   (:mod:`transient.analysis.loads.crank_slider`): ``loads_phi`` (N,) [rad]; ``loads_P``,
   ``loads_N``, ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load
@@ -50,7 +50,8 @@ import numpy as np
 
 from ..errors import SceneError
 from .irregularity import cycle_boundaries
-from .orders import order_spectrum, piston_acceleration, resolve_detrend, to_angle_grid
+from .orders import order_spectrum, resolve_detrend, to_angle_grid
+from .pistons import piston_kinematics
 from .thermo import cycle_thermodynamics
 
 #: A derived signal of ``orders``: the piston acceleration of cylinder k.
@@ -112,10 +113,10 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     names = tuple(dict.fromkeys(["t", *columns]))
     grid, cols = to_angle_grid(traj, names, n, cycle, phi0=scene.initial.phi, cuts=cuts,
                                closed=True)
+    pk = piston_kinematics(mech, grid) if derived else None
     for s, k in derived.items():
-        # W = ω²s″ + εs′ (Semenov §4), exact kinematics.
-        cols[s] = piston_acceleration(grid, cols["omega"], cols["epsilon"], mech.crank_radius,
-                                      mech.rod_length, mech.offset, mech.firing_angles[k - 1])
+        # W = ω²s″ + εs′ (Semenov §4), exact kinematics of any mechanism's piston
+        cols[s] = cols["omega"] ** 2 * pk.dds[k - 1] + cols["epsilon"] * pk.ds[k - 1]
         units[s] = "m/s^2"
     mode = resolve_detrend(req.detrend, scene.initial.omega, float(traj["omega"][-1]))
     t_marks = cols["t"][::n]  # every cycle's start and the last one's end (closed grid)

@@ -105,8 +105,8 @@ def check_analysis(scene: Scene) -> None:
 
     a, mech = scene.analysis, scene.mechanism
     columns = list(output_columns(scene))
-    derived = ([f"W_{k + 1}" for k in range(mech.n_cylinders)] if mech.slider_law
-               else [])
+    # every mechanism's pistons have an acceleration (transient.analysis.pistons)
+    derived = [f"W_{k + 1}" for k in range(mech.n_cylinders)]
     for name in a.orders:
         if name not in columns + derived:
             raise SceneError("analysis.orders", f"unknown signal {show_value(name)}; allowed: "

@@ -366,7 +366,7 @@ class Analysis:
     ``loads``: forces, pin and journal loads and torques over the last cycle, as the mechanism's
     loads analysis gives them. ``orders``: signals whose order spectrum is stored per whole cycle
     — trajectory columns (``omega``, ``M_gas``, ``p_1`` …) or ``W_<k>``, the piston acceleration
-    of cylinder k (crank-slider). ``irregularity``: δ and the mean speed of every cycle.
+    of cylinder k (any mechanism). ``irregularity``: δ and the mean speed of every cycle.
     ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
     engine cycle.
     ``detrend``: ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
