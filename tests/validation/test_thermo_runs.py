@@ -169,3 +169,45 @@ def test_wiebe_imep_and_burned_fraction_angles(wiebe_run):
     # the heat released is the fuel's, m_f·LHV·η_c·x_b(EVO) (no wall heat here)
     Q = th["thermo_Q"][0]
     assert Q[np.isfinite(Q)] == pytest.approx(full.heat_released, rel=1e-4)
+
+
+def test_woschni_state_pressure_work_and_net_heat():
+    """With wall heat the closed part's pressure is a state of the run. At a held 4400 rpm (a
+    10⁶ kg m² flywheel, full fuel, no load or pairs) each cylinder's ∮p dV over its second
+    cycle equals the closed work of transient.forces.woschni's own integration (solve_ivp at
+    rtol 1e-12) plus the pumping loop, to 1e-6; the apparent heat release of the run's pressure
+    is the fuel's heat less the wall's, Q_b − Q_w of that integration, to 1e-4 (measured 3.5e-5; the heat release
+    is a trapezoid over 0.25° samples, and dp/dφ a spline of them)."""
+    from transient.assemble import clearance_volume
+    from transient.forces.woschni import WoschniParameters, closed_cycle
+    from transient.scene import Inertia, Load
+
+    base = load_scene(CASES / "gots_diesel_woschni.toml")
+    omega = 4400 * RPM
+    scene = replace(base, governor=Governor(), friction=Friction(), load=Load(),
+                    inertia=replace(base.inertia, flywheel=1e6),
+                    initial=Initial(phi=0.0, omega=omega), run=Run(revolutions=6.0),
+                    solver=replace(base.solver, rtol=1e-11, atol=1e-11),
+                    output=Output(samples_per_rev=1440), analysis=Analysis(thermodynamics=True))
+    data = integrate(scene)
+    assert data.complete, data.message
+    th = cycle_thermodynamics(scene, data.trajectory, data.events)
+    mech, gas = scene.mechanism, scene.gas
+    w, h = gas.wiebe, gas.woschni
+    volume = mech.volume_function(clearance_volume(scene))
+    ref = closed_cycle(volume, p_a=gas.p_a, start=w.start, duration=w.duration,
+                       fuel_mass=w.fuel_mass,
+                       woschni=WoschniParameters(bore=mech.bore, stroke=mech.stroke(), c1=h.c1,
+                                                 c2=h.c2, wall_temperature=h.wall_temperature),
+                       omega=float(np.mean(data.trajectory["omega"])), a=w.a, m=w.m, lhv=w.lhv,
+                       efficiency=w.efficiency, gamma=w.gamma, gamma_slope=w.gamma_slope,
+                       gamma_t_ref=w.gamma_t_ref, t_a=w.t_a, strokes=mech.strokes)
+    v = volume(np.array([0.0, ref.start, ref.end, 4 * math.pi]))
+    loop = ref.work + gas.p_intake * (v[1] - v[0]) + gas.p_exhaust * (v[3] - v[2])
+    # the second engine cycle: every cylinder has closed its intake once before it
+    W = th["thermo_W_indicated"][0][:, 1]
+    print(f"\nWoschni at 4400 rpm: ∮p dV {W.round(3).tolist()} J against {loop:.3f} J; Q "
+          f"{th['thermo_Q'][0][:, 1].round(2).tolist()} J against "
+          f"{ref.heat_released - ref.heat_lost:.2f} J")
+    assert W == pytest.approx(np.full(3, loop), rel=1e-6)
+    assert th["thermo_Q"][0][:, 1] == pytest.approx(ref.heat_released - ref.heat_lost, rel=1e-4)
