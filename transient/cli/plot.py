@@ -32,7 +32,7 @@ def cmd_plot(args) -> int:
     out = output_folder(args.output, res.path.parent)
     stem = result_stem(res.path)
     traj = res.trajectory
-    _check_choices(args, scene, res)
+    held = _check_choices(args, scene, res)
     written = []
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     plots.speed(a1, traj)
@@ -69,7 +69,7 @@ def cmd_plot(args) -> int:
         ax.set_title(f"{scene.name}: each cylinder's gas torque over the last cycle")
         written.append(save(fig, out / f"{stem}_cylinder_torques.png", args.force, res))
     table = gas_table(scene)
-    if table is not None and not gas_is_force(scene) and whole:
+    if table is not None and not gas_is_force(scene) and held:
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8))
         plots.run_indicator_phi(a1, traj, scene, args.cylinder, args.cycles, table=table)
         # a gas table gives no clearance volume: V is then the swept part F_p·s
@@ -91,8 +91,9 @@ def _has_whole_cycle(scene, traj) -> bool:
                             scene.initial.phi)[1].size >= 2
 
 
-def _check_choices(args, scene, res) -> None:
-    """--cylinder and --cycles within what the result holds, before any figure is drawn."""
+def _check_choices(args, scene, res) -> int:
+    """--cylinder and --cycles within what the result holds, before any figure is drawn; returns
+    how many whole cycles of their own the cylinders drawn hold (0: no indicator diagram)."""
     from ..analysis.thermo import own_cycles
 
     n = scene.mechanism.n_cylinders
@@ -100,14 +101,15 @@ def _check_choices(args, scene, res) -> None:
         if not 1 <= k <= n:
             raise SceneError("--cylinder", f"cylinder {k} is out of range; allowed: 1 … {n}",
                              file=str(res.path))
-    if args.cycles != [-1]:
-        held = min(own_cycles(scene, res.trajectory, k).size
-                   for k in (args.cylinder or range(1, n + 1)))
+    held = min(own_cycles(scene, res.trajectory, k).size
+               for k in (args.cylinder or range(1, n + 1)))
+    if args.cycles != [-1]:  # (the default draws the last cycle, or none if there is none)
         for c in args.cycles:
             if not -held <= c < held:
                 raise SceneError("--cycles", f"cycle {c} is not held: the run has {held} whole "
                                              f"cycle(s) of the cylinders drawn; allowed "
                                              f"{-held} … {held - 1}", file=str(res.path))
+    return held
 
 
 def _plot_comparison(args) -> int:
