@@ -107,3 +107,22 @@ def test_cylinder_torque_orders_add_up_to_the_gas_torques(friction_result, capsy
     code = main(["orders", str(tmp / "fr.h5"), "-o", str(tmp / "orders"), "--cylinder", "0"])
     err = capsys.readouterr().err
     assert code == 2 and len(err.splitlines()) == 1 and "allowed: 1 … 3" in err
+
+
+def test_plot_without_a_whole_cycle_of_a_cylinder_draws_no_indicator(tmp_path, capsys):
+    """Two revolutions from φ = 0: one engine cycle, which holds a whole cycle of its own only
+    for cylinder 1 (its gas phase is 0); the others' diagrams are left out, not failed on."""
+    text = (CASES / "gots_diesel_friction.toml").read_text()
+    scene = tmp_path / "short.toml"
+    scene.write_text(text.replace("revolutions = 600", "revolutions = 2").replace(
+        "omega_rpm = 1000", "omega_rpm = 3900"))
+    assert main(["run", str(scene), "-o", str(tmp_path), "-q"]) == 0
+    capsys.readouterr()
+    assert main(["plot", str(tmp_path / "short.h5")]) == 0
+    names = [Path(x.removeprefix("wrote ")).name for x in capsys.readouterr().out.splitlines()]
+    assert "short_speed_cycle.png" in names and "short_indicator.png" not in names
+    assert main(["plot", str(tmp_path / "short.h5"), "--cylinder", "1", "--force"]) == 0
+    assert "short_indicator.png" in capsys.readouterr().out
+    assert main(["plot", str(tmp_path / "short.h5"), "--cylinder", "2", "--cycles", "-1",
+                 "--force"]) == 2
+    assert "--cycles: cycle -1 is not held" in capsys.readouterr().err

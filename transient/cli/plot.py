@@ -12,7 +12,7 @@ def register(sub) -> None:
     pl.add_argument("--cylinder", type=int, action="append", default=None, metavar="K",
                     help="cylinder (1-based) of the run's indicator diagrams; repeat for "
                          "several (default: all)")
-    pl.add_argument("--cycles", type=int, nargs="+", default=[-1], metavar="C",
+    pl.add_argument("--cycles", type=int, nargs="+", default=None, metavar="C",
                     help="each cylinder's own whole cycles in those diagrams, counted from 0 "
                          "or from the end with −1 the last (default: −1)")
     add_force(pl)
@@ -71,9 +71,10 @@ def cmd_plot(args) -> int:
     table = gas_table(scene)
     if table is not None and not gas_is_force(scene) and held:
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8))
-        plots.run_indicator_phi(a1, traj, scene, args.cylinder, args.cycles, table=table)
+        plots.run_indicator_phi(a1, traj, scene, args.cylinder, args.cycles or [-1],
+                                table=table)
         # a gas table gives no clearance volume: V is then the swept part F_p·s
-        plots.run_indicator_pv(a2, traj, scene, args.cylinder, args.cycles,
+        plots.run_indicator_pv(a2, traj, scene, args.cylinder, args.cycles or [-1],
                                log=scene.gas.model != "table")
         if scene.gas.model == "table":
             a2.set_xlabel("swept volume F_p·s [dm³]")
@@ -103,7 +104,7 @@ def _check_choices(args, scene, res) -> int:
                              file=str(res.path))
     held = min(own_cycles(scene, res.trajectory, k).size
                for k in (args.cylinder or range(1, n + 1)))
-    if args.cycles != [-1]:  # (the default draws the last cycle, or none if there is none)
+    if args.cycles is not None:  # (by default the last cycle, or none if there is none)
         for c in args.cycles:
             if not -held <= c < held:
                 raise SceneError("--cycles", f"cycle {c} is not held: the run has {held} whole "
