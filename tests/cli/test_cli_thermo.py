@@ -40,7 +40,8 @@ def test_run_and_info_print_the_mean_effective_pressures(friction_result, capsys
     assert f"IMEP {a['thermo_last_imep_engine'][0] / 1e5:.5g} bar" in line
     assert f"BMEP {a['thermo_last_bmep'][0] / 1e5:.5g} bar" in line
     assert f"FMEP {a['thermo_last_fmep'][0] / 1e5:.5g} bar" in line
-    assert a["thermo_imep"][1] == "Pa" and a["thermo_imep"][0].shape == (3, 6)  # 12 revolutions from φ0 = 0
+    # 12 revolutions from φ0 = 0: six cycles
+    assert a["thermo_imep"][1] == "Pa" and a["thermo_imep"][0].shape == (3, 6)
     assert main(["info", str(tmp / "fr.h5")]) == 0
     assert line in capsys.readouterr().out
 

@@ -16,8 +16,9 @@
 * With Wiebe combustion at constant speed and full fuel: IMEP = ``WiebeCycle.work``/V_h (the
   cycle's own integration, :mod:`transient.forces.wiebe`) to 1e-6, and the burned-fraction
   angles MFB10/50/90 from the apparent heat release of the run's pressure against the Wiebe
-  law's closed form θ_s + Δθ·(−ln(1 − x)/a)^(1/(m+1)), x the level times x_b(EVO) = 1 − e^(−a), within 0.01° (trapezoidal heat release on
-  0.25° samples; measured 0.0034°), and the heat released m_f·LHV·η_c·x_b(EVO) to 1e-4.
+  law's closed form θ_s + Δθ·(−ln(1 − x)/a)^(1/(m+1)), x the level times x_b(EVO) = 1 − e^(−a),
+  within 0.01° (trapezoidal heat release on 0.25° samples; measured 0.0034°), and the heat
+  released m_f·LHV·η_c·x_b(EVO) to 1e-4.
 """
 from __future__ import annotations
 
@@ -176,8 +177,8 @@ def test_woschni_state_pressure_work_and_net_heat():
     10⁶ kg m² flywheel, full fuel, no load or pairs) each cylinder's ∮p dV over its second
     cycle equals the closed work of transient.forces.woschni's own integration (solve_ivp at
     rtol 1e-12) plus the pumping loop, to 1e-6; the apparent heat release of the run's pressure
-    is the fuel's heat less the wall's, Q_b − Q_w of that integration, to 1e-4 (measured 3.5e-5; the heat release
-    is a trapezoid over 0.25° samples, and dp/dφ a spline of them)."""
+    is the fuel's heat less the wall's, Q_b − Q_w of that integration, to 1e-4 (measured 3.5e-5;
+    the heat release is a trapezoid over 0.25° samples, and dp/dφ a spline of them)."""
     from transient.assemble import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
     from transient.scene import Inertia, Load

@@ -42,8 +42,8 @@ cross term of order 1 × c in h² puts odd orders into the slave's motion at con
 (tests/unit/test_orders_mechanisms.py shows both).
 
 **Swash plate** (:mod:`transient.mechanisms.swash_plate`). The piston joint B_k turns on the plate
-with θ(φ) = −φ + δ(φ), δ the Hooke joint's non-uniformity, of period π, so B_x ∝ cos(θ + ψ_k) changes
-sign over half a turn, B_x(φ + π) = −B_x(φ): odd orders only. The rod of length ℓ adds
+with θ(φ) = −φ + δ(φ), δ the Hooke joint's non-uniformity, of period π, so B_x ∝ cos(θ + ψ_k)
+changes sign over half a turn, B_x(φ + π) = −B_x(φ): odd orders only. The rod of length ℓ adds
 x_D = B_x − √(ℓ² − h²) ≈ B_x − ℓ + h²/(2ℓ), h the joint's lateral offset from the cylinder axis,
 which holds every order: the even orders of a swash-plate piston at constant speed are that rod
 term, O(h²/ℓ), and vanish as ℓ → ∞ (the tests show amplitude·ℓ converging). The δ(φ) ripple

@@ -43,12 +43,13 @@ checked against θ_s + Δθ·(−ln(1 − x)/a)^(1/(m+1)).
 Stored names (n cylinders, C whole cycles): ``thermo_cycle_start`` (C,) [rad],
 ``thermo_cycle_omega_mean`` (C,) [rad/s], ``thermo_swept_volume`` (n,) [m^3],
 ``thermo_W_indicated`` (n, C) [J], ``thermo_imep`` (n, C) [Pa], ``thermo_P_indicated`` (n, C)
-[W], ``thermo_p_max`` (n, C) [Pa], ``thermo_p_max_angle`` (n, C) [rad]; engine: ``thermo_imep_engine``,
-``thermo_bmep``, ``thermo_fmep`` (C,) [Pa], ``thermo_P_indicated_engine``, ``thermo_P_brake``,
-``thermo_P_friction`` (C,) [W], ``thermo_W_gas``, ``thermo_W_load``, ``thermo_W_loss``,
-``thermo_dK`` (C,) [J], ``thermo_balance_residual`` (C,) [1]; with heat release
-``thermo_Q`` (n, C) [J], ``thermo_mfb10``, ``thermo_mfb50``, ``thermo_mfb90`` (n, C) [rad];
-and the last cycle's engine figures as scalars ``thermo_last_*`` for the run's summary.
+[W], ``thermo_p_max`` (n, C) [Pa], ``thermo_p_max_angle`` (n, C) [rad]; engine:
+``thermo_imep_engine``, ``thermo_bmep``, ``thermo_fmep`` (C,) [Pa],
+``thermo_P_indicated_engine``, ``thermo_P_brake``, ``thermo_P_friction`` (C,) [W],
+``thermo_W_gas``, ``thermo_W_load``, ``thermo_W_loss``, ``thermo_dK`` (C,) [J],
+``thermo_balance_residual`` (C,) [1]; with heat release ``thermo_Q`` (n, C) [J],
+``thermo_mfb10``, ``thermo_mfb50``, ``thermo_mfb90`` (n, C) [rad]; and the last cycle's engine
+figures and residual as scalars ``thermo_last_*`` for the run's summary.
 """
 from __future__ import annotations
 
@@ -300,7 +301,8 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     }
     if scene.gas.model == "wiebe":
         out.update(heat_release(scene, phi, traj, part, marks, vol, cuts))
-    for name in ("imep_engine", "bmep", "fmep", "P_indicated_engine", "P_brake", "P_friction"):
+    for name in ("imep_engine", "bmep", "fmep", "P_indicated_engine", "P_brake", "P_friction",
+                 "balance_residual"):
         value, unit = out[f"thermo_{name}"]
         out[f"thermo_last_{name}"] = (float(value[-1]), unit)
     out["thermo_last_p_max"] = (float(p_max[:, -1].max()), "Pa")

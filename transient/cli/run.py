@@ -194,6 +194,11 @@ def _print_thermodynamics(v: dict) -> None:
           f"{v['thermo_last_P_brake'] / 1e3:.5g} kW, friction "
           f"{v['thermo_last_P_friction'] / 1e3:.5g} kW; peak pressure "
           f"{v['thermo_last_p_max'] / 1e6:.5g} MPa")
+    # ∮p dV is a quadrature of the stored samples: how well it closes the energy balance says
+    # whether the output spacing is fine enough for the digits above
+    print(f"    IMEP − BMEP − FMEP closes the cycle's energy balance to "
+          f"{abs(v['thermo_last_balance_residual']):.1e} of the indicated work (finer "
+          f"[output] samples_per_rev make it smaller)")
 
 
 def cmd_info(args) -> int:
