@@ -172,6 +172,30 @@ def run_indicator_pv(ax, traj, scene, cylinders=None, cycles=(-1,), log=True):
     return artists
 
 
+def heat_release(ax, traj, scene, cylinders=None, cycles=(-1,)):
+    """Apparent heat-release rate dQ/dφ [J/deg] of the run's pressure over the closed part of
+    each cylinder's own cycles ``cycles``, against its local angle [deg]
+    (:func:`transient.analysis.thermo.heat_release_rate`; Wiebe combustion with constant γ).
+    Returns the artists (none where the run does not hold a closed part)."""
+    traj = _columns(traj)
+    from .analysis.thermo import heat_release_rate
+
+    artists = []
+    for k in _cylinders(scene, cylinders):
+        for c, _, a in _cycle_samples(traj, scene, k, cycles):
+            got = heat_release_rate(scene, traj, k, a)
+            if got is not None:
+                artists += ax.plot(np.degrees(got[0]), got[1] * math.pi / 180.0, lw=1.0,
+                                   label=f"cylinder {k}, cycle {c}")
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel("cylinder's own crank angle [deg]")
+    ax.set_ylabel("dQ/dφ [J/deg]")
+    ax.grid(True, alpha=0.3)
+    if artists:
+        ax.legend(fontsize=7)
+    return artists
+
+
 def speed_over_cycle(ax, traj, scene):
     """ω(φ) [rpm] over the last whole cycle against the angle in it [deg], with its mean, its
     extremes and δ = (ω_max − ω_min)/ω_mean (Gots §2.8) marked. Returns the artists."""

@@ -127,3 +127,20 @@ def test_plot_without_a_whole_cycle_of_a_cylinder_draws_no_indicator(tmp_path, c
     assert main(["plot", str(tmp_path / "short.h5"), "--cylinder", "2", "--cycles", "-1",
                  "--force"]) == 2
     assert "--cycles: cycle -1 is not held" in capsys.readouterr().err
+
+
+def test_plot_draws_the_heat_release_of_a_wiebe_run(tmp_path, capsys):
+    """The Wiebe case near its droop line, 4 revolutions at 0.5°: the heat-release figure is
+    written (its curve: tests/validation/test_thermo_runs.py), and not for the mixed cycle."""
+    text = (CASES / "gots_diesel_wiebe.toml").read_text()
+    assert "revolutions = 1000" in text and "samples_per_rev = 72" in text
+    scene = tmp_path / "wb.toml"
+    scene.write_text(text.replace("revolutions = 1000", "revolutions = 4").replace(
+        "omega_rpm = 1000", "omega_rpm = 4300").replace("samples_per_rev = 72",
+                                                        "samples_per_rev = 720"))
+    assert main(["run", str(scene), "-o", str(tmp_path), "-q"]) == 0
+    capsys.readouterr()
+    assert main(["plot", str(tmp_path / "wb.h5"), "--cylinder", "1"]) == 0
+    assert "wb_heat_release.png" in capsys.readouterr().out
+    data = (tmp_path / "wb_heat_release.png").read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 1000

@@ -144,13 +144,13 @@ def wiebe_run():
                     analysis=Analysis(thermodynamics=True))
     data = integrate(scene)
     assert data.complete, data.message
-    return scene, cycle_thermodynamics(scene, data.trajectory, data.events)
+    return scene, data, cycle_thermodynamics(scene, data.trajectory, data.events)
 
 
 def test_wiebe_imep_and_burned_fraction_angles(wiebe_run):
     from transient.assemble import gas_tables
 
-    scene, th = wiebe_run
+    scene, _, th = wiebe_run
     full = gas_tables(scene)[0]
     imep = th["thermo_imep"][0]
     assert imep.shape == (3, 2)
@@ -170,6 +170,32 @@ def test_wiebe_imep_and_burned_fraction_angles(wiebe_run):
     # the heat released is the fuel's, m_f·LHV·η_c·x_b(EVO) (no wall heat here)
     Q = th["thermo_Q"][0]
     assert Q[np.isfinite(Q)] == pytest.approx(full.heat_released, rel=1e-4)
+
+
+def test_wiebe_heat_release_rate_is_the_wiebe_law(wiebe_run):
+    """dQ/dφ of the run's pressure (the plots' curve) against the Wiebe law's rate
+    Q·a(m+1)/Δθ·y^m·exp(−a·y^(m+1)), y = (θ − θ_s)/Δθ, Q = m_f·LHV·η_c, at every sample 1°
+    or more from the combustion's start and end (at the start y^m has an infinite slope, at
+    the end the rate jumps to 0, which the spline of dp/dφ rounds off): within 1e-4 of the
+    peak rate (measured 9e-6 on 0.25° samples)."""
+    from transient.analysis.thermo import heat_release_rate, own_cycles
+    from transient.assemble import gas_tables
+
+    scene, data, th = wiebe_run
+    w = scene.gas.wiebe
+    total = gas_tables(scene)[0].heat_released / (1.0 - math.exp(-w.a))
+    start = own_cycles(scene, data.trajectory, 1)[0]
+    theta, rate = heat_release_rate(scene, data.trajectory, 1, start)
+    y = np.clip((theta - w.start) / w.duration, 0.0, None)
+    law = np.where(y <= 1.0, total * w.a * (w.m + 1.0) / w.duration * y ** w.m
+                   * np.exp(-w.a * y ** (w.m + 1.0)), 0.0)
+    end = w.start + w.duration
+    away = (theta > w.start + DEG) & (np.abs(theta - end) > DEG)
+    err = np.max(np.abs(rate[away] - law[away])) / law.max()
+    print(f"\nheat-release rate against the Wiebe law: {err:.1e} of the peak at "
+          f"{np.degrees(theta[away][np.argmax(np.abs(rate[away] - law[away]))]):.2f}°")
+    assert err <= 1e-4
+    assert heat_release_rate(scene, data.trajectory, 1, start + 8 * math.pi) is None
 
 
 def test_woschni_state_pressure_work_and_net_heat():

@@ -330,42 +330,62 @@ def _peaks(scene, phi, traj, part, marks):
     return p_max, p_arg
 
 
-def heat_release(scene, phi, traj, part, marks, vol, cuts) -> dict[str, tuple[Any, str]]:
-    """Apparent heat released per cylinder and cycle over the closed part (Heywood (9.25), module
-    docstring) and the MFB angles; empty if γ varies with temperature (``gamma_slope`` ≠ 0: the
-    constant-γ form would not be the model's own first law)."""
-    from ..assemble import gas_phases, wiebe_levels
+def _closed_part(scene):
+    """(γ, intake closing, exhaust opening) of the scene's Wiebe cycle, angles local [rad]; None
+    if γ varies with temperature (``gamma_slope`` ≠ 0: the constant-γ form would not be the
+    model's own first law)."""
+    from ..assemble import wiebe_levels
 
     w = scene.gas.wiebe
     if w.gamma_slope != 0.0:
+        return None
+    table = wiebe_levels(scene.mechanism, scene.gas)[-1]  # its closed part, resolved
+    return w.gamma, table.intake_closing, table.exhaust_opening
+
+
+def _release(gamma, phi, p, V, dV, a, b):
+    """(φ, dQ/dφ [J/rad], Q [J] from a) at the samples strictly inside the closed part [a, b]
+    (Heywood (9.25)); None with fewer than 8 samples there. The ends are left out: at exhaust
+    opening the pressure falls (a jump), and a sample on it may hold either side."""
+    from scipy.interpolate import CubicSpline
+
+    tol = 1e-9 * max(1.0, abs(b))
+    sel = (phi > a + tol) & (phi < b - tol)
+    if sel.sum() < 8:
+        return None
+    x, pv = phi[sel], p[sel]
+    dp = CubicSpline(x, pv, bc_type="not-a-knot")(x, 1)
+    rate = gamma / (gamma - 1.0) * pv * dV[sel] + V[sel] * dp / (gamma - 1.0)
+    q = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(x))])
+    return x, rate, q
+
+
+def heat_release(scene, phi, traj, part, marks, vol, cuts) -> dict[str, tuple[Any, str]]:
+    """Apparent heat released per cylinder over the closed part that starts in each cycle
+    (Heywood (9.25), module docstring) and the MFB angles; ``thermo_heat_release_skipped`` if γ
+    varies with temperature."""
+    from ..assemble import gas_phases
+
+    closed = _closed_part(scene)
+    if closed is None:
         return {"thermo_heat_release_skipped": ("γ varies with temperature (gamma_slope ≠ 0)",
                                                 "")}
-    g = w.gamma
+    g, ivc, evo = closed
     cycle = scene.mechanism.cycle
     n = scene.mechanism.n_cylinders
     n_c = marks.size - 1
     Q = np.full((n, n_c), np.nan)
     mfb = np.full((len(MFB_LEVELS), n, n_c), np.nan)
-    table = wiebe_levels(scene.mechanism, scene.gas)[-1]  # its closed part, resolved
-    ivc, evo = table.intake_closing, table.exhaust_opening
-    from scipy.interpolate import CubicSpline
-
     for k, phase in enumerate(gas_phases(scene)):
         p = np.asarray(traj[f"p_{k + 1}"], float)[part]
         for j in range(n_c):
             # the closed part of cylinder k that starts in cycle j
-            start = phase + cycle * math.ceil((marks[j] - phase - ivc) / cycle) + ivc
-            a, b = start, start + (evo - ivc)
-            # the ends left out: at exhaust opening the pressure falls (a jump), and a sample
-            # on it may hold either side
-            tol = 1e-9 * max(1.0, abs(b))
-            sel = (phi > a + tol) & (phi < b - tol)
-            if b > phi[-1] or sel.sum() < 8:
+            a = phase + cycle * math.ceil((marks[j] - phase - ivc) / cycle) + ivc
+            b = a + (evo - ivc)
+            got = None if b > phi[-1] else _release(g, phi, p, vol.V[k], vol.dV[k], a, b)
+            if got is None:
                 continue
-            x, pv = phi[sel], p[sel]
-            dp = CubicSpline(x, pv, bc_type="not-a-knot")(x, 1)
-            rate = g / (g - 1.0) * pv * vol.dV[k][sel] + vol.V[k][sel] * dp / (g - 1.0)
-            q = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(x))])
+            x, _, q = got
             Q[k, j] = q[-1]
             frac = q / q[-1] if q[-1] > 0 else q * np.nan
             for i, level in enumerate(MFB_LEVELS):
@@ -380,19 +400,27 @@ def heat_release(scene, phi, traj, part, marks, vol, cuts) -> dict[str, tuple[An
     return out
 
 
-def rate_of_heat_release(scene, phi: ArrayLike, p: ArrayLike, cylinder: int = 1
-                         ) -> NDArray[np.float64]:
-    """dQ/dφ [J/rad] of ``cylinder`` (1-based) at the angles ``phi`` from its pressure ``p``
-    there (Heywood (9.25), constant γ of the scene's Wiebe model; dp/dφ from a not-a-knot
-    spline), for plots."""
-    from scipy.interpolate import CubicSpline
-
-    phi = np.asarray(phi, float)
-    p = np.asarray(p, float)
-    g = scene.gas.wiebe.gamma
-    vol = cylinder_volumes(scene, phi)
-    dp = CubicSpline(phi, p, bc_type="not-a-knot")(phi, 1)
-    return g / (g - 1.0) * p * vol.dV[cylinder - 1] + vol.V[cylinder - 1] * dp / (g - 1.0)
+def heat_release_rate(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int,
+                      start: float) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """(local angle [rad], dQ/dφ [J/rad]) of ``cylinder`` (1-based) over the closed part of its
+    own cycle that starts at the shaft angle ``start`` (:func:`own_cycles`), from the stored
+    pressure; None where the scene's gas model is not Wiebe combustion with constant γ or the run
+    does not hold that closed part."""
+    closed = _closed_part(scene) if scene.gas.model == "wiebe" else None
+    if closed is None:
+        return None
+    g, ivc, evo = closed
+    part = _increasing_part(traj)
+    phi = np.asarray(traj["phi"], float)[part]
+    if start + evo > phi[-1]:
+        return None
+    window = (phi > start + ivc - 1e-6) & (phi < start + evo + 1e-6)
+    x = phi[window]
+    vol = cylinder_volumes(scene, x)
+    p = np.asarray(traj[f"p_{cylinder}"], float)[part][window]
+    got = _release(g, x, p, vol.V[cylinder - 1], vol.dV[cylinder - 1], start + ivc,
+                   start + evo)
+    return None if got is None else (got[0] - start, got[1])
 
 
 # ------------------------------------------------------------------------------------------------

@@ -23,6 +23,8 @@ def cmd_plot(args) -> int:
     plt = pyplot()
 
     from .. import plots
+    import numpy as np
+
     from ..assemble import gas_is_force, gas_table
 
     if len(args.result) > 1:
@@ -80,6 +82,15 @@ def cmd_plot(args) -> int:
             a2.set_xlabel("swept volume F_p·s [dm³]")
         a1.set_title(f"{scene.name}: indicator diagrams of the run")
         written.append(save(fig, out / f"{stem}_indicator.png", args.force, res))
+    if scene.gas.model == "wiebe" and held:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        if plots.heat_release(ax, traj, scene, args.cylinder, args.cycles or [-1]):
+            ax.set_xlim(np.degrees(scene.gas.wiebe.start) - 20.0,
+                        np.degrees(scene.gas.wiebe.start + scene.gas.wiebe.duration) + 30.0)
+            ax.set_title(f"{scene.name}: apparent heat-release rate of the run")
+            written.append(save(fig, out / f"{stem}_heat_release.png", args.force, res))
+        else:
+            plt.close(fig)
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
