@@ -173,7 +173,8 @@ def integrals_between(x: ArrayLike, f: ArrayLike, marks: ArrayLike, cuts: ArrayL
     lo = edges[0]
     for j in range(1, edges.size):
         hi = edges[j]
-        first, last = j == 1 and lo == x[0], j == edges.size - 1
+        # the data's own ends are samples of the first and last segments, not cuts
+        first, last = lo == x[0], j == edges.size - 1
         keep = ((x > lo + tol) | (first & (x >= lo))) & ((x < hi - tol) | (last & (x <= hi)))
         if keep.sum() < 2 and not last:
             continue  # joined to the next segment
@@ -218,11 +219,13 @@ def _corner_cuts(scene, phi_lo: float, phi_hi: float, events) -> list[NDArray[np
     return out
 
 
-def _at_marks(traj, part, name, marks, derivative=None, cuts=()):
+def _at_marks(traj, part, name, marks, derivative=None):
+    """Column ``name`` at the cycle marks: the samples there in crank angle, else the cubic
+    Hermite interpolant with dv/dφ = ``derivative`` (:func:`.orders.resample_angle`)."""
     phi = np.asarray(traj["phi"], float)[part]
     v = np.asarray(traj[name], float)[part]
     d = None if derivative is None else np.asarray(derivative, float)[part]
-    return resample_angle(phi, v, marks, d, cuts)
+    return resample_angle(phi, v, marks, d)
 
 
 def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=None
@@ -300,7 +303,7 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
         "thermo_balance_residual": (residual, "1"),
     }
     if scene.gas.model == "wiebe":
-        out.update(heat_release(scene, phi, traj, part, marks, vol, cuts))
+        out.update(heat_release(scene, phi, traj, part, marks, vol))
     for name in ("imep_engine", "bmep", "fmep", "P_indicated_engine", "P_brake", "P_friction",
                  "balance_residual"):
         value, unit = out[f"thermo_{name}"]
@@ -360,7 +363,7 @@ def _release(gamma, phi, p, V, dV, a, b):
     return x, rate, q
 
 
-def heat_release(scene, phi, traj, part, marks, vol, cuts) -> dict[str, tuple[Any, str]]:
+def heat_release(scene, phi, traj, part, marks, vol) -> dict[str, tuple[Any, str]]:
     """Apparent heat released per cylinder over the closed part that starts in each cycle
     (Heywood (9.25), module docstring) and the MFB angles; ``thermo_heat_release_skipped`` if γ
     varies with temperature."""
