@@ -1,7 +1,8 @@
-"""The quadrature of stored samples behind ∮p dV (:func:`transient.analysis.thermo.integrals_between`)
-against closed forms: a smooth function converges as h⁷ or faster (degree 6), a jump given as a cut or
-written as two samples at one angle is integrated as two smooth pieces, a sample on a cut that
-holds the wrong side is not used, and marks between samples are exact nodes."""
+"""The quadrature of stored samples behind ∮p dV
+(:func:`transient.analysis.thermo.integrals_between`) against closed forms: a smooth function
+converges as h⁷ or faster (degree 6), a jump given as a cut or written as two samples at one
+angle is integrated as two smooth pieces, a sample on a cut that holds the wrong side is not
+used, and marks between samples are exact nodes."""
 from __future__ import annotations
 
 import math
