@@ -18,7 +18,8 @@ result → analysis, and each layer imports only those below it (the contracts i
 - ``results``        the in-memory run, the HDF5 writer (streaming) and reader
 - ``reference``      the same model in plain numpy through ``scipy.integrate.solve_ivp``
 - ``analysis``       irregularity, steady state, efficiency, orders, transient response, loads,
-                     load and wear diagrams, the end-of-run summary
+                     load and wear diagrams, the run's thermodynamics (IMEP, BMEP, FMEP), every
+                     piston's kinematics, the end-of-run summary
 - ``run``            drives the compiled stepper in chunks (or the reference path), prescribed
                      speed, and :func:`simulate`
 - ``plots``          ax-first plotting helpers

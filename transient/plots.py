@@ -100,6 +100,178 @@ def indicator_pv(ax, table, volume, log=True):
     return artists
 
 
+def _cylinders(scene, cylinders):
+    """Cylinder numbers (1-based) to draw: all for None; ValueError for one out of range."""
+    n = scene.mechanism.n_cylinders
+    picked = list(range(1, n + 1)) if cylinders is None else [int(c) for c in cylinders]
+    bad = [c for c in picked if not 1 <= c <= n]
+    if bad:
+        raise ValueError(f"cylinder {bad[0]} is out of range; allowed: 1 … {n}")
+    return picked
+
+
+def _cycle_samples(traj, scene, cylinder, cycles):
+    """(label "i of n", sample mask, start angle) of each of ``cylinder``'s own whole cycles asked
+    for (indices as in a list: −1 the last); ValueError for an index the run does not hold."""
+    from .analysis.thermo import own_cycles
+
+    starts = own_cycles(scene, traj, cylinder)
+    phi = traj["phi"]
+    out = []
+    for c in cycles:
+        if not -starts.size <= c < starts.size:
+            raise ValueError(f"cycle {c} is out of range: cylinder {cylinder} has "
+                             f"{starts.size} whole cycle(s) in the run (allowed "
+                             f"{-starts.size} … {starts.size - 1})")
+        a = starts[c]
+        out.append((f"{c % starts.size + 1} of {starts.size}",
+                    (phi >= a) & (phi <= a + scene.mechanism.cycle), a))
+    return out
+
+
+def run_indicator_phi(ax, traj, scene, cylinders=None, cycles=(-1,), table=None):
+    """The pressure the run applied [MPa] against each cylinder's own (local) angle [deg], over
+    its whole cycles ``cycles`` (−1: the last), for ``cylinders`` (1-based; None: all).
+    ``table``: the input table (a :class:`~transient.forces.gas.PressureTable`) drawn dashed
+    for comparison. Returns the artists."""
+    traj = _columns(traj)
+    artists = []
+    for k in _cylinders(scene, cylinders):
+        for c, sel, a in _cycle_samples(traj, scene, k, cycles):
+            artists += ax.plot(np.degrees(traj["phi"][sel] - a), traj[f"p_{k}"][sel] / 1e6,
+                               lw=1.0, label=f"cylinder {k}, cycle {c}")
+    if table is not None:
+        x = np.linspace(0.0, table.period, 2881)
+        artists += ax.plot(np.degrees(x), table(x) / 1e6, lw=0.8, ls="--", color="0.5",
+                           label="input table, full fuel")
+    ax.set_xlabel("cylinder's own crank angle [deg]")
+    ax.set_ylabel("p [MPa]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    return artists
+
+
+def run_indicator_pv(ax, traj, scene, cylinders=None, cycles=(-1,), log=True):
+    """p–V diagram of the run: the pressure applied [MPa] against the cylinder's exact volume
+    [dm³] (:func:`transient.analysis.thermo.cylinder_volumes`; the swept part only where the gas
+    model gives no clearance), log-log unless ``log`` is False. Returns the artists."""
+    traj = _columns(traj)
+    from .analysis.thermo import cylinder_volumes
+
+    plot = ax.loglog if log else ax.plot
+    artists = []
+    for k in _cylinders(scene, cylinders):
+        for c, sel, _ in _cycle_samples(traj, scene, k, cycles):
+            V = cylinder_volumes(scene, traj["phi"][sel]).V[k - 1]
+            artists += plot(V * 1e3, traj[f"p_{k}"][sel] / 1e6, lw=1.0,
+                            label=f"cylinder {k}, cycle {c}")
+    ax.set_xlabel("V [dm³]")
+    ax.set_ylabel("p [MPa]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    return artists
+
+
+def heat_release(ax, traj, scene, cylinders=None, cycles=(-1,)):
+    """Apparent heat-release rate dQ/dφ [J/deg] of the run's pressure over the closed part of
+    each cylinder's own cycles ``cycles``, against its local angle [deg]
+    (:func:`transient.analysis.thermo.heat_release_rate`; Wiebe combustion with constant γ).
+    Returns the artists (none where the run does not hold a closed part)."""
+    traj = _columns(traj)
+    from .analysis.thermo import heat_release_rate
+
+    artists = []
+    for k in _cylinders(scene, cylinders):
+        for c, _, a in _cycle_samples(traj, scene, k, cycles):
+            got = heat_release_rate(scene, traj, k, a)
+            if got is not None:
+                artists += ax.plot(np.degrees(got[0]), got[1] * math.pi / 180.0, lw=1.0,
+                                   label=f"cylinder {k}, cycle {c}")
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel("cylinder's own crank angle [deg]")
+    ax.set_ylabel("dQ/dφ [J/deg]")
+    ax.grid(True, alpha=0.3)
+    if artists:
+        ax.legend(fontsize=7)
+    return artists
+
+
+def speed_over_cycle(ax, traj, scene):
+    """ω(φ) [rpm] over the last whole cycle against the angle in it [deg], with its mean, its
+    extremes and δ = (ω_max − ω_min)/ω_mean (Gots §2.8) marked. Returns the artists."""
+    traj = _columns(traj)
+    from .analysis.irregularity import cycle_boundaries
+
+    cycle = scene.mechanism.cycle
+    tb, marks = cycle_boundaries(traj["t"], traj["phi"], cycle, scene.initial.phi)
+    if marks.size < 2:
+        raise ValueError("the run holds no whole cycle")
+    a, b = marks[-2], marks[-1]
+    sel = (traj["phi"] >= a) & (traj["phi"] <= b)
+    rpm = 30.0 / math.pi
+    x = np.degrees(traj["phi"][sel] - a)
+    w = traj["omega"][sel] * rpm
+    mean = cycle / (tb[-1] - tb[-2]) * rpm
+    artists = ax.plot(x, w, lw=1.2, label="ω")
+    i, j = int(np.argmax(w)), int(np.argmin(w))
+    artists.append(ax.axhline(mean, color="k", lw=0.6, ls="--", label="cycle mean"))
+    artists += ax.plot([x[i], x[j]], [w[i], w[j]], "o", color="C3", ms=4)
+    artists.append(ax.annotate("", xy=(x[i], w[j]), xytext=(x[i], w[i]),
+                               arrowprops={"arrowstyle": "<->", "color": "C3", "lw": 0.8}))
+    artists.append(ax.text(x[i], 0.5 * (w[i] + w[j]), f"  δ = {(w[i] - w[j]) / mean:.4g}",
+                           color="C3", va="center", fontsize=9))
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel("ω [rpm]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return artists
+
+
+def cylinder_torque_curves(ax, traj, scene):
+    """Each cylinder's gas torque and their sum M_gas [N m] over the last whole cycle against
+    the angle in it [deg] (:func:`transient.analysis.pistons.cylinder_torques`). Returns the
+    artists."""
+    traj = _columns(traj)
+    from .analysis.pistons import cylinder_torques
+
+    sel = last_cycle(traj, scene.mechanism.cycle)
+    part = {k: np.asarray(traj[k])[sel] for k in traj if k == "phi" or k.startswith("p_")}
+    x = np.degrees(part["phi"] - part["phi"][0])
+    torques = cylinder_torques(scene, part)
+    artists = [ax.plot(x, m, lw=0.9, label=f"cylinder {k + 1}")[0]
+               for k, m in enumerate(torques)]
+    artists += ax.plot(x, torques.sum(axis=0), lw=1.6, color="k", label="sum (M_gas)")
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.set_xlabel("crank angle in the last cycle [deg]")
+    ax.set_ylabel("M [N m]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return artists
+
+
+def inertia_and_gas(axes, traj, cycle):
+    """Over the last cycle against the angle in it [deg]: J(φ) [kg m²] on ``axes[0]``, and on
+    ``axes[1]`` the inertia moment ½J′(φ)ω² beside the gas and load moments [N m] — the terms
+    of (18), J φ̈ = M − ½J′φ̇², whose balance sets ε. Returns the artists."""
+    traj = _columns(traj)
+    sel = last_cycle(traj, cycle)
+    x = np.degrees(traj["phi"][sel] - traj["phi"][sel][0])
+    a_j, a_m = axes
+    artists = a_j.plot(x, traj["J"][sel], lw=1.2, color="C4")
+    a_j.set_ylabel("J [kg m²]")
+    artists += a_m.plot(x, 0.5 * traj["dJ_dphi"][sel] * traj["omega"][sel] ** 2, lw=1.2,
+                        color="C4", label="½J′ω²")
+    artists += a_m.plot(x, traj["M_gas"][sel], lw=1.0, color="C0", label="M_gas")
+    artists += a_m.plot(x, traj["M_load"][sel], lw=1.0, color="C3", label="M_load")
+    a_m.axhline(0.0, color="0.6", lw=0.5)
+    a_m.set_ylabel("M [N m]")
+    a_m.set_xlabel("crank angle in the last cycle [deg]")
+    a_m.legend(fontsize=8)
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    return artists
+
+
 def transfer_functions(ax, table):
     """Transfer functions of a kinematics table against the shaft angle: u₉,₁ and u₁₃,₁ of a
     swash plate (the paper's Fig. 4), the piston ones u_k [m/rad] on a second axis."""
@@ -311,25 +483,74 @@ def order_bars(ax, orders, amplitude, ylabel, max_order=12.0, width=0.35, offset
     return artists
 
 
-def order_waterfall(ax, omega_mean_rpm, orders, amplitude, max_order=12.0):
-    """Run-up waterfall: each cycle's order spectrum [unit of the signal] as one line, raised by
-    its cycle-mean speed (the y axis reads speed at each line's base). ``amplitude``: (n_cycles,
-    n_orders). Returns the artists."""
+def order_waterfall(ax, omega_mean_rpm, orders, amplitude, max_order=12.0, label=None):
+    """Run-up waterfall as a colour map: the amplitude of each order (x) in each cycle, placed at
+    the cycle's mean speed (y), on a logarithmic colour scale over four decades below the
+    largest (weaker lines are drawn at its floor). ``amplitude``: (n_cycles, n_orders) in the
+    unit of the signal, ``label`` names it on the colour bar. Returns the mesh."""
+    from matplotlib.colors import LogNorm
+
     orders = np.asarray(orders)
     sel = (orders > 0.0) & (orders <= max_order + 1e-9)
-    amp = np.asarray(amplitude)[:, sel]
-    w = np.asarray(omega_mean_rpm)
-    step = np.ptp(w) / max(len(w) - 1, 1) if len(w) > 1 else 1.0
+    amp = np.asarray(amplitude, dtype=float)[:, sel]
+    w = np.asarray(omega_mean_rpm, dtype=float)
     top = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
-    scale = 3.0 * (step if step > 0 else 1.0) / top
-    artists = []
-    for c in range(amp.shape[0]):
-        artists += ax.plot(orders[sel], w[c] + scale * amp[c], lw=0.6,
-                           color=f"C{c % 10}" if amp.shape[0] <= 10 else "C0")
+    x = orders[sel]
+    dx = x[1] - x[0] if x.size > 1 else 1.0
+    x_edges = np.concatenate([x - dx / 2, [x[-1] + dx / 2]])
+    # each cycle's band reaches halfway to its neighbours' speeds
+    if w.size > 1:
+        mid = 0.5 * (w[1:] + w[:-1])
+        y_edges = np.concatenate([[w[0] - (mid[0] - w[0])], mid, [w[-1] + (w[-1] - mid[-1])]])
+    else:
+        y_edges = np.array([w[0] - 0.5, w[0] + 0.5]) if w.size else np.array([0.0, 1.0])
+    order = np.argsort(w)
+    if np.all(np.diff(w) > 0) or w.size < 2:
+        mesh = ax.pcolormesh(x_edges, y_edges, np.maximum(amp, top * 1e-4),
+                             norm=LogNorm(top * 1e-4, top), cmap="viridis", shading="flat")
+    else:  # not monotonic in speed (a run-down or a load step): one row per cycle, speed labels
+        mesh = ax.pcolormesh(x_edges, np.arange(w.size + 1), np.maximum(amp[order], top * 1e-4),
+                             norm=LogNorm(top * 1e-4, top), cmap="viridis", shading="flat")
+        ticks = np.linspace(0, w.size - 1, min(w.size, 8)).round().astype(int)
+        ax.set_yticks(ticks + 0.5, [f"{w[order][i]:.0f}" for i in ticks])
+    ax.figure.colorbar(mesh, ax=ax, label=label or "amplitude")
     ax.set_xlabel("engine order [1/rev]")
-    ax.set_ylabel("cycle-mean speed [rpm] (+ amplitude)")
+    ax.set_ylabel("cycle-mean speed [rpm]")
+    return mesh
+
+
+def campbell(ax, omega_mean_rpm, orders, amplitude, max_order=12.0, label=None):
+    """Campbell chart: each cycle's orders as points at (cycle-mean speed [rpm], frequency
+    ν·n/60 [Hz]), their colour and size the amplitude (logarithmic, four decades), over the
+    order lines ν = 1, 2, … (grey rays). ``amplitude``: (n_cycles, n_orders). Returns the
+    scatter."""
+    from matplotlib.colors import LogNorm
+
+    orders = np.asarray(orders)
+    sel = (orders > 0.0) & (orders <= max_order + 1e-9)
+    amp = np.asarray(amplitude, dtype=float)[:, sel]
+    w = np.asarray(omega_mean_rpm, dtype=float)
+    top = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
+    speed = np.repeat(w[:, None], sel.sum(), axis=1)
+    freq = speed * orders[sel][None, :] / 60.0
+    floor = top * 1e-4
+    shown = np.maximum(amp, floor)
+    size = 4.0 + 60.0 * (np.log10(shown / floor) / 4.0)
+    keep = amp >= floor
+    dots = ax.scatter(speed[keep], freq[keep], c=shown[keep], s=size[keep], cmap="viridis",
+                      norm=LogNorm(floor, top), edgecolors="none")
+    span = np.array([0.0, float(w.max()) * 1.05 if w.size else 1.0])
+    for nu in range(1, int(max_order) + 1):
+        ax.plot(span, span * nu / 60.0, color="0.8", lw=0.6, zorder=0)
+        ax.annotate(f"{nu}", (span[1], span[1] * nu / 60.0), fontsize=6, color="0.5")
+    ax.figure.colorbar(dots, ax=ax, label=label or "amplitude")
+    low = float(w.min()) if w.size else 0.0
+    ax.set_xlim(max(0.0, low - 0.1 * max(float(np.ptp(w)) if w.size else 0.0, low)),
+                span[1] * 1.04)
+    ax.set_xlabel("cycle-mean speed [rpm]")
+    ax.set_ylabel("frequency [Hz]")
     ax.grid(True, alpha=0.3)
-    return artists
+    return dots
 
 
 def order_tracks(ax, omega_mean_rpm, tracks, ylabel):

@@ -468,20 +468,21 @@ def test_plot_writes_png_figures(tmp_path, capsys):
     figures = tmp_path / "figures"
     code, out, err = cli(capsys, "plot", tmp_path / "spinup.h5", "-o", figures)
     assert (code, err) == (0, "")
-    names = ["spinup_speed.png", "spinup_torques.png", "spinup_indicator.png"]
+    names = ["spinup_speed.png", "spinup_torques.png", "spinup_speed_cycle.png",
+             "spinup_inertia.png", "spinup_cylinder_torques.png", "spinup_indicator.png"]
     assert out.splitlines() == [f"wrote {figures / n}" for n in names]
     for n in names:
         data = (figures / n).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 1000, n
 
 
-def test_plot_defaults_to_the_result_folder_and_skips_indicator_without_gas(tmp_path, capsys):
+def test_plot_defaults_to_the_result_folder_and_skips_gas_figures_without_gas(tmp_path, capsys):
     scene = write(tmp_path, "coast", COASTING.format(revolutions=2, samples=12))
     assert cli(capsys, "run", scene, "-o", tmp_path / "res", "-q")[0] == 0
     code, out, err = cli(capsys, "plot", tmp_path / "res" / "coast.h5")
     assert (code, err) == (0, "")
     assert sorted(p.name for p in (tmp_path / "res").glob("*.png")) == [
-        "coast_speed.png", "coast_torques.png"]
+        "coast_inertia.png", "coast_speed.png", "coast_speed_cycle.png", "coast_torques.png"]
 
 
 def test_kinematics_writes_csv(tmp_path, capsys):

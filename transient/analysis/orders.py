@@ -29,6 +29,31 @@ s = y_TDC − r cos φ − l cos β ⊃ ⅛ l k λ⁴ sin 3φ, and the third ord
 first is ≈ (9/8)·k·λ³. For λ = 0.3176: exact 3rd/1st = 8.03e-3 and 5th/1st = 4.5e-4 at k = 0.2
 (series 7.21e-3), 3.99e-3 and 2.2e-4 at k = 0.1 (series 3.60e-3) (tests/unit/test_orders.py).
 
+**Radial engines** (:mod:`transient.mechanisms.articulated`). The master piston is a central
+crank-slider: orders 1, 2, 4 … at constant ω. A slave piston's link pin is A_i = A + r_i e^{iψ_i}
+e, A = r e^{iα} the crankpin and e = c − iλ sin α, c = √(1 − λ² sin²α), the master rod's direction
+(Semenov §3). In the slave cylinder's frame (axis δ_i) the pin lies at w = A_i e^{−iδ_i}, whose
+part across the axis is h = r sin(α − δ_i) + r_i[sin(ψ_i − δ_i)·c − cos(ψ_i − δ_i)·λ sin α], and
+the slave piston at X_i = Re w + √(l_i² − h²). Re w holds order 1 (r cos(α − δ_i), λ sin α) and c
+(even orders only). With the link pin at the cylinder's own angle, ψ_i = δ_i, the c term leaves
+h, so h is of order 1 alone, h² of orders 0 and 2 and the root of even orders: X_i holds order 1
+and even orders, and W = ω̄²X″ no odd order ≥ 3, exactly as the master. With ψ_i ≠ δ_i the
+cross term of order 1 × c in h² puts odd orders into the slave's motion at constant speed
+(tests/unit/test_orders_mechanisms.py shows both).
+
+**Swash plate** (:mod:`transient.mechanisms.swash_plate`). The piston joint B_k turns on the plate
+with θ(φ) = −φ + δ(φ), δ the Hooke joint's non-uniformity, of period π, so B_x ∝ cos(θ + ψ_k)
+changes sign over half a turn, B_x(φ + π) = −B_x(φ): odd orders only. The rod of length ℓ adds
+x_D = B_x − √(ℓ² − h²) ≈ B_x − ℓ + h²/(2ℓ), h the joint's lateral offset from the cylinder axis,
+which holds every order: the even orders of a swash-plate piston at constant speed are that rod
+term, O(h²/ℓ), and vanish as ℓ → ∞ (the tests show amplitude·ℓ converging). The δ(φ) ripple
+(order 2) turns order 1 into 3, 5 …: a large third order (0.16 of the first at α = 21.4°) that is
+kinematic, not a speed effect. The cycle is one turn: no half orders.
+
+**Half orders.** Every piston's travel repeats every turn, so at constant speed a 4-stroke
+engine's piston accelerations hold no half order; a speed ripple of a half order (a 5-cylinder
+radial fires every 144°: order 2.5) puts them in.
+
 Functions
 ---------
 :func:`resample_angle`, :func:`to_angle_grid`
@@ -614,10 +639,11 @@ class OddHarmonicReport:
         return out
 
 
-def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float, l: float,
-                        e: float = 0.0, *, cycle: float = 4.0 * math.pi, phi0: float = 0.0,
-                        phase: float = 0.0, samples_per_cycle: int = 1440,
-                        cycles: int | None = None, cuts: ArrayLike = ()) -> OddHarmonicReport:
+def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float = 0.0,
+                        l: float = 0.0, e: float = 0.0, *, cycle: float = 4.0 * math.pi,
+                        phi0: float = 0.0, phase: float = 0.0, samples_per_cycle: int = 1440,
+                        cycles: int | None = None, cuts: ArrayLike = (),
+                        kinematics=None) -> OddHarmonicReport:
     """Orders of the piston acceleration of a run against the same engine at constant mean speed.
 
     Parameters
@@ -636,6 +662,10 @@ def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float, l: fl
         Only the last ``cycles`` whole cycles.
     cuts : array, optional
         Corner angles of the run (breakpoints), see :func:`resample_angle`.
+    kinematics : callable, optional
+        φ ↦ (s′(φ), s″(φ)) [m/rad, m/rad²] of the piston at the shaft angles φ, for a piston
+        that is not a crank-slider's (:func:`report_for_scene` makes it from
+        :func:`transient.analysis.pistons.piston_kinematics`); then r, l, e and phase are unused.
 
     Notes
     -----
@@ -665,7 +695,10 @@ def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float, l: fl
     wc = cols["omega"].reshape(n_cyc, n)
     delta = (np.maximum(wc.max(axis=1), w_end) - np.minimum(wc.min(axis=1), w_end)) / omega_mean
 
-    _, ds, dds, _, _, _ = slider_arrays(grid - phase, r, l, e)
+    if kinematics is None:
+        def kinematics(x):
+            return slider_arrays(x - phase, r, l, e)[1:3]
+    ds, dds = kinematics(grid)
     W = cols["omega"] ** 2 * dds + cols["epsilon"] * ds
     W_const = np.repeat(omega_mean, n) ** 2 * dds
     spec = order_spectrum(W, n, cycle)
@@ -673,7 +706,7 @@ def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float, l: fl
     # the last cycle's drift from its own end (the next cycle's start is not on the grid)
     drift = spec.drift.copy()
     eps_end = resample_angle(phi, eps, ends[-1:], None, cuts)
-    _, ds_e, dds_e, _, _, _ = slider_arrays(ends[-1:] - phase, r, l, e)
+    ds_e, dds_e = kinematics(ends[-1:])
     drift[-1] = float(w_end[-1] ** 2 * dds_e[0] + eps_end[0] * ds_e[0] - W[-n])
     return OddHarmonicReport(spec.orders, grid[::n].copy(), omega_mean, delta, spec.coef,
                              spec_c.coef, drift)
@@ -681,15 +714,32 @@ def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float, l: fl
 
 def report_for_scene(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int = 1,
                      **options) -> OddHarmonicReport:
-    """:func:`odd_harmonic_report` for cylinder ``cylinder`` (1-based) of a crank-slider scene:
-    r, l, e, Φ, φ0 and the cylinder's firing angle taken from the scene; ``options`` as there."""
+    """:func:`odd_harmonic_report` for cylinder ``cylinder`` (1-based) of the scene's mechanism:
+    a crank-slider's r, l, e and firing angle, or any other piston's exact s′, s″
+    (:func:`transient.analysis.pistons.piston_kinematics`: a radial engine's master and slave
+    pistons, a swash plate's); Φ and φ0 from the scene; ``options`` as there. ValueError for a
+    cylinder out of range.
+
+    Which orders the constant-speed W = ω̄²s″ holds is the mechanism's geometry (module
+    docstring): a central crank-slider and a radial engine's master piston no odd order ≥ 3; a
+    slave piston none either when its link pin lies at its own cylinder's angle on the master
+    rod (ψ_i = δ_i); a swash plate's piston no even order in the limit of long rods; and no
+    piston a half order, its travel repeating every turn."""
     m = scene.mechanism
-    if not m.slider_law:
-        raise ValueError(f"the odd-harmonic report needs a crank-slider mechanism, "
-                         f"not {type(m).__name__}")
-    return odd_harmonic_report(traj, m.crank_radius, m.rod_length, m.offset, cycle=m.cycle,
-                               phi0=scene.initial.phi, phase=m.firing_angles[cylinder - 1],
-                               **options)
+    n = len(m.firing_angles)  # one per cylinder
+    if not 1 <= cylinder <= n:
+        raise ValueError(f"cylinder {cylinder} is out of range; allowed: 1 … {n}")
+    common = dict(cycle=m.cycle, phi0=scene.initial.phi, **options)
+    if m.slider_law:
+        return odd_harmonic_report(traj, m.crank_radius, m.rod_length, m.offset,
+                                   phase=m.firing_angles[cylinder - 1], **common)
+    from .pistons import piston_kinematics
+
+    def kinematics(x):
+        pk = piston_kinematics(m, x)
+        return pk.ds[cylinder - 1], pk.dds[cylinder - 1]
+
+    return odd_harmonic_report(traj, kinematics=kinematics, **common)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -716,6 +766,10 @@ class RunOrders:
         M_gas over the last whole cycle, where the run has gas forces.
     piston : OddHarmonicReport or None
         The piston acceleration of one cylinder over the last whole cycle, where asked for.
+    cylinder_torques : OrderSpectrum or None
+        Each cylinder's gas torque over the last whole cycle
+        (:func:`transient.analysis.pistons.cylinder_torques`), one row per cylinder (where the
+        spectrum's rows are otherwise cycles), where the run has gas forces.
     """
 
     cycle_start: NDArray[np.float64]
@@ -725,6 +779,7 @@ class RunOrders:
     detrend: str
     gas_torque: OrderSpectrum | None = None
     piston: OddHarmonicReport | None = None
+    cylinder_torques: OrderSpectrum | None = None
 
     @property
     def orders(self) -> NDArray[np.float64]:
@@ -755,8 +810,8 @@ def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle
         For ω, as :func:`resolve_detrend`: a spin-up's trend would otherwise leak into every
         order of each cycle.
     piston_cylinder : int, optional
-        Cylinder (1-based) of a crank-slider whose piston acceleration is reported
-        (:func:`report_for_scene`); None: no report.
+        Cylinder (1-based) whose piston acceleration is reported (:func:`report_for_scene`,
+        any mechanism); None: no report.
 
     Raises :class:`~.irregularity.NoWholeCycle` if the run holds no whole cycle.
     """
@@ -765,10 +820,11 @@ def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle
     detrend = resolve_detrend(detrend, scene.initial.omega, float(traj["omega"][-1]))
     starts, omega = cycle_spectra(traj, "omega", n, cycle, phi0=phi0, cuts=cuts,
                                   detrend=detrend)
-    gas = None
+    gas = per_cylinder = None
     if "M_gas" in traj and scene.gas.model != "none":
         _, cm = to_angle_grid(traj, ("M_gas",), n, cycle, phi0=phi0, cycles=1, cuts=cuts)
         gas = order_spectrum(cm["M_gas"], n, cycle)
+        per_cylinder = _cylinder_torque_spectra(scene, traj, n, cuts)
     piston = None
     if piston_cylinder is not None:
         piston = report_for_scene(scene, traj, piston_cylinder, samples_per_cycle=n, cycles=1,
@@ -776,7 +832,32 @@ def run_orders(scene, traj: Mapping[str, NDArray[np.float64]], samples_per_cycle
     t, phi = traj["t"], traj["phi"]
     delta = fluctuation(t, phi, traj["omega"], cycle, phi0)
     means, _ = cycle_means(t, phi, cycle, phi0)
-    return RunOrders(starts, omega, means[-starts.size:], delta, detrend, gas, piston)
+    return RunOrders(starts, omega, means[-starts.size:], delta, detrend, gas, piston,
+                     per_cylinder)
+
+
+def _cylinder_torque_spectra(scene, traj, n, cuts) -> OrderSpectrum | None:
+    """Each cylinder's gas torque over the last whole cycle, one spectrum row per cylinder: the
+    torques on the stored samples of the last two cycles (:func:`.pistons.cylinder_torques`,
+    adding up to M_gas there), resampled onto the grid as M_gas is, so that their spectra add up
+    to M_gas's (the resampling is linear in the samples). None without per-cylinder columns."""
+    from .pistons import cylinder_torques
+
+    count = getattr(scene.mechanism, "n_cylinders", 0)
+    names = [f"p_{k + 1}" for k in range(count)]
+    if not names or not all(c in traj for c in names):
+        return None
+    cycle = scene.mechanism.cycle
+    part = _increasing_part(traj)
+    phi = np.asarray(traj["phi"], dtype=float)[part]
+    recent = phi >= phi[-1] - 2.0 * cycle
+    cols = {"phi": phi[recent], **{c: np.asarray(traj[c], dtype=float)[part][recent]
+                                   for c in names}}
+    torques = cylinder_torques(scene, cols)
+    named = {"phi": cols["phi"], **{f"M_{k}": m for k, m in enumerate(torques)}}
+    _, grid_cols = to_angle_grid(named, list(named)[1:], n, cycle, phi0=scene.initial.phi,
+                                 cycles=1, cuts=cuts)
+    return order_spectrum(np.array([grid_cols[f"M_{k}"] for k in range(count)]), n, cycle)
 
 
 def orders_up_to(orders: ArrayLike, max_order: float) -> NDArray[np.intp]:

@@ -17,7 +17,7 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   ``orders_<s>_amplitude`` (C, K) [unit of s] and ``orders_<s>_phase`` (C, K) [rad]
   (:class:`transient.analysis.orders.OrderSpectrum`; order 0 is the mean of the detrended cycle).
   A signal is a trajectory column or ``W_<k>``, the piston acceleration of cylinder k,
-  W = ω²s″ + εs′ [m/s²] (crank-slider).
+  W = ω²s″ + εs′ [m/s²] (any mechanism, :mod:`transient.analysis.pistons`).
 * ``loads = true`` (crank-slider), over the last whole cycle on a uniform grid of N angles
   (:mod:`transient.analysis.loads.crank_slider`): ``loads_phi`` (N,) [rad]; ``loads_P``,
   ``loads_N``, ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load
@@ -38,6 +38,9 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   ``loads_N_tangential`` (z, N) [N], ``loads_torque`` (z, N) [N m]; ``loads_engine_torque``
   (Σ torque) and ``loads_shaft_torque`` (with the rods' and link 9's inertia) (N,) [N m]. No
   crankpin.
+* ``thermodynamics = true``: per cylinder and whole cycle ``thermo_*`` — indicated work, IMEP,
+  BMEP, FMEP, the powers, the peak pressures and, for Wiebe combustion, the heat released and
+  the burned-fraction angles (:mod:`transient.analysis.thermo` lists the names and units).
 """
 from __future__ import annotations
 
@@ -48,7 +51,9 @@ import numpy as np
 
 from ..errors import SceneError
 from .irregularity import cycle_boundaries
-from .orders import order_spectrum, piston_acceleration, resolve_detrend, to_angle_grid
+from .orders import order_spectrum, resolve_detrend, to_angle_grid
+from .pistons import piston_kinematics
+from .thermo import cycle_thermodynamics
 
 #: A derived signal of ``orders``: the piston acceleration of cylinder k.
 PISTON_ACCELERATION = re.compile(r"W_([1-9][0-9]*)$")
@@ -62,7 +67,8 @@ def requested_analyses(scene, traj: dict[str, np.ndarray], events=None
     out: dict[str, tuple[Any, str]] = {}
     parts = (("irregularity", req.irregularity, lambda: cycle_irregularity(scene, traj)),
              ("orders", bool(req.orders), lambda: stored_orders(scene, traj, cuts)),
-             ("loads", req.loads, lambda: stored_loads(scene, traj, cuts)))
+             ("loads", req.loads, lambda: stored_loads(scene, traj, cuts)),
+             ("thermo", req.thermodynamics, lambda: cycle_thermodynamics(scene, traj, events)))
     for name, asked, compute in parts:
         if not asked:
             continue
@@ -108,10 +114,10 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     names = tuple(dict.fromkeys(["t", *columns]))
     grid, cols = to_angle_grid(traj, names, n, cycle, phi0=scene.initial.phi, cuts=cuts,
                                closed=True)
+    pk = piston_kinematics(mech, grid) if derived else None
     for s, k in derived.items():
-        # W = ω²s″ + εs′ (Semenov §4), exact kinematics.
-        cols[s] = piston_acceleration(grid, cols["omega"], cols["epsilon"], mech.crank_radius,
-                                      mech.rod_length, mech.offset, mech.firing_angles[k - 1])
+        # W = ω²s″ + εs′ (Semenov §4), exact kinematics of any mechanism's piston
+        cols[s] = cols["omega"] ** 2 * pk.dds[k - 1] + cols["epsilon"] * pk.ds[k - 1]
         units[s] = "m/s^2"
     mode = resolve_detrend(req.detrend, scene.initial.omega, float(traj["omega"][-1]))
     t_marks = cols["t"][::n]  # every cycle's start and the last one's end (closed grid)

@@ -11,20 +11,17 @@ from .common import (EXIT_OK, MAX_POINTS, add_force, output_folder, pyplot, read
                      result_stem, save, whole, write_columns)
 
 
-#: The cylinder whose piston acceleration W is reported (a crank-slider's).
-PISTON_CYLINDER = 1
-
-
 def register(sub) -> None:
     od = sub.add_parser(
         "orders", help="order spectra of ω, M_gas and the piston acceleration (PNG + CSV "
                        "files; the result file is not changed)",
         description="Order spectra over the last whole cycle (transient.analysis.orders): ω, "
-                    "the gas torque M_gas and, for a crank-slider, the piston acceleration of "
-                    "cylinder 1 against the same engine at constant mean speed (odd-harmonic "
-                    "report); δ of the last cycle; with two or more whole cycles, a run-up "
-                    "waterfall and order tracks of ω against the cycle-mean speed. Results are "
-                    "written as files into DIR, never into the HDF5 result (read only here).")
+                    "the gas torque M_gas and each cylinder's, and the piston acceleration of "
+                    "one cylinder (any mechanism) against the same engine at constant mean "
+                    "speed (odd-harmonic report); δ of the last cycle; with two or more whole "
+                    "cycles, a run-up waterfall (a colour map), a Campbell chart and order "
+                    "tracks of ω against the cycle-mean speed. Results are written as files "
+                    "into DIR, never into the HDF5 result (read only here).")
     od.add_argument("result")
     od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
     od.add_argument("--samples-per-cycle", type=whole(16, MAX_POINTS), default=720,
@@ -35,6 +32,9 @@ def register(sub) -> None:
     od.add_argument("--detrend", choices=("auto", "ramp", "none"), default="auto",
                     help="remove each cycle's ramp from ω before its DFT (default auto: for a "
                          "spin-up, a run starting below 90 %% of its final speed)")
+    od.add_argument("--cylinder", type=int, default=1, metavar="K",
+                    help="cylinder (1-based) of the odd-harmonic report of the piston "
+                         "acceleration (default 1)")
     add_force(od)
     od.set_defaults(func=cmd_orders)
 
@@ -49,12 +49,16 @@ def cmd_orders(args) -> int:
     n = args.samples_per_cycle
     traj = res.trajectory
     cuts = res.events.get("breakpoint", {}).get("phi", np.zeros(0))
+    if not 1 <= args.cylinder <= mech.n_cylinders:
+        raise SceneError("--cylinder", f"cylinder {args.cylinder} is out of range; allowed: "
+                                       f"1 … {mech.n_cylinders}", file=str(res.path))
     try:
         ro = run_orders(scene, traj, n, cuts=cuts, detrend=args.detrend,
-                        piston_cylinder=PISTON_CYLINDER if mech.slider_law else None)
+                        piston_cylinder=args.cylinder)
     except NoWholeCycle as exc:
         raise SceneError("(trajectory)", str(exc), file=str(res.path)) from None
-    spec_w, spec_m, rep = ro.omega, ro.gas_torque, ro.piston
+    spec_w, spec_m, rep, per_cyl = ro.omega, ro.gas_torque, ro.piston, ro.cylinder_torques
+    k_w = args.cylinder
     starts, means, n_cyc, detrend = ro.cycle_start, ro.omega_mean, ro.cycles, ro.detrend
     rpm = 30.0 / math.pi
     orders = ro.orders
@@ -68,8 +72,12 @@ def cmd_orders(args) -> int:
     if spec_m is not None:
         cols_csv["M_gas_amplitude_Nm"] = spec_m.amplitude[-1]
         cols_csv["M_gas_phase_rad"] = spec_m.phase[-1]
-    if rep is not None:  # W_1: the piston acceleration of cylinder 1, as [analysis] orders names it
-        w = f"W_{PISTON_CYLINDER}"
+    if per_cyl is not None:
+        for k in range(per_cyl.coef.shape[0]):
+            cols_csv[f"M_cylinder_{k + 1}_amplitude_Nm"] = per_cyl.amplitude[k]
+            cols_csv[f"M_cylinder_{k + 1}_phase_rad"] = per_cyl.phase[k]
+    if rep is not None:  # W_k: cylinder k's piston acceleration, as [analysis] orders names it
+        w = f"W_{args.cylinder}"
         cols_csv[f"{w}_amplitude_m_s2"] = rep.amplitude[-1]
         cols_csv[f"{w}_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
         cols_csv[f"{w}_relative"] = rep.relative[-1]
@@ -83,7 +91,7 @@ def cmd_orders(args) -> int:
 
     from .. import plots
 
-    rows = 1 + (spec_m is not None) + (rep is not None)
+    rows = 1 + (spec_m is not None) + (rep is not None) + (per_cyl is not None)
     fig, axes = plt.subplots(rows, 1, figsize=(9, 3.2 * rows), squeeze=False)
     axes = axes[:, 0]
     plots.order_bars(axes[0], orders, spec_w.amplitude[-1], "ω amplitude [rad/s]", top)
@@ -94,21 +102,31 @@ def cmd_orders(args) -> int:
     if spec_m is not None:
         plots.order_bars(axes[i], orders, spec_m.amplitude[-1], "M_gas amplitude [N m]", top)
         i += 1
+    if per_cyl is not None:
+        z = per_cyl.coef.shape[0]
+        width = 0.8 * float(orders[1]) / z
+        for k in range(z):
+            plots.order_bars(axes[i], orders, per_cyl.amplitude[k], "cylinder torque [N m]",
+                             top, width=width, offset=(k - (z - 1) / 2) * width,
+                             label=f"cylinder {k + 1}")
+        axes[i].legend(fontsize=7, ncol=min(z, 6))
+        i += 1
     if rep is not None:
-        plots.order_bars(axes[i], orders, rep.relative[-1], "W / W₁ (cylinder 1)", top,
+        label = f"W / W₁ (cylinder {k_w})"
+        plots.order_bars(axes[i], orders, rep.relative[-1], label, top,
                          width=0.2, offset=-0.1, label="run", log=True)
-        plots.order_bars(axes[i], orders, rep.relative_constant[-1], "W / W₁ (cylinder 1)", top,
+        plots.order_bars(axes[i], orders, rep.relative_constant[-1], label, top,
                          width=0.2, offset=0.1, label="constant ω̄", log=True)
         axes[i].legend(fontsize=8)
     written.append(save(fig, out / f"{stem}_orders.png", args.force, res))
 
     if n_cyc >= 2:
         amp = spec_w.amplitude
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5))
-        # (at most 60 cycles, evenly spread: more lines would not be told apart)
-        pick = np.unique(np.linspace(0, n_cyc - 1, min(n_cyc, 60)).round().astype(int))
-        plots.order_waterfall(a1, means[pick] * rpm, orders, amp[pick], top)
-        a1.set_title(f"ω spectrum per cycle ({pick.size} of {n_cyc} cycles)", fontsize=9)
+        fig, (a1, a3, a2) = plt.subplots(1, 3, figsize=(19, 5.5))
+        plots.order_waterfall(a1, means * rpm, orders, amp, top, label="ω amplitude [rad/s]")
+        a1.set_title(f"ω spectrum per cycle ({n_cyc} cycles)", fontsize=9)
+        plots.campbell(a3, means * rpm, orders, amp, top, label="ω amplitude [rad/s]")
+        a3.set_title("Campbell chart of ω: orders over speed", fontsize=9)
         # the last cycle's strongest orders, in order of the order
         tracks = {f"order {orders[j]:g}": amp[:, j]
                   for j in sorted(strongest_orders(orders, amp[-1], top))}
@@ -136,8 +154,14 @@ def cmd_orders(args) -> int:
         print(f"  M_gas (mean {spec_m.mean[-1]:.6g} N m), strongest orders: " + ", ".join(
             f"{orders[j]:g}: {spec_m.amplitude[-1][j]:.4g} N m"
             for j in strongest_orders(orders, spec_m.amplitude[-1], top)))
+    if per_cyl is not None:
+        for k in range(per_cyl.coef.shape[0]):
+            print(f"  cylinder {k + 1} torque (mean {per_cyl.mean[k]:.6g} N m), strongest "
+                  f"orders: " + ", ".join(f"{orders[j]:g}: {per_cyl.amplitude[k][j]:.4g} N m"
+                                          for j in strongest_orders(orders, per_cyl.amplitude[k],
+                                                                    top, 4)))
     if rep is not None:
-        print(f"  piston acceleration W of cylinder 1, relative to its first order "
+        print(f"  piston acceleration W of cylinder {k_w}, relative to its first order "
               f"(|W₁| = {rep.first[-1]:.6g} m/s²), against the same engine at constant "
               f"ω̄ = {rep.omega_mean[-1]:.6g} rad/s:")
         print(f"  {'order':>6} {'|W| [m/s²]':>12} {'rel. run':>10} {'rel. ω̄':>10} "

@@ -1,6 +1,7 @@
 """``transient plot``: PNG figures of a result, or of several side by side."""
 from __future__ import annotations
 
+from ..errors import SceneError
 from .common import EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save
 
 
@@ -8,6 +9,12 @@ def register(sub) -> None:
     pl = sub.add_parser("plot", help="write PNG figures of a result, or compare several")
     pl.add_argument("result", nargs="+", help="one result, or several to compare side by side")
     pl.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
+    pl.add_argument("--cylinder", type=int, action="append", default=None, metavar="K",
+                    help="cylinder (1-based) of the run's indicator diagrams; repeat for "
+                         "several (default: all)")
+    pl.add_argument("--cycles", type=int, nargs="+", default=None, metavar="C",
+                    help="each cylinder's own whole cycles in those diagrams, counted from 0 "
+                         "or from the end with −1 the last (default: −1)")
     add_force(pl)
     pl.set_defaults(func=cmd_plot)
 
@@ -16,7 +23,9 @@ def cmd_plot(args) -> int:
     plt = pyplot()
 
     from .. import plots
-    from ..assemble import clearance_volume, gas_is_force, gas_table
+    import numpy as np
+
+    from ..assemble import gas_is_force, gas_table
 
     if len(args.result) > 1:
         return _plot_comparison(args)
@@ -25,6 +34,7 @@ def cmd_plot(args) -> int:
     out = output_folder(args.output, res.path.parent)
     stem = result_stem(res.path)
     traj = res.trajectory
+    held = _check_choices(args, scene, res)
     written = []
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     plots.speed(a1, traj)
@@ -53,21 +63,73 @@ def cmd_plot(args) -> int:
         ax.set_title(f"{scene.name}: FMEP per pair (η_mech = "
                      f"{res.analysis['eta_mech_work'][0]:.4f})")
         written.append(save(fig, out / f"{stem}_budget.png", args.force, res))
+    whole = _has_whole_cycle(scene, traj)
+    if whole:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        plots.speed_over_cycle(ax, traj, scene)
+        ax.set_title(f"{scene.name}: speed over the last cycle")
+        written.append(save(fig, out / f"{stem}_speed_cycle.png", args.force, res))
+        fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+        plots.inertia_and_gas((a1, a2), traj, scene.mechanism.cycle)
+        a1.set_title(f"{scene.name}: J(φ) and the inertia moment ½J′ω² beside the gas torque")
+        written.append(save(fig, out / f"{stem}_inertia.png", args.force, res))
+    if whole and scene.gas.model != "none":
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        plots.cylinder_torque_curves(ax, traj, scene)
+        ax.set_title(f"{scene.name}: each cylinder's gas torque over the last cycle")
+        written.append(save(fig, out / f"{stem}_cylinder_torques.png", args.force, res))
     table = gas_table(scene)
-    if table is not None and not gas_is_force(scene):
-        mech = scene.mechanism
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
-        plots.indicator_phi(a1, table)
-        if scene.gas.model in ("mixed-cycle", "wiebe"):
-            plots.indicator_pv(a2, table, mech.volume_function(clearance_volume(scene)))
-        else:  # a table gives no clearance volume: plot against the swept part F_p·s
-            plots.indicator_pv(a2, table, mech.volume_function(0.0), log=False)
+    if table is not None and not gas_is_force(scene) and held:
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8))
+        plots.run_indicator_phi(a1, traj, scene, args.cylinder, args.cycles or [-1],
+                                table=table)
+        # a gas table gives no clearance volume: V is then the swept part F_p·s
+        plots.run_indicator_pv(a2, traj, scene, args.cylinder, args.cycles or [-1],
+                               log=scene.gas.model != "table")
+        if scene.gas.model == "table":
             a2.set_xlabel("swept volume F_p·s [dm³]")
-        a1.set_title(f"{scene.name}: indicator diagram")
+        a1.set_title(f"{scene.name}: indicator diagrams of the run")
         written.append(save(fig, out / f"{stem}_indicator.png", args.force, res))
+    if scene.gas.model == "wiebe" and held:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        if plots.heat_release(ax, traj, scene, args.cylinder, args.cycles or [-1]):
+            ax.set_xlim(np.degrees(scene.gas.wiebe.start) - 20.0,
+                        np.degrees(scene.gas.wiebe.start + scene.gas.wiebe.duration) + 30.0)
+            ax.set_title(f"{scene.name}: apparent heat-release rate of the run")
+            written.append(save(fig, out / f"{stem}_heat_release.png", args.force, res))
+        else:
+            plt.close(fig)
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
+
+
+def _has_whole_cycle(scene, traj) -> bool:
+    from ..analysis.irregularity import cycle_boundaries
+
+    return cycle_boundaries(traj["t"], traj["phi"], scene.mechanism.cycle,
+                            scene.initial.phi)[1].size >= 2
+
+
+def _check_choices(args, scene, res) -> int:
+    """--cylinder and --cycles within what the result holds, before any figure is drawn; returns
+    how many whole cycles of their own the cylinders drawn hold (0: no indicator diagram)."""
+    from ..analysis.thermo import own_cycles
+
+    n = scene.mechanism.n_cylinders
+    for k in args.cylinder or ():
+        if not 1 <= k <= n:
+            raise SceneError("--cylinder", f"cylinder {k} is out of range; allowed: 1 … {n}",
+                             file=str(res.path))
+    held = min(own_cycles(scene, res.trajectory, k).size
+               for k in (args.cylinder or range(1, n + 1)))
+    if args.cycles is not None:  # (by default the last cycle, or none if there is none)
+        for c in args.cycles:
+            if not -held <= c < held:
+                raise SceneError("--cycles", f"cycle {c} is not held: the run has {held} whole "
+                                             f"cycle(s) of the cylinders drawn; allowed "
+                                             f"{-held} … {held - 1}", file=str(res.path))
+    return held
 
 
 def _plot_comparison(args) -> int:

@@ -139,6 +139,7 @@ def _print_summary(summary, solver, names=()) -> None:
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
     _print_response(v)
     _print_efficiency(v, names)
+    _print_thermodynamics(v)
     asked = [k for k, val in v.items() if np.ndim(val) > 0]
     if asked:
         print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
@@ -209,6 +210,23 @@ def _print_efficiency(v: dict, names=()) -> None:
         print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
 
 
+def _print_thermodynamics(v: dict) -> None:
+    """The last whole cycle's mean effective pressures and powers (``analysis.thermo``)."""
+    if "thermo_last_imep_engine" not in v:
+        return
+    print(f"  last cycle: IMEP {v['thermo_last_imep_engine'] / 1e5:.5g} bar, BMEP "
+          f"{v['thermo_last_bmep'] / 1e5:.5g} bar, FMEP {v['thermo_last_fmep'] / 1e5:.5g} bar; "
+          f"indicated {v['thermo_last_P_indicated_engine'] / 1e3:.5g} kW, brake "
+          f"{v['thermo_last_P_brake'] / 1e3:.5g} kW, friction "
+          f"{v['thermo_last_P_friction'] / 1e3:.5g} kW; peak pressure "
+          f"{v['thermo_last_p_max'] / 1e6:.5g} MPa")
+    # ∮p dV is a quadrature of the stored samples: how well it closes the energy balance says
+    # whether the output spacing is fine enough for the digits above
+    print(f"    IMEP − BMEP − FMEP closes the cycle's energy balance to "
+          f"{abs(v['thermo_last_balance_residual']):.1e} of the indicated work (finer "
+          f"[output] samples_per_rev make it smaller)")
+
+
 def cmd_info(args) -> int:
     res = read_result(args.result)
     a = res.attrs
@@ -233,6 +251,7 @@ def cmd_info(args) -> int:
     _print_response(values)
     # (the pairs' names are in the resolved scene, read only when there are pairs)
     _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())
+    _print_thermodynamics(values)
     arrays = []
     for k, (v, unit) in res.analysis.items():
         if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped

@@ -18,6 +18,8 @@ Adding a mechanism takes
 3. its loads analysis: a module of :mod:`transient.analysis` and its line in
    ``transient.analysis.requested.LOADS`` (without one, ``[analysis] loads = true`` is refused
    for it: the analyses sit above the mechanisms, so a mechanism cannot name them itself),
+   its pistons' travel in ``transient.analysis.pistons.KINEMATICS`` (cylinder volumes, piston
+   accelerations, each cylinder's torque),
    and, if ``transient loads`` is to draw its diagrams, a line in
    ``transient.cli.loads.DRAWERS``;
 4. one line in :data:`MECHANISMS` below.
@@ -57,8 +59,9 @@ class Mechanism(Protocol):
     #: ``transient.core.cylinder`` is built for the crank-slider's volume.
     wall_heat_transfer: ClassVar[bool]
     #: Whether every piston follows the crank-slider law s(φ − φ_k) of ``crank_radius``,
-    #: ``rod_length`` and ``offset``, from which the analyses derive the piston accelerations
-    #: W_k = ω²s″ + εs′ (the ``W_<k>`` signals of ``[analysis] orders``, the odd-harmonic report).
+    #: ``rod_length`` and ``offset`` (the odd-harmonic report then uses that closed form; other
+    #: pistons' s′, s″ come from ``transient.analysis.pistons``, which needs a line for a new
+    #: mechanism).
     slider_law: ClassVar[bool]
     #: 2 or 4: the gas cycle's length, ``cycle`` = π·strokes.
     strokes: int

@@ -105,12 +105,16 @@ def check_analysis(scene: Scene) -> None:
 
     a, mech = scene.analysis, scene.mechanism
     columns = list(output_columns(scene))
-    derived = ([f"W_{k + 1}" for k in range(mech.n_cylinders)] if mech.slider_law
-               else [])
+    # every mechanism's pistons have an acceleration (transient.analysis.pistons)
+    derived = [f"W_{k + 1}" for k in range(mech.n_cylinders)]
     for name in a.orders:
         if name not in columns + derived:
             raise SceneError("analysis.orders", f"unknown signal {show_value(name)}; allowed: "
                                                 f"{', '.join(columns + derived)}")
+    if a.thermodynamics and scene.gas.model in ("none", "trapezoid"):
+        raise SceneError("analysis.thermodynamics",
+                         f"gas model {show_value(scene.gas.model)} applies no cylinder pressure "
+                         f"(∮p dV needs one); allowed with it: false")
     if len(set(a.orders)) != len(a.orders):
         raise SceneError("analysis.orders", "a signal is named twice; name each once")
     nyquist = (a.samples_per_cycle // 2) * 2.0 * math.pi / mech.cycle

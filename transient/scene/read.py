@@ -472,6 +472,7 @@ def _read_run(s: Section) -> Run:
 def _read_analysis(s: Section) -> Analysis:
     return Analysis(loads=s.flag("loads", False), orders=s.strings("orders", ()),
                     irregularity=s.flag("irregularity", False),
+                    thermodynamics=s.flag("thermodynamics", False),
                     max_order=s.number("max_order", default=12.0, gt=0.0),
                     samples_per_cycle=s.integer("samples_per_cycle", 720, ge=16),
                     detrend=s.string("detrend", "auto", choices=DETREND))

@@ -366,24 +366,29 @@ class Analysis:
     ``loads``: forces, pin and journal loads and torques over the last cycle, as the mechanism's
     loads analysis gives them. ``orders``: signals whose order spectrum is stored per whole cycle
     — trajectory columns (``omega``, ``M_gas``, ``p_1`` …) or ``W_<k>``, the piston acceleration
-    of cylinder k (crank-slider). ``irregularity``: δ and the mean speed of every cycle.
+    of cylinder k (any mechanism). ``irregularity``: δ and the mean speed of every cycle.
     ``max_order`` [1/rev]: orders stored up to it. ``samples_per_cycle``: crank-angle grid per
     engine cycle.
     ``detrend``: what is done to ω before each cycle's DFT, as ``transient orders --detrend``:
     ``"auto"`` (the ramp for a spin-up, none otherwise), ``"ramp"`` or ``"none"``
     (:func:`transient.analysis.orders.order_spectrum`); other signals are not detrended.
+    ``thermodynamics``: per cylinder and
+    cycle the indicated work, IMEP, BMEP, FMEP, powers, peak pressures and, for Wiebe
+    combustion, the heat release and burned-fraction angles, from the pressure the run applied
+    (:mod:`transient.analysis.thermo`).
     """
 
     loads: bool = False
     orders: tuple[str, ...] = ()
     irregularity: bool = False
+    thermodynamics: bool = False
     max_order: float = 12.0
     samples_per_cycle: int = 720
     detrend: str = "auto"
 
     @property
     def requested(self) -> bool:
-        return self.loads or bool(self.orders) or self.irregularity
+        return self.loads or bool(self.orders) or self.irregularity or self.thermodynamics
 
 
 DETREND = ("auto", "ramp", "none")
