@@ -4,8 +4,9 @@ costs, function by function.
 A first run on a cold cache compiles the stepper and every kernel it calls (numba's on-disk
 cache, :mod:`transient.core`); later runs load them. :func:`warm_up` does that compile at a
 time the user chooses — at install, or on each node of a cluster before a sweep — by running
-built-in scenes for a fraction of a revolution, and the user's scenes too where given (their
-mechanisms' kinematics are small kernels of their own). Every scene shares one stepper
+built-in scenes for a fraction of a revolution, and the user's scenes too where given; other
+commands compile a few small kernels of their own on first use (the kinematics tables of
+``transient kinematics``, a loads analysis). Every scene shares one stepper
 (its Model's types do not depend on the features used), so one compile serves them all.
 
 :class:`CompileLog` listens to numba's ``numba:compile`` events, which fire for functions
