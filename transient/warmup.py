@@ -50,10 +50,26 @@ WARMUP_SCENE = {
 
 #: How long :func:`warm_up` runs each scene [revolutions].
 WARMUP_REVOLUTIONS = WARMUP_SCENE["run"]["revolutions"]
-#: The built-in scenes: :data:`WARMUP_SCENE`, and the same engine at a prescribed speed (the
-#: inverse dynamics are kernels of their own).
-WARMUP_SCENES = (WARMUP_SCENE, {**WARMUP_SCENE, "run": {
-    "mode": "prescribed-speed", "speed_rpm": 1000, "revolutions": WARMUP_REVOLUTIONS}})
+#: The built-in scenes: :data:`WARMUP_SCENE`; the same engine at a prescribed speed (the inverse
+#: dynamics are kernels of their own); and with Wiebe combustion, Woschni's heat transfer and a
+#: flyweight governor (Gots §3; the cylinder and governor states start from Python-side calls of
+#: the kernels).
+WARMUP_SCENES = (
+    WARMUP_SCENE,
+    {**WARMUP_SCENE, "run": {"mode": "prescribed-speed", "speed_rpm": 1000,
+                             "revolutions": WARMUP_REVOLUTIONS}},
+    {**WARMUP_SCENE,
+     "gas": {"model": "wiebe", "p0_MPa": 0.1, "compression_ratio": 18, "p_a_MPa": 0.1436,
+             "p_intake_MPa": 0.165, "p_exhaust_MPa": 0.182, "injection_deg": 340,
+             "wiebe": {"start_deg": 358, "duration_deg": 50, "a": 6.908, "m": 0.5,
+                       "fuel_mass": 0.031e-3, "lhv": 42.5e6, "efficiency": 1.0,
+                       "gamma": 1.368, "gamma_slope": 0.0, "t_a": 329.9},
+             "woschni": {"c1": 2.28, "c2": 3.24e-3, "wall_temperature": 450}},
+     "governor": {"model": "flyweight", "weights": 2, "weight_mass": 0.1, "radius_mm": 30,
+                  "arm_ratio": 1.0, "gear_ratio": 0.5, "sleeve_mass": 0.2,
+                  "spring_rate": 23.8e3, "spring_preload": 213.0, "damping": 72.0,
+                  "travel_mm": 8}},
+)
 
 
 @dataclass(frozen=True)

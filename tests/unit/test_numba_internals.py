@@ -475,8 +475,13 @@ spec.loader.exec_module(module)
 from transient.core.jit import _symbol_prefix
 t = (np.arange(3.0), 0.5)
 if sys.argv[2] == "callees":  # compiled and cached, as the compile helper does
-    print(module.scaled(t, 1.0))
-    module.offset(t, 1.0)
+    from numba import float64, typeof
+    module.scaled.compile((typeof(t), float64))
+    module.offset.compile((typeof(t), float64))
+    print(module.scaled(t, 1.0))  # (from Python: the Python entry, compiled apart)
+elif sys.argv[2] == "python":
+    print(module.scaled(t, 1.0), sum(module.scaled.python_entry.stats.cache_hits.values()),
+          sum(module.scaled.stats.cache_hits.values()))
 else:
     assert module.caller(t, 2.0) == (2.0 + 0.5) + (4.0 + 0.5) + module.offset.py_func(t, 2.0)
     ir = module.caller.inspect_llvm(module.caller.signatures[0])
@@ -490,7 +495,8 @@ else:
 def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cache(tmp_path):
     """``kernel(inline=True)``: no call to it is left in a caller's optimized code, whether the
     callee was compiled with the caller or loaded from numba's cache (where the compile helper
-    saved it); a plain kernel stays a call, which shows the check sees calls."""
+    saved it); a plain kernel stays a call, which shows the check sees calls. Called from
+    Python, it runs its Python entry, compiled and cached apart from the kernel."""
     source = tmp_path / "kern.py"
     source.write_text(INLINE_KERNELS)
 
@@ -503,6 +509,7 @@ def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cac
 
     assert probe("together", "caller") == ["False", "True", "0"]  # inlined, a call, compiled
     assert probe("apart", "callees") == ["1.5"]
+    assert probe("apart", "python") == ["1.5", "1", "0"]  # the Python entry, loaded
     assert probe("apart", "caller") == ["False", "True", "1"]  # the same, loaded
 
 

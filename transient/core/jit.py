@@ -33,6 +33,7 @@ from numba.core.caching import CompileResultCacheImpl, FunctionCache, UserProvid
 from numba.core.codegen import CPUCodeLibrary
 from numba.core.itanium_mangler import mangle_identifier
 from numba.core.compiler_lock import global_compiler_lock
+from numba.core.registry import CPUDispatcher
 from numba.core.runtime import rtsys
 
 #: The numba release whose internals the replacements were checked against.
@@ -101,18 +102,52 @@ class _RegistryFreeCache(FunctionCache):
             return self._load_overload(sig, target_context)
 
 
-def compiled(fn=None, **options):
+class _PythonEntryCacheImpl(_SharedCacheImpl):
+    """The cache files of a kernel's Python entry (:class:`_CalledFromCompiledCode`), named
+    apart from the kernel's own: numba's index keys an entry by its signature and CPU, not by
+    whether it has numba's Python wrappers."""
+
+    def get_filename_base(self, fullname, abiflags):
+        return super().get_filename_base(f"{fullname}-python", abiflags)
+
+
+class _PythonEntryCache(_RegistryFreeCache):
+    _impl_class = _PythonEntryCacheImpl
+
+
+def compiled(fn=None, *, _cache=_RegistryFreeCache, **options):
     """``@compiled`` or ``@compiled(nogil=True)``: njit, cached (:class:`_RegistryFreeCache`)."""
     if fn is None:
-        return lambda f: compiled(f, **options)
+        return lambda f: compiled(f, _cache=_cache, **options)
     if not REPLACEMENTS_ON:
         return njit(fn, cache=True, **options)
     dispatcher = njit(fn, **options)
     if not config.DISABLE_JIT:  # (then njit returns fn itself)
-        dispatcher._cache = _RegistryFreeCache(dispatcher.py_func)  # (what cache=True sets)
+        dispatcher._cache = _cache(dispatcher.py_func)  # (what cache=True sets)
         _compile_per_type(dispatcher)
         _compile_once_across_processes(dispatcher)
     return dispatcher
+
+
+class _CalledFromCompiledCode(CPUDispatcher):
+    """A kernel compiled without numba's Python wrappers (``no_cpython_wrapper``,
+    ``no_cfunc_wrapper``), for the calls from compiled code: each wrapper unboxes every field of
+    its arguments — the Model's dozens — and was a large part of compiling a small kernel that
+    compiled code alone calls. A call from Python goes to :attr:`python_entry`, the same function
+    compiled with the wrappers (and cached apart), made on the first such call."""
+
+    def __call__(self, *args, **kwargs):
+        return self.python_entry(*args, **kwargs)
+
+    @property
+    def python_entry(self):
+        entry = self.__dict__.get("_python_entry")
+        if entry is None:
+            options = {k: v for k, v in self.targetoptions.items()
+                       if k not in ("no_cpython_wrapper", "no_cfunc_wrapper", "nopython")}
+            entry = self.__dict__["_python_entry"] = compiled(
+                self.py_func, _cache=_PythonEntryCache, **options)
+        return entry
 
 
 def _compile_once_across_processes(dispatcher):
@@ -203,16 +238,21 @@ def kernel(fn=None, *, inline=False, **options):
     Model tuple's ~150 words would be copied onto the stack at every call. With ``inline=True``
     LLVM inlines the kernel at every call site (:func:`_inlined_by_llvm`), where the copy
     vanishes: the machine code is that of one function, while numba types and lowers each
-    kernel once. numba's own inlining (``inline="always"``) copies the callee's IR into every
+    kernel once, without the Python wrappers (:class:`_CalledFromCompiledCode`). numba's own
+    inlining (``inline="always"``) copies the callee's IR into every
     caller before typing it, which made the cold compile grow with the nesting of calls."""
     if fn is None:
         return lambda f: kernel(f, inline=inline, **options)
-    if inline:
-        if REPLACEMENTS_ON:
-            _INLINED_BY_LLVM.add(_symbol_prefix(fn))
-        else:  # (numba's inliner: the same machine code, a slower compile)
-            options["inline"] = "always"
-    return compiled(fn, _nrt=False, **options)
+    if not inline:
+        return compiled(fn, _nrt=False, **options)
+    if not REPLACEMENTS_ON:  # (numba's inliner: the same machine code, a slower compile)
+        return compiled(fn, _nrt=False, inline="always", **options)
+    _INLINED_BY_LLVM.add(_symbol_prefix(fn))
+    dispatcher = compiled(fn, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+                          **options)
+    if not config.DISABLE_JIT:
+        dispatcher.__class__ = _CalledFromCompiledCode
+    return dispatcher
 
 
 #: The symbol prefixes of the kernels that LLVM inlines at their call sites.
