@@ -21,8 +21,8 @@ EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
 
 #: The progress bar's words until a compiled run's first block (``run``) or a sweep's first
 #: finished run (``sweep``): the kernels load from numba's cache, or, on a first run (an empty
-#: cache), compile, which takes minutes; so a first run does not look hung.
-KERNELS_NOTICE = "loading the kernels; a first run compiles them, minutes"
+#: cache), compile, which takes a while; so a first run does not look hung.
+KERNELS_NOTICE = "loading the kernels; a first run compiles them (transient warmup: ahead)"
 
 
 #: Most points of a grid over one cycle an option may ask for, as many as a scene may write per
