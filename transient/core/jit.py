@@ -1,12 +1,14 @@
 """The compile decorators of transient's numba functions.
 
-``compiled`` is ``numba.njit`` with numba's on-disk cache and five replacements of numba
-internals, each for its gain: the cache loads without numba's compiler registries
+``compiled`` is ``numba.njit`` with numba's on-disk cache and replacements of numba internals,
+each for its gain: the cache loads without numba's compiler registries
 (:class:`_RegistryFreeCache`) from a folder that copies of the sources at other paths share
 (:class:`_SharedLocator`), constants passed between kernels share one compile
-(:func:`_compile_per_type`), processes compiling the same function take turns
-(:func:`_compile_once_across_processes`), and LLVM inlines the kernels marked so
-(:func:`_inlined_by_llvm`). ``kernel`` is ``compiled`` without numba's reference counting
+(:func:`_compile_per_type`), and processes compiling the same function take turns
+(:func:`_compile_once_across_processes`). ``kernel(inline=True)`` adds two: LLVM inlines the
+kernel at its call sites (:func:`_inlined_by_llvm`), and it is compiled without numba's Python
+wrappers, a twin with them serving calls from Python (:class:`_CalledFromCompiledCode`).
+``kernel`` is ``compiled`` without numba's reference counting
 (``_nrt=False``), because with it every call that passes arrays — the
 :data:`transient.core.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
 an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
@@ -80,8 +82,6 @@ class _SharedCacheImpl(CompileResultCacheImpl):
 
 
 class _RegistryFreeCache(FunctionCache):
-    _impl_class = _SharedCacheImpl
-
     """numba's on-disk cache of a function, in the folder :class:`_SharedLocator` names, loading
     its machine code without first loading numba's compiler registries.
 
@@ -93,6 +93,8 @@ class _RegistryFreeCache(FunctionCache):
     which the allocating functions call, and the hash secrets that numba's hashing code reads as
     symbols. A function that is not in the cache is compiled as usual, and numba's compiler
     loads the registries itself (``CompilerBase.__init__``)."""
+
+    _impl_class = _SharedCacheImpl
 
     def load_overload(self, sig, target_context):
         from numba.cpython import hashing  # noqa: F401 (its import registers the hash secrets)
@@ -239,8 +241,8 @@ def kernel(fn=None, *, inline=False, **options):
     LLVM inlines the kernel at every call site (:func:`_inlined_by_llvm`), where the copy
     vanishes: the machine code is that of one function, while numba types and lowers each
     kernel once, without the Python wrappers (:class:`_CalledFromCompiledCode`). numba's own
-    inlining (``inline="always"``) copies the callee's IR into every
-    caller before typing it, which made the cold compile grow with the nesting of calls."""
+    inlining (``inline="always"``) copies the callee's IR into every caller before typing it,
+    which made the cold compile grow with the nesting of calls."""
     if fn is None:
         return lambda f: kernel(f, inline=inline, **options)
     if not inline:
