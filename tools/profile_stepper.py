@@ -14,7 +14,7 @@ Needs ``perf`` and binutils (``nm``, ``objdump``). Run (warm cache)::
 
     perf record -o /tmp/perf.data .venv/bin/python tools/profile_stepper.py run \
         gots_diesel_governed [REPEATS [SAMPLES_PER_TURN]]
-    .venv/bin/python tools/profile_stepper.py report [--calls _advance]
+    .venv/bin/python tools/profile_stepper.py report [--calls advance]
 """
 from __future__ import annotations
 
@@ -79,7 +79,7 @@ def run(name: str, repeats: int = 20, samples_per_rev: int = 1) -> None:
 
 
 def _short(mangled: str) -> str:
-    """``transient.core.stepper._advance`` from numba's mangled name."""
+    """``transient.core.stepper.advance`` from numba's mangled name."""
     parts, i = [], mangled.find("_ZN") + 3
     while i < len(mangled) and mangled[i].isdigit():
         j = i
