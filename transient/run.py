@@ -16,6 +16,7 @@ from typing import Callable
 import numpy as np
 
 from .assemble import build_model, initial_governor
+from .forces.load_table import interpolant
 from .core import forcing, layout, stepper
 from .core import stepper_io as sio
 from .core.inverse import inverse_dynamics
@@ -289,14 +290,15 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     phi0 = scene.initial.phi
     dphi = 2.0 * math.pi / scene.output.samples_per_rev
     if run.time:
-        from scipy.interpolate import CubicSpline
-
-        spline = CubicSpline(run.time, run.speed_table)
-        angle = spline.antiderivative()
+        # ω(t) as the scene interpolates it (linear or monotone cubic: neither overshoots the
+        # table's speeds); φ its exact integral, ε its derivative (at a corner of a linear
+        # table, the slope after it)
+        speed = interpolant(run.time, run.speed_table, run.interpolation)
+        angle = speed.antiderivative()
         t_end = min(run.t_end, run.time[-1])
         n = int(math.ceil((angle(t_end) - angle(run.time[0])) / dphi)) + 1
         t = np.linspace(run.time[0], t_end, max(n, 2))
-        omega, eps, phi = spline(t), spline(t, 1), phi0 + angle(t) - angle(run.time[0])
+        omega, eps, phi = speed(t), speed(t, 1), phi0 + angle(t) - angle(run.time[0])
         stop = phi <= phi0 + 2 * math.pi * run.revolutions
         t, omega, eps, phi = t[stop], omega[stop], eps[stop], phi[stop]
     else:

@@ -51,6 +51,10 @@ N_SWITCHES = 7
 #: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
 CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
 
+#: Abscissae of a tabulated load (``Model.lt_kind``; :func:`.forcing.table_load`): none, the
+#: speed ω, the shaft angle φ in its cycle, the time t.
+LT_NONE, LT_SPEED, LT_ANGLE, LT_TIME = 0, 1, 2, 3
+
 #: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
 POWER_FLOW, PAPER = 0, 1
 
@@ -105,6 +109,9 @@ Model = namedtuple(
         "load_x",  # float64[:]: corners of the load schedule, non-decreasing (empty: s ≡ 1)
         "load_s",  # float64[:]: the load's scale s at each corner (piecewise linear between)
         "load_comp",  # int: state component the corners are values of, T [s] or PHI [rad]
+        "lt_kind",  # int: the tabulated load's abscissa, LT_NONE, LT_SPEED, LT_ANGLE or LT_TIME
+        "lt_x",  # float64[n + 1]: its knots, increasing [rad/s, rad or s]
+        "lt_coef",  # float64[n, 4]: its cubic per knot interval, ascending powers [N m]
         "gen_power",  # float: generator power P in −s·P/max(ω, ω_min) [W] (0: none)
         "gen_min",  # float: ω_min, below it the generator's torque is held at −s·P/ω_min [rad/s]
         "starter_torque",  # float: starter stall torque [N m]
