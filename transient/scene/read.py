@@ -272,10 +272,9 @@ def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
         found = {what: next((c for c in header if c in columns), None)
                  for what, columns in groups.items()}
         if None in found.values():
-            needs = " and ".join(f"{what} column ({', '.join(columns)})"
-                                 for what, columns in groups.items())
-            raise SceneError("(line)", f"needs {'an' if needs[0] in 'aeiou' else 'a'} {needs}; "
-                                       f"header is {show_value(header)}")
+            needs = " and ".join(f"{'an' if what[0] in 'aeiou' else 'a'} {what} column "
+                                 f"({', '.join(columns)})" for what, columns in groups.items())
+            raise SceneError("(line)", f"needs {needs}; header is {show_value(header)}")
         out = [(c, _table_column(rows[1:], header.index(c), c, groups[what][c]))
                for what, c in found.items()]
     except SceneError as exc:  # (placed here: the message names the table, the key the scene's)
@@ -442,6 +441,9 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
         where = f"{file}: column {column}"
     else:
         given = [n for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items() if s.has(n, kind)]
+        if not given:  # (a key with a unit suffix its quantity does not take is named first)
+            for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items():
+                s.numbers(n, kind, ())
         if len(given) != 1:
             names = ", ".join(repr(n) for n in LOAD_TABLE_ABSCISSAE)
             what = "none" if not given else " and ".join(repr(n) for n in given)
