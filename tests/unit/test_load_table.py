@@ -50,24 +50,25 @@ def test_inline_tables_are_read_in_si(tmp_path):
     speed = scene_of(tmp_path, with_load(
         "[load.table]\nspeed_rpm = [0, 1000, 2000]\ntorque = [0, 5, 20]\n"
         "interpolation = \"pchip\"")).load.table
-    assert speed == LoadTable("speed", (0.0, 1000 * RPM, 2000 * RPM), (0.0, 5.0, 20.0), "pchip")
+    assert speed == LoadTable((0.0, 5.0, 20.0), speed=(0.0, 1000 * RPM, 2000 * RPM),
+                              interpolation="pchip")
     angle = scene_of(tmp_path, with_load(
         "[load.table]\nphi_deg = [0, 360, 720]\ntorque = [1, -1, 1]")).load.table
     # (a point at the cycle's end repeating the one at 0 is dropped: the curve is periodic)
-    assert angle == LoadTable("angle", (0.0, 2.0 * math.pi), (1.0, -1.0), "linear")
+    assert angle == LoadTable((1.0, -1.0), phi=(0.0, 2.0 * math.pi))
     trace = scene_of(tmp_path, with_load("[load.table]\ntime = [0, 0.1]\ntorque = [2, 3]")).load
-    assert trace.table == LoadTable("time", (0.0, 0.1), (2.0, 3.0), "linear")
+    assert trace.table == LoadTable((2.0, 3.0), time=(0.0, 0.1))
 
 
 def test_csv_table_is_read_in_si(tmp_path):
     (tmp_path / "fan.csv").write_text("# a fan map\nspeed_rpm,torque\n0,0\n1000,5\n2000,20\n",
                                       encoding="utf-8")
     table = scene_of(tmp_path, with_load("[load.table]\nfile = \"fan.csv\"")).load.table
-    assert table == LoadTable("speed", (0.0, 1000 * RPM, 2000 * RPM), (0.0, 5.0, 20.0))
+    assert table == LoadTable((0.0, 5.0, 20.0), speed=(0.0, 1000 * RPM, 2000 * RPM))
     (tmp_path / "valve.csv").write_text("phi_deg,torque\n0,1\n180,2\n", encoding="utf-8")
     table = scene_of(tmp_path, with_load("[load.table]\nfile = \"valve.csv\"\n"
                                          "interpolation = \"pchip\"")).load.table
-    assert table == LoadTable("angle", (0.0, math.pi), (1.0, 2.0), "pchip")
+    assert table == LoadTable((1.0, 2.0), phi=(0.0, math.pi), interpolation="pchip")
 
 
 @pytest.mark.parametrize("lines", [

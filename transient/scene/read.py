@@ -405,6 +405,7 @@ def _read_load(s: Section, base_dir: Path, cycle: float) -> Load:
     extra = s.number("inertia", default=0.0, ge=0.0)
     at = s.number("inertia_time", default=MISSING if extra > 0.0 else 0.0, gt=0.0)
     table = None
+    s.known.append("table")
     if s.has("table"):
         st = s.sub("table")
         table = _read_load_table(st, base_dir, cycle)
@@ -423,7 +424,6 @@ LOAD_TABLE_ABSCISSAE = {
     "phi": ("angle", {"phi": 1.0, "phi_deg": math.pi / 180.0}),
     "time": (None, {"time": 1.0}),
 }
-LOAD_TABLE_KIND = {"speed": "speed", "phi": "angle", "time": "time"}
 
 
 def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
@@ -471,7 +471,7 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
             1.0, *map(abs, x)):
         raise SceneError(key, f"{where}: two times closer than {SCHEDULE_MIN_GAP:g} (relative); "
                               f"each is a corner the stepper stops on, give them further apart")
-    return LoadTable(LOAD_TABLE_KIND[name], tuple(x), tuple(torque), interpolation)
+    return LoadTable(tuple(torque), interpolation=interpolation, **{name: tuple(x)})
 
 
 def _one_cycle(key: str, where: str, x, torque, cycle: float):

@@ -135,22 +135,36 @@ class Gas:
 
 @dataclass(frozen=True)
 class LoadTable:
-    """A load from data, the ``[load.table]`` table: the resisting torque T(x) [N m] at the
-    points ``x`` of its ``abscissa``, signed as ``[load] torque`` (> 0 resists the rotation,
-    < 0 drives it), interpolated by ``interpolation`` (:mod:`transient.forces.load_table`).
+    """A load from data, the ``[load.table]`` table: the resisting torque T(x) ``torque`` [N m]
+    at the points of one abscissa, signed as ``[load] torque`` (> 0 resists the rotation, < 0
+    drives it), interpolated by ``interpolation`` (:mod:`transient.forces.load_table`).
 
-    ``abscissa``: ``"speed"`` (x the shaft speed ω [rad/s]: a generator's, propeller's or
-    fan's map), ``"angle"`` (x the shaft angle in the engine cycle [rad], from 0 to the cycle's
-    length, 720° for a 4-stroke: a valve train's or an accessory's torque; periodic) or
-    ``"time"`` (x the time [s]: a measured trace). Outside the speeds or times of the table its
-    end values hold. ``x`` increases strictly; ``interpolation`` ``"linear"`` or ``"pchip"``
-    (monotone cubic, no overshoot).
+    The abscissa is one of ``speed`` (the shaft speed ω [rad/s]: a generator's, propeller's or
+    fan's map), ``phi`` (the shaft angle in the engine cycle [rad], from 0 to the cycle's
+    length, 720° for a 4-stroke: a valve train's or an accessory's torque; periodic) or ``time``
+    [s] (a measured trace); the others are empty. Outside the speeds or times of the table its
+    end values hold. The abscissae increase strictly; ``interpolation`` ``"linear"`` or
+    ``"pchip"`` (monotone cubic, no overshoot). Inline, or from a CSV ``file`` next to the scene
+    with a column of the abscissa (``speed``, ``speed_rpm``, ``phi``, ``phi_deg``, ``time``) and
+    one ``torque``.
     """
 
-    abscissa: str
-    x: tuple[float, ...]
     torque: tuple[float, ...]
+    speed: tuple[float, ...] = ()
+    phi: tuple[float, ...] = ()
+    time: tuple[float, ...] = ()
     interpolation: str = "linear"
+
+    @property
+    def abscissa(self) -> str:
+        """``"speed"``, ``"angle"`` or ``"time"``
+        (:data:`transient.forces.load_table.ABSCISSAE`)."""
+        return "speed" if self.speed else "angle" if self.phi else "time"
+
+    @property
+    def x(self) -> tuple[float, ...]:
+        """The points of the abscissa, in SI."""
+        return self.speed or self.phi or self.time
 
 
 @dataclass(frozen=True)

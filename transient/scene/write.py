@@ -78,7 +78,7 @@ def _load_section(load: Load) -> list[str]:
                   "schedule_scale"]
     lines = ["", "[load]"] + [f"{k} = {toml_value(getattr(load, k))}" for k in names]
     if load.table is not None:  # (a table from a file is written inline: the scene stands alone)
-        key = {"speed": "speed", "angle": "phi", "time": "time"}[load.table.abscissa]
+        key = next(k for k in ("speed", "phi", "time") if getattr(load.table, k))
         lines += ["", "[load.table]", f"{key} = {toml_value(list(load.table.x))}",
                   f"torque = {toml_value(list(load.table.torque))}",
                   f"interpolation = {toml_value(load.table.interpolation)}"]
