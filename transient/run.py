@@ -239,7 +239,7 @@ def switch_inertia(model, extra: float, y, ist):
     J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the energy lost, ½Jω₋² − ½(J + J_x)ω₊², is taken
     from ``W_load``, so that the work–energy balance still closes. Updates the state ``y`` and
     the switches that depend on the speed, which jumped across their levels without an event
-    (the governor's branch, the generator's); returns the model with the extra inertia on the
+    (the governor's branch, the generator's, the speed map's interval); returns the model with the extra inertia on the
     shaft (``J0``)."""
     angle_mode = ist[sio.I_ANGLE_MODE] == 1
     J = forcing.inertia(model, y[layout.PHI], layout.work_array(model))
@@ -252,6 +252,7 @@ def switch_inertia(model, extra: float, y, ist):
         y[layout.OMEGA] = w_new
     ist[sio.I_GOV_BRANCH] = forcing.start_branch(model, w_new, y)
     ist[sio.I_GEN_LOW] = forcing.generator_branch(model, w_new, True)
+    ist[sio.I_LOAD_TABLE] = forcing.speed_knot_segment(model, w_new, True)
     ist[sio.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
     return model._replace(J0=model.J0 + extra)
 

@@ -25,7 +25,8 @@ from scene_texts import SMALL
 from transient.assemble import build_model, load_table_curve
 from transient.cli import main
 from transient.core import forcing
-from transient.core.layout import LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI, T, work_array
+from transient.core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI, SW_LOAD_TABLE,
+                                   T, work_array)
 from transient.forces.load_table import LoadCurve, interpolant, load_curve
 from transient.scene import LoadTable, load_scene, to_toml
 
@@ -299,5 +300,6 @@ def test_kernel_equals_numpy_twin(tmp_path, table, kind, interpolation):
         assert abs(got - expect) <= 1e-12 * max(1.0, abs(expect)), (x, got, expect)
         # M_load of the model in time mode (y[2] = ω): −(torque + T(x)), no schedule
         y[2] = w
+        sw[SW_LOAD_TABLE] = forcing.speed_knot_segment(model, w, True)
         M_load = forcing.moments(model, False, y, y[PHI], sw, wk, True)[4]
         assert abs(M_load + 0.5 + expect) <= 1e-12 * max(1.0, abs(expect))

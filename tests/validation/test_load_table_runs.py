@@ -5,7 +5,8 @@ work is the load's: the work–energy balance ½J(φ)ω²|end − ½J(φ₀)ω�
 solver's accuracy, and W_load (integrated with the motion) agrees with a quadrature of
 M_load·ω over the samples.
 
-* **Fan law from a table** (M(ω) = −Kω², tabulated every Δω): linear interpolation is within
+* **Fan law from a table** (M(ω) = −Kω², tabulated every Δω, from a speed on a knot): the steps
+  end on the knots the speed crosses (``load_table_speed`` events); linear interpolation is within
   Δω²/8·max|f″| = KΔω²/4 of Kω² (de Boor, ch. II (2.5)); the monotone cubic's error is bounded by
   the Hermite form with the curve's own knot slopes, Σ over the interval's ends of
   (4Δω/27)·|slope error| (f⁗ = 0 for a quadratic), computed from the table here.
@@ -65,9 +66,15 @@ def test_fan_law_from_a_table(interpolation):
     w_knots = np.arange(0.0, 1200.0 * RPM + dw / 2, dw)
     scene = coasting({"table": {"speed": list(w_knots), "torque": list(K * w_knots ** 2),
                                 "interpolation": interpolation}})
-    tr = finished(scene).trajectory
+    data = finished(scene)
+    tr = data.trajectory
     w = tr["omega"]
     assert w[-1] < 0.9 * w[0]  # the load slowed the shaft down
+    # the steps end on the knots the speed crosses (state events; the start is on a knot)
+    ev = data.events["load_table_speed"]
+    w_at = np.interp(ev[:, 1], tr["phi"], w)
+    assert len(ev) >= 4 and w_at.min() < 800.5 * RPM
+    assert np.all(np.min(np.abs(np.subtract.outer(w_at, w_knots)), axis=1) <= 1e-3 * dw)
     curve = load_table_curve(scene)
     # the applied load is the table's curve, to rounding
     np.testing.assert_allclose(-tr["M_load"], curve.evaluate(w), rtol=1e-12, atol=1e-14)
@@ -139,3 +146,42 @@ def test_prescribed_speed_with_a_corner_does_not_overshoot(interpolation):
         at = np.argmin(np.abs(t - 0.1))
         ramp = 1000.0 * RPM * t[at] + 0.5 * (2000.0 * RPM / 0.1) * t[at] ** 2
         assert abs(phi[at] - phi[0] - ramp) <= 1e-9 * ramp, (phi[at], ramp)
+
+
+TABLES = {
+    "speed-pchip": {"speed_rpm": [0, 400, 800, 1200], "torque": [0.0, 0.4, 1.5, 3.2],
+                    "interpolation": "pchip"},
+    "angle-linear": {"phi_deg": [0, 90, 250, 400, 600], "torque": [1.0, 2.5, -0.5, 1.5, 0.2]},
+    "time-linear": {"time": [0.0, 0.03, 0.06, 0.1], "torque": [0.5, 2.0, 1.0, 3.0]},
+}
+
+
+@pytest.mark.parametrize("name", list(TABLES))
+def test_compiled_agrees_with_reference(name):
+    """The compiled path against the reference path (numpy model with the curve's numpy twin,
+    solve_ivp DOP853 with max_step 0.5°; angle knots are its segment ends, time knots its terminal
+    events, speed knots only bounded by the small steps), final state
+    e = (y − y_ref)/(atol + rtol·|y_ref|) ≤ 100 as ``test_reference_path.py``."""
+    tol = {"rtol": 1e-10, "atol": 1e-10}
+    comp = coasting({"table": TABLES[name]}, revolutions=5)
+    comp = comp.replace(solver=tol)
+    ref = comp.replace(solver={**tol, "method": "scipy-DOP853", "max_step_deg": 0.5})
+    c, r = finished(comp).trajectory, finished(ref).trajectory
+    assert c["phi"][-1] == pytest.approx(r["phi"][-1], rel=1e-15)
+    for key in ("t", "omega"):
+        e = (c[key][-1] - r[key][-1]) / (1e-10 + 1e-10 * abs(r[key][-1]))
+        print(f"{name}: final e({key}) = {e:.3g}")
+        assert abs(e) <= 100.0, (key, e)
+    assert r["omega"][-1] < 0.99 * r["omega"][0]  # (the load did work)
+
+
+def test_prescribed_speed_applies_the_table():
+    """Inverse dynamics at a prescribed speed: M_load = −T(ω) at every sample."""
+    base = load_scene(CASES / "coasting_single.toml")
+    scene = base.replace(run={"mode": "prescribed-speed", "time": [0.0, 0.2],
+                              "speed_table_rpm": [300, 1500], "revolutions": 1000},
+                         load={"table": TABLES["speed-pchip"]}, initial={"omega": 0.0})
+    tr = prescribed(scene).trajectory
+    curve = load_table_curve(scene)
+    np.testing.assert_allclose(tr["M_load"], -curve.evaluate(tr["omega"]), rtol=1e-13,
+                               atol=1e-15)

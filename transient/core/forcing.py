@@ -251,13 +251,32 @@ def load_scale(m, y, seg):
     return s0 + (m.load_s[seg] - s0) * (y[m.load_comp] - x0) / (m.load_x[seg] - x0)
 
 
+@kernel
+def speed_knot_segment(m, w, rising):
+    """Interval of a tabulated load against speed (``m.lt_kind`` = LT_SPEED) at the speed w: the
+    number of its knots below w, on a knot the interval the motion enters (``rising``: ω
+    increasing), as :func:`load_segment` counts a schedule's corners; 0 for other loads."""
+    if m.lt_kind != LT_SPEED:
+        return 0
+    j = 0
+    n = m.lt_x.shape[0]
+    while j < n and (m.lt_x[j] < w or (m.lt_x[j] == w and rising)):
+        j += 1
+    return j
+
+
 @kernel(inline=True)
 def table_load(m, w, y):
     """The tabulated load's resisting torque [N m] (``m.lt_kind`` ≠ LT_NONE): the curve at the
     speed ω, at the shaft angle in its cycle (the knots span one period from a negative first
-    one, :func:`transient.forces.load_table.load_curve`), or at the time t. The angle and time
-    curves' knots are breakpoints or load corners, so no step integrates across one; a speed
-    curve's knots are levels of ω that the step-size control handles."""
+    one, :func:`transient.forces.load_table.load_curve`), or at the time t; below the first knot
+    and above the last the end values hold.
+
+    Steps end on the knots, where the curve kinks (linear) or its curvature jumps (pchip): the
+    angle curve's knots are breakpoints, the time curve's load corners, the speed curve's levels
+    of ω (state events, watched from the interval :func:`speed_knot_segment`). The value is
+    always the curve's at x, found by bisection, so that a knot the event search passes over
+    costs accuracy in that step only, never a value off the curve."""
     if m.lt_kind == LT_SPEED:
         x = w
     elif m.lt_kind == LT_ANGLE:

@@ -43,10 +43,12 @@ W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 #: (bit k set: pair k backward, its far side drives), the direction of motion σ = ±1 that the
 #: pair modes refer to (sign of ω; changed only at a speed reversal, where the modes are chosen
 #: afresh), the segment of the load schedule (:func:`.forcing.load_segment`) and the generator's
-#: low-speed branch (:func:`.forcing.generator_branch`), and the flyweight governor's sleeve,
-#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``).
-SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE = range(7)
-N_SWITCHES = 7
+#: low-speed branch (:func:`.forcing.generator_branch`), the flyweight governor's sleeve,
+#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``), and the interval of
+#: a tabulated load against speed (:func:`.forcing.speed_knot_segment`).
+(SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE,
+ SW_LOAD_TABLE) = range(8)
+N_SWITCHES = 8
 
 #: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
 CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
