@@ -136,7 +136,7 @@ def test_invalid_table_is_one_line_exit_2(tmp_path, capsys, lines, key, fragment
 
 
 CSV_ERRORS = [
-    ("speed_rpm,torque\n0,0\n1000,5\n900,20\n", "fan.csv: column speed_rpm must increase"),
+    ("speed_rpm,torque\n0,0\n1000,5\n900,20\n", "fan.csv, column speed_rpm: must increase"),
     ("speed_rpm,moment\n0,0\n1000,5\n", "needs an abscissa column (speed, speed_rpm, phi, "
                                         "phi_deg, time) and a torque column (torque)"),
     ("speed_rpm,torque\n0,0\n1000,inf\n", "line 3, column torque: 'inf' is not finite"),

@@ -438,7 +438,7 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
                                                            "torque": {"torque": 1.0}})
         key = s.key("file")
         name = next(n for n, (_, cols) in LOAD_TABLE_ABSCISSAE.items() if column in cols)
-        where = f"{file}: column {column}"
+        where = f"{file}, column {column}: "
     else:
         given = [n for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items() if s.has(n, kind)]
         if not given:  # (a key with a unit suffix its quantity does not take is named first)
@@ -454,22 +454,22 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
         x = s.numbers(name, LOAD_TABLE_ABSCISSAE[name][0])
         torque = s.numbers("torque")
         key = s.key(s.written.get(name, name))
-        where = key
+        where = ""
         if len(torque) != len(x):
-            raise SceneError(s.key("torque"), f"needs one value per entry of {where}; got "
+            raise SceneError(s.key("torque"), f"needs one value per entry of {key}; got "
                                               f"{len(torque)} and {len(x)}")
     if len(x) < 2:
-        raise SceneError(key, f"{where}: needs at least 2 points, got {len(x)}")
+        raise SceneError(key, f"{where}needs at least 2 points, got {len(x)}")
     for i in range(1, len(x)):
         if x[i] <= x[i - 1]:
-            raise SceneError(key, f"{where} must increase strictly, but entry {i + 1} "
+            raise SceneError(key, f"{where}must increase strictly, but entry {i + 1} "
                                   f"({x[i]:g} in SI) follows {x[i - 1]:g}; give each abscissa once, "
                                   f"in increasing order")
     if name == "phi":
         x, torque = _one_cycle(key, where, x, torque, cycle)
     if name == "time" and min(b - a for a, b in zip(x, x[1:])) < SCHEDULE_MIN_GAP * max(
             1.0, *map(abs, x)):
-        raise SceneError(key, f"{where}: two times closer than {SCHEDULE_MIN_GAP:g} (relative); "
+        raise SceneError(key, f"{where}two times closer than {SCHEDULE_MIN_GAP:g} (relative); "
                               f"each is a corner the stepper stops on, give them further apart")
     return LoadTable(tuple(torque), interpolation=interpolation, **{name: tuple(x)})
 
@@ -478,17 +478,17 @@ def _one_cycle(key: str, where: str, x, torque, cycle: float):
     """The points of a load over the cycle in [0, cycle): one at the cycle's end is dropped when
     it repeats the value at 0 (the curve is periodic), else refused."""
     if x[0] < 0.0 or x[-1] > cycle * (1.0 + 1e-12):
-        raise SceneError(key, f"{where}: angles must lie within one cycle, 0 to "
+        raise SceneError(key, f"{where}angles must lie within one cycle, 0 to "
                               f"{math.degrees(cycle):g}°; got {math.degrees(x[0]):g}° to "
                               f"{math.degrees(x[-1]):g}°")
     if x[-1] >= cycle * (1.0 - 1e-12):
         if x[0] != 0.0 or torque[-1] != torque[0]:
-            raise SceneError(key, f"{where}: a point at the cycle's end "
+            raise SceneError(key, f"{where}a point at the cycle's end "
                                   f"({math.degrees(cycle):g}°) is the point at 0° again; give it "
                                   f"with the same torque as at 0°, or leave it out")
         x, torque = x[:-1], torque[:-1]
     if len(x) < 2:
-        raise SceneError(key, f"{where}: needs at least 2 points in the cycle")
+        raise SceneError(key, f"{where}needs at least 2 points in the cycle")
     return x, torque
 
 
