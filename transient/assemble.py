@@ -14,8 +14,10 @@ from numpy.typing import NDArray
 from .core import cylinder as cyl
 from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
-from .core.layout import PAPER, PHI, POWER_FLOW, TABULATED, Model, T, work_array
+from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, PAPER, PHI, POWER_FLOW, TABULATED,
+                          Model, T, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
+from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
 from .forces.trapezoid import trapezoid_table
 
 
@@ -128,6 +130,18 @@ def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period
     return angles
 
 
+def union_of_angles(a: NDArray[np.float64], b: NDArray[np.float64], period: float
+                    ) -> NDArray[np.float64]:
+    """The sorted angles of ``a`` and ``b`` in [0, period), those closer than 1e-12 of the
+    period (also across the period's end) taken as one, as :func:`breakpoints` merges them."""
+    angles = np.union1d(a, np.mod(b, period))
+    keep = np.concatenate(([True], np.diff(angles) > 1e-12 * period))
+    angles = angles[keep]
+    if angles.size > 1 and period - angles[-1] < 1e-12 * period:
+        angles = angles[:-1]
+    return angles
+
+
 def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64],
                      period: float, mech) -> NDArray[np.bool_]:
     """For each breakpoint, whether a cylinder's gas torque jumps there: its pressure (any of
@@ -201,7 +215,10 @@ def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]
 
     ``x`` are the corners as values of the state component they are levels of: times [s] (T), or
     shaft angles φ₀ + 2π·revolutions [rad] (PHI), counted from the initial angle; ``s`` the scale
-    at each. Empty arrays without a schedule (s ≡ 1).
+    at each. Empty arrays without a schedule (s ≡ 1). The knots of a tabulated load in time are
+    corners too, with the scale the schedule has there (1 without one), so that the stepper stops
+    on each (a state event, as on the schedule's own corners) and no step integrates across the
+    curve's kink; the reader refuses a load in time with a schedule in revolutions.
     """
     load = scene.load
     s = np.asarray(load.schedule_scale, dtype=np.float64)
@@ -209,7 +226,38 @@ def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]
         x = scene.initial.phi + 2.0 * math.pi * np.asarray(load.schedule_revolutions,
                                                            dtype=np.float64)
         return x, s, PHI
-    return np.asarray(load.schedule_time, dtype=np.float64), s, T
+    x = np.asarray(load.schedule_time, dtype=np.float64)
+    if load.table is None or load.table.abscissa != "time":
+        return x, s, T
+    knots = np.asarray(load.table.x, dtype=np.float64)
+    if x.size:  # (a knot within the schedule's least gap of a corner is that corner)
+        gap = np.abs(np.subtract.outer(knots, x)).min(axis=1)
+        knots = knots[gap > SCHEDULE_MIN_GAP * np.maximum(1.0, np.abs(knots))]
+        s_knots = np.interp(knots, x, s)
+    else:
+        s_knots = np.ones(knots.size)
+    order = np.argsort(np.concatenate([x, knots]), kind="stable")
+    return (np.concatenate([x, knots])[order], np.concatenate([s, s_knots])[order], T)
+
+
+def load_table_fields(scene) -> dict:
+    """The tabulated load's part of the Model (``transient.core.forcing.table_load``): its
+    abscissa, knots and cubics; one zero interval without a table (the kernels never read it)."""
+    curve = load_table_curve(scene)
+    if curve is None:
+        return dict(lt_kind=LT_NONE, lt_x=np.array([0.0, 1.0]), lt_coef=np.zeros((1, 4)))
+    kind = {"speed": LT_SPEED, "angle": LT_ANGLE, "time": LT_TIME}[curve.abscissa]
+    return dict(lt_kind=kind, lt_x=np.ascontiguousarray(curve.knots),
+                lt_coef=np.ascontiguousarray(curve.coef))
+
+
+def load_table_curve(scene) -> LoadCurve | None:
+    """The scene's tabulated load T(x) (:mod:`transient.forces.load_table`), or None."""
+    table = scene.load.table
+    if table is None:
+        return None
+    return load_curve(table.abscissa, table.x, table.torque, table.interpolation,
+                      scene.mechanism.cycle if table.abscissa == "angle" else 0.0)
 
 
 def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None]:
@@ -229,6 +277,9 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     tabulated = kin is not None and kin.coef is not None
     load_x, load_s, load_comp = load_schedule(scene)
     bp = breakpoints(table, phases, period, motored, scene.gas.injection)
+    curve = load_table_curve(scene)
+    if curve is not None and curve.abscissa == "angle":  # its knots are kinks in φ
+        bp = union_of_angles(bp, curve.corners, period)
     model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -240,7 +291,7 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), phases, period, mech),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
-        gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,
+        **load_table_fields(scene), gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,

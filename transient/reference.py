@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from .assemble import build_model, gas_tables, initial_governor
+from .assemble import build_model, gas_tables, initial_governor, load_table_curve
 from .core.breakpoints import next_breakpoint
 from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
@@ -244,6 +244,7 @@ class ReferenceModel:
         self.seg = int(load_segment(m, x0, True))
         self.gen_low = bool(generator_branch(m, w0, True))
         self.t = 0.0  # time of the state being evaluated (the schedule may be in time)
+        self.load_curve = load_table_curve(scene)  # the tabulated load, in numpy
         self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
         self.n_gov = gv.n_states(m.gov_dyn)
         self.latched = None  # fuel per cylinder, with latching (set by run_reference)
@@ -293,6 +294,9 @@ class ReferenceModel:
         resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
         if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min
             resist += m.gen_power / (m.gen_min if self.gen_low else w)
+        if self.load_curve is not None:  # T(x) at the speed, the angle or the time
+            x = {"speed": w, "angle": phi, "time": self.t}[self.load_curve.abscissa]
+            resist += float(self.load_curve.evaluate(x))
         M_load = -self.load_scale(phi) * resist
         M_starter = m.starter_torque * (1 - w / m.starter_noload) if self.starter_on else 0.0
         return J, dJ, M_gas, M_load, M_starter, p

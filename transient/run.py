@@ -16,6 +16,7 @@ from typing import Callable
 import numpy as np
 
 from .assemble import build_model, initial_governor
+from .forces.load_table import interpolant
 from .core import forcing, layout, stepper
 from .core import stepper_io as sio
 from .core.inverse import inverse_dynamics
@@ -238,7 +239,7 @@ def switch_inertia(model, extra: float, y, ist):
     J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the energy lost, ½Jω₋² − ½(J + J_x)ω₊², is taken
     from ``W_load``, so that the work–energy balance still closes. Updates the state ``y`` and
     the switches that depend on the speed, which jumped across their levels without an event
-    (the governor's branch, the generator's); returns the model with the extra inertia on the
+    (the governor's branch, the generator's, the speed map's interval); returns the model with the extra inertia on the
     shaft (``J0``)."""
     angle_mode = ist[sio.I_ANGLE_MODE] == 1
     J = forcing.inertia(model, y[layout.PHI], layout.work_array(model))
@@ -251,6 +252,7 @@ def switch_inertia(model, extra: float, y, ist):
         y[layout.OMEGA] = w_new
     ist[sio.I_GOV_BRANCH] = forcing.start_branch(model, w_new, y)
     ist[sio.I_GEN_LOW] = forcing.generator_branch(model, w_new, True)
+    ist[sio.I_LOAD_TABLE] = forcing.speed_knot_segment(model, w_new, True)
     ist[sio.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
     return model._replace(J0=model.J0 + extra)
 
@@ -289,14 +291,15 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     phi0 = scene.initial.phi
     dphi = 2.0 * math.pi / scene.output.samples_per_rev
     if run.time:
-        from scipy.interpolate import CubicSpline
-
-        spline = CubicSpline(run.time, run.speed_table)
-        angle = spline.antiderivative()
+        # ω(t) as the scene interpolates it (linear or monotone cubic: neither overshoots the
+        # table's speeds); φ its exact integral, ε its derivative (at a corner of a linear
+        # table, the slope after it)
+        speed = interpolant(run.time, run.speed_table, run.interpolation)
+        angle = speed.antiderivative()
         t_end = min(run.t_end, run.time[-1])
         n = int(math.ceil((angle(t_end) - angle(run.time[0])) / dphi)) + 1
         t = np.linspace(run.time[0], t_end, max(n, 2))
-        omega, eps, phi = spline(t), spline(t, 1), phi0 + angle(t) - angle(run.time[0])
+        omega, eps, phi = speed(t), speed(t, 1), phi0 + angle(t) - angle(run.time[0])
         stop = phi <= phi0 + 2 * math.pi * run.revolutions
         t, omega, eps, phi = t[stop], omega[stop], eps[stop], phi[stop]
     else:

@@ -39,6 +39,10 @@ EXTRA_TABLES = (
     ("gas", {"model": "table", "file": "diagram.csv"}),
     ("run", {"mode": "prescribed-speed", "t_end": 1.0, "time": [0.0, 1.0],
              "speed_table_rpm": [1000, 1000]}),
+    ("load", {"table": {"speed_rpm": [0.0, 1000.0], "torque": [0.0, 1.0]}}),
+    ("load", {"table": {"phi_deg": [0.0, 360.0], "torque": [0.0, 1.0]}}),
+    ("load", {"table": {"time": [0.0, 1.0], "torque": [0.0, 1.0]}}),
+    ("load", {"table": {"file": "load_map.csv"}}),
 )
 
 TYPES = {"number": "number", "numbers": "list of numbers", "integer": "whole number",

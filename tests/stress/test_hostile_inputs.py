@@ -295,7 +295,7 @@ SWEEP_CASES = [
     ("key-long-and-unknown", BASE + f'[[axis]]\nkey = "load.{LONG}"\nvalues = [1.0]\n',
      "run 0 (load.xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx... = 1.0): scene load." + "x" * 152
      + "...: unknown key; allowed here: fan, generator_min_speed, generator_power, inertia, "
-     "inertia_time, linear, schedule_revolutions, schedule_scale, schedule_time, torque"),
+     "inertia_time, linear, schedule_revolutions, schedule_scale, schedule_time, table, torque"),
     ("key-malformed-long", BASE + f'[[axis]]\nkey = "load..{LONG}"\nvalues = [1.0]\n',
      "axis[0].key: 'load..xxxxxxxxxxxxxxxxxxxxxxxxxxxxxx... is not a scene key; give dotted TOML "
      "keys such as 'load.torque' or 'friction.pairs[0].eta_forward'"),

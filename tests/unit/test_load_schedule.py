@@ -129,7 +129,7 @@ ERRORS = [
      "must be ≥ 0, got -1"),
     ("unknown-key", "schedule = [0, 1]", "load.schedule",
      ("unknown key; allowed here: fan, generator_min_speed, generator_power, inertia, "
-      "inertia_time, linear, schedule_revolutions, schedule_scale, schedule_time, torque")),
+      "inertia_time, linear, schedule_revolutions, schedule_scale, schedule_time, table, torque")),
 ]
 
 

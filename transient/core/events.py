@@ -19,12 +19,12 @@ from .jit import kernel
 from .chain import MAX_PAIRS
 from . import governor as gv
 from .forcing import demand, inertia, is_pi, speed
-from .layout import (OMEGA, PHI, SW_LOAD, SW_SLEEVE, SW_STARTER, T, WK_DEMAND, WK_G, WK_G_MIN,
-                     gov_index)
+from .layout import (LT_SPEED, OMEGA, PHI, SW_LOAD, SW_LOAD_TABLE, SW_SLEEVE, SW_STARTER, T,
+                     WK_DEMAND, WK_G, WK_G_MIN, gov_index)
 from .rhs import margins_at, margins_inline
 from .rk import _dense, _dense_eval, _dense_state
 from .stepper_io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR,
-                         EV_LOAD, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
+                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
                          EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
 
 # Event "components" at and above PAIR_COMP are the mode margins of the pairs (rhs.mode_margins);
@@ -191,7 +191,7 @@ def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
     return 0.0, N_FINE_SAMPLES
 
 
-FIRST_PAIR_EVENT = 14
+FIRST_PAIR_EVENT = 16
 N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
 
 
@@ -239,6 +239,10 @@ def _event_spec(m, cfg, e, angle_mode, sw):
         return EV_GENERATOR, OMEGA, m.gen_min, 0
     if 10 <= e < 14 and m.gov_dyn == gv.FLYWEIGHT:
         return _sleeve_event(m, e, sw)
+    if e == 14 and m.lt_kind == LT_SPEED and sw[SW_LOAD_TABLE] < m.lt_x.shape[0]:
+        return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE]], 1  # a speed map's knot above ω
+    if e == 15 and m.lt_kind == LT_SPEED and sw[SW_LOAD_TABLE] > 0:  # and the one below
+        return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE] - 1], -1
     if e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
         # the mode margin of pair e − FIRST_PAIR_EVENT falls to zero
         return EV_PAIR_MODE, PAIR_COMP + e - FIRST_PAIR_EVENT, 0.0, -1

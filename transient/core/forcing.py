@@ -18,12 +18,13 @@ from . import cylinder as cyl
 from . import governor as gv
 from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
-from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, OMEGA, PHI, SW_GENERATOR, SW_GOVERNOR,
-                     SW_LOAD, SW_SLEEVE, SW_STARTER, TABULATED, WK_DEMAND, WK_DU, WK_LOCAL,
-                     WK_PIECE, WK_SEL, WK_U, cyl_index, gov_index, latch_index)
+from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, LT_ANGLE, LT_NONE, LT_SPEED, OMEGA, PHI,
+                     SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_SLEEVE, SW_STARTER, T, TABULATED,
+                     WK_DEMAND, WK_DU, WK_LOCAL, WK_PIECE, WK_SEL, WK_U, cyl_index, gov_index,
+                     latch_index)
 from .swash_plate import swash_terms
 from .tabulated import tabulated_terms
-from .tables import find_piece, table_eval, table_eval_pair
+from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
 
 
 @kernel(inline=True)
@@ -251,6 +252,42 @@ def load_scale(m, y, seg):
 
 
 @kernel
+def speed_knot_segment(m, w, rising):
+    """Interval of a tabulated load against speed (``m.lt_kind`` = LT_SPEED) at the speed w: the
+    number of its knots below w, on a knot the interval the motion enters (``rising``: ω
+    increasing), as :func:`load_segment` counts a schedule's corners; 0 for other loads."""
+    if m.lt_kind != LT_SPEED:
+        return 0
+    j = 0
+    n = m.lt_x.shape[0]
+    while j < n and (m.lt_x[j] < w or (m.lt_x[j] == w and rising)):
+        j += 1
+    return j
+
+
+@kernel(inline=True)
+def table_load(m, w, y):
+    """The tabulated load's resisting torque [N m] (``m.lt_kind`` ≠ LT_NONE): the curve at the
+    speed ω, at the shaft angle in its cycle (the knots span one period from a negative first
+    one, :func:`transient.forces.load_table.load_curve`), or at the time t; below the first knot
+    and above the last the end values hold.
+
+    Steps end on the knots, where the curve kinks (linear) or its curvature jumps (pchip): the
+    angle curve's knots are breakpoints, the time curve's load corners, the speed curve's levels
+    of ω (state events, watched from the interval :func:`speed_knot_segment`). The value is
+    always the curve's at x, found by bisection, so that a knot the event search passes over
+    costs accuracy in that step only, never a value off the curve."""
+    if m.lt_kind == LT_SPEED:
+        x = w
+    elif m.lt_kind == LT_ANGLE:
+        x0 = m.lt_x[0]
+        x = x0 + wrap_angle(y[PHI] - x0, m.period)
+    else:
+        x = y[T]
+    return held_curve_value(m.lt_x, m.lt_coef, x)
+
+
+@kernel
 def generator_branch(m, w, rising):
     """1 while the generator's torque is held at −s·P/ω_min (ω < ω_min, or on it falling), else 0."""
     if w < m.gen_min or (w == m.gen_min and not rising):
@@ -270,9 +307,10 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force of cylinder k is
     (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel f
     (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
-    P/max(ω, ω_min)), s from the schedule's segment ``sw[SW_LOAD]`` and the max from the
-    generator's branch ``sw[SW_GENERATOR]``. With fuel latching cylinder k burns the fuel it
-    took at its last injection, else every cylinder the governor's command (:func:`command`).
+    P/max(ω, ω_min) + T(x)), s from the schedule's segment ``sw[SW_LOAD]``, the max from the
+    generator's branch ``sw[SW_GENERATOR]`` and T(x) the tabulated load (:func:`table_load`).
+    With fuel latching cylinder k burns the fuel it took at its last injection, else every
+    cylinder the governor's command (:func:`command`).
     """
     phi = y[PHI]
     u = wk[WK_U]
@@ -302,6 +340,8 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
         # the branch at ω_min, as at the governor's corners, keeping each step smooth.
         w_gen = m.gen_min if sw[SW_GENERATOR] else w
         M_load -= s * m.gen_power / w_gen
+    if m.lt_kind != LT_NONE:
+        M_load -= s * table_load(m, w, y)
     M_starter = 0.0
     if sw[SW_STARTER]:
         M_starter = m.starter_torque * (1.0 - w / m.starter_noload)

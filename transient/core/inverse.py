@@ -11,9 +11,10 @@ import numpy as np
 
 from .jit import compiled, kernel
 
-from .forcing import fuel, generator_branch, governor_branch, load_segment, moments
+from .forcing import (fuel, generator_branch, governor_branch, load_segment, moments,
+                      speed_knot_segment)
 from .layout import (COL_EPS, N_OUT_FIXED, N_SWITCHES, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
-                     SW_GOVERNOR, SW_LOAD, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY, WK_J, WK_M,
+                     SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY, WK_J, WK_M,
                      WK_S, WK_S_TRY, latch_index, n_state, work_array)
 from .outputs import output_row, pair_rows
 from .rhs import pair_etas, split_subchains
@@ -88,6 +89,7 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
         sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
         sw[SW_LOAD] = load_segment(m, y[m.load_comp], True)  # t and φ increase here (ω > 0)
         sw[SW_GENERATOR] = generator_branch(m, omega[i], eps[i] >= 0.0)
+        sw[SW_LOAD_TABLE] = speed_knot_segment(m, omega[i], eps[i] >= 0.0)
         if m.latch:  # (a static governor only) at a prescribed speed each cylinder latches it
             for k in range(m.ncyl):
                 y[latch_index(m) + k] = fuel(m, omega[i], sw[SW_GOVERNOR])

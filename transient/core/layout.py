@@ -43,13 +43,19 @@ W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
 #: (bit k set: pair k backward, its far side drives), the direction of motion σ = ±1 that the
 #: pair modes refer to (sign of ω; changed only at a speed reversal, where the modes are chosen
 #: afresh), the segment of the load schedule (:func:`.forcing.load_segment`) and the generator's
-#: low-speed branch (:func:`.forcing.generator_branch`), and the flyweight governor's sleeve,
-#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``).
-SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE = range(7)
-N_SWITCHES = 7
+#: low-speed branch (:func:`.forcing.generator_branch`), the flyweight governor's sleeve,
+#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``), and the interval of
+#: a tabulated load against speed (:func:`.forcing.speed_knot_segment`).
+(SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE,
+ SW_LOAD_TABLE) = range(8)
+N_SWITCHES = 8
 
 #: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
 CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
+
+#: Abscissae of a tabulated load (``Model.lt_kind``; :func:`.forcing.table_load`): none, the
+#: speed ω, the shaft angle φ in its cycle, the time t.
+LT_NONE, LT_SPEED, LT_ANGLE, LT_TIME = 0, 1, 2, 3
 
 #: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
 POWER_FLOW, PAPER = 0, 1
@@ -105,6 +111,9 @@ Model = namedtuple(
         "load_x",  # float64[:]: corners of the load schedule, non-decreasing (empty: s ≡ 1)
         "load_s",  # float64[:]: the load's scale s at each corner (piecewise linear between)
         "load_comp",  # int: state component the corners are values of, T [s] or PHI [rad]
+        "lt_kind",  # int: the tabulated load's abscissa, LT_NONE, LT_SPEED, LT_ANGLE or LT_TIME
+        "lt_x",  # float64[n + 1]: its knots, increasing [rad/s, rad or s]
+        "lt_coef",  # float64[n, 4]: its cubic per knot interval, ascending powers [N m]
         "gen_power",  # float: generator power P in −s·P/max(ω, ω_min) [W] (0: none)
         "gen_min",  # float: ω_min, below it the generator's torque is held at −s·P/ω_min [rad/s]
         "starter_torque",  # float: starter stall torque [N m]

@@ -43,20 +43,20 @@ from .chain import LOCKED as LOCKED_STATUS
 from .events import (DEMAND_COMP, MAX_UNSEEN, N_MARGIN_SAMPLES, PAIR_COMP, _dense_once, _event_g,
                      _locate_events, _sleeve_stops)
 from . import governor as gv
-from .forcing import (generator_branch, governor_branch, inertia, load_segment, speed,
-                      start_branch)
+from .forcing import (generator_branch, governor_branch, inertia, load_segment, moments, speed,
+                      speed_knot_segment, start_branch)
 from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_MODES, T, WK_DEMAND, WK_G, WK_G_MIN,
                      WK_SPEED, cyl_index, gov_index, n_state, work_array)
 from .rhs import choose_modes, derivative, margins_at
 from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
 from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
                          C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR,
-                         EV_GOVERNOR, EV_LOAD, EV_PAIR_MODE, EV_REVERSAL,
+                         EV_GOVERNOR, EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL,
                          EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_TO_ANGLE,
                          EV_TO_TIME, F_ERR_OLD, F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T,
                          F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
                          I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_F_VALID, I_FLIPPED,
-                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_MODES, I_NBAD, I_NCHATTER, I_NEV,
+                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES, I_NBAD, I_NCHATTER, I_NEV,
                          I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS, I_NSWITCH,
                          I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED, I_STARTER_ON,
                          I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event, _emit_row,
@@ -259,6 +259,15 @@ def _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk):
     # (time only increases; the shaft angle as ω's sign says, forward from rest)
     ist[I_LOAD_SEG] = load_segment(m, y[m.load_comp], m.load_comp == T or y[OMEGA] >= 0.0)
     ist[I_GEN_LOW] = generator_branch(m, y[OMEGA], True)
+    ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], True)
+    if ist[I_LOAD_TABLE] != speed_knot_segment(m, y[OMEGA], False):
+        # On a speed map's knot the interval is the one the speed moves into (else the knot
+        # it leaves by would not be watched): the sign of ε from the moments, the pairs'
+        # losses left out (they do not change the sign of a net moment that decides a tie).
+        J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, y[PHI], ist[:N_SWITCHES], wk,
+                                                     True)
+        rising = M_gas + M_load + M_starter - 0.5 * dJ * w * w >= 0.0
+        ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], rising)
     fst[F_LAST_SWITCH] = np.nan
     if _start_modes(m, y, y[PHI], ist, wk) == LOCKED_STATUS:
         return _locked(m, y, y[PHI], outbuf, evbuf, ist, fst, wk)
@@ -493,7 +502,7 @@ def _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel
 def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y, ist,
                      fst, wk):
     """What the event switches: a pair's mode, the starter, the governor's branch, the load
-    schedule's segment, the generator's branch, the sleeve on or off a stop, or the independent
+    schedule's segment, the generator's branch, the speed map's interval, the sleeve on or off a stop, or the independent
     variable (with the next step's size converted by ω = level and the output grid of the new
     variable)."""
     if ev_code == EV_PAIR_MODE:
@@ -511,6 +520,8 @@ def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, 
         ist[I_LOAD_SEG] = load_segment(m, ev_level, ev_rising)
     elif ev_code == EV_GENERATOR:
         ist[I_GEN_LOW] = generator_branch(m, ev_level, ev_rising)
+    elif ev_code == EV_LOAD_KNOT:
+        ist[I_LOAD_TABLE] = speed_knot_segment(m, ev_level, ev_rising)
     elif ev_code == EV_SLEEVE_STOP:
         J = inertia(m, y[PHI], wk)
         ist[I_SLEEVE] = _sleeve_stops(m, y, ev_level, speed(J, angle_mode, y))

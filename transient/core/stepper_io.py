@@ -15,8 +15,8 @@ import numpy as np
 from .jit import kernel
 
 from .forcing import inertia, speed
-from .layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_MODES,
-                     SW_SLEEVE, SW_STARTER, T, n_state)
+from .layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
+                     SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T, n_state)
 from .outputs import output_row, output_row_inline
 from .rk import _dense_eval
 
@@ -35,9 +35,10 @@ N_FST = 9
 F_DERIV = N_FST
 # ist[...] — integer stepper state kept between chunks
 # ist[:N_SWITCHES] are the model's switches (starter, governor branch, pair modes, direction,
-# load-schedule segment, generator branch, sleeve on a stop), passed on as ``sw``.
+# load-schedule segment, generator branch, sleeve on a stop, speed map's interval), passed on as
+# ``sw``.
 I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
-I_LOAD_SEG, I_GEN_LOW, I_SLEEVE = SW_LOAD, SW_GENERATOR, SW_SLEEVE
+I_LOAD_SEG, I_GEN_LOW, I_SLEEVE, I_LOAD_TABLE = SW_LOAD, SW_GENERATOR, SW_SLEEVE, SW_LOAD_TABLE
 (I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
  I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT, I_STIFF,
  I_NONSTIFF) = range(N_SWITCHES, N_SWITCHES + 17)
@@ -51,10 +52,10 @@ RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING, STIFF
 # event codes written to the event buffer as (code, t, phi, omega)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
  EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR, EV_SLEEVE_STOP, EV_SLEEVE_FREE,
- EV_INJECTION) = range(14)
+ EV_INJECTION, EV_LOAD_KNOT) = range(15)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
                "speed_reversal", "end", "governor_corner", "pair_mode", "locked", "load_schedule",
-               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection")
+               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection", "load_table_speed")
 
 
 @kernel

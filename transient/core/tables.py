@@ -18,6 +18,9 @@ smooth parts. The layout, shared by the right-hand side and by :mod:`transient.f
 The corners in angle are ``knots[piece_knot]``. Angles are in radians, values in SI (Pa).
 The plain-numpy twin is :meth:`transient.forces.gas.PressureTable.evaluate`.
 
+A **held curve** (a tabulated load, :func:`held_curve_value`) is one such cubic on increasing
+knots that are not a cycle: below the first knot and above the last it keeps its end values.
+
 A **paired** table holds two curves on the same knots and corners (the full-load and the motored
 cylinder pressure, ``transient.assemble.paired_table``): ``coef`` is float64[n, 8], columns 0–3
 the first curve's cubic and 4–7 the second's. :func:`table_eval` reads the first curve of it,
@@ -183,3 +186,27 @@ def table_value(knots, coef, piece_knot, x):
     piece = find_piece(knots, piece_knot, y)
     value, _ = table_eval(knots, coef, piece_knot, piece, y)
     return value
+
+
+@kernel(inline=True)
+def held_curve_value(x_knots, coef, x):
+    """Value at ``x`` of the piecewise cubic on ``x_knots`` (float64[n + 1], increasing; ``coef``
+    float64[n, 4] as above), its end values held outside ``[x_knots[0], x_knots[n]]``: a load
+    map or trace says nothing beyond its range, and a held value stays bounded where an
+    extrapolated cubic would not."""
+    n = coef.shape[0]
+    if x <= x_knots[0]:
+        return coef[0, 0]
+    if x >= x_knots[n]:
+        d = x_knots[n] - x_knots[n - 1]
+        return coef[n - 1, 0] + d * (coef[n - 1, 1] + d * (coef[n - 1, 2] + d * coef[n - 1, 3]))
+    lo = 0
+    hi = n - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if x_knots[mid] <= x:
+            lo = mid
+        else:
+            hi = mid - 1
+    d = x - x_knots[lo]
+    return coef[lo, 0] + d * (coef[lo, 1] + d * (coef[lo, 2] + d * coef[lo, 3]))

@@ -19,10 +19,11 @@ from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table
 from .files import parse_toml, read_text, table_number, table_rows
 from .reader import MISSING, Section, show_value
+from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
                       MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES, Analysis, Friction,
-                      Gas, Governor, Inertia, Initial, Load, Output, Pair, Run, Scene, Solver,
-                      Starter, Wiebe, Woschni)
+                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
+                      Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
 
@@ -96,7 +97,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["gas"] = _read_gas(sg, base_dir, mech.strokes)
         sg.finish()
         sl = root.sub("load")
-        sections["load"] = _read_load(sl)
+        sections["load"] = _read_load(sl, base_dir, mech.cycle)
         sl.finish()
         ss = root.sub("starter")
         torque = ss.number("torque", default=0.0, ge=0.0)
@@ -247,6 +248,15 @@ PRESSURE_COLUMNS = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
 
 def _read_pressure_csv(s: Section, base_dir: Path):
     """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
+    (_, phi), (_, p) = _read_csv(s, base_dir, {"angle": ANGLE_COLUMNS,
+                                               "pressure": PRESSURE_COLUMNS})
+    return phi, p
+
+
+def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
+    """The CSV file named by the key ``file`` of ``s`` (relative to the scene): for each group
+    of column names (what it is → {column name: factor to SI}) the first column of the header
+    in it, as ``(name, values in SI)``. Every error names the file under the key ``file``."""
     name = s.string("file")
     try:
         path = (base_dir / name).resolve()
@@ -259,17 +269,17 @@ def _read_pressure_csv(s: Section, base_dir: Path):
     try:
         rows = table_rows(read_text(path, "table"))
         header = [h.strip() for h in rows[0][1]] if rows else []
-        a = next((c for c in header if c in ANGLE_COLUMNS), None)
-        b = next((c for c in header if c in PRESSURE_COLUMNS), None)
-        if a is None or b is None:
-            raise SceneError("(line)", f"needs an angle column ({', '.join(ANGLE_COLUMNS)}) and a "
-                                       f"pressure column ({', '.join(PRESSURE_COLUMNS)}); header "
-                                       f"is {show_value(header)}")
-        phi = _table_column(rows[1:], header.index(a), a, ANGLE_COLUMNS[a])
-        p = _table_column(rows[1:], header.index(b), b, PRESSURE_COLUMNS[b])
+        found = {what: next((c for c in header if c in columns), None)
+                 for what, columns in groups.items()}
+        if None in found.values():
+            needs = " and ".join(f"{'an' if what[0] in 'aeiou' else 'a'} {what} column "
+                                 f"({', '.join(columns)})" for what, columns in groups.items())
+            raise SceneError("(line)", f"needs {needs}; header is {show_value(header)}")
+        out = [(c, _table_column(rows[1:], header.index(c), c, groups[what][c]))
+               for what, c in found.items()]
     except SceneError as exc:  # (placed here: the message names the table, the key the scene's)
         raise SceneError(s.key("file"), f"{path.name}: {exc.message}") from None
-    return phi, p
+    return out
 
 
 def _table_column(rows, index: int, column: str, factor: float) -> tuple[float, ...]:
@@ -341,15 +351,10 @@ def _efficiency(s: Section, name: str) -> float:
     return eta
 
 
-#: Distinct abscissae of a load schedule closer than this (relative to max(1, |x|)) are
-#: refused: a ramp that short is a step to the solver, and the event search could not tell its
-#: two corners apart (``transient.core.events.ON_LEVEL`` is 1e-12).
-SCHEDULE_MIN_GAP = 1e-9
-
-
-def _read_load(s: Section) -> Load:
-    """The [load] table: resisting torques, a generator and the schedule of their scale."""
-    torque = s.number("torque", default=0.0, ge=0.0)
+def _read_load(s: Section, base_dir: Path, cycle: float) -> Load:
+    """The [load] table: resisting torques (``torque`` of either sign), a generator, a load from
+    data ([load.table]) and the schedule of their scale."""
+    torque = s.number("torque", default=0.0)
     linear = s.number("linear", default=0.0, ge=0.0)
     fan = s.number("fan", default=0.0, ge=0.0)
     power = s.number("generator_power", default=0.0, ge=0.0)
@@ -399,7 +404,92 @@ def _read_load(s: Section) -> Load:
                                                       f"the scale multiplies a resisting load")
     extra = s.number("inertia", default=0.0, ge=0.0)
     at = s.number("inertia_time", default=MISSING if extra > 0.0 else 0.0, gt=0.0)
-    return Load(torque, linear, fan, power, w_min, times, revs, scale, extra, at)
+    table = None
+    s.known.append("table")
+    if s.has("table"):
+        st = s.sub("table")
+        table = _read_load_table(st, base_dir, cycle)
+        st.finish()
+        if table.abscissa == "time" and revs:
+            raise SceneError(st.key("time"), "a load in time with a schedule in revolutions: the "
+                                             "load's corners are all in time or all in "
+                                             "revolutions; give the schedule in 'schedule_time'")
+    return Load(torque, linear, fan, power, w_min, times, revs, scale, extra, at, table)
+
+
+#: The abscissae of [load.table]: key (its CSV column names, with their factors to SI), the
+#: quantity kind of its unit suffixes, and what it is (:data:`transient.forces.load_table.ABSCISSAE`).
+LOAD_TABLE_ABSCISSAE = {
+    "speed": ("speed", {"speed": 1.0, "speed_rpm": math.pi / 30.0}),
+    "phi": ("angle", {"phi": 1.0, "phi_deg": math.pi / 180.0}),
+    "time": (None, {"time": 1.0}),
+}
+
+
+def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
+    """``[load.table]``: one abscissa (``speed``, ``phi`` or ``time``, with unit suffixes) and
+    ``torque`` inline, or a CSV ``file`` with such columns; the abscissae strictly increasing,
+    angles within one cycle (a point at the cycle's end only as the repeat of the one at 0)."""
+    interpolation = s.string("interpolation", "linear", choices=INTERPOLATIONS)
+    if s.has("file"):
+        columns = {n: c for _, (_, cols) in LOAD_TABLE_ABSCISSAE.items() for n, c in cols.items()}
+        file = Path(str(s.data["file"])).name
+        (column, x), (_, torque) = _read_csv(s, base_dir, {"abscissa": columns,
+                                                           "torque": {"torque": 1.0}})
+        key = s.key("file")
+        name = next(n for n, (_, cols) in LOAD_TABLE_ABSCISSAE.items() if column in cols)
+        where = f"{file}, column {column}: "
+    else:
+        given = [n for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items() if s.has(n, kind)]
+        if not given:  # (a key with a unit suffix its quantity does not take is named first)
+            for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items():
+                s.numbers(n, kind, ())
+        if len(given) != 1:
+            names = ", ".join(repr(n) for n in LOAD_TABLE_ABSCISSAE)
+            what = "none" if not given else " and ".join(repr(n) for n in given)
+            raise SceneError(s.key(given[1] if len(given) > 1 else "torque"),
+                             f"needs exactly one abscissa of {names} (or a CSV 'file'), got "
+                             f"{what}")
+        name = given[0]
+        x = s.numbers(name, LOAD_TABLE_ABSCISSAE[name][0])
+        torque = s.numbers("torque")
+        key = s.key(s.written.get(name, name))
+        where = ""
+        if len(torque) != len(x):
+            raise SceneError(s.key("torque"), f"needs one value per entry of {key}; got "
+                                              f"{len(torque)} and {len(x)}")
+    if len(x) < 2:
+        raise SceneError(key, f"{where}needs at least 2 points, got {len(x)}")
+    for i in range(1, len(x)):
+        if x[i] <= x[i - 1]:
+            raise SceneError(key, f"{where}must increase strictly, but entry {i + 1} "
+                                  f"({x[i]:g} in SI) follows {x[i - 1]:g}; give each abscissa once, "
+                                  f"in increasing order")
+    if name == "phi":
+        x, torque = _one_cycle(key, where, x, torque, cycle)
+    if name == "time" and min(b - a for a, b in zip(x, x[1:])) < SCHEDULE_MIN_GAP * max(
+            1.0, *map(abs, x)):
+        raise SceneError(key, f"{where}two times closer than {SCHEDULE_MIN_GAP:g} (relative); "
+                              f"each is a corner the stepper stops on, give them further apart")
+    return LoadTable(tuple(torque), interpolation=interpolation, **{name: tuple(x)})
+
+
+def _one_cycle(key: str, where: str, x, torque, cycle: float):
+    """The points of a load over the cycle in [0, cycle): one at the cycle's end is dropped when
+    it repeats the value at 0 (the curve is periodic), else refused."""
+    if x[0] < 0.0 or x[-1] > cycle * (1.0 + 1e-12):
+        raise SceneError(key, f"{where}angles must lie within one cycle, 0 to "
+                              f"{math.degrees(cycle):g}°; got {math.degrees(x[0]):g}° to "
+                              f"{math.degrees(x[-1]):g}°")
+    if x[-1] >= cycle * (1.0 - 1e-12):
+        if x[0] != 0.0 or torque[-1] != torque[0]:
+            raise SceneError(key, f"{where}a point at the cycle's end "
+                                  f"({math.degrees(cycle):g}°) is the point at 0° again; give it "
+                                  f"with the same torque as at 0°, or leave it out")
+        x, torque = x[:-1], torque[:-1]
+    if len(x) < 2:
+        raise SceneError(key, f"{where}needs at least 2 points in the cycle")
+    return x, torque
 
 
 def _read_governor(s: Section) -> Governor:
@@ -465,8 +555,9 @@ def _read_run(s: Section) -> Run:
         raise SceneError(s.key("time"), "must increase strictly")
     if min(table) <= 0:
         raise SceneError(s.key("speed_table"), "speeds must be > 0 in a prescribed-speed run")
+    interpolation = s.string("interpolation", "linear", choices=INTERPOLATIONS)
     return Run(mode=mode, t_end=min(t_end, time[-1]), revolutions=revs, time=time,
-               speed_table=table, **budgets)
+               speed_table=table, interpolation=interpolation, **budgets)
 
 
 def _read_analysis(s: Section) -> Analysis:

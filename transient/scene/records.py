@@ -134,11 +134,47 @@ class Gas:
 
 
 @dataclass(frozen=True)
-class Load:
-    """Resisting moment M_load = −s·(torque + linear·ω + fan·ω|ω| + P/max(ω, ω_min)) [N m]
-    (signs as Gots §1: + with rotation).
+class LoadTable:
+    """A load from data, the ``[load.table]`` table: the resisting torque T(x) ``torque`` [N m]
+    at the points of one abscissa, signed as ``[load] torque`` (> 0 resists the rotation, < 0
+    drives it), interpolated by ``interpolation`` (:mod:`transient.forces.load_table`).
 
-    ``torque`` [N m], ``linear`` [N m s], ``fan`` [N m s²]. ``generator_power`` P [W]: an
+    The abscissa is one of ``speed`` (the shaft speed ω [rad/s]: a generator's, propeller's or
+    fan's map), ``phi`` (the shaft angle in the engine cycle [rad], from 0 to the cycle's
+    length, 720° for a 4-stroke: a valve train's or an accessory's torque; periodic) or ``time``
+    [s] (a measured trace); the others are empty. Outside the speeds or times of the table its
+    end values hold. The abscissae increase strictly; ``interpolation`` ``"linear"`` or
+    ``"pchip"`` (monotone cubic, no overshoot). Inline, or from a CSV ``file`` next to the scene
+    with a column of the abscissa (``speed``, ``speed_rpm``, ``phi``, ``phi_deg``, ``time``) and
+    one ``torque``.
+    """
+
+    torque: tuple[float, ...]
+    speed: tuple[float, ...] = ()
+    phi: tuple[float, ...] = ()
+    time: tuple[float, ...] = ()
+    interpolation: str = "linear"
+
+    @property
+    def abscissa(self) -> str:
+        """``"speed"``, ``"angle"`` or ``"time"``
+        (:data:`transient.forces.load_table.ABSCISSAE`)."""
+        return "speed" if self.speed else "angle" if self.phi else "time"
+
+    @property
+    def x(self) -> tuple[float, ...]:
+        """The points of the abscissa, in SI."""
+        return self.speed or self.phi or self.time
+
+
+@dataclass(frozen=True)
+class Load:
+    """Load moment M_load = −s·(torque + linear·ω + fan·ω|ω| + P/max(ω, ω_min) + T(x)) [N m]
+    (signs as Gots §1: + with rotation, so M_load < 0 resists and > 0 drives).
+
+    ``torque`` [N m]: > 0 resists the rotation, < 0 drives it (a constant driving torque).
+    ``linear`` [N m s], ``fan`` [N m s²] ≥ 0. ``table``: a load from data, T(x)
+    (:class:`LoadTable`), or None. ``generator_power`` P [W]: an
     electrical load, M·ω = −s·P; below ``generator_min_speed`` ω_min [rad/s] its torque is held
     at −s·P/ω_min, so that it stays finite at a start from rest (like ``torque``, it does not
     change sign with ω). ω_min must be > 0 when P > 0.
@@ -165,6 +201,7 @@ class Load:
     schedule_scale: tuple[float, ...] = ()
     inertia: float = 0.0
     inertia_time: float = 0.0
+    table: LoadTable | None = None
 
 
 @dataclass(frozen=True)
@@ -258,7 +295,10 @@ class Run:
 
     The run ends at ``t_end`` [s] or after ``revolutions`` of the shaft, whichever comes first
     (``inf`` = not set). For prescribed speed: ``speed`` [rad/s] constant, or a table ``time`` [s],
-    ``speed_table`` [rad/s] interpolated by a cubic spline.
+    ``speed_table`` [rad/s] interpolated by ``interpolation``: ``"linear"`` (the default: a table
+    with corners, a ramp to a plateau, is followed exactly, with ε jumping at each point) or
+    ``"pchip"`` (monotone cubic, C¹: it never overshoots the table's speeds);
+    :mod:`transient.forces.load_table`.
 
     Budgets (:mod:`.budget`), so that a mistyped end or limit is refused before any work instead
     of filling the disk or running for ever: ``max_output_bytes`` [bytes], the trajectory a run
@@ -272,6 +312,7 @@ class Run:
     speed: float = 0.0
     time: tuple[float, ...] = ()
     speed_table: tuple[float, ...] = ()
+    interpolation: str = "linear"
     max_output_bytes: float = DEFAULT_MAX_OUTPUT_BYTES
     max_steps: float = DEFAULT_MAX_STEPS
 

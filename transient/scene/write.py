@@ -30,7 +30,8 @@ def to_toml(scene: Scene) -> str:
             run[k] = getattr(scene.run, k)
     if scene.run.mode == "prescribed-speed":
         if scene.run.time:
-            run.update(time=list(scene.run.time), speed_table=list(scene.run.speed_table))
+            run.update(time=list(scene.run.time), speed_table=list(scene.run.speed_table),
+                       interpolation=scene.run.interpolation)
         else:
             run["speed"] = scene.run.speed
     run.update(max_output_bytes=scene.run.max_output_bytes, max_steps=scene.run.max_steps)
@@ -75,7 +76,13 @@ def _load_section(load: Load) -> list[str]:
     if load.schedule_scale:
         names += ["schedule_revolutions" if load.schedule_revolutions else "schedule_time",
                   "schedule_scale"]
-    return ["", "[load]"] + [f"{k} = {toml_value(getattr(load, k))}" for k in names]
+    lines = ["", "[load]"] + [f"{k} = {toml_value(getattr(load, k))}" for k in names]
+    if load.table is not None:  # (a table from a file is written inline: the scene stands alone)
+        key = next(k for k in ("speed", "phi", "time") if getattr(load.table, k))
+        lines += ["", "[load.table]", f"{key} = {toml_value(list(load.table.x))}",
+                  f"torque = {toml_value(list(load.table.torque))}",
+                  f"interpolation = {toml_value(load.table.interpolation)}"]
+    return lines
 
 
 def _section(name: str, obj: Any) -> list[str]:
