@@ -223,9 +223,16 @@ def load_segment(m, x, rising):
     (``rising``: x increasing), so that a step (two equal corners) takes its value after the
     step in the direction of motion. A step's empty segment is never the result.
     """
+    return knots_passed(m.load_x, x, rising)
+
+
+@kernel(inline=True)
+def knots_passed(knots, x, rising):
+    """The number of ``knots`` (increasing) below x, counting one at x where the motion leaves
+    it (``rising``: x increasing): the interval the motion is in, on a knot the one it enters."""
     j = 0
-    n = m.load_x.shape[0]
-    while j < n and (m.load_x[j] < x or (m.load_x[j] == x and rising)):
+    n = knots.shape[0]
+    while j < n and (knots[j] < x or (knots[j] == x and rising)):
         j += 1
     return j
 
@@ -258,11 +265,7 @@ def speed_knot_segment(m, w, rising):
     increasing), as :func:`load_segment` counts a schedule's corners; 0 for other loads."""
     if m.lt_kind != LT_SPEED:
         return 0
-    j = 0
-    n = m.lt_x.shape[0]
-    while j < n and (m.lt_x[j] < w or (m.lt_x[j] == w and rising)):
-        j += 1
-    return j
+    return knots_passed(m.lt_x, w, rising)
 
 
 @kernel(inline=True)

@@ -71,8 +71,13 @@ def _interval(knots, piece_knot, piece, x):
     """The knot interval of ``piece`` that holds x (bisection). Only the piece's own intervals
     are searched: the same result as a global search clamped into the piece, and fewer
     comparisons."""
-    lo = piece_knot[piece]
-    hi = piece_knot[piece + 1] - 1
+    return last_knot_at_or_below(knots, piece_knot[piece], piece_knot[piece + 1] - 1, x)
+
+
+@kernel(inline=True)
+def last_knot_at_or_below(knots, lo, hi, x):
+    """The largest index i in [lo, hi] with knots[i] ≤ x (bisection; ``knots`` increasing,
+    knots[lo] ≤ x assumed)."""
     while lo < hi:
         mid = (lo + hi + 1) // 2
         if knots[mid] <= x:
@@ -200,13 +205,6 @@ def held_curve_value(x_knots, coef, x):
     if x >= x_knots[n]:
         d = x_knots[n] - x_knots[n - 1]
         return coef[n - 1, 0] + d * (coef[n - 1, 1] + d * (coef[n - 1, 2] + d * coef[n - 1, 3]))
-    lo = 0
-    hi = n - 1
-    while lo < hi:
-        mid = (lo + hi + 1) // 2
-        if x_knots[mid] <= x:
-            lo = mid
-        else:
-            hi = mid - 1
+    lo = last_knot_at_or_below(x_knots, 0, n - 1, x)
     d = x - x_knots[lo]
     return coef[lo, 0] + d * (coef[lo, 1] + d * (coef[lo, 2] + d * coef[lo, 3]))
