@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 from .core import cylinder as cyl
 from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core.variation import cycle_fuel
 from .core.layout import PAPER, PHI, POWER_FLOW, TABULATED, Model, T, work_array
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .forces.trapezoid import trapezoid_table
@@ -110,9 +111,11 @@ def gas_phases(scene) -> NDArray[np.float64]:
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
                 motored: PressureTable | None = None,
-                injection: float | None = None) -> NDArray[np.float64]:
+                injection: float | None = None,
+                cycle_begin: float | None = None) -> NDArray[np.float64]:
     """Sorted shaft angles in [0, period) where any cylinder's table (full-load or motored) has a
-    corner, or (fuel latching) a cylinder starts its injection."""
+    corner, or (fuel latching) a cylinder starts its injection, or (per-cylinder variation) a
+    cylinder begins a cycle (local angle ``cycle_begin``), where its fuel factor may change."""
     if table is None:
         return np.zeros(0)
     corners = table.corners[:-1]  # the period's end is the next cycle's 0
@@ -120,6 +123,8 @@ def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period
         corners = np.union1d(corners, motored.corners[:-1])
     if injection is not None:
         corners = np.union1d(corners, [injection])
+    if cycle_begin is not None:
+        corners = np.union1d(corners, [cycle_begin])
     angles = np.sort(np.mod(np.add.outer(phases, corners).ravel(), period))
     keep = np.concatenate(([True], np.diff(angles) > 1e-12 * period))
     angles = angles[keep]
@@ -228,7 +233,9 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     kin = kinematics_table(scene)
     tabulated = kin is not None and kin.coef is not None
     load_x, load_s, load_comp = load_schedule(scene)
-    bp = breakpoints(table, phases, period, motored, scene.gas.injection)
+    variation = variation_fields(scene, phases)
+    begin = cycle_begin(mech) if variation["var_on"] else None
+    bp = breakpoints(table, phases, period, motored, scene.gas.injection, begin)
     model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -244,10 +251,56 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene))
+        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation)
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
+    if begin is not None:
+        model.bp_jump[:] |= _on_cycle_begin(bp, phases, model, mech, begin)
     return model, model.breakpoints, table
+
+
+def cycle_begin(mech) -> float:
+    """Local angle where a cylinder's cycle begins, for its fuel factor and misfires
+    (:mod:`transient.core.variation`): 0, the gas-exchange TDC of a 4-stroke, whose cycle then
+    holds one intake, compression, combustion and exhaust; π, the BDC of a 2-stroke, whose
+    local 0 is its firing TDC, so that no combustion straddles two cycles."""
+    return 0.0 if mech.strokes == 4 else math.pi
+
+
+def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
+    """The per-cylinder variation's part of the Model (:mod:`transient.core.variation`) from the
+    ``[[gas.cylinders]]`` entries; factors of 1 and no misfires for cylinders without one, and
+    ``var_on`` False without any, so that such a scene runs the kernels' plain path."""
+    mech, entries = scene.mechanism, scene.gas.cylinders
+    n, period = mech.n_cylinders, mech.cycle
+    fuel, press, rate = np.ones(n), np.ones(n), np.zeros(n)
+    every, seed = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    cycles = np.zeros((n, max([len(c.misfire_cycles) for c in entries] + [1])), dtype=np.int64)
+    for c in entries:
+        k = c.cylinder - 1
+        fuel[k], press[k], rate[k] = c.fuel, c.pressure, c.misfire_rate
+        every[k], seed[k] = c.misfire_every, c.misfire_seed
+        cycles[k, :len(c.misfire_cycles)] = c.misfire_cycles
+    # cycle 1 of cylinder k: the one in progress at the initial angle φ0
+    first = np.mod(phases + cycle_begin(mech), period)
+    phi0 = scene.initial.phi
+    start = phi0 - np.mod(phi0 - first, period)
+    return dict(var_on=bool(entries), var_fuel=fuel, var_press=press, cycle_start=start,
+                mis_every=every, mis_cycles=cycles, mis_rate=rate, mis_seed=seed)
+
+
+def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model, mech,
+                    begin: float) -> NDArray[np.bool_]:
+    """Breakpoints where a cylinder begins a cycle while its piston moves: its fuel factor may
+    change there, and with it its gas torque (at a dead centre, where every crank-slider's cycle
+    begins, the torque stays continuous and the stepper's carried-over stage stays valid)."""
+    out = np.zeros(bp.size, dtype=np.bool_)
+    for k, phase in enumerate(phases):
+        angle = (phase + begin) % model.period
+        gap = np.abs(bp - angle)
+        j = np.flatnonzero(np.minimum(gap, model.period - gap) <= 1e-12 * model.period)
+        out[j] |= _piston_moves(mech, k, angle)
+    return out
 
 
 def cylinder_fields(scene) -> dict:
@@ -364,7 +417,8 @@ def initial_cylinders(scene, model: Model, f0: float) -> list[float]:
     for k in range(model.ncyl):
         local = (phi0 - model.gas_phase[k]) % model.period
         closed = cyl.closed_angle(model.cyl_par, local, model.period) >= 0.0
-        out.append(applied_value(model, k, phi0, sel, f0, wk) if closed
+        f_k = f0 * cycle_fuel(model, k, sel) if model.var_on else f0
+        out.append(applied_value(model, k, phi0, sel, f_k, wk) if closed
                    else model.cyl_par[cyl.P_A])
     return out
 

@@ -28,6 +28,7 @@ from .core.breakpoints import next_breakpoint
 from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
 from .core.layout import T
+from .core.variation import cycle_fuel
 from .errors import SimulationError
 
 
@@ -247,6 +248,7 @@ class ReferenceModel:
         self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
         self.n_gov = gv.n_states(m.gov_dyn)
         self.latched = None  # fuel per cylinder, with latching (set by run_reference)
+        self.factors = 1.0  # each cylinder's fuel factor in its cycle (set by select)
         self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov)
                           if m.woschni else None)
 
@@ -272,6 +274,10 @@ class ReferenceModel:
         if self.motored is not None:
             self.motored_pieces = self.motored.piece_of(local)
         self.mid = mid
+        m = self.model
+        # each cylinder's fuel factor in the cycle of the segment (its cycle begins on a breakpoint)
+        self.factors = (np.array([cycle_fuel(m, k, mid) for k in range(m.ncyl)])
+                        if m.var_on else 1.0)
 
     def moments(self, phi: float, w: float, y):
         m = self.model
@@ -281,7 +287,7 @@ class ReferenceModel:
         p = np.zeros(m.ncyl)
         if self.table is not None:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
-            f = self.latched if self.latched is not None else self.command(w, y)
+            f = (self.latched if self.latched is not None else self.command(w, y)) * self.factors
             p_full = self.table.evaluate(local, self.pieces)[0]
             # p = p_mot + f·(p_full − p_mot); the motored curve is p0 without a motored table
             p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
@@ -289,6 +295,8 @@ class ReferenceModel:
             p = p_mot + f * (p_full - p_mot)
             if self.cylinders is not None:
                 p = self.cylinders.pressures(p, np.mod(self.mid - m.gas_phase, m.period), y)
+            if m.var_on:  # the pressure factor acts on p − p0 (transient.scene.Cylinder)
+                p = m.gas_offset + m.var_press * (p - m.gas_offset)
             M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
         resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
         if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min
@@ -341,7 +349,7 @@ class ReferenceModel:
         m = self.model
         u = self.mechanism_terms(phi)[2]
         fuel = (self.latched if self.latched is not None
-                else np.full(m.ncyl, self.command(w, y)))
+                else np.full(m.ncyl, self.command(w, y))) * self.factors
         return self.cylinders.rates(np.mod(self.mid - m.gas_phase, m.period), phi - self.mid, u,
                                     w, fuel, y)
 

@@ -75,9 +75,10 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
 #: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
 #: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
-#: (:func:`.forcing.select_pieces`).
+#: (:func:`.forcing.select_pieces`), with per-cylinder variation its fuel factor in that cycle
+#: (WK_FUEL, :func:`.variation.cycle_fuel`).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
- WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_SCRATCH) = range(17)
+ WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_SCRATCH) = range(18)
 N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
 
 Model = namedtuple(
@@ -125,6 +126,16 @@ Model = namedtuple(
         "policy",  # int: POWER_FLOW or PAPER
         "link_sub",  # int64[n_links]: sub-chain of each link (shaft first, gas-carrying link last)
         "link_J",  # float64[n_links]: constant reduced inertia of the middle links [kg m²]
+        # per-cylinder variation (transient.core.variation; the arrays' types are the same
+        # without it, so that one compile serves every scene)
+        "var_on",  # bool: some cylinder has a [[gas.cylinders]] entry
+        "var_fuel",  # float64[ncyl]: fuel factor φ_k (0: cut out)
+        "var_press",  # float64[ncyl]: pressure factor β_k on p − p0
+        "cycle_start",  # float64[ncyl]: shaft angle where cylinder k's cycle 1 begins [rad]
+        "mis_every",  # int64[ncyl]: cycles n with n % mis_every == 0 misfire (0: none)
+        "mis_cycles",  # int64[ncyl, :]: cycles that misfire, padded with 0
+        "mis_rate",  # float64[ncyl]: probability that a cycle misfires
+        "mis_seed",  # int64[ncyl]: seed of the draws
     ],
 )
 
