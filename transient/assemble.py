@@ -134,13 +134,15 @@ def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period
 
 
 def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64],
-                     period: float, mech) -> NDArray[np.bool_]:
+                     period: float, mech, owner=None) -> NDArray[np.bool_]:
     """For each breakpoint, whether a cylinder's gas torque jumps there: its pressure (any of
     ``tables``) jumps while its piston moves (u_k ≠ 0; a jump at a dead centre, as all of the
     crank-slider cycles' are, leaves the torque continuous). The stepper's first stage beyond such
     a breakpoint must be evaluated afresh, not carried over from the step that ended on it (which
     used the table piece before the corner). Vectorised over the corners, which a table from
-    points has at every knot."""
+    points has at every knot. ``owner``: the cylinder of each phase (default: phase k is
+    cylinder k's)."""
+    owner = np.arange(len(phases)) if owner is None else owner
     out = np.zeros(bp.size, dtype=np.bool_)
     tol = 1e-12 * period
     for table in (t for t in tables if t is not None):
@@ -154,7 +156,7 @@ def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64
             for angle in np.mod(phase + jumps, period):
                 gap = np.abs(bp - angle)
                 j = np.flatnonzero(np.minimum(gap, period - gap) <= tol)
-                out[j] |= _piston_moves(mech, k, angle)
+                out[j] |= _piston_moves(mech, int(owner[k]), angle)
     return out
 
 
@@ -235,7 +237,13 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     load_x, load_s, load_comp = load_schedule(scene)
     variation = variation_fields(scene, phases)
     begin = cycle_begin(mech) if variation["var_on"] else None
-    bp = breakpoints(table, phases, period, motored, scene.gas.injection, begin)
+    # with combustion offsets a cylinder's tables are read at its angle less δ_k too: their
+    # corners there are breakpoints as well (cylinder ``owner[j]`` for each phase j)
+    moved = np.flatnonzero(variation["var_shift"] != 0.0)
+    all_phases = np.concatenate([phases, np.mod(phases[moved] + variation["var_shift"][moved],
+                                                period)])
+    owner = np.concatenate([np.arange(n), moved])
+    bp = breakpoints(table, all_phases, period, motored, scene.gas.injection, begin)
     model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -244,7 +252,8 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), has_motored=motored is not None,
-        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), phases, period, mech),
+        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), all_phases, period, mech,
+                                                 owner),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
         gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,
@@ -254,6 +263,8 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation)
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
+        if moved.size:  # the combustion's start and end, δ_k later
+            model.bp_jump[:] |= _on_closed_part_corner(bp, all_phases[n:], model)
     if begin is not None:
         model.bp_jump[:] |= _on_cycle_begin(bp, phases, model, mech, begin)
     return model, model.breakpoints, table
@@ -285,8 +296,12 @@ def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
     first = np.mod(phases + cycle_begin(mech), period)
     phi0 = scene.initial.phi
     start = phi0 - np.mod(phi0 - first, period)
+    shift = np.array([0.0] * n)
+    for c in entries:
+        shift[c.cylinder - 1] = c.combustion_offset
     return dict(var_on=bool(entries), var_fuel=fuel, var_press=press, cycle_start=start,
-                mis_every=every, mis_cycles=cycles, mis_rate=rate, mis_seed=seed)
+                mis_every=every, mis_cycles=cycles, mis_rate=rate, mis_seed=seed,
+                var_shifted=bool(np.any(shift != 0.0)), var_shift=shift)
 
 
 def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model, mech,

@@ -180,3 +180,32 @@ def test_cli_check_exits_2_with_file_and_key(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "Traceback" not in err
     assert "bad.toml" in err and "gas.cylinders[1].misfire_rate" in err and "≤ 1" in err
+
+
+def test_combustion_offset_corners_are_breakpoints(scene):
+    base_model, base_bp, table = build_model(scene.replace(gas={"cylinders": []}))
+    s = scene.replace(gas={"cylinders": [{"cylinder": 2, "combustion_offset_deg": 3.0}]})
+    model, bp, _ = build_model(s)
+    assert model.var_shifted and model.var_shift[1] == pytest.approx(math.radians(3.0))
+    P = model.period
+    moved = np.mod(model.gas_phase[1] + math.radians(3.0) + table.corners[:-1], P)
+    gap = np.abs(np.subtract.outer(moved, bp))
+    assert np.all(np.min(np.minimum(gap, P - gap), axis=1) < 1e-12 * P)
+    assert set(np.round(base_bp, 12)) <= set(np.round(bp, 12))
+
+
+def test_combustion_offset_range(scene):
+    with pytest.raises(SceneError,
+                       match=r"gas.cylinders\[0\].combustion_offset_deg: must be ≤ 30"):
+        scene.replace(gas={"cylinders": [{"cylinder": 1, "combustion_offset_deg": 31}]})
+
+
+def test_woschni_offset_must_keep_the_combustion_in_the_closed_part():
+    # combustion 358° to 408° (local), exhaust opening moved to 420°: 12° of room after it
+    woschni = load_scene(CASE.parent / "gots_diesel_woschni.toml").replace(
+        gas={"wiebe": {"exhaust_opening_deg": 420}})
+    woschni.replace(gas={"cylinders": [{"cylinder": 1, "combustion_offset_deg": 11.9}]})
+    with pytest.raises(SceneError, match=r"gas.cylinders\[0\].combustion_offset: 12.1° moves the "
+                                         r"combustion out of the closed part .* allowed -178° to "
+                                         r"12°$"):
+        woschni.replace(gas={"cylinders": [{"cylinder": 1, "combustion_offset_deg": 12.1}]})

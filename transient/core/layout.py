@@ -76,9 +76,11 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
 #: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
 #: (:func:`.forcing.select_pieces`), with per-cylinder variation its fuel factor in that cycle
-#: (WK_FUEL, :func:`.variation.cycle_fuel`).
+#: (WK_FUEL, :func:`.variation.cycle_fuel`) and, with combustion offsets, its angle and piece
+#: on the curve shifted by its offset (WK_LOCAL_SHIFT, WK_PIECE_SHIFT).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
- WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_SCRATCH) = range(18)
+ WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
+ WK_SCRATCH) = range(20)
 N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
 
 Model = namedtuple(
@@ -136,6 +138,8 @@ Model = namedtuple(
         "mis_cycles",  # int64[ncyl, :]: cycles that misfire, padded with 0
         "mis_rate",  # float64[ncyl]: probability that a cycle misfires
         "mis_seed",  # int64[ncyl]: seed of the draws
+        "var_shifted",  # bool: some cylinder has a combustion offset
+        "var_shift",  # float64[ncyl]: combustion offset δ_k [rad]
     ],
 )
 

@@ -25,5 +25,5 @@ Scene.replace = replace_scene
 Scene.to_toml = to_toml
 
 __all__ = ["load_scene", "scene_from_dict", "replace_scene", "to_toml", "Scene", "Inertia", "Gas", "Wiebe",
-           "Woschni", "Cylinder", "Load", "Starter", "Governor", "Initial", "Run", "Solver", "Output",
-           "Friction", "Pair", "Analysis", "POLICIES", "runs_compiled"]
+           "Woschni", "Cylinder", "Load", "Starter", "Governor", "Initial", "Run", "Solver",
+           "Output", "Friction", "Pair", "Analysis", "POLICIES", "runs_compiled"]

@@ -20,9 +20,10 @@ from .checks import check_analysis, check_consistency, check_gas_table
 from .files import parse_toml, read_text, table_number, table_rows
 from .reader import MISSING, Section, show_value
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
-                      MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES,
-                      Analysis, Cylinder, Friction, Gas, Governor, Inertia, Initial, Load, Output,
-                      Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
+                      MIN_OUTPUT_DT, POLICIES, Analysis, Cylinder, Friction, Gas, Governor,
+                      Inertia, Initial, Load, Output, Pair, Run, Scene, Solver, Starter, Wiebe,
+                      Woschni)
 from .write import to_toml
 
 
@@ -204,11 +205,14 @@ def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
                 raise SceneError(cs.key("misfire_cycles"), f"must hold cycle numbers ≥ 1, got "
                                                            f"{c}; cycle 1 is the one in "
                                                            f"progress at the start")
+        offset = cs.number("combustion_offset", "angle", 0.0, ge=-MAX_COMBUSTION_OFFSET,
+                           le=MAX_COMBUSTION_OFFSET)
         entry = Cylinder(cylinder=k, fuel=0.0 if cut_out else fuel, pressure=pressure,
                          cut_out=cut_out, misfire_cycles=tuple(sorted(set(cycles))),
                          misfire_every=cs.integer("misfire_every", 0, ge=0),
                          misfire_rate=cs.number("misfire_rate", default=0.0, ge=0.0, le=1.0),
-                         misfire_seed=cs.integer("misfire_seed", 0, ge=0, le=2 ** 63 - 1))
+                         misfire_seed=cs.integer("misfire_seed", 0, ge=0, le=2 ** 63 - 1),
+                         combustion_offset=offset)
         cs.finish()
         out.append(entry)
     return tuple(sorted(out, key=lambda c: c.cylinder))

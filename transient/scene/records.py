@@ -77,6 +77,9 @@ class Woschni:
 #: Largest fuel or pressure factor of a cylinder [1]: beyond twice the full-load cycle the
 #: interpolation p_mot + f·(p_full − p_mot) extrapolates far outside what its tables describe.
 MAX_CYLINDER_FACTOR = 2.0
+#: Largest combustion offset of a cylinder [rad] (30°): an injection timing's spread is a few
+#: degrees, and a shift much larger would move a table's combustion into its gas exchange.
+MAX_COMBUSTION_OFFSET = math.pi / 6.0
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,14 @@ class Cylinder:
     [1]: its pressure factor β_k, multiplying its pressure above p0 where it acts on the piston,
     p0 + β_k·(p − p0) (a leaking cylinder, or an indicator's calibration): the gas force, the
     ``p_<k>`` column and the work all see it. Both in [0, 2].
+
+    ``combustion_offset`` δ_k [rad] (``combustion_offset_deg``), within ±30°: its combustion
+    happens δ_k later (earlier if negative),
+    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x. For ``"table"``, ``"mixed-cycle"`` and ``"trapezoid"``, whose motored
+    curve is p0, that moves the whole curve (the table holds no other account of the
+    combustion); for ``"wiebe"`` the combustion's part only, the motored compression staying
+    with the piston; with ``[gas.woschni]`` the heat release and Woschni's combustion term of
+    the closed part, which must then still lie inside it.
 
     **Misfire.** In a misfiring cycle the cylinder burns nothing (its fuel is 0 for that whole
     cycle). A cylinder's cycles begin at its local angle 0 (the gas-exchange TDC of a 4-stroke)
@@ -110,6 +121,7 @@ class Cylinder:
     misfire_every: int = 0
     misfire_rate: float = 0.0
     misfire_seed: int = 0
+    combustion_offset: float = 0.0
 
 
 @dataclass(frozen=True)
