@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 from .core import cylinder as cyl
 from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core import variation as var
 from .core.variation import cycle_fuel
 from .core.layout import PAPER, PHI, POWER_FLOW, TABULATED, Model, T, work_array
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
@@ -239,9 +240,9 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     begin = cycle_begin(mech) if variation["var_on"] else None
     # with combustion offsets a cylinder's tables are read at its angle less δ_k too: their
     # corners there are breakpoints as well (cylinder ``owner[j]`` for each phase j)
-    moved = np.flatnonzero(variation["var_shift"] != 0.0)
-    all_phases = np.concatenate([phases, np.mod(phases[moved] + variation["var_shift"][moved],
-                                                period)])
+    shift = variation["var_par"][:, var.SHIFT]
+    moved = np.flatnonzero(shift != 0.0)
+    all_phases = np.concatenate([phases, np.mod(phases[moved] + shift[moved], period)])
     owner = np.concatenate([np.arange(n), moved])
     bp = breakpoints(table, all_phases, period, motored, scene.gas.injection, begin)
     model = Model(
@@ -284,24 +285,22 @@ def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
     ``var_on`` False without any, so that such a scene runs the kernels' plain path."""
     mech, entries = scene.mechanism, scene.gas.cylinders
     n, period = mech.n_cylinders, mech.cycle
-    fuel, press, rate = np.ones(n), np.ones(n), np.zeros(n)
-    every, seed = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
-    cycles = np.zeros((n, max([len(c.misfire_cycles) for c in entries] + [1])), dtype=np.int64)
+    par = np.zeros((n, var.N_VAR_PAR))
+    par[:, [var.FUEL, var.PRESSURE]] = 1.0
+    listed = max([len(c.misfire_cycles) for c in entries] + [1])
+    ints = np.zeros((n, var.CYCLES + listed), dtype=np.int64)
     for c in entries:
         k = c.cylinder - 1
-        fuel[k], press[k], rate[k] = c.fuel, c.pressure, c.misfire_rate
-        every[k], seed[k] = c.misfire_every, c.misfire_seed
-        cycles[k, :len(c.misfire_cycles)] = c.misfire_cycles
+        par[k, [var.FUEL, var.PRESSURE, var.RATE, var.SHIFT]] = (
+            c.fuel, c.pressure, c.misfire_rate, c.combustion_offset)
+        ints[k, [var.EVERY, var.SEED]] = c.misfire_every, c.misfire_seed
+        ints[k, var.CYCLES:var.CYCLES + len(c.misfire_cycles)] = c.misfire_cycles
     # cycle 1 of cylinder k: the one in progress at the initial angle φ0
     first = np.mod(phases + cycle_begin(mech), period)
     phi0 = scene.initial.phi
-    start = phi0 - np.mod(phi0 - first, period)
-    shift = np.array([0.0] * n)
-    for c in entries:
-        shift[c.cylinder - 1] = c.combustion_offset
-    return dict(var_on=bool(entries), var_fuel=fuel, var_press=press, cycle_start=start,
-                mis_every=every, mis_cycles=cycles, mis_rate=rate, mis_seed=seed,
-                var_shifted=bool(np.any(shift != 0.0)), var_shift=shift)
+    par[:, var.START] = phi0 - np.mod(phi0 - first, period)
+    return dict(var_on=bool(entries), var_shifted=bool(np.any(par[:, var.SHIFT] != 0.0)),
+                var_par=par, var_int=ints)
 
 
 def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model, mech,

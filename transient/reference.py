@@ -28,7 +28,7 @@ from .core.breakpoints import next_breakpoint
 from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
 from .core.layout import T
-from .core.variation import cycle_fuel
+from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
 
 
@@ -254,7 +254,7 @@ class ReferenceModel:
         self.factors = 1.0  # each cylinder's fuel factor in its cycle (set by select)
         self.shift = None  # combustion offsets the tables are read with (set by select)
         self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov,
-                                         m.var_shift)
+                                         m.var_par[:, SHIFT])
                           if m.woschni else None)
 
     def load_scale(self, phi: float) -> float:
@@ -285,7 +285,7 @@ class ReferenceModel:
                         if m.var_on else 1.0)
         # with combustion offsets the tables are also read δ_k earlier (not the Woschni closed
         # part's: its combustion is shifted in CylindersNumpy.rates)
-        self.shift = m.var_shift if m.var_shifted and not m.woschni else None
+        self.shift = m.var_par[:, SHIFT] if m.var_shifted and not m.woschni else None
         if self.shift is not None:
             local_shift = np.mod(mid - m.gas_phase - self.shift, m.period)
             self.pieces_shift = self.table.piece_of(local_shift)
@@ -316,7 +316,7 @@ class ReferenceModel:
             if self.cylinders is not None:
                 p = self.cylinders.pressures(p, np.mod(self.mid - m.gas_phase, m.period), y)
             if m.var_on:  # the pressure factor acts on p − p0 (transient.scene.Cylinder)
-                p = m.gas_offset + m.var_press * (p - m.gas_offset)
+                p = m.gas_offset + m.var_par[:, PRESSURE] * (p - m.gas_offset)
             M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
         resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
         if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min

@@ -12,7 +12,8 @@ import pytest
 
 from transient.assemble import build_model
 from transient.cli import main
-from transient.core.variation import cycle_fuel, misfire_draw
+from transient.core.variation import (FUEL, PRESSURE, SHIFT, START, cycle_fuel,
+                                      misfire_draw)
 from transient.errors import SceneError
 from transient.scene import load_scene, scene_from_dict
 
@@ -96,7 +97,7 @@ def test_fuel_factor_per_cycle_follows_the_schedule(scene, phi0_deg):
             assert cycle_fuel(model, k, first + (n - 1) * P + 1e-6) == schedule(entry, k, n)
             assert cycle_fuel(model, k, first + n * P - 1e-6) == schedule(entry, k, n)
     # a random schedule at rate 0.25 misfires about a quarter of the cycles
-    share = np.mean([cycle_fuel(model, 2, model.cycle_start[2] + (n + 0.5) * P) == 0.0
+    share = np.mean([cycle_fuel(model, 2, model.var_par[2, START] + (n + 0.5) * P) == 0.0
                      for n in range(4000)])
     assert abs(share - 0.25) < 5 * math.sqrt(0.25 * 0.75 / 4000)
 
@@ -118,7 +119,7 @@ def test_two_stroke_cycles_begin_at_bdc():
     model, bp, _ = build_model(scene_from_dict(data))
     assert model.period == pytest.approx(2 * math.pi)
     assert np.min(np.abs(bp - math.pi)) < 1e-12  # cylinder 1's BDC: its cycle start
-    assert model.cycle_start[0] == pytest.approx(-math.pi)  # cycle 1 in progress at φ0 = 0
+    assert model.var_par[0, START] == pytest.approx(-math.pi)  # cycle 1 in progress at φ0 = 0
     assert cycle_fuel(model, 0, 0.5) == 1.0  # cycle 1
     assert cycle_fuel(model, 0, math.pi + 0.5) == 0.0  # cycle 2
 
@@ -126,7 +127,7 @@ def test_two_stroke_cycles_begin_at_bdc():
 def test_without_entries_the_model_runs_the_plain_path(scene):
     model, _, _ = build_model(scene.replace(gas={"cylinders": []}))
     assert not model.var_on
-    assert np.all(model.var_fuel == 1.0) and np.all(model.var_press == 1.0)
+    assert np.all(model.var_par[:, [FUEL, PRESSURE]] == 1.0)
 
 
 def test_resolved_scene_reads_back_equal(scene):
@@ -186,7 +187,7 @@ def test_combustion_offset_corners_are_breakpoints(scene):
     base_model, base_bp, table = build_model(scene.replace(gas={"cylinders": []}))
     s = scene.replace(gas={"cylinders": [{"cylinder": 2, "combustion_offset_deg": 3.0}]})
     model, bp, _ = build_model(s)
-    assert model.var_shifted and model.var_shift[1] == pytest.approx(math.radians(3.0))
+    assert model.var_shifted and model.var_par[1, SHIFT] == pytest.approx(math.radians(3.0))
     P = model.period
     moved = np.mod(model.gas_phase[1] + math.radians(3.0) + table.corners[:-1], P)
     gap = np.abs(np.subtract.outer(moved, bp))

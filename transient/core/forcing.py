@@ -25,7 +25,7 @@ from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, OMEGA, PHI, SW_GENERATO
 from .swash_plate import swash_terms
 from .tabulated import tabulated_terms
 from .tables import find_piece, table_eval, table_eval_pair
-from .variation import cycle_fuel
+from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
@@ -58,7 +58,7 @@ def select_pieces(m, sel, wk):
             if m.var_on:
                 wk[WK_FUEL, k] = cycle_fuel(m, k, sel)
             if m.var_shifted:
-                local_shift = (sel - m.gas_phase[k] - m.var_shift[k]) % m.period
+                local_shift = (sel - m.gas_phase[k] - m.var_par[k, SHIFT]) % m.period
                 wk[WK_LOCAL_SHIFT, k] = local_shift
                 wk[WK_PIECE_SHIFT, k] = find_piece(m.knots, m.piece_knot, local_shift)
         wk[WK_SEL, 0] = sel
@@ -151,7 +151,7 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
         x_burn = x_sel  # the combustion's angle: δ_k later with a combustion offset
         if m.var_on:
             f_k *= wk[WK_FUEL, k]
-            x_burn -= m.var_shift[k]
+            x_burn -= m.var_par[k, SHIFT]
         A, B = cyl.pressure_rate(m.mech, m.cyl_par, x_burn + shift, x_burn, local_sel + shift,
                                  y[c + k], m.gas_scale[k] * wk[WK_U, k], w, f_k)
         out[c + k] = A - B / w if angle_mode else w * A - B
@@ -327,13 +327,13 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
                 p_k = cylinder_value(m, k, y, sel, f_k, wk)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
                 if m.var_on:
-                    M_k *= m.var_press[k]
+                    M_k *= m.var_par[k, PRESSURE]
                 M_gas += M_k
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
                 M_k = m.gas_scale[k] * (gas_value(m, k, phi, sel, wk) - m.gas_offset) * u[k]
                 if m.var_on:  # (factors of 1 leave M_k to the last bit)
-                    M_k *= wk[WK_FUEL, k] * m.var_press[k]
+                    M_k *= wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                 M_gas += M_k
             M_gas *= f
     # (with s = 1 exactly the formula without a schedule, to the last bit)

@@ -129,17 +129,12 @@ Model = namedtuple(
         "link_sub",  # int64[n_links]: sub-chain of each link (shaft first, gas-carrying link last)
         "link_J",  # float64[n_links]: constant reduced inertia of the middle links [kg m²]
         # per-cylinder variation (transient.core.variation; the arrays' types are the same
-        # without it, so that one compile serves every scene)
+        # without it, so that one compile serves every scene; packed in two arrays, as a
+        # kernel that is not inlined copies every field of the Model at each call)
         "var_on",  # bool: some cylinder has a [[gas.cylinders]] entry
-        "var_fuel",  # float64[ncyl]: fuel factor φ_k (0: cut out)
-        "var_press",  # float64[ncyl]: pressure factor β_k on p − p0
-        "cycle_start",  # float64[ncyl]: shaft angle where cylinder k's cycle 1 begins [rad]
-        "mis_every",  # int64[ncyl]: cycles n with n % mis_every == 0 misfire (0: none)
-        "mis_cycles",  # int64[ncyl, :]: cycles that misfire, padded with 0
-        "mis_rate",  # float64[ncyl]: probability that a cycle misfires
-        "mis_seed",  # int64[ncyl]: seed of the draws
         "var_shifted",  # bool: some cylinder has a combustion offset
-        "var_shift",  # float64[ncyl]: combustion offset δ_k [rad]
+        "var_par",  # float64[ncyl, variation.N_VAR_PAR]: factors, cycle start, rate, offset
+        "var_int",  # int64[ncyl, 2 + cycles listed]: misfire period, seed, misfiring cycles
     ],
 )
 

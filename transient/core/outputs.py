@@ -14,6 +14,7 @@ from .forcing import command, cylinder_value, moments
 from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_ETA,
                      WK_FUEL, WK_S, cyl_index, gov_index, latch_index)
 from .rhs import acceleration
+from .variation import PRESSURE
 
 
 @kernel
@@ -51,8 +52,9 @@ def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
         if m.var_on:
             f_k *= wk[WK_FUEL, k]
         p_k = cylinder_value(m, k, y, sel, f_k, wk) if m.has_gas else 0.0
-        if m.var_on and m.var_press[k] != 1.0:  # (as it acts on the piston: p0 + β_k(p − p0))
-            p_k = m.gas_offset + m.var_press[k] * (p_k - m.gas_offset)
+        beta = m.var_par[k, PRESSURE] if m.var_on else 1.0
+        if beta != 1.0:  # (as it acts on the piston: p0 + β_k(p − p0))
+            p_k = m.gas_offset + beta * (p_k - m.gas_offset)
         row[N_OUT_FIXED + k] = p_k
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
     j = N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
