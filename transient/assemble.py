@@ -14,6 +14,8 @@ from numpy.typing import NDArray
 from .core import cylinder as cyl
 from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core import variation as var
+from .core.variation import cycle_fuel
 from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, PAPER, PHI, POWER_FLOW, TABULATED,
                           Model, T, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
@@ -112,9 +114,11 @@ def gas_phases(scene) -> NDArray[np.float64]:
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
                 motored: PressureTable | None = None,
-                injection: float | None = None) -> NDArray[np.float64]:
+                injection: float | None = None,
+                cycle_begin: float | None = None) -> NDArray[np.float64]:
     """Sorted shaft angles in [0, period) where any cylinder's table (full-load or motored) has a
-    corner, or (fuel latching) a cylinder starts its injection."""
+    corner, or (fuel latching) a cylinder starts its injection, or (per-cylinder variation) a
+    cylinder begins a cycle (local angle ``cycle_begin``), where its fuel factor may change."""
     if table is None:
         return np.zeros(0)
     corners = table.corners[:-1]  # the period's end is the next cycle's 0
@@ -122,6 +126,8 @@ def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period
         corners = np.union1d(corners, motored.corners[:-1])
     if injection is not None:
         corners = np.union1d(corners, [injection])
+    if cycle_begin is not None:
+        corners = np.union1d(corners, [cycle_begin])
     angles = np.sort(np.mod(np.add.outer(phases, corners).ravel(), period))
     keep = np.concatenate(([True], np.diff(angles) > 1e-12 * period))
     angles = angles[keep]
@@ -143,13 +149,15 @@ def union_of_angles(a: NDArray[np.float64], b: NDArray[np.float64], period: floa
 
 
 def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64],
-                     period: float, mech) -> NDArray[np.bool_]:
+                     period: float, mech, owner=None) -> NDArray[np.bool_]:
     """For each breakpoint, whether a cylinder's gas torque jumps there: its pressure (any of
     ``tables``) jumps while its piston moves (u_k ≠ 0; a jump at a dead centre, as all of the
     crank-slider cycles' are, leaves the torque continuous). The stepper's first stage beyond such
     a breakpoint must be evaluated afresh, not carried over from the step that ended on it (which
     used the table piece before the corner). Vectorised over the corners, which a table from
-    points has at every knot."""
+    points has at every knot. ``owner``: the cylinder of each phase (default: phase k is
+    cylinder k's)."""
+    owner = np.arange(len(phases)) if owner is None else owner
     out = np.zeros(bp.size, dtype=np.bool_)
     tol = 1e-12 * period
     for table in (t for t in tables if t is not None):
@@ -163,7 +171,7 @@ def breakpoint_jumps(bp: NDArray[np.float64], tables, phases: NDArray[np.float64
             for angle in np.mod(phase + jumps, period):
                 gap = np.abs(bp - angle)
                 j = np.flatnonzero(np.minimum(gap, period - gap) <= tol)
-                out[j] |= _piston_moves(mech, k, angle)
+                out[j] |= _piston_moves(mech, int(owner[k]), angle)
     return out
 
 
@@ -276,7 +284,15 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     kin = kinematics_table(scene)
     tabulated = kin is not None and kin.coef is not None
     load_x, load_s, load_comp = load_schedule(scene)
-    bp = breakpoints(table, phases, period, motored, scene.gas.injection)
+    variation = variation_fields(scene, phases)
+    begin = cycle_begin(mech) if variation["var_on"] else None
+    # with combustion offsets a cylinder's tables are read at its angle less δ_k too: their
+    # corners there are breakpoints as well (cylinder ``owner[j]`` for each phase j)
+    shift = variation["var_par"][:, var.SHIFT]
+    moved = np.flatnonzero(shift != 0.0)
+    all_phases = np.concatenate([phases, np.mod(phases[moved] + shift[moved], period)])
+    owner = np.concatenate([np.arange(n), moved])
+    bp = breakpoints(table, all_phases, period, motored, scene.gas.injection, begin)
     curve = load_table_curve(scene)
     if curve is not None and curve.abscissa == "angle":  # its knots are kinks in φ
         bp = union_of_angles(bp, curve.corners, period)
@@ -288,17 +304,68 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), has_motored=motored is not None,
-        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), phases, period, mech),
+        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), all_phases, period, mech,
+                                                 owner),
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
         **load_table_fields(scene), gen_power=scene.load.generator_power, gen_min=scene.load.generator_min_speed,
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene))
+        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation)
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
+        if moved.size:  # the combustion's start and end, δ_k later
+            model.bp_jump[:] |= _on_closed_part_corner(bp, all_phases[n:], model)
+    if begin is not None:
+        model.bp_jump[:] |= _on_cycle_begin(bp, phases, model, mech, begin)
     return model, model.breakpoints, table
+
+
+def cycle_begin(mech) -> float:
+    """Local angle where a cylinder's cycle begins, for its fuel factor and misfires
+    (:mod:`transient.core.variation`): 0, the gas-exchange TDC of a 4-stroke, whose cycle then
+    holds one intake, compression, combustion and exhaust; π, the BDC of a 2-stroke, whose
+    local 0 is its firing TDC, so that no combustion straddles two cycles."""
+    return 0.0 if mech.strokes == 4 else math.pi
+
+
+def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
+    """The per-cylinder variation's part of the Model (:mod:`transient.core.variation`) from the
+    ``[[gas.cylinders]]`` entries; factors of 1 and no misfires for cylinders without one, and
+    ``var_on`` False without any, so that such a scene runs the kernels' plain path."""
+    mech, entries = scene.mechanism, scene.gas.cylinders
+    n, period = mech.n_cylinders, mech.cycle
+    par = np.zeros((n, var.N_VAR_PAR))
+    par[:, [var.FUEL, var.PRESSURE]] = 1.0
+    listed = max([len(c.misfire_cycles) for c in entries] + [1])
+    ints = np.zeros((n, var.CYCLES + listed), dtype=np.int64)
+    for c in entries:
+        k = c.cylinder - 1
+        par[k, [var.FUEL, var.PRESSURE, var.RATE, var.SHIFT]] = (
+            c.fuel, c.pressure, c.misfire_rate, c.combustion_offset)
+        ints[k, [var.EVERY, var.SEED]] = c.misfire_every, c.misfire_seed
+        ints[k, var.CYCLES:var.CYCLES + len(c.misfire_cycles)] = c.misfire_cycles
+    # cycle 1 of cylinder k: the one in progress at the initial angle φ0
+    first = np.mod(phases + cycle_begin(mech), period)
+    phi0 = scene.initial.phi
+    par[:, var.START] = phi0 - np.mod(phi0 - first, period)
+    return dict(var_on=bool(entries), var_shifted=bool(np.any(par[:, var.SHIFT] != 0.0)),
+                var_par=par, var_int=ints)
+
+
+def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model, mech,
+                    begin: float) -> NDArray[np.bool_]:
+    """Breakpoints where a cylinder begins a cycle while its piston moves: its fuel factor may
+    change there, and with it its gas torque (at a dead centre, where every crank-slider's cycle
+    begins, the torque stays continuous and the stepper's carried-over stage stays valid)."""
+    out = np.zeros(bp.size, dtype=np.bool_)
+    for k, phase in enumerate(phases):
+        angle = (phase + begin) % model.period
+        gap = np.abs(bp - angle)
+        j = np.flatnonzero(np.minimum(gap, model.period - gap) <= 1e-12 * model.period)
+        out[j] |= _piston_moves(mech, k, angle)
+    return out
 
 
 def cylinder_fields(scene) -> dict:
@@ -415,7 +482,8 @@ def initial_cylinders(scene, model: Model, f0: float) -> list[float]:
     for k in range(model.ncyl):
         local = (phi0 - model.gas_phase[k]) % model.period
         closed = cyl.closed_angle(model.cyl_par, local, model.period) >= 0.0
-        out.append(applied_value(model, k, phi0, sel, f0, wk) if closed
+        f_k = f0 * cycle_fuel(model, k, sel) if model.var_on else f0
+        out.append(applied_value(model, k, phi0, sel, f_k, wk) if closed
                    else model.cyl_par[cyl.P_A])
     return out
 

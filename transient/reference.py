@@ -28,6 +28,7 @@ from .core.breakpoints import next_breakpoint
 from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
 from .core.layout import T
+from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
 
 
@@ -106,12 +107,14 @@ class CylindersNumpy:
     Woschni's combustion term are switched by the segment between breakpoints, as in
     :func:`transient.forces.closed_cycle.integrate_closed`."""
 
-    def __init__(self, scene, phases: np.ndarray, period: float, c: int) -> None:
+    def __init__(self, scene, phases: np.ndarray, period: float, c: int,
+                 offsets: np.ndarray) -> None:
         from .assemble import clearance_volume, wiebe_levels
         from .forces import closed_cycle, woschni
 
         gas, mech = scene.gas, scene.mechanism
         self.fn, self.w, self.c, self.period, self.phases = woschni, gas.wiebe, c, period, phases
+        self.offsets = offsets  # each cylinder's combustion offset [rad]
         self.zone = closed_cycle
         self.heat = woschni.WoschniParameters.of_mechanism(
             mech, c1=gas.woschni.c1, c2=gas.woschni.c2,
@@ -142,8 +145,9 @@ class CylindersNumpy:
             if not np.isfinite(x_mid):
                 out.append(0.0)
                 continue
-            x, p = x_mid + phi_shift, y[self.c + k]
             v = float(self.volume(np.array([local_mid[k] + phi_shift]))[0])
+            x_mid = x_mid - self.offsets[k]  # (the combustion's angle, δ_k later)
+            x, p = x_mid + phi_shift, y[self.c + k]
             burnt = x_mid >= self.start
             burning = burnt and x_mid < self.start + w_.duration
             q = fuel[k] * w_.fuel_mass * w_.lhv * w_.efficiency
@@ -248,7 +252,10 @@ class ReferenceModel:
         self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
         self.n_gov = gv.n_states(m.gov_dyn)
         self.latched = None  # fuel per cylinder, with latching (set by run_reference)
-        self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov)
+        self.factors = 1.0  # each cylinder's fuel factor in its cycle (set by select)
+        self.shift = None  # combustion offsets the tables are read with (set by select)
+        self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov,
+                                         m.var_par[:, SHIFT])
                           if m.woschni else None)
 
     def load_scale(self, phi: float) -> float:
@@ -273,6 +280,18 @@ class ReferenceModel:
         if self.motored is not None:
             self.motored_pieces = self.motored.piece_of(local)
         self.mid = mid
+        m = self.model
+        # each cylinder's fuel factor in the cycle of the segment (its cycle begins on a breakpoint)
+        self.factors = (np.array([cycle_fuel(m, k, mid) for k in range(m.ncyl)])
+                        if m.var_on else 1.0)
+        # with combustion offsets the tables are also read δ_k earlier (not the Woschni closed
+        # part's: its combustion is shifted in CylindersNumpy.rates)
+        self.shift = m.var_par[:, SHIFT] if m.var_shifted and not m.woschni else None
+        if self.shift is not None:
+            local_shift = np.mod(mid - m.gas_phase - self.shift, m.period)
+            self.pieces_shift = self.table.piece_of(local_shift)
+            if self.motored is not None:
+                self.motored_pieces_shift = self.motored.piece_of(local_shift)
 
     def moments(self, phi: float, w: float, y):
         m = self.model
@@ -282,14 +301,23 @@ class ReferenceModel:
         p = np.zeros(m.ncyl)
         if self.table is not None:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
-            f = self.latched if self.latched is not None else self.command(w, y)
+            f = (self.latched if self.latched is not None else self.command(w, y)) * self.factors
             p_full = self.table.evaluate(local, self.pieces)[0]
             # p = p_mot + f·(p_full − p_mot); the motored curve is p0 without a motored table
             p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
                      if self.motored is not None else m.gas_offset)
-            p = p_mot + f * (p_full - p_mot)
+            if self.shift is None:
+                p = p_mot + f * (p_full - p_mot)
+            else:  # p_mot(x) + f·(p_full(x − δ) − p_mot(x − δ))
+                x = np.mod(self.mid - m.gas_phase - self.shift, m.period) + (phi - self.mid)
+                p_full = self.table.evaluate(x, self.pieces_shift)[0]
+                p_mot_shift = (self.motored.evaluate(x, self.motored_pieces_shift)[0]
+                               if self.motored is not None else m.gas_offset)
+                p = p_mot + f * (p_full - p_mot_shift)
             if self.cylinders is not None:
                 p = self.cylinders.pressures(p, np.mod(self.mid - m.gas_phase, m.period), y)
+            if m.var_on:  # the pressure factor acts on p − p0 (transient.scene.Cylinder)
+                p = m.gas_offset + m.var_par[:, PRESSURE] * (p - m.gas_offset)
             M_gas = float(np.sum(m.gas_scale * (p - m.gas_offset) * u))
         resist = m.load_const + m.load_linear * w + m.load_fan * w * abs(w)
         if m.gen_power != 0.0:  # an electrical load of power s·P, held below ω_min
@@ -345,7 +373,7 @@ class ReferenceModel:
         m = self.model
         u = self.mechanism_terms(phi)[2]
         fuel = (self.latched if self.latched is not None
-                else np.full(m.ncyl, self.command(w, y)))
+                else np.full(m.ncyl, self.command(w, y))) * self.factors
         return self.cylinders.rates(np.mod(self.mid - m.gas_phase, m.period), phi - self.mid, u,
                                     w, fuel, y)
 

@@ -320,7 +320,7 @@ def _type(entry: dict, name: str, classes: list[type]) -> str:
         for cls in classes:
             hint = typing.get_type_hints(cls).get(name) if dataclasses.is_dataclass(cls) else None
             if hint is not None:
-                text = "array of tables" if name == "pairs" else _hint(hint)
+                text = "array of tables" if name in ("pairs", "cylinders") else _hint(hint)
         text = text or "value"
     if entry["kind"]:
         text += f" [{SI_UNIT[entry['kind']]}]"

@@ -85,7 +85,9 @@ def wall_heat(par, burnt, p, V, T, w):
 
 @kernel(inline=True)
 def pressure_rate(mech, par, x, x_sel, local, p, dVdx, w, fuel):
-    """(A, B) of dp/dx = A − B/ω at ``x`` past intake closing (module docstring). The combustion
+    """(A, B) of dp/dx = A − B/ω at ``x`` past intake closing (module docstring; ``x`` and
+    ``x_sel`` less the cylinder's combustion offset, which moves its combustion, not its
+    volume at ``local``). The combustion
     and Woschni's combustion term are on or off for the whole step, as the angle ``x_sel`` of
     the step's piece says (its start and end are breakpoints), so that every step integrates a
     smooth right-hand side."""

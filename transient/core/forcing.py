@@ -20,11 +20,12 @@ from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
 from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, LT_ANGLE, LT_NONE, LT_SPEED, OMEGA, PHI,
                      SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_SLEEVE, SW_STARTER, T, TABULATED,
-                     WK_DEMAND, WK_DU, WK_LOCAL, WK_PIECE, WK_SEL, WK_U, cyl_index, gov_index,
-                     latch_index)
+                     WK_DEMAND, WK_DU, WK_FUEL, WK_LOCAL, WK_LOCAL_SHIFT, WK_PIECE, WK_PIECE_SHIFT,
+                     WK_SEL, WK_U, cyl_index, gov_index, latch_index)
 from .swash_plate import swash_terms
 from .tabulated import tabulated_terms
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
+from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
@@ -42,15 +43,24 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
 
 @kernel(inline=True)
 def select_pieces(m, sel, wk):
-    """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL) and the gas table's piece there
-    (WK_PIECE). ``sel`` is one angle for a whole step, so they are computed when it changes and
-    kept, not recomputed in each of a step's right-hand sides, whose cost numba's float modulo
-    would otherwise add to noticeably."""
+    """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL), the gas table's piece there
+    (WK_PIECE) and, with per-cylinder variation, its fuel factor in that cycle (WK_FUEL) and the
+    angle and piece of its curve shifted by its combustion offset (WK_LOCAL_SHIFT,
+    WK_PIECE_SHIFT). ``sel``
+    is one angle for a whole step, so they are computed when it changes and kept, not recomputed
+    in each of a step's right-hand sides, whose cost numba's float modulo would otherwise add to
+    noticeably."""
     if wk[WK_SEL, 0] != sel:
         for k in range(m.ncyl):
             local_sel = (sel - m.gas_phase[k]) % m.period
             wk[WK_LOCAL, k] = local_sel
             wk[WK_PIECE, k] = find_piece(m.knots, m.piece_knot, local_sel)
+            if m.var_on:
+                wk[WK_FUEL, k] = cycle_fuel(m, k, sel)
+            if m.var_shifted:
+                local_shift = (sel - m.gas_phase[k] - m.var_par[k, SHIFT]) % m.period
+                wk[WK_LOCAL_SHIFT, k] = local_shift
+                wk[WK_PIECE_SHIFT, k] = find_piece(m.knots, m.piece_knot, local_shift)
         wk[WK_SEL, 0] = sel
 
 
@@ -60,12 +70,25 @@ def gas_value(m, k, phi, sel, wk):
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
     ends exactly on a corner keeps using the piece it integrates over (DESIGN §2, breakpoints).
-    The piece is the one :func:`select_pieces` left in ``wk`` for it.
+    The piece is the one :func:`select_pieces` left in ``wk`` for it. With combustion offsets
+    the value is the curve's δ_k later, p_full(x − δ_k) (:func:`shifted`).
     """
-    local_sel = wk[WK_LOCAL, k]
-    value, _ = table_eval(m.knots, m.coef, m.piece_knot, int(wk[WK_PIECE, k]),
-                          local_sel + (phi - sel))
+    if shifted(m):
+        local_sel = wk[WK_LOCAL_SHIFT, k]
+        piece = int(wk[WK_PIECE_SHIFT, k])
+    else:
+        local_sel = wk[WK_LOCAL, k]
+        piece = int(wk[WK_PIECE, k])
+    value, _ = table_eval(m.knots, m.coef, m.piece_knot, piece, local_sel + (phi - sel))
     return value
+
+
+@kernel(inline=True)
+def shifted(m):
+    """Whether the tables are read at each cylinder's angle less its combustion offset: with
+    offsets, unless the closed part is a state (``m.woschni``), whose combustion is shifted in
+    its rates (:func:`cylinder_rates`) and whose gas exchange is the same at every fuel."""
+    return m.var_shifted and not m.woschni
 
 
 @kernel(inline=True)
@@ -87,6 +110,11 @@ def applied_value(m, k, phi, sel, f, wk):
     """
     if m.has_motored:
         p, p_mot = gas_pair(m, k, phi, sel, wk)
+        if shifted(m):  # the combustion's part δ_k later, the motored curve with the piston
+            p, p_mot_shift = table_eval_pair(m.knots, m.coef, m.piece_knot,
+                                             int(wk[WK_PIECE_SHIFT, k]),
+                                             wk[WK_LOCAL_SHIFT, k] + (phi - sel))
+            return p_mot + f * (p - p_mot_shift)
         return p_mot + f * (p - p_mot)
     p = gas_value(m, k, phi, sel, wk)
     if f == 1.0:
@@ -120,7 +148,11 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
             continue
         shift = y[PHI] - sel  # the angles at y, continued from the step's piece
         f_k = y[lc + k] if m.latch else f
-        A, B = cyl.pressure_rate(m.mech, m.cyl_par, x_sel + shift, x_sel, local_sel + shift,
+        x_burn = x_sel  # the combustion's angle: δ_k later with a combustion offset
+        if m.var_on:
+            f_k *= wk[WK_FUEL, k]
+            x_burn -= m.var_par[k, SHIFT]
+        A, B = cyl.pressure_rate(m.mech, m.cyl_par, x_burn + shift, x_burn, local_sel + shift,
                                  y[c + k], m.gas_scale[k] * wk[WK_U, k], w, f_k)
         out[c + k] = A - B / w if angle_mode else w * A - B
 
@@ -309,7 +341,9 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
 
     Generalized forces follow (19): M = Σ P_q u_q + Σ M_k. The gas force of cylinder k is
     (p_k − p0)·F_p with p_k = p_mot + f·(p_full − p_mot) at the governor's fuel f
-    (:func:`applied_value`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
+    (:func:`applied_value`); with per-cylinder variation f is cylinder k's fuel factor in its
+    cycle times the command, and the force is multiplied by its pressure factor β_k
+    (:mod:`.variation`). The load is M_load = −s·(torque + linear·ω + fan·ω|ω| +
     P/max(ω, ω_min) + T(x)), s from the schedule's segment ``sw[SW_LOAD]``, the max from the
     generator's branch ``sw[SW_GENERATOR]`` and T(x) the tabulated load (:func:`table_load`).
     With fuel latching cylinder k burns the fuel it took at its last injection, else every
@@ -328,11 +362,19 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
             c = latch_index(m)
             for k in range(m.ncyl):
                 f_k = y[c + k] if m.latch else f
+                if m.var_on:
+                    f_k *= wk[WK_FUEL, k]
                 p_k = cylinder_value(m, k, y, sel, f_k, wk)
-                M_gas += m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
+                M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
+                if m.var_on:
+                    M_k *= m.var_par[k, PRESSURE]
+                M_gas += M_k
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
-                M_gas += m.gas_scale[k] * (gas_value(m, k, phi, sel, wk) - m.gas_offset) * u[k]
+                M_k = m.gas_scale[k] * (gas_value(m, k, phi, sel, wk) - m.gas_offset) * u[k]
+                if m.var_on:  # (factors of 1 leave M_k to the last bit)
+                    M_k *= wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
+                M_gas += M_k
             M_gas *= f
     # (with s = 1 exactly the formula without a schedule, to the last bit)
     s = load_scale(m, y, sw[SW_LOAD])

@@ -81,9 +81,12 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
 #: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
 #: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
-#: (:func:`.forcing.select_pieces`).
+#: (:func:`.forcing.select_pieces`), with per-cylinder variation its fuel factor in that cycle
+#: (WK_FUEL, :func:`.variation.cycle_fuel`) and, with combustion offsets, its angle and piece
+#: on the curve shifted by its offset (WK_LOCAL_SHIFT, WK_PIECE_SHIFT).
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
- WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_SCRATCH) = range(17)
+ WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
+ WK_SCRATCH) = range(20)
 N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
 
 Model = namedtuple(
@@ -134,6 +137,13 @@ Model = namedtuple(
         "policy",  # int: POWER_FLOW or PAPER
         "link_sub",  # int64[n_links]: sub-chain of each link (shaft first, gas-carrying link last)
         "link_J",  # float64[n_links]: constant reduced inertia of the middle links [kg m²]
+        # per-cylinder variation (transient.core.variation; the arrays' types are the same
+        # without it, so that one compile serves every scene; packed in two arrays, as a
+        # kernel that is not inlined copies every field of the Model at each call)
+        "var_on",  # bool: some cylinder has a [[gas.cylinders]] entry
+        "var_shifted",  # bool: some cylinder has a combustion offset
+        "var_par",  # float64[ncyl, variation.N_VAR_PAR]: factors, cycle start, rate, offset
+        "var_int",  # int64[ncyl, 2 + cycles listed]: misfire period, seed, misfiring cycles
     ],
 )
 

@@ -12,8 +12,9 @@ from .jit import kernel
 
 from .forcing import command, cylinder_value, moments
 from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_ETA,
-                     WK_S, cyl_index, gov_index, latch_index)
+                     WK_FUEL, WK_S, cyl_index, gov_index, latch_index)
 from .rhs import acceleration
+from .variation import PRESSURE
 
 
 @kernel
@@ -26,7 +27,8 @@ def output_row(m, angle_mode, y, sel, sw, wk, row):
 @kernel(inline=True)
 def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
-    (p_mot + f·(p_full − p_mot), see :func:`applied_value`), ``PAIR_OUTPUTS`` of each pair, the
+    (p_mot + f·(p_full − p_mot), see :func:`applied_value`, with a cylinder's fuel and pressure
+    factors), ``PAIR_OUTPUTS`` of each pair, the
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
     samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
@@ -47,7 +49,13 @@ def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
     c = latch_index(m)
     for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
         f_k = y[c + k] if m.latch else f
-        row[N_OUT_FIXED + k] = cylinder_value(m, k, y, sel, f_k, wk) if m.has_gas else 0.0
+        if m.var_on:
+            f_k *= wk[WK_FUEL, k]
+        p_k = cylinder_value(m, k, y, sel, f_k, wk) if m.has_gas else 0.0
+        beta = m.var_par[k, PRESSURE] if m.var_on else 1.0
+        if beta != 1.0:  # (as it acts on the piston: p0 + β_k(p − p0))
+            p_k = m.gas_offset + beta * (p_k - m.gas_offset)
+        row[N_OUT_FIXED + k] = p_k
     pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
     j = N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
     for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels

@@ -13,8 +13,9 @@ Every key may be written in SI (``crank_radius = 0.047``) or with one unit suffi
 - :mod:`.write`    :func:`to_toml`, the resolved scene back to TOML
 """
 from .read import load_scene, replace_scene, scene_from_dict
-from .records import (POLICIES, Analysis, Friction, Gas, Governor, Inertia, Initial, Load, LoadTable,
-                      Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni, runs_compiled)
+from .records import (POLICIES, Analysis, Cylinder, Friction, Gas, Governor, Inertia, Initial,
+                      Load, LoadTable, Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni,
+                      runs_compiled)
 from .write import to_toml
 
 # Scenes from code: the records cannot import their reader (it imports them), so the methods
@@ -24,5 +25,5 @@ Scene.replace = replace_scene
 Scene.to_toml = to_toml
 
 __all__ = ["load_scene", "scene_from_dict", "replace_scene", "to_toml", "Scene", "Inertia", "Gas", "Wiebe",
-           "Woschni", "Load", "LoadTable", "Starter", "Governor", "Initial", "Run", "Solver", "Output",
-           "Friction", "Pair", "Analysis", "POLICIES", "runs_compiled"]
+           "Woschni", "Cylinder", "Load", "LoadTable", "Starter", "Governor", "Initial", "Run",
+           "Solver", "Output", "Friction", "Pair", "Analysis", "POLICIES", "runs_compiled"]

@@ -97,6 +97,29 @@ def check_gas_table(scene: Scene, section: Section) -> None:
         if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi"):
             exc.key = "gas.file"
         raise section.rename(exc) from None
+    if scene.gas.woschni is not None:
+        check_offsets_in_closed_part(scene)
+
+
+def check_offsets_in_closed_part(scene: Scene) -> None:
+    """With wall heat transfer a cylinder's combustion is integrated inside its closed part:
+    shifted by its combustion offset, it must still lie between intake closing and exhaust
+    opening."""
+    from ..assemble import wiebe_levels
+
+    mech, gas = scene.mechanism, scene.gas
+    cycle = wiebe_levels(mech, gas)[-1]
+    closed = (cycle.closed.end - cycle.closed.start) % mech.cycle or mech.cycle
+    start = (cycle.combustion_start - cycle.closed.start) % mech.cycle
+    for i, c in enumerate(gas.cylinders):
+        a, b = start + c.combustion_offset, start + gas.wiebe.duration + c.combustion_offset
+        if a < 0.0 or b > closed:
+            lo, hi = -start, closed - start - gas.wiebe.duration
+            raise SceneError(f"gas.cylinders[{i}].combustion_offset",
+                             f"{math.degrees(c.combustion_offset):g}° moves the combustion out "
+                             f"of the closed part (intake closing to exhaust opening), which "
+                             f"[gas.woschni] integrates; allowed {math.degrees(lo):g}° to "
+                             f"{math.degrees(hi):g}°")
 
 
 def check_analysis(scene: Scene) -> None:

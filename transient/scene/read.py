@@ -21,9 +21,10 @@ from .files import parse_toml, read_text, table_number, table_rows
 from .reader import MISSING, Section, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
-                      MAX_SAMPLES_PER_REV, METHODS, MIN_OUTPUT_DT, POLICIES, Analysis, Friction,
-                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
-                      Solver, Starter, Wiebe, Woschni)
+                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
+                      MIN_OUTPUT_DT, POLICIES, Analysis, Cylinder, Friction, Gas, Governor,
+                      Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene, Solver, Starter,
+                      Wiebe, Woschni)
 from .write import to_toml
 
 
@@ -94,7 +95,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
                                       si.number("load", default=0.0, ge=0.0))
         si.finish()
         sg = root.sub("gas")
-        sections["gas"] = _read_gas(sg, base_dir, mech.strokes)
+        sections["gas"] = _read_gas(sg, base_dir, mech.strokes, mech.n_cylinders)
         sg.finish()
         sl = root.sub("load")
         sections["load"] = _read_load(sl, base_dir, mech.cycle)
@@ -162,12 +163,60 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         raise
 
 
-def _read_gas(s: Section, base_dir: Path, strokes: int) -> Gas:
+def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: int) -> Gas:
     gas = _read_gas_model(s, base_dir, strokes)
+    cylinders = _read_cylinders(s, n_cylinders)
     if gas.model == "none":
+        if cylinders:
+            raise SceneError(s.key("cylinders"), "varies the gas force of cylinders that have "
+                                                 "none; give a gas model (gas.model) or leave "
+                                                 "[[gas.cylinders]] out")
         return gas
     cycle = 2.0 * math.pi * strokes / 2
-    return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle))
+    return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle),
+                   cylinders=cylinders)
+
+
+def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
+    """The [[gas.cylinders]] entries: per cylinder its fuel and pressure factors, cut-out and
+    misfires (:class:`~.records.Cylinder`), sorted by cylinder."""
+    s.known.append("cylinders")
+    raw = s.data.pop("cylinders", [])
+    if not isinstance(raw, list):
+        raise SceneError(s.key("cylinders"), "must be an array of tables ([[gas.cylinders]])")
+    out, seen = [], {}
+    top = MAX_CYLINDER_FACTOR
+    for i, item in enumerate(raw):
+        cs = Section(item, f"{s.key('cylinders')}[{i}]")
+        k = cs.integer("cylinder", ge=1, le=n_cylinders)
+        if k in seen:
+            raise SceneError(cs.key("cylinder"), f"cylinder {k} has an entry already "
+                                                 f"({s.key('cylinders')}[{seen[k]}]); give each "
+                                                 f"cylinder one entry")
+        seen[k] = i
+        fuel = cs.number("fuel", default=1.0, ge=0.0, le=top)
+        pressure = cs.number("pressure", default=1.0, ge=0.0, le=top)
+        cut_out = cs.flag("cut_out", False)
+        if cut_out and cs.written.get("fuel"):
+            raise SceneError(cs.key("cut_out"), "is given with 'fuel'; a cut-out cylinder gets "
+                                                "no fuel (factor 0): give one of them")
+        cycles = cs.integers("misfire_cycles", ())
+        for c in cycles:
+            if c < 1:
+                raise SceneError(cs.key("misfire_cycles"), f"must hold cycle numbers ≥ 1, got "
+                                                           f"{c}; cycle 1 is the one in "
+                                                           f"progress at the start")
+        offset = cs.number("combustion_offset", "angle", 0.0, ge=-MAX_COMBUSTION_OFFSET,
+                           le=MAX_COMBUSTION_OFFSET)
+        entry = Cylinder(cylinder=k, fuel=0.0 if cut_out else fuel, pressure=pressure,
+                         cut_out=cut_out, misfire_cycles=tuple(sorted(set(cycles))),
+                         misfire_every=cs.integer("misfire_every", 0, ge=0),
+                         misfire_rate=cs.number("misfire_rate", default=0.0, ge=0.0, le=1.0),
+                         misfire_seed=cs.integer("misfire_seed", 0, ge=0, le=2 ** 63 - 1),
+                         combustion_offset=offset)
+        cs.finish()
+        out.append(entry)
+    return tuple(sorted(out, key=lambda c: c.cylinder))
 
 
 def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:

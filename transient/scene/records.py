@@ -74,6 +74,56 @@ class Woschni:
     wall_temperature: float = 450.0
 
 
+#: Largest fuel or pressure factor of a cylinder [1]: beyond twice the full-load cycle the
+#: interpolation p_mot + f·(p_full − p_mot) extrapolates far outside what its tables describe.
+MAX_CYLINDER_FACTOR = 2.0
+#: Largest combustion offset of a cylinder [rad] (30°): an injection timing's spread is a few
+#: degrees, and a shift much larger would move a table's combustion into its gas exchange.
+MAX_COMBUSTION_OFFSET = math.pi / 6.0
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """How one cylinder departs from the others: a ``[[gas.cylinders]]`` entry.
+
+    ``cylinder`` [1]: its number, 1 to the mechanism's cylinder count. ``fuel`` [1]: its fuel
+    factor φ_k, multiplying the governor's command, so that its pressure is
+    p_mot + φ_k·f·(p_full − p_mot) (:class:`Gas`; for ``"wiebe"`` with ``[gas.woschni]`` the
+    heat released); ``cut_out``: no fuel in any cycle (φ_k = 0, the motored curve). ``pressure``
+    [1]: its pressure factor β_k, multiplying its pressure above p0 where it acts on the piston,
+    p0 + β_k·(p − p0) (a leaking cylinder, or an indicator's calibration): the gas force, the
+    ``p_<k>`` column and the work all see it. Both in [0, 2].
+
+    ``combustion_offset`` δ_k [rad] (``combustion_offset_deg``), within ±30°: its combustion
+    happens δ_k later (earlier if negative),
+    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x. For ``"table"``, ``"mixed-cycle"`` and ``"trapezoid"``, whose motored
+    curve is p0, that moves the whole curve (the table holds no other account of the
+    combustion); for ``"wiebe"`` the combustion's part only, the motored compression staying
+    with the piston; with ``[gas.woschni]`` the heat release and Woschni's combustion term of
+    the closed part, which must then still lie inside it.
+
+    **Misfire.** In a misfiring cycle the cylinder burns nothing (its fuel is 0 for that whole
+    cycle). A cylinder's cycles begin at its local angle 0 (the gas-exchange TDC of a 4-stroke)
+    or π (the BDC of a 2-stroke, so that no combustion straddles two cycles); cycle 1 is the
+    one in progress at the initial angle. ``misfire_cycles``: the cycles that misfire (each
+    ≥ 1); ``misfire_every`` n [1]: cycles n, 2n, 3n, … misfire (0: none); ``misfire_rate`` [1]
+    in [0, 1]: each cycle misfires with this probability, drawn from ``misfire_seed`` (a
+    counter-based generator, :func:`transient.core.variation.misfire_draw`, the same draws for the
+    same seed, cylinder and cycle in every run and on every machine). A cycle misfires if any
+    of the three says so.
+    """
+
+    cylinder: int
+    fuel: float = 1.0
+    pressure: float = 1.0
+    cut_out: bool = False
+    misfire_cycles: tuple[int, ...] = ()
+    misfire_every: int = 0
+    misfire_rate: float = 0.0
+    misfire_seed: int = 0
+    combustion_offset: float = 0.0
+
+
 @dataclass(frozen=True)
 class Gas:
     """Cylinder pressure model (angle-only in this version).
@@ -105,6 +155,10 @@ class Gas:
     indicated work at f = 0.25 is then 7.6 % low). Use a constant γ where part load matters.
     The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"``).
 
+    **Per-cylinder variation.** ``cylinders``: the ``[[gas.cylinders]]`` entries
+    (:class:`Cylinder`), a cylinder's fuel and pressure factors, its cut-out and its misfires;
+    cylinders without an entry are as the model gives them.
+
     **Fuel latching.** With ``injection`` [rad] (a local angle, as the tables'), each cylinder
     takes the governor's command at its start of injection and burns that fuel until its next
     one, so that the governor acts with the real per-cylinder delay (event ``injection``);
@@ -131,6 +185,7 @@ class Gas:
     wiebe: Wiebe | None = None
     injection: float | None = None
     woschni: Woschni | None = None
+    cylinders: tuple[Cylinder, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -65,6 +65,11 @@ def _gas_section(gas: Gas) -> list[str]:
     if gas.woschni is not None:
         lines += ["", "[gas.woschni]"] + [f"{f.name} = {toml_value(getattr(gas.woschni, f.name))}"
                                           for f in fields(gas.woschni)]
+    for c in gas.cylinders:  # (a cut-out writes no fuel: the reader refuses both together)
+        lines += ["", "[[gas.cylinders]]"] + [
+            f"{f.name} = {toml_value(list(v) if isinstance(v, tuple) else v)}"
+            for f in fields(c) for v in [getattr(c, f.name)]
+            if not (f.name == "fuel" and c.cut_out)]
     return lines
 
 
