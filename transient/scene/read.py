@@ -499,8 +499,8 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
             raise SceneError(s.key(given[1] if len(given) > 1 else "torque"),
                              f"needs exactly one abscissa of {names} (or a CSV 'file'), got "
                              f"{what}")
-        name = given[0]
-        x = s.numbers(name, LOAD_TABLE_ABSCISSAE[name][0])
+        name = given[0]  # (read as optional: any one of them is, none alone is required)
+        x = s.numbers(name, LOAD_TABLE_ABSCISSAE[name][0], ())
         torque = s.numbers("torque")
         key = s.key(s.written.get(name, name))
         where = ""
