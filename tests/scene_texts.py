@@ -1,4 +1,5 @@
-"""Scene files the tests share, as TOML text: one copy of each (on ``pythonpath``, pyproject)."""
+"""Scene files the tests share, as TOML text: one copy of each (on ``pythonpath``, pyproject),
+and :func:`check_text`, which runs ``transient check`` on such a text."""
 
 #: A valid small scene: one crank-slider cylinder (the Gots diesel's, two-mass rod), no forces,
 #: 2 revolutions from 1000 rpm, coarse output. The scene-error tests break one thing of it; line
@@ -51,3 +52,15 @@ n2 = 1.228
 p_intake_MPa = 0.165
 p_exhaust_MPa = 0.182
 """
+
+
+def check_text(tmp_path, capsys, text: str):
+    """``transient check`` on ``text`` written to ``tmp_path/bad.toml``: (path, exit code,
+    stdout, stderr)."""
+    from transient.cli import main
+
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    code = main(["check", str(path)])
+    out, err = capsys.readouterr()
+    return path, code, out, err

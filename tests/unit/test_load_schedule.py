@@ -19,10 +19,9 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scene_texts import SMALL
+from scene_texts import SMALL, check_text
 
 from transient.assemble import build_model
-from transient.cli import main
 from transient.core import forcing
 from transient.core import layout
 from transient.scene import Load, load_scene, scene_from_dict, to_toml
@@ -133,18 +132,10 @@ ERRORS = [
 ]
 
 
-def check(tmp_path, capsys, text):
-    path = tmp_path / "bad.toml"
-    path.write_text(text, encoding="utf-8")
-    code = main(["check", str(path)])
-    out, err = capsys.readouterr()
-    return path, code, out, err
-
-
 @pytest.mark.parametrize("lines, key, fragment",
                          [pytest.param(t, k, f, id=i) for i, t, k, f in ERRORS])
 def test_invalid_load_is_one_line_exit_2(tmp_path, capsys, lines, key, fragment):
-    path, code, out, err = check(tmp_path, capsys, with_load(lines))
+    path, code, out, err = check_text(tmp_path, capsys, with_load(lines))
     assert code == 2 and out == ""
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert err.startswith(f"{path}: {key}: "), err
@@ -157,7 +148,7 @@ def test_valid_schedules_pass(tmp_path, capsys):
                   "schedule_revolutions = [-1, 5]\nschedule_scale = [0, 0]",
                   "schedule_time = [2]\nschedule_scale = [0.5]",
                   "schedule_time = []\nschedule_scale = []"):
-        assert check(tmp_path, capsys, with_load(lines))[1] == 0, lines
+        assert check_text(tmp_path, capsys, with_load(lines))[1] == 0, lines
 
 
 # ------------------------------------------------------------------------------------------------

@@ -20,14 +20,13 @@ import tomllib
 
 import numpy as np
 import pytest
-from scene_texts import SMALL
+from scene_texts import SMALL, check_text
 
 from transient.assemble import build_model, load_table_curve
-from transient.cli import main
 from transient.core import forcing
 from transient.core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI, SW_LOAD_TABLE,
                                    T, work_array)
-from transient.forces.load_table import LoadCurve, interpolant, load_curve
+from transient.forces.load_table import interpolant, load_curve
 from transient.scene import LoadTable, load_scene, to_toml
 
 RPM = math.pi / 30.0
@@ -117,18 +116,10 @@ ERRORS = [
 ]
 
 
-def check(tmp_path, capsys, text):
-    path = tmp_path / "bad.toml"
-    path.write_text(text, encoding="utf-8")
-    code = main(["check", str(path)])
-    out, err = capsys.readouterr()
-    return path, code, out, err
-
-
 @pytest.mark.parametrize("lines, key, fragment",
                          [pytest.param(t, k, f, id=i) for i, t, k, f in ERRORS])
 def test_invalid_table_is_one_line_exit_2(tmp_path, capsys, lines, key, fragment):
-    path, code, out, err = check(tmp_path, capsys, with_load(lines))
+    path, code, out, err = check_text(tmp_path, capsys, with_load(lines))
     assert code == 2 and out == "", err
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert err.startswith(f"{path}: {key}: "), err
@@ -147,7 +138,7 @@ CSV_ERRORS = [
 @pytest.mark.parametrize("csv, fragment", CSV_ERRORS)
 def test_invalid_csv_is_one_line_exit_2(tmp_path, capsys, csv, fragment):
     (tmp_path / "fan.csv").write_text(csv, encoding="utf-8")
-    path, code, out, err = check(tmp_path, capsys, with_load("[load.table]\nfile = \"fan.csv\""))
+    path, code, out, err = check_text(tmp_path, capsys, with_load("[load.table]\nfile = \"fan.csv\""))
     assert code == 2 and out == "", err
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert err.startswith(f"{path}: load.table.file: "), err
@@ -155,7 +146,7 @@ def test_invalid_csv_is_one_line_exit_2(tmp_path, capsys, csv, fragment):
 
 
 def test_missing_csv_names_the_key(tmp_path, capsys):
-    path, code, _, err = check(tmp_path, capsys, with_load("[load.table]\nfile = \"no.csv\""))
+    path, code, _, err = check_text(tmp_path, capsys, with_load("[load.table]\nfile = \"no.csv\""))
     assert code == 2 and err.startswith(f"{path}: load.table.file: no such file 'no.csv'"), err
 
 
