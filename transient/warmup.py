@@ -75,8 +75,9 @@ WARMUP_SCENES = (
 @dataclass(frozen=True)
 class Compiled:
     """One function compiled: ``name`` (module and qualified name), the CPU seconds and the
-    wall seconds it took including the callees compiled inside it, and the CPU seconds of its
-    own (``own_cpu_s``: without them)."""
+    wall seconds it took including the callees compiled inside it, the CPU seconds of its own
+    (``own_cpu_s``: without them), and ``depth``, how many compiles it ran inside (0: called
+    from Python)."""
 
     name: str
     cpu_s: float

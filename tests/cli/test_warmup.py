@@ -44,6 +44,6 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
     assert lines[-1] == f"{len(compiled)} kernel(s) compiled"
     runs = [*mechanisms, *(str(CASES / f"{c}.toml") for c in (
         "coasting_single", "gots_diesel_governed", "gots_diesel_woschni", "gots_diesel_4400",
-        "swash_plate_4cyl_friction", "gots_diesel_start_flyweight"))]
+        "swash_plate_4cyl_friction", "gots_diesel_start_flyweight", "diesel_4cyl_misfire"))]
     assert transient(*runs, code=PROBE) == ["0"]
     assert transient("warmup")[1:] == ["all kernels were cached"]
