@@ -3,8 +3,8 @@
 On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) is the bulk of
 a first run, on one core: while numba types the stepper it compiles, one after another, each
 of its callees (every kernel is a compile unit of its own, which LLVM inlines afterwards:
-:func:`transient.core.jit.kernel`). A helper process started at the same time compiles those callees in the
-reverse order, each under its compile lock
+:func:`transient.core.jit.kernel`). A helper process started at the same time compiles those
+callees in the reverse order, each under its compile lock
 (:func:`transient.core.jit._compile_once_across_processes`), so that the two use two cores. The
 stepper's compile loads each callee the helper has saved, waits for the one the helper is
 compiling, and compiles the others itself; nothing is compiled twice.

@@ -239,8 +239,8 @@ def switch_inertia(model, extra: float, y, ist):
     J(φ)ω is conserved, ω₊ = J ω₋/(J + J_x); the energy lost, ½Jω₋² − ½(J + J_x)ω₊², is taken
     from ``W_load``, so that the work–energy balance still closes. Updates the state ``y`` and
     the switches that depend on the speed, which jumped across their levels without an event
-    (the governor's branch, the generator's, the speed map's interval); returns the model with the extra inertia on the
-    shaft (``J0``)."""
+    (the governor's branch, the generator's, the speed map's interval); returns the model with
+    the extra inertia on the shaft (``J0``)."""
     angle_mode = ist[sio.I_ANGLE_MODE] == 1
     J = forcing.inertia(model, y[layout.PHI], layout.work_array(model))
     w = forcing.speed(J, angle_mode, y)

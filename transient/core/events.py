@@ -24,8 +24,8 @@ from .layout import (LT_SPEED, OMEGA, PHI, SW_LOAD, SW_LOAD_TABLE, SW_SLEEVE, SW
 from .rhs import margins_at, margins_inline
 from .rk import _dense, _dense_eval, _dense_state
 from .stepper_io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR,
-                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
-                         EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
+                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE,
+                         EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
 
 # Event "components" at and above PAIR_COMP are the mode margins of the pairs (rhs.mode_margins);
 # DEMAND_COMP is the PI governor's demand u (forcing.demand).

@@ -14,8 +14,8 @@ from .jit import compiled, kernel
 from .forcing import (fuel, generator_branch, governor_branch, load_segment, moments,
                       speed_knot_segment)
 from .layout import (COL_EPS, N_OUT_FIXED, N_SWITCHES, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
-                     SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY, WK_J, WK_M,
-                     WK_S, WK_S_TRY, latch_index, n_state, work_array)
+                     SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY,
+                     WK_J, WK_M, WK_S, WK_S_TRY, latch_index, n_state, work_array)
 from .outputs import output_row, pair_rows
 from .rhs import pair_etas, split_subchains
 

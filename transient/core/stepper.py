@@ -56,8 +56,8 @@ from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_EN
                          EV_TO_TIME, F_ERR_OLD, F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T,
                          F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
                          I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_F_VALID, I_FLIPPED,
-                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES, I_NBAD, I_NCHATTER, I_NEV,
-                         I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS, I_NSWITCH,
+                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES, I_NBAD,
+                         I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS, I_NSWITCH,
                          I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED, I_STARTER_ON,
                          I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event, _emit_row,
                          _emit_samples, _finish, _locked, _out_spacing, _reset_output_grid,
@@ -502,9 +502,9 @@ def _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel
 def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y, ist,
                      fst, wk):
     """What the event switches: a pair's mode, the starter, the governor's branch, the load
-    schedule's segment, the generator's branch, the speed map's interval, the sleeve on or off a stop, or the independent
-    variable (with the next step's size converted by ω = level and the output grid of the new
-    variable)."""
+    schedule's segment, the generator's branch, the speed map's interval, the sleeve on or off a
+    stop, or the independent variable (with the next step's size converted by ω = level and the
+    output grid of the new variable)."""
     if ev_code == EV_PAIR_MODE:
         ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
         ist[I_NSWITCH] += 1

@@ -467,7 +467,8 @@ def _read_load(s: Section, base_dir: Path, cycle: float) -> Load:
 
 
 #: The abscissae of [load.table]: key (its CSV column names, with their factors to SI), the
-#: quantity kind of its unit suffixes, and what it is (:data:`transient.forces.load_table.ABSCISSAE`).
+#: quantity kind of its unit suffixes, and what it is
+#: (:data:`transient.forces.load_table.ABSCISSAE`).
 LOAD_TABLE_ABSCISSAE = {
     "speed": ("speed", {"speed": 1.0, "speed_rpm": math.pi / 30.0}),
     "phi": ("angle", {"phi": 1.0, "phi_deg": math.pi / 180.0}),
@@ -512,8 +513,8 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
     for i in range(1, len(x)):
         if x[i] <= x[i - 1]:
             raise SceneError(key, f"{where}must increase strictly, but entry {i + 1} "
-                                  f"({x[i]:g} in SI) follows {x[i - 1]:g}; give each abscissa once, "
-                                  f"in increasing order")
+                                  f"({x[i]:g} in SI) follows {x[i - 1]:g}; give each abscissa "
+                                  f"once, in increasing order")
     if name == "phi":
         x, torque = _one_cycle(key, where, x, torque, cycle)
     if name == "time" and min(b - a for a, b in zip(x, x[1:])) < SCHEDULE_MIN_GAP * max(

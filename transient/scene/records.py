@@ -96,8 +96,8 @@ class Cylinder:
 
     ``combustion_offset`` δ_k [rad] (``combustion_offset_deg``), within ±30°: its combustion
     happens δ_k later (earlier if negative),
-    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x. For ``"table"``, ``"mixed-cycle"`` and ``"trapezoid"``, whose motored
-    curve is p0, that moves the whole curve (the table holds no other account of the
+    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x. For
+    ``"table"``, ``"mixed-cycle"`` and ``"trapezoid"``, whose motored curve is p0, that moves the whole curve (the table holds no other account of the
     combustion); for ``"wiebe"`` the combustion's part only, the motored compression staying
     with the piston; with ``[gas.woschni]`` the heat release and Woschni's combustion term of
     the closed part, which must then still lie inside it.
