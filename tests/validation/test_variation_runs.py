@@ -294,3 +294,40 @@ def test_woschni_offset_agrees_with_the_reference_path():
     ref = columns(simulate(scene.replace(solver={"method": "scipy-DOP853"})))
     assert fast["omega"][-1] == pytest.approx(ref["omega"][-1], rel=1e-6)
     assert fast["W_gas"][-1] == pytest.approx(ref["W_gas"][-1], rel=1e-6)
+
+
+def test_two_stroke_misfire_schedule_burns_nothing_in_every_third_cycle():
+    """A 2-stroke's cycle is one revolution and begins at its BDC, local angle π (docs: gas
+    guide, *Cycles*): on the swash-plate engine (trapezoidal force pulses from the firing TDC)
+    cylinder 1 with ``misfire_every = 3`` has no force in cycles 3, 6, 9 … and the full pulse
+    in the others (the plateau's force over the governor's fuel command is the amplitude), the
+    other cylinders fire in every cycle, and the balance closes."""
+    scene = load_scene(CASES / "swash_plate_4cyl.toml")
+    mech = scene.mechanism
+    assert mech.strokes == 2 and mech.cycle == pytest.approx(2 * math.pi)
+    scene = scene.replace(gas={"cylinders": [{"cylinder": 1, "misfire_every": 3}]},
+                          initial={"omega": 50.0}, run={"t_end": 2.0})
+    traj = columns(simulate(scene))
+    P, phi = mech.cycle, traj["phi"]
+    phi0 = scene.initial.phi
+    first = (mech.firing_angles[0] + math.pi) % P  # cylinder 1's BDC: its cycles begin there
+    start = phi0 - (phi0 - first) % P  # cycle 1: the one in progress at φ0
+    amplitude = scene.gas.amplitude
+    seen = {}
+    for n in range(1, int((phi[-1] - start) / P) + 1):
+        a = start + (n - 1) * P
+        inside = (phi > a) & (phi < a + P)
+        if a >= phi[0] and a + P <= phi[-1]:
+            fuel = traj["fuel"][inside]
+            seen[n] = tuple(np.max(traj[c][inside] / fuel) for c in ("p_1", "p_2"))
+    assert len(seen) >= 9
+    for n, (p1, p2) in seen.items():
+        assert p2 == pytest.approx(amplitude, rel=1e-12)
+        if n % 3 == 0:
+            assert p1 == 0.0
+        else:
+            assert p1 == pytest.approx(amplitude, rel=1e-12)
+    kinetic = 0.5 * traj["J"] * traj["omega"] ** 2
+    balance = kinetic - kinetic[0] - (traj["W_gas"] + traj["W_load"] + traj["W_starter"]
+                                      - traj["W_loss"])
+    assert np.max(np.abs(balance)) < 1e-7 * kinetic.max()
