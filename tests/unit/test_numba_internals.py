@@ -20,7 +20,8 @@ from pathlib import Path
 
 import llvmlite.binding as ll
 import numba
-from numba.core import caching, codegen, cpu, dispatcher, sigutils, types
+from numba.core import (caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes,
+                        types)
 from numba.core.base import BaseContext
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
@@ -438,6 +439,57 @@ def test_llvm_inlining_marks_the_module_numba_links_into_callers_and_caches():
         "symbols after its mangled qualified name, then B and its ABI tags)")
 
 
+LINKED_ONLY = "transient.core.jit._linked_only"
+
+
+def test_linked_only_libraries_rely_on_how_numba_lowers_links_and_caches():
+    lowering = cpu.CPUContext.get_executable
+    assert _parameters(lowering) == ["self", "library", "fndesc", "env"], _relies(
+        LINKED_ONLY, "numba.core.cpu.CPUContext.get_executable(library, fndesc, env)")
+    assert _in_order(_statements(lowering), _code("""
+        fnptr = library.get_pointer_to_function(fndesc.llvm_cpython_wrapper_name)
+        """)), _relies(LINKED_ONLY, "CPUContext.get_executable finalizing the library by taking "
+                       "the address of its Python wrapper (null without one)")
+    assert _in_order(_statements(typed_passes.BaseNativeLowering.run_pass), _code("""
+        if not flags.no_cpython_wrapper:
+            lower.create_cpython_wrapper(flags.release_gil)
+        cfunc = targetctx.get_executable(library, fndesc, env)
+        """)), _relies(LINKED_ONLY, "numba.core.typed_passes.BaseNativeLowering.run_pass adding "
+                       "the Python wrapper to the library before get_executable, only without "
+                       "no_cpython_wrapper")
+    assert _in_order(_statements(compiler.CompileResult._rebuild.__func__), _code("""
+        library = target_context.codegen().unserialize_library(libdata)
+        cfunc = target_context.get_executable(library, fndesc, env)
+        for env in referenced_envs:
+            library.codegen.set_env(env.env_name, env)
+        """)), _relies(LINKED_ONLY, "numba.core.compiler.CompileResult._rebuild unserializing the "
+                       "library, then get_executable, then set_env for its environments")
+    assert _in_order(_statements(codegen.CPUCodeLibrary.finalize), _code("""
+        self._raise_if_finalized()
+        self._reload_init.update(library._reload_init)
+        self._final_module.link_in(library._get_module_for_linking(), preserve=True)
+        self._optimize_final_module()
+        self._final_module.verify()
+        self._finalize_final_module()
+        """)), _relies(LINKED_ONLY, "numba.core.codegen.CPUCodeLibrary.finalize: what "
+                       "_finalize_linked_only does of it (the linking) and leaves out")
+    assert _in_order(_statements(codegen.CPUCodeLibrary._get_module_for_linking), _code("""
+        self._ensure_finalized()
+        if self._shared_module is not None:
+            return self._shared_module
+        mod = self._final_module
+        """)), _relies(LINKED_ONLY, "CPUCodeLibrary._get_module_for_linking reading "
+                       "_shared_module, else _final_module, of a finalized library")
+    assert _in_order(_statements(codegen.CPUCodeLibrary._unserialize.__func__), _code("""
+        name, kind, data = state
+        self = codegen.create_library(name)
+        """)), _relies(LINKED_ONLY, "CPUCodeLibrary._unserialize reading (name, kind, data)")
+    assert _in_order(_statements(codegen.JITCPUCodegen.set_env), _code("""
+        gvaddr = self._engine.get_global_value_address(env_name)
+        """)), _relies(LINKED_ONLY, "numba.core.codegen.JITCPUCodegen.set_env writing at the "
+                       "environment's address in the execution engine")
+
+
 def rhs_derivative():
     from transient.core.rhs import derivative
 
@@ -484,11 +536,15 @@ elif sys.argv[2] == "python":
           sum(module.scaled.stats.cache_hits.values()))
 else:
     assert module.caller(t, 2.0) == (2.0 + 0.5) + (4.0 + 0.5) + module.offset.py_func(t, 2.0)
-    ir = module.caller.inspect_llvm(module.caller.signatures[0])
+    entry = module.caller.python_entry
+    ir = entry.inspect_llvm(entry.signatures[0])
     calls = [line for line in ir.splitlines() if " call " in line]
+    callees = [c.library for d in (module.scaled, module.offset) for c in d.overloads.values()]
     print(any(_symbol_prefix(module.scaled.py_func) in c for c in calls),
           any(_symbol_prefix(module.offset.py_func) in c for c in calls),
-          sum(module.scaled.stats.cache_hits.values()))
+          sum(module.scaled.stats.cache_hits.values()),
+          len(callees) == 2 and all(lib._linked_only for lib in callees),
+          any(getattr(lib, "_compiled_object", None) for lib in callees))
 """
 
 
@@ -496,7 +552,9 @@ def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cac
     """``kernel(inline=True)``: no call to it is left in a caller's optimized code, whether the
     callee was compiled with the caller or loaded from numba's cache (where the compile helper
     saved it); a plain kernel stays a call, which shows the check sees calls. Called from
-    Python, it runs its Python entry, compiled and cached apart from the kernel."""
+    Python, a kernel runs its Python entry, compiled and cached apart from the kernel. Both
+    callees' libraries are linked only, compiled or loaded: no machine code of their own
+    (:func:`transient.core.jit._linked_only`), while the caller's Python entry runs."""
     source = tmp_path / "kern.py"
     source.write_text(INLINE_KERNELS)
 
@@ -507,10 +565,11 @@ def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cac
         assert run.returncode == 0, run.stderr
         return run.stdout.split()
 
-    assert probe("together", "caller") == ["False", "True", "0"]  # inlined, a call, compiled
+    # inlined, a call, compiled; linked only, no machine code
+    assert probe("together", "caller") == ["False", "True", "0", "True", "False"]
     assert probe("apart", "callees") == ["1.5"]
     assert probe("apart", "python") == ["1.5", "1", "0"]  # the Python entry, loaded
-    assert probe("apart", "caller") == ["False", "True", "1"]  # the same, loaded
+    assert probe("apart", "caller") == ["False", "True", "1", "True", "False"]  # the same, loaded
 
 
 # ----------------------------------------------------------------------------------------------

@@ -5,10 +5,12 @@ each for its gain: the cache loads without numba's compiler registries
 (:class:`_RegistryFreeCache`) from a folder that copies of the sources at other paths share
 (:class:`_SharedLocator`), constants passed between kernels share one compile
 (:func:`_compile_per_type`), and processes compiling the same function take turns
-(:func:`_compile_once_across_processes`). ``kernel(inline=True)`` adds two: LLVM inlines the
-kernel at its call sites (:func:`_inlined_by_llvm`), and it is compiled without numba's Python
-wrappers, a twin with them serving calls from Python (:class:`_CalledFromCompiledCode`).
-``kernel`` is ``compiled`` without numba's reference counting
+(:func:`_compile_once_across_processes`). ``kernel`` is for functions that compiled code
+calls: compiled without numba's Python wrappers, a twin with them serving calls from Python
+(:class:`_CalledFromCompiledCode`), its library linked into its callers' and never optimized or
+made into machine code on its own (:func:`_linked_only`); ``kernel(inline=True)`` adds that
+LLVM inlines it at its call sites (:func:`_inlined_by_llvm`). What Python calls to run
+(the stepper) is ``compiled``. ``kernel`` is ``compiled`` without numba's reference counting
 (``_nrt=False``), because with it every call that passes arrays — the
 :data:`transient.core.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
 an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
@@ -24,15 +26,18 @@ without failing.
 from __future__ import annotations
 
 import fcntl
+import functools
 import os
 import warnings
 from contextlib import contextmanager
 
+import llvmlite.binding as ll
 import numba
-from numba import config, njit, types
+from numba import _dynfunc, config, njit, types
 from numba.core import sigutils
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, UserProvidedCacheLocator
-from numba.core.codegen import CPUCodeLibrary
+from numba.core.codegen import CPUCodeLibrary, JITCPUCodegen
+from numba.core.cpu import CPUContext
 from numba.core.itanium_mangler import mangle_identifier
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
@@ -233,23 +238,26 @@ def _compile_per_type(dispatcher):
 
 
 def kernel(fn=None, *, inline=False, **options):
-    """``@kernel`` or ``@kernel(inline=True)``: compiled, no reference counting.
+    """``@kernel`` or ``@kernel(inline=True)``: compiled for calls from compiled code, no
+    reference counting.
 
-    A kernel is a compile unit of its own. As a plain call in machine code, numba passes a tuple
-    argument flattened, by value: each array as its pointers, sizes, shape and strides, so the
-    Model tuple's ~150 words would be copied onto the stack at every call. With ``inline=True``
-    LLVM inlines the kernel at every call site (:func:`_inlined_by_llvm`), where the copy
-    vanishes: the machine code is that of one function, while numba types and lowers each
-    kernel once, without the Python wrappers (:class:`_CalledFromCompiledCode`). numba's own
-    inlining (``inline="always"``) copies the callee's IR into every caller before typing it,
-    which made the cold compile grow with the nesting of calls."""
+    A kernel is a compile unit of its own, compiled without numba's Python wrappers; a call from
+    Python goes to a twin compiled with them (:class:`_CalledFromCompiledCode`). Its library is
+    only ever linked into its callers', so it is neither optimized as a module nor turned into
+    machine code on its own (:func:`_linked_only`): the caller that Python calls does both once,
+    for everything linked into it. As a plain call in machine code, numba passes a tuple argument
+    flattened, by value: each array as its pointers, sizes, shape and strides, so the Model
+    tuple's ~150 words would be copied onto the stack at every call. With ``inline=True`` LLVM
+    inlines the kernel at every call site (:func:`_inlined_by_llvm`), where the copy vanishes.
+    numba's own inlining (``inline="always"``) copies the callee's IR into every caller before
+    typing it, which made the cold compile grow with the nesting of calls."""
     if fn is None:
         return lambda f: kernel(f, inline=inline, **options)
-    if not inline:
-        return compiled(fn, _nrt=False, **options)
     if not REPLACEMENTS_ON:  # (numba's inliner: the same machine code, a slower compile)
-        return compiled(fn, _nrt=False, inline="always", **options)
-    _INLINED_BY_LLVM.add(_symbol_prefix(fn))
+        return compiled(fn, _nrt=False, **({"inline": "always"} if inline else {}), **options)
+    if inline:
+        _INLINED_BY_LLVM.add(_symbol_prefix(fn))
+    _LINKED_ONLY.add(_symbol_prefix(fn))
     dispatcher = compiled(fn, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
                           **options)
     if not config.DISABLE_JIT:
@@ -276,6 +284,7 @@ def _inlined_by_llvm(get_module_for_linking):
     numba's cache stores beside the machine code, so a callee loaded from the cache is inlined
     alike."""
 
+    @functools.wraps(get_module_for_linking)
     def get_marked_module(library):
         module = get_module_for_linking(library)
         prefixes = tuple(_INLINED_BY_LLVM)
@@ -289,6 +298,115 @@ def _inlined_by_llvm(get_module_for_linking):
     return get_marked_module
 
 
+#: The symbol prefixes of every kernel: compiled without the Python wrappers, their libraries
+#: are linked only (:func:`_linked_only`).
+_LINKED_ONLY: set[str] = set()
+
+#: numba's serialization kind of a library that is linked only: its module for linking, as
+#: bitcode (:func:`_serialize_linked_only`).
+LINKED_ONLY_KIND = "transient-linked-only"
+
+
+def _is_linked_only(library, fndesc) -> bool:
+    """Whether ``library``, lowered for ``fndesc``, is a kernel's without the Python wrappers.
+    Its twin with them (:class:`_CalledFromCompiledCode`) has the same symbol prefix and the
+    wrapper, and is compiled in full; so is every other function numba compiles."""
+    if library._finalized:  # (loaded from the cache)
+        return getattr(library, "_linked_only", False)
+    if not fndesc.mangled_name.startswith(tuple(_LINKED_ONLY)):
+        return False
+    try:
+        library._final_module.get_function(fndesc.llvm_cpython_wrapper_name)
+    except NameError:
+        return True
+    return False
+
+
+def _finalize_linked_only(library):
+    """``CPUCodeLibrary.finalize`` without its optimization and its machine code: the callees'
+    modules are linked in, so that the module for linking holds everything the kernel calls,
+    and the library is marked finalized but never added to the execution engine. The caller
+    that Python calls optimizes the whole and generates its machine code, as numba's finalize
+    does for it anyway; optimizing each kernel's module and generating code for it as well was
+    most of a cold compile, and that code was never run."""
+    library._raise_if_finalized()
+    seen = set()
+    for callee in library._linking_libraries:
+        if callee not in seen:
+            seen.add(callee)
+            library._reload_init.update(callee._reload_init)
+            library._final_module.link_in(callee._get_module_for_linking(), preserve=True)
+    library._final_module.verify()
+    library._finalized = True
+    library._linked_only = True
+
+
+def _linked_only(get_executable):
+    """numba's ``CPUContext.get_executable``, which finalizes a library and takes its function's
+    address, with a kernel's library finalized by :func:`_finalize_linked_only` and a null
+    address, as numba gives a function without the Python wrapper."""
+
+    @functools.wraps(get_executable)
+    def get(context, library, fndesc, env):
+        if not _is_linked_only(library, fndesc):
+            return get_executable(context, library, fndesc, env)
+        if not library._finalized:
+            _finalize_linked_only(library)
+        return _dynfunc.make_function(fndesc.lookup_module(), fndesc.qualname.split(".")[-1],
+                                      "linked only", 0, env, (library,))
+
+    return get
+
+
+def _serialize_linked_only(serialize):
+    """numba's ``CPUCodeLibrary.serialize_using_object_code``, which the cache calls: a library
+    that is linked only has no machine code, and is saved as its module for linking."""
+
+    @functools.wraps(serialize)
+    def save(library):
+        if getattr(library, "_linked_only", False):
+            return (library.name, LINKED_ONLY_KIND, library._get_module_for_linking().as_bitcode())
+        return serialize(library)
+
+    return save
+
+
+def _unserialize_linked_only(unserialize):
+    """numba's ``CPUCodeLibrary._unserialize`` (a classmethod's function), reading back what
+    :func:`_serialize_linked_only` saved without optimizing it or making machine code."""
+
+    @functools.wraps(unserialize)
+    def load(cls, codegen, state):
+        name, kind, data = state
+        if kind != LINKED_ONLY_KIND:
+            return unserialize(cls, codegen, state)
+        library = codegen.create_library(name)
+        library._final_module = library._shared_module = ll.parse_bitcode(data)
+        library._finalized = True
+        library._linked_only = True
+        return library
+
+    return classmethod(load)
+
+
+def _environment_in_engine(set_env):
+    """numba's ``JITCPUCodegen.set_env``, which a loaded function's environments go through, with
+    those of a library that is linked only (so not in the execution engine, where the address
+    of its environment would be null) left alone: its code never runs."""
+
+    @functools.wraps(set_env)
+    def set_if_loaded(codegen, env_name, env):
+        if codegen._engine.get_global_value_address(env_name):
+            set_env(codegen, env_name, env)
+
+    return set_if_loaded
+
+
 if REPLACEMENTS_ON:
     CPUCodeLibrary._get_module_for_linking = _inlined_by_llvm(
         CPUCodeLibrary._get_module_for_linking)
+    CPUContext.get_executable = _linked_only(CPUContext.get_executable)
+    CPUCodeLibrary.serialize_using_object_code = _serialize_linked_only(
+        CPUCodeLibrary.serialize_using_object_code)
+    CPUCodeLibrary._unserialize = _unserialize_linked_only(CPUCodeLibrary._unserialize.__func__)
+    JITCPUCodegen.set_env = _environment_in_engine(JITCPUCodegen.set_env)

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from .jit import compiled, kernel
 
 from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .chain import AMBIGUOUS, NONE_CONSISTENT
@@ -83,7 +83,7 @@ def buffers(m, tab, n: int) -> tuple:
             np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))))
 
 
-@kernel(nogil=True)  # (nogil: the previous block is written meanwhile, simulate)
+@compiled(nogil=True, _nrt=False)  # (nogil: the previous block is written meanwhile, simulate)
 def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk, gs):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 
