@@ -362,7 +362,11 @@ def _read_friction(s: Section, mech) -> Friction:
                 raise SceneError(ps.key("model"), f"friction on the reactions is implemented for "
                                                   f"the crank-slider only, not for {mech.name!r}; "
                                                   f"use model = \"constant-eta\" here")
-        between = _between(ps, links, model)
+        hint = ""
+        if model != "reaction" and getattr(mech, "reaction_links", ()):
+            hint = (f" (pairs with model = \"reaction\" join "
+                    f"{' – '.join(mech.reaction_links)})")
+        between = _between(ps, links, hint)
         ia = links.index(between[0])
         if ia in seen:
             raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
@@ -394,8 +398,9 @@ def _read_friction(s: Section, mech) -> Friction:
     return Friction(policy, tuple(pairs))
 
 
-def _between(ps: Section, links: tuple[str, ...], model: str) -> tuple[str, str]:
-    """The pair's two links, neighbours in ``links``, shaft side first."""
+def _between(ps: Section, links: tuple[str, ...], hint: str) -> tuple[str, str]:
+    """The pair's two links, neighbours in ``links``, shaft side first (``hint`` ends the message
+    of an unknown link)."""
     chain = " – ".join(links)
     ps.known.append("between")
     between = ps.data.pop("between", None)
@@ -405,8 +410,8 @@ def _between(ps: Section, links: tuple[str, ...], model: str) -> tuple[str, str]
                                             f"the links are {chain}")
     for b in between:
         if b not in links:
-            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links of a "
-                                                f"{model} pair are {chain}")
+            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links "
+                                                f"are {chain}{hint}")
     ia, ib = links.index(between[0]), links.index(between[1])
     if abs(ia - ib) != 1:
         raise SceneError(ps.key("between"),
@@ -433,9 +438,10 @@ def _reaction_pair(ps: Section, between: tuple[str, str], name: str, slider: boo
 
 
 def _check_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
-    """Friction must not wedge the crank-slider: the rod's equation in the side force N has the
-    slope l cos β (1 − q) with q ≤ μ_slider tan β + (μ r)_crankpin + (μ r)_pin)(1 + μ_slider)/(l cos β)
-    (:mod:`transient.core.joint_friction`); q < 1 keeps one solution for every state."""
+    """Friction must not wedge the crank-slider: the rod's equation in the side force N has a
+    slope of at least l cos β (1 − q), q = μ_s tan β + (μ r of crankpin and pin)(1 + μ_s)/(l cos β)
+    at the largest rod angle (:mod:`transient.core.joint_friction`); q < 1 keeps it increasing,
+    hence one solution at every state."""
     r, l, e = mech.crank_radius, mech.rod_length, mech.offset
     sin_b = (r + abs(e)) / l
     cos_b = math.sqrt(max(1.0 - sin_b * sin_b, 0.0))
