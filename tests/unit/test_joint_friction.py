@@ -117,9 +117,9 @@ def compiled_cylinders(mech, jp, phi, w, eps, P):
     T = np.empty(n)
     terms = np.empty((8, n))
     for k in range(n):
-        wk[WK_RX + jf.R_N, k] = 0.0
-        T[k] = jf.solve_cylinder(mp, jp, wk, k, eps, w, sigma)[0]
+        assert jf.solve_cylinder(mp, jp, wk, k, eps, w, sigma)
         terms[:, k] = jf.joint_terms(mp, jp, wk, k, eps, w, sigma, wk[WK_RX + jf.R_N, k])
+        T[k] = -terms[0, k]  # the main bearing's S is what the shaft puts into the throw, −T
     return wk[WK_RX + jf.R_N, :n].copy(), T, terms[:4], terms[4:]
 
 

@@ -31,18 +31,20 @@ except the friction, which depends on |F_O|, |F_A|, |F_B|, |N|.
 
 The exact solve
 ---------------
-For a given ε each cylinder has one unknown, N: its rod equation g(N) = 0 with the friction
-terms in it, g′(N) = l cos β (1 + O(μ tan β) + O(μ r/l)) > 0. Newton's method from N = 0 (each
-outer iteration starting from the last N) solves it. The shaft equation
-h(ε) = J₀ ε − M_shaft − Σ T(ε, N(ε)) = 0 is then solved by Newton's method in ε from the
-frictionless φ̈, with the exact derivative h′ = J₀ − Σ (∂T/∂ε − ∂T/∂N · (∂g/∂ε)/(∂g/∂N))
-(implicit differentiation; h′ ≈ J, the reduced inertia). Both iterations stop when the last
-correction is below :data:`TOL` of the magnitude of the terms and evaluate once more there, so
-the result is the solution of the implicit equations to rounding: the residuals are of the
-order of the square of a correction already at rounding (linear with a factor O(μ) where a
-|·| has its kink inside the last step). Nothing is lagged from an earlier evaluation. If either
-iteration has not converged after :data:`MAX_ITER` corrections, φ̈ is NaN and the run stops with
-the non-finite derivative reported with its time, angle and state (:mod:`.stepper_io`).
+Each cylinder has one more unknown, N, and one more equation, its rod's g(N, ε) = 0, with
+∂g/∂N = l cos β (1 + O(μ tan β) + O(μ r/l)) > 0; the shaft adds h(ε, N) = J₀ ε − M_shaft −
+Σ T = 0. Newton's method solves (ε, N_1 … N_n) together, from the frictionless φ̈ and N = 0,
+with the exact Jacobian: its only couplings are through ε (an arrowhead matrix), so each
+iteration costs one evaluation per cylinder and the correction is explicit (:func:`solve`); the
+functions are smooth except for the |·| of N and of the joint forces. It stops when the last
+corrections are below :data:`TOL` of the magnitude of the terms and applies them: convergence
+being quadratic, what remains is of the order of their square, below rounding (linear with a
+factor O(μ) in the rare case that a |·| has its kink within the last correction). The residuals
+of the implicit equations are then rounding (``tests/unit/test_joint_friction.py``). Nothing is
+lagged from an earlier evaluation: the solve starts afresh at every state, so the result is a
+function of the state alone. If it has not converged after :data:`MAX_ITER` corrections (a
+wedging mechanism, which the scene check excludes), φ̈ is NaN and the run stops with the
+non-finite derivative reported with its time, angle and state.
 
 Directions and smoothness
 -------------------------
@@ -81,12 +83,16 @@ from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU,
 #: crankpin's position r sin α, r cos α, β′, s′), then per acceleration its part at ε = 0 and its
 #: slope in ε (a_By, a_Ax, a_Ay, D_x, D_y, H), the gas force P, the signs of the crankpin's, the
 #: piston pin's and the piston's relative speed at ``sel`` per unit σ, the ``sel`` they are for
-#: ([0]), N's iterate, and per pair the loss moment.
+#: ([0]), N's iterate, per pair the loss moment, and per cylinder the parts g/g′ and
+#: (∂g/∂ε)/g′ of its Newton correction.
 (R_LCB, R_LSB, R_AX, R_AY, R_DB, R_DS, R_ABY0, R_ABY1, R_AAX0, R_AAX1, R_AAY0, R_AAY1, R_DX0,
- R_DX1, R_DY0, R_DY1, R_H0, R_H1, R_P, R_SA, R_SB, R_SS, R_SEL, R_N, R_LOSS) = range(25)
+ R_DX1, R_DY0, R_DY1, R_H0, R_H1, R_P, R_SA, R_SB, R_SS, R_SEL, R_N, R_LOSS, R_STEP,
+ R_COUPLE) = range(27)
 
-#: A Newton iteration has converged when its last correction is below TOL of its scale.
-TOL = 1e-12
+#: Newton's method has converged when its corrections are below TOL of their scales; the
+#: correction is then applied and, convergence being quadratic, leaves an error of the order of
+#: its square, below rounding.
+TOL = 1e-9
 #: Corrections at most before a solve is reported as failed (NaN).
 MAX_ITER = 40
 
@@ -161,8 +167,8 @@ def _slope(fx, fy, dx, dy, norm):
 
 @kernel
 def cylinder(mp, jp, wk, k, eps, w, sigma, N):
-    """Cylinder k at φ̈ = ``eps`` and side force ``N``: the residual of its rod equation g, g′(N),
-    the throw's torque T, dT/dε along g = 0 (implicit differentiation) and its forces' scale."""
+    """Cylinder k at φ̈ = ``eps`` and side force ``N``: the residual g of its rod equation, ∂g/∂N,
+    ∂g/∂ε, the throw's torque T, ∂T/∂N, ∂T/∂ε and the scale of its forces."""
     c = WK_RX
     lcb, lsb = wk[c + R_LCB, k], wk[c + R_LSB, k]
     ax, ay = wk[c + R_AX, k], wk[c + R_AY, k]
@@ -216,7 +222,7 @@ def cylinder(mp, jp, wk, k, eps, w, sigma, N):
     g_e = -lcb * dx1 - lsb * (py1 + dy1) - Ma1 - Mb1 + h1
     T_e = -m_k * r * r - Mo1 + Ma1 + (ax * fay1 - ay * fax1)
     scale = abs(N) + abs(py) + abs(dx) + abs(dy) + abs(h) / lcb
-    return g, g_n, T, T_e - T_n * g_e / g_n, scale
+    return g, g_n, g_e, T, T_n, T_e, scale
 
 
 @kernel
@@ -257,50 +263,58 @@ def joint_terms(mp, jp, wk, k, eps, w, sigma, N):
 
 @kernel
 def solve_cylinder(mp, jp, wk, k, eps, w, sigma):
-    """N of cylinder k at φ̈ = ``eps`` by Newton's method from the last N (module docstring);
-    returns ``(T, dT/dε, scale)`` there, or NaNs if it does not converge."""
-    N = wk[WK_RX + R_N, k]
-    done = False
-    for _ in range(MAX_ITER + 1):
-        g, g_n, T, dT, scale = cylinder(mp, jp, wk, k, eps, w, sigma, N)
-        if done:
-            wk[WK_RX + R_N, k] = N
-            return T, dT, scale
+    """N of cylinder k at a given φ̈ = ``eps`` (inverse dynamics) by Newton's method from 0, into
+    the row R_N; returns False if it does not converge."""
+    N = 0.0
+    for _ in range(MAX_ITER):
+        g, g_n, _, _, _, _, scale = cylinder(mp, jp, wk, k, eps, w, sigma, N)
         step = g / g_n
         N -= step
-        done = abs(step) <= TOL * scale
-    return np.nan, np.nan, np.nan
+        if abs(step) <= TOL * scale:
+            wk[WK_RX + R_N, k] = N
+            return True
+    return False
 
 
 @kernel
 def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
     """φ̈ with the joints' friction on their reactions, and per pair η*, S, L into ``wk``.
 
-    ``eps0`` starts Newton's method in ε (the frictionless φ̈); ``pair_of`` = ``Model.rx_pair``;
-    the rows of :func:`prepare` and each cylinder's gas force (row R_P) must be filled. Returns
-    NaN if the solve does not converge (module docstring)."""
+    Newton's method on the unknowns (φ̈, N_1 … N_n) together (module docstring): with r_k = g_k/g′_k
+    and q_k = (∂g_k/∂ε)/g′_k the correction of N_k is −r_k − q_k δε, and the shaft's equation
+    H = J₀ ε − M_shaft − Σ T_k = 0 gives δε = −(H + Σ ∂T_k/∂N r_k) / (J₀ − Σ (∂T_k/∂ε −
+    ∂T_k/∂N q_k)). ``eps0`` starts it (the frictionless φ̈), N from 0; ``pair_of`` =
+    ``Model.rx_pair``; the rows of :func:`prepare` and each cylinder's gas force (row R_P) must be
+    filled. Returns NaN if it does not converge (module docstring)."""
     n = int(mp[N_CYL])
+    c = WK_RX
     for k in range(n):
-        wk[WK_RX + R_N, k] = 0.0
+        wk[c + R_N, k] = 0.0
     eps = eps0
-    done = False
-    for _ in range(MAX_ITER + 1):
-        total = 0.0
-        slope = J0
+    for _ in range(MAX_ITER):
+        H = J0 * eps - M_shaft
+        den = J0
         scale = abs(M_shaft) + J0 * abs(eps)
+        small = True
         for k in range(n):
-            T, dT, s = solve_cylinder(mp, jp, wk, k, eps, w, sigma)
-            total += T
-            slope -= dT
+            g, g_n, g_e, T, T_n, T_e, s = cylinder(mp, jp, wk, k, eps, w, sigma, wk[c + R_N, k])
+            r = g / g_n
+            q = g_e / g_n
+            wk[c + R_STEP, k] = r
+            wk[c + R_COUPLE, k] = q
+            H += T_n * r - T
+            den -= T_e - T_n * q
             scale += abs(T)
-        if not np.isfinite(total):
+            small = small and abs(r) <= TOL * s
+        if not np.isfinite(H):
             return np.nan
-        if done:
+        step = H / den
+        eps -= step
+        for k in range(n):
+            wk[c + R_N, k] -= wk[c + R_STEP, k] - wk[c + R_COUPLE, k] * step
+        if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps
-        step = (J0 * eps - M_shaft - total) / slope
-        eps -= step
-        done = abs(step) * abs(slope) <= TOL * scale
     return np.nan
 
 
@@ -362,8 +376,8 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     mp = m.mech
     total = 0.0
     for k in range(int(mp[N_CYL])):
-        wk[WK_RX + R_N, k] = 0.0
-        T, _, _ = solve_cylinder(mp, m.rx_par, wk, k, eps, w, sigma)
-        total += T
+        if not solve_cylinder(mp, m.rx_par, wk, k, eps, w, sigma):
+            return np.nan
+        total -= joint_terms(mp, m.rx_par, wk, k, eps, w, sigma, wk[WK_RX + R_N, k])[0]
     _pair_terms(mp, m.rx_par, m.rx_pair, wk, eps, w, sigma, m.n_pairs)
     return m.J0 * eps - M_shaft - total
