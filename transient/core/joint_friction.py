@@ -33,13 +33,14 @@ The exact solve
 ---------------
 Each cylinder has one more unknown, N, and one more equation, its rod's g(N, ε) = 0, with
 ∂g/∂N = l cos β (1 + O(μ tan β) + O(μ r/l)) > 0; the shaft adds h(ε, N) = J₀ ε − M_shaft −
-Σ T = 0. Newton's method solves (ε, N_1 … N_n) together, from the frictionless φ̈ and N = 0,
+Σ T = 0. Newton's method solves (ε, N_1 … N_n) together, from the frictionless φ̈ and N,
 with the exact Jacobian: its only couplings are through ε (an arrowhead matrix), so each
 iteration costs one evaluation per cylinder and the correction is explicit (:func:`solve`); the
 functions are smooth except for the |·| of N and of the joint forces. It stops when the last
-corrections are below :data:`TOL` of the magnitude of the terms and applies them: convergence
-being quadratic, what remains is of the order of their square, below rounding (linear with a
-factor O(μ) in the rare case that a |·| has its kink within the last correction). The residuals
+corrections are below :data:`TOL` (1e-7) of the magnitude of the terms and applies them:
+convergence being quadratic with a constant of the order of μ·r/l over the forces, what remains
+is about 1e-3·TOL² of them, below rounding (in the rare case that a |·| has its kink within the
+last correction it is at most μ·TOL instead). Two or three iterations do it. The residuals
 of the implicit equations are then rounding (``tests/unit/test_joint_friction.py``). Nothing is
 lagged from an earlier evaluation: the solve starts afresh at every state, so the result is a
 function of the state alone. If it has not converged after :data:`MAX_ITER` corrections (a
@@ -90,9 +91,9 @@ from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU,
  R_COUPLE) = range(27)
 
 #: Newton's method has converged when its corrections are below TOL of their scales; the
-#: correction is then applied and, convergence being quadratic, leaves an error of the order of
-#: its square, below rounding.
-TOL = 1e-9
+#: correction is then applied and, convergence being quadratic with a constant of the order of
+#: μ·r/l over the force scale, leaves a relative error of about 1e-3·TOL², below rounding.
+TOL = 1e-7
 #: Corrections at most before a solve is reported as failed (NaN).
 MAX_ITER = 40
 
@@ -262,10 +263,28 @@ def joint_terms(mp, jp, wk, k, eps, w, sigma, N):
 
 
 @kernel
+def start_n(mp, jp, wk, k, eps, w, sigma):
+    """N of cylinder k at φ̈ = ``eps`` without the friction that depends on the forces (the rod
+    equation is then linear in N): where Newton's method starts, so that its first step already
+    has the side force's sign."""
+    c = WK_RX
+    lcb, lsb, db, ds = wk[c + R_LCB, k], wk[c + R_LSB, k], wk[c + R_DB, k], wk[c + R_DS, k]
+    P = wk[c + R_P, k]
+    f0 = jp[JOINT_SLIDER, RX_RING_FORCE] + jp[JOINT_SLIDER, RX_RING_PRESSURE] * max(P, 0.0)
+    py = (mp[M_PISTON] * (wk[c + R_ABY0, k] + wk[c + R_ABY1, k] * eps) + P
+          - wk[c + R_SS, k] * sigma * f0 - jp[JOINT_SLIDER, RX_VISCOUS] * ds * w)
+    dx = wk[c + R_DX0, k] + wk[c + R_DX1, k] * eps
+    dy = wk[c + R_DY0, k] + wk[c + R_DY1, k] * eps
+    h = wk[c + R_H0, k] + wk[c + R_H1, k] * eps
+    m_visc = -(jp[JOINT_CRANKPIN, RX_VISCOUS] * (1.0 + db) + jp[JOINT_PIN, RX_VISCOUS] * db) * w
+    return dx + (lsb * (py + dy) + m_visc - h) / lcb
+
+
+@kernel
 def solve_cylinder(mp, jp, wk, k, eps, w, sigma):
-    """N of cylinder k at a given φ̈ = ``eps`` (inverse dynamics) by Newton's method from 0, into
-    the row R_N; returns False if it does not converge."""
-    N = 0.0
+    """N of cylinder k at a given φ̈ = ``eps`` (inverse dynamics) by Newton's method from
+    :func:`start_n`, into the row R_N; returns False if it does not converge."""
+    N = start_n(mp, jp, wk, k, eps, w, sigma)
     for _ in range(MAX_ITER):
         g, g_n, _, _, _, _, scale = cylinder(mp, jp, wk, k, eps, w, sigma, N)
         step = g / g_n
@@ -288,9 +307,9 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
     filled. Returns NaN if it does not converge (module docstring)."""
     n = int(mp[N_CYL])
     c = WK_RX
-    for k in range(n):
-        wk[c + R_N, k] = 0.0
     eps = eps0
+    for k in range(n):
+        wk[c + R_N, k] = start_n(mp, jp, wk, k, eps, w, sigma)
     for _ in range(MAX_ITER):
         H = J0 * eps - M_shaft
         den = J0
