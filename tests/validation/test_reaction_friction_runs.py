@@ -21,6 +21,8 @@ against what holds independently of the friction model:
   sample, and the total FMEP at 4400 rpm lies between a fifth of the Chen–Flynn correlation's and
   the correlation's (which counts the valve train and auxiliaries too): an order-of-magnitude
   check, not a fit.
+* **At rest**: the rings' tension holds a starter torque up to Σ F_ring |s′_k| (the run ends
+  *locked* at once) and lets 10 % more start the engine.
 """
 from __future__ import annotations
 
@@ -32,9 +34,10 @@ import numpy as np
 import pytest
 
 from transient.analysis.efficiency import chen_flynn_fmep, mean_piston_speed, mechanical_efficiency
+from transient.analysis.loads.crank_slider import slider_arrays
 from transient.assemble import gas_table
 from transient.run import integrate, prescribed
-from transient.scene import Friction, Gas, Initial, Output, Pair, Run, load_scene
+from transient.scene import Friction, Gas, Initial, Output, Pair, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study, point_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -175,3 +178,37 @@ def test_the_pistons_lose_most_and_the_fmep_has_the_order_of_chen_flynn(study):
                                                   zip(names, fmep))
           + f"; total {r['fmep'] / 1e5:.3f}; Chen–Flynn {cf / 1e5:.3f}; ratio {r['fmep'] / cf:.2f}")
     assert 0.2 * cf <= r["fmep"] <= cf
+
+
+def ring_only(starter_torque: float, phi0: float):
+    """The reaction case at rest, without gas, its pistons' only friction the rings' tension
+    (every other coefficient zero), started by a constant starter torque."""
+    base = reaction_case()
+    pairs = tuple(replace(p, mu=0.0, viscous=0.0, ring_pressure=0.0) for p in
+                  base.friction.pairs)
+    return replace(base, gas=Gas(model="none"), friction=Friction("power-flow", pairs),
+                   starter=Starter(starter_torque, 1e4, 1e4), initial=Initial(phi0, 0.0),
+                   run=Run(t_end=0.05), output=Output(samples_per_rev=72, dt=1e-3))
+
+
+@pytest.mark.parametrize("factor, moves", [(0.9, False), (1.1, True)])
+def test_at_rest_the_rings_hold_a_starter_below_their_friction(factor, moves):
+    """At rest the rings' tension friction F_ring acts against the incipient motion whatever
+    the acceleration, so the shaft is held (the run ends *locked*, at t = 0, with its angle)
+    exactly when the starter torque is at most Σ F_ring |s′_k(φ)|, the friction's moment on the
+    shaft (s′ from the loads analysis' kinematics, written apart from the kernel's); 10 % above
+    that it starts forward and the rings lose energy from the first sample."""
+    scene = ring_only(1.0, 0.7)
+    mech = scene.mechanism
+    alpha = 0.7 - np.asarray(mech.firing_angles)
+    s1 = slider_arrays(alpha, mech.crank_radius, mech.rod_length, mech.offset)[1]
+    ring = scene.friction.pairs[-1].ring_force
+    hold = ring * float(np.sum(np.abs(s1)))
+    data = integrate(ring_only(factor * hold, 0.7))
+    tr = data.trajectory
+    if moves:
+        assert data.complete, data.message
+        assert tr["omega"][-1] > 0.0 and tr["W_loss_4"][-1] > 0.0
+    else:
+        assert not data.complete and data.message.startswith("locked"), data.message
+        assert "locked" in data.events and tr["omega"][-1] == 0.0 and tr["t"][-1] == 0.0
