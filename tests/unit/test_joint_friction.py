@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from transient.analysis.loads.crank_slider import slider_arrays
+from transient.assemble import build_model
 from transient.core import crank_slider as core
 from transient.core import joint_friction as jf
 from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_RX_PAR,
@@ -32,6 +34,7 @@ from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_
                                    RX_VISCOUS, WK_ETA, WK_RX, WK_S)
 from transient.mechanisms.crank_slider import CrankSlider
 from transient.reference import crank_slider_joint_forces
+from transient.scene import load_scene, to_toml
 
 RTOL = 1e-12
 
@@ -214,3 +217,30 @@ def test_without_friction_the_solve_is_the_reduced_model(name):
         assert np.all(wk[WK_RX + jf.R_LOSS, :4] == 0.0)
         assert np.all(wk[WK_ETA, :3] == 1.0)
 
+
+
+CASE = Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_reaction_friction.toml"
+
+
+def test_reaction_pairs_survive_the_resolved_scene():
+    scene = load_scene(CASE)
+    back = load_scene("resolved.toml", text=to_toml(scene))
+    assert back.friction == scene.friction
+    assert [p.model for p in back.friction.pairs] == ["reaction"] * 4
+
+
+def test_every_reversal_of_a_joint_is_a_breakpoint_where_the_derivative_jumps():
+    """The pistons' speeds change sign at their dead centres, the rods' rates β̇ at local 90° and
+    270° (both turns of the 4-stroke cycle): each is a breakpoint marked as a jump, so that no
+    step straddles a friction force's reversal and none carries its derivative across one."""
+    scene = load_scene(CASE)
+    model, bp, _ = build_model(scene)
+    mech = scene.mechanism
+    want = np.mod(np.add.outer(np.asarray(mech.firing_angles),
+                               np.arange(8) * math.pi / 2).ravel(), mech.cycle)
+    for angle in want:
+        gap = np.abs(bp - angle)
+        i = int(np.argmin(np.minimum(gap, mech.cycle - gap)))
+        assert min(gap[i], mech.cycle - gap[i]) <= 1e-12 * mech.cycle, angle
+        assert model.bp_jump[i]
+    assert model.reaction and list(model.rx_pair) == [0, 1, 2, 3]
