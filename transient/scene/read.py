@@ -22,9 +22,9 @@ from .reader import MISSING, Section, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
                       MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
-                      MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction, Gas, Governor,
-                      Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene, Solver, Starter,
-                      Wiebe, Woschni)
+                      MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction, Gas,
+                      Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
+                      Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
 

@@ -47,7 +47,8 @@ def to_toml(scene: Scene) -> str:
         if pair.model == "reaction":
             keys = (("mu", "ring_force", "ring_pressure", "viscous") if pair.between[0] == "piston"
                     else ("mu", "radius", "viscous"))
-            lines += ['model = "reaction"'] + [f"{k} = {toml_value(getattr(pair, k))}" for k in keys]
+            lines += ['model = "reaction"']
+            lines += [f"{k} = {toml_value(getattr(pair, k))}" for k in keys]
         else:
             lines += [f"eta_forward = {toml_value(pair.eta_forward)}",
                       f"eta_backward = {toml_value(pair.eta_backward)}"]
