@@ -53,8 +53,11 @@ Directions and smoothness
 The sign of each joint's relative speed is taken at the angle ``sel`` of the current step
 (cached per ``sel``) times the direction of motion σ: the piston's speed changes sign at the
 dead centres, the rod's rate β̇ at α = 90°, 270°, and ``transient.assemble`` makes those angles
-breakpoints, so no step straddles one and the right-hand side is smooth inside every step;
-the throw's and the crankpin's relative rates keep the sign of ω. At rest (ω = 0) the chain's
+breakpoints, so no friction force reverses inside a step; the throw's and the crankpin's
+relative rates keep the sign of ω. What remains non-smooth inside a step are the kinks of the
+|·|: chiefly μ·|N| where a side force changes side, at angles that depend on the motion, which
+the step-size control meets as it meets any kink (they account for most of the extra steps of
+a run with a slider's μ). At rest (ω = 0) the chain's
 rule for the incipient motion applies unchanged (:func:`choose_direction`).
 
 Outputs per pair (the joints of all cylinders that one pair names): the loss moment L (the power
