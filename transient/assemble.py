@@ -16,8 +16,9 @@ from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
 from .core import variation as var
 from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, PAPER, PHI, POWER_FLOW, TABULATED,
-                          Model, T, work_array)
+from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_PAR, PAPER, PHI, POWER_FLOW,
+                          RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
+                          TABULATED, Model, T, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
 from .forces.trapezoid import trapezoid_table
@@ -296,6 +297,8 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
     curve = load_table_curve(scene)
     if curve is not None and curve.abscissa == "angle":  # its knots are kinks in φ
         bp = union_of_angles(bp, curve.corners, period)
+    if reaction_friction(scene):
+        bp = union_of_angles(bp, reaction_breakpoints(scene), period)
     model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -320,6 +323,9 @@ def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None
             model.bp_jump[:] |= _on_closed_part_corner(bp, all_phases[n:], model)
     if begin is not None:
         model.bp_jump[:] |= _on_cycle_begin(bp, phases, model, mech, begin)
+    if model.reaction:  # a friction force reverses there: the derivative jumps
+        gap = np.abs(bp[:, None] - reaction_breakpoints(scene)[None, :])
+        model.bp_jump[:] |= np.any(np.minimum(gap, period - gap) <= 1e-12 * period, axis=1)
     return model, model.breakpoints, table
 
 
@@ -509,6 +515,8 @@ def chain_fields(scene) -> dict:
     of link i is the number of non-ideal pairs before it.
     """
     mech, friction = scene.mechanism, scene.friction
+    if reaction_friction(scene):
+        return reaction_fields(scene)
     cut_after = [mech.links.index(p.between[0]) for p in friction.pairs]
     link_sub = np.array([sum(c < i for c in cut_after) for i in range(len(mech.links))],
                         dtype=np.int64)
@@ -517,4 +525,46 @@ def chain_fields(scene) -> dict:
         eta_fwd=np.array([p.eta_forward for p in friction.pairs], dtype=np.float64),
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
-        link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64))
+        link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
+        reaction=False, rx_par=np.zeros((4, N_RX_PAR)), rx_pair=np.full(4, -1, dtype=np.int64))
+
+
+def reaction_friction(scene) -> bool:
+    """Whether the scene's pairs have friction on their reactions (one model for all pairs)."""
+    return any(p.model == "reaction" for p in scene.friction.pairs)
+
+
+def reaction_fields(scene) -> dict:
+    """The chain's part of the Model with reaction friction (:mod:`transient.core.joint_friction`):
+    no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
+    ``reaction_links`` (main bearing, crankpin, piston pin, slider) has its pair's coefficients
+    and reports as that pair."""
+    mech, pairs = scene.mechanism, scene.friction.pairs
+    rx_par = np.zeros((4, N_RX_PAR))
+    rx_pair = np.full(4, -1, dtype=np.int64)
+    for k, p in enumerate(pairs):
+        j = mech.reaction_links.index(p.between[0])
+        rx_pair[j] = k
+        rx_par[j, RX_MU] = p.mu
+        rx_par[j, RX_RADIUS] = p.radius
+        rx_par[j, RX_VISCOUS] = p.viscous
+        rx_par[j, RX_RING_FORCE] = p.ring_force
+        rx_par[j, RX_RING_PRESSURE] = p.ring_pressure
+    n = len(pairs)
+    return dict(n_pairs=n, eta_fwd=np.ones(n), eta_bwd=np.ones(n),
+                policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
+                link_sub=np.zeros(len(mech.links), dtype=np.int64),
+                link_J=np.array(mech.link_inertias(), dtype=np.float64),
+                reaction=True, rx_par=rx_par, rx_pair=rx_pair)
+
+
+def reaction_breakpoints(scene) -> NDArray[np.float64]:
+    """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction):
+    each piston's dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α),
+    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``)."""
+    mech = scene.mechanism
+    tdc, bdc = mech.dead_centre_angles()
+    local = np.array([tdc, 0.5 * math.pi, bdc, 1.5 * math.pi])
+    turns = np.arange(0.0, mech.cycle - 1e-9, 2.0 * math.pi)
+    angles = np.add.outer(np.asarray(mech.firing_angles), np.add.outer(turns, local)).ravel()
+    return np.unique(np.mod(angles, mech.cycle))

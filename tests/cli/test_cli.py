@@ -782,6 +782,39 @@ def test_efficiency_study_writes_table_and_plot(tmp_path, capsys):
     assert fmep[("power-flow", 1.0, 5000.0)] > fmep[("power-flow", 1.0, 1000.0)]
 
 
+def test_efficiency_study_and_budget_with_reaction_friction(tmp_path, capsys):
+    """The budget reads reaction pairs as constant-η ones: `transient efficiency` writes every
+    point's per-pair FMEP (summing to the total), the budget chart and the η map; η_mech falls
+    with speed and load; `transient run` at a prescribed speed names the pistons as the pair
+    that loses most and stores the budget under /analysis."""
+    scene = CASES / "gots_diesel_reaction_friction.toml"
+    code, out, err = cli(capsys, "efficiency", scene, "--rpm", "1000,4400", "--fuel", "1,0.5",
+                         "--samples-per-rev", "360", "-o", tmp_path)
+    assert (code, err) == (0, "")
+    csv = (tmp_path / "gots_diesel_reaction_friction_efficiency.csv").read_text().splitlines()
+    header = csv[0].split(",")
+    rows = {(float(r["fuel"]), float(r["rpm"])): r for r in
+            (dict(zip(header, line.split(","))) for line in csv[1:])}
+    assert len(rows) == 4
+    for r in rows.values():
+        assert float(r["fmep"]) == pytest.approx(sum(float(r[f"fmep_{k}"]) for k in range(1, 5)),
+                                                 rel=1e-9)
+    eta = {key: float(r["eta_mech_work"]) for key, r in rows.items()}
+    assert eta[(1.0, 4400.0)] < eta[(1.0, 1000.0)] and eta[(0.5, 4400.0)] < eta[(1.0, 4400.0)]
+    for figure in ("efficiency", "friction_budget", "efficiency_map"):
+        assert (tmp_path / f"gots_diesel_reaction_friction_{figure}.png").stat().st_size > 10_000
+    text = scene.read_text().replace('[run]\nrevolutions = 600',
+                                     '[run]\nmode = "prescribed-speed"\nspeed_rpm = 4400\n'
+                                     'revolutions = 2')
+    assert text != scene.read_text()
+    path = write(tmp_path, "reaction_4400", text)
+    code, out, err = cli(capsys, "run", path, "-o", tmp_path)
+    assert (code, err) == (0, "")
+    assert "pair 4 (pistons) loses most" in out
+    res = transient.open_result(tmp_path / "reaction_4400.h5")
+    assert res.analysis["fmep_4"][1] == "Pa" and res.analysis["fmep_4"][0] > 0.0
+
+
 def test_efficiency_study_refuses_a_figure_before_the_study(tmp_path, capsys, monkeypatch):
     """A figure that exists is refused (exit 2) before any point is run, not after the study."""
     import transient.study.efficiency as study
@@ -879,8 +912,9 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert not cold["cold"] and cold["compile_s"] >= 0 and cold["run_wall_s"] > 0
     assert "(quick: caches warm)" in targets and "## Cold compile profile" in targets
     lines = verdicts(res)
-    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 2 \
+    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 1 + 2 \
         + len(BENCH_SCENES) * len(ADAPTIVE) + 2
+    assert res["reaction"]["constant_s"] > 0 and res["reaction"]["reaction_s"] > 0
     for target, case, measured, verdict in lines:
         assert verdict in ("met", "met at the baseline's best error", "**missed**",
                            "**not measured**")

@@ -43,6 +43,51 @@ def pair(between: str = '["shaft", "crank"]', fwd: str = "0.98", bwd: str = "0.9
                     f"eta_forward = {fwd}\neta_backward = {bwd}\n{extra}")
 
 
+def reaction(between: str = '["shaft", "crank"]', keys: str = "mu = 0.003\nradius_mm = 30\n",
+             extra: str = "") -> str:
+    """VALID with one pair with friction on its reaction."""
+    return VALID + (f'\n[friction]\n\n[[friction.pairs]]\nbetween = {between}\n'
+                    f'model = "reaction"\n{keys}{extra}')
+
+
+SLIDER = '["piston", "cylinder"]'
+REACTION_CASES = [  # (id, scene text, key, fragment), part of CASES below
+    ("reaction-unknown-model", pair(extra='model = "coulomb"\n'), "friction.pairs[0].model",
+     "unknown value 'coulomb'; allowed: 'constant-eta', 'reaction'"),
+    ("reaction-mu-negative", reaction(keys="mu = -0.01\nradius_mm = 30\n"),
+     "friction.pairs[0].mu", "must be ≥ 0, got -0.01"),
+    ("reaction-mu-missing", reaction(keys="radius_mm = 30\n"), "friction.pairs[0].mu",
+     "is missing"),
+    ("reaction-radius-missing", reaction(keys="mu = 0.003\n"), "friction.pairs[0].radius",
+     "is missing"),
+    ("reaction-radius-zero", reaction(keys="mu = 0.003\nradius_mm = 0\n"),
+     "friction.pairs[0].radius_mm", "must be > 0, got 0"),
+    ("reaction-eta-given", reaction(extra="eta_forward = 0.98\n"),
+     "friction.pairs[0].eta_forward", "unknown key; allowed here: between, model, mu, name, "
+                                      "radius, viscous"),
+    ("reaction-radius-on-slider", reaction(SLIDER, "mu = 0.03\nradius_mm = 30\n"),
+     "friction.pairs[0].radius_mm", "unknown key; allowed here: between, model, mu, name, "
+                                    "ring_force, ring_pressure, viscous"),
+    ("reaction-ring-share-above-1", reaction(SLIDER, "mu = 0.03\nring_pressure = 2\n"),
+     "friction.pairs[0].ring_pressure", "must be ≤ 1, got 2"),
+    ("reaction-crankpin-wedges", reaction('["crank", "rod"]', "mu = 1\nradius_mm = 150\n"),
+     "friction.pairs[0].mu", "the friction would wedge the mechanism"),
+    ("reaction-unknown-link", reaction('["piston", "wall"]', "mu = 0.03\n"),
+     "friction.pairs[0].between",
+     "unknown link 'wall'; the links are shaft – crank – rod – piston – cylinder"),
+    ("constant-eta-on-piston", pair(between='["rod", "piston"]'), "friction.pairs[0].between",
+     "unknown link 'piston'; the links are shaft – crank – rod (pairs with model = \"reaction\" "
+     "join shaft – crank – rod – piston – cylinder)"),
+    ("reaction-mixed-with-constant-eta",
+     reaction(extra='\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
+                    'eta_backward = 0.9\n'),
+     "friction.pairs[1].model", "mixing constant-eta and reaction pairs is not implemented"),
+    ("reaction-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"')
+     + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\nmodel = "reaction"\n'
+       'mu = 0.003\nradius_mm = 30\n',
+     "solver.method", "friction on the reactions runs on the compiled methods"),
+]
+
 # Dynamic governors and fuel latching (issue 6): limits, gains, what a prescribed run cannot do.
 PI = '\n[governor]\nmodel = "pi"\nspeed_rpm = 1000\ngain_p = 10\ngain_i = 30\n'
 FLYWEIGHT = ('\n[governor]\nmodel = "flyweight"\nweight_mass = 0.1\nradius_mm = 30\n'
@@ -263,7 +308,8 @@ CASES = [
                               'eta_forward = 0.9\neta_backward = 0.9\n'),
      "friction.pairs[1].between", "the same pair as friction.pairs[0]"),
     ("pair-unknown-key", pair(extra="efficiency = 0.9\n"), "friction.pairs[0].efficiency",
-     "unknown key; allowed here: between, eta_backward, eta_forward, name"),
+     "unknown key; allowed here: between, eta_backward, eta_forward, model, name"),
+    *REACTION_CASES,
     ("pairs-not-array", VALID + '\n[friction]\npairs = 3\n', "friction.pairs",
      "must be an array of tables"),
     ("unknown-policy", pair(policy="coulomb"), "friction.policy",
@@ -432,6 +478,22 @@ def test_invalid_swash_plate_is_one_line_exit_2(tmp_path, capsys, command, old, 
     assert code == 2
     assert_one_line_error(err, scene, key, fragment)
     assert not (tmp_path / "res").exists()
+
+
+@pytest.mark.parametrize("case", ["swash_plate_4cyl.toml", "radial_5cyl.toml"])
+def test_reaction_friction_where_it_is_not_implemented_is_one_line_exit_2(tmp_path, capsys,
+                                                                          case):
+    """Friction on the reactions exists for the crank-slider only: a swash plate's or a radial
+    engine's reaction pair is refused, naming what is allowed."""
+    text = (Path(__file__).resolve().parents[2] / "cases" / case).read_text()
+    text = text.split("\n[friction]")[0]
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "link"]\n'
+                            'model = "reaction"\nmu = 0.003\nradius_mm = 30\n', encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, "friction.pairs[0].model",
+                          "friction on the reactions is implemented for the crank-slider only")
 
 
 def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):

@@ -18,10 +18,11 @@ from . import cylinder as cyl
 from . import governor as gv
 from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
+from . import joint_friction as jf
 from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, LT_ANGLE, LT_NONE, LT_SPEED, OMEGA, PHI,
                      SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_SLEEVE, SW_STARTER, T, TABULATED,
                      WK_DEMAND, WK_DU, WK_FUEL, WK_LOCAL, WK_LOCAL_SHIFT, WK_PIECE, WK_PIECE_SHIFT,
-                     WK_SEL, WK_U, cyl_index, gov_index, latch_index)
+                     WK_RX, WK_SEL, WK_U, cyl_index, gov_index, latch_index)
 from .swash_plate import swash_terms
 from .tabulated import tabulated_terms
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
@@ -369,12 +370,20 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
                 if m.var_on:
                     M_k *= m.var_par[k, PRESSURE]
                 M_gas += M_k
+                if m.reaction:  # each piston's force, for its joints' reactions
+                    wk[WK_RX + jf.R_P, k] = (m.gas_scale[k] * (p_k - m.gas_offset)
+                                             * (m.var_par[k, PRESSURE] if m.var_on else 1.0))
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
-                M_k = m.gas_scale[k] * (gas_value(m, k, phi, sel, wk) - m.gas_offset) * u[k]
+                p_k = gas_value(m, k, phi, sel, wk)
+                M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
                 if m.var_on:  # (factors of 1 leave M_k to the last bit)
                     M_k *= wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                 M_gas += M_k
+                if m.reaction:
+                    wk[WK_RX + jf.R_P, k] = (f * m.gas_scale[k] * (p_k - m.gas_offset)
+                                             * (wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
+                                                if m.var_on else 1.0))
             M_gas *= f
     # (with s = 1 exactly the formula without a schedule, to the last bit)
     s = load_scale(m, y, sw[SW_LOAD])
@@ -390,4 +399,9 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     M_starter = 0.0
     if sw[SW_STARTER]:
         M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
+    if m.reaction:
+        if not m.has_gas:
+            for k in range(m.ncyl):
+                wk[WK_RX + jf.R_P, k] = 0.0
+        jf.prepare(m.mech, phi, w, sel, wk)
     return J, dJ, w, M_gas, M_load, M_starter

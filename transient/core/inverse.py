@@ -16,6 +16,7 @@ from .forcing import (fuel, generator_branch, governor_branch, load_segment, mom
 from .layout import (COL_EPS, N_OUT_FIXED, N_SWITCHES, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
                      SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY,
                      WK_J, WK_M, WK_S, WK_S_TRY, latch_index, n_state, work_array)
+from .joint_friction import inverse_drive
 from .outputs import output_row, pair_rows
 from .rhs import pair_etas, split_subchains
 
@@ -100,7 +101,11 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
             M_drive[i] = J * eps[i] + 0.5 * dJ * w * w - (M_gas + M_load)
             n_consistent[i] = 1
             continue
-        split_subchains(m, J, dJ, M_gas, M_load, wk)
         sigma = 1.0 if w > 0.0 or (w == 0.0 and eps[i] >= 0.0) else -1.0
-        M_drive[i], n_consistent[i] = inverse_chain(m, eps[i], w, sigma, wk)
+        if m.reaction:
+            M_drive[i] = inverse_drive(m, eps[i], w, sigma, M_load, wk)
+            n_consistent[i] = 1
+        else:
+            split_subchains(m, J, dJ, M_gas, M_load, wk)
+            M_drive[i], n_consistent[i] = inverse_chain(m, eps[i], w, sigma, wk)
         pair_rows(m, w, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, N_OUT_FIXED + m.ncyl:])

@@ -87,7 +87,24 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
  WK_SCRATCH) = range(20)
-N_WK = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into
+#: With reaction friction (``Model.reaction``, :mod:`.joint_friction`) the rows from WK_RX on
+#: hold, per cylinder, the crank-slider's geometry and accelerations at the state, the gas force,
+#: the joints' directions of sliding at the step's angle ``sel`` and the solve's iterates
+#: (``joint_friction.R_*`` are the offsets), and per pair the moment its losses reduce to.
+WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
+N_WK_RX = 28
+N_WK = WK_RX + N_WK_RX
+
+#: The joints of the crank-slider that reaction friction acts in (rows of ``Model.rx_par``): the
+#: main bearing (frame – throw), the crankpin (throw – rod), the piston pin (rod – piston) and the
+#: piston in its cylinder (the slider).
+JOINT_MAIN, JOINT_CRANKPIN, JOINT_PIN, JOINT_SLIDER = range(4)
+#: Columns of ``Model.rx_par``: the friction coefficient μ [1], the journal's radius r [m], the
+#: viscous coefficient (journal: N m s/rad on the relative angular speed; slider: N s/m on the
+#: piston speed), the rings' tension friction force [N] and the share of the gas force that
+#: presses the rings to the wall times their μ [1] (slider only).
+RX_MU, RX_RADIUS, RX_VISCOUS, RX_RING_FORCE, RX_RING_PRESSURE = range(5)
+N_RX_PAR = 5
 
 Model = namedtuple(
     "Model",
@@ -144,6 +161,11 @@ Model = namedtuple(
         "var_shifted",  # bool: some cylinder has a combustion offset
         "var_par",  # float64[ncyl, variation.N_VAR_PAR]: factors, cycle start, rate, offset
         "var_int",  # int64[ncyl, 2 + cycles listed]: misfire period, seed, misfiring cycles
+        # reaction friction in the crank-slider's joints (transient.core.joint_friction); the
+        # pairs are then the joints that have friction, and no sub-chain is cut
+        "reaction",  # bool: the pairs' losses follow from the joint reactions
+        "rx_par",  # float64[4, N_RX_PAR]: each joint's coefficients (zeros: an ideal joint)
+        "rx_pair",  # int64[4]: the pair each joint reports as, −1 for an ideal joint
     ],
 )
 
@@ -184,4 +206,5 @@ def work_array(m):
     """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
     wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
     wk[WK_SEL, 0] = np.nan  # no pieces selected yet
+    wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
     return wk

@@ -12,6 +12,7 @@ from .jit import kernel
 
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import governor as gv
+from . import joint_friction as jf
 from .forcing import command, cylinder_rates, governor_rates, moments
 from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T, W_GAS, W_LOAD,
                      W_LOSS0, W_STARTER, WK_DJ, WK_ETA, WK_G, WK_G_MIN, WK_J, WK_M, WK_S,
@@ -51,7 +52,8 @@ def pair_etas(m, modes, eta_out):
 
 @kernel(inline=True)
 def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
-    """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)."""
+    """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)
+    or with the joints' reaction friction (``joint_friction``)."""
     if m.n_pairs == 0:
         return (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J
     return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
@@ -60,7 +62,10 @@ def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
 @kernel(inline=True)
 def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
-    and the pairs' η*, S in the rows of ``wk``."""
+    and the pairs' η*, S in the rows of ``wk``. With reaction friction the pairs are joints of
+    one rigid chain: φ̈ and their η*, S and losses come from ``joint_friction``, in direction σ."""
+    if m.reaction:
+        return jf.reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]), wk)
     n = m.n_pairs
     split_subchains(m, J, dJ, M_gas, M_shaft, wk)
     pair_etas(m, sw[SW_MODES], wk[WK_ETA])
@@ -93,7 +98,7 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
         mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
         for k in range(m.n_pairs):
-            lk = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
+            lk = jf.loss_moment(wk, k) if m.reaction else (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
             out[W_LOSS0 + k] = lk * q
             loss += lk
             wk[WK_G_MIN, k] = min(wk[WK_G_MIN, k], wk[WK_G, k])
@@ -124,6 +129,10 @@ def mode_margins(m, sw, wk):
     (Σ_{j≤k} M_j) σ ≥ 0 forward (``transient.core.chain.modes_paper``).
     """
     sigma = sw[SW_DIRECTION]
+    if m.reaction:  # no modes: the joints' directions change on breakpoints only
+        for k in range(m.n_pairs):
+            wk[WK_G, k] = 1.0
+        return
     upstream = 0.0
     for k in range(m.n_pairs):
         upstream += wk[WK_M, k]
@@ -168,6 +177,11 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
         sw[SW_DIRECTION] = -1 if w < 0.0 else 1
         sw[SW_MODES] = 0
         return UNIQUE
+    if m.reaction:
+        sigma, _, status = jf.choose_direction(m, J, dJ, w, M_gas, M_load + M_starter, wk)
+        sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
+        sw[SW_MODES] = 0
+        return status
     split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
     a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
                                          wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,

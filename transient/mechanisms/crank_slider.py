@@ -86,6 +86,10 @@ class CrankSlider:
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
     #: flywheel and load, the crank, and the rods with pistons and gas forces.
     links = ("shaft", "crank", "rod")
+    #: Links for pairs with friction on their reactions (:mod:`transient.core.joint_friction`):
+    #: the piston is a link of its own and the cylinder (the frame) the last, so the pairs are
+    #: the main bearings, the crankpins, the piston pins and the pistons in their cylinders.
+    reaction_links = ("shaft", "crank", "rod", "piston", "cylinder")
 
     @property
     def n_cylinders(self) -> int:

@@ -40,6 +40,10 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("solver.method", "the reference path (scipy-*) follows the power-flow "
                                           "policy only; use method = \"dop853\" or \"dopri5\" "
                                           "with policy \"paper\"")
+    if any(p.model == "reaction" for p in scene.friction.pairs) and not compiled:
+        raise SceneError("solver.method", f"friction on the reactions runs on the compiled "
+                                          f"methods ({', '.join(COMPILED_METHODS)}), not "
+                                          f"{sv.method!r}")
     if sv.fixed_step > 0.0 and not compiled:
         raise SceneError("solver.fixed_step", f"fixed steps need a compiled method "
                                               f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")

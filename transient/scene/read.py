@@ -22,9 +22,9 @@ from .reader import MISSING, Section, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
                       MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
-                      MIN_OUTPUT_DT, POLICIES, Analysis, Cylinder, Friction, Gas, Governor,
-                      Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene, Solver, Starter,
-                      Wiebe, Woschni)
+                      MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction, Gas,
+                      Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
+                      Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
 
@@ -140,7 +140,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["output"] = Output(spr, dt)
         so.finish()
         sf = root.sub("friction")
-        sections["friction"] = _read_friction(sf, mech.links)
+        sections["friction"] = _read_friction(sf, mech)
         sf.finish()
         sa = root.sub("analysis")
         sections["analysis"] = _read_analysis(sa)
@@ -343,42 +343,40 @@ def _table_column(rows, index: int, column: str, factor: float) -> tuple[float, 
     return tuple(out)
 
 
-def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
+def _read_friction(s: Section, mech) -> Friction:
     """The [friction] table: a policy and an array of [[friction.pairs]] between neighbouring
-    links of the mechanism (shaft side first)."""
+    links of the mechanism (shaft side first), each with its friction model."""
     policy = s.string("policy", "power-flow", choices=POLICIES)
     s.known.append("pairs")
     raw = s.data.pop("pairs", [])
     if not isinstance(raw, list):
         raise SceneError(s.key("pairs"), "must be an array of tables ([[friction.pairs]])")
-    chain = " – ".join(links)
-    pairs, seen = [], {}
+    pairs, seen, models = [], {}, []
     for i, item in enumerate(raw):
         ps = Section(item, f"{s.key('pairs')}[{i}]")
-        ps.known.append("between")
-        between = ps.data.pop("between", None)
-        if (not isinstance(between, list) or len(between) != 2
-                or not all(isinstance(b, str) for b in between)):
-            raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
-                                                f"the links are {chain}")
-        for b in between:
-            if b not in links:
-                raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links "
-                                                    f"are {chain}")
-        ia, ib = links.index(between[0]), links.index(between[1])
-        if abs(ia - ib) != 1:
-            raise SceneError(ps.key("between"),
-                             f"{between[0]!r} and {between[1]!r} are not neighbours; a pair joins "
-                             f"two adjacent links of the chain {chain}")
-        if ib < ia:
-            raise SceneError(ps.key("between"), f"give the shaft-side link first: "
-                                                f"[{between[1]!r}, {between[0]!r}]")
+        model = ps.string("model", "constant-eta", choices=PAIR_MODELS)
+        links = mech.links
+        if model == "reaction":
+            links = getattr(mech, "reaction_links", ())
+            if not links:
+                raise SceneError(ps.key("model"), f"friction on the reactions is implemented for "
+                                                  f"the crank-slider only, not for {mech.name!r}; "
+                                                  f"use model = \"constant-eta\" here")
+        hint = ""
+        if model != "reaction" and getattr(mech, "reaction_links", ()):
+            hint = (f" (pairs with model = \"reaction\" join "
+                    f"{' – '.join(mech.reaction_links)})")
+        between = _between(ps, links, hint)
+        ia = links.index(between[0])
         if ia in seen:
             raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
         seen[ia] = i
-        pair = Pair(between=(between[0], between[1]), eta_forward=_efficiency(ps, "eta_forward"),
-                    eta_backward=_efficiency(ps, "eta_backward"),
-                    name=ps.string("name", f"{between[0]}-{between[1]}"))
+        name = ps.string("name", f"{between[0]}-{between[1]}")
+        if model == "reaction":
+            pair = _reaction_pair(ps, between, name, slider=ia == len(links) - 2)
+        else:
+            pair = Pair(between=between, eta_forward=_efficiency(ps, "eta_forward"),
+                        eta_backward=_efficiency(ps, "eta_backward"), name=name)
         ps.finish()
         twin = next((j for j, q in enumerate(pairs) if q.name == pair.name), None)
         if twin is not None:
@@ -386,9 +384,78 @@ def _read_friction(s: Section, links: tuple[str, ...]) -> Friction:
                                              f"{s.key('pairs')}[{twin}] "
                                              f"too; give each pair its own name (it labels the "
                                              f"pair's result columns and reports)")
+        if models and model != models[0]:
+            raise SceneError(ps.key("model"), f"{model!r} after {models[0]!r} in "
+                                              f"{s.key('pairs')}[0]; the pairs of a scene share "
+                                              f"one model (mixing constant-eta and reaction "
+                                              f"pairs is not implemented)")
+        models.append(model)
         pairs.append(pair)
-    pairs.sort(key=lambda p: links.index(p.between[0]))
+    order = getattr(mech, "reaction_links", ()) if "reaction" in models else mech.links
+    pairs.sort(key=lambda p: order.index(p.between[0]))
+    if "reaction" in models:
+        _check_wedging(s, mech, pairs, raw)
     return Friction(policy, tuple(pairs))
+
+
+def _between(ps: Section, links: tuple[str, ...], hint: str) -> tuple[str, str]:
+    """The pair's two links, neighbours in ``links``, shaft side first (``hint`` ends the message
+    of an unknown link)."""
+    chain = " – ".join(links)
+    ps.known.append("between")
+    between = ps.data.pop("between", None)
+    if (not isinstance(between, list) or len(between) != 2
+            or not all(isinstance(b, str) for b in between)):
+        raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
+                                            f"the links are {chain}")
+    for b in between:
+        if b not in links:
+            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links "
+                                                f"are {chain}{hint}")
+    ia, ib = links.index(between[0]), links.index(between[1])
+    if abs(ia - ib) != 1:
+        raise SceneError(ps.key("between"),
+                         f"{between[0]!r} and {between[1]!r} are not neighbours; a pair joins "
+                         f"two adjacent links of the chain {chain}")
+    if ib < ia:
+        raise SceneError(ps.key("between"), f"give the shaft-side link first: "
+                                            f"[{between[1]!r}, {between[0]!r}]")
+    return between[0], between[1]
+
+
+def _reaction_pair(ps: Section, between: tuple[str, str], name: str, slider: bool) -> Pair:
+    """A pair with friction on its reaction: a journal or pin (μ, radius, viscous) or the piston
+    in its cylinder (μ, ring force, ring pressure share, viscous)."""
+    mu = ps.number("mu", ge=0.0, le=1.0)
+    if slider:
+        return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name,
+                    model="reaction", mu=mu, viscous=ps.number("viscous", default=0.0, ge=0.0),
+                    ring_force=ps.number("ring_force", default=0.0, ge=0.0),
+                    ring_pressure=ps.number("ring_pressure", default=0.0, ge=0.0, le=1.0))
+    return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name, model="reaction",
+                mu=mu, radius=ps.number("radius", "length", gt=0.0),
+                viscous=ps.number("viscous", default=0.0, ge=0.0))
+
+
+def _check_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
+    """Friction must not wedge the crank-slider: the rod's equation in the side force N has a
+    slope of at least l cos β (1 − q), q = μ_s tan β + (μ r of crankpin and pin)(1 + μ_s)/(l cos β)
+    at the largest rod angle (:mod:`transient.core.joint_friction`); q < 1 keeps it increasing,
+    hence one solution at every state."""
+    r, l, e = mech.crank_radius, mech.rod_length, mech.offset
+    sin_b = (r + abs(e)) / l
+    cos_b = math.sqrt(max(1.0 - sin_b * sin_b, 0.0))
+    by_joint = {p.between[0]: p for p in pairs}
+    mu_s = by_joint["piston"].mu if "piston" in by_joint else 0.0
+    mr = sum(by_joint[j].mu * by_joint[j].radius for j in ("crank", "rod") if j in by_joint)
+    q = (mu_s * sin_b / cos_b + mr * (1.0 + mu_s) / (l * cos_b)) if cos_b > 0.0 else math.inf
+    if q >= 1.0:
+        i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
+                 and item.get("between", [None])[0] in ("piston", "crank", "rod"))
+        raise SceneError(f"{s.key('pairs')}[{i}].mu",
+                         f"the friction would wedge the mechanism: μ_slider·tan β_max + "
+                         f"(μ·r of crankpin and pin)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; "
+                         f"allowed below 1 (lubricated pairs are around 0.01)")
 
 
 def _efficiency(s: Section, name: str) -> float:

@@ -437,6 +437,22 @@ class Pair:
     eta_forward: float
     eta_backward: float
     name: str = ""
+    #: ``"constant-eta"`` (the efficiencies above) or ``"reaction"``: friction on the joint's
+    #: reaction (crank-slider only, :mod:`transient.core.joint_friction`; then η is unused, 1).
+    model: str = "constant-eta"
+    #: Reaction model: friction coefficient μ [1] (journal: friction-circle μ·r·|R|; slider:
+    #: μ·|N| on the side force).
+    mu: float = 0.0
+    #: Reaction model, journals: the journal's or pin's radius r [m].
+    radius: float = 0.0
+    #: Reaction model: viscous coefficient, journals on the relative angular speed [N m s/rad],
+    #: the slider on the piston speed [N s/m].
+    viscous: float = 0.0
+    #: Reaction model, slider: friction force of the rings' tension [N].
+    ring_force: float = 0.0
+    #: Reaction model, slider: friction from the gas pressure behind the rings as a share of
+    #: the gas force on the piston, c_p = 4 μ_ring h/D for a top ring of height h [1].
+    ring_pressure: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -452,6 +468,8 @@ class Friction:
 
 
 POLICIES = ("power-flow", "paper")
+#: Friction models of a pair.
+PAIR_MODELS = ("constant-eta", "reaction")
 
 
 @dataclass(frozen=True)

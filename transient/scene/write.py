@@ -43,9 +43,15 @@ def to_toml(scene: Scene) -> str:
     lines += ["", "[friction]", f"policy = {toml_value(scene.friction.policy)}"]
     for pair in scene.friction.pairs:
         lines += ["", "[[friction.pairs]]", f"name = {toml_value(pair.name)}",
-                  f"between = {toml_value(list(pair.between))}",
-                  f"eta_forward = {toml_value(pair.eta_forward)}",
-                  f"eta_backward = {toml_value(pair.eta_backward)}"]
+                  f"between = {toml_value(list(pair.between))}"]
+        if pair.model == "reaction":
+            keys = (("mu", "ring_force", "ring_pressure", "viscous") if pair.between[0] == "piston"
+                    else ("mu", "radius", "viscous"))
+            lines += ['model = "reaction"']
+            lines += [f"{k} = {toml_value(getattr(pair, k))}" for k in keys]
+        else:
+            lines += [f"eta_forward = {toml_value(pair.eta_forward)}",
+                      f"eta_backward = {toml_value(pair.eta_backward)}"]
     return "\n".join(lines) + "\n"
 
 

@@ -9,6 +9,7 @@ measured, how, and whether it is met or by how much it is missed.
   last cycle, independent calls (throughput) and chained ones (latency, as a step's stages are);
 * the bare scene (equation (18) alone) against a kernel written by hand for that equation
   (within 5 %), and the bare scene against itself carrying unused options (no measurable change);
+* friction on the joints' reactions on three pairs against constant efficiencies (≤ 2×);
 * warm start (≤ 1 s process wall of ``transient run``) and scale (wall time per revolution at 10⁶
   revolutions within 10 % of 10³, peak memory independent of the length), each in new processes;
 * cold start, each in new processes on an empty cache: the first ``transient run`` of the default
@@ -330,6 +331,31 @@ def unused_options(repeat=15, revolutions=1000.0) -> dict:
             "bare_iqr": (q3 - q1) / w_bare}
 
 
+#: Friction on the joints' reactions (three pairs) against constant efficiencies (the two pairs
+#: a crank-slider's constant-η chain has): at most this many times the wall time.
+REACTION_TARGET = 2.0
+#: The constant-η scene; the reaction scene is it with the main bearings, crankpins and pistons
+#: of the reaction case.
+FRICTION_SCENE = DEFAULT_SCENE.parent / "gots_diesel_friction.toml"
+REACTION_SCENE = DEFAULT_SCENE.parent / "gots_diesel_reaction_friction.toml"
+
+
+def reaction_cost(repeat=5, revolutions=1000.0) -> dict:
+    """Whole runs of the Gots diesel's spin-up with constant-η pairs (main bearings, crankpins)
+    against the same with reaction friction on three pairs (main bearings, crankpins, pistons),
+    medians of ``repeat`` alternating runs, with their solver counts."""
+    from ..scene import Friction
+
+    base = load_scene(FRICTION_SCENE)
+    pairs = [p for p in load_scene(REACTION_SCENE).friction.pairs if p.name != "piston pins"]
+    constant = timed_scene(base, revolutions)
+    reaction = dc.replace(constant, friction=Friction("power-flow", tuple(pairs)))
+    (w_c, w_r), _, (c, r) = median_walls(constant, reaction, repeat=repeat)
+    return {"constant_s": w_c, "reaction_s": w_r, "ratio": w_r / w_c,
+            "constant_nfev": c["nfev"], "reaction_nfev": r["nfev"],
+            "per_call_ratio": (w_r / r["nfev"]) / (w_c / c["nfev"])}
+
+
 # ------------------------------------------------------------------------------------------------
 # new processes: warm start, scale
 
@@ -520,6 +546,8 @@ def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     res["bare"] = bare_kernel(rounds=q.get("rounds", 7))
     res["unused"] = unused_options(**({"repeat": 2, "revolutions": 10.0} if quick else {}))
     progress("targets: bare scene")
+    res["reaction"] = reaction_cost(**({"repeat": 1, "revolutions": 10.0} if quick else {}))
+    progress("targets: reaction friction")
     res["warm_start"] = warm_start(repeat=1 if quick else 5)
     progress("targets: warm start")
     res["scale"] = scale((10.0, 100.0) if quick else (1e3, 2e5, 1e6))
@@ -560,6 +588,14 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
     lines.append(("unused options change nothing measurable (within the bare runs' IQR)",
                   "idle governor + starter", f"{u['change']:+.1%} (IQR {u['bare_iqr']:.1%})",
                   _missed(abs(u["change"]), u["bare_iqr"])))
+    rx = res.get("reaction")  # (none in a record from before it was measured)
+    if rx is not None:
+        lines.append((f"reaction friction on three pairs ≤ {REACTION_TARGET:g}× constant η",
+                      FRICTION_SCENE.stem,
+                      f"{rx['ratio']:.2f}× ({rx['reaction_s']:.3f} s against "
+                      f"{rx['constant_s']:.3f} s; {rx['reaction_nfev']} against "
+                      f"{rx['constant_nfev']} RHS calls, {rx['per_call_ratio']:.2f}× per call)",
+                      _missed(rx["ratio"], REACTION_TARGET)))
     w = res["warm_start"]
     lines.append((f"warm start ≤ {WARM_TARGET_S:g} s", w["scene"],
                   f"{w['median_s']:.2f} s (interpreter alone {w['python_alone_s']:.2f} s)",
