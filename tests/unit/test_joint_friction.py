@@ -19,7 +19,6 @@ model's φ̈ = (M − ½J′ω²)/J (Lagrange: J, J′ of :func:`transient.core.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -32,27 +31,12 @@ from transient.core import joint_friction as jf
 from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_RX_PAR,
                                    N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE,
                                    RX_VISCOUS, WK_ETA, WK_RX, WK_S)
-from transient.mechanisms.crank_slider import CrankSlider
 from transient.reference import crank_slider_joint_forces
 from transient.scene import load_scene, to_toml
 
+from engines import MECHS
+
 RTOL = 1e-12
-
-
-def gots_mech(**changes) -> CrankSlider:
-    """The Gots example engine (Gots §2.9, App. 1): 3 cylinders, firing 1-2-3, two-mass rod."""
-    base = CrankSlider(crank_radius=0.047, rod_length=0.148, offset=0.0, bore=0.088,
-                       piston_mass=1.520, crank_mass=0.912, rod_model="two-mass", rod_mass=1.752,
-                       rod_cg_from_pin=0.725 * 0.148, rod_inertia_cg=0.0, strokes=4,
-                       firing_angles=tuple(np.radians([360.0, 600.0, 120.0])),
-                       bank_angles=(0.0, 0.0, 0.0))
-    return replace(base, **changes)
-
-
-MECHS = {"two-mass": gots_mech(),
-         "offset-two-mass": gots_mech(offset=0.012, rod_length=0.11),
-         "offset-rigid": gots_mech(offset=0.012, rod_length=0.11, rod_model="rigid",
-                                   rod_cg_from_pin=0.07, rod_inertia_cg=2.5e-3)}
 
 
 def coefficients(scale: float = 1.0) -> np.ndarray:
@@ -216,7 +200,6 @@ def test_without_friction_the_solve_is_the_reduced_model(name):
         assert abs(eps - lagrange) <= RTOL * scale, (phi, w, (eps - lagrange) / scale)
         assert np.all(wk[WK_RX + jf.R_LOSS, :4] == 0.0)
         assert np.all(wk[WK_ETA, :3] == 1.0)
-
 
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_reaction_friction.toml"
