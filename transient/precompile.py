@@ -30,7 +30,7 @@ import sys
 
 from numba import config, typeof, types
 
-from .core import breakpoints, events, jit, rhs, rk, stepper
+from .core import breakpoints, events, jit, layout, rhs, rk, stepper
 from .core import stepper_io as sio
 
 #: The stepper's callees, each compiled apart with its own callees (:func:`.core.jit.kernel`), in
@@ -75,7 +75,8 @@ def _types_by_parameter(model, tab) -> dict:
                                   "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
              types.int64[::1]: ("ist", "sw")}
-    by_name = {"m": typeof(model), "tab": typeof(tab)}
+    # (``extras`` is None or True: the plain or the full variant, :func:`.core.layout.extras_of`)
+    by_name = {"m": typeof(model), "tab": typeof(tab), "extras": typeof(layout.extras_of(model))}
     for numba_type, names in (scalar | array).items():
         by_name.update(dict.fromkeys(names, numba_type))
     return by_name
