@@ -18,7 +18,7 @@ from .core import variation as var
 from .core.variation import cycle_fuel
 from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_PAR, PAPER, PHI, POWER_FLOW,
                           RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
-                          TABULATED, Model, T, work_array)
+                          TABULATED, Model, T, extras_of, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
 from .forces.trapezoid import trapezoid_table
@@ -484,13 +484,13 @@ def initial_cylinders(scene, model: Model, f0: float) -> list[float]:
     phi0 = scene.initial.phi
     sel = phi0 + 1e-9  # (the piece just ahead)
     wk = work_array(model)
-    select_pieces(model, sel, wk)
+    select_pieces(model, extras_of(model), sel, wk)
     out = []
     for k in range(model.ncyl):
         local = (phi0 - model.gas_phase[k]) % model.period
         closed = cyl.closed_angle(model.cyl_par, local, model.period) >= 0.0
         f_k = f0 * cycle_fuel(model, k, sel) if model.var_on else f0
-        out.append(applied_value(model, k, phi0, sel, f_k, wk) if closed
+        out.append(applied_value(model, extras_of(model), k, phi0, sel, f_k, wk) if closed
                    else model.cyl_par[cyl.P_A])
     return out
 

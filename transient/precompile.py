@@ -30,7 +30,7 @@ import sys
 
 from numba import config, typeof, types
 
-from .core import breakpoints, events, jit, rhs, rk, stepper
+from .core import breakpoints, events, jit, layout, rhs, rk, stepper
 from .core import stepper_io as sio
 
 #: The stepper's callees, each compiled apart with its own callees (:func:`.core.jit.kernel`), in
@@ -75,7 +75,8 @@ def _types_by_parameter(model, tab) -> dict:
                                   "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
              types.int64[::1]: ("ist", "sw")}
-    by_name = {"m": typeof(model), "tab": typeof(tab)}
+    # (``extras`` is None or True: the plain or the full variant, :func:`.core.layout.extras_of`)
+    by_name = {"m": typeof(model), "tab": typeof(tab), "extras": typeof(layout.extras_of(model))}
     for numba_type, names in (scalar | array).items():
         by_name.update(dict.fromkeys(names, numba_type))
     return by_name
@@ -97,9 +98,13 @@ def compile_callees(model, tab, callees=CALLEES) -> None:
 STEPPER = stepper.advance
 
 
-def stepper_is_cached() -> bool:
-    """Whether the stepper is compiled in this process or saved in numba's cache."""
-    return bool(STEPPER.overloads) or bool(STEPPER._cache._cache_file._load_index())
+def stepper_is_cached(model, tab) -> bool:
+    """Whether the stepper, in the kernels' variant for ``model``
+    (:func:`.core.layout.extras_of`), is compiled in this process or saved in numba's cache: a
+    cache that holds only the other variant leaves this one to compile."""
+    sig = signature(STEPPER, model, tab)
+    return sig in STEPPER.overloads or any(
+        key[0] == sig for key in STEPPER._cache._cache_file._load_index())
 
 
 def _cores() -> int:
@@ -111,9 +116,10 @@ def _cores() -> int:
 
 def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
     """A helper process compiling ``callees`` (:func:`compile_callees`), or None where it would
-    not help: the stepper is cached, the JIT is off, numba runs without transient's replacements,
-    or this process has one core."""
-    if config.DISABLE_JIT or not jit.REPLACEMENTS_ON or _cores() < 2 or stepper_is_cached():
+    not help: the stepper is cached (in the model's variant), the JIT is off, numba runs without
+    transient's replacements, or this process has one core."""
+    if (config.DISABLE_JIT or not jit.REPLACEMENTS_ON or _cores() < 2
+            or stepper_is_cached(model, tab)):
         return None
     helper = None
     try:

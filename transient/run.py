@@ -90,9 +90,10 @@ def _compile(model, tab, cfg, bp) -> float:
     y[2] = 1.0
     helper = start_helper(model, tab)
     try:
-        stepper.advance(model, tab, warm, bp, y, np.zeros(sio.fst_size(model)),
-                        np.zeros(sio.N_IST, dtype=np.int64), np.empty((1024, n_outputs(model))),
-                        np.empty((64, 4)), *stepper.buffers(model, tab, y.shape[0]))
+        stepper.advance(model, layout.extras_of(model), tab, warm, bp, y,
+                        np.zeros(sio.fst_size(model)), np.zeros(sio.N_IST, dtype=np.int64),
+                        np.empty((1024, n_outputs(model))), np.empty((64, 4)),
+                        *stepper.buffers(model, tab, y.shape[0]))
     finally:
         stop_helper(helper)
     return time.perf_counter() - t0
@@ -132,6 +133,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     cfg = _config(scene)
     names = list(output_columns(scene))
     tab = TABLEAUS[scene.solver.method]
+    extras = layout.extras_of(model)
     compile_s = _compile(model, tab, cfg, bp)
     y, fst, ist = _initial_state(scene, model)
     outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
@@ -152,7 +154,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     t0 = time.perf_counter()
     try:
         while status == sio.RUNNING:
-            status = stepper.advance(model, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf,
+            status = stepper.advance(model, extras, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf,
                                      *stepper.buffers(model, tab, y.shape[0]))
             switching = status == sio.FINISHED and y[layout.T] == switch_at
             block = {name: outbuf[: ist[sio.I_NOUT], j].copy() for j, name in enumerate(names)}
@@ -250,7 +252,7 @@ def switch_inertia(model, extra: float, y, ist):
         y[layout.KINETIC] = 0.5 * (J + extra) * w_new * w_new
     else:
         y[layout.OMEGA] = w_new
-    ist[sio.I_GOV_BRANCH] = forcing.start_branch(model, w_new, y)
+    ist[sio.I_GOV_BRANCH] = forcing.start_branch(model, layout.extras_of(model), w_new, y)
     ist[sio.I_GEN_LOW] = forcing.generator_branch(model, w_new, True)
     ist[sio.I_LOAD_TABLE] = forcing.speed_knot_segment(model, w_new, True)
     ist[sio.I_F_VALID] = 0  # the derivative the last chunk left is the old state's
@@ -313,10 +315,11 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     drive = np.empty(phi.size)
     n_ok = np.empty(phi.size, dtype=np.int64)
     t0 = time.perf_counter()
-    inverse_dynamics(model, t[:1], phi[:1], omega[:1], eps[:1], rows[:1], drive[:1], n_ok[:1])
+    inverse_dynamics(model, layout.extras_of(model), t[:1], phi[:1], omega[:1], eps[:1], rows[:1],
+                     drive[:1], n_ok[:1])
     compile_s = time.perf_counter() - t0
     t0 = time.perf_counter()
-    inverse_dynamics(model, t, phi, omega, eps, rows, drive, n_ok)
+    inverse_dynamics(model, layout.extras_of(model), t, phi, omega, eps, rows, drive, n_ok)
     names = list(output_columns(scene))
     traj = {name: rows[:, j].copy() for j, name in enumerate(names) if name not in ("M_drive", "W_drive")}
     traj["M_drive"] = drive

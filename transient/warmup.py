@@ -6,8 +6,11 @@ cache, :mod:`transient.core`); later runs load them. :func:`warm_up` does that c
 time the user chooses — at install, or on each node of a cluster before a sweep — by running
 built-in scenes for a fraction of a revolution, and the user's scenes too where given; other
 commands compile a few small kernels of their own on first use (the kinematics tables of
-``transient kinematics``, a loads analysis). Every scene shares one stepper
-(its Model's types do not depend on the features used), so one compile serves them all.
+``transient kinematics``, a loads analysis). The kernels come in two variants
+(:func:`transient.core.layout.extras_of`): the plain one that scenes without friction pairs,
+governor states, latched fuel, cylinder states, per-cylinder variation or a tabulated load run,
+and the full one that the others share (its Model's types do not depend on the features used);
+the built-in scenes compile both.
 
 :class:`CompileLog` listens to numba's ``numba:compile`` events, which fire for functions
 compiled, not for those loaded from the cache: per function, the seconds it took with and
@@ -50,14 +53,19 @@ WARMUP_SCENE = {
 
 #: How long :func:`warm_up` runs each scene [revolutions].
 WARMUP_REVOLUTIONS = WARMUP_SCENE["run"]["revolutions"]
-#: The built-in scenes: :data:`WARMUP_SCENE`; the same engine at a prescribed speed (the inverse
-#: dynamics are kernels of their own); and with Wiebe combustion, Woschni's heat transfer and a
-#: flyweight governor (Gots §3; the cylinder and governor states start from Python-side calls of
-#: the kernels).
+#: The same engine without friction pairs: a plain scene (the kernels' plain variant).
+PLAIN_SCENE = {key: value for key, value in WARMUP_SCENE.items() if key != "friction"}
+#: A prescribed speed (the inverse dynamics are kernels of their own).
+PRESCRIBED = {"run": {"mode": "prescribed-speed", "speed_rpm": 1000,
+                      "revolutions": WARMUP_REVOLUTIONS}}
+#: The built-in scenes: :data:`WARMUP_SCENE` and :data:`PLAIN_SCENE`, each also at a prescribed
+#: speed; and with Wiebe combustion, Woschni's heat transfer and a flyweight governor (Gots §3;
+#: the cylinder and governor states start from Python-side calls of the kernels).
 WARMUP_SCENES = (
     WARMUP_SCENE,
-    {**WARMUP_SCENE, "run": {"mode": "prescribed-speed", "speed_rpm": 1000,
-                             "revolutions": WARMUP_REVOLUTIONS}},
+    {**WARMUP_SCENE, **PRESCRIBED},
+    PLAIN_SCENE,
+    {**PLAIN_SCENE, **PRESCRIBED},
     {**WARMUP_SCENE,
      "gas": {"model": "wiebe", "p0_MPa": 0.1, "compression_ratio": 18, "p_a_MPa": 0.1436,
              "p_intake_MPa": 0.165, "p_exhaust_MPa": 0.182, "injection_deg": 340,

@@ -1,5 +1,10 @@
 """``transient warmup``: on an empty cache it compiles, one line per kernel, what runs of every
-mechanism and mode then load without compiling anything; a second warm-up finds all cached."""
+mechanism and mode then load without compiling anything; a second warm-up finds all cached.
+
+Before it, on the same empty cache, a run of a plain scene compiles none of the kernels that only
+the features it does not use need (the kernels' plain variant, ``transient.core.layout.extras_of``),
+and the warm-up, whose built-in scenes use them, does: the cache's files say which kernels were
+compiled, by this process or by its compile helper (``transient.precompile``)."""
 from __future__ import annotations
 
 import os
@@ -23,6 +28,29 @@ print(len(log.compiled), *(c.name for c in log.compiled))
 """
 
 
+#: Kernels that only the features a plain scene does not use need, by feature.
+FEATURE_KERNELS = {
+    "friction pairs": ("chain.modes_power_flow_into", "chain._best_candidate", "rhs.margins_at",
+                       "rhs.chain_acceleration", "events._pair_event", "events._sample_margins",
+                       "stepper._settle_modes", "outputs.pair_rows"),
+    "governor states": ("forcing.governor_rates", "governor.pi_rates", "governor.flyweight_rates",
+                        "forcing.demand", "events._sleeve_event", "events._sleeve_stops"),
+    "latched fuel": ("breakpoints._inject",),
+    "cylinder states": ("forcing.cylinder_rates", "cylinder.pressure_rate",
+                        "breakpoints._close_intake"),
+    "per-cylinder variation": ("variation.cycle_fuel", "variation.misfire_draw"),
+    "tabulated loads": ("forcing.table_load", "forcing.speed_knot_segment"),
+    "reaction friction": ("joint_friction.prepare", "joint_friction.solve",
+                          "joint_friction.reaction_acceleration"),
+}
+
+
+def cached_kernels(cache: Path) -> set[str]:
+    """The kernels with a compiled version in the numba cache under ``cache``, as module and
+    name (``rhs.derivative``): numba names each index file after them (then ``-`` and the line)."""
+    return {path.name.split("-")[0] for path in cache.rglob("*.nbi")}
+
+
 def test_warmup_compiles_what_runs_then_load(tmp_path):
     env = {**os.environ, "TRANSIENT_CACHE_DIR": str(tmp_path / "cache")}
     env.pop("NUMBA_CACHE_DIR", None)
@@ -35,6 +63,12 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
         return run.stdout.splitlines()
 
     mechanisms = [str(CASES / f"{c}.toml") for c in ("swash_plate_4cyl", "radial_5cyl")]
+    # the default scene: a static droop governor, no friction pairs, nothing else of the kind
+    assert transient(mechanisms[0], code=PROBE)[0] != "0"
+    plain = cached_kernels(tmp_path / "cache")
+    assert {"stepper.advance", "rhs.derivative", "forcing.moments"} <= plain
+    for feature, kernels in FEATURE_KERNELS.items():
+        assert not plain & set(kernels), feature
     lines = transient("warmup", *mechanisms)
     assert lines[0].startswith(f"kernels in {tmp_path / 'cache' / 'numba'}")
     compiled = [line.strip().split()[1] for line in lines[1:-1]]
@@ -42,6 +76,9 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
     assert {"transient.core.stepper.advance", "transient.core.rhs.derivative",
             "transient.core.inverse.inverse_dynamics"} <= set(compiled)
     assert lines[-1] == f"{len(compiled)} kernel(s) compiled"
+    full = cached_kernels(tmp_path / "cache")
+    for feature, kernels in FEATURE_KERNELS.items():
+        assert set(kernels) <= full, feature
     runs = [*mechanisms, *(str(CASES / f"{c}.toml") for c in (
         "coasting_single", "gots_diesel_governed", "gots_diesel_woschni", "gots_diesel_4400",
         "swash_plate_4cyl_friction", "gots_diesel_start_flyweight", "diesel_4cyl_misfire"))]

@@ -238,7 +238,7 @@ def moments_load(m, w, seg=0, gen_low=0, x=0.0):
     sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
     sw[layout.SW_LOAD] = seg
     sw[layout.SW_GENERATOR] = gen_low
-    return forcing.moments(m, False, y, 0.0, sw, layout.work_array(m), True)[4]
+    return forcing.moments(m, layout.extras_of(m), False, y, 0.0, sw, layout.work_array(m), True)[4]
 
 
 def test_default_load_moment_is_the_formula_bit_for_bit():

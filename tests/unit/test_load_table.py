@@ -25,7 +25,7 @@ from scene_texts import SMALL, check_text
 from transient.assemble import build_model, load_table_curve
 from transient.core import forcing
 from transient.core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI, SW_LOAD_TABLE,
-                                   T, work_array)
+                                   T, extras_of, work_array)
 from transient.forces.load_table import interpolant, load_curve
 from transient.scene import LoadTable, load_scene, to_toml
 
@@ -292,5 +292,5 @@ def test_kernel_equals_numpy_twin(tmp_path, table, kind, interpolation):
         # M_load of the model in time mode (y[2] = ω): −(torque + T(x)), no schedule
         y[2] = w
         sw[SW_LOAD_TABLE] = forcing.speed_knot_segment(model, w, True)
-        M_load = forcing.moments(model, False, y, y[PHI], sw, wk, True)[4]
+        M_load = forcing.moments(model, extras_of(model), False, y, y[PHI], sw, wk, True)[4]
         assert abs(M_load + 0.5 + expect) <= 1e-12 * max(1.0, abs(expect))

@@ -38,8 +38,9 @@ def forward(model, phi, omega, modes):
     wk = layout.work_array(model)
     sw = np.array([0, 0, modes, 1 if omega >= 0 else -1])
     y = state(model, phi, omega)
-    J, dJ, w, Mg, Ml, Ms = forcing.moments(model, False, y, phi, sw, wk, True)
-    a = rhs.acceleration(model, J, dJ, w, Mg, Ml, Ms, sw, wk)
+    J, dJ, w, Mg, Ml, Ms = forcing.moments(model, layout.extras_of(model), False, y, phi, sw, wk,
+                                           True)
+    a = rhs.acceleration(model, layout.extras_of(model), J, dJ, w, Mg, Ml, Ms, sw, wk)
     return a, J, dJ, Mg + Ml + Ms, wk, sw, y
 
 
@@ -85,7 +86,7 @@ def test_energy_form_equals_the_acceleration_form(policy):
         a, J, dJ, M, wk, sw, y = forward(model, phi, omega, modes)
         y[layout.KINETIC] = 0.5 * J * omega ** 2
         out = np.empty_like(y)
-        rhs.derivative(model, True, y, phi, sw, wk, out)
+        rhs.derivative(model, layout.extras_of(model), True, y, phi, sw, wk, out)
         assert out[layout.KINETIC] == pytest.approx(J * a + 0.5 * dJ * omega ** 2, rel=1e-12,
                                                     abs=1e-12 * abs(M))
         losses = out[layout.W_LOSS0:layout.W_LOSS0 + model.n_pairs]
@@ -104,7 +105,7 @@ def test_inverse_chain_recovers_the_forward_motion():
         wk = layout.work_array(model)
         y = state(model, phi, omega)
         sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
-        assert rhs.choose_modes(model, False, y, phi, sw, wk) == UNIQUE
+        assert rhs.choose_modes(model, layout.extras_of(model), False, y, phi, sw, wk) == UNIQUE
         a, J, dJ, M, wk, _, _ = forward(model, phi, omega, sw[layout.SW_MODES])
         S, eta = wk[layout.WK_S, :n].copy(), wk[layout.WK_ETA, :n].copy()
         drive, n_ok = inverse.inverse_chain(model, a, omega, float(np.sign(omega)), wk)
@@ -125,7 +126,7 @@ def test_modes_chosen_at_a_state_follow_the_policy(policy):
         wk = layout.work_array(model)
         y = state(model, phi, omega)
         sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
-        rhs.choose_modes(model, False, y, phi, sw, wk)
+        rhs.choose_modes(model, layout.extras_of(model), False, y, phi, sw, wk)
         assert sw[layout.SW_DIRECTION] == np.sign(omega)
         _, _, _, _, wk, _, _ = forward(model, phi, omega, sw[layout.SW_MODES])
         rhs.mode_margins(model, sw, wk)
@@ -147,16 +148,18 @@ def test_locked_at_rest_when_friction_holds_starter_against_compression():
     y = state(model, phi, 0.0)
     wk = layout.work_array(model)
     sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
-    _, _, _, Mg, _, _ = forcing.moments(model, False, y, phi, sw, wk, True)
+    _, _, _, Mg, _, _ = forcing.moments(model, layout.extras_of(model), False, y, phi, sw, wk, True)
     assert Mg < 0  # the gas resists forward motion here
     for ratio, locked in ((1.0, True), (1 / 0.9, False), (0.9, False)):
         m = model._replace(starter_torque=-Mg * ratio)
         sw = np.array([1, 0, 0, 1])
-        status = rhs.choose_modes(m, False, y, phi, sw, wk)
+        status = rhs.choose_modes(m, layout.extras_of(m), False, y, phi, sw, wk)
         assert (status == LOCKED) == locked, ratio
         if not locked:
             assert sw[layout.SW_DIRECTION] == (1 if ratio > 1 else -1)
     ideal, _, _ = build_model(gots(()))
     ideal = ideal._replace(starter_torque=-Mg * 1.001)
-    J, dJ, w, Mg2, Ml, Ms = forcing.moments(ideal, False, y, phi, np.array([1, 0, 0, 1]), wk, True)
-    assert rhs.acceleration(ideal, J, dJ, w, Mg2, Ml, Ms, np.array([1, 0, 0, 1]), wk) > 0
+    J, dJ, w, Mg2, Ml, Ms = forcing.moments(ideal, layout.extras_of(ideal), False, y, phi,
+                                            np.array([1, 0, 0, 1]), wk, True)
+    assert rhs.acceleration(ideal, layout.extras_of(ideal), J, dJ, w, Mg2, Ml, Ms,
+                            np.array([1, 0, 0, 1]), wk) > 0

@@ -23,7 +23,7 @@ def _model_and_tableau():
 
 def test_a_helper_process_compiles_into_the_shared_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # (the helper's, inherited)
-    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda *args: False)
     monkeypatch.setattr(precompile, "_cores", lambda: 2)
     helper = precompile.start_helper(*_model_and_tableau(), callees=(breakpoints.next_breakpoint,))
     assert helper is not None
@@ -34,10 +34,10 @@ def test_a_helper_process_compiles_into_the_shared_cache(tmp_path, monkeypatch):
 
 def test_no_helper_where_it_cannot_help(monkeypatch):
     model, tab = _model_and_tableau()
-    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: True)
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda *args: True)
     monkeypatch.setattr(precompile, "_cores", lambda: 2)
     assert precompile.start_helper(model, tab) is None  # cached: nothing to compile
-    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda *args: False)
     monkeypatch.setattr(precompile, "_cores", lambda: 1)
     assert precompile.start_helper(model, tab) is None  # one core: it would only take turns
     monkeypatch.setattr(precompile, "_cores", lambda: 2)
@@ -51,9 +51,35 @@ def test_no_helper_where_it_cannot_help(monkeypatch):
 
 def test_stop_helper_ends_the_process(monkeypatch, tmp_path):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
-    monkeypatch.setattr(precompile, "stepper_is_cached", lambda: False)
+    monkeypatch.setattr(precompile, "stepper_is_cached", lambda *args: False)
     monkeypatch.setattr(precompile, "_cores", lambda: 2)
     helper = precompile.start_helper(*_model_and_tableau())  # (all callees: minutes of work)
     precompile.stop_helper(helper)
     assert helper.poll() is not None
     precompile.stop_helper(None)  # (no helper: nothing to do)
+
+
+def test_the_stepper_counts_as_cached_in_the_models_variant_only(monkeypatch):
+    """A cache holding the stepper's plain variant leaves a scene of the full variant to compile
+    with the helper's help, and the other way round (:func:`transient.core.layout.extras_of`)."""
+    plain, tab = _model_and_tableau()
+    full = build_model(load_scene(CASES / "gots_diesel_friction.toml"))[0]
+    saved = {}
+
+    class Stepper:  # (numba's dispatcher as stepper_is_cached reads it)
+        py_func = precompile.STEPPER.py_func
+        overloads = {}
+
+        class _cache:
+            class _cache_file:
+                @staticmethod
+                def _load_index():
+                    return saved
+
+    monkeypatch.setattr(precompile, "STEPPER", Stepper)
+    assert not precompile.stepper_is_cached(plain, tab)
+    saved[(precompile.signature(Stepper, plain, tab), "cpu")] = 1  # (saved in the cache)
+    assert precompile.stepper_is_cached(plain, tab)
+    assert not precompile.stepper_is_cached(full, tab)
+    Stepper.overloads = {precompile.signature(Stepper, full, tab): None}  # (compiled here)
+    assert precompile.stepper_is_cached(full, tab)

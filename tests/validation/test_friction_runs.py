@@ -22,7 +22,7 @@ from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
 from transient.core.chain import LOCKED, modes_power_flow
 from transient.core.forcing import moments
-from transient.core.layout import WK_DJ, WK_J, WK_M, work_array
+from transient.core.layout import WK_DJ, WK_J, WK_M, extras_of, work_array
 from transient.core.rhs import split_subchains
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 from transient.run import integrate, prescribed
@@ -130,7 +130,7 @@ def static_lock(scene, phi):
     y = np.zeros(6 + model.n_pairs)
     y[0] = phi
     sw = np.array([int(scene.starter.torque > 0), 0, 0, 1])
-    J, dJ, w, Mg, Ml, Ms = moments(model, False, y, phi, sw, wk, True)
+    J, dJ, w, Mg, Ml, Ms = moments(model, extras_of(model), False, y, phi, sw, wk, True)
     split_subchains(model, J, dJ, Mg, Ml + Ms, wk)
     n = model.n_pairs
     _, status, _ = modes_power_flow(wk[WK_J, :n + 1], wk[WK_DJ, :n + 1], wk[WK_M, :n + 1],

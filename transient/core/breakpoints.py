@@ -94,17 +94,17 @@ def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
 
 
 @kernel(inline=True)
-def _aim_at_breakpoint(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, fst, ist, up,
-                       down, min_step):
+def _aim_at_breakpoint(tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, fst, ist,
+                       up, down, min_step):
     """In time, a step must not cross a breakpoint: one that does is retaken so that it ends
     there, at most four times in a row. Returns ``(retake, dense_ready)``: whether the step is
     to be computed again (``fst[F_H]`` set), and whether its dense output is in F."""
     if angle_mode:
         return False, False
     if y_new[PHI] > up or y_new[PHI] < down:
-        _dense_once(False, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
+        _dense_once(False, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
         level = up if y_new[PHI] > up else down
-        theta = _crossing(m, angle_mode, F, y, y_new, PHI, level, sel, sw, tmp, wk)
+        theta = _crossing(m, extras, angle_mode, F, y, y_new, PHI, level, sel, sw, tmp, wk)
         fst[F_REDO_LEVEL] = level
         if theta * h > min_step and ist[I_NREDO] < 4:
             _retake(fst, ist, theta * h)
@@ -150,7 +150,7 @@ def _jumps_at(m, bp, phi):
 
 
 @kernel
-def _inject(m, y, sw, evbuf, ist, wk):
+def _inject(m, extras, y, sw, evbuf, ist, wk):
     """At a breakpoint, moving forward: each cylinder whose start of injection this is latches the
     governor's command (``m.latch``). Returns whether any did (the derivative at y changes)."""
     if not m.latch:
@@ -163,7 +163,7 @@ def _inject(m, y, sw, evbuf, ist, wk):
     hit = False
     for k in range(m.ncyl):
         if _on_angle(y[PHI], m.gas_phase[k] + m.inj_angle, m.period):
-            y[c + k] = command(m, w, y, sw)
+            y[c + k] = command(m, extras, w, y, sw)
             hit = True
             _emit_event(m, evbuf, ist, EV_INJECTION, y, wk)
     return hit
@@ -185,10 +185,12 @@ def _close_intake(m, y):
 
 
 @kernel
-def _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+def _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
     """What a breakpoint does to the state (injections, intake closings); returns whether the
     derivative carried over from the last step (FSAL) is stale: the state changed, or a pressure
     jumps here."""
-    injected = _inject(m, y, sw, evbuf, ist, wk)
-    closed = _close_intake(m, y)
+    injected = closed = False
+    if extras is not None:
+        injected = _inject(m, extras, y, sw, evbuf, ist, wk)
+        closed = _close_intake(m, y)
     return injected or closed or _jumps_at(m, bp, y[PHI])

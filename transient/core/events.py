@@ -37,34 +37,36 @@ ON_LEVEL = 1e-12
 
 
 @kernel(inline=True)
-def _event_g(m, angle_mode, yv, comp, level, sel, sw, wk):
+def _event_g(m, extras, angle_mode, yv, comp, level, sel, sw, wk):
     """Event function: ω − level for the speed (K = ½Jω² in crank-angle mode), the mode margin of
     pair comp − PAIR_COMP, the PI demand u − level, else y[comp] − level."""
-    if comp >= PAIR_COMP:
-        margins_at(m, angle_mode, yv, sel, sw, wk)
+    if extras is not None and comp >= PAIR_COMP:
+        margins_at(m, extras, angle_mode, yv, sel, sw, wk)
         return wk[WK_G, comp - PAIR_COMP]
     if comp == OMEGA or comp == DEMAND_COMP:
         J = inertia(m, yv[PHI], wk)
         w = speed(J, angle_mode, yv)
-        return (w if comp == OMEGA else demand(m, w, yv)) - level
+        if extras is not None and comp == DEMAND_COMP:
+            return demand(m, w, yv) - level
+        return w - level
     return yv[comp] - level
 
 
 @kernel
-def _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
+def _crossing(m, extras, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
     """θ ∈ (0, 1] where the event function crosses zero on the dense output.
 
     The caller has checked that it changes sign between y and y_new. The bracket's right end is
     y_new itself, not the dense output at θ = 1, which can differ from it by rounding and then
     would not bracket a root that sits at the very end of the step.
     """
-    ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
-    gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
-    return _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)[0]
+    ga = _event_g(m, extras, angle_mode, y, comp, level, sel, sw, wk)
+    gb = _event_g(m, extras, angle_mode, y_new, comp, level, sel, sw, wk)
+    return _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)[0]
 
 
 @kernel
-def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
+def _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
     """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
     (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations).
 
@@ -82,11 +84,11 @@ def _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense_eval(F, y, c, tmp)
-        if comp >= PAIR_COMP:  # most iterations: the margins inlined, no copy of the Model
-            margins_inline(m, angle_mode, tmp, sel, sw, wk)
+        if extras is not None and comp >= PAIR_COMP:  # most iterations: the margins inlined
+            margins_inline(m, extras, angle_mode, tmp, sel, sw, wk)
             gc = wk[WK_G, comp - PAIR_COMP]
         else:
-            gc = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
+            gc = _event_g(m, extras, angle_mode, tmp, comp, level, sel, sw, wk)
         if gc == 0.0:
             return c, i + 1
         if (gc > 0.0) == (gb > 0.0):
@@ -110,13 +112,13 @@ N_MARGIN_SAMPLES = 4
 
 
 @kernel(inline=True)
-def _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
+def _sample_margins(m, extras, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
     """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
     holds the step's start and row N its end already)."""
     ix = PHI if angle_mode else T
     for j in range(1, N_MARGIN_SAMPLES):
         _dense_state(F, y, x, h, j / N_MARGIN_SAMPLES, ix, tmp)
-        margins_at(m, angle_mode, tmp, sel, sw, wk)
+        margins_at(m, extras, angle_mode, tmp, sel, sw, wk)
         for k in range(m.n_pairs):
             gs[j, k] = wk[WK_G, k]
 
@@ -128,8 +130,8 @@ N_FINE_SAMPLES, MAX_UNSEEN = 64, 3
 
 
 @kernel
-def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp, wk,
-                     n_samples):
+def _crossing_inside(m, extras, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp,
+                     wk, n_samples):
     """θ where the speed, the PI demand or a pair's margin (``comp``) first crosses ``level``
     (in ``direction``) inside a step whose ends are on the same side of it, sampled at
     θ = j/n_samples on the dense output; 2 if the samples see no crossing (it was only in a
@@ -139,9 +141,9 @@ def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel,
     for j in range(1, n_samples + 1):
         theta = j / n_samples
         _dense_state(F, y, x, h, theta, ix, tmp)
-        g = _event_g(m, angle_mode, tmp, comp, level, sel, sw, wk)
+        g = _event_g(m, extras, angle_mode, tmp, comp, level, sel, sw, wk)
         if _crosses(g_prev, g, direction):
-            root, evals = _root(m, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
+            root, evals = _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
                                 (j - 1) / n_samples, theta, g_prev, g)
             return root, j + evals
         g_prev = g
@@ -149,7 +151,7 @@ def _crossing_inside(m, angle_mode, F, y, x, h, comp, level, direction, ga, sel,
 
 
 @kernel(inline=True)
-def _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
+def _pair_crossing(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
     margin evaluations (right-hand sides) the root finding took.
 
@@ -159,17 +161,17 @@ def _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     (the power reversed for a few degrees): :func:`_fall_after_rise` tells which.
     """
     if gs[0, k] == 0.0 and gs[1, k] < 0.0:
-        return _fall_after_rise(m, angle_mode, F, y, x, h, k, 1.0 / N_MARGIN_SAMPLES, sel, sw,
-                                tmp, wk)
+        return _fall_after_rise(m, extras, angle_mode, F, y, x, h, k, 1.0 / N_MARGIN_SAMPLES, sel,
+                                sw, tmp, wk)
     for j in range(N_MARGIN_SAMPLES):
         if _crosses(gs[j, k], gs[j + 1, k], -1):
-            return _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
+            return _root(m, extras, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
                          j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
     return 2.0, 0
 
 
 @kernel
-def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
+def _fall_after_rise(m, extras, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
     """For a margin that starts at 0 and is below it at ``theta_end``: θ where it falls to zero
     after rising above it (sampled at N_FINE_SAMPLES points up to ``theta_end``), or 0 if no
     sample rises above zero (it fell at once). Returns (θ, evaluations)."""
@@ -180,9 +182,9 @@ def _fall_after_rise(m, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
     for j in range(1, N_FINE_SAMPLES + 1):
         theta = theta_end * j / N_FINE_SAMPLES
         _dense_state(F, y, x, h, theta, ix, tmp)
-        g = _event_g(m, angle_mode, tmp, PAIR_COMP + k, 0.0, sel, sw, wk)
+        g = _event_g(m, extras, angle_mode, tmp, PAIR_COMP + k, 0.0, sel, sw, wk)
         if rose and g <= 0.0:
-            root, evals = _root(m, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
+            root, evals = _root(m, extras, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
                                 th_prev, theta, g_prev, g)
             return root, j + evals
         rose = rose or g > 0.0
@@ -206,7 +208,7 @@ def _load_corner(m, ix, sw):
 
 
 @kernel(inline=True)
-def _event_spec(m, cfg, e, angle_mode, sw):
+def _event_spec(m, extras, cfg, e, angle_mode, sw):
     """State event number e that applies now: (code, component, level, direction), code −1 if
     none. The component OMEGA means the speed (K = ½Jω² in crank angle); direction +1 rising,
     −1 falling, 0 either way.
@@ -229,7 +231,7 @@ def _event_spec(m, cfg, e, angle_mode, sw):
         return EV_END, PHI, cfg[C_PHI_END], 1
     if 5 <= e < 7 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
         return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
-    if 5 <= e < 7 and is_pi(m):  # the PI demand reaching its upper or lower limit
+    if extras is not None and 5 <= e < 7 and is_pi(m):  # the PI demand reaching a limit
         return EV_GOVERNOR, DEMAND_COMP, m.gov_par[gv.P_FMAX if e == 5 else gv.P_FMIN], 0
     if e == 7 and sw[SW_LOAD] < m.load_x.shape[0]:  # the schedule's corner ahead
         return EV_LOAD, m.load_comp, m.load_x[sw[SW_LOAD]], 1
@@ -237,13 +239,14 @@ def _event_spec(m, cfg, e, angle_mode, sw):
         return EV_LOAD, PHI, m.load_x[sw[SW_LOAD] - 1], -1
     if e == 9 and m.gen_power != 0.0:  # the generator's minimum speed
         return EV_GENERATOR, OMEGA, m.gen_min, 0
-    if 10 <= e < 14 and m.gov_dyn == gv.FLYWEIGHT:
+    if extras is not None and 10 <= e < 14 and m.gov_dyn == gv.FLYWEIGHT:
         return _sleeve_event(m, e, sw)
-    if e == 14 and m.lt_kind == LT_SPEED and sw[SW_LOAD_TABLE] < m.lt_x.shape[0]:
+    if (extras is not None and e == 14 and m.lt_kind == LT_SPEED
+            and sw[SW_LOAD_TABLE] < m.lt_x.shape[0]):
         return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE]], 1  # a speed map's knot above ω
-    if e == 15 and m.lt_kind == LT_SPEED and sw[SW_LOAD_TABLE] > 0:  # and the one below
-        return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE] - 1], -1
-    if e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
+    if extras is not None and e == 15 and m.lt_kind == LT_SPEED and sw[SW_LOAD_TABLE] > 0:
+        return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE] - 1], -1  # and the one below
+    if extras is not None and e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
         # the mode margin of pair e − FIRST_PAIR_EVENT falls to zero
         return EV_PAIR_MODE, PAIR_COMP + e - FIRST_PAIR_EVENT, 0.0, -1
     return -1, OMEGA, 0.0, 0
@@ -295,18 +298,18 @@ def _crosses(g0, g1, direction):
 
 
 @kernel(inline=True)
-def _dense_once(ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist):
+def _dense_once(ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist):
     """The last step's dense output into F, unless ``ready`` (it costs the pair's extra stages,
     so a step computes it only when an event or an output sample needs it); returns True."""
     if not ready:
-        _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+        _dense(tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
         ist[I_NFEV] += tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
     return True
 
 
 @kernel(inline=True)
-def _locate_events(tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist,
-                   dip, dense_ready, w_lo, w_hi):
+def _locate_events(tab, m, extras, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs,
+                   ist, dip, dense_ready, w_lo, w_hi):
     """The earliest state event in the last step (from x, size h; accepted, not yet taken):
     ``(code, θ, component, level, rising, unseen, dense_ready)``, code −1 if there is none.
 
@@ -324,27 +327,31 @@ def _locate_events(tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tm
     # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
     w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
     w1 = 1.0 / K[tab.n_stages, T] if angle_mode else y_new[OMEGA]
-    if dip:
-        dense_ready = _dense_once(dense_ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F,
-                                  tmp, wk, ist)
-        _sample_margins(m, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs)
+    if extras is not None and dip:
+        dense_ready = _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K,
+                                  F, tmp, wk, ist)
+        _sample_margins(m, extras, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs)
         ist[I_NFEV] += N_MARGIN_SAMPLES - 1
-    for e in range(N_EVENT_KINDS):
-        code, comp, level, direction = _event_spec(m, cfg, e, angle_mode, sw)
+    # (the plain variant watches no pair: its events end before the pairs')
+    n_kinds = FIRST_PAIR_EVENT
+    if extras is not None:
+        n_kinds = N_EVENT_KINDS
+    for e in range(n_kinds):
+        code, comp, level, direction = _event_spec(m, extras, cfg, e, angle_mode, sw)
         if code < 0:
             continue
-        if comp >= PAIR_COMP:
+        if extras is not None and comp >= PAIR_COMP:
             if not dip:
                 continue
-            theta, only_stages = _pair_event(m, angle_mode, F, y, x, h, comp - PAIR_COMP, sel, sw,
-                                             tmp, wk, gs, ist)
+            theta, only_stages = _pair_event(m, extras, angle_mode, F, y, x, h, comp - PAIR_COMP,
+                                             sel, sw, tmp, wk, gs, ist)
             unseen = unseen or only_stages
             if theta < ev_theta:
                 ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
             continue
-        theta, rising, dense_ready = _level_event(tab, m, angle_mode, x, h, y, y_new, K, F, code,
-                                                  comp, level, direction, w0, w1, w_lo, w_hi, sel,
-                                                  sw, tmp, wk, ist, dense_ready)
+        theta, rising, dense_ready = _level_event(tab, m, extras, angle_mode, x, h, y, y_new, K, F,
+                                                  code, comp, level, direction, w0, w1, w_lo, w_hi,
+                                                  sel, sw, tmp, wk, ist, dense_ready)
         if theta < ev_theta:
             ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
             ev_rising = rising
@@ -352,15 +359,15 @@ def _locate_events(tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tm
 
 
 @kernel(inline=True)
-def _pair_event(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
+def _pair_event(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
     """θ where pair k's margin first falls to zero in the step (2 if it does not), and whether
     only the stages saw it fall below zero (the samples, coarse and fine, did not)."""
-    theta, evals = _pair_crossing(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs)
+    theta, evals = _pair_crossing(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs)
     ist[I_NFEV] += evals
     only_stages = False
     if theta > 1.0 and wk[WK_G_MIN, k] < 0.0 <= gs[0, k]:
         # the stages saw the margin fall below zero, the samples did not
-        theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, PAIR_COMP + k, 0.0, -1,
+        theta, evals = _crossing_inside(m, extras, angle_mode, F, y, x, h, PAIR_COMP + k, 0.0, -1,
                                         gs[0, k], sel, sw, tmp, wk, N_FINE_SAMPLES)
         ist[I_NFEV] += evals
         only_stages = theta > 1.0
@@ -368,14 +375,14 @@ def _pair_event(m, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
 
 
 @kernel(inline=True)
-def _level_event(tab, m, angle_mode, x, h, y, y_new, K, F, code, comp, level, direction, w0, w1,
-                 w_lo, w_hi, sel, sw, tmp, wk, ist, dense_ready):
+def _level_event(tab, m, extras, angle_mode, x, h, y, y_new, K, F, code, comp, level, direction, w0,
+                 w1, w_lo, w_hi, sel, sw, tmp, wk, ist, dense_ready):
     """θ where the speed, the PI demand or the state ``comp`` first crosses ``level`` (in
     ``direction``) in the step, 2 if it does not; whether it crosses from below; ``dense_ready``.
     ``w0``, ``w1``: the speed at the step's ends."""
-    if comp == DEMAND_COMP:
-        ga = _event_g(m, angle_mode, y, comp, level, sel, sw, wk)
-        gb = _event_g(m, angle_mode, y_new, comp, level, sel, sw, wk)
+    if extras is not None and comp == DEMAND_COMP:
+        ga = _event_g(m, extras, angle_mode, y, comp, level, sel, sw, wk)
+        gb = _event_g(m, extras, angle_mode, y_new, comp, level, sel, sw, wk)
     else:
         ga = (w0 if comp == OMEGA else y[comp]) - level
         gb = (w1 if comp == OMEGA else y_new[comp]) - level
@@ -385,17 +392,18 @@ def _level_event(tab, m, angle_mode, x, h, y, y_new, K, F, code, comp, level, di
     # The speed (the PI demand) can pass a level and come back within one step (its
     # fluctuation within a cycle about a governor corner): the stages' range shows it.
     inside = not ends and ((comp == OMEGA and w_lo < level < w_hi) or (
-        comp == DEMAND_COMP and wk[WK_DEMAND, 0] < level < wk[WK_DEMAND, 1]))
+        extras is not None and comp == DEMAND_COMP
+        and wk[WK_DEMAND, 0] < level < wk[WK_DEMAND, 1]))
     theta = 2.0
     rising = True
     if ends or inside:
-        dense_ready = _dense_once(dense_ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F,
-                                  tmp, wk, ist)
+        dense_ready = _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K,
+                                  F, tmp, wk, ist)
         if ends:
-            theta = _crossing(m, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
+            theta = _crossing(m, extras, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
         else:
             for n_samples in (N_MARGIN_SAMPLES, N_FINE_SAMPLES):  # coarse, then fine
-                theta, evals = _crossing_inside(m, angle_mode, F, y, x, h, comp, level,
+                theta, evals = _crossing_inside(m, extras, angle_mode, F, y, x, h, comp, level,
                                                 direction, ga, sel, sw, tmp, wk, n_samples)
                 ist[I_NFEV] += evals
                 if theta <= 1.0:

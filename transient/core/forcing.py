@@ -43,7 +43,7 @@ def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
 
 
 @kernel(inline=True)
-def select_pieces(m, sel, wk):
+def select_pieces(m, extras, sel, wk):
     """Each cylinder's angle ``sel`` in its own cycle (WK_LOCAL), the gas table's piece there
     (WK_PIECE) and, with per-cylinder variation, its fuel factor in that cycle (WK_FUEL) and the
     angle and piece of its curve shifted by its combustion offset (WK_LOCAL_SHIFT,
@@ -56,9 +56,9 @@ def select_pieces(m, sel, wk):
             local_sel = (sel - m.gas_phase[k]) % m.period
             wk[WK_LOCAL, k] = local_sel
             wk[WK_PIECE, k] = find_piece(m.knots, m.piece_knot, local_sel)
-            if m.var_on:
+            if extras is not None and m.var_on:
                 wk[WK_FUEL, k] = cycle_fuel(m, k, sel)
-            if m.var_shifted:
+            if extras is not None and m.var_shifted:
                 local_shift = (sel - m.gas_phase[k] - m.var_par[k, SHIFT]) % m.period
                 wk[WK_LOCAL_SHIFT, k] = local_shift
                 wk[WK_PIECE_SHIFT, k] = find_piece(m.knots, m.piece_knot, local_shift)
@@ -66,7 +66,7 @@ def select_pieces(m, sel, wk):
 
 
 @kernel(inline=True)
-def gas_value(m, k, phi, sel, wk):
+def gas_value(m, extras, k, phi, sel, wk):
     """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
@@ -74,7 +74,7 @@ def gas_value(m, k, phi, sel, wk):
     The piece is the one :func:`select_pieces` left in ``wk`` for it. With combustion offsets
     the value is the curve's δ_k later, p_full(x − δ_k) (:func:`shifted`).
     """
-    if shifted(m):
+    if extras is not None and shifted(m):
         local_sel = wk[WK_LOCAL_SHIFT, k]
         piece = int(wk[WK_PIECE_SHIFT, k])
     else:
@@ -103,7 +103,7 @@ def gas_pair(m, k, phi, sel, wk):
 
 
 @kernel(inline=True)
-def applied_value(m, k, phi, sel, f, wk):
+def applied_value(m, extras, k, phi, sel, f, wk):
     """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot).
 
     Without a motored table the motored curve is the constant ``gas_offset`` (p0), and at f = 1
@@ -111,26 +111,27 @@ def applied_value(m, k, phi, sel, f, wk):
     """
     if m.has_motored:
         p, p_mot = gas_pair(m, k, phi, sel, wk)
-        if shifted(m):  # the combustion's part δ_k later, the motored curve with the piston
+        if extras is not None and shifted(m):
+            # the combustion's part δ_k later, the motored curve with the piston
             p, p_mot_shift = table_eval_pair(m.knots, m.coef, m.piece_knot,
                                              int(wk[WK_PIECE_SHIFT, k]),
                                              wk[WK_LOCAL_SHIFT, k] + (phi - sel))
             return p_mot + f * (p - p_mot_shift)
         return p_mot + f * (p - p_mot)
-    p = gas_value(m, k, phi, sel, wk)
+    p = gas_value(m, extras, k, phi, sel, wk)
     if f == 1.0:
         return p
     return m.gas_offset + f * (p - m.gas_offset)
 
 
 @kernel(inline=True)
-def cylinder_value(m, k, y, sel, f, wk):
+def cylinder_value(m, extras, k, y, sel, f, wk):
     """The pressure on piston k: its state in the closed part with wall heat transfer
     (``m.woschni``, :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
-    if m.woschni:
+    if extras is not None and m.woschni:
         if cyl.closed_angle(m.cyl_par, wk[WK_LOCAL, k], m.period) >= 0.0:
             return y[cyl_index(m) + k]
-    return applied_value(m, k, y[PHI], sel, f, wk)
+    return applied_value(m, extras, k, y[PHI], sel, f, wk)
 
 
 @kernel(inline=True)
@@ -199,12 +200,12 @@ def fuel(m, w, branch):
 
 
 @kernel(inline=True)
-def command(m, w, y, sw):
+def command(m, extras, w, y, sw):
     """The governor's fuel command at state ``y``: the rack of a dynamic governor (PI(D): its
     position state; flyweight: linked to the sleeve), else the droop characteristic (:func:`fuel`)."""
-    if is_pi(m):
+    if extras is not None and is_pi(m):
         return y[gov_index(m) + gv.PI_RACK]
-    if m.gov_dyn == gv.FLYWEIGHT:
+    if extras is not None and m.gov_dyn == gv.FLYWEIGHT:
         return gv.rack_of_lift(m.gov_par, y[gov_index(m) + gv.FW_LIFT])
     return fuel(m, w, sw[SW_GOVERNOR])
 
@@ -222,10 +223,10 @@ def demand(m, w, y):
 
 
 @kernel
-def start_branch(m, w, y):
+def start_branch(m, extras, w, y):
     """``SW_GOVERNOR`` at the start of a run: the PI demand's clipping branch, or the droop
     characteristic's branch (:func:`governor_branch`)."""
-    if is_pi(m):
+    if extras is not None and is_pi(m):
         return gv.demand_branch(m.gov_par, demand(m, w, y), True)
     return governor_branch(m, w, True)
 
@@ -332,7 +333,7 @@ def generator_branch(m, w, rising):
 
 
 @kernel(inline=True)
-def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
+def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
     """Reduced inertia, speed and moments at state ``y``.
 
     Returns ``(J, dJ, w, M_gas, M_load, M_starter)``, dJ possibly NaN without ``with_dJ``; the
@@ -357,30 +358,31 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
     w = speed(J, angle_mode, y)
     M_gas = 0.0
     if m.has_gas:
-        f = command(m, w, y, sw)
-        select_pieces(m, sel, wk)
-        if m.latch or m.has_motored:  # p = p_mot + f_k·(p_full − p_mot), per cylinder
+        f = command(m, extras, w, y, sw)
+        select_pieces(m, extras, sel, wk)
+        if (extras is not None and m.latch) or m.has_motored:
+            # p = p_mot + f_k·(p_full − p_mot), per cylinder
             c = latch_index(m)
             for k in range(m.ncyl):
-                f_k = y[c + k] if m.latch else f
-                if m.var_on:
+                f_k = y[c + k] if extras is not None and m.latch else f
+                if extras is not None and m.var_on:
                     f_k *= wk[WK_FUEL, k]
-                p_k = cylinder_value(m, k, y, sel, f_k, wk)
+                p_k = cylinder_value(m, extras, k, y, sel, f_k, wk)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
-                if m.var_on:
+                if extras is not None and m.var_on:
                     M_k *= m.var_par[k, PRESSURE]
                 M_gas += M_k
-                if m.reaction:  # each piston's force, for its joints' reactions
+                if extras is not None and m.reaction:  # each piston's force, for the joints
                     wk[WK_RX + jf.R_P, k] = (m.gas_scale[k] * (p_k - m.gas_offset)
                                              * (m.var_par[k, PRESSURE] if m.var_on else 1.0))
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
-                p_k = gas_value(m, k, phi, sel, wk)
+                p_k = gas_value(m, extras, k, phi, sel, wk)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
-                if m.var_on:  # (factors of 1 leave M_k to the last bit)
+                if extras is not None and m.var_on:  # (factors of 1 leave M_k to the last bit)
                     M_k *= wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                 M_gas += M_k
-                if m.reaction:
+                if extras is not None and m.reaction:
                     wk[WK_RX + jf.R_P, k] = (f * m.gas_scale[k] * (p_k - m.gas_offset)
                                              * (wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                                                 if m.var_on else 1.0))
@@ -394,12 +396,12 @@ def moments(m, angle_mode, y, sel, sw, wk, with_dJ):
         # the branch at ω_min, as at the governor's corners, keeping each step smooth.
         w_gen = m.gen_min if sw[SW_GENERATOR] else w
         M_load -= s * m.gen_power / w_gen
-    if m.lt_kind != LT_NONE:
+    if extras is not None and m.lt_kind != LT_NONE:
         M_load -= s * table_load(m, w, y)
     M_starter = 0.0
     if sw[SW_STARTER]:
         M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
-    if m.reaction:
+    if extras is not None and m.reaction:
         if not m.has_gas:
             for k in range(m.ncyl):
                 wk[WK_RX + jf.R_P, k] = 0.0

@@ -70,7 +70,7 @@ def inverse_chain(m, a, w, sigma, wk):
 
 
 @compiled
-def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
+def inverse_dynamics(m, extras, t, phi, omega, eps, rows, M_drive, n_consistent):
     """Prescribed motion: the drive torque on the shaft that the chain needs [N m].
 
     Without pairs M_drive = J ε + ½ J′ ω² − M, from (18); with pairs see :func:`inverse_chain`.
@@ -78,6 +78,7 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
     columns are left zero, integrated by the caller), ``M_drive`` and ``n_consistent`` (the number
     of consistent mode vectors per sample, 1 unless a policy is ambiguous there). The starter is
     off, ``sel`` is the sample angle itself and a load-schedule corner takes its value after.
+    ``extras``: the kernels' variant for ``m`` (:func:`.layout.extras_of`).
     """
     wk = work_array(m)
     y = np.zeros(n_state(m))
@@ -90,14 +91,16 @@ def inverse_dynamics(m, t, phi, omega, eps, rows, M_drive, n_consistent):
         sw[SW_GOVERNOR] = governor_branch(m, omega[i], eps[i] >= 0.0)
         sw[SW_LOAD] = load_segment(m, y[m.load_comp], True)  # t and φ increase here (ω > 0)
         sw[SW_GENERATOR] = generator_branch(m, omega[i], eps[i] >= 0.0)
-        sw[SW_LOAD_TABLE] = speed_knot_segment(m, omega[i], eps[i] >= 0.0)
-        if m.latch:  # (a static governor only) at a prescribed speed each cylinder latches it
+        if extras is not None:
+            sw[SW_LOAD_TABLE] = speed_knot_segment(m, omega[i], eps[i] >= 0.0)
+        if extras is not None and m.latch:
+            # (a static governor only) at a prescribed speed each cylinder latches it
             for k in range(m.ncyl):
                 y[latch_index(m) + k] = fuel(m, omega[i], sw[SW_GOVERNOR])
-        J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, phi[i], sw, wk, True)
-        output_row(m, False, y, phi[i], sw, wk, rows[i])
+        J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, False, y, phi[i], sw, wk, True)
+        output_row(m, extras, False, y, phi[i], sw, wk, rows[i])
         rows[i, COL_EPS] = eps[i]
-        if n == 0:
+        if extras is None or n == 0:
             M_drive[i] = J * eps[i] + 0.5 * dJ * w * w - (M_gas + M_load)
             n_consistent[i] = 1
             continue

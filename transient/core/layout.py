@@ -170,6 +170,23 @@ Model = namedtuple(
 )
 
 
+def extras_of(m):
+    """The kernels' ``extras`` argument for model ``m``: None for a plain scene, True for one
+    that uses a feature only the full variant of the kernels compiles: non-ideal friction pairs,
+    a governor with states (PI, PID, flyweight), latched fuel, cylinder-pressure states
+    (Woschni), per-cylinder variation or a tabulated load.
+
+    Each kernel that reaches such a feature takes ``extras`` as a direct argument and tests it
+    with ``extras is not None``: numba prunes a branch on whether an argument typed None is None
+    before it types the function, so the plain variant (``extras`` typed None) neither compiles
+    the kernels inside such branches nor branches around them at run time. A test on a field of
+    the Model would not be pruned (its fields are run-time values), nor one on a local. The two
+    variants are two signatures of the same kernels, each compiled once and cached."""
+    plain = (m.n_pairs == 0 and m.gov_dyn == gv.NONE and not m.latch and not m.woschni
+             and not m.var_on and not m.var_shifted and m.lt_kind == LT_NONE)
+    return None if plain else True
+
+
 @kernel(inline=True)
 def gov_index(m):
     """Index of the dynamic governor's first state."""

@@ -19,45 +19,46 @@ from .variation import PRESSURE
 
 
 @kernel
-def output_row(m, angle_mode, y, sel, sw, wk, row):
+def output_row(m, extras, angle_mode, y, sel, sw, wk, row):
     """:func:`output_row_inline` as a call: one compiled copy of the model's terms for the
     output rows written at events."""
-    output_row_inline(m, angle_mode, y, sel, sw, wk, row)
+    output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row)
 
 
 @kernel(inline=True)
-def output_row_inline(m, angle_mode, y, sel, sw, wk, row):
+def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
     (p_mot + f·(p_full − p_mot), see :func:`applied_value`, with a cylinder's fuel and pressure
     factors), ``PAIR_OUTPUTS`` of each pair, the
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
     samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     row[0] = y[T]
     row[1] = y[PHI]
     row[2] = w
-    row[3] = acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
+    row[3] = acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     row[4] = J
     row[5] = dJ
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
-    f = command(m, w, y, sw)
+    f = command(m, extras, w, y, sw)
     row[9] = f
     row[10] = y[W_GAS]
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
     c = latch_index(m)
     for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
-        f_k = y[c + k] if m.latch else f
-        if m.var_on:
+        f_k = y[c + k] if extras is not None and m.latch else f
+        if extras is not None and m.var_on:
             f_k *= wk[WK_FUEL, k]
-        p_k = cylinder_value(m, k, y, sel, f_k, wk) if m.has_gas else 0.0
-        beta = m.var_par[k, PRESSURE] if m.var_on else 1.0
+        p_k = cylinder_value(m, extras, k, y, sel, f_k, wk) if m.has_gas else 0.0
+        beta = m.var_par[k, PRESSURE] if extras is not None and m.var_on else 1.0
         if beta != 1.0:  # (as it acts on the piston: p0 + β_k(p − p0))
             p_k = m.gas_offset + beta * (p_k - m.gas_offset)
         row[N_OUT_FIXED + k] = p_k
-    pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
+    if extras is not None:
+        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[N_OUT_FIXED + m.ncyl:])
     j = N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs
     for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels
         row[j] = y[i]

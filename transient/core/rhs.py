@@ -51,10 +51,10 @@ def pair_etas(m, modes, eta_out):
 
 
 @kernel(inline=True)
-def acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
+def acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)
     or with the joints' reaction friction (``joint_friction``)."""
-    if m.n_pairs == 0:
+    if extras is None or m.n_pairs == 0:
         return (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J
     return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
 
@@ -74,7 +74,7 @@ def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
 
 
 @kernel(inline=True)
-def derivative(m, angle_mode, y, sel, sw, wk, out):
+def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     """dy/dt = (ω, 1, ε, powers), or in crank angle dy/dφ = (1, 1/ω, dK/dφ, moments), y[2] = K.
 
     Inlined into its callers, because as a call, passing the Model (numba flattens it into ~130
@@ -82,17 +82,19 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
 
     In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
     (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
+    ``extras``: the kernels' variant for ``m`` (:func:`.layout.extras_of`), as for every kernel
+    that reaches a feature only some scenes use.
     """
     # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
-    with_dJ = not angle_mode or m.n_pairs > 0
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, with_dJ)
+    with_dJ = not angle_mode or (extras is not None and m.n_pairs > 0)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ)
     # the speed's range over a step's stages: a speed event inside the step shows here
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w)
     wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w)
     M = M_gas + M_load + M_starter
     loss = 0.0  # Σ (1 − η*) S, the moment equivalent of the pairs' losses
     q = 1.0 if angle_mode else w  # work per unit of the independent variable
-    if m.n_pairs == 0:  # equation (18); no chain to solve (a scene without pairs pays nothing)
+    if extras is None or m.n_pairs == 0:  # equation (18); no chain to solve
         a = (M - 0.5 * dJ * w * w) / J  # read in time mode only (in crank angle dJ may be NaN)
     else:
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
@@ -105,10 +107,10 @@ def derivative(m, angle_mode, y, sel, sw, wk, out):
     out[W_GAS] = M_gas * q
     out[W_LOAD] = M_load * q
     out[W_STARTER] = M_starter * q
-    if m.gov_dyn != gv.NONE or m.latch:
+    if extras is not None and (m.gov_dyn != gv.NONE or m.latch):
         governor_rates(m, w, y, 1.0 / w if angle_mode else 1.0, sw, wk, out)
-    if m.woschni:
-        cylinder_rates(m, angle_mode, y, sel, w, command(m, w, y, sw), wk, out)
+    if extras is not None and m.woschni:
+        cylinder_rates(m, angle_mode, y, sel, w, command(m, extras, w, y, sw), wk, out)
     if angle_mode:
         out[PHI] = 1.0
         out[T] = 1.0 / w
@@ -144,24 +146,24 @@ def mode_margins(m, sw, wk):
 
 
 @kernel(inline=True)
-def margins_inline(m, angle_mode, y, sel, sw, wk):
+def margins_inline(m, extras, angle_mode, y, sel, sw, wk):
     """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``; inlined into the
     stepper's root finder, whose iterations evaluate them most: there a call would copy the Model
     at every iteration."""
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
-    acceleration(m, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
+    acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     mode_margins(m, sw, wk)
 
 
 @kernel
-def margins_at(m, angle_mode, y, sel, sw, wk):
+def margins_at(m, extras, angle_mode, y, sel, sw, wk):
     """:func:`margins_inline` as a call: one compiled copy of the model's terms for the sites
     that evaluate the margins rarely."""
-    margins_inline(m, angle_mode, y, sel, sw, wk)
+    margins_inline(m, extras, angle_mode, y, sel, sw, wk)
 
 
 @kernel
-def choose_modes(m, angle_mode, y, sel, sw, wk):
+def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
     """Choose σ and the pair modes afresh at state ``y`` (start of a run, speed reversal).
 
     With ω ≠ 0, σ = sign ω; ``power-flow`` takes the unique consistent mode vector
@@ -171,9 +173,9 @@ def choose_modes(m, angle_mode, y, sel, sw, wk):
     ``sw[SW_MODES]``. Returns the status of ``chain.modes_power_flow``: UNIQUE, LOCKED, or (a
     rounding tie S_k ≈ 0, resolved by its documented rule) AMBIGUOUS or NONE_CONSISTENT.
     """
-    J, dJ, w, M_gas, M_load, M_starter = moments(m, angle_mode, y, sel, sw, wk, True)
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     n = m.n_pairs
-    if n == 0:
+    if extras is None or n == 0:
         sw[SW_DIRECTION] = -1 if w < 0.0 else 1
         sw[SW_MODES] = 0
         return UNIQUE

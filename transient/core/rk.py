@@ -112,7 +112,7 @@ def _grow(tab, err, err_old, after_rejection):
 
 
 @kernel(inline=True)
-def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
+def _step(tab, m, extras, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
     """One Runge–Kutta step of size h from (x, y) with f = y′; K[0] must hold f.
 
     Leaves the stages in K (K[tab.n_stages] = f(y_new)) and the new state in y_new.
@@ -132,11 +132,11 @@ def _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk):
             tmp[PHI if angle_mode else T] = x + h
             for i in range(n):
                 y_new[i] = tmp[i]
-        derivative(m, angle_mode, tmp, sel, sw, wk, K[s])
+        derivative(m, extras, angle_mode, tmp, sel, sw, wk, K[s])
 
 
 @kernel
-def _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
+def _dense(tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
     """Dense-output coefficients F (3 + tab.D rows × n) of the last step, after the extra stages
     (three for DOP853, none for DOPRI5; layout in :mod:`.tableaus`)."""
     n = y.shape[0]
@@ -148,7 +148,7 @@ def _dense(tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk):
             for j in range(s):
                 acc += a[j] * K[j, i]
             tmp[i] = y[i] + h * acc
-        derivative(m, angle_mode, tmp, sel, sw, wk, K[s])
+        derivative(m, extras, angle_mode, tmp, sel, sw, wk, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]
         F[0, i] = dy

@@ -30,6 +30,12 @@ large to copy at several sites (the dense output, the margins, the output row), 
 margins and the output row are inlined at one site each, into a small function: the margins
 into the root finder, whose iterations evaluate them most (``rhs.margins_inline``), the output
 row into the writing of the grid's samples (``outputs.output_row_inline``).
+
+The kernels on a path from :func:`advance` to a feature that only some scenes use take the
+argument ``extras`` (:func:`.layout.extras_of`) and test it where the feature's code begins, so
+that a plain scene's compile leaves that code out. The time-domain phase is in both variants: a
+scene of either may need it at any point of a run (a start from rest, a load that slows the shaft
+below the switch speed, a reversal).
 """
 from __future__ import annotations
 
@@ -73,7 +79,7 @@ CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
 
 
 def buffers(m, tab, n: int) -> tuple:
-    """The work arrays of one call of :func:`advance`, after its first nine arguments: the
+    """The work arrays of one call of :func:`advance`, after its first ten arguments: the
     stages ``K``, the dense output ``F``, the derivative ``f``, three states, the right-hand
     side's scratch ``wk`` and the pairs' margins over a step ``gs``. Allocated by the caller,
     so that the stepper is one compile unit of its own, without reference counting. ``n``: the
@@ -84,12 +90,16 @@ def buffers(m, tab, n: int) -> tuple:
 
 
 @compiled(nogil=True, _nrt=False)  # (nogil: the previous block is written meanwhile, simulate)
-def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk, gs):
+def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk,
+            gs):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 
     Parameters
     ----------
     m : Model
+    extras : None or True
+        The kernels' variant for ``m`` (:func:`.layout.extras_of`): None compiles none of the
+        features a plain scene does not use.
     tab : tableaus.Tableau
         The Runge–Kutta pair (DOP853, DOPRI5).
     cfg : float64[N_CFG]
@@ -124,7 +134,7 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
     c0 = cyl_index(m)  # and so are the cylinder pressures y[c0:]
 
     if ist[I_STARTED] == 0:
-        status = _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk)
+        status = _start_run(m, extras, cfg, y, fst, ist, outbuf, evbuf, wk)
         if status != RUNNING:
             return status
     # As the last chunk left them: its derivative and margins (F_DERIV), if valid, and the
@@ -149,19 +159,19 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
             # A run that ends only by revolutions, turning backwards (from rest, or given a
             # negative speed), would never reach them: report it as a stall, with what was
             # computed, instead of integrating on.
-            _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+            _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
             return STALLED
         if ist[I_F_VALID] == 0:
             # The derivative and the pairs' margins afresh.
-            ahead = _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf)
-            derivative(m, angle_mode, y, ahead, sw, wk, f)
+            ahead = _settle_at_restart(m, extras, angle_mode, y, sw, wk, gs, ist, evbuf)
+            derivative(m, extras, angle_mode, y, ahead, sw, wk, f)
             _restarted(cfg, angle_mode, fst, ist)
 
         # The segment and the step size.
         x_end, up, down, h_max, tol_end, corner = _segment_end(m, cfg, bp, angle_mode, ix, x, y,
                                                                sw, fst)
         if x_end - x <= tol_end:
-            return _finish(m, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
+            return _finish(m, extras, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
         fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
         h, h_planned, at_segment_end = _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end)
         min_step = 10.0 * (np.nextafter(abs(x), np.inf) - abs(x))
@@ -174,7 +184,7 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
 
         # The step attempt, its acceptance and the next step size.
         _start_attempt(f, K, wk)
-        _step(tab, m, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+        _step(tab, m, extras, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
         finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
                                                       rtol, atol, g0, g1, c0,
                                                       at_segment_end and x_end == corner, corner)
@@ -201,10 +211,10 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
         if not fixed and _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
-                _emit_row(m, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+                _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
             return STIFF
-        retake, dense_ready = _aim_at_breakpoint(tab, m, angle_mode, y, y_new, h, sel, sw, K, F,
-                                                 tmp, wk, fst, ist, up, down, min_step)
+        retake, dense_ready = _aim_at_breakpoint(tab, m, extras, angle_mode, y, y_new, h, sel, sw,
+                                                 K, F, tmp, wk, fst, ist, up, down, min_step)
         if retake:
             steps_here += 1
             continue
@@ -213,8 +223,8 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
 
         # State events on this step: the earliest one truncates it.
         ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready = _locate_events(
-            tab, m, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist, dip,
-            dense_ready, w_lo, w_hi)
+            tab, m, extras, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist,
+            dip, dense_ready, w_lo, w_hi)
         if unseen and ev_code < 0 and n_unseen < MAX_UNSEEN:
             _retake(fst, ist, 0.5 * h)  # computed again, shorter
             n_unseen += 1
@@ -222,14 +232,14 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
             continue
         n_unseen = 0
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
-        _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F,
-                           tmp, wk, outbuf, ist, fst, dense_ready)
+        _emit_step_samples(tab, m, extras, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K,
+                           F, tmp, wk, outbuf, ist, fst, dense_ready)
         ist[I_NSTEPS] += 1
         steps_here += 1
         fst[F_H] = h_next
         fst[F_SEL] = sel
         if ev_code < 0:
-            status = _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up,
+            status = _take_step(tab, m, extras, cfg, bp, angle_mode, at_segment_end, x_end, up,
                                 redo_hit_breakpoint, y, y_new, f, K, gs, sel, sw, outbuf, evbuf,
                                 ist, fst, wk)
             if status != RUNNING:
@@ -237,50 +247,53 @@ def advance(m, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, 
             continue
 
         # Truncate the step at the event, act on it and restart from there.
-        x_stop, on_breakpoint = _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp,
+        x_stop, on_breakpoint = _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp,
                                                ev_level, at_segment_end and x_end == up, x_end,
                                                tol_end, F, y, y_evt, sel, sw, wk, ist)
-        status = _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw,
-                               outbuf, evbuf, ist, fst, wk)
+        status = _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y,
+                               sel, sw, outbuf, evbuf, ist, fst, wk)
         if status != RUNNING:
             return status
-        _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y,
-                         ist, fst, wk)
+        _switch_at_event(m, extras, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next,
+                         y, ist, fst, wk)
 
 
 @kernel(inline=True)
-def _start_run(m, cfg, y, fst, ist, outbuf, evbuf, wk):
+def _start_run(m, extras, cfg, y, fst, ist, outbuf, evbuf, wk):
     """The first chunk's start: the switches chosen at the initial state, the independent
     variable, the output grid and the first row. Returns RUNNING, or LOCKED where the pairs'
     friction holds the machine at rest."""
     ist[I_STARTED] = 1
     fst[F_ERR_OLD] = 1e-4
-    ist[I_GOV_BRANCH] = start_branch(m, y[OMEGA], y)
+    ist[I_GOV_BRANCH] = start_branch(m, extras, y[OMEGA], y)
     # (time only increases; the shaft angle as ω's sign says, forward from rest)
     ist[I_LOAD_SEG] = load_segment(m, y[m.load_comp], m.load_comp == T or y[OMEGA] >= 0.0)
     ist[I_GEN_LOW] = generator_branch(m, y[OMEGA], True)
-    ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], True)
-    if ist[I_LOAD_TABLE] != speed_knot_segment(m, y[OMEGA], False):
-        # On a speed map's knot the interval is the one the speed moves into (else the knot
-        # it leaves by would not be watched): the sign of ε from the moments, the pairs'
-        # losses left out (they do not change the sign of a net moment that decides a tie).
-        J, dJ, w, M_gas, M_load, M_starter = moments(m, False, y, y[PHI], ist[:N_SWITCHES], wk,
-                                                     True)
-        rising = M_gas + M_load + M_starter - 0.5 * dJ * w * w >= 0.0
-        ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], rising)
+    ist[I_LOAD_TABLE] = 0  # (the interval of a load tabulated against speed; none else)
+    if extras is not None:
+        ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], True)
+        if ist[I_LOAD_TABLE] != speed_knot_segment(m, y[OMEGA], False):
+            # On a speed map's knot the interval is the one the speed moves into (else the
+            # knot it leaves by would not be watched): the sign of ε from the moments, the
+            # pairs' losses left out (they do not change the sign of a net moment that decides
+            # a tie).
+            J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, False, y, y[PHI],
+                                                         ist[:N_SWITCHES], wk, True)
+            rising = M_gas + M_load + M_starter - 0.5 * dJ * w * w >= 0.0
+            ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], rising)
     fst[F_LAST_SWITCH] = np.nan
-    if _start_modes(m, y, y[PHI], ist, wk) == LOCKED_STATUS:
-        return _locked(m, y, y[PHI], outbuf, evbuf, ist, fst, wk)
+    if _start_modes(m, extras, y, y[PHI], ist, wk) == LOCKED_STATUS:
+        return _locked(m, extras, y, y[PHI], outbuf, evbuf, ist, fst, wk)
     if y[OMEGA] >= cfg[C_W_HI]:
         _to_angle_mode(m, y, ist, wk)
     fst[F_SEL] = y[PHI]
     _reset_output_grid(cfg, ist, fst, y)
-    _emit_row(m, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, wk)
+    _emit_row(m, extras, y, fst[F_SEL], ist[:N_SWITCHES], outbuf, ist, fst, wk)
     return RUNNING
 
 
 @kernel(inline=True)
-def _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf):
+def _settle_at_restart(m, extras, angle_mode, y, sw, wk, gs, ist, evbuf):
     """Where the step before did not leave the derivative and the margins valid (a start, an
     event, a breakpoint that changes the state or where a pressure jumps): the pairs' margins
     ``gs[0]`` at the state, with the modes settled; returns the angle that picks the table pieces
@@ -288,8 +301,8 @@ def _settle_at_restart(m, angle_mode, y, sw, wk, gs, ist, evbuf):
     # (the table piece just ahead in the direction of motion: on a breakpoint, rounding of the
     # shaft angle must not pick the piece behind it)
     ahead = y[PHI] + (1e-9 if angle_mode or y[OMEGA] >= 0.0 else -1e-9)
-    if m.n_pairs > 0:
-        _settle_modes(m, angle_mode, y, ahead, sw, wk, gs, ist, evbuf)
+    if extras is not None and m.n_pairs > 0:
+        _settle_modes(m, extras, angle_mode, y, ahead, sw, wk, gs, ist, evbuf)
         ist[I_NFEV] += 1
     return ahead
 
@@ -388,19 +401,20 @@ def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
 
 
 @kernel(inline=True)
-def _emit_step_samples(tab, m, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F, tmp,
-                       wk, outbuf, ist, fst, dense_ready):
+def _emit_step_samples(tab, m, extras, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F,
+                       tmp, wk, outbuf, ist, fst, dense_ready):
     """The output grid's samples inside the step, up to ``x_stop`` (its end, or its event), from
     the dense output."""
     if fst[F_NEXT_OUT] <= x_stop:
-        _dense_once(dense_ready, tab, m, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
-        _emit_samples(m, F, y, x, h, x_stop, ix, _out_spacing(cfg, angle_mode), sel, sw, outbuf,
-                      ist, fst, tmp, wk)
+        _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk,
+                    ist)
+        _emit_samples(m, extras, F, y, x, h, x_stop, ix, _out_spacing(cfg, angle_mode), sel, sw,
+                      outbuf, ist, fst, tmp, wk)
 
 
 @kernel(inline=True)
-def _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_breakpoint, y,
-               y_new, f, K, gs, sel, sw, outbuf, evbuf, ist, fst, wk):
+def _take_step(tab, m, extras, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_breakpoint,
+               y, y_new, f, K, gs, sel, sw, outbuf, evbuf, ist, fst, wk):
     """The accepted step, without an event in it, becomes the state (with its derivative and
     margins carried over); a breakpoint it ends on acts. Returns RUNNING, or FINISHED where the
     run ends with it."""
@@ -418,23 +432,23 @@ def _take_step(tab, m, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_
             ist[I_F_VALID] = 0
     if angle_mode and at_segment_end and x_end == up:
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
-        if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+        if _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
             ist[I_F_VALID] = 0
     elif redo_hit_breakpoint:
         fst[F_PASSED_BP] = fst[F_REDO_LEVEL]
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
-        if _at_breakpoint(m, bp, y, sw, evbuf, ist, wk):
+        if _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
             ist[I_F_VALID] = 0
     if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
-        return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
+        return _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk)
     if not angle_mode and at_segment_end and x_end == cfg[C_T_END]:
-        return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
+        return _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk)
     return RUNNING
 
 
 @kernel(inline=True)
-def _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level, ends_on_breakpoint,
-                   x_end, tol_end, F, y, y_evt, sel, sw, wk, ist):
+def _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level,
+                   ends_on_breakpoint, x_end, tol_end, F, y, y_evt, sel, sw, wk, ist):
     """The state at the event (at θ = ``ev_theta`` of the step, independent variable
     ``x_stop``), put exactly on the event's level, becomes the state. Returns ``(x_stop,
     on_breakpoint)``: an event within rounding of the breakpoint the step ends on (a pair whose
@@ -448,10 +462,10 @@ def _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level, ends_
     y_evt[ix] = x_stop
     if ev_comp >= PAIR_COMP:
         pass  # the margin is zero here to the root finder's accuracy; nothing to put on a level
-    elif ev_comp == DEMAND_COMP:
+    elif extras is not None and ev_comp == DEMAND_COMP:
         # the demand onto the limit exactly, by its integrator (a shift of the root finder's
         # accuracy), so that the next step starts on the level and does not cross it again
-        y_evt[gov_index(m) + gv.PI_INTEGRAL] -= _event_g(m, angle_mode, y_evt, ev_comp,
+        y_evt[gov_index(m) + gv.PI_INTEGRAL] -= _event_g(m, extras, angle_mode, y_evt, ev_comp,
                                                          ev_level, sel, sw, wk)
     elif ev_comp != OMEGA:
         y_evt[ev_comp] = ev_level
@@ -467,40 +481,40 @@ def _move_to_event(m, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level, ends_
 
 
 @kernel(inline=True)
-def _record_event(m, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw, outbuf,
-                  evbuf, ist, fst, wk):
+def _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw,
+                  outbuf, evbuf, ist, fst, wk):
     """The event (and a breakpoint it sits on) into the event buffer, and the ends of a run it
     may bring: the end, a stall, the pairs locking at rest, chattering. Returns RUNNING, or the
     code the run ends with."""
     if on_breakpoint:
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
-        _at_breakpoint(m, bp, y, sw, evbuf, ist, wk)
+        _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk)
     _emit_event(m, evbuf, ist, ev_code, y, wk)
     if ev_code == EV_END:
-        return _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk)
+        return _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk)
     if ev_code == EV_REVERSAL and not np.isfinite(cfg[C_T_END]):
         # A run that ends only by revolutions would never end once the shaft stops: report
         # the stall (with what was computed) instead of integrating on.
-        _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+        _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
         return STALLED
-    if ev_code == EV_REVERSAL and m.n_pairs > 0:
+    if extras is not None and ev_code == EV_REVERSAL and m.n_pairs > 0:
         # At rest the pairs may hold the applied moments; else the modes start afresh.
-        if _start_modes(m, y, sel, ist, wk) == LOCKED_STATUS:
-            return _locked(m, y, sel, outbuf, evbuf, ist, fst, wk)
+        if _start_modes(m, extras, y, sel, ist, wk) == LOCKED_STATUS:
+            return _locked(m, extras, y, sel, outbuf, evbuf, ist, fst, wk)
     gap = CHATTER_GAP * (1.0 if angle_mode else cfg[C_DT_OUT])
     ist[I_NCHATTER] = ist[I_NCHATTER] + 1 if abs(x_stop - fst[F_LAST_SWITCH]) < gap else 0
     fst[F_LAST_SWITCH] = x_stop
     if ist[I_NCHATTER] >= CHATTER_COUNT:
         ist[I_CHATTER_CODE] = ev_code
-        _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+        _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
         return CHATTERING
     ist[I_AT_EVENT] = ev_code + 1
     return RUNNING
 
 
 @kernel(inline=True)
-def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y, ist,
-                     fst, wk):
+def _switch_at_event(m, extras, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y,
+                     ist, fst, wk):
     """What the event switches: a pair's mode, the starter, the governor's branch, the load
     schedule's segment, the generator's branch, the speed map's interval, the sleeve on or off a
     stop, or the independent variable (with the next step's size converted by ω = level and the
@@ -511,7 +525,7 @@ def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, 
         ist[I_FLIPPED] = ev_comp - PAIR_COMP + 1
     elif ev_code == EV_STARTER_CUTOUT:
         ist[I_STARTER_ON] = 0
-    elif ev_code == EV_GOVERNOR and ev_comp == DEMAND_COMP:
+    elif extras is not None and ev_code == EV_GOVERNOR and ev_comp == DEMAND_COMP:
         ist[I_GOV_BRANCH] = gv.demand_branch(m.gov_par, ev_level, ev_rising)
     elif ev_code == EV_GOVERNOR:
         ist[I_GOV_BRANCH] = governor_branch(m, ev_level, ev_rising)
@@ -520,9 +534,9 @@ def _switch_at_event(m, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, 
         ist[I_LOAD_SEG] = load_segment(m, ev_level, ev_rising)
     elif ev_code == EV_GENERATOR:
         ist[I_GEN_LOW] = generator_branch(m, ev_level, ev_rising)
-    elif ev_code == EV_LOAD_KNOT:
+    elif extras is not None and ev_code == EV_LOAD_KNOT:
         ist[I_LOAD_TABLE] = speed_knot_segment(m, ev_level, ev_rising)
-    elif ev_code == EV_SLEEVE_STOP:
+    elif extras is not None and ev_code == EV_SLEEVE_STOP:
         J = inertia(m, y[PHI], wk)
         ist[I_SLEEVE] = _sleeve_stops(m, y, ev_level, speed(J, angle_mode, y))
     elif ev_code == EV_SLEEVE_FREE:
@@ -554,12 +568,12 @@ def _to_time_mode(m, y, ist, wk):
 
 
 @kernel(inline=True)
-def _settle_modes(m, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
+def _settle_modes(m, extras, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     """The pair margins at the start of a step, into ``gs[0]``. The pair whose mode an event has
     just switched sits on its level (margin 0). Any other pair already past its level here (two
     pairs switching within the event location's accuracy) is switched now, so that no step starts
     with a mode against its criterion: the stepper watches a margin only while it is positive."""
-    margins_at(m, angle_mode, y, sel, sw, wk)
+    margins_at(m, extras, angle_mode, y, sel, sw, wk)
     flipped = ist[I_FLIPPED] - 1
     ist[I_FLIPPED] = 0
     changed = False
@@ -570,17 +584,17 @@ def _settle_modes(m, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
             changed = True
             _emit_event(m, evbuf, ist, EV_PAIR_MODE, y, wk)
     if changed:
-        margins_at(m, angle_mode, y, sel, sw, wk)
+        margins_at(m, extras, angle_mode, y, sel, sw, wk)
         ist[I_NFEV] += 1
     for k in range(m.n_pairs):
         gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]
 
 
 @kernel
-def _start_modes(m, y, sel, ist, wk):
+def _start_modes(m, extras, y, sel, ist, wk):
     """Choose σ and the pair modes afresh (start, speed reversal; time domain); a rounding tie
     that the kernel had to resolve by its rule is counted (``I_NTIES``)."""
-    status = choose_modes(m, False, y, sel, ist[:N_SWITCHES], wk)
+    status = choose_modes(m, extras, False, y, sel, ist[:N_SWITCHES], wk)
     if status == AMBIGUOUS or status == NONE_CONSISTENT:
         ist[I_NTIES] += 1
     return status

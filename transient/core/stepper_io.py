@@ -102,9 +102,9 @@ def _emit_event(m, evbuf, ist, code, y, wk):
 
 
 @kernel
-def _emit_row(m, y, sel, sw, outbuf, ist, fst, wk):
+def _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk):
     """One output row at state ``y`` (an event's): a call into ``outputs.output_row``."""
-    output_row(m, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
+    output_row(m, extras, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
     _count_row(y, ist, fst)
 
 
@@ -117,7 +117,7 @@ def _count_row(y, ist, fst):
 
 
 @kernel
-def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, tmp, wk):
+def _emit_samples(m, extras, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, tmp, wk):
     """The output samples of the grid (spacing ``d_out``) up to ``x_stop`` inside the last step
     (from x, size h), from its dense output F. A call of its own, with the output row inlined,
     because every other arrangement copies the Model per sample: a call into the output row from
@@ -127,7 +127,7 @@ def _emit_samples(m, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist, fst, t
     while fst[F_NEXT_OUT] <= x_stop:
         _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
         tmp[ix] = fst[F_NEXT_OUT]
-        output_row_inline(m, angle_mode, tmp, sel, sw, wk, outbuf[ist[I_NOUT]])
+        output_row_inline(m, extras, angle_mode, tmp, sel, sw, wk, outbuf[ist[I_NOUT]])
         _count_row(tmp, ist, fst)
         fst[F_NEXT_OUT] = np.floor(fst[F_NEXT_OUT] / d_out + 0.5) * d_out + d_out
 
@@ -148,21 +148,21 @@ def _reset_output_grid(cfg, ist, fst, y):
 
 
 @kernel
-def _locked(m, y, sel, outbuf, evbuf, ist, fst, wk):
+def _locked(m, extras, y, sel, outbuf, evbuf, ist, fst, wk):
     """End a run at rest that the pairs' friction holds (``rhs.choose_modes``): φ̈ = 0 from here,
     and nothing in the model depends on time explicitly, so the machine stays where it is."""
     _emit_event(m, evbuf, ist, EV_LOCKED, y, wk)
     if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI] or ist[I_NOUT] == 0:
-        _emit_row(m, y, sel, ist[:N_SWITCHES], outbuf, ist, fst, wk)
+        _emit_row(m, extras, y, sel, ist[:N_SWITCHES], outbuf, ist, fst, wk)
     return LOCKED
 
 
 @kernel
-def _finish(m, y, sel, sw, outbuf, evbuf, ist, fst, wk):
+def _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk):
     """Write the final state as the last sample (unless it already is one, possibly in an
     already drained buffer) and an end event."""
     if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
-        _emit_row(m, y, sel, sw, outbuf, ist, fst, wk)
+        _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
     if ist[I_NEV] == 0 or evbuf[ist[I_NEV] - 1, 0] != EV_END:
         _emit_event(m, evbuf, ist, EV_END, y, wk)
     return FINISHED

@@ -12,7 +12,8 @@ import numba as nb
 import numpy as np
 
 from ..core.forcing import governor_branch
-from ..core.layout import N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, n_state, work_array
+from ..core.layout import (N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, extras_of, n_state,
+                          work_array)
 from ..core.rhs import choose_modes, derivative
 
 # CyRK's callback signature: dy (double*), t, y (double*), args (double*).
@@ -26,6 +27,7 @@ def make_rhs(m):
     this model (its arrays are frozen into the code)."""
     n = n_state(m)
     shape = work_array(m).shape
+    extras = extras_of(m)
 
     @nb.cfunc(SIGNATURE)
     def rhs(dy, t, y, args):
@@ -37,7 +39,7 @@ def make_rhs(m):
         sw[SW_GOVERNOR] = governor_branch(m, w, True)
         sw[SW_DIRECTION] = 1 if w >= 0.0 else -1
         if m.n_pairs > 0:
-            choose_modes(m, False, state, state[PHI], sw, wk)
-        derivative(m, False, state, state[PHI], sw, wk, out)
+            choose_modes(m, extras, False, state, state[PHI], sw, wk)
+        derivative(m, extras, False, state, state[PHI], sw, wk, out)
 
     return rhs

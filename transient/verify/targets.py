@@ -77,14 +77,15 @@ BARE_SCENE = BENCH_SCENES["coasting_single"]
 
 
 @kernel
-def rhs_loop(m, states, y, out, sw, wk, chained):
+def rhs_loop(m, states, y, out, sw, wk, chained, extras):
     """Evaluate the crank-angle RHS at every state (rows: φ, t, K, works); return a checksum.
     ``chained``: each call's state depends on the previous result (0·out still has to wait for
     out), as a Runge–Kutta step's stages do — the RHS's latency; otherwise the calls are
     independent — its throughput, where the division, square root and sine of one call overlap
     the next's. Independent calls read the row itself: copying it into ``y`` costs a measurable
     part of a call on the bare cylinder, and the hand-written loop (:func:`make_hand_loop`) copies
-    nothing."""
+    nothing. ``extras``: the kernels' variant for ``m``
+    (:func:`transient.core.layout.extras_of`)."""
     acc = 0.0
     for i in range(states.shape[0]):
         state = states[i]
@@ -93,7 +94,7 @@ def rhs_loop(m, states, y, out, sw, wk, chained):
                 y[j] = states[i, j] + 0.0 * out[j]
             state = y
         sel = states[i - i % CALLS_PER_STEP, layout.PHI]
-        derivative(m, True, state, sel, sw, wk, out)
+        derivative(m, extras, True, state, sel, sw, wk, out)
         acc += out[layout.KINETIC]
     return acc
 
@@ -137,7 +138,8 @@ def _switches():
 def rhs_costs(scene, rounds=7, loops=100) -> tuple[float, float]:
     """(independent, chained) cost of one crank-angle right-hand side of ``scene`` [s]."""
     args = rhs_arguments(scene)
-    return tuple(per_call(rhs_loop, *args, chained, rounds=rounds, loops=loops)
+    return tuple(per_call(rhs_loop, *args, chained, layout.extras_of(args[0]), rounds=rounds,
+                          loops=loops)
                  for chained in (False, True))
 
 
@@ -287,7 +289,8 @@ def hand_against_transient(base, rows, **flags) -> tuple[np.ndarray, np.ndarray]
     theirs = np.zeros(6)
     hand, transient = [], []
     for i in rows:
-        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), layout.work_array(m), False)
+        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), layout.work_array(m), False,
+                 layout.extras_of(m))
         rhs(p, states[i], out, rec)
         hand.append((out[layout.T], out[layout.KINETIC]))
         transient.append((theirs[layout.T], theirs[layout.KINETIC]))
@@ -315,7 +318,7 @@ def bare_kernel(rounds=7) -> dict:
     for kin in ("exact", "tabulated"):
         m, _, _ = build_model(dc.replace(base, solver=dc.replace(base.solver, kinematics=kin)))
         costs[kin] = per_call(rhs_loop, m, states, np.empty(6), np.zeros(6), _switches(),
-                              layout.work_array(m), False, rounds=rounds)
+                              layout.work_array(m), False, layout.extras_of(m), rounds=rounds)
     return {"hand_written_s": hand, "exact_s": costs["exact"], "tabulated_s": costs["tabulated"]}
 
 
