@@ -451,10 +451,10 @@ def _table_pair(ps: Section, between: tuple[str, str], name: str, base_dir: Path
     eta_backward) or inline (``speed``, ``torque``, and ``eta_forward``, ``eta_backward`` as one
     row per speed)."""
     if ps.has("file"):
-        for k in ("speed", "torque", "eta_forward", "eta_backward"):
-            if ps.has(k, "speed" if k == "speed" else None):
-                raise SceneError(ps.key(k), "is given with 'file'; give the map in the file or "
-                                            "inline, not both")
+        inline = ("speed", "speed_rpm", "torque", "eta_forward", "eta_backward")
+        for k in (k for k in inline if k in ps.data):
+            raise SceneError(ps.key(k), "is given with 'file'; give the map in the file or "
+                                        "inline, not both")
         ps_file = str(ps.data["file"])
         cols = [c for _, c in _read_csv(ps, base_dir, MAP_COLUMNS)]
         points = [(i + 1, *vals) for i, vals in enumerate(zip(*cols))]
