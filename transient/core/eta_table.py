@@ -14,10 +14,11 @@ Existence and uniqueness
 ------------------------
 With x = |S|, h′_k(S) = e + x·de/dx: forward η_fwd + x ∂η_fwd/∂x, backward
 (η_bwd − x ∂η_bwd/∂x)/η_bwd². The scene check requires both > 0 on the whole map
-(``transient.scene.read``; bilinear, they are linear in x in each cell and convex combinations
+(``transient.scene.eta_map``; bilinear, they are linear in x in each cell and convex combinations
 over the speed, so the grid's cell ends decide it, and held beyond the edges e' = 0). Then every
-h_k is continuous and strictly increasing with h′ ≥ γ > 0, so S_k(a) is continuous and strictly
-decreasing in a, and F′(a) = −Σ_j J_j Π_{i≥j} h′_i ≤ −γⁿ Σ J_j < 0: F has exactly one root. The
+h_k is continuous and strictly increasing with h′ ≥ γ for some 0 < γ ≤ 1 (finitely many linear
+pieces), so S_k(a) is continuous and strictly decreasing in a, and
+F′(a) = −Σ_j J_j Π_{j≤i<n} h′_i ≤ −γⁿ Σ J_j < 0: F has exactly one root. The
 same holds for the power-flow map g_k(S) = h_k(S) with the mode given by the sign of Sσ (the two
 branches meet at S = 0 with value 0), so the power-flow-consistent mode vector is unique, as for
 constant η; :func:`solve_auto` finds it directly, as the root of F with g_k in place of h_k.
