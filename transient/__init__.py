@@ -5,7 +5,8 @@ result → analysis, and each layer imports only those below it (the contracts i
 ``pyproject.toml``, checked by ``make test``). From the bottom up:
 
 - ``core``           numba only: kinematics per mechanism, the reduced model (18), the serial
-                     chain (22), (27), governor, cylinder, RK tableaus, events, the stepper
+                     chain (22), (27) with constant or mapped efficiencies, reaction friction,
+                     governor, cylinder, RK tableaus, events, the stepper
 - ``errors``, ``roots``, ``tomlout``, ``units``, ``version``, ``precompile``
                      what every layer shares: errors, scalar roots, TOML values, unit suffixes,
                      the version, the compile helper process

@@ -526,7 +526,33 @@ def chain_fields(scene) -> dict:
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
         link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
-        reaction=False, rx_par=np.zeros((4, N_RX_PAR)), rx_pair=np.full(4, -1, dtype=np.int64))
+        reaction=False, rx_par=np.zeros((4, N_RX_PAR)), rx_pair=np.full(4, -1, dtype=np.int64),
+        **eta_table_fields(friction.pairs))
+
+
+def eta_table_fields(pairs) -> dict:
+    """The Model's efficiency maps (:mod:`transient.core.eta_table`), padded to one shape: each
+    pair's speed and moment axes and its two maps; a constant-η pair among mapped ones becomes a
+    one-point map of its two efficiencies (held everywhere: the same η). Without mapped pairs,
+    one row of zeros of the same types."""
+    n = len(pairs)
+    if not any(p.model == "table" for p in pairs):
+        return dict(eta_table=False, et_speed=np.zeros((n, 1)), et_torque=np.zeros((n, 1)),
+                    et_size=np.zeros((n, 2), dtype=np.int64), et_eta=np.zeros((n, 2, 1, 1)),
+                    et_min=np.ones(n))
+    maps = [(p.speed, p.torque, p.eta_forward_map, p.eta_backward_map) if p.model == "table"
+            else ((0.0,), (0.0,), ((p.eta_forward,),), ((p.eta_backward,),)) for p in pairs]
+    nw = max(len(m[0]) for m in maps)
+    ns = max(len(m[1]) for m in maps)
+    speed, torque = np.zeros((n, nw)), np.zeros((n, ns))
+    size, eta = np.zeros((n, 2), dtype=np.int64), np.ones((n, 2, nw, ns))
+    for k, (w, s, fwd, bwd) in enumerate(maps):
+        size[k] = len(w), len(s)
+        speed[k, :len(w)], torque[k, :len(s)] = w, s
+        eta[k, 0, :len(w), :len(s)], eta[k, 1, :len(w), :len(s)] = fwd, bwd
+    et_min = np.array([min(min(map(min, m[2])), min(map(min, m[3]))) for m in maps])
+    return dict(eta_table=True, et_speed=speed, et_torque=torque, et_size=size, et_eta=eta,
+                et_min=et_min)
 
 
 def reaction_friction(scene) -> bool:
@@ -555,7 +581,7 @@ def reaction_fields(scene) -> dict:
                 policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
                 link_sub=np.zeros(len(mech.links), dtype=np.int64),
                 link_J=np.array(mech.link_inertias(), dtype=np.float64),
-                reaction=True, rx_par=rx_par, rx_pair=rx_pair)
+                reaction=True, rx_par=rx_par, rx_pair=rx_pair, **eta_table_fields(pairs))
 
 
 def reaction_breakpoints(scene) -> NDArray[np.float64]:

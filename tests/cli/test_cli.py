@@ -983,3 +983,27 @@ def test_spin_up_is_measured(tmp_path, capsys):
     t90 = tm[k - 1] + (target - wm[k - 1]) * (tm[k] - tm[k - 1]) / (wm[k] - wm[k - 1])
     assert a["spin_up_t90_s"] - tr["t"][0] == pytest.approx(t90 - tr["t"][0], abs=1e-4)
     assert 0 < a["spin_up_t90_s"] < a["spin_up_settling_s"] < tr["t"][-1]
+
+
+def test_efficiency_study_with_an_efficiency_map(tmp_path, capsys):
+    """`transient efficiency` on the map case (its CSV next to the scene): every point's pair
+    FMEPs sum to the total, the charts are written, η_mech falls with speed at both loads (the
+    map's drag grows with speed) and with load at high speed."""
+    scene = CASES / "gots_diesel_eta_map.toml"
+    code, out, err = cli(capsys, "efficiency", scene, "--rpm", "1000,5000", "--fuel", "1,0.5",
+                         "--samples-per-rev", "360", "-o", tmp_path)
+    assert (code, err) == (0, "")
+    csv = (tmp_path / "gots_diesel_eta_map_efficiency.csv").read_text().splitlines()
+    header = csv[0].split(",")
+    rows = {(float(r["fuel"]), float(r["rpm"])): r for r in
+            (dict(zip(header, line.split(","))) for line in csv[1:])}
+    assert len(rows) == 4
+    for r in rows.values():
+        assert float(r["fmep"]) == pytest.approx(float(r["fmep_1"]) + float(r["fmep_2"]),
+                                                 rel=1e-9)
+        assert float(r["fmep_1"]) > 0.0 and float(r["inconsistent_samples"]) == 0
+    eta = {key: float(r["eta_mech_work"]) for key, r in rows.items()}
+    assert eta[(1.0, 5000.0)] < eta[(1.0, 1000.0)] and eta[(0.5, 5000.0)] < eta[(0.5, 1000.0)]
+    assert eta[(0.5, 5000.0)] < eta[(1.0, 5000.0)]
+    for figure in ("efficiency", "friction_budget", "efficiency_map"):
+        assert (tmp_path / f"gots_diesel_eta_map_{figure}.png").stat().st_size > 10_000

@@ -81,11 +81,45 @@ REACTION_CASES = [  # (id, scene text, key, fragment), part of CASES below
     ("reaction-mixed-with-constant-eta",
      reaction(extra='\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
                     'eta_backward = 0.9\n'),
-     "friction.pairs[1].model", "mixing constant-eta and reaction pairs is not implemented"),
+     "friction.pairs[1].model", "reaction pairs do not mix with others (constant-eta and table "
+                                "pairs do)"),
     ("reaction-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"')
      + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\nmodel = "reaction"\n'
        'mu = 0.003\nradius_mm = 30\n',
      "solver.method", "friction on the reactions runs on the compiled methods"),
+]
+
+
+def table(keys: str = "", speed: str = "speed_rpm = [0, 3000]", torque: str = "torque = [0, 100]",
+          fwd: str = "eta_forward = [[0.97, 0.98], [0.96, 0.97]]",
+          bwd: str = "eta_backward = [[0.97, 0.98], [0.96, 0.97]]") -> str:
+    """VALID with one pair whose efficiencies are an inline map (rows: speeds)."""
+    return VALID + (f'\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\n'
+                    f'model = "table"\n{speed}\n{torque}\n{fwd}\n{bwd}\n{keys}')
+
+
+TABLE_CASES = [  # (id, scene text, key, fragment), part of CASES below
+    ("table-speed-not-increasing", table(speed="speed_rpm = [3000, 3000]"),
+     "friction.pairs[0].speed_rpm", "must increase strictly, got 3000 rpm then 3000 rpm"),
+    ("table-torque-negative", table(torque="torque = [-10, 100]"), "friction.pairs[0].torque",
+     "starts at -10; a map's axes are magnitudes (|ω|, |S|), ≥ 0"),
+    ("table-eta-above-1", table(fwd="eta_forward = [[0.97, 1.01], [0.96, 0.97]]"),
+     "friction.pairs[0].eta_forward", "is 1.01 at (0 rpm, 100 N m); allowed: 0 < η ≤ 1"),
+    ("table-row-short", table(bwd="eta_backward = [[0.97], [0.96, 0.97]]"),
+     "friction.pairs[0].eta_backward", "must have 2 row(s) (one per speed) of 2 value(s)"),
+    ("table-not-rows", table(bwd="eta_backward = [0.97, 0.98]"),
+     "friction.pairs[0].eta_backward", "must be a list of rows of finite numbers"),
+    ("table-breaks-uniqueness", table(torque="torque = [10, 20]",
+                                      fwd="eta_forward = [[0.9, 0.4], [0.96, 0.97]]"),
+     "friction.pairs[0].eta_forward", "η_fwd + x·∂η_fwd/∂x = -0.6 at 20 N m; the moment a pair "
+                                      "passes on must grow with the moment it takes"),
+    ("table-file-and-inline", table(keys='file = "map.csv"'), "friction.pairs[0].speed_rpm",
+     "is given with 'file'; give the map in the file or inline, not both"),
+    ("table-no-such-file", VALID + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", '
+                                   '"crank"]\nmodel = "table"\nfile = "nowhere.csv"\n',
+     "friction.pairs[0].file", "no such file 'nowhere.csv'"),
+    ("table-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"') + table()[
+        len(VALID):], "solver.method", "efficiency maps run on the compiled methods"),
 ]
 
 # Dynamic governors and fuel latching (issue 6): limits, gains, what a prescribed run cannot do.
@@ -310,6 +344,7 @@ CASES = [
     ("pair-unknown-key", pair(extra="efficiency = 0.9\n"), "friction.pairs[0].efficiency",
      "unknown key; allowed here: between, eta_backward, eta_forward, model, name"),
     *REACTION_CASES,
+    *TABLE_CASES,
     ("pairs-not-array", VALID + '\n[friction]\npairs = 3\n', "friction.pairs",
      "must be an array of tables"),
     ("unknown-policy", pair(policy="coulomb"), "friction.policy",
@@ -509,3 +544,25 @@ def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2
     assert_one_line_error(err, scene, "inertia", "the reduced inertia J(φ) falls to")
+
+
+@pytest.mark.parametrize("csv, fragment", [
+    ("speed_rpm,torque,eta_forward,eta_backward\n0,0,0.97,0.97\n0,100,0.98,0.98\n"
+     "3000,0,0.96,0.96\n", "the grid is incomplete: no row for (3000 rpm, 100 N m)"),
+    ("speed_rpm,torque,eta_forward,eta_backward\n0,0,0.97,0.97\n0,0,0.98,0.98\n",
+     "data row 2 repeats the grid point (0 rpm, 0 N m) of data row 1"),
+    ("speed_rpm,torque,eta_forward\n0,0,0.97\n", "needs a speed column"),
+    ("speed_rpm,torque,eta_forward,eta_backward\n0,0,0.97,0\n0,100,0.98,0.98\n",
+     "column eta_backward: is 0 at (0 rpm, 0 N m); allowed: 0 < η ≤ 1"),
+])
+def test_invalid_efficiency_map_file_is_one_line_exit_2(tmp_path, capsys, csv, fragment):
+    """A map from a CSV file (one row per grid point): the error names the scene's key ``file``,
+    the CSV file and what is wrong in it."""
+    (tmp_path / "map.csv").write_text(csv, encoding="utf-8")
+    scene = tmp_path / "bad.toml"
+    scene.write_text(VALID + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\n'
+                             'model = "table"\nfile = "map.csv"\n', encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, "friction.pairs[0].file", "map.csv: ")
+    assert fragment in err, err

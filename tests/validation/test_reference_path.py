@@ -63,12 +63,13 @@ START_T_END = 0.25
 
 def dynamic_scenes():
     """The dynamic scenes the reference path runs: not those with friction on the joints'
-    reactions, which run on the compiled methods only (their independent check is the
-    Newton–Euler model, ``tests/unit/test_joint_friction.py``)."""
+    reactions or with efficiency maps, which run on the compiled methods only (their
+    independent checks are the Newton–Euler model, ``tests/unit/test_joint_friction.py``, and
+    scipy's interpolator at every sample, ``tests/validation/test_eta_table_runs.py``)."""
     names = []
     for path in sorted(CASES.glob("*.toml")):
         scene = load_scene(path)
-        if scene.run.mode == "dynamic" and not any(p.model == "reaction"
+        if scene.run.mode == "dynamic" and not any(p.model in ("reaction", "table")
                                                    for p in scene.friction.pairs):
             names.append(path.stem)
     return names

@@ -16,6 +16,7 @@ from .forcing import (fuel, generator_branch, governor_branch, load_segment, mom
 from .layout import (COL_EPS, N_OUT_FIXED, N_SWITCHES, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
                      SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY,
                      WK_J, WK_M, WK_S, WK_S_TRY, latch_index, n_state, work_array)
+from .eta_table import invert
 from .joint_friction import inverse_drive
 from .outputs import output_row, pair_rows
 from .rhs import pair_etas, split_subchains
@@ -31,7 +32,9 @@ def inverse_chain(m, a, w, sigma, wk):
     and the first consistent one kept: for ``power-flow`` S_k σ must have the mode's sign (always
     exactly one vector, because η* > 0 keeps the sign of η* S_k), for ``paper`` the criterion (25)
     with the drive counted among the shaft-side moments; if none is consistent, the one violating
-    least. Needs the rows J, J′, M of ``wk``; fills η*, S. Returns ``(M_drive, n_consistent)``.
+    least. With efficiency maps each pair's S solves η*(|S|)·S = the moment carried
+    (``eta_table.invert``; η* > 0 keeps its sign too). Needs the rows J, J′, M of ``wk``; fills
+    η*, S. Returns ``(M_drive, n_consistent)``.
     """
     n = m.n_pairs
     half_w2 = 0.5 * w * w
@@ -45,7 +48,12 @@ def inverse_chain(m, a, w, sigma, wk):
             carried = wk[WK_J, k] * a - (wk[WK_M, k] - wk[WK_DJ, k] * half_w2)
             if k < n:
                 carried += S[k]
-            S[k - 1] = carried / eta[k - 1]
+            if m.eta_table:  # η* depends on S: h(S) = carried solved for S (``eta_table``)
+                S[k - 1], eta[k - 1] = invert(m.et_speed, m.et_torque, m.et_size, m.et_eta,
+                                              m.et_min, k - 1, ((mask >> (k - 1)) & 1) == 1,
+                                              abs(w), carried)
+            else:
+                S[k - 1] = carried / eta[k - 1]
         drive = wk[WK_J, 0] * a - (wk[WK_M, 0] - wk[WK_DJ, 0] * half_w2) + S[0]
         ok = True
         viol = 0.0

@@ -166,6 +166,14 @@ Model = namedtuple(
         "reaction",  # bool: the pairs' losses follow from the joint reactions
         "rx_par",  # float64[4, N_RX_PAR]: each joint's coefficients (zeros: an ideal joint)
         "rx_pair",  # int64[4]: the pair each joint reports as, −1 for an ideal joint
+        # efficiencies mapped over speed and transmitted moment (transient.core.eta_table); the
+        # arrays keep their types without maps (one row of zeros), so one compile serves all
+        "eta_table",  # bool: the pairs' η come from the maps below (eta_fwd, eta_bwd unused)
+        "et_speed",  # float64[n_pairs, nw_max]: pair k's speed axis |ω|, increasing [rad/s]
+        "et_torque",  # float64[n_pairs, ns_max]: its moment axis |S|, increasing [N m]
+        "et_size",  # int64[n_pairs, 2]: the lengths of pair k's two axes
+        "et_eta",  # float64[n_pairs, 2, nw_max, ns_max]: η_fwd, η_bwd on pair k's grid [1]
+        "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
     ],
 )
 

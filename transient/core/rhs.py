@@ -8,10 +8,13 @@ inlined form for the root finder's iterations and as a call for the rare sites.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from .jit import kernel
 
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import governor as gv
+from . import eta_table as et
 from . import joint_friction as jf
 from .forcing import command, cylinder_rates, governor_rates, moments
 from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T, W_GAS, W_LOAD,
@@ -68,6 +71,10 @@ def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
         return jf.reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]), wk)
     n = m.n_pairs
     split_subchains(m, J, dJ, M_gas, M_shaft, wk)
+    if m.eta_table:  # η* depends on S: solved with the modes held (``eta_table``)
+        return et.solve_held(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], w,
+                             sw[SW_MODES], m.et_speed, m.et_torque, m.et_size, m.et_eta,
+                             m.et_min, wk[WK_ETA, :n], wk[WK_S, :n])
     pair_etas(m, sw[SW_MODES], wk[WK_ETA])
     return chain_solve(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], wk[WK_ETA, :n], w,
                        wk[WK_S, :n])
@@ -185,10 +192,13 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         sw[SW_MODES] = 0
         return status
     split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
-    a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
-                                         wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,
-                                         wk[WK_ETA, :n], wk[WK_S, :n],
-                                         wk[WK_SCRATCH: WK_SCRATCH + 4, :n])
+    if m.eta_table:
+        a, status = _table_modes(m, w, wk)
+    else:
+        a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
+                                             wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,
+                                             wk[WK_ETA, :n], wk[WK_S, :n],
+                                             wk[WK_SCRATCH: WK_SCRATCH + 4, :n])
     if status == LOCKED:
         return status
     if w != 0.0:
@@ -199,7 +209,9 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
     upstream = 0.0
     for k in range(n):
         upstream += wk[WK_M, k]
-        if m.policy == POWER_FLOW:
+        if m.policy == POWER_FLOW and m.eta_table:
+            backward = wk[WK_S, k] * sw[SW_DIRECTION] < 0.0
+        elif m.policy == POWER_FLOW:
             backward = wk[WK_ETA, k] != m.eta_fwd[k]
         else:
             backward = upstream * sw[SW_DIRECTION] < 0.0
@@ -207,3 +219,27 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
             modes |= 1 << k
     sw[SW_MODES] = modes
     return status
+
+
+@kernel
+def _table_modes(m, w, wk):
+    """(φ̈, status) with mapped efficiencies and every pair's mode given by its transmitted power
+    (``eta_table.solve_auto``, unique for ω ≠ 0); at rest the incipient motion decides, as in
+    ``chain.modes_power_flow``: σ = +1 if it accelerates forward, σ = −1 if backward, else
+    locked. Fills the rows η*, S of ``wk``."""
+    n = m.n_pairs
+    J, dJ, M = wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1]
+    sigma = -1.0 if w < 0.0 else 1.0
+    a = et.solve_auto(J, dJ, M, w, sigma, m.et_speed, m.et_torque, m.et_size, m.et_eta,
+                      m.et_min, wk[WK_ETA, :n], wk[WK_S, :n])
+    if w != 0.0 or a > 0.0:
+        return a, UNIQUE
+    a = et.solve_auto(J, dJ, M, w, -1.0, m.et_speed, m.et_torque, m.et_size, m.et_eta,
+                      m.et_min, wk[WK_ETA, :n], wk[WK_S, :n])
+    if a < 0.0:
+        return a, UNIQUE
+    for k in range(n):  # held by the pairs' friction (``chain.modes_power_flow``)
+        wk[WK_ETA, k] = np.nan
+        wk[WK_S, k] = np.nan
+    wk[WK_S, 0] = wk[WK_M, 0]
+    return 0.0, LOCKED

@@ -44,6 +44,9 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("solver.method", f"friction on the reactions runs on the compiled "
                                           f"methods ({', '.join(COMPILED_METHODS)}), not "
                                           f"{sv.method!r}")
+    if any(p.model == "table" for p in scene.friction.pairs) and not compiled:
+        raise SceneError("solver.method", f"efficiency maps run on the compiled methods "
+                                          f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")
     if sv.fixed_step > 0.0 and not compiled:
         raise SceneError("solver.fixed_step", f"fixed steps need a compiled method "
                                               f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")

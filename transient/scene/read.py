@@ -18,7 +18,8 @@ from ..units import ALL_SUFFIXES
 from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table
 from .files import parse_toml, read_text, table_number, table_rows
-from .reader import MISSING, Section, show_value
+from .eta_map import check_map, grid_from_points
+from .reader import MISSING, Section, finite_number, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
                       MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
@@ -140,7 +141,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["output"] = Output(spr, dt)
         so.finish()
         sf = root.sub("friction")
-        sections["friction"] = _read_friction(sf, mech)
+        sections["friction"] = _read_friction(sf, mech, base_dir)
         sf.finish()
         sa = root.sub("analysis")
         sections["analysis"] = _read_analysis(sa)
@@ -343,7 +344,7 @@ def _table_column(rows, index: int, column: str, factor: float) -> tuple[float, 
     return tuple(out)
 
 
-def _read_friction(s: Section, mech) -> Friction:
+def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
     """The [friction] table: a policy and an array of [[friction.pairs]] between neighbouring
     links of the mechanism (shaft side first), each with its friction model."""
     policy = s.string("policy", "power-flow", choices=POLICIES)
@@ -374,6 +375,8 @@ def _read_friction(s: Section, mech) -> Friction:
         name = ps.string("name", f"{between[0]}-{between[1]}")
         if model == "reaction":
             pair = _reaction_pair(ps, between, name, slider=ia == len(links) - 2)
+        elif model == "table":
+            pair = _table_pair(ps, between, name, base_dir)
         else:
             pair = Pair(between=between, eta_forward=_efficiency(ps, "eta_forward"),
                         eta_backward=_efficiency(ps, "eta_backward"), name=name)
@@ -384,11 +387,10 @@ def _read_friction(s: Section, mech) -> Friction:
                                              f"{s.key('pairs')}[{twin}] "
                                              f"too; give each pair its own name (it labels the "
                                              f"pair's result columns and reports)")
-        if models and model != models[0]:
+        if models and (model == "reaction") != (models[0] == "reaction"):
             raise SceneError(ps.key("model"), f"{model!r} after {models[0]!r} in "
-                                              f"{s.key('pairs')}[0]; the pairs of a scene share "
-                                              f"one model (mixing constant-eta and reaction "
-                                              f"pairs is not implemented)")
+                                              f"{s.key('pairs')}[0]; reaction pairs do not mix "
+                                              f"with others (constant-eta and table pairs do)")
         models.append(model)
         pairs.append(pair)
     order = getattr(mech, "reaction_links", ()) if "reaction" in models else mech.links
@@ -435,6 +437,55 @@ def _reaction_pair(ps: Section, between: tuple[str, str], name: str, slider: boo
     return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name, model="reaction",
                 mu=mu, radius=ps.number("radius", "length", gt=0.0),
                 viscous=ps.number("viscous", default=0.0, ge=0.0))
+
+
+#: Column names of an efficiency map (CSV) and their factors to SI.
+MAP_COLUMNS = {"speed": {"speed_rpm": math.pi / 30.0, "speed": 1.0}, "torque": {"torque": 1.0},
+               "forward efficiency": {"eta_forward": 1.0},
+               "backward efficiency": {"eta_backward": 1.0}}
+
+
+def _table_pair(ps: Section, between: tuple[str, str], name: str, base_dir: Path) -> Pair:
+    """A pair whose efficiencies are maps over |ω| and |S| (:mod:`.eta_map`): from a CSV file
+    (``file``: one row per grid point, columns speed_rpm or speed, torque, eta_forward,
+    eta_backward) or inline (``speed``, ``torque``, and ``eta_forward``, ``eta_backward`` as one
+    row per speed)."""
+    if ps.has("file"):
+        inline = ("speed", "speed_rpm", "torque", "eta_forward", "eta_backward")
+        for k in (k for k in inline if k in ps.data):
+            raise SceneError(ps.key(k), "is given with 'file'; give the map in the file or "
+                                        "inline, not both")
+        ps_file = str(ps.data["file"])
+        cols = [c for _, c in _read_csv(ps, base_dir, MAP_COLUMNS)]
+        points = [(i + 1, *vals) for i, vals in enumerate(zip(*cols))]
+        try:  # (placed as _read_csv places its errors: the key the scene's, the file named)
+            speed, torque, fwd, bwd = grid_from_points("(grid)", points)
+            check_map(lambda k: f"column {k}", speed, torque, fwd, bwd)
+        except SceneError as exc:
+            raise SceneError(ps.key("file"), f"{Path(ps_file).name}: {exc.key}: "
+                                             f"{exc.message}") from None
+    else:
+        speed = ps.numbers("speed", "speed")
+        torque = ps.numbers("torque")
+        fwd = _rows(ps, "eta_forward")
+        bwd = _rows(ps, "eta_backward")
+        check_map(lambda k: ps.key(ps.written.get(k, k)), speed, torque, fwd, bwd)
+    return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name, model="table",
+                speed=speed, torque=torque, eta_forward_map=fwd, eta_backward_map=bwd)
+
+
+def _rows(ps: Section, name: str) -> tuple[tuple[float, ...], ...]:
+    """A map's values inline: a list of rows (one per speed) of finite numbers."""
+    ps.known.append(name)
+    if name not in ps.data:
+        raise SceneError(ps.key(name), "is missing; give one row per speed of one value per "
+                                       "torque, e.g. [[0.97, 0.98], [0.96, 0.975]]")
+    value = ps.data.pop(name)
+    if (not isinstance(value, list) or not value
+            or not all(isinstance(r, list) and all(finite_number(v) for v in r) for r in value)):
+        raise SceneError(ps.key(name), f"must be a list of rows of finite numbers (one row per "
+                                       f"speed), got {show_value(value)}")
+    return tuple(tuple(float(v) for v in r) for r in value)
 
 
 def _check_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:

@@ -453,6 +453,14 @@ class Pair:
     #: Reaction model, slider: friction from the gas pressure behind the rings as a share of
     #: the gas force on the piston, c_p = 4 μ_ring h/D for a top ring of height h [1].
     ring_pressure: float = 0.0
+    #: Table model (:mod:`transient.core.eta_table`; then the scalar η are unused, 1): the maps'
+    #: speed axis |ω| [rad/s] and moment axis |S| [N m], each increasing and ≥ 0.
+    speed: tuple[float, ...] = ()
+    torque: tuple[float, ...] = ()
+    #: Table model: η_fwd and η_bwd on the grid, one row per speed, one value per moment, in
+    #: (0, 1] [1].
+    eta_forward_map: tuple[tuple[float, ...], ...] = ()
+    eta_backward_map: tuple[tuple[float, ...], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -469,7 +477,7 @@ class Friction:
 
 POLICIES = ("power-flow", "paper")
 #: Friction models of a pair.
-PAIR_MODELS = ("constant-eta", "reaction")
+PAIR_MODELS = ("constant-eta", "reaction", "table")
 
 
 @dataclass(frozen=True)

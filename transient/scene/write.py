@@ -49,6 +49,11 @@ def to_toml(scene: Scene) -> str:
                     else ("mu", "radius", "viscous"))
             lines += ['model = "reaction"']
             lines += [f"{k} = {toml_value(getattr(pair, k))}" for k in keys]
+        elif pair.model == "table":  # (a map from a file is written inline: the scene stands alone)
+            lines += ['model = "table"', f"speed = {toml_value(list(pair.speed))}",
+                      f"torque = {toml_value(list(pair.torque))}",
+                      f"eta_forward = {toml_value([list(r) for r in pair.eta_forward_map])}",
+                      f"eta_backward = {toml_value([list(r) for r in pair.eta_backward_map])}"]
         else:
             lines += [f"eta_forward = {toml_value(pair.eta_forward)}",
                       f"eta_backward = {toml_value(pair.eta_backward)}"]
