@@ -52,10 +52,11 @@ RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING, STIFF
 # event codes written to the event buffer as (code, t, phi, omega)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
  EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR, EV_SLEEVE_STOP, EV_SLEEVE_FREE,
- EV_INJECTION, EV_LOAD_KNOT) = range(15)
+ EV_INJECTION, EV_LOAD_KNOT, EV_STUCK, EV_RELEASED) = range(17)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
                "speed_reversal", "end", "governor_corner", "pair_mode", "locked", "load_schedule",
-               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection", "load_table_speed")
+               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection", "load_table_speed",
+               "stuck", "released")
 
 
 @kernel
