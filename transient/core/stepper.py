@@ -126,7 +126,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
     int
         RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED (the speed reached zero in a run
         that ends only by revolutions), LOCKED (at rest, the friction of the non-ideal pairs holds
-        the applied moments), CHATTERING (pair modes switching without progress) or STIFF
+        the applied moments and the machine cannot be stuck instead, :func:`_stick`), CHATTERING (pair modes switching without progress) or STIFF
         (Hairer's stiffness test fired).
     """
     rtol = cfg[C_RTOL]

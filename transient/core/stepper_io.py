@@ -150,8 +150,9 @@ def _reset_output_grid(cfg, ist, fst, y):
 
 @kernel
 def _locked(m, extras, y, sel, outbuf, evbuf, ist, fst, wk):
-    """End a run at rest that the pairs' friction holds (``rhs.choose_modes``): φ̈ = 0 from here,
-    and nothing in the model depends on time explicitly, so the machine stays where it is."""
+    """End a run at rest that the pairs' friction holds (``rhs.choose_modes``) where it cannot be
+    stuck (``stepper._stick``): φ̈ = 0 from here, and nothing would ever release it, or the run
+    has no end in time to wait for it."""
     _emit_event(m, evbuf, ist, EV_LOCKED, y, wk)
     if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI] or ist[I_NOUT] == 0:
         _emit_row(m, extras, y, sel, ist[:N_SWITCHES], outbuf, ist, fst, wk)
