@@ -232,6 +232,82 @@ def test_stuck_until_the_end_and_locked_where_nothing_can_release_it():
     assert "run.t_end" in data.message
 
 
+def static_hold(scene, phi, gas_force, sigma):
+    """The drive on the shaft that the joints' friction balances at rest at φ (ε = ω = 0) against
+    an incipient motion σ: the Newton–Euler joint forces of every cylinder
+    (``transient.reference.crank_slider_joint_forces``) with the friction of each joint on its
+    force — μ r |F| against the joint's relative rotation in the main bearing, crankpin and
+    piston pin, μ |N| + F_ring + c_p P⁺ against the piston's motion — iterated to a fixed point
+    (a contraction: μ r / l and μ tan β are small), then the drive −Σ T that keeps ε = 0."""
+    from transient.reference import crank_slider_joint_forces
+
+    mech = scene.mechanism
+    main, crankpin, pin, piston = scene.friction.pairs
+    alpha = phi - np.asarray(mech.firing_angles)
+    r, l, e = mech.crank_radius, mech.rod_length, mech.offset
+    sb = (r * np.sin(alpha) - e) / l
+    cb = np.sqrt(1.0 - sb * sb)
+    db = r * np.cos(alpha) / (l * cb)  # β′ = dβ/dφ
+    vy = -r * np.sin(alpha) - l * sb * db  # the piston's speed along +y (toward the head) per ω
+    s_a, s_b = sigma * np.sign(1.0 + db), sigma * np.sign(db)
+    P = np.asarray(gas_force, dtype=float)
+    f0 = piston.ring_force + piston.ring_pressure * np.maximum(P, 0.0)
+    N = np.zeros_like(P)
+    moments = (np.zeros_like(P),) * 3
+    for _ in range(200):
+        # the piston's friction, −sign(v)(μ|N| + f0) along +y, adds to the force toward the crank
+        slide = np.sign(vy) * sigma * (piston.mu * np.abs(N) + f0)
+        jf = crank_slider_joint_forces(mech, phi, 0.0, 0.0, gas_force=(P + slide)[:, None],
+                                       joint_moments=tuple(m[:, None] for m in moments))
+        norm = [np.hypot(*np.asarray(v)[:, :, 0]) for v in (jf.main, jf.crankpin, jf.pin)]
+        new = (-sigma * main.mu * main.radius * norm[0],
+               s_a * crankpin.mu * crankpin.radius * norm[1],
+               s_b * pin.mu * pin.radius * norm[2])
+        change = max(max(float(np.max(np.abs(n - m))) for n, m in zip(new, moments)),
+                     float(np.max(np.abs(jf.N[:, 0] - N))))
+        moments, N = new, jf.N[:, 0]
+        if change <= 1e-13 * max(1.0, float(np.max(np.abs(P)))):
+            break
+    # (the last solve's forces are those of the moments one iteration back: within 1e-13)
+    return -float(np.sum(jf.throw_torque))
+
+
+def test_the_joints_release_the_diesel_at_the_newton_euler_hold():
+    """The reaction diesel with all four pairs (journals, pins, pistons; the viscous terms vanish
+    at rest), at rest where a cylinder compresses, the gas on: the drive it holds forward and
+    backward, M₊ and M₋, from an independent static Newton–Euler solution with the friction
+    on the joints' forces (:func:`static_hold`); a drive ramping from their mean past M₊ (past M₋)
+    releases it forward (backward) at the instant it reaches it, to 1e-8 of M₊."""
+    base = load_scene(CASES / "gots_diesel_reaction_friction.toml")
+    phi0 = 5.5
+    base = replace(base, starter=Starter(0.0, 1.0, 1.0), initial=Initial(phi0, 0.0),
+                   output=Output(samples_per_rev=72, dt=1e-2),
+                   solver=replace(base.solver, rtol=1e-10, atol=1e-10))
+    probe = integrate(replace(base, load=Load(), friction=Friction(), run=Run(t_end=1e-6)))
+    mech = base.mechanism
+    p0 = base.gas.p0
+    P = np.array([(probe.trajectory[f"p_{k + 1}"][0] - p0) * mech.piston_area
+                  for k in range(len(mech.firing_angles))])
+    hold_fwd = static_hold(base, phi0, P, 1.0)
+    hold_bwd = static_hold(base, phi0, P, -1.0)
+    print(f"gas forces {P} N; holds {hold_fwd:.9g} N m forward, {hold_bwd:.9g} N m backward")
+    assert hold_bwd < hold_fwd
+    mid = 0.5 * (hold_fwd + hold_bwd)
+    width = hold_fwd - hold_bwd
+    for target, sign in ((hold_fwd, 1.0), (hold_bwd, -1.0)):
+        end = mid + sign * width  # reached at t = 1 s
+        scene = replace(base, load=drive(mid, end, 1.0), run=Run(t_end=0.8))
+        data = integrate(scene)
+        t_rel = data.events["released"][0, 0]
+        t_star = (target - mid) / (end - mid)
+        print(f"σ = {sign:+g}: release at {t_rel!r}, Newton–Euler {t_star!r}")
+        assert data.events["stuck"][0, 0] == 0.0
+        assert abs(t_rel - t_star) * abs(end - mid) <= 1e-8 * abs(hold_fwd)
+        after = data.trajectory["t"] > t_rel + 0.05
+        assert np.all(sign * data.trajectory["omega"][after][:5] > 0.0)
+        losses_nonnegative(scene, data.trajectory)
+
+
 def test_stuck_phases_from_the_events():
     """The summary's count and total time of the stuck phases, the last one open to the end."""
     ev = {"stuck": np.array([[0.0, 1.0], [2.0, 3.0], [5.0, 4.0]]),
