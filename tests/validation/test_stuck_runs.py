@@ -308,6 +308,35 @@ def test_the_joints_release_the_diesel_at_the_newton_euler_hold():
         losses_nonnegative(scene, data.trajectory)
 
 
+def test_a_run_resumed_inside_a_stuck_phase_is_bit_identical():
+    """The stuck switch is part of the stepper's state that a checkpoint keeps: the reversing
+    run resumed from every block that ends while it is stuck continues bit-identically."""
+    from transient.results import Checkpoint
+    from transient.run import run_compiled
+
+    phi0 = 0.7
+    H0 = ring_hold(rings_only(Load(), phi0), phi0)
+    scene = rings_only(drive(0.5 * H0, -3.5 * H0, 2.0), phi0, omega0=2.0, t_end=1.0, dt=2e-5)
+    states = []
+    whole = run_compiled(scene, on_block=lambda block, ev, state: states.append(
+        (block["t"].size, state)))
+    assert whole.complete, whole.message
+    t_stop, t_rel = whole.events["stuck"][0, 0], whole.events["released"][0, 0]
+    rows, resumed = 0, 0
+    for n, (floats, ints, switched, code) in states:
+        rows += n
+        t = whole.trajectory["t"][rows - 1]
+        if not t_stop < t < t_rel:
+            continue
+        part = run_compiled(scene, start=Checkpoint(rows, 0, switched, code, floats, ints))
+        assert part.complete
+        for name, column in part.trajectory.items():
+            assert np.array_equal(column, whole.trajectory[name][rows:]), name
+        assert np.array_equal(part.events["released"], whole.events["released"])
+        resumed += 1
+    assert resumed >= 2
+
+
 def test_stuck_phases_from_the_events():
     """The summary's count and total time of the stuck phases, the last one open to the end."""
     ev = {"stuck": np.array([[0.0, 1.0], [2.0, 3.0], [5.0, 4.0]]),
