@@ -308,6 +308,38 @@ def test_the_joints_release_the_diesel_at_the_newton_euler_hold():
         losses_nonnegative(scene, data.trajectory)
 
 
+def test_a_governor_raises_the_fuel_while_stuck_until_the_gas_breaks_loose():
+    """The constant-η diesel at rest early in a cylinder's expansion under a PI governor far below its set
+    speed, against a constant load L equal to its gas torque at the initial fuel: stuck, ω
+    exactly 0, while the governor's states evolve and raise the fuel; released forward when the
+    gas torque reaches L/(η_b1 η_b2) (the gas side drives, both pairs backward; closed form from
+    the efficiencies, the gas torque read from the samples around the event, 1e-6 relative)."""
+    base = load_scene(CASES / "gots_diesel_friction.toml")
+    gov = replace(load_scene(CASES / "gots_diesel_pi.toml").governor, fuel_initial=0.1)
+    phi0 = 2.5  # a cylinder early in its expansion: the gas drives forward
+    base = replace(base, governor=gov, starter=Starter(0.0, 1.0, 1.0),
+                   initial=Initial(phi0, 0.0), output=Output(samples_per_rev=72, dt=2e-6),
+                   solver=replace(base.solver, rtol=1e-10, atol=1e-10))
+    probe = integrate(replace(base, load=Load(), friction=Friction(), run=Run(t_end=1e-6)))
+    L = float(probe.trajectory["M_gas"][0])
+    assert L > 100.0
+    scene = replace(base, load=Load(torque=L), run=Run(t_end=0.01))
+    data = integrate(scene)
+    tr, ev = data.trajectory, data.events
+    assert ev["stuck"][0, 0] == 0.0
+    t_rel = ev["released"][0, 0]
+    held = stuck_samples(tr, 0.0, t_rel)
+    assert np.all(tr["omega"][held] == 0.0) and np.all(tr["W_loss_1"][held] == 0.0)
+    assert np.all(np.diff(tr["fuel"][held]) > 0.0) and np.ptp(tr["gov_integral"][held]) > 0.0
+    (p1, p2) = scene.friction.pairs
+    M_at = float(np.interp(t_rel, tr["t"], tr["M_gas"]))  # (samples 2e-6 s apart)
+    target = L / (p1.eta_backward * p2.eta_backward)
+    print(f"released at t = {t_rel:.9g} s: gas torque {M_at:.9g} N m, closed form {target:.9g}")
+    assert abs(M_at - target) <= 1e-6 * target
+    assert tr["omega"][-1] > 0.0
+    losses_nonnegative(scene, tr)
+
+
 def test_a_run_resumed_inside_a_stuck_phase_is_bit_identical():
     """The stuck switch is part of the stepper's state that a checkpoint keeps: the reversing
     run resumed from every block that ends while it is stuck continues bit-identically."""
