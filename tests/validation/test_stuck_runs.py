@@ -210,6 +210,19 @@ def test_a_drive_hovering_at_the_threshold_does_not_chatter():
         "released", np.zeros((0, 2))).shape[0] <= 1
 
 
+def test_a_load_step_beyond_the_hold_releases_the_shaft_at_the_step():
+    """A drive that jumps from H/2 to 3H/2 at t = 0.2 s (a step in the load schedule, an event on
+    time): stuck until the step, released at it exactly, forward."""
+    phi0 = 0.7
+    H = ring_hold(rings_only(Load(), phi0), phi0)
+    load = Load(torque=-1.0, schedule_time=(0.2, 0.2), schedule_scale=(0.5 * H, 1.5 * H))
+    data = integrate(rings_only(load, phi0, t_end=0.4))
+    assert data.complete, data.message
+    ev, tr = data.events, data.trajectory
+    assert ev["stuck"][:, 0].tolist() == [0.0] and ev["released"][:, 0].tolist() == [0.2]
+    assert np.all(tr["omega"][tr["t"] <= 0.2] == 0.0) and tr["omega"][-1] > 0.0
+
+
 def test_stuck_until_the_end_and_locked_where_nothing_can_release_it():
     """A drive that never reaches the hold keeps the shaft stuck to t_end (the run finishes, stuck
     the whole time); the same drive held constant cannot release it, and the run ends *locked*
@@ -309,8 +322,8 @@ def test_the_joints_release_the_diesel_at_the_newton_euler_hold():
 
 
 def test_a_governor_raises_the_fuel_while_stuck_until_the_gas_breaks_loose():
-    """The constant-η diesel at rest early in a cylinder's expansion under a PI governor far below its set
-    speed, against a constant load L equal to its gas torque at the initial fuel: stuck, ω
+    """The constant-η diesel at rest early in a cylinder's expansion under a PI governor far below
+    its set speed, against a constant load L equal to its gas torque at the initial fuel: stuck, ω
     exactly 0, while the governor's states evolve and raise the fuel; released forward when the
     gas torque reaches L/(η_b1 η_b2) (the gas side drives, both pairs backward; closed form from
     the efficiencies, the gas torque read from the samples around the event, 1e-6 relative)."""

@@ -56,21 +56,19 @@ from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T,
 from .rhs import choose_modes, derivative, margins_at, release
 from . import stuck as st
 from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
-from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
-                         C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR,
-                         EV_GOVERNOR, EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED,
-                         EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT,
-                         EV_STUCK, EV_TO_ANGLE,
+from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL, C_T_END,
+                         C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
+                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL,
+                         EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_STUCK, EV_TO_ANGLE,
                          EV_TO_TIME, F_ERR_OLD, F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T,
                          F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
                          I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_DIRECTION, I_F_VALID,
-                         I_FLIPPED,
-                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES, I_NBAD,
-                         I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS, I_NSWITCH,
-                         I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED, I_STARTER_ON,
-                         I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event, _emit_row,
-                         _emit_samples, _finish, _locked, _out_spacing, _reset_output_grid,
-                         _retake)
+                         I_FLIPPED, I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES,
+                         I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS,
+                         I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED,
+                         I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
+                         _emit_row, _emit_samples, _finish, _locked, _out_spacing,
+                         _reset_output_grid, _retake)
 
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
@@ -126,8 +124,9 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
     int
         RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED (the speed reached zero in a run
         that ends only by revolutions), LOCKED (at rest, the friction of the non-ideal pairs holds
-        the applied moments and the machine cannot be stuck instead, :func:`_stick`), CHATTERING (pair modes switching without progress) or STIFF
-        (Hairer's stiffness test fired).
+        the applied moments and the machine cannot be stuck instead, :func:`_stick`),
+        CHATTERING (pair modes switching without progress) or STIFF (Hairer's stiffness test
+        fired).
     """
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
