@@ -1,5 +1,7 @@
 r"""The stuck mode: a machine at rest that the non-ideal pairs' friction holds, released when the
-drive exceeds what the friction can hold in one direction (as Modelica's LossyGear sticks).
+drive exceeds what the friction can hold in one direction (as Modelica's LossyGear sticks:
+Pelchen, Schweiger & Otter, "Modeling and simulating the efficiency of gearboxes and of planetary
+gearboxes", 2nd International Modelica Conference, 2002, §3, the stuck and sliding modes).
 
 At ω = 0 the friction's direction is that of the incipient motion (``transient.core.chain``, *At
 rest*): with the friction opposing σ = +1 the chain's acceleration is a₊, opposing σ = −1 it is
@@ -24,10 +26,14 @@ root finder's accuracy on the dense output); the pair margins' slot 0 carries g,
 constant 1 that never falls. At the release the direction is the one whose margin crossed (the
 lower of −a₊, a₋) and the modes are chosen afresh for it.
 
-g ≥ 0 needs no rule of its own against chattering: the machine leaves rest only where g < 0,
-i.e. a_σ σ > 0, so it moves away, and it sticks again only after its speed has come back to zero,
+No rule against chattering is needed: the machine leaves rest only where g < 0, i.e.
+a_σ σ > 0, so it moves away, and it sticks again only after its speed has come back to zero,
 which takes a time of its own (a speed reversal); entering and leaving at one instant happens only
-where g is zero exactly there, and is then one stuck and one released event.
+where g is exactly zero there, and is then one stuck and one released event.
+
+A machine held at rest is stuck only where the run ends by time and something can still change
+the moments (:func:`can_change`); elsewhere nothing could release it and the run ends *locked*
+(``stepper._stick``).
 """
 from __future__ import annotations
 
