@@ -24,7 +24,8 @@ STATUSES = {
                "the switch speed)",
     "reversed": "the shaft was driven backwards and turned backwards at the end (faster than "
                 "the switch speed)",
-    "locked": "at rest, the friction of the non-ideal pairs holds the machine",
+    "locked": "at rest, the friction of the non-ideal pairs holds the machine and nothing can "
+              "release it",
     "chattering": "pair modes or other switches flip without progress",
     "runaway": "the speed grew beyond RUNAWAY_SPEED",
     "no-progress": "steps stopped advancing time and angle",

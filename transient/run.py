@@ -191,9 +191,12 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
                    f"the run ends by; give run.t_end to follow the motion after a stall")
     at = f"t = {y[1]:.9g} s, φ = {y[0]:.9g} rad ({math.degrees(y[0]):.6g}°)"
     if status == sio.LOCKED:
+        why = ("nothing in the scene changes them later, so the machine stays there"
+               if math.isfinite(scene.run.t_end) else
+               "the run ends by revolutions only; give run.t_end to follow it stuck until the "
+               "drive exceeds the friction")
         message = (f"locked: at rest at {at} the friction of the non-ideal pairs holds the "
-                   f"applied moments in both directions (nothing changes them later, so the "
-                   f"machine stays there)")
+                   f"applied moments in both directions ({why})")
     if status == sio.CHATTERING:
         event = sio.EVENT_NAMES[int(ist[sio.I_CHATTER_CODE])]
         message = (f"chattering: {stepper.CHATTER_COUNT} state events in a row ({event}) without "

@@ -21,6 +21,7 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
     state and the efficiency are looked for after the last one."""
     # what the scene's [analysis] table asks for, over the whole stored run (before the cut below)
     requested = requested_analyses(scene, traj, events) if scene.analysis.requested else {}
+    stuck = stuck_phases(events or {}, float(traj["t"][-1]))
     response = run_response(scene, traj, events) if scene.run.mode == "dynamic" else {}
     steps = load_step_times(scene, events) if scene.run.mode == "dynamic" else []
     if steps and steps[-1] < traj["t"][-1]:
@@ -48,7 +49,28 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
                                                                   phi[last]) / cycle), "N m")
     if scene.gas.model != "none":
         out.update(mechanical_efficiency(scene, traj, events))
+    out.update(stuck)
     out.update(requested)
     # the mechanism's own figures (articulated rods: slave harmonics against Semenov's series)
     out.update(scene.mechanism.analysis_summary())
     return out
+
+
+def stuck_phases(events: dict, t_last: float) -> dict[str, tuple[float, str]]:
+    """How often and how long the machine was stuck at rest, held by its pairs' friction
+    (``transient.core.stuck``), from the events ``stuck`` and ``released`` (each stuck phase
+    ends with the next release, or with the run at ``t_last``): ``stuck_phases`` [1],
+    ``stuck_time`` [s] in all, and the first phase's start ``stuck_first_t`` [s] and angle
+    ``stuck_first_phi`` [rad]; nothing if it never was."""
+    stuck = np.asarray(events.get("stuck", np.zeros((0, 2))), dtype=float).reshape(-1, 2)
+    if not stuck.shape[0]:
+        return {}
+    released = np.sort(np.asarray(events.get("released", np.zeros((0, 2))),
+                                  dtype=float).reshape(-1, 2)[:, 0])
+    total = 0.0
+    for t0 in stuck[:, 0]:
+        later = released[released >= t0]
+        total += (later[0] if later.size else t_last) - t0
+    return {"stuck_phases": (float(stuck.shape[0]), "1"), "stuck_time": (float(total), "s"),
+            "stuck_first_t": (float(stuck[0, 0]), "s"),
+            "stuck_first_phi": (float(stuck[0, 1]), "rad")}

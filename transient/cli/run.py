@@ -137,6 +137,10 @@ def _print_summary(summary, solver, names=()) -> None:
     if "mean_drive_torque_last_cycle" in v:
         print(f"  mean drive torque required over the last cycle: "
               f"{v['mean_drive_torque_last_cycle']:.6g} N m")
+    if "stuck_phases" in v:
+        print(f"  stuck at rest, held by the pairs' friction: {v['stuck_phases']:.0f} time(s), "
+              f"{v['stuck_time']:.6g} s in all (first at t = {v['stuck_first_t']:.9g} s, "
+              f"φ = {v['stuck_first_phi']:.9g} rad)")
     _print_response(v)
     _print_efficiency(v, names)
     _print_thermodynamics(v)

@@ -16,6 +16,7 @@ from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import governor as gv
 from . import eta_table as et
 from . import joint_friction as jf
+from . import stuck as st
 from .forcing import command, cylinder_rates, governor_rates, moments
 from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T, W_GAS, W_LOAD,
                      W_LOSS0, W_STARTER, WK_DJ, WK_ETA, WK_G, WK_G_MIN, WK_J, WK_M, WK_S,
@@ -66,7 +67,12 @@ def acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
 def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
     and the pairs' η*, S in the rows of ``wk``. With reaction friction the pairs are joints of
-    one rigid chain: φ̈ and their η*, S and losses come from ``joint_friction``, in direction σ."""
+    one rigid chain: φ̈ and their η*, S and losses come from ``joint_friction``, in direction σ.
+    Stuck at rest (``stuck``): φ̈ = 0, and the holding margin in ``wk[WK_G]``."""
+    if sw[SW_DIRECTION] == st.STUCK:
+        if not m.reaction:
+            split_subchains(m, J, dJ, M_gas, M_shaft, wk)
+        return st.hold(m, J, M_gas, M_shaft, wk)
     if m.reaction:
         return jf.reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]), wk)
     n = m.n_pairs
@@ -138,6 +144,8 @@ def mode_margins(m, sw, wk):
     (Σ_{j≤k} M_j) σ ≥ 0 forward (``transient.core.chain.modes_paper``).
     """
     sigma = sw[SW_DIRECTION]
+    if sigma == st.STUCK:  # the holding margin, left by chain_acceleration
+        return
     if m.reaction:  # no modes: the joints' directions change on breakpoints only
         for k in range(m.n_pairs):
             wk[WK_G, k] = 1.0
@@ -205,20 +213,40 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         sw[SW_DIRECTION] = 1 if w > 0.0 else -1
     else:
         sw[SW_DIRECTION] = 1 if a > 0.0 else -1
+    sw[SW_MODES] = _mode_mask(m, sw[SW_DIRECTION], wk)
+    return status
+
+
+@kernel
+def release(m, extras, y, sel, sw, wk):
+    """A stuck machine starts to move (its holding margin has fallen to zero, ``stuck``): σ the
+    direction whose margin crossed, the modes chosen afresh for it; time domain, ω = 0."""
+    J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, False, y, sel, sw, wk, True)
+    if not m.reaction:
+        split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
+    sigma = st.release_direction(m, J, M_gas, M_load + M_starter, wk)
+    sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
+    sw[SW_MODES] = 0 if m.reaction else _mode_mask(m, sw[SW_DIRECTION], wk)
+
+
+@kernel
+def _mode_mask(m, sigma, wk):
+    """The pairs' mode bits (bit k set: pair k backward) in direction σ from the η* the chain's
+    solve left in ``wk``: ``power-flow`` its modes, ``paper`` criterion (25)."""
+    n = m.n_pairs
     modes = 0
     upstream = 0.0
     for k in range(n):
         upstream += wk[WK_M, k]
         if m.policy == POWER_FLOW and m.eta_table:
-            backward = wk[WK_S, k] * sw[SW_DIRECTION] < 0.0
+            backward = wk[WK_S, k] * sigma < 0.0
         elif m.policy == POWER_FLOW:
             backward = wk[WK_ETA, k] != m.eta_fwd[k]
         else:
-            backward = upstream * sw[SW_DIRECTION] < 0.0
+            backward = upstream * sigma < 0.0
         if backward:
             modes |= 1 << k
-    sw[SW_MODES] = modes
-    return status
+    return modes
 
 
 @kernel

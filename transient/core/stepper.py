@@ -51,23 +51,24 @@ from .events import (DEMAND_COMP, MAX_UNSEEN, N_MARGIN_SAMPLES, PAIR_COMP, _dens
 from . import governor as gv
 from .forcing import (generator_branch, governor_branch, inertia, load_segment, moments, speed,
                       speed_knot_segment, start_branch)
-from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_MODES, T, WK_DEMAND, WK_G, WK_G_MIN,
-                     WK_SPEED, cyl_index, gov_index, n_state, work_array)
-from .rhs import choose_modes, derivative, margins_at
+from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND, WK_G,
+                     WK_G_MIN, WK_SPEED, cyl_index, gov_index, n_state, work_array)
+from .rhs import choose_modes, derivative, margins_at, release
+from . import stuck as st
 from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
-from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
-                         C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR,
-                         EV_GOVERNOR, EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL,
-                         EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_TO_ANGLE,
+from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL, C_T_END,
+                         C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
+                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL,
+                         EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_STUCK, EV_TO_ANGLE,
                          EV_TO_TIME, F_ERR_OLD, F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T,
                          F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
-                         I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_F_VALID, I_FLIPPED,
-                         I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES, I_NBAD,
-                         I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS, I_NSWITCH,
-                         I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED, I_STARTER_ON,
-                         I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event, _emit_row,
-                         _emit_samples, _finish, _locked, _out_spacing, _reset_output_grid,
-                         _retake)
+                         I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_DIRECTION, I_F_VALID,
+                         I_FLIPPED, I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES,
+                         I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS,
+                         I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED,
+                         I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
+                         _emit_row, _emit_samples, _finish, _locked, _out_spacing,
+                         _reset_output_grid, _retake)
 
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
@@ -123,8 +124,9 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
     int
         RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED (the speed reached zero in a run
         that ends only by revolutions), LOCKED (at rest, the friction of the non-ideal pairs holds
-        the applied moments), CHATTERING (pair modes switching without progress) or STIFF
-        (Hairer's stiffness test fired).
+        the applied moments and the machine cannot be stuck instead, :func:`_stick`),
+        CHATTERING (pair modes switching without progress) or STIFF (Hairer's stiffness test
+        fired).
     """
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
@@ -247,6 +249,8 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             continue
 
         # Truncate the step at the event, act on it and restart from there.
+        if extras is not None and ev_code == EV_PAIR_MODE and ist[I_DIRECTION] == st.STUCK:
+            ev_code = EV_RELEASED  # (the holding margin, in pair 0's slot, fell to zero)
         x_stop, on_breakpoint = _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp,
                                                ev_level, at_segment_end and x_end == up, x_end,
                                                tol_end, F, y, y_evt, sel, sw, wk, ist)
@@ -282,7 +286,8 @@ def _start_run(m, extras, cfg, y, fst, ist, outbuf, evbuf, wk):
             rising = M_gas + M_load + M_starter - 0.5 * dJ * w * w >= 0.0
             ist[I_LOAD_TABLE] = speed_knot_segment(m, y[OMEGA], rising)
     fst[F_LAST_SWITCH] = np.nan
-    if _start_modes(m, extras, y, y[PHI], ist, wk) == LOCKED_STATUS:
+    if (_start_modes(m, extras, y, y[PHI], ist, wk) == LOCKED_STATUS
+            and not _stick(m, extras, cfg, y, evbuf, ist, wk)):
         return _locked(m, extras, y, y[PHI], outbuf, evbuf, ist, fst, wk)
     if y[OMEGA] >= cfg[C_W_HI]:
         _to_angle_mode(m, y, ist, wk)
@@ -499,8 +504,11 @@ def _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code
         return STALLED
     if extras is not None and ev_code == EV_REVERSAL and m.n_pairs > 0:
         # At rest the pairs may hold the applied moments; else the modes start afresh.
-        if _start_modes(m, extras, y, sel, ist, wk) == LOCKED_STATUS:
+        if (_start_modes(m, extras, y, sel, ist, wk) == LOCKED_STATUS
+                and not _stick(m, extras, cfg, y, evbuf, ist, wk)):
             return _locked(m, extras, y, sel, outbuf, evbuf, ist, fst, wk)
+    if extras is not None and ev_code == EV_RELEASED:
+        release(m, extras, y, sel, sw, wk)
     gap = CHATTER_GAP * (1.0 if angle_mode else cfg[C_DT_OUT])
     ist[I_NCHATTER] = ist[I_NCHATTER] + 1 if abs(x_stop - fst[F_LAST_SWITCH]) < gap else 0
     fst[F_LAST_SWITCH] = x_stop
@@ -574,6 +582,12 @@ def _settle_modes(m, extras, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     pairs switching within the event location's accuracy) is switched now, so that no step starts
     with a mode against its criterion: the stepper watches a margin only while it is positive."""
     margins_at(m, extras, angle_mode, y, sel, sw, wk)
+    if sw[SW_DIRECTION] == st.STUCK and wk[WK_G, 0] < 0.0:
+        # stuck, and a jump of the drive (a load step at a corner in time) releases it here
+        _emit_event(m, evbuf, ist, EV_RELEASED, y, wk)
+        release(m, extras, y, sel, sw, wk)
+        margins_at(m, extras, angle_mode, y, sel, sw, wk)
+        ist[I_NFEV] += 2
     flipped = ist[I_FLIPPED] - 1
     ist[I_FLIPPED] = 0
     changed = False
@@ -588,6 +602,21 @@ def _settle_modes(m, extras, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
         ist[I_NFEV] += 1
     for k in range(m.n_pairs):
         gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]
+
+
+@kernel
+def _stick(m, extras, cfg, y, evbuf, ist, wk):
+    """At rest with the pairs holding the applied moments: the machine is stuck (``stuck``) if
+    the run ends by time and something can still change the moments, so that the drive may come
+    to exceed the friction; returns False where the run is to end *locked* instead (nothing
+    would ever release it, or no end in time would end the wait)."""
+    if (extras is not None and np.isfinite(cfg[C_T_END])
+            and st.can_change(m, y, ist[:N_SWITCHES])):
+        ist[I_DIRECTION] = st.STUCK
+        ist[I_MODES] = 0
+        _emit_event(m, evbuf, ist, EV_STUCK, y, wk)
+        return True
+    return False
 
 
 @kernel

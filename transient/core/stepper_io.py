@@ -52,10 +52,11 @@ RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING, STIFF
 # event codes written to the event buffer as (code, t, phi, omega)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
  EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR, EV_SLEEVE_STOP, EV_SLEEVE_FREE,
- EV_INJECTION, EV_LOAD_KNOT) = range(15)
+ EV_INJECTION, EV_LOAD_KNOT, EV_STUCK, EV_RELEASED) = range(17)
 EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
                "speed_reversal", "end", "governor_corner", "pair_mode", "locked", "load_schedule",
-               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection", "load_table_speed")
+               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection", "load_table_speed",
+               "stuck", "released")
 
 
 @kernel
@@ -149,8 +150,9 @@ def _reset_output_grid(cfg, ist, fst, y):
 
 @kernel
 def _locked(m, extras, y, sel, outbuf, evbuf, ist, fst, wk):
-    """End a run at rest that the pairs' friction holds (``rhs.choose_modes``): φ̈ = 0 from here,
-    and nothing in the model depends on time explicitly, so the machine stays where it is."""
+    """End a run at rest that the pairs' friction holds (``rhs.choose_modes``) where it cannot be
+    stuck (``stepper._stick``): φ̈ = 0 from here, and nothing would ever release it, or the run
+    has no end in time to wait for it."""
     _emit_event(m, evbuf, ist, EV_LOCKED, y, wk)
     if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI] or ist[I_NOUT] == 0:
         _emit_row(m, extras, y, sel, ist[:N_SWITCHES], outbuf, ist, fst, wk)
