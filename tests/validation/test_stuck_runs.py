@@ -391,3 +391,32 @@ def test_stuck_phases_from_the_events():
     assert s["stuck_first_t"][0] == 0.0 and s["stuck_first_phi"][0] == 1.0
     assert stuck_phases({}, 1.0) == {}
     assert math.isclose(stuck_phases({"stuck": np.array([[1.0, 0.0]])}, 3.0)["stuck_time"][0], 2.0)
+
+
+def test_mapped_pairs_stick_and_release_as_their_constants():
+    """Pairs given as efficiency maps that hold their constant-η values everywhere stick and are
+    released at the same instants as the constant-η pairs, and keep the balance (the mapped
+    chain's solve at rest, ``eta_table.solve_auto``, reduces to the constant one)."""
+    base = load_scene(CASES / "gots_diesel_friction.toml")
+    base = replace(base, starter=Starter(0.0, 1.0, 1.0),
+                   output=Output(samples_per_rev=72, dt=1e-2),
+                   solver=replace(base.solver, rtol=1e-10, atol=1e-10))
+    phi0 = 5.5
+    probe = integrate(replace(base, load=Load(), friction=Friction(), initial=Initial(phi0, 0.0),
+                              run=Run(t_end=1e-6)))
+    G = -float(probe.trajectory["M_gas"][0])
+    pairs = base.friction.pairs
+    mapped = Friction(base.friction.policy, tuple(
+        replace(p, model="table", eta_forward=1.0, eta_backward=1.0, speed=(0.0, 600.0),
+                torque=(0.0, 10.0, 1000.0), eta_forward_map=((p.eta_forward,) * 3,) * 2,
+                eta_backward_map=((p.eta_backward,) * 3,) * 2) for p in pairs))
+    for s1 in (1.1, 0.9):
+        common = dict(load=drive(G, s1 * G, 1.0), initial=Initial(phi0, 0.0), run=Run(t_end=0.6))
+        constant = integrate(replace(base, **common))
+        table = integrate(replace(base, friction=mapped, **common))
+        for name in ("stuck", "released"):
+            np.testing.assert_allclose(table.events[name][:, 0], constant.events[name][:, 0],
+                                       rtol=0.0, atol=TOL_T)
+        scene = replace(base, friction=mapped, **common)
+        assert balance(scene, table.trajectory) <= 1e-8
+        losses_nonnegative(scene, table.trajectory)
