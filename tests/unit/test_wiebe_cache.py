@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model, wiebe_levels
-from transient.core import source_hash
+from transient.core import CACHE_DIR_VARIABLE, source_hash
 from transient.errors import SceneError
 from transient.forces import wiebe_cache
 from transient.forces.wiebe import WiebeCycle, wiebe_tables
@@ -36,7 +36,9 @@ LEVELS = [0.0, 0.031e-3]
 
 @pytest.fixture
 def folder(tmp_path, monkeypatch):
-    """The cache in a fresh folder (numba's stays where it is: its folder was fixed at import)."""
+    """The cache in a fresh folder (numba's stays where it is: its folder was fixed at import),
+    found through ``XDG_CACHE_HOME`` whatever the user's ``TRANSIENT_CACHE_DIR``."""
+    monkeypatch.delenv(CACHE_DIR_VARIABLE, raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     return tmp_path / "transient" / "tables"
 
@@ -148,6 +150,7 @@ def test_unreadable_file_computed_again_and_replaced(folder, damage):
 
 def test_unwritable_folder_still_gives_the_cycles(tmp_path, monkeypatch):
     (tmp_path / "transient").write_text("a file where the folder would be")
+    monkeypatch.delenv(CACHE_DIR_VARIABLE, raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     cycles = wiebe_cache.cached_cycles(arguments(), compute())
     assert_same_cycles(cycles, compute()())
