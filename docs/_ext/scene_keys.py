@@ -364,13 +364,14 @@ def render(rec: Recorder) -> list[str]:
 
 
 def _check_fields(table: str, keys: dict, classes: list[type]) -> None:
-    """Every field of a scene record must be a key the reader reads (mechanisms name theirs
-    after the geometry, not the key, so they are left out)."""
+    """Every field of a scene record must be a key the reader reads, its own name or the key
+    its metadata names (mechanisms name theirs after the geometry, not the key, so they are left
+    out)."""
     if table in ("mechanism", "scene"):
         return
     for cls in classes:
         for f in dataclasses.fields(cls):
-            if f.name not in keys:
+            if f.metadata.get("key", f.name) not in keys:
                 logger.warning(f"scene-keys: {cls.__name__}.{f.name} is no key the reader of "
                                f"[{table}] reads in any scene or branch")
 

@@ -458,9 +458,11 @@ class Pair:
     speed: tuple[float, ...] = ()
     torque: tuple[float, ...] = ()
     #: Table model: η_fwd and η_bwd on the grid, one row per speed, one value per moment, in
-    #: (0, 1] [1].
-    eta_forward_map: tuple[tuple[float, ...], ...] = ()
-    eta_backward_map: tuple[tuple[float, ...], ...] = ()
+    #: (0, 1] [1]; read from the keys ``eta_forward``, ``eta_backward`` given as such grids.
+    eta_forward_map: tuple[tuple[float, ...], ...] = field(default=(),
+                                                           metadata={"key": "eta_forward"})
+    eta_backward_map: tuple[tuple[float, ...], ...] = field(default=(),
+                                                            metadata={"key": "eta_backward"})
 
 
 @dataclass(frozen=True)
