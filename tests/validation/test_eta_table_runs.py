@@ -17,6 +17,8 @@ from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study
 
+from balances import closure, losses_nonnegative
+
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
 
@@ -27,23 +29,6 @@ def constant_map(pair):
                    speed=(0.0, 600.0), torque=(0.0, 10.0, 100.0),
                    eta_forward_map=((pair.eta_forward,) * 3,) * 2,
                    eta_backward_map=((pair.eta_backward,) * 3,) * 2)
-
-
-def closure(scene, tr):
-    """Relative residual of the work–energy balance at every sample (as test_friction_runs)."""
-    n = len(scene.friction.pairs)
-    K = 0.5 * tr["J"] * tr["omega"] ** 2
-    works = tr["W_gas"] + tr["W_load"] + tr["W_starter"]
-    lost = sum(tr[f"W_loss_{k + 1}"] for k in range(n))
-    scale = K.max() + np.abs(tr["W_gas"]).max() + np.abs(tr["W_load"]).max() + np.abs(
-        tr["W_starter"]).max()
-    return np.max(np.abs(K - K[0] - (works - lost))) / scale
-
-
-def losses_nonnegative(scene, tr):
-    for k in range(len(scene.friction.pairs)):
-        P = tr[f"P_loss_{k + 1}"]
-        assert P.min() >= -1e-9 * np.abs(P).max(), (k, P.min())
 
 
 def map_scene(**changes):

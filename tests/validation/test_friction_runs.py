@@ -27,6 +27,8 @@ from transient.core.rhs import split_subchains
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 from transient.run import integrate, prescribed
 
+from balances import closure, losses_nonnegative
+
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
 RPM = math.pi / 30.0
@@ -36,25 +38,6 @@ POLICIES = ("power-flow", "paper")
 def friction_scene(policy="power-flow", **changes):
     base = load_scene(CASES / "gots_diesel_friction.toml")
     return replace(base, friction=Friction(policy, base.friction.pairs), **changes)
-
-
-def closure(scene, tr):
-    """Relative residual of the work–energy balance at every sample."""
-    n = len(scene.friction.pairs)
-    K = 0.5 * tr["J"] * tr["omega"] ** 2
-    works = tr["W_gas"] + tr["W_load"] + tr["W_starter"]
-    lost = sum(tr[f"W_loss_{k + 1}"] for k in range(n))
-    scale = K.max() + np.abs(tr["W_gas"]).max() + np.abs(tr["W_load"]).max() + np.abs(
-        tr["W_starter"]).max()
-    return np.max(np.abs(K - K[0] - (works - lost))) / scale
-
-
-def losses_nonnegative(scene, tr):
-    """Every pair's loss ≥ 0 at every sample (beyond rounding): the held modes agree with the
-    power the pairs transmit, including crossings inside a step."""
-    for k in range(len(scene.friction.pairs)):
-        P = tr[f"P_loss_{k + 1}"]
-        assert P.min() >= -1e-9 * np.abs(P).max(), (k, P.min())
 
 
 @pytest.mark.parametrize("policy", POLICIES)

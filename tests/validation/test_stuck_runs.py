@@ -36,6 +36,8 @@ from transient.analysis.summary import stuck_phases
 from transient.run import integrate
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 
+from balances import closure, losses_nonnegative
+
 CASES = Path(__file__).resolve().parents[2] / "cases"
 TOL_T = 1e-9  # s
 
@@ -69,22 +71,6 @@ def stuck_samples(tr, t0, t1):
     inside = (tr["t"] > t0) & (tr["t"] < t1)
     assert np.count_nonzero(inside) >= 10
     return inside
-
-
-def balance(scene, tr):
-    n = len(scene.friction.pairs)
-    K = 0.5 * tr["J"] * tr["omega"] ** 2
-    lost = sum(tr[f"W_loss_{k + 1}"] for k in range(n))
-    works = tr["W_gas"] + tr["W_load"] + tr["W_starter"]
-    scale = (K.max() + np.abs(tr["W_gas"]).max() + np.abs(tr["W_load"]).max()
-             + np.abs(lost).max())
-    return float(np.max(np.abs(K - K[0] - (works - lost))) / scale)
-
-
-def losses_nonnegative(scene, tr):
-    for k in range(len(scene.friction.pairs)):
-        P = tr[f"P_loss_{k + 1}"]
-        assert np.all(np.isfinite(P)) and P.min() >= -1e-9 * max(np.abs(P).max(), 1e-300), k
 
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])
@@ -150,7 +136,7 @@ def test_constant_eta_pairs_release_at_the_static_reaction_ratio(policy):
         assert np.all(sign * tr["omega"][after][:5] > 0.0)
         if policy == "power-flow":
             losses_nonnegative(scene, tr)
-        assert balance(scene, tr) <= 1e-8
+        assert closure(scene, tr) <= 1e-8
 
 
 def test_a_falling_drive_stops_the_shaft_holds_it_and_turns_it_back():
@@ -179,7 +165,7 @@ def test_a_falling_drive_stops_the_shaft_holds_it_and_turns_it_back():
     assert np.all(W == W[0]) and W[0] > 0.0
     assert tr["omega"][-1] < 0.0 and tr["phi"][-1] < phi1
     losses_nonnegative(scene, tr)
-    assert balance(scene, tr) <= 1e-8
+    assert closure(scene, tr) <= 1e-8
 
 
 def test_a_drive_hovering_at_the_threshold_does_not_chatter():
@@ -418,5 +404,5 @@ def test_mapped_pairs_stick_and_release_as_their_constants():
             np.testing.assert_allclose(table.events[name][:, 0], constant.events[name][:, 0],
                                        rtol=0.0, atol=TOL_T)
         scene = replace(base, friction=mapped, **common)
-        assert balance(scene, table.trajectory) <= 1e-8
+        assert closure(scene, table.trajectory) <= 1e-8
         losses_nonnegative(scene, table.trajectory)

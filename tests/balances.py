@@ -1,0 +1,25 @@
+"""Checks of runs with friction pairs that the tests share (on ``pythonpath``, pyproject)."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def closure(scene, tr) -> float:
+    """Relative residual of the work–energy balance ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load +
+    W_starter − Σ W_loss,k at every sample, against the largest energies of the run."""
+    n = len(scene.friction.pairs)
+    K = 0.5 * tr["J"] * tr["omega"] ** 2
+    works = tr["W_gas"] + tr["W_load"] + tr["W_starter"]
+    lost = sum(tr[f"W_loss_{k + 1}"] for k in range(n))
+    scale = K.max() + np.abs(tr["W_gas"]).max() + np.abs(tr["W_load"]).max() + np.abs(
+        tr["W_starter"]).max()
+    return float(np.max(np.abs(K - K[0] - (works - lost))) / scale)
+
+
+def losses_nonnegative(scene, tr) -> None:
+    """Every pair's loss is finite and ≥ 0 at every sample (beyond rounding): the held modes agree
+    with the power the pairs transmit, including crossings inside a step."""
+    for k in range(len(scene.friction.pairs)):
+        P = tr[f"P_loss_{k + 1}"]
+        assert np.all(np.isfinite(P)) and P.min() >= -1e-9 * max(np.abs(P).max(), 1e-300), (
+            k, P.min())
