@@ -7,9 +7,12 @@ Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
 from __future__ import annotations
 
 import math
+import signal
+import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from concurrent.futures import wait as futures_wait
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable
 
@@ -522,8 +525,37 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         writes.settle()
         msg = data.message if data is not None and data.message else (
             str(exc) if isinstance(exc, SimulationError) else f"{type(exc).__name__}: {exc}")
-        writer.finish(False, msg, status_of(exc), data.solver if data is not None else None)
+        with _signals_deferred():
+            writer.finish(False, msg, status_of(exc), data.solver if data is not None else None)
         raise
     finally:
         writes.shutdown()
-    writer.finish(data.complete, data.message, data.status, data.solver, summary, data.warnings)
+    with _signals_deferred():
+        writer.finish(data.complete, data.message, data.status, data.solver, summary,
+                      data.warnings)
+
+
+#: The signals that stop a command (Ctrl-C, ``transient.cli.INTERRUPTING_SIGNALS``).
+_STOPPING = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
+                  if hasattr(signal, name))
+
+
+@contextmanager
+def _signals_deferred():
+    """The signals that stop a command wait until the block ends, then act as they would have:
+    the result file's last step moves the run into its layout, and stopped halfway it would leave
+    neither the finished file nor the interrupted one (in the main thread only, where Python
+    handles signals)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    kept = {sig: signal.signal(sig, lambda signum, frame: caught.append(signum))
+            for sig in _STOPPING}
+    try:
+        yield
+    finally:
+        for sig, handler in kept.items():
+            signal.signal(sig, handler)
+        if caught:
+            signal.raise_signal(caught[0])

@@ -119,3 +119,24 @@ def test_killed_runs_keep_a_prefix_and_resume_bit_identically(tmp_path, case, ru
         _same(open_result(result), full, what)
     assert (killed, terms) == (kills, TERMS)  # every one landed while the run ran
     assert resumed_from_middle >= kills // 2  # most after some blocks, not before the first
+
+
+def test_a_stop_during_the_last_write_waits_until_the_file_is_whole(tmp_path, monkeypatch):
+    """A stop signal that arrives while the result file's last step moves the run into its layout
+    acts once that step is done: the file is whole and complete, and the stop still stops the
+    command (the signal comes from inside that step here, so it cannot land anywhere else)."""
+    from transient.results import ResultWriter
+
+    real_finish = ResultWriter.finish
+
+    def finish(self, *args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)  # (Python's handler: KeyboardInterrupt)
+        return real_finish(self, *args, **kwargs)
+
+    monkeypatch.setattr(ResultWriter, "finish", finish)
+    scene = load_scene(REPO / "cases" / "coasting_single.toml").replace(run={"revolutions": 4})
+    result = tmp_path / "coasting_single.h5"
+    with pytest.raises(KeyboardInterrupt):
+        simulate(scene, result)
+    assert open_result(result).complete
+    assert not partial_path(result).exists()
