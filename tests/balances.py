@@ -1,7 +1,12 @@
 """Checks of runs with friction pairs that the tests share (on ``pythonpath``, pyproject)."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
+
+from transient.run import integrate
+from transient.scene import Output, Run
 
 
 def closure(scene, tr) -> float:
@@ -23,3 +28,16 @@ def losses_nonnegative(scene, tr) -> None:
         P = tr[f"P_loss_{k + 1}"]
         assert np.all(np.isfinite(P)) and P.min() >= -1e-9 * max(np.abs(P).max(), 1e-300), (
             k, P.min())
+
+
+def dense_spin_up(make):
+    """``make(**changes)`` → a scene with friction pairs, run 8 revolutions in time throughout
+    (a switch speed above every ω reached) at tight tolerances, densely sampled; (scene, data)."""
+    base = make()
+    scene = make(run=Run(revolutions=8.0),
+                 solver=replace(base.solver, rtol=1e-11, atol=1e-11, switch_speed=1e4),
+                 output=Output(samples_per_rev=720, dt=1e-6))
+    data = integrate(scene)
+    assert data.complete, data.message
+    assert "to_angle_domain" not in data.events
+    return scene, data

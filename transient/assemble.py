@@ -542,6 +542,15 @@ def eta_table_fields(pairs) -> dict:
                     et_min=np.ones(n))
     maps = [(p.speed, p.torque, p.eta_forward_map, p.eta_backward_map) if p.model == "table"
             else ((0.0,), (0.0,), ((p.eta_forward,),), ((p.eta_backward,),)) for p in pairs]
+    speed, torque, size, eta, et_min = pack_maps(maps)
+    return dict(eta_table=True, et_speed=speed, et_torque=torque, et_size=size, et_eta=eta,
+                et_min=et_min)
+
+
+def pack_maps(maps) -> tuple:
+    """The arrays (speed, torque, size, eta, η_min) of :mod:`transient.core.eta_table` from one
+    (speed axis, moment axis, η_fwd grid, η_bwd grid) per pair, padded to one shape."""
+    n = len(maps)
     nw = max(len(m[0]) for m in maps)
     ns = max(len(m[1]) for m in maps)
     speed, torque = np.zeros((n, nw)), np.zeros((n, ns))
@@ -550,9 +559,8 @@ def eta_table_fields(pairs) -> dict:
         size[k] = len(w), len(s)
         speed[k, :len(w)], torque[k, :len(s)] = w, s
         eta[k, 0, :len(w), :len(s)], eta[k, 1, :len(w), :len(s)] = fwd, bwd
-    et_min = np.array([min(min(map(min, m[2])), min(map(min, m[3]))) for m in maps])
-    return dict(eta_table=True, et_speed=speed, et_torque=torque, et_size=size, et_eta=eta,
-                et_min=et_min)
+    et_min = np.array([min(np.min(m[2]), np.min(m[3])) for m in maps])
+    return speed, torque, size, eta, et_min
 
 
 def reaction_friction(scene) -> bool:

@@ -8,27 +8,13 @@ import numpy as np
 import pytest
 from scipy.interpolate import RegularGridInterpolator
 
+from transient.assemble import pack_maps
 from transient.core import eta_table as et
 from transient.core.chain import chain_solve, eta_star, modes_power_flow
 from transient.errors import SceneError
 from transient.scene.eta_map import check_map
 
 N_CASES = 200
-
-
-def pack(maps):
-    """The Model's et_* arrays from [(speed, torque, fwd, bwd)] per pair, as assemble packs them."""
-    n = len(maps)
-    nw = max(len(m[0]) for m in maps)
-    ns = max(len(m[1]) for m in maps)
-    speed, torque = np.zeros((n, nw)), np.zeros((n, ns))
-    size, eta = np.zeros((n, 2), dtype=np.int64), np.ones((n, 2, nw, ns))
-    for k, (w, s, f, b) in enumerate(maps):
-        size[k] = len(w), len(s)
-        speed[k, :len(w)], torque[k, :len(s)] = w, s
-        eta[k, 0, :len(w), :len(s)], eta[k, 1, :len(w), :len(s)] = f, b
-    et_min = np.array([min(np.min(m[2]), np.min(m[3])) for m in maps])
-    return speed, torque, size, eta, et_min
 
 
 def random_map(rng):
@@ -71,7 +57,7 @@ def test_lookup_is_scipys_bilinear_map_held_at_the_edges():
     rng = np.random.default_rng(1)
     for _ in range(N_CASES):
         m = random_map(rng)
-        arrays = pack([m])
+        arrays = pack_maps([m])
         for d in (0, 1):
             for w_abs in (0.0, *rng.uniform(0.0, 1.2 * m[0][-1], 3)):
                 for x in (0.0, *rng.uniform(0.0, 1.2 * m[1][-1], 3)):
@@ -109,7 +95,7 @@ def test_held_modes_satisfy_the_subchain_equations_at_their_own_eta(n):
     for _ in range(N_CASES):
         J, dJ, M, w = random_chain(rng, n)
         maps = [random_map(rng) for _ in range(n)]
-        arrays = pack(maps)
+        arrays = pack_maps(maps)
         modes = int(rng.integers(0, 1 << n))
         eta_out, S = np.empty(n), np.empty(n)
         a = et.solve_held(J, dJ, M, w, modes, *arrays, eta_out, S)
@@ -125,7 +111,7 @@ def test_exactly_one_mode_vector_is_power_flow_consistent_and_solve_auto_finds_i
     for _ in range(N_CASES):
         J, dJ, M, w = random_chain(rng, n)
         maps = [random_map(rng) for _ in range(n)]
-        arrays = pack(maps)
+        arrays = pack_maps(maps)
         sigma = 1.0 if w >= 0.0 else -1.0
         found = []
         for mask in range(1 << n):
@@ -175,7 +161,7 @@ def test_map_linear_in_S_gives_the_quadratics_root(backward):
         lin = np.array([[alpha, alpha + beta * top]])
         other = np.full((1, 2), 0.9)
         m = (np.array([100.0]), s, other if backward else lin, lin if backward else other)
-        arrays = pack([m])
+        arrays = pack_maps([m])
         eta_out, S = np.empty(1), np.empty(1)
         a = et.solve_auto(J, dJ, M, w, 1.0, *arrays, eta_out, S)
         want = quadratic_S(J, R, alpha, beta, backward)
@@ -192,7 +178,7 @@ def test_a_constant_map_is_the_constant_eta_chain_bit_for_bit(n):
         ef, eb = rng.uniform(0.3, 1.0, n), rng.uniform(0.3, 1.0, n)
         maps = [(np.array([0.0, 50.0]), np.array([0.0, 1.0, 9.0]), np.full((2, 3), ef[k]),
                  np.full((2, 3), eb[k])) for k in range(n)]
-        arrays = pack(maps)
+        arrays = pack_maps(maps)
         e_ref, S_ref = np.empty(n), np.empty(n)
         a_ref, _, _ = modes_power_flow(J, dJ, M, ef, eb, w, e_ref, S_ref)
         e, S = np.empty(n), np.empty(n)
@@ -214,7 +200,7 @@ def test_invert_solves_the_pairs_transfer():
     rng = np.random.default_rng(50)
     for _ in range(N_CASES):
         m = random_map(rng)
-        arrays = pack([m])
+        arrays = pack_maps([m])
         w_abs = rng.uniform(0.0, 1.2 * m[0][-1])
         received = rng.uniform(-1.5, 1.5) * m[1][-1]
         for back in (False, True):

@@ -79,16 +79,23 @@ def check_samples(scene, tr):
     np.testing.assert_allclose(tr["eta_1"], want, rtol=1e-12)
 
 
-def test_gots_map_balance_losses_and_eta_at_every_sample():
-    """The case over 60 revolutions in crank angle: balance ≤ 1e-8, losses ≥ 0, η* from the map
-    at each sample's own state, and η* really varies (forward and backward, over the grid)."""
-    scene = map_scene(run=Run(revolutions=60.0))
+def checked_run(scene):
+    """The run's trajectory, complete, its balance closed to 1e-8, every loss ≥ 0 and every η*
+    the map's at its own sample (:func:`check_samples`)."""
     data = integrate(scene)
     assert data.complete, data.message
     tr = data.trajectory
     assert closure(scene, tr) <= 1e-8
     losses_nonnegative(scene, tr)
     check_samples(scene, tr)
+    return tr
+
+
+def test_gots_map_balance_losses_and_eta_at_every_sample():
+    """The case over 60 revolutions in crank angle: balance ≤ 1e-8, losses ≥ 0, η* from the map
+    at each sample's own state, and η* really varies (forward and backward, over the grid)."""
+    scene = map_scene(run=Run(revolutions=60.0))
+    tr = checked_run(scene)
     fwd = tr["eta_1"][tr["eta_1"] < 1.0]
     bwd = tr["eta_1"][tr["eta_1"] > 1.0]
     assert fwd.size and bwd.size and np.ptp(fwd) > 5e-3 and np.ptp(1.0 / bwd) > 5e-3
@@ -105,12 +112,7 @@ def test_gots_map_in_time_from_rest_and_coasting():
                       run=Run(revolutions=5.0, t_end=1.0), **common)
     coast = map_scene(run=Run(t_end=0.3), gas=Gas(), load=Load(fan=5e-3), **common)
     for scene in (start, coast):
-        data = integrate(scene)
-        assert data.complete, data.message
-        tr = data.trajectory
-        assert closure(scene, tr) <= 1e-8
-        losses_nonnegative(scene, tr)
-        check_samples(scene, tr)
+        tr = checked_run(scene)
         assert tr["W_loss_1"][-1] > 0
 
 

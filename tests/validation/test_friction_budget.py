@@ -40,6 +40,8 @@ from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, load_scene
 from transient.study.efficiency import point_scene
 
+from balances import dense_spin_up
+
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
 
@@ -51,15 +53,8 @@ def gots_friction(**changes):
 @pytest.fixture(scope="module")
 def spin_up():
     """The Gots diesel with both pairs (power-flow) spinning up from 1000 rpm for 4 cycles, in
-    time throughout (switch speed above every ω reached), densely sampled."""
-    base = gots_friction()
-    scene = gots_friction(run=Run(revolutions=8.0),
-                          solver=replace(base.solver, rtol=1e-11, atol=1e-11, switch_speed=1e4),
-                          output=Output(samples_per_rev=720, dt=1e-6))
-    data = integrate(scene)
-    assert data.complete, data.message
-    assert "to_angle_domain" not in data.events
-    return scene, data
+    time throughout, densely sampled."""
+    return dense_spin_up(gots_friction)
 
 
 def window(scene, tr, first: int, last: int):

@@ -40,6 +40,8 @@ from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study, point_scene
 
+from balances import dense_spin_up
+
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
 CASE = CASES / "gots_diesel_reaction_friction.toml"
@@ -56,14 +58,7 @@ def without_friction(pairs):
 
 @pytest.fixture(scope="module")
 def spin_up():
-    base = reaction_case()
-    scene = reaction_case(run=Run(revolutions=8.0),
-                          solver=replace(base.solver, rtol=1e-11, atol=1e-11, switch_speed=1e4),
-                          output=Output(samples_per_rev=720, dt=1e-6))
-    data = integrate(scene)
-    assert data.complete, data.message
-    assert "to_angle_domain" not in data.events
-    return scene, data
+    return dense_spin_up(reaction_case)
 
 
 def test_the_work_energy_balance_closes(spin_up):
