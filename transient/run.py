@@ -26,7 +26,8 @@ from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
-from .outcome import FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of
+from .outcome import (FINISHED, INTERRUPTING_SIGNALS, RunStopped, Watch, code_status,
+                      failure_cause, judge, status_of)
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
@@ -535,8 +536,8 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
                       data.warnings)
 
 
-#: The signals that stop a command (Ctrl-C, ``transient.cli.INTERRUPTING_SIGNALS``).
-_STOPPING = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
+#: The signals that stop a command: Ctrl-C and :data:`.outcome.INTERRUPTING_SIGNALS`.
+_STOPPING = tuple(getattr(signal, name) for name in ("SIGINT", *INTERRUPTING_SIGNALS)
                   if hasattr(signal, name))
 
 

@@ -19,6 +19,7 @@ import os
 import sys
 
 from ..errors import SceneError, SimulationError, WriteFailed
+from ..outcome import INTERRUPTING_SIGNALS
 from . import efficiency, kinematics, loads, orders, plot, run, sweep, verify
 from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE, OptionParser
 
@@ -78,9 +79,6 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_FAILED
 
 
-#: Signals that end a command as Ctrl-C does, so that a run stopped by ``timeout``, a batch
-#: scheduler's preemption or a closed terminal keeps its partial result marked incomplete.
-INTERRUPTING_SIGNALS = ("SIGTERM", "SIGHUP")
 
 
 @contextmanager
