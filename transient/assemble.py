@@ -16,8 +16,8 @@ from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
 from .core import variation as var
 from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_PAR, PAPER, PHI, POWER_FLOW,
-                          RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
+from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_JOINTS, N_RX_PAR, PAPER,
+                          PHI, POWER_FLOW, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
                           TABULATED, Model, T, extras_of, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
@@ -526,7 +526,8 @@ def chain_fields(scene) -> dict:
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
         link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
-        reaction=False, rx_par=np.zeros((4, N_RX_PAR)), rx_pair=np.full(4, -1, dtype=np.int64),
+        reaction=False, rx_par=np.zeros((N_RX_JOINTS, N_RX_PAR)),
+        rx_pair=np.full(N_RX_JOINTS, -1, dtype=np.int64),
         **eta_table_fields(friction.pairs))
 
 
@@ -574,8 +575,8 @@ def reaction_fields(scene) -> dict:
     ``reaction_links`` (main bearing, crankpin, piston pin, slider) has its pair's coefficients
     and reports as that pair."""
     mech, pairs = scene.mechanism, scene.friction.pairs
-    rx_par = np.zeros((4, N_RX_PAR))
-    rx_pair = np.full(4, -1, dtype=np.int64)
+    rx_par = np.zeros((N_RX_JOINTS, N_RX_PAR))
+    rx_pair = np.full(N_RX_JOINTS, -1, dtype=np.int64)
     for k, p in enumerate(pairs):
         j = mech.reaction_links.index(p.between[0])
         rx_pair[j] = k

@@ -5,7 +5,9 @@ request must name one), so this module reads a scene's records without importing
 """
 from __future__ import annotations
 
-from .assemble import gas_is_force, governor_kind
+import re
+
+from .assemble import gas_is_force, governor_kind, reaction_friction
 from .core import governor as gv
 from .core.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
 
@@ -23,10 +25,18 @@ def output_columns(scene) -> dict[str, str]:
     cols.update(zip(gv.STATE_NAMES[kind], gv.STATE_UNITS[kind]))
     if scene.gas.injection is not None:  # the fuel each cylinder latched at its last injection
         cols.update({f"fuel_{k + 1}": "1" for k in range(scene.mechanism.n_cylinders)})
+    if reaction_friction(scene):  # each reaction pair's loss split over the cylinders
+        cols.update({cylinder_loss_column(k, c): "W" for k in range(len(scene.friction.pairs))
+                     for c in range(scene.mechanism.n_cylinders)})
     if scene.run.mode == "prescribed-speed":
         cols["M_drive"] = "N m"
         cols["W_drive"] = "J"
     return cols
+
+
+def cylinder_loss_column(pair: int, cylinder: int) -> str:
+    """The column of the power that reaction pair ``pair`` loses in ``cylinder`` (both from 0)."""
+    return f"P_loss_{pair + 1}_cyl{cylinder + 1}"
 
 
 #: What each trajectory column holds, with its sign convention (torques and speeds positive in
@@ -55,6 +65,8 @@ DESCRIPTIONS = {
                "1/η_backward (> 1) when it flows back",
     "P_loss_{k}": "power lost in pair {k}, (1 − eta_{k})·S_{k}·ω",
     "W_loss_{k}": "energy lost in pair {k} since the start, ∫P_loss_{k} dt",
+    "P_loss_{k}_cyl{c}": "power lost in reaction pair {k} at the joints of cylinder {c}; over "
+                         "the cylinders it sums to P_loss_{k}",
     "gov_integral": "the PI(D) governor's integral state",
     "gov_rack": "the PI(D) governor's rack (actuator) position",
     "gov_filter": "the PID governor's filtered speed",
@@ -70,6 +82,10 @@ def describe(column: str) -> str:
     """The description of a trajectory column (:data:`DESCRIPTIONS`), for numbered ones too."""
     if column in DESCRIPTIONS:
         return DESCRIPTIONS[column]
+    split = re.fullmatch(r"P_loss_(\d+)_cyl(\d+)", column)
+    if split:
+        k, c = split.groups()
+        return DESCRIPTIONS["P_loss_{k}_cyl{c}"].replace("{k}", k).replace("{c}", c)
     head, _, k = column.rpartition("_")
     pattern = f"{head}_{{k}}"
     if k.isdigit() and pattern in DESCRIPTIONS:

@@ -786,7 +786,8 @@ def test_efficiency_study_and_budget_with_reaction_friction(tmp_path, capsys):
     """The budget reads reaction pairs as constant-η ones: `transient efficiency` writes every
     point's per-pair FMEP (summing to the total), the budget chart and the η map; η_mech falls
     with speed and load; `transient run` at a prescribed speed names the pistons as the pair
-    that loses most and stores the budget under /analysis."""
+    that loses most, stores the budget under /analysis with each cylinder's share, and `transient
+    plot` draws it."""
     scene = CASES / "gots_diesel_reaction_friction.toml"
     code, out, err = cli(capsys, "efficiency", scene, "--rpm", "1000,4400", "--fuel", "1,0.5",
                          "--samples-per-rev", "360", "-o", tmp_path)
@@ -811,8 +812,15 @@ def test_efficiency_study_and_budget_with_reaction_friction(tmp_path, capsys):
     code, out, err = cli(capsys, "run", path, "-o", tmp_path)
     assert (code, err) == (0, "")
     assert "pair 4 (pistons) loses most" in out
+    assert "fmep per cylinder, on its own swept volume: 1 " in out
     res = transient.open_result(tmp_path / "reaction_4400.h5")
     assert res.analysis["fmep_4"][1] == "Pa" and res.analysis["fmep_4"][0] > 0.0
+    # cylinders that work alike at a constant speed: each one's FMEP is the engine's
+    for c in (1, 2, 3):
+        assert res.analysis[f"fmep_cyl{c}"][0] == pytest.approx(res.analysis["fmep"][0], rel=2e-3)
+    code, out, err = cli(capsys, "plot", tmp_path / "reaction_4400.h5", "-o", tmp_path)
+    assert (code, err) == (0, "")
+    assert (tmp_path / "reaction_4400_budget.png").stat().st_size > 10_000
 
 
 def test_efficiency_study_refuses_a_figure_before_the_study(tmp_path, capsys, monkeypatch):

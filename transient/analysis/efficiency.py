@@ -53,6 +53,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from ..outputs import cylinder_loss_column
 from .irregularity import cycle_boundaries, cycle_means, steady_state_time
 
 #: |P_in| below this fraction of its mean is left out of (30) as printed.
@@ -188,6 +189,38 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         out[f"mode_against_power_share_{k + 1}"] = (_time_share(t, against), "1")
         out[f"mode_against_power_per_cycle_{k + 1}"] = (
             float(np.count_nonzero(against[1:] & ~against[:-1]) + against[0]) / n_cyc, "1")
+    n_cyl = scene.mechanism.n_cylinders
+    out.update(_cylinder_budget(traj, sel, losses, n_cyc, n_cyl, v_d / n_cyl))
+    return out
+
+
+def _cylinder_budget(traj, sel, losses, n_cyc: int, n_cylinders: int, v_cyl: float) -> dict:
+    """Each reaction pair's loss split over the cylinders (``P_loss_<k>_cyl<c>`` columns): per
+    cylinder c the energy lost per cycle in pair k, its FMEP on the cylinder's own swept volume
+    ``v_cyl`` and the cylinder's total FMEP (``fmep_cyl<c>``). The shares come from the trapezoidal
+    rule over the samples and scale the pair's exact integral, so that the cylinders sum to it;
+    ``cylinder_split_residual_<k>`` is the quadrature's relative mismatch of that integral, which
+    finer output sampling makes smaller. Empty without those columns (constant-η and mapped pairs
+    join links that every cylinder shares: their loss has no split)."""
+    if not losses or cylinder_loss_column(0, 0) not in traj:
+        return {}
+    out: dict[str, tuple[float, str]] = {}
+    t = traj["t"][sel]
+    total = np.zeros(n_cylinders)
+    for k, exact in enumerate(losses):
+        quad = np.array([np.trapezoid(traj[cylinder_loss_column(k, c)][sel], t)
+                         for c in range(n_cylinders)])
+        whole = float(np.sum(quad))
+        share = quad / whole if whole != 0.0 else np.zeros(n_cylinders)
+        out[f"cylinder_split_residual_{k + 1}"] = (
+            whole / exact - 1.0 if exact != 0.0 else math.nan, "1")
+        for c in range(n_cylinders):
+            w_c = exact * share[c] / n_cyc
+            out[f"W_loss_{k + 1}_cyl{c + 1}_per_cycle"] = (w_c, "J")
+            out[f"fmep_{k + 1}_cyl{c + 1}"] = (w_c / v_cyl, "Pa")
+            total[c] += w_c
+    for c in range(n_cylinders):
+        out[f"fmep_cyl{c + 1}"] = (total[c] / v_cyl, "Pa")
     return out
 
 

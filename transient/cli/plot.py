@@ -57,9 +57,14 @@ def cmd_plot(args) -> int:
         written.append(save(fig, out / f"{stem}_pairs.png", args.force, res))
     if "fmep_1" in res.analysis:  # the friction budget of the steady cycles
         names = [p.name for p in scene.friction.pairs]
-        fig, ax = plt.subplots(figsize=(5, 4.5))
-        plots.friction_budget(ax, ["steady cycles"], [res.analysis[f"fmep_{k + 1}"][0]
-                                                      for k in range(len(names))], names)
+        labels, suffixes = ["steady cycles"], [""]
+        if "fmep_cyl1" in res.analysis:  # reaction pairs: each cylinder on its own volume too
+            n = scene.mechanism.n_cylinders
+            labels = ["engine"] + [f"cylinder {c + 1}" for c in range(n)]
+            suffixes += [f"_cyl{c + 1}" for c in range(n)]
+        fig, ax = plt.subplots(figsize=(4 + 0.8 * len(labels), 4.5))
+        plots.friction_budget(ax, labels, [res.analysis[f"fmep_{k + 1}{s}"][0]
+                                           for k in range(len(names)) for s in suffixes], names)
         ax.set_title(f"{scene.name}: FMEP per pair (η_mech = "
                      f"{res.analysis['eta_mech_work'][0]:.4f})")
         written.append(save(fig, out / f"{stem}_budget.png", args.force, res))

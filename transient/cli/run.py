@@ -210,6 +210,12 @@ def _print_efficiency(v: dict, names=()) -> None:
     if k > 2:
         most = max(range(1, k), key=lambda j: v[f"W_loss_{j}_per_cycle"])
         print(f"    {label.get(most, f'pair {most}')} loses most")
+    c = 1
+    while f"fmep_cyl{c}" in v:
+        c += 1
+    if c > 1:
+        print("    fmep per cylinder, on its own swept volume: " + ", ".join(
+            f"{j} {v[f'fmep_cyl{j}'] / 1e3:.6g} kPa" for j in range(1, c)))
     if "pair_mode_switches_per_cycle" in v:
         print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
 

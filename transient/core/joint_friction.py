@@ -67,7 +67,7 @@ piston for the piston pins, the piston into the wall for the slider) and η* = 1
 the loss is (1 − η*) S ω as for a constant-η pair: η* < 1 when the shaft side drives, > 1 when
 the far side does, 0 for the slider (the wall takes no power), NaN where S = 0.
 
-Shapes: ``jp`` = ``Model.rx_par`` float64[4, N_RX_PAR]; the rows ``WK_RX + R_*`` of ``wk`` hold
+Shapes: ``jp`` = ``Model.rx_par`` float64[N_RX_JOINTS, N_RX_PAR]; the rows ``WK_RX + R_*`` of ``wk`` hold
 one value per cylinder (``R_LOSS``: per pair).
 """
 from __future__ import annotations
@@ -82,7 +82,8 @@ from .chain import LOCKED, UNIQUE
 from .crank_slider import (E, I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, N_CYL, R,
                            ROD_CG, SIN0, rod_and_piston, rod_and_piston_second)
 from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
-                     RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+                     RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS, WK_ETA, WK_RX,
+                     WK_S)
 
 #: Offsets of the rows from ``layout.WK_RX``: geometry at the state (l cos β, l sin β, the
 #: crankpin's position r sin α, r cos α, β′, s′), then per acceleration its part at ε = 0 and its
@@ -343,17 +344,22 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
 
 @kernel
 def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
-    """S, L and η* = 1 − L/S of each pair, summed over the cylinders, into ``wk``."""
+    """S, L and η* = 1 − L/S of each pair, summed over the cylinders, into ``wk``; each
+    cylinder's share of L in the rows ``WK_CYL_LOSS``."""
+    n = int(mp[N_CYL])
     for p in range(n_pairs):
         wk[WK_S, p] = 0.0
         wk[WK_RX + R_LOSS, p] = 0.0
-    for k in range(int(mp[N_CYL])):
+        for k in range(n):
+            wk[WK_CYL_LOSS + p, k] = 0.0
+    for k in range(n):
         t = joint_terms(mp, jp, wk, k, eps, w, sigma, wk[WK_RX + R_N, k])
         for j in range(4):
             p = pair_of[j]
             if p >= 0:
                 wk[WK_S, p] += t[j]
                 wk[WK_RX + R_LOSS, p] += t[4 + j]
+                wk[WK_CYL_LOSS + p, k] += t[4 + j]
     for p in range(n_pairs):
         s = wk[WK_S, p]
         wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan

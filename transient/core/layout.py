@@ -93,7 +93,12 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: (``joint_friction.R_*`` are the offsets), and per pair the moment its losses reduce to.
 WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
 N_WK_RX = 28
-N_WK = WK_RX + N_WK_RX
+#: With reaction friction, row WK_CYL_LOSS + p holds pair p's loss moment in each cylinder (one
+#: column per cylinder): the split of the pair's loss that the output rows report per cylinder.
+WK_CYL_LOSS = WK_RX + N_WK_RX
+#: The most joints that reaction friction acts in, of any mechanism (rows of ``Model.rx_par``).
+N_RX_JOINTS = 4
+N_WK = WK_CYL_LOSS + N_RX_JOINTS
 
 #: The joints of the crank-slider that reaction friction acts in (rows of ``Model.rx_par``): the
 #: main bearing (frame – throw), the crankpin (throw – rod), the piston pin (rod – piston) and the
@@ -164,8 +169,8 @@ Model = namedtuple(
         # reaction friction in the crank-slider's joints (transient.core.joint_friction); the
         # pairs are then the joints that have friction, and no sub-chain is cut
         "reaction",  # bool: the pairs' losses follow from the joint reactions
-        "rx_par",  # float64[4, N_RX_PAR]: each joint's coefficients (zeros: an ideal joint)
-        "rx_pair",  # int64[4]: the pair each joint reports as, −1 for an ideal joint
+        "rx_par",  # float64[N_RX_JOINTS, N_RX_PAR]: each joint's coefficients (zeros: an ideal joint)
+        "rx_pair",  # int64[N_RX_JOINTS]: the pair each joint reports as, −1 for an ideal joint
         # efficiencies mapped over speed and transmitted moment (transient.core.eta_table); the
         # arrays keep their types without maps (one row of zeros), so one compile serves all
         "eta_table",  # bool: the pairs' η come from the maps below (eta_fwd, eta_bwd unused)
@@ -222,6 +227,13 @@ def n_state(m):
 @kernel
 def n_outputs(m):
     """Columns of an output row of model ``m``."""
+    return cylinder_loss_col(m) + (m.n_pairs * m.ncyl if m.reaction else 0)
+
+
+@kernel(inline=True)
+def cylinder_loss_col(m):
+    """Column of an output row where the reaction pairs' losses per cylinder start (the last
+    columns: pair 1 in cylinders 1 … n, then pair 2, …)."""
     return (N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs + gv.n_states(m.gov_dyn)
             + (m.ncyl if m.latch else 0))
 

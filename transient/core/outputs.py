@@ -12,8 +12,8 @@ from .jit import kernel
 
 from .joint_friction import loss_moment
 from .forcing import command, cylinder_value, moments
-from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_ETA,
-                     WK_FUEL, WK_S, cyl_index, gov_index, latch_index)
+from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER,
+                     WK_CYL_LOSS, WK_ETA, WK_FUEL, WK_S, cyl_index, gov_index, latch_index)
 from .rhs import acceleration
 from .variation import PRESSURE
 
@@ -63,6 +63,17 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels
         row[j] = y[i]
         j += 1
+    if extras is not None and m.reaction:
+        cylinder_loss_rows(m, w, wk, row[j:])
+
+
+@kernel(inline=True)
+def cylinder_loss_rows(m, w, wk, out):
+    """The power each reaction pair loses in each cylinder (pair 1 in cylinders 1 … n, then pair
+    2, …), from the rows ``WK_CYL_LOSS`` that the joints' solve leaves."""
+    for p in range(m.n_pairs):
+        for k in range(m.ncyl):
+            out[p * m.ncyl + k] = wk[WK_CYL_LOSS + p, k] * w
 
 
 @kernel(inline=True)
