@@ -1,7 +1,8 @@
 r"""The stuck mode: a machine at rest that the non-ideal pairs' friction holds, released when the
-drive exceeds what the friction can hold in one direction (as Modelica's LossyGear sticks:
-Pelchen, Schweiger & Otter, "Modeling and simulating the efficiency of gearboxes and of planetary
-gearboxes", 2nd International Modelica Conference, 2002: a gear's stuck and sliding modes).
+drive exceeds what the friction can hold in one direction (as the Modelica Standard Library's
+``Rotational.Components.LossyGear`` sticks: Pelchen, Schweiger & Otter, "Modeling and simulating
+the efficiency of gearboxes and of planetary gearboxes", 2nd International Modelica Conference,
+2002, pp. 257–266: a gear's stuck and rolling modes).
 
 At ω = 0 the friction's direction is that of the incipient motion (``transient.core.chain``, *At
 rest*): with the friction opposing σ = +1 the chain's acceleration is a₊, opposing σ = −1 it is
