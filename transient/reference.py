@@ -27,7 +27,8 @@ from .assemble import build_model, gas_tables, initial_governor, load_table_curv
 from .core.breakpoints import next_breakpoint
 from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
-from .core.layout import T
+from .core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
+                           RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
 from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
 
@@ -47,6 +48,10 @@ class ChainNumpy:
         self.sub = [sum(c < i for c in cuts) for i in range(len(mech.links))]
         self.link_J = mech.link_inertias()
         self.J0 = scene.inertia.total
+
+    def inputs(self, phi, J, dJ, M_gas, M_shaft, forces, sel):
+        """What :meth:`solve` and :meth:`start_direction` take at a state: the sub-chains."""
+        return self.split(J, dJ, M_gas, M_shaft)
 
     def split(self, J, dJ, M_gas, M_shaft):
         """(J_k, J′_k, M_k) per sub-chain: shaft link, constant middle links, the rest last."""
@@ -68,8 +73,13 @@ class ChainNumpy:
             arriving = S[k] * (self.eta_f[k] if S[k] * sigma >= 0 else 1.0 / self.eta_b[k])
         return R[-1] - Jk[-1] * a + arriving, S
 
-    def solve(self, Jk, dJk, Mk, w, sigma):
-        """(φ̈, S_k, η*_k) for direction σ (sign of ω, or of the incipient motion at rest)."""
+    def solve(self, inputs, w, sigma):
+        """(φ̈, S_k, η*_k, L_k) for direction σ (sign of ω, or of the incipient motion at rest),
+        L_k = (1 − η*_k) S_k the loss moments."""
+        a, S, eta = self._solve(*inputs, w, sigma)
+        return a, S, eta, (1.0 - eta) * S
+
+    def _solve(self, Jk, dJk, Mk, w, sigma):
         R = Mk - 0.5 * dJk * w * w
         # The residual is Σ c_k (R_k − J_k a) with weights c_k, products of n factors η_f or
         # 1/η_b, so its root a = Σ c_k R_k / Σ c_k J_k is within Σ|R| / ΣJ · η_min^(−2n). (ΣJ is
@@ -89,13 +99,78 @@ class ChainNumpy:
         eta = np.where(S * sigma >= 0, self.eta_f, 1.0 / self.eta_b)
         return a, S, eta
 
-    def start_direction(self, Jk, dJk, Mk):
+    def start_direction(self, inputs):
         """σ of the incipient motion at rest, or 0 when the pairs' friction holds the chain."""
-        if self.solve(Jk, dJk, Mk, 0.0, 1.0)[0] > 0:
+        if self.solve(inputs, 0.0, 1.0)[0] > 0:
             return 1.0
-        if self.solve(Jk, dJk, Mk, 0.0, -1.0)[0] < 0:
+        if self.solve(inputs, 0.0, -1.0)[0] < 0:
             return -1.0
         return 0.0
+
+
+class ReactionNumpy(ChainNumpy):
+    """Friction on the crank-slider's joint reactions, solved as the compiled kernel does not:
+    the joint forces by Newton–Euler (:func:`crank_slider_joint_forces`, eight linear equations
+    per cylinder) with the friction laws applied to them (:func:`crank_slider_friction_laws`),
+    iterated to a fixed point. For given friction moments and forces every joint force is affine
+    in φ̈, so each turn takes φ̈ exactly from the shaft's equation J₀ φ̈ = M_shaft + Σ T(φ̈) with
+    the forces at φ̈ = 0 and 1; the friction is a small share of the forces (μ·r/l), so the
+    turns contract to rounding within a few dozen. The joints' directions are those at the
+    segment's angle ``sel``, as the compiled path holds them between breakpoints."""
+
+    #: Turns at most; a fixed point not reached by then (a wedging mechanism) is NaN.
+    TURNS = 200
+
+    def __init__(self, scene, model) -> None:
+        self.mech = scene.mechanism
+        self.jp = model.rx_par
+        self.pair_of = model.rx_pair
+        self.n = len(scene.friction.pairs)
+        self.J0 = scene.inertia.total
+
+    def inputs(self, phi, J, dJ, M_gas, M_shaft, forces, sel):
+        return phi, M_shaft, forces, sel
+
+    def solve(self, inputs, w, sigma):
+        """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after."""
+        phi, M_shaft, P, sel = inputs
+        mech, n_cyl = self.mech, self.mech.n_cylinders
+        signs = crank_slider_joint_signs(mech, sel) * sigma
+        moments, f_s = np.zeros((3, n_cyl)), np.zeros(n_cyl)
+        eps = np.nan
+        for _ in range(self.TURNS):
+            both = crank_slider_joint_forces(mech, phi, w, np.array([0.0, 1.0]),
+                                             (P + f_s)[:, None], moments[:, :, None])
+            T0, T1 = both.throw_torque[:, 0], both.throw_torque[:, 1]
+            eps_new = (M_shaft + np.sum(T0)) / (self.J0 - np.sum(T1 - T0))
+            forces = _at_acceleration(both, eps_new)
+            new_moments, new_f_s = crank_slider_friction_laws(mech, self.jp, phi, w, forces, P,
+                                                              signs)
+            # (moments on the scale of the forces times r, φ̈ on that of the torques over J₀)
+            scale = (mech.crank_radius * (np.max(np.abs(forces.main)) + np.max(np.abs(P))
+                                          + np.max(np.abs(new_f_s))) + abs(M_shaft) + 1e-300)
+            change = max(np.max(np.abs(new_moments - moments)),
+                         np.max(np.abs(new_f_s - f_s)) * mech.crank_radius,
+                         abs(eps_new - eps) * self.J0) / scale
+            moments, f_s, eps = new_moments, new_f_s, eps_new
+            if change <= 1e-12:  # (φ̈ from the eight equations' solve is ~1e-13 of its scale)
+                break
+        else:
+            nan = np.full(self.n, np.nan)
+            return np.nan, nan, nan, nan
+        final = crank_slider_joint_forces(mech, phi, w, eps, (P + f_s)[:, None],
+                                          moments[:, :, None])
+        loss, through = crank_slider_joint_powers(mech, phi, w, final, moments, f_s)
+        S, L = np.zeros(self.n), np.zeros(self.n)
+        self.cylinder_losses = np.zeros((self.n, n_cyl))
+        for j, p in enumerate(self.pair_of):
+            if p >= 0:
+                S[p] += np.sum(through[j])
+                L[p] += np.sum(loss[j])
+                self.cylinder_losses[p] += loss[j]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            eta = np.where(S != 0.0, 1.0 - L / S, np.nan)
+        return eps, S, eta, L
 
 
 class CylindersNumpy:
@@ -240,7 +315,10 @@ class ReferenceModel:
         self.pieces = None
         w0 = scene.initial.omega
         self.branch = self.droop_branch(w0)
-        self.chain = ChainNumpy(scene) if scene.friction.pairs else None
+        self.chain = None  # the non-ideal pairs: a serial chain, or the joints' reactions
+        if scene.friction.pairs:
+            reaction = any(p.model == "reaction" for p in scene.friction.pairs)
+            self.chain = ReactionNumpy(scene, self.model) if reaction else ChainNumpy(scene)
         self.sigma = 1.0 if w0 >= 0 else -1.0
         m = self.model
         # the load schedule's segment and the generator's branch, switched at terminal events
@@ -272,14 +350,14 @@ class ReferenceModel:
 
     def select(self, a: float, b: float) -> None:
         """Table pieces for the segment of shaft angle (a, b) between two breakpoints."""
+        mid = 0.5 * (a + b) if math.isfinite(a) and math.isfinite(b) else (a if math.isfinite(a) else b)
+        self.mid = mid  # (the joints' directions of reaction friction are taken here too)
         if self.table is None:
             return
-        mid = 0.5 * (a + b) if math.isfinite(a) and math.isfinite(b) else (a if math.isfinite(a) else b)
         local = np.mod(mid - self.model.gas_phase, self.model.period)
         self.pieces = self.table.piece_of(local)
         if self.motored is not None:
             self.motored_pieces = self.motored.piece_of(local)
-        self.mid = mid
         m = self.model
         # each cylinder's fuel factor in the cycle of the segment (its cycle begins on a breakpoint)
         self.factors = (np.array([cycle_fuel(m, k, mid) for k in range(m.ncyl)])
@@ -348,22 +426,30 @@ class ReferenceModel:
         return 0.0 if self.branch == 2 else (g.speed_zero - w) / (g.speed_zero - g.speed_full)
 
     def evaluate(self, phi, w, y):
-        """(moments, φ̈, S_k, η*_k) at state y (φ, ω and the governor's states)."""
+        """(moments, φ̈, S_k, η*_k, L_k) at state y (φ, ω and the governor's states), L_k the
+        pairs' loss moments."""
         J, dJ, Mg, Ml, Ms, pc = self.moments(phi, w, y)
         if self.chain is None:
-            return (J, dJ, Mg, Ml, Ms, pc), (Mg + Ml + Ms - 0.5 * dJ * w * w) / J, (), ()
+            return (J, dJ, Mg, Ml, Ms, pc), (Mg + Ml + Ms - 0.5 * dJ * w * w) / J, (), (), ()
         # σ is held over a segment and changed only at rest, as the compiled path holds it: taken
         # from sign ω, the friction would flip inside a step where the shaft comes to rest
         # against pairs that lock, and solve_ivp's steps would shrink towards ω = 0 for ever
         # instead of crossing it to the rest event.
-        a, S, eta = self.chain.solve(*self.chain.split(J, dJ, Mg, Ml + Ms), w, self.sigma)
-        return (J, dJ, Mg, Ml, Ms, pc), a, S, eta
+        a, S, eta, L = self.chain.solve(self.friction_inputs(phi, J, dJ, Mg, Ml + Ms, pc), w,
+                                        self.sigma)
+        return (J, dJ, Mg, Ml, Ms, pc), a, S, eta, L
+
+    def friction_inputs(self, phi, J, dJ, M_gas, M_shaft, p):
+        """The pairs' solve's inputs at a state, its pressures ``p`` giving the pistons' forces."""
+        m = self.model
+        forces = m.gas_scale * (p - m.gas_offset) if self.table is not None else np.zeros(m.ncyl)
+        return self.chain.inputs(phi, J, dJ, M_gas, M_shaft, forces, self.mid)
 
     def rhs(self, t, y):
         self.t = t
         phi, w = y[:2]
-        (J, dJ, Mg, Ml, Ms, _), a, S, eta = self.evaluate(phi, w, y)
-        return [w, a, Mg * w, Ml * w, Ms * w, *((1 - np.asarray(eta)) * S * w),
+        (J, dJ, Mg, Ml, Ms, _), a, S, eta, L = self.evaluate(phi, w, y)
+        return [w, a, Mg * w, Ml * w, Ms * w, *(np.asarray(L) * w),
                 *self.governor.rates(w, y), *self.cylinder_rates(phi, w, y)]
 
     def cylinder_rates(self, phi, w, y):
@@ -382,13 +468,14 @@ class ReferenceModel:
         for ti, yi in zip(t, y.T):
             self.t = ti
             p, w = yi[:2]
-            (J, dJ, Mg, Ml, Ms, pc), a, S, eta = self.evaluate(p, w, yi)
-            pairs = [v for k in range(len(S))
-                     for v in (S[k], eta[k], (1 - eta[k]) * S[k] * w, yi[5 + k])]
+            (J, dJ, Mg, Ml, Ms, pc), a, S, eta, L = self.evaluate(p, w, yi)
+            pairs = [v for k in range(len(S)) for v in (S[k], eta[k], L[k] * w, yi[5 + k])]
             latched = [] if self.latched is None else list(self.latched)
             g = self.governor.g
+            split = (list(self.chain.cylinder_losses.ravel() * w)
+                     if isinstance(self.chain, ReactionNumpy) else [])
             out.append([ti, p, w, a, J, dJ, Mg, Ml, Ms, self.command(w, yi), *yi[2:5], *pc, *pairs,
-                        *yi[g:g + self.n_gov], *latched])
+                        *yi[g:g + self.n_gov], *latched, *split])
         return np.asarray(out)
 
 
@@ -533,8 +620,8 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
             stop.terminal, stop.direction = True, -1
             evs.append(("stall", stop))
         if ref.chain is not None and y[1] == 0.0:  # at rest: the pairs may hold the chain
-            J, dJ, Mg, Ml, Ms, _ = ref.moments(y[0], 0.0, y)
-            ref.sigma = ref.chain.start_direction(*ref.chain.split(J, dJ, Mg, Ml + Ms))
+            J, dJ, Mg, Ml, Ms, pc = ref.moments(y[0], 0.0, y)
+            ref.sigma = ref.chain.start_direction(ref.friction_inputs(y[0], J, dJ, Mg, Ml + Ms, pc))
             if ref.sigma == 0.0:
                 message = (f"locked: at rest at t = {t:.9g} s, φ = {y[0]:.9g} rad the friction of "
                            f"the non-ideal pairs holds the applied moments")
@@ -788,3 +875,90 @@ def crank_slider_joint_forces(mech, phi, omega, epsilon, gas_force=None,
     m1 = m * (l - l1) / l
     return JointForces(main=-x[0:2], crankpin=-x[3:5], pin=pin, N=x[7],
                        S=-np.sum((pin + m1 * acc_b) * u_hat, axis=0), throw_torque=x[2])
+
+
+# ------------------------------------------------------------------------------------------------
+# Friction on the crank-slider's joint reactions, applied to the Newton–Euler forces
+
+
+def _rod_and_piston_rates(mech, phi):
+    """β′ = dβ/dα and s′ = ds/dα (toward the crank) of every cylinder at shaft angle φ, from the
+    loop x_B = e as :func:`crank_slider_joint_forces` writes it: sin β = (r sin α − e)/l,
+    β′ = r cos α/(l cos β), and y_B = r cos α + l cos β gives s′ = −y_B′ = r sin α + l sin β·β′."""
+    alpha = phi - np.asarray(mech.firing_angles, dtype=np.float64)
+    r, l, e = mech.crank_radius, mech.rod_length, mech.offset
+    sb = (r * np.sin(alpha) - e) / l
+    db = r * np.cos(alpha) / (l * np.sqrt(1.0 - sb * sb))
+    return db, r * np.sin(alpha) + l * sb * db
+
+
+def crank_slider_joint_signs(mech, sel) -> NDArray[np.float64]:
+    """Per joint (main bearing, crankpin, piston pin, slider; rows) and cylinder the sign of its
+    relative rate per unit of ω at the angle ``sel``: the throw on the frame 1, the rod on the
+    throw 1 + β′, the rod on the piston β′, the piston s′."""
+    db, ds = _rod_and_piston_rates(mech, sel)
+    return np.array([np.ones_like(db), np.sign(1.0 + db), np.sign(db), np.sign(ds)])
+
+
+def crank_slider_friction_laws(mech, jp, phi, w, forces: JointForces, P, signs):
+    """The joints' friction from their forces (``forces`` at one sample, trailing axis 1): the
+    moments (3, n_cylinders) on the outer bodies, positive in the direction of rotation, of the
+    main bearing (on the throw), the crankpin and the piston pin (on the rod), each
+    ±μ·r·|F| and a viscous term opposing the relative rate (``signs`` × σ:
+    :func:`crank_slider_joint_signs`), and the slider's force on the piston toward the crank,
+    −(μ|N| + F_ring + c_p P⁺) against the piston's speed and −c·s′ω (``jp`` = ``Model.rx_par``)."""
+    db, ds = _rod_and_piston_rates(mech, phi)
+    k = jp[:, RX_MU] * jp[:, RX_RADIUS]
+    visc = jp[:, RX_VISCOUS]
+    m_main = (-signs[0] * k[JOINT_MAIN] * np.hypot(*forces.main[:, :, 0])
+              - visc[JOINT_MAIN] * w)
+    m_cp = (signs[1] * k[JOINT_CRANKPIN] * np.hypot(*forces.crankpin[:, :, 0])
+            + visc[JOINT_CRANKPIN] * (1.0 + db) * w)
+    m_pin = signs[2] * k[JOINT_PIN] * np.hypot(*forces.pin[:, :, 0]) + visc[JOINT_PIN] * db * w
+    f_s = (-signs[3] * (jp[JOINT_SLIDER, RX_MU] * np.abs(forces.N[:, 0])
+                        + jp[JOINT_SLIDER, RX_RING_FORCE]
+                        + jp[JOINT_SLIDER, RX_RING_PRESSURE] * np.maximum(P, 0.0))
+           - visc[JOINT_SLIDER] * ds * w)
+    return np.array([m_main, m_cp, m_pin]), f_s
+
+
+def crank_slider_joint_powers(mech, phi, w, forces: JointForces, moments, f_s):
+    """Per joint (rows: main bearing, crankpin, piston pin, slider) and cylinder the loss moment
+    (the power lost over ω) and the moment its shaft side puts in (the power it sends in over ω),
+    from the forces and the friction at one sample: the shaft into the throw −T, the throw into
+    the rod (the crankpin's force on the rod times the crankpin's velocity, over ω, and the
+    friction moment), the rod into the piston, the piston into the wall."""
+    db, ds = _rod_and_piston_rates(mech, phi)
+    alpha = phi - np.asarray(mech.firing_angles, dtype=np.float64)
+    m_main, m_cp, m_pin = moments
+    f_a = -forces.crankpin[:, :, 0]  # the throw's force on the rod
+    r = mech.crank_radius
+    loss = np.array([-m_main, m_cp * (1.0 + db), m_pin * db, -f_s * ds])
+    through = np.array([-forces.throw_torque[:, 0],
+                        r * (f_a[0] * np.cos(alpha) - f_a[1] * np.sin(alpha)) + m_cp,
+                        -forces.pin[1, :, 0] * ds + m_pin * db,
+                        -f_s * ds])
+    return loss, through
+
+
+def crank_slider_friction(mech, jp, phi, w, eps, P, signs, turns=60):
+    """The joint forces at a prescribed φ̈ = ``eps`` with the friction laws applied to them,
+    iterated ``turns`` times (a contraction: the friction is μ·r/l of the forces):
+    ``(forces, loss, through)`` as :func:`crank_slider_joint_powers`."""
+    n = mech.n_cylinders
+    moments, f_s = np.zeros((3, n)), np.zeros(n)
+    for _ in range(turns):
+        forces = crank_slider_joint_forces(mech, phi, w, eps, (P + f_s)[:, None],
+                                           moments[:, :, None])
+        moments, f_s = crank_slider_friction_laws(mech, jp, phi, w, forces, P, signs)
+    forces = crank_slider_joint_forces(mech, phi, w, eps, (P + f_s)[:, None], moments[:, :, None])
+    return (forces, *crank_slider_joint_powers(mech, phi, w, forces, moments, f_s))
+
+
+def _at_acceleration(both: JointForces, eps: float) -> JointForces:
+    """The forces at φ̈ = ``eps`` from those at φ̈ = 0 and 1 (last axis), being affine in φ̈ at
+    given friction; the last axis of the result has length 1."""
+    def at(v):
+        return v[..., :1] + eps * (v[..., 1:2] - v[..., :1])
+    return JointForces(*(at(getattr(both, f)) for f in
+                         ("main", "crankpin", "pin", "N", "S", "throw_torque")))

@@ -3,9 +3,10 @@ the Newton–Euler model written separately in numpy
 (:func:`transient.reference.crank_slider_joint_forces`, eight linear equations per cylinder with
 known joint moments).
 
-The reference knows nothing of friction: here its joint moments and the slider's axial force are
-computed from its own joint forces by the friction laws written out again below, and iterated to
-a fixed point (plain substitution; the friction changes the forces by a few per mille, so the
+The reference knows nothing of friction: its joint moments and the slider's axial force are
+computed from its own joint forces by the friction laws written out again in numpy
+(:func:`transient.reference.crank_slider_friction_laws`), and iterated to a fixed point (plain
+substitution; the friction changes the forces by a few per mille, so the
 iteration contracts by about that factor each turn and 60 turns are far past rounding). Then, at
 many states of three mechanisms (central two-mass, offset two-mass, offset rigid rod; speeds
 both ways, accelerations to 1e5 rad/s², gas forces of both signs), the compiled solve must give
@@ -24,14 +25,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.analysis.loads.crank_slider import slider_arrays
 from transient.assemble import build_model
 from transient.core import crank_slider as core
 from transient.core import joint_friction as jf
 from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_RX_PAR,
                                    N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE,
                                    RX_VISCOUS, WK_ETA, WK_RX, WK_S)
-from transient.reference import crank_slider_joint_forces
+from transient.reference import (crank_slider_friction, crank_slider_joint_forces,
+                                 crank_slider_joint_signs)
 from transient.scene import load_scene, to_toml
 
 from engines import MECHS
@@ -51,45 +52,13 @@ def coefficients(scale: float = 1.0) -> np.ndarray:
     return jp
 
 
-def reference_friction(mech, jp, phi, w, eps, P, turns=60):
-    """The reference's forces with the friction laws applied to them, iterated to a fixed point.
-
-    Moments positive in the direction of rotation on the joint's outer body (the reference's
-    convention): the main bearing's on the throw opposes ω, the crankpin's on the rod opposes
-    the rod's rate relative to the throw, −(1 + β′)ω, the piston pin's on the rod opposes −β′ω;
-    the slider's force on the piston (toward the crank) opposes the piston's speed s′ω.
-    Returns (forces, per-joint loss moments L, per-joint transmitted moments S), arrays over the
+def reference_friction(mech, jp, phi, w, eps, P):
+    """The reference's forces with the friction laws applied to them, iterated to a fixed point
+    (:func:`transient.reference.crank_slider_friction`), the joints' directions at φ itself:
+    (forces, per-joint loss moments L, per-joint transmitted moments S), arrays over the
     cylinders."""
-    alpha = phi - np.asarray(mech.firing_angles)
-    _, ds, _, _, db, _ = slider_arrays(alpha, mech.crank_radius, mech.rod_length, mech.offset)
-    mu, rad, visc = jp[:, RX_MU], jp[:, RX_RADIUS], jp[:, RX_VISCOUS]
-    n = mech.n_cylinders
-    m_main, m_cp, m_pin, f_s = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    for _ in range(turns):
-        jf_ = crank_slider_joint_forces(mech, phi, w, eps, (P + f_s)[:, None],
-                                        joint_moments=(m_main[:, None], m_cp[:, None],
-                                                       m_pin[:, None]))
-        f_o = np.hypot(*jf_.main[:, :, 0])
-        f_a = np.hypot(*jf_.crankpin[:, :, 0])
-        f_b = np.hypot(*jf_.pin[:, :, 0])
-        N = jf_.N[:, 0]
-        m_main = (-np.sign(w) * mu[JOINT_MAIN] * rad[JOINT_MAIN] * f_o - visc[JOINT_MAIN] * w)
-        m_cp = (np.sign((1 + db) * w) * mu[JOINT_CRANKPIN] * rad[JOINT_CRANKPIN] * f_a
-                + visc[JOINT_CRANKPIN] * (1 + db) * w)
-        m_pin = (np.sign(db * w) * mu[JOINT_PIN] * rad[JOINT_PIN] * f_b
-                 + visc[JOINT_PIN] * db * w)
-        f_s = (-np.sign(ds * w) * (mu[JOINT_SLIDER] * np.abs(N) + jp[JOINT_SLIDER, RX_RING_FORCE]
-                                   + jp[JOINT_SLIDER, RX_RING_PRESSURE] * np.maximum(P, 0.0))
-               - visc[JOINT_SLIDER] * ds * w)
-    sa, ca = np.sin(alpha), np.cos(alpha)
-    r = mech.crank_radius
-    f_a_vec = -jf_.crankpin[:, :, 0]  # the throw's force on the rod
-    loss = np.array([-m_main, m_cp * (1 + db), m_pin * db, -f_s * ds])
-    through = np.array([-jf_.throw_torque[:, 0],
-                        r * (f_a_vec[0] * ca - f_a_vec[1] * sa) + m_cp,
-                        -jf_.pin[1, :, 0] * ds + m_pin * db,
-                        -f_s * ds])
-    return jf_, loss, through
+    return crank_slider_friction(mech, jp, phi, w, eps, P,
+                                 crank_slider_joint_signs(mech, phi) * np.sign(w))
 
 
 def compiled_cylinders(mech, jp, phi, w, eps, P):

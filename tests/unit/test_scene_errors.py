@@ -83,10 +83,6 @@ REACTION_CASES = [  # (id, scene text, key, fragment), part of CASES below
                     'eta_backward = 0.9\n'),
      "friction.pairs[1].model", "reaction pairs do not mix with others (constant-eta and table "
                                 "pairs do)"),
-    ("reaction-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"')
-     + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\nmodel = "reaction"\n'
-       'mu = 0.003\nradius_mm = 30\n',
-     "solver.method", "friction on the reactions runs on the compiled methods"),
 ]
 
 

@@ -62,10 +62,12 @@ START_T_END = 0.25
 
 
 def dynamic_scenes():
-    """The dynamic scenes the reference path runs: not those with friction on the joints'
-    reactions or with efficiency maps, which run on the compiled methods only (their
-    independent checks are the Newton–Euler model, ``tests/unit/test_joint_friction.py``, and
-    scipy's interpolator at every sample, ``tests/validation/test_eta_table_runs.py``)."""
+    """The dynamic scenes the reference path runs here: not those with efficiency maps, which
+    run on the compiled methods only (their independent check is scipy's interpolator at every
+    sample, ``tests/validation/test_eta_table_runs.py``), nor those with friction on the joints'
+    reactions, whose reference (a fixed point of the Newton–Euler forces per evaluation) is too
+    slow for these runs: :func:`test_reaction_friction_agrees_with_reference` runs a shorter
+    one."""
     names = []
     for path in sorted(CASES.glob("*.toml")):
         scene = load_scene(path)
@@ -203,6 +205,35 @@ def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch
     assert e_w <= E_SAMPLES and e_t <= E_SAMPLES
 
 
+def test_reaction_friction_agrees_with_reference(monkeypatch):
+    """Friction on the joints' reactions, two ways: the compiled Newton solve of φ̈ and the side
+    forces against the reference path's fixed point of the Newton–Euler joint forces
+    (:class:`transient.reference.ReactionNumpy`), over two revolutions of the reaction case from
+    1000 rpm. Final t and ω in the scipy units above (≤ E_FINAL); each pair's energy lost and
+    each cylinder's share of its loss power at the end, relative to the pair's (1e-6: the loss
+    integrals are of the order of 10⁻³ of the gas work whose tolerance they share)."""
+    scene = load_scene(CASES / "gots_diesel_reaction_friction.toml")
+    scene = replace(scene, run=replace(scene.run, revolutions=2.0),
+                    solver=replace(scene.solver, rtol=RTOL, atol=ATOL))
+    comp = integrate(scene)
+    with watched_reference(monkeypatch):
+        ref = integrate(replace(scene, solver=replace(scene.solver, method="scipy-DOP853")))
+    assert comp.complete and ref.complete, (comp.message, ref.message)
+    c, r = comp.trajectory, ref.trajectory
+    assert c["phi"][-1] == pytest.approx(r["phi"][-1], rel=1e-15)
+    final = {"t": e(c["t"][-1], r["t"][-1]), "omega": e(c["omega"][-1], r["omega"][-1])}
+    print("final e = " + ", ".join(f"{k} {v:.3g}" for k, v in final.items()))
+    assert max(abs(v) for v in final.values()) <= E_FINAL, final
+    n_cyl = scene.mechanism.n_cylinders
+    for k in range(1, len(scene.friction.pairs) + 1):
+        W, P = r[f"W_loss_{k}"][-1], r[f"P_loss_{k}"][-1]
+        assert W > 0.0 and c[f"W_loss_{k}"][-1] == pytest.approx(W, rel=1e-6)
+        for cyl in range(1, n_cyl + 1):
+            name = f"P_loss_{k}_cyl{cyl}"
+            assert abs(c[name][-1] - r[name][-1]) <= 1e-6 * abs(P), (name, c[name][-1],
+                                                                     r[name][-1])
+
+
 @pytest.mark.parametrize("max_step_deg", [180.0, 10.0, 5.0, 2.0, 1.0])
 def test_compiled_run_reaches_its_end_for_any_max_step(max_step_deg, compiled_runs):
     """The step-size limit is a solver setting, not the model: for every max_step the compiled run
@@ -231,11 +262,12 @@ def test_chain_of_a_nonfinite_trial_stage_is_not_a_number():
     chain = reference.ChainNumpy(scene)
     n = chain.n
     Jk, dJk = np.full(n + 1, 0.1), np.zeros(n + 1)
-    a, S, eta = chain.solve(Jk, dJk, np.full(n + 1, 10.0), 100.0, 1.0)
+    a, S, eta, L = chain.solve((Jk, dJk, np.full(n + 1, 10.0)), 100.0, 1.0)
     assert np.isfinite(a) and np.all(np.isfinite(S))  # (a finite state: a number)
     for Mk in (np.array([np.inf] + [0.0] * n), np.array([1e308] * (n + 1))):
-        a, S, eta = chain.solve(Jk, dJk, Mk, 100.0, 1.0)
+        a, S, eta, L = chain.solve((Jk, dJk, Mk), 100.0, 1.0)
         assert np.isnan(a) and np.all(np.isnan(S)) and np.all(np.isnan(eta))
+        assert np.all(np.isnan(L))
 
 
 def test_a_segment_started_on_a_governor_corner_does_not_stop_at_once(monkeypatch):

@@ -40,10 +40,12 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("solver.method", "the reference path (scipy-*) follows the power-flow "
                                           "policy only; use method = \"dop853\" or \"dopri5\" "
                                           "with policy \"paper\"")
-    if any(p.model == "reaction" for p in scene.friction.pairs) and not compiled:
-        raise SceneError("solver.method", f"friction on the reactions runs on the compiled "
-                                          f"methods ({', '.join(COMPILED_METHODS)}), not "
-                                          f"{sv.method!r}")
+    if (any(p.model == "reaction" for p in scene.friction.pairs) and not compiled
+            and scene.mechanism.name != "crank-slider"):
+        raise SceneError("solver.method", f"friction on the reactions of a "
+                                          f"{scene.mechanism.name} runs on the compiled methods "
+                                          f"({', '.join(COMPILED_METHODS)}), not {sv.method!r} "
+                                          f"(the reference path has the crank-slider's)")
     if any(p.model == "table" for p in scene.friction.pairs) and not compiled:
         raise SceneError("solver.method", f"efficiency maps run on the compiled methods "
                                           f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")
