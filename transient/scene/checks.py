@@ -44,6 +44,11 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("solver.method", f"friction on the reactions runs on the compiled "
                                           f"methods ({', '.join(COMPILED_METHODS)}), not "
                                           f"{sv.method!r}")
+    if (any(p.model == "reaction" for p in scene.friction.pairs)
+            and sv.kinematics == "tabulated" and scene.mechanism.name != "crank-slider"):
+        raise SceneError("solver.kinematics", f"friction on the reactions of the "
+                                              f"{scene.mechanism.name!r} mechanism takes its "
+                                              f"exact kinematics; use kinematics = \"exact\"")
     if any(p.model == "table" for p in scene.friction.pairs) and not compiled:
         raise SceneError("solver.method", f"efficiency maps run on the compiled methods "
                                           f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")

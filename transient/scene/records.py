@@ -438,7 +438,8 @@ class Pair:
     eta_backward: float
     name: str = ""
     #: ``"constant-eta"`` (the efficiencies above) or ``"reaction"``: friction on the joint's
-    #: reaction (crank-slider only, :mod:`transient.core.joint_friction`; then η is unused, 1).
+    #: reaction (crank-slider and articulated, :mod:`transient.core.reactions`; then η is
+    #: unused, 1).
     model: str = "constant-eta"
     #: Reaction model: friction coefficient μ [1] (journal: friction-circle μ·r·|R|; slider:
     #: μ·|N| on the side force).
