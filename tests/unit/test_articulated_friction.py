@@ -171,3 +171,11 @@ def test_no_joint_reverses_between_breakpoints():
         assert min(gap[i], 2 * np.pi - gap[i]) <= 1e-9 and model.bp_jump[i]
     assert model.reaction and list(model.rx_pair) == list(range(N_JOINTS))
     assert len(reversal) > 4 * (1 + mech.n_slaves)  # the slaves' own reversals are there
+
+
+def test_reaction_pairs_survive_the_resolved_scene():
+    from transient.scene import to_toml
+    scene = load_scene(CASES / "radial_5cyl_reaction_friction.toml")
+    back = load_scene("resolved.toml", text=to_toml(scene))
+    assert back.friction == scene.friction
+    assert [p.between for p in back.friction.pairs] == list(scene.mechanism.reaction_joints)
