@@ -16,8 +16,8 @@ from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
 from .core import variation as var
 from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER, PHI, POWER_FLOW,
-                          RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
+from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER, PHI,
+                          POWER_FLOW, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
                           TABULATED, Model, T, extras_of, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .mechanisms import reaction_joints

@@ -30,6 +30,7 @@ from .core.forcing import generator_branch, load_segment
 from .core.layout import T
 from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
+from .mechanisms.articulated import positions
 
 
 class ChainNumpy:
@@ -870,7 +871,6 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
     turn contracts by about μ, so a few dozen turns). The directions are the relative rates' signs
     at ``sel`` (default φ) times σ (default sign ω).
     """
-    from .mechanisms.articulated import positions
     jp = np.asarray(coefficients, dtype=np.float64)
     sigma = float(np.sign(omega)) if sigma is None else sigma
     sel = phi if sel is None else sel
@@ -919,7 +919,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
     n = rows * per_row + (1 if unknown_eps else 0)
     ie = n - 1
 
-    def acc(p, k):  # acceleration of point p = (pos, p′, p″): constant part, ε coefficient
+    def acc(p):  # acceleration of point p = (pos, p′, p″): constant part, ε coefficient
         return p[2] * w2, p[1]
 
     # friction state (from the previous solve): moments on the outer bodies, slider forces
@@ -940,7 +940,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
             B = K["B"][0]
             t0, t0b = K["t0"]
             # throw: F_O − F_A = m_k a_A;  −A × F_A + M_sh = m_k A × a_A + M_A − M_O
-            aA0, aA1 = acc(K["A"], j)
+            aA0, aA1 = acc(K["A"])
             e = o
             Amat[e, iFO], Amat[e, iFA] = 1.0, -1.0
             Amat[e + 1, iFO + 1], Amat[e + 1, iFA + 1] = 1.0, -1.0
@@ -978,7 +978,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
                 rhs[e + 2] += i0 * t0 * epsilon
             # master piston: F_B0 + N ŷ + (F_s − P) x̂ = m_p a_B
             k = j * (1 + ns)
-            aB0, aB1 = acc(K["B"], j)
+            aB0, aB1 = acc(K["B"])
             e = o + 6
             Amat[e, iFB], Amat[e + 1, iFB + 1], Amat[e + 1, iN] = 1.0, 1.0, 1.0
             rhs[e] = m_p * aB0.real + P[k] - F_s[k]
@@ -1014,7 +1014,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
                 # slave piston: F_Bi + N_i m_i + (F_s − P) d_i = m_p a_Bi
                 d = d_s[i]
                 mi = 1j * d
-                aB0, aB1 = acc(S_["B"], j)
+                aB0, aB1 = acc(S_["B"])
                 Amat[q + 3, iFb], Amat[q + 4, iFb + 1] = 1.0, 1.0
                 Amat[q + 3, iNi], Amat[q + 4, iNi] = mi.real, mi.imag
                 rhs[q + 3] = m_p * aB0.real - (F_s[k] - P[k]) * d.real

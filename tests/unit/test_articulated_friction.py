@@ -1,5 +1,5 @@
-"""Friction on the articulated mechanism's joint reactions (:mod:`transient.core.articulated_friction`)
-against the Newton–Euler model written separately in numpy
+"""Friction on the articulated mechanism's joint reactions
+(:mod:`transient.core.articulated_friction`) against the Newton–Euler model written separately in numpy
 (:func:`transient.reference.articulated_joint_forces`: its own loop-closure kinematics, every
 body's equations of a row as one linear system with φ̈ among the unknowns, the friction iterated
 to a fixed point).
@@ -33,7 +33,7 @@ from transient.core.layout import (N_JOINTS, N_RX_PAR, N_WK, RX_MU, RX_RADIUS, R
                                    RX_RING_PRESSURE, RX_VISCOUS, WK_AX, WK_ETA, WK_RX, WK_S)
 from transient.mechanisms.articulated import _slave_rates
 from transient.reference import articulated_joint_forces
-from transient.scene import load_scene
+from transient.scene import load_scene, to_toml
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RTOL = 1e-12
@@ -174,7 +174,6 @@ def test_no_joint_reverses_between_breakpoints():
 
 
 def test_reaction_pairs_survive_the_resolved_scene():
-    from transient.scene import to_toml
     scene = load_scene(CASES / "radial_5cyl_reaction_friction.toml")
     back = load_scene("resolved.toml", text=to_toml(scene))
     assert back.friction == scene.friction

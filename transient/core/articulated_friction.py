@@ -34,10 +34,10 @@ with F_sk the slider's friction along d_k, D the rods' masses times their accele
 (the master rod's point masses at B and A and its rigid part at G; each slave rod rigid) and H
 their rates of angular momentum about the piston pin (Σ (p − B) × m a_p + I θ̈). T is the
 throw's torque on the shaft and the shaft obeys J₀ ε = M_shaft + Σ_rows T. Without friction T
-summed over the rows is J(φ)ε + ½J′ω² − M_gas less J₀ ε, the reduced model's (Lagrange:
-``tests/unit/test_articulated_friction.py`` checks it). ``transient.reference.articulated_joint_forces``
-solves the same bodies as one linear system per state, its kinematics by its own loop-closure
-analysis: the independent check.
+summed over the rows is M_gas − J(φ)ε − ½J′ω² with J the mechanism's part of the reduced
+inertia, the reduced model's (Lagrange: ``tests/unit/test_articulated_friction.py`` checks it).
+``transient.reference.articulated_joint_forces`` solves the same bodies as one linear system
+per state, its kinematics by its own loop-closure analysis: the independent check.
 
 The exact solve
 ---------------
@@ -84,7 +84,6 @@ from .jit import kernel
 from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0, SLAVE_CG,
                           SLAVE_I, SLAVE_L, SLAVE_PISTON, SLAVE_ROD, SLAVE_STRIDE, master_rod,
                           row0, slave)
-from .chain import LOCKED, UNIQUE
 from .crank_slider import I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, R, ROD_CG
 from .joint_friction import MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_AX,

@@ -132,7 +132,8 @@ class Articulated:
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, then the
     #: rods with the pistons and gas forces.
     links = ("shaft", "crank", "rod")
-    #: Links for pairs with friction on their reactions (:mod:`transient.core.articulated_friction`).
+    #: Links for pairs with friction on their reactions
+    #: (:mod:`transient.core.articulated_friction`).
     reaction_links = ("shaft", "crank", "master rod", "slave rod", "piston", "cylinder")
     #: The joints such a pair may name, in the order of ``articulated_friction.J_*``: the main
     #: bearings, the master crankpins, the link pins, the master piston pins, the slave piston
