@@ -1,6 +1,6 @@
 """Friction on the articulated mechanism's joint reactions
-(:mod:`transient.core.articulated_friction`) against the Newton–Euler model written separately in numpy
-(:func:`transient.reference.articulated_joint_forces`: its own loop-closure kinematics, every
+(:mod:`transient.core.articulated_friction`) against the Newton–Euler model written separately in
+numpy (:func:`transient.reference.articulated_joint_forces`: its own loop-closure kinematics, every
 body's equations of a row as one linear system with φ̈ among the unknowns, the friction iterated
 to a fixed point).
 

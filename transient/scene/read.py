@@ -549,9 +549,9 @@ def _check_wedging_articulated(s: Section, mech, pairs: list[Pair], raw: list) -
     """Friction must not wedge a rod of the articulated mechanism: as for the crank-slider
     (:func:`_check_wedging`), each rod's equation in its piston's side force has a slope of at
     least c (1 − q), q = μ_slider tan β_max + (μ r of its two pins)(1 + μ_slider)/c with
-    c = l cos β_max at its largest angle to its cylinder (the master rod: sin β_max = λ; slave rod i: its link
-    pin's largest offset from its axis over l_i, ``slave_reach``); q < 1 for every rod keeps the
-    row's equations solvable (``transient.core.articulated_friction``)."""
+    c = l cos β_max at its largest angle to its cylinder (the master rod: sin β_max = λ; slave
+    rod i: its link pin's largest offset from its axis over l_i, ``slave_reach``); q < 1 for
+    every rod keeps the row's equations solvable (``transient.core.articulated_friction``)."""
     by_joint = {p.between: p for p in pairs}
     joints = mech.reaction_joints
 
