@@ -9,6 +9,8 @@ against what holds independently of the friction model:
 * **No friction**: all coefficients zero, the losses are exactly zero and the motion is the
   scene's without pairs (solved as (18)) to ~ the solver's tolerance (bound 1e-6 of ω).
 * **The case**: its steady budget closes and names the pair that loses most, the pistons.
+* **Prescribed speed** (inverse dynamics): the drive torque and each pair's S and loss are the
+  Newton–Euler reference's at every state checked, to rounding.
 * **At rest** (the stuck mode, :mod:`transient.core.stuck`): without gas, the joints' friction
   holds a drive between M₋ and M₊, computed by the independent static Newton–Euler
   (:func:`transient.reference.articulated_joint_forces` at ω = φ̈ = 0 with the friction opposing
@@ -25,7 +27,7 @@ import pytest
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
-from transient.run import integrate
+from transient.run import integrate, prescribed
 from transient.reference import articulated_joint_forces
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 
@@ -149,3 +151,29 @@ def test_the_joints_release_the_radial_at_the_newton_euler_hold(gas):
         after = tr["t"] > t_rel + 0.05
         assert np.all(sign * tr["omega"][after][:5] > 0.0)
         losses_nonnegative(scene, tr)
+
+
+def test_prescribed_speed_drive_is_the_newton_euler_torque():
+    """Inverse dynamics at 1500 rpm (the efficiency study's path): at every tenth sample the drive
+    torque, each pair's S and its power lost are the reference's at that state (gas forces from
+    the run's pressures, φ̈ = 0), to 1e-12 of the largest torque."""
+    scene = reaction_case(run=Run(mode="prescribed-speed", speed=1500 * np.pi / 30.0,
+                                  revolutions=2.0),
+                          initial=Initial(0.3, 1500 * np.pi / 30.0))
+    tr = prescribed(scene).trajectory
+    model, _, _ = build_model(scene)
+    mech = scene.mechanism
+    worst = 0.0
+    for i in range(0, tr["phi"].size, 10):
+        P = np.array([(tr[f"p_{k + 1}"][i] - scene.gas.p0) * mech.piston_area
+                      for k in range(mech.n_cylinders)])
+        w = tr["omega"][i]
+        ref = articulated_joint_forces(mech, tr["phi"][i], w, P, model.rx_par, epsilon=0.0)
+        scale = np.abs(ref.throw_torque).sum() + abs(tr["M_load"][i])
+        errs = [abs(tr["M_drive"][i] + tr["M_load"][i] + ref.throw_torque.sum()) / scale]
+        for k in range(N_PAIRS):
+            errs.append(abs(tr[f"S_{k + 1}"][i] - ref.S[k]) / scale)
+            errs.append(abs(tr[f"P_loss_{k + 1}"][i] - ref.L[k] * w) / (scale * w))
+        worst = max(worst, *errs)
+        assert max(errs) <= 1e-12, (i, errs)
+    print(f"largest relative difference {worst:.1e}")
