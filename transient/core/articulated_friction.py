@@ -121,7 +121,7 @@ def _sign(x):
 def prepare(mp, phi, w, sel, wk):
     """The rows of the state (φ, ω) for :func:`solve`: per cylinder its rod's geometry and the
     parts of the accelerations, per row the crankpin's; the joints' directions at ``sel`` when
-    ``sel`` has changed."""
+    ``sel`` has changed (:func:`_directions`)."""
     c = WK_AX
     r, l = mp[R], mp[L]
     ns = int(mp[N_SLAVES])
@@ -129,80 +129,87 @@ def prepare(mp, phi, w, sel, wk):
     f = mp[ROD_CG] / l
     m_pin, m_cp, m_rod, i_rod = mp[M_PIN], mp[M_CRANKPIN], mp[M_ROD], mp[I_ROD]
     w2 = w * w
-    new_sel = wk[c + A_SEL, 0] != sel
     for j in range(int(mp[N_ROWS])):
         k0 = j * (1 + ns)
-        for at_sel in range(2):
-            if at_sel == 1 and not new_sel:
-                break
-            alpha = (sel if at_sel else phi) - mp[j0 + j]
-            ca, sa, cb, sb, db, ddb = master_rod(alpha, r, l)
-            x1 = -r * sa - l * sb * db  # X₀′ = −s′ (Semenov (31), Gots (12))
-            if at_sel:
-                wk[c + A_SS, k0] = _sign(x1)
-                wk[c + A_SP, k0] = _sign(-db)
-                wk[c + A_SJ, k0] = _sign(-db - 1.0)
+        ca, sa, cb, sb, db, ddb = master_rod(phi - mp[j0 + j], r, l)
+        x1 = -r * sa - l * sb * db  # X₀′ = −s′ (Semenov (31), Gots (12))
+        x2 = -r * ca - l * cb * db * db - l * sb * ddb
+        ax, ay = r * ca, r * sa
+        lx, ly = -l * cb, l * sb  # A − B
+        wk[c + A_LX, k0] = lx
+        wk[c + A_LY, k0] = ly
+        wk[c + A_DX, k0] = x1
+        wk[c + A_DT, k0] = -db
+        wk[c + A_AX, k0] = ax
+        wk[c + A_AY, k0] = ay
+        for part in range(2):  # 0: the ω² terms at ε = 0; 1: the slope in ε
+            if part == 0:
+                aax, aay, abx, tdd = -ax * w2, -ay * w2, x2 * w2, -ddb * w2
             else:
-                x2 = -r * ca - l * cb * db * db - l * sb * ddb
-                ax, ay = r * ca, r * sa
-                lx, ly = -l * cb, l * sb  # A − B
-                wk[c + A_LX, k0] = lx
-                wk[c + A_LY, k0] = ly
-                wk[c + A_DX, k0] = x1
-                wk[c + A_DT, k0] = -db
-                wk[c + A_AX, k0] = ax
-                wk[c + A_AY, k0] = ay
-                for part in range(2):  # 0: the ω² terms at ε = 0; 1: the slope in ε
-                    if part == 0:
-                        aax, aay, abx, tdd = -ax * w2, -ay * w2, x2 * w2, -ddb * w2
-                    else:
-                        aax, aay, abx, tdd = -ay, ax, x1, -db
-                    agx = (1.0 - f) * abx + f * aax
-                    agy = f * aay
-                    wk[c + A_AB0 + part, k0] = abx
-                    wk[c + A_AAX0 + part, k0] = aax
-                    wk[c + A_AAY0 + part, k0] = aay
-                    wk[c + A_DX0 + part, k0] = m_pin * abx + m_cp * aax + m_rod * agx
-                    wk[c + A_DY0 + part, k0] = m_cp * aay + m_rod * agy
-                    wk[c + A_H0 + part, k0] = (_cross(lx, ly, m_cp * aax, m_cp * aay)
-                                               + f * _cross(lx, ly, m_rod * agx, m_rod * agy)
-                                               + i_rod * tdd)
-            for i in range(ns):
-                k = k0 + 1 + i
-                s0 = SLAVE0 + SLAVE_STRIDE * i
-                X, X1, X2, a1x, a1y, a2x, a2y, t1, t2 = slave(mp, i, r, ca, sa, cb, sb, db, ddb)
-                if at_sel:
-                    wk[c + A_SS, k] = _sign(X1)
-                    wk[c + A_SP, k] = _sign(t1)
-                    wk[c + A_SJ, k] = _sign(t1 + db)
-                    continue
-                cd, sd = mp[s0 + COS_D], mp[s0 + SIN_D]
-                a, q = mp[s0 + LINK_A], mp[s0 + LINK_Q]
-                ox, oy = a * cb + q * sb, q * cb - a * sb  # A_i − A = a e + q n
-                lx, ly = r * ca + ox - X * cd, r * sa + oy - X * sd  # A_i − B_i
-                fi = mp[s0 + SLAVE_CG] / mp[s0 + SLAVE_L]
-                ms, i_s = mp[s0 + SLAVE_ROD], mp[s0 + SLAVE_I]
-                wk[c + A_LX, k] = lx
-                wk[c + A_LY, k] = ly
-                wk[c + A_DX, k] = X1
-                wk[c + A_DT, k] = t1
-                wk[c + A_OX, k] = ox
-                wk[c + A_OY, k] = oy
-                wk[c + A_PX, k] = a1x
-                wk[c + A_PY, k] = a1y
-                for part in range(2):
-                    if part == 0:
-                        aix, aiy, abx, tdd = a2x * w2, a2y * w2, X2 * w2, t2 * w2
-                    else:
-                        aix, aiy, abx, tdd = a1x, a1y, X1, t1
-                    agx = (1.0 - fi) * abx * cd + fi * aix
-                    agy = (1.0 - fi) * abx * sd + fi * aiy
-                    wk[c + A_AB0 + part, k] = abx
-                    wk[c + A_DX0 + part, k] = ms * agx
-                    wk[c + A_DY0 + part, k] = ms * agy
-                    wk[c + A_H0 + part, k] = fi * _cross(lx, ly, ms * agx, ms * agy) + i_s * tdd
-    if new_sel:
-        wk[c + A_SEL, 0] = sel
+                aax, aay, abx, tdd = -ay, ax, x1, -db
+            agx = (1.0 - f) * abx + f * aax
+            agy = f * aay
+            wk[c + A_AB0 + part, k0] = abx
+            wk[c + A_AAX0 + part, k0] = aax
+            wk[c + A_AAY0 + part, k0] = aay
+            wk[c + A_DX0 + part, k0] = m_pin * abx + m_cp * aax + m_rod * agx
+            wk[c + A_DY0 + part, k0] = m_cp * aay + m_rod * agy
+            wk[c + A_H0 + part, k0] = (_cross(lx, ly, m_cp * aax, m_cp * aay)
+                                       + f * _cross(lx, ly, m_rod * agx, m_rod * agy)
+                                       + i_rod * tdd)
+        for i in range(ns):
+            k = k0 + 1 + i
+            s0 = SLAVE0 + SLAVE_STRIDE * i
+            X, X1, X2, a1x, a1y, a2x, a2y, t1, t2 = slave(mp, i, r, ca, sa, cb, sb, db, ddb)
+            cd, sd = mp[s0 + COS_D], mp[s0 + SIN_D]
+            a, q = mp[s0 + LINK_A], mp[s0 + LINK_Q]
+            ox, oy = a * cb + q * sb, q * cb - a * sb  # A_i − A = a e + q n
+            lx, ly = ax + ox - X * cd, ay + oy - X * sd  # A_i − B_i
+            fi = mp[s0 + SLAVE_CG] / mp[s0 + SLAVE_L]
+            ms, i_s = mp[s0 + SLAVE_ROD], mp[s0 + SLAVE_I]
+            wk[c + A_LX, k] = lx
+            wk[c + A_LY, k] = ly
+            wk[c + A_DX, k] = X1
+            wk[c + A_DT, k] = t1
+            wk[c + A_OX, k] = ox
+            wk[c + A_OY, k] = oy
+            wk[c + A_PX, k] = a1x
+            wk[c + A_PY, k] = a1y
+            for part in range(2):
+                if part == 0:
+                    aix, aiy, abx, tdd = a2x * w2, a2y * w2, X2 * w2, t2 * w2
+                else:
+                    aix, aiy, abx, tdd = a1x, a1y, X1, t1
+                agx = (1.0 - fi) * abx * cd + fi * aix
+                agy = (1.0 - fi) * abx * sd + fi * aiy
+                wk[c + A_AB0 + part, k] = abx
+                wk[c + A_DX0 + part, k] = ms * agx
+                wk[c + A_DY0 + part, k] = ms * agy
+                wk[c + A_H0 + part, k] = fi * _cross(lx, ly, ms * agx, ms * agy) + i_s * tdd
+    if wk[c + A_SEL, 0] != sel:
+        _directions(mp, sel, wk)
+
+
+@kernel
+def _directions(mp, sel, wk):
+    """The signs at the angle ``sel`` of each cylinder's slider rate X′, its piston pin's and its
+    big end's (crankpin or link pin) relative rate, per unit σ."""
+    c = WK_AX
+    r, l = mp[R], mp[L]
+    ns = int(mp[N_SLAVES])
+    j0 = row0(mp)
+    for j in range(int(mp[N_ROWS])):
+        k0 = j * (1 + ns)
+        ca, sa, cb, sb, db, ddb = master_rod(sel - mp[j0 + j], r, l)
+        wk[c + A_SS, k0] = _sign(-r * sa - l * sb * db)
+        wk[c + A_SP, k0] = _sign(-db)
+        wk[c + A_SJ, k0] = _sign(-db - 1.0)
+        for i in range(ns):
+            _, X1, _, _, _, _, _, t1, _ = slave(mp, i, r, ca, sa, cb, sb, db, ddb)
+            wk[c + A_SS, k0 + 1 + i] = _sign(X1)
+            wk[c + A_SP, k0 + 1 + i] = _sign(t1)
+            wk[c + A_SJ, k0 + 1 + i] = _sign(t1 + db)
+    wk[c + A_SEL, 0] = sel
 
 
 @kernel
