@@ -10,7 +10,9 @@ cut-out are terminal events of solve_ivp, so every segment between them is smoot
 
 The joint forces of a crank-slider (:func:`crank_slider_joint_forces`) are that model's
 reactions by Newton–Euler, body by body, for a prescribed motion: what the analyses' force
-relations and the reduced model's torque are checked against.
+relations and the reduced model's torque are checked against. Those of the articulated mechanism
+(:func:`articulated_joint_forces`) add the friction on its joints and may solve for φ̈: what its
+compiled reaction-friction solve is checked against.
 """
 from __future__ import annotations
 
