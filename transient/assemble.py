@@ -16,10 +16,11 @@ from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
 from .core import variation as var
 from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_JOINTS, N_RX_PAR, PAPER,
-                          PHI, POWER_FLOW, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
+from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER, PHI,
+                          POWER_FLOW, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
                           TABULATED, Model, T, extras_of, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
+from .mechanisms import reaction_joints
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
 from .forces.trapezoid import trapezoid_table
 
@@ -526,8 +527,8 @@ def chain_fields(scene) -> dict:
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
         link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
-        reaction=False, rx_par=np.zeros((N_RX_JOINTS, N_RX_PAR)),
-        rx_pair=np.full(N_RX_JOINTS, -1, dtype=np.int64),
+        reaction=False, rx_par=np.zeros((N_JOINTS, N_RX_PAR)),
+        rx_pair=np.full(N_JOINTS, -1, dtype=np.int64),
         **eta_table_fields(friction.pairs))
 
 
@@ -570,15 +571,16 @@ def reaction_friction(scene) -> bool:
 
 
 def reaction_fields(scene) -> dict:
-    """The chain's part of the Model with reaction friction (:mod:`transient.core.joint_friction`):
+    """The chain's part of the Model with reaction friction (:mod:`transient.core.reactions`):
     no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
-    ``reaction_links`` (main bearing, crankpin, piston pin, slider) has its pair's coefficients
-    and reports as that pair."""
+    the mechanism's ``reaction_joints`` (:func:`transient.mechanisms.reaction_joints`) has its
+    pair's coefficients and reports as that pair."""
     mech, pairs = scene.mechanism, scene.friction.pairs
-    rx_par = np.zeros((N_RX_JOINTS, N_RX_PAR))
-    rx_pair = np.full(N_RX_JOINTS, -1, dtype=np.int64)
+    joints = reaction_joints(mech)
+    rx_par = np.zeros((N_JOINTS, N_RX_PAR))
+    rx_pair = np.full(N_JOINTS, -1, dtype=np.int64)
     for k, p in enumerate(pairs):
-        j = mech.reaction_links.index(p.between[0])
+        j = joints.index(tuple(p.between))
         rx_pair[j] = k
         rx_par[j, RX_MU] = p.mu
         rx_par[j, RX_RADIUS] = p.radius
@@ -596,10 +598,16 @@ def reaction_fields(scene) -> dict:
 def reaction_breakpoints(scene) -> NDArray[np.float64]:
     """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction):
     each piston's dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α),
-    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``)."""
+    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``).
+    The articulated mechanism gives the local angles of a row where any of its joints reverses
+    (``Articulated.reaction_reversals``), repeated at each row's phase."""
     mech = scene.mechanism
-    tdc, bdc = mech.dead_centre_angles()
-    local = np.array([tdc, 0.5 * math.pi, bdc, 1.5 * math.pi])
     turns = np.arange(0.0, mech.cycle - 1e-9, 2.0 * math.pi)
-    angles = np.add.outer(np.asarray(mech.firing_angles), np.add.outer(turns, local)).ravel()
+    if hasattr(mech, "reaction_reversals"):
+        local, phases = mech.reaction_reversals(), np.asarray(mech.row_phases)
+    else:
+        tdc, bdc = mech.dead_centre_angles()
+        local = np.array([tdc, 0.5 * math.pi, bdc, 1.5 * math.pi])
+        phases = np.asarray(mech.firing_angles)
+    angles = np.add.outer(phases, np.add.outer(turns, local)).ravel()
     return np.unique(np.mod(angles, mech.cycle))

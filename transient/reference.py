@@ -10,7 +10,9 @@ cut-out are terminal events of solve_ivp, so every segment between them is smoot
 
 The joint forces of a crank-slider (:func:`crank_slider_joint_forces`) are that model's
 reactions by Newton–Euler, body by body, for a prescribed motion: what the analyses' force
-relations and the reduced model's torque are checked against.
+relations and the reduced model's torque are checked against. Those of the articulated mechanism
+(:func:`articulated_joint_forces`) add the friction on its joints and may solve for φ̈: what its
+compiled reaction-friction solve is checked against.
 """
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ from .core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, R
                            RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
 from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
+from .mechanisms.articulated import positions
 
 
 class ChainNumpy:
@@ -962,3 +965,323 @@ def _at_acceleration(both: JointForces, eps: float) -> JointForces:
         return v[..., :1] + eps * (v[..., 1:2] - v[..., :1])
     return JointForces(*(at(getattr(both, f)) for f in
                          ("main", "crankpin", "pin", "N", "S", "throw_torque")))
+# Joint forces of the articulated mechanism by Newton–Euler, with friction on the joints
+
+
+@dataclass(frozen=True)
+class ArticulatedForces:
+    """The joint forces of an articulated mechanism at one state, from
+    :func:`articulated_joint_forces`; vectors ``(2, …)`` in each row's frame
+    (:mod:`transient.core.articulated`: x along the row's master cylinder, y a quarter-turn on
+    in the direction of rotation), cylinders numbered as the mechanism numbers them.
+
+    Attributes
+    ----------
+    epsilon : φ̈ [rad/s²] (the prescribed one, or the solution of the shaft's equation).
+    N : (n_cyl,) the wall's side force on each piston along ẑ × (its axis) [N].
+    pin : (2, n_cyl) each rod's force on its piston [N].
+    big_end : (2, n_cyl) at the master cylinders the throw's force on the master rod at the
+        crankpin, at the slaves the master rod's on the slave rod at its link pin [N].
+    main : (2, rows) the frame's force on each throw [N].
+    throw_torque : (rows,) each throw's moment on the shaft, positive in the direction of
+        rotation [N m].
+    S, L : (6,) per joint (main bearings, crankpins, link pins, master pins, slave pins,
+        pistons) summed over the rows: the moment the shaft side puts into the joint and the
+        loss moment [N m] (powers over ω, as ``transient.core.articulated_friction`` defines
+        them).
+    iterations : fixed-point turns taken by the friction.
+    """
+
+    epsilon: float
+    N: NDArray[np.float64]
+    pin: NDArray[np.float64]
+    big_end: NDArray[np.float64]
+    main: NDArray[np.float64]
+    throw_torque: NDArray[np.float64]
+    S: NDArray[np.float64]
+    L: NDArray[np.float64]
+    iterations: int
+
+
+def _loop_rates(ap: complex, app: complex, rod: float, u: complex, d: complex,
+                t1: float | None = None) -> tuple[float, float]:
+    """A loop P + rod·u = X d (u = e^{iθ}, d fixed): (θ′, X′) from P′ = ``ap`` when ``t1`` is
+    None, else (θ″, X″) from P″ = ``app`` and θ′ = ``t1``: i rod u θ″ − rod u θ′² + P″ = X″ d."""
+    c1, c2 = 1j * rod * u, -d
+    rhs = -ap if t1 is None else -(app - rod * u * t1 * t1)
+    A = np.array([[c1.real, c2.real], [c1.imag, c2.imag]])
+    x = np.linalg.solve(A, np.array([rhs.real, rhs.imag]))
+    return float(x[0]), float(x[1])
+
+
+def _cross2(a: complex, b: complex) -> float:
+    return a.real * b.imag - a.imag * b.real
+
+
+def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coefficients,
+                             sigma: float | None = None, epsilon: float | None = None,
+                             J0: float = 0.0, M_shaft: float = 0.0, turns: int = 400,
+                             sel: float | None = None) -> ArticulatedForces:
+    """Joint forces of an articulated mechanism (radial or V) at one state by Newton–Euler, with
+    friction on its joints: the independent check of ``transient.core.articulated_friction``.
+
+    Each row is 3 + 2 + 5 z′ bodies' equations — the throw (mass m_k at the crankpin: Newton and
+    Euler about O, with the shaft's moment on it unknown), the master rod (rigid: mass at its
+    centre of mass, inertia about it; a two-mass rod is the rigid one with I = m c(l − c)), the
+    master piston (Newton along and across its axis, the wall's side force unknown), each slave
+    rod and slave piston alike — linear in the joint forces and in φ̈ when the friction moments
+    are known; with ``epsilon`` None, φ̈ is an unknown too and the shaft's J₀ φ̈ = M_shaft + Σ T
+    closes the system. The kinematics are written out here by loop closure, not from the kernel:
+    positions from :func:`transient.mechanisms.articulated.positions`, and per loop (crankpin →
+    master piston pin on the x axis; link pin → slave piston pin on its axis) the rod's rate and
+    the piston's from the loop's derivative, two linear equations, and their derivatives from the
+    loop's second derivative.
+
+    The friction (``coefficients`` = the (6, 5) rows of ``Model.rx_par``: per joint μ, radius,
+    viscous, ring force, ring pressure share) acts as the module docstring of
+    ``transient.core.articulated_friction`` states it, on the forces of the previous solve: a plain
+    fixed point, repeated until nothing changes by more than 1e-15 of the largest force (each
+    turn contracts by about μ, so a few dozen turns). The directions are the relative rates' signs
+    at ``sel`` (default φ) times σ (default sign ω).
+    """
+    jp = np.asarray(coefficients, dtype=np.float64)
+    sigma = float(np.sign(omega)) if sigma is None else sigma
+    sel = phi if sel is None else sel
+    ns, rows = mech.n_slaves, mech.rows
+    nc = rows * (1 + ns)
+    r, l = mech.crank_radius, mech.rod_length
+    P = np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (nc,))
+    m_k, m_p = mech.crank_mass, mech.piston_mass
+    m0, c0 = mech.rod_mass, mech.rod_cg_from_pin
+    i0 = mech.rod_inertia_cg if mech.rod_model == "rigid" else m0 * c0 * (l - c0)
+    ms, cs = mech.slave_rod_mass, mech.slave_rod_cg_from_pin
+    li = np.asarray(mech.slave_lengths)
+    i_s = (np.full(ns, mech.slave_rod_inertia_cg) if mech.slave_rod_model == "rigid"
+           else ms * cs * (li - cs))
+    d_s = np.exp(1j * np.asarray(mech.slave_banks))
+    z_s = np.asarray(mech.link_radii) * np.exp(1j * np.asarray(mech.link_angles))
+
+    def kinematics(alpha):
+        """Per row: points (position, first, second derivative in α) and rod rates."""
+        pos = positions(mech, alpha)
+        A = pos["A"][0]
+        Ap, App = 1j * A, -A
+        B = pos["B"][0]
+        u0 = (B - A) / l
+        t0, x0 = _loop_rates(Ap, 0j, l, u0, 1.0 + 0j)
+        t0b, x0b = _loop_rates(Ap, App, l, u0, 1.0 + 0j, t0)
+        out = {"A": (A, Ap, App), "B": (B, x0 + 0j, x0b + 0j), "t0": (t0, t0b), "slaves": []}
+        for i in range(ns):
+            Ai = pos["Ai"][0, i]
+            Aip = Ap + 1j * z_s[i] * u0 * t0
+            Aipp = App + 1j * z_s[i] * u0 * t0b - z_s[i] * u0 * t0 * t0
+            Bi = pos["Bi"][0, i]
+            ui = (Bi - Ai) / li[i]
+            ti, xi = _loop_rates(Aip, 0j, li[i], ui, d_s[i])
+            tib, xib = _loop_rates(Aip, Aipp, li[i], ui, d_s[i], ti)
+            out["slaves"].append({"A": (Ai, Aip, Aipp), "B": (Bi, xi * d_s[i], xib * d_s[i]),
+                                  "t": (ti, tib), "X1": xi})
+        return out
+
+    phases = np.asarray(mech.row_phases)
+    kin = [kinematics(phi - ph) for ph in phases]
+    at_sel = [kinematics(sel - ph) for ph in phases]
+    w2 = omega * omega
+    unknown_eps = epsilon is None
+    per_row = 8 + 5 * ns
+    n = rows * per_row + (1 if unknown_eps else 0)
+    ie = n - 1
+
+    def acc(p):  # acceleration of point p = (pos, p′, p″): constant part, ε coefficient
+        return p[2] * w2, p[1]
+
+    # friction state (from the previous solve): moments on the outer bodies, slider forces
+    M_O, M_A, M_B0 = np.zeros(rows), np.zeros(rows), np.zeros(rows)
+    M_L, M_Bs = np.zeros((rows, ns)), np.zeros((rows, ns))
+    F_s = np.zeros(nc)
+    mu = jp[:, 0] * jp[:, 1]  # μ r per journal
+    sl_mu, sl_ring, sl_p, sl_c = jp[5, 0], jp[5, 3], jp[5, 4], jp[5, 2]
+    prev = None
+    for it in range(turns):
+        Amat = np.zeros((n, n))
+        rhs = np.zeros(n)
+        for j in range(rows):
+            o = j * per_row
+            K = kin[j]
+            iFO, iM, iFA, iFB, iN = o, o + 2, o + 3, o + 5, o + 7
+            A, Ap, App = K["A"]
+            B = K["B"][0]
+            t0, t0b = K["t0"]
+            # throw: F_O − F_A = m_k a_A;  −A × F_A + M_sh = m_k A × a_A + M_A − M_O
+            aA0, aA1 = acc(K["A"])
+            e = o
+            Amat[e, iFO], Amat[e, iFA] = 1.0, -1.0
+            Amat[e + 1, iFO + 1], Amat[e + 1, iFA + 1] = 1.0, -1.0
+            rhs[e], rhs[e + 1] = m_k * aA0.real, m_k * aA0.imag
+            Amat[e + 2, iFA], Amat[e + 2, iFA + 1] = A.imag, -A.real
+            Amat[e + 2, iM] = 1.0
+            rhs[e + 2] = m_k * _cross2(A, aA0) + M_A[j] - M_O[j]
+            if unknown_eps:
+                Amat[e, ie], Amat[e + 1, ie] = -m_k * aA1.real, -m_k * aA1.imag
+                Amat[e + 2, ie] = -m_k * _cross2(A, aA1)
+            else:
+                rhs[e] += m_k * aA1.real * epsilon
+                rhs[e + 1] += m_k * aA1.imag * epsilon
+                rhs[e + 2] += m_k * _cross2(A, aA1) * epsilon
+            # master rod: F_A − F_B0 − Σ F_Ai = m a_G; about G: moments = I θ̈
+            f = c0 / l
+            G = B + f * (A - B)
+            Gp = (1 - f) * K["B"][1] + f * Ap
+            Gpp = (1 - f) * K["B"][2] + f * App
+            aG0, aG1 = Gpp * w2, Gp
+            e = o + 3
+            Amat[e, iFA], Amat[e, iFB] = 1.0, -1.0
+            Amat[e + 1, iFA + 1], Amat[e + 1, iFB + 1] = 1.0, -1.0
+            ra, rb = A - G, B - G
+            Amat[e + 2, iFA], Amat[e + 2, iFA + 1] = -ra.imag, ra.real
+            Amat[e + 2, iFB], Amat[e + 2, iFB + 1] = rb.imag, -rb.real
+            rhs[e], rhs[e + 1] = m0 * aG0.real, m0 * aG0.imag
+            rhs[e + 2] = i0 * t0b * w2 - M_A[j] - M_B0[j] + M_L[j].sum()
+            if unknown_eps:
+                Amat[e, ie], Amat[e + 1, ie] = -m0 * aG1.real, -m0 * aG1.imag
+                Amat[e + 2, ie] = -i0 * t0
+            else:
+                rhs[e] += m0 * aG1.real * epsilon
+                rhs[e + 1] += m0 * aG1.imag * epsilon
+                rhs[e + 2] += i0 * t0 * epsilon
+            # master piston: F_B0 + N ŷ + (F_s − P) x̂ = m_p a_B
+            k = j * (1 + ns)
+            aB0, aB1 = acc(K["B"])
+            e = o + 6
+            Amat[e, iFB], Amat[e + 1, iFB + 1], Amat[e + 1, iN] = 1.0, 1.0, 1.0
+            rhs[e] = m_p * aB0.real + P[k] - F_s[k]
+            rhs[e + 1] = m_p * aB0.imag
+            if unknown_eps:
+                Amat[e, ie], Amat[e + 1, ie] = -m_p * aB1.real, -m_p * aB1.imag
+            else:
+                rhs[e] += m_p * aB1.real * epsilon
+                rhs[e + 1] += m_p * aB1.imag * epsilon
+            for i, S_ in enumerate(K["slaves"]):
+                q = o + 8 + 5 * i
+                iFa, iFb, iNi = q, q + 2, q + 4
+                k = j * (1 + ns) + 1 + i
+                Ai = S_["A"][0]
+                Bi = S_["B"][0]
+                ti, tib = S_["t"]
+                # the slave's force on the master rod, −F_Ai: in its Newton and its moment
+                Amat[o + 3, iFa], Amat[o + 4, iFa + 1] = -1.0, -1.0
+                rai = Ai - G
+                Amat[o + 5, iFa], Amat[o + 5, iFa + 1] = rai.imag, -rai.real
+                # slave rod: F_Ai − F_Bi = m_s a_Gi; about G_i
+                fi = cs / li[i]
+                Gi = Bi + fi * (Ai - Bi)
+                Gip = (1 - fi) * S_["B"][1] + fi * S_["A"][1]
+                Gipp = (1 - fi) * S_["B"][2] + fi * S_["A"][2]
+                Amat[q, iFa], Amat[q, iFb] = 1.0, -1.0
+                Amat[q + 1, iFa + 1], Amat[q + 1, iFb + 1] = 1.0, -1.0
+                rhs[q], rhs[q + 1] = ms * (Gipp * w2).real, ms * (Gipp * w2).imag
+                ra, rb = Ai - Gi, Bi - Gi
+                Amat[q + 2, iFa], Amat[q + 2, iFa + 1] = -ra.imag, ra.real
+                Amat[q + 2, iFb], Amat[q + 2, iFb + 1] = rb.imag, -rb.real
+                rhs[q + 2] = i_s[i] * tib * w2 - M_L[j, i] - M_Bs[j, i]
+                # slave piston: F_Bi + N_i m_i + (F_s − P) d_i = m_p a_Bi
+                d = d_s[i]
+                mi = 1j * d
+                aB0, aB1 = acc(S_["B"])
+                Amat[q + 3, iFb], Amat[q + 4, iFb + 1] = 1.0, 1.0
+                Amat[q + 3, iNi], Amat[q + 4, iNi] = mi.real, mi.imag
+                rhs[q + 3] = m_p * aB0.real - (F_s[k] - P[k]) * d.real
+                rhs[q + 4] = m_p * aB0.imag - (F_s[k] - P[k]) * d.imag
+                if unknown_eps:
+                    Amat[q, ie], Amat[q + 1, ie] = -ms * Gip.real, -ms * Gip.imag
+                    Amat[q + 2, ie] = -i_s[i] * ti
+                    Amat[q + 3, ie], Amat[q + 4, ie] = -m_p * aB1.real, -m_p * aB1.imag
+                else:
+                    rhs[q] += ms * Gip.real * epsilon
+                    rhs[q + 1] += ms * Gip.imag * epsilon
+                    rhs[q + 2] += i_s[i] * ti * epsilon
+                    rhs[q + 3] += m_p * aB1.real * epsilon
+                    rhs[q + 4] += m_p * aB1.imag * epsilon
+            if unknown_eps:  # the shaft: J₀ ε + Σ M_sh = M_shaft
+                Amat[ie, iM] = 1.0
+        if unknown_eps:
+            Amat[ie, ie] = J0
+            rhs[ie] = M_shaft
+        x = np.linalg.solve(Amat, rhs)
+        eps = x[ie] if unknown_eps else epsilon
+        # the friction of these forces
+        N = np.empty(nc)
+        pin, big, main = np.empty((2, nc)), np.empty((2, nc)), np.empty((2, rows))
+        for j in range(rows):
+            o = j * per_row
+            k = j * (1 + ns)
+            main[:, j] = x[o:o + 2]
+            big[:, k] = x[o + 3:o + 5]
+            pin[:, k] = x[o + 5:o + 7]
+            N[k] = x[o + 7]
+            for i in range(ns):
+                q = o + 8 + 5 * i
+                big[:, k + 1 + i] = x[q:q + 2]
+                pin[:, k + 1 + i] = x[q + 2:q + 4]
+                N[k + 1 + i] = x[q + 4]
+        scale = max(np.abs(x[:ie if unknown_eps else n]).max(), 1.0)
+        if prev is not None and np.max(np.abs(x - prev)) <= 1e-15 * scale and it > 2:
+            break
+        prev = x
+        for j in range(rows):
+            k = j * (1 + ns)
+            t0 = kin[j]["t0"][0]
+            s0 = at_sel[j]["t0"][0]
+            M_O[j] = -sigma * mu[0] * np.hypot(*main[:, j]) - jp[0, 2] * omega
+            M_A[j] = (-np.sign((s0 - 1.0)) * sigma * mu[1] * np.hypot(*big[:, k])
+                      - jp[1, 2] * (t0 - 1.0) * omega)
+            M_B0[j] = -np.sign(s0) * sigma * mu[3] * np.hypot(*pin[:, k]) - jp[3, 2] * t0 * omega
+            x0 = kin[j]["B"][1].real
+            F_s[k] = (-np.sign(at_sel[j]["B"][1].real) * sigma
+                      * (sl_mu * abs(N[k]) + sl_ring + sl_p * max(P[k], 0.0)) - sl_c * x0 * omega)
+            for i in range(ns):
+                ti = kin[j]["slaves"][i]["t"][0]
+                si = at_sel[j]["slaves"][i]["t"][0]
+                M_L[j, i] = (-np.sign(si - s0) * sigma * mu[2] * np.hypot(*big[:, k + 1 + i])
+                             - jp[2, 2] * (ti - t0) * omega)
+                M_Bs[j, i] = (-np.sign(si) * sigma * mu[4] * np.hypot(*pin[:, k + 1 + i])
+                              - jp[4, 2] * ti * omega)
+                xi = kin[j]["slaves"][i]["X1"]
+                F_s[k + 1 + i] = (-np.sign(at_sel[j]["slaves"][i]["X1"]) * sigma
+                                  * (sl_mu * abs(N[k + 1 + i]) + sl_ring
+                                     + sl_p * max(P[k + 1 + i], 0.0)) - sl_c * xi * omega)
+    # throw torques and each joint's S, L
+    T = np.empty(rows)
+    S, L = np.zeros(6), np.zeros(6)
+    for j in range(rows):
+        o = j * per_row
+        k = j * (1 + ns)
+        K = kin[j]
+        T[j] = -x[o + 2]
+        t0 = K["t0"][0]
+        Ap = K["A"][1]
+        fa = complex(*big[:, k])
+        fb = complex(*pin[:, k])
+        S[0] += x[o + 2]
+        L[0] -= M_O[j]
+        S[1] += fa.real * Ap.real + fa.imag * Ap.imag + M_A[j]
+        L[1] -= M_A[j] * (t0 - 1.0)
+        x0 = K["B"][1].real
+        S[3] += fb.real * x0 - M_B0[j] * t0
+        L[3] -= M_B0[j] * t0
+        S[5] -= F_s[k] * x0
+        L[5] -= F_s[k] * x0
+        for i in range(ns):
+            Sl = K["slaves"][i]
+            ti = Sl["t"][0]
+            fa = complex(*big[:, k + 1 + i])
+            fb = complex(*pin[:, k + 1 + i])
+            Aip, Bip = Sl["A"][1], Sl["B"][1]
+            S[2] += fa.real * Aip.real + fa.imag * Aip.imag + M_L[j, i] * t0
+            L[2] -= M_L[j, i] * (ti - t0)
+            S[4] += fb.real * Bip.real + fb.imag * Bip.imag - M_Bs[j, i] * ti
+            L[4] -= M_Bs[j, i] * ti
+            S[5] -= F_s[k + 1 + i] * Sl["X1"]
+            L[5] -= F_s[k + 1 + i] * Sl["X1"]
+    return ArticulatedForces(epsilon=float(eps), N=N, pin=pin, big_end=big, main=main,
+                             throw_torque=T, S=S, L=L, iterations=it + 1)

@@ -28,8 +28,8 @@ import pytest
 from transient.assemble import build_model
 from transient.core import crank_slider as core
 from transient.core import joint_friction as jf
-from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_RX_PAR,
-                                   N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE,
+from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_JOINTS,
+                                   N_RX_PAR, N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE,
                                    RX_VISCOUS, WK_ETA, WK_RX, WK_S)
 from transient.reference import (crank_slider_friction, crank_slider_joint_forces,
                                  crank_slider_joint_signs)
@@ -195,4 +195,4 @@ def test_every_reversal_of_a_joint_is_a_breakpoint_where_the_derivative_jumps():
         i = int(np.argmin(np.minimum(gap, mech.cycle - gap)))
         assert min(gap[i], mech.cycle - gap[i]) <= 1e-12 * mech.cycle, angle
         assert model.bp_jump[i]
-    assert model.reaction and list(model.rx_pair) == [0, 1, 2, 3]
+    assert model.reaction and list(model.rx_pair) == [0, 1, 2, 3] + [-1] * (N_JOINTS - 4)

@@ -511,11 +511,11 @@ def test_invalid_swash_plate_is_one_line_exit_2(tmp_path, capsys, command, old, 
     assert not (tmp_path / "res").exists()
 
 
-@pytest.mark.parametrize("case", ["swash_plate_4cyl.toml", "radial_5cyl.toml"])
+@pytest.mark.parametrize("case", ["swash_plate_4cyl.toml"])
 def test_reaction_friction_where_it_is_not_implemented_is_one_line_exit_2(tmp_path, capsys,
                                                                           case):
-    """Friction on the reactions exists for the crank-slider only: a swash plate's or a radial
-    engine's reaction pair is refused, naming what is allowed."""
+    """Friction on the reactions exists for the crank-slider and the articulated mechanism: a
+    swash plate's reaction pair is refused, naming what is allowed."""
     text = (Path(__file__).resolve().parents[2] / "cases" / case).read_text()
     text = text.split("\n[friction]")[0]
     scene = tmp_path / "bad.toml"
@@ -524,7 +524,47 @@ def test_reaction_friction_where_it_is_not_implemented_is_one_line_exit_2(tmp_pa
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2
     assert_one_line_error(err, scene, "friction.pairs[0].model",
-                          "friction on the reactions is implemented for the crank-slider only")
+                          "friction on the reactions is not implemented for 'swash-plate'")
+
+
+# The radial with friction on its joints' reactions: one pair broken (the case's first, the main
+# bearing, unless said), or a key of the scene.
+RADIAL_REACTION = (CASES_DIR / "radial_5cyl_reaction_friction.toml").read_text()
+MAIN = 'between = ["shaft", "crank"]'
+JOINTS = ("the joints are ['shaft', 'crank'], ['crank', 'master rod'], ['master rod', "
+          "'slave rod'], ['master rod', 'piston'], ['slave rod', 'piston'], ['piston', "
+          "'cylinder']")
+RADIAL_REACTION_CASES = [
+    (MAIN, 'between = ["shaft", "rod"]', "friction.pairs[0].between",
+     "unknown link 'rod'; the links of 'articulated' are shaft, crank, master rod, slave rod, "
+     "piston, cylinder"),
+    (MAIN, 'between = ["crank", "shaft"]', "friction.pairs[0].between",
+     "give the shaft-side link first: ['shaft', 'crank']"),
+    (MAIN, 'between = ["crank", "slave rod"]', "friction.pairs[0].between",
+     "'crank' and 'slave rod' are not joined in 'articulated'; " + JOINTS),
+    (MAIN, 'between = "shaft"', "friction.pairs[0].between", "must be two link names"),
+    (MAIN, 'between = ["crank", "master rod"]', "friction.pairs[1].between",
+     "the same pair as friction.pairs[0]"),
+    ('radius_mm = 50', 'radius_mm = 0', "friction.pairs[0].radius_mm", "must be > 0"),
+    ('ring_force = 50.0', 'ring_force = 50.0\nradius_mm = 20', "friction.pairs[5].radius_mm",
+     "unknown key; allowed here: between, model, mu, name, ring_force, ring_pressure, viscous"),
+    ('mu = 0.0015\nradius_mm = 44', 'mu = 1\nradius_mm = 300', "friction.pairs[1].mu",
+     "the friction would wedge the master rod"),
+    ('[solver]', '[solver]\nkinematics = "tabulated"', "solver.kinematics",
+     "friction on the reactions of the 'articulated' mechanism takes its exact kinematics"),
+]
+
+
+@pytest.mark.parametrize("old, new, key, fragment", RADIAL_REACTION_CASES,
+                         ids=[c[1] for c in RADIAL_REACTION_CASES])
+def test_invalid_radial_reaction_pair_is_one_line_exit_2(tmp_path, capsys, old, new, key,
+                                                         fragment):
+    assert RADIAL_REACTION.count(old) == 1, old
+    scene = tmp_path / "bad.toml"
+    scene.write_text(RADIAL_REACTION.replace(old, new), encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, key, fragment)
 
 
 def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):

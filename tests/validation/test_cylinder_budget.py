@@ -8,6 +8,8 @@ closed forms and a quadrature written here from other columns.
   so each cylinder loses F times the piston's travel per cycle, 4 strokes of a four-stroke —
   its FMEP on its own swept volume is 4F/A_p, whatever the motion (1e-3: the per-cylinder
   shares come from the trapezoidal rule over the samples; the pair's total is exact).
+* **A radial engine**: its slaves' strokes differ from the master's, so ring tension alone loses
+  F times four of each cylinder's own strokes per cycle (from the mechanism's kinematics table).
 * **Gas pressure behind the rings alone**, with cylinder 2 at half pressure: each cylinder loses
   c_p ∫ F_c⁺ |s′_c ω| dt, computed here from its ``p_c`` column and the piston's kinematics
   (:func:`transient.analysis.loads.crank_slider.slider_arrays`), and the weak cylinder the least.
@@ -27,17 +29,18 @@ from transient.outputs import cylinder_loss_column
 from transient.run import integrate
 from transient.scene import Cylinder, Friction, Output, Pair, Run, load_scene
 
-CASE = Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_reaction_friction.toml"
+CASES = Path(__file__).resolve().parents[2] / "cases"
+CASE = CASES / "gots_diesel_reaction_friction.toml"
 
 
-def piston_rings(scene, cylinders=(), **coefficients):
+def piston_rings(scene, cylinders=(), revolutions=12.0, **coefficients):
     """The reaction case with friction on the pistons only, ``coefficients`` of the slider, and
     ``cylinders`` as its [[gas.cylinders]], run 6 cycles sampled every half degree."""
     pair = Pair(between=("piston", "cylinder"), eta_forward=1.0, eta_backward=1.0,
                 name="pistons", model="reaction", **coefficients)
     scene = replace(scene, friction=Friction("power-flow", (pair,)),
                     gas=replace(scene.gas, cylinders=tuple(cylinders)),
-                    run=Run(revolutions=12.0), output=Output(samples_per_rev=720))
+                    run=Run(revolutions=revolutions), output=Output(samples_per_rev=720))
     data = integrate(scene)
     assert data.complete, data.message
     return scene, data.trajectory
@@ -102,3 +105,18 @@ def test_a_cylinder_at_half_pressure_loses_half_as_much_on_its_rings(case):
     assert lost[1] / others == pytest.approx(0.5, rel=0.02)
     assert eff["fmep_cyl2"] / eff["fmep_cyl1"] == pytest.approx(0.5, rel=0.02)
     assert math.isfinite(eff["cylinder_split_residual_1"])
+
+
+def test_a_radials_cylinders_lose_ring_tension_over_their_own_strokes():
+    F = 50.0
+    scene, tr = piston_rings(load_scene(CASES / "radial_5cyl_reaction_friction.toml"),
+                             revolutions=5.0, ring_force=F)
+    mech = scene.mechanism
+    eff = {k: v for k, (v, _) in mechanical_efficiency(
+        scene, tr, window=whole_cycles(scene, tr, 1, 2)).items()}
+    s = mech.kinematics_table(np.linspace(0.0, 2.0 * np.pi, 20001))
+    strokes = [np.ptp(s[f"s_{c + 1}"]) for c in range(mech.n_cylinders)]
+    assert max(strokes) > min(strokes) * (1 + 1e-3)  # (the slaves' strokes are not the master's)
+    print(strokes, [eff[f"W_loss_1_cyl{c + 1}_per_cycle"] for c in range(mech.n_cylinders)])
+    for c, stroke in enumerate(strokes):
+        assert eff[f"W_loss_1_cyl{c + 1}_per_cycle"] == pytest.approx(4.0 * F * stroke, rel=1e-3)

@@ -19,6 +19,7 @@ from . import governor as gv
 from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
 from . import joint_friction as jf
+from . import reactions as rx
 from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, LT_ANGLE, LT_NONE, LT_SPEED, OMEGA, PHI,
                      SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_SLEEVE, SW_STARTER, T, TABULATED,
                      WK_DEMAND, WK_DU, WK_FUEL, WK_LOCAL, WK_LOCAL_SHIFT, WK_PIECE, WK_PIECE_SHIFT,
@@ -405,5 +406,5 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
         if not m.has_gas:
             for k in range(m.ncyl):
                 wk[WK_RX + jf.R_P, k] = 0.0
-        jf.prepare(m.mech, phi, w, sel, wk)
+        rx.prepare(m, phi, w, sel, wk)
     return J, dJ, w, M_gas, M_load, M_starter

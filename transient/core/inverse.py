@@ -18,7 +18,7 @@ from .layout import (COL_EPS, N_OUT_FIXED, N_SWITCHES, OMEGA, PHI, POWER_FLOW, S
                      WK_J, WK_M, WK_S, WK_S_TRY, cylinder_loss_col, latch_index, n_state,
                      work_array)
 from .eta_table import invert
-from .joint_friction import inverse_drive
+from .reactions import inverse_drive
 from .outputs import cylinder_loss_rows, output_row, pair_rows
 from .rhs import pair_etas, split_subchains
 

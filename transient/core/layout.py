@@ -93,17 +93,24 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: (``joint_friction.R_*`` are the offsets), and per pair the moment its losses reduce to.
 WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
 N_WK_RX = 28
-#: With reaction friction, row WK_CYL_LOSS + p holds pair p's loss moment in each cylinder (one
-#: column per cylinder): the split of the pair's loss that the output rows report per cylinder.
-WK_CYL_LOSS = WK_RX + N_WK_RX
-#: The most joints that reaction friction acts in, of any mechanism (rows of ``Model.rx_par``).
-N_RX_JOINTS = 4
-N_WK = WK_CYL_LOSS + N_RX_JOINTS
+#: The articulated mechanism's rows (:mod:`.articulated_friction`, ``A_*`` are the offsets): per
+#: cylinder its rods' geometry and accelerations, the directions and the solve's iterates; it
+#: shares the gas force's and the pairs' loss rows of WK_RX.
+WK_AX = WK_RX + N_WK_RX
+N_WK_AX = 39
 
 #: The joints of the crank-slider that reaction friction acts in (rows of ``Model.rx_par``): the
 #: main bearing (frame – throw), the crankpin (throw – rod), the piston pin (rod – piston) and the
 #: piston in its cylinder (the slider).
 JOINT_MAIN, JOINT_CRANKPIN, JOINT_PIN, JOINT_SLIDER = range(4)
+#: Rows of ``Model.rx_par`` and ``Model.rx_pair``: the most joints of a mechanism's reaction
+#: friction (the articulated mechanism's six, ``articulated_friction.J_*``), so that the arrays
+#: have one shape and one compile serves every scene.
+N_JOINTS = 6
+#: With reaction friction, row WK_CYL_LOSS + p holds pair p's loss moment in each cylinder (one
+#: column per cylinder): the split of the pair's loss that the output rows report per cylinder.
+WK_CYL_LOSS = WK_AX + N_WK_AX
+N_WK = WK_CYL_LOSS + N_JOINTS
 #: Columns of ``Model.rx_par``: the friction coefficient μ [1], the journal's radius r [m], the
 #: viscous coefficient (journal: N m s/rad on the relative angular speed; slider: N s/m on the
 #: piston speed), the rings' tension friction force [N] and the share of the gas force that
@@ -166,11 +173,12 @@ Model = namedtuple(
         "var_shifted",  # bool: some cylinder has a combustion offset
         "var_par",  # float64[ncyl, variation.N_VAR_PAR]: factors, cycle start, rate, offset
         "var_int",  # int64[ncyl, 2 + cycles listed]: misfire period, seed, misfiring cycles
-        # reaction friction in the crank-slider's joints (transient.core.joint_friction); the
-        # pairs are then the joints that have friction, and no sub-chain is cut
+        # reaction friction in the joints (transient.core.reactions: the crank-slider's or the
+        # articulated mechanism's); the pairs are then the joints that have friction, and no
+        # sub-chain is cut
         "reaction",  # bool: the pairs' losses follow from the joint reactions
-        "rx_par",  # float64[N_RX_JOINTS, N_RX_PAR]: each joint's coefficients (zeros: an ideal joint)
-        "rx_pair",  # int64[N_RX_JOINTS]: the pair each joint reports as, −1 for an ideal joint
+        "rx_par",  # float64[N_JOINTS, N_RX_PAR]: each joint's coefficients (zeros: ideal)
+        "rx_pair",  # int64[N_JOINTS]: the pair each joint reports as, −1 for an ideal joint
         # efficiencies mapped over speed and transmitted moment (transient.core.eta_table); the
         # arrays keep their types without maps (one row of zeros), so one compile serves all
         "eta_table",  # bool: the pairs' η come from the maps below (eta_fwd, eta_bwd unused)

@@ -142,6 +142,15 @@ class Mechanism(Protocol):
         {} if it has none."""
 
 
+def reaction_joints(mech) -> tuple[tuple[str, str], ...]:
+    """The joints that pairs with friction on their reactions may name, (shaft-side link, far
+    link) in the order of the rows of ``Model.rx_par``: the mechanism's own
+    ``reaction_joints``, else the neighbours of its ``reaction_links`` (a chain, as the
+    crank-slider's); () if it has no reaction friction."""
+    links = getattr(mech, "reaction_links", ())
+    return getattr(mech, "reaction_joints", tuple(zip(links, links[1:])))
+
+
 #: Every mechanism by its ``type`` in the ``[mechanism]`` table.
 MECHANISMS: dict[str, type[Mechanism]] = {
     "crank-slider": CrankSlider,

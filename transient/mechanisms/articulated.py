@@ -132,6 +132,14 @@ class Articulated:
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, then the
     #: rods with the pistons and gas forces.
     links = ("shaft", "crank", "rod")
+    #: Links for pairs with friction on their reactions
+    #: (:mod:`transient.core.articulated_friction`).
+    reaction_links = ("shaft", "crank", "master rod", "slave rod", "piston", "cylinder")
+    #: The joints such a pair may name, in the order of ``articulated_friction.J_*``: the main
+    #: bearings, the master crankpins, the link pins, the master piston pins, the slave piston
+    #: pins and the pistons in their cylinders (every cylinder of every row that the joint has).
+    reaction_joints = (("shaft", "crank"), ("crank", "master rod"), ("master rod", "slave rod"),
+                       ("master rod", "piston"), ("slave rod", "piston"), ("piston", "cylinder"))
 
     # -- sizes and constants ---------------------------------------------------------------------
     @property
@@ -362,6 +370,27 @@ class Articulated:
         """V(x) of the master cylinder over its local angle x [rad] (vectorised)."""
         return self.master().volume_function(clearance)
 
+    def reaction_reversals(self) -> NDArray[np.float64]:
+        """Local angles α [rad] in [0, 2π) of a row where a joint's relative rate changes sign
+        (:mod:`transient.core.articulated_friction`, *Directions*): the master piston's dead
+        centres 0, π and the master rod's β′ = 0 at π/2, 3π/2 exactly; per slave the roots of
+        its piston's X_i′, of its rod's β_i′ and of its link pin's β_i′ + β′, bracketed on a
+        grid and refined by bisection to the last bit. The crankpin's −β′ − 1 never vanishes."""
+        grid = np.linspace(0.0, 2.0 * pi, 4 * SAMPLES + 1)
+        rates = np.array([_slave_rates(self, a) for a in grid])  # (n, 3, z′)
+        out = [0.0, 0.5 * pi, pi, 1.5 * pi]
+        for which in range(3):
+            for i in range(self.n_slaves):
+                f = rates[:, which, i]
+                for j in np.flatnonzero(np.sign(f[:-1]) * np.sign(f[1:]) <= 0.0):
+                    if f[j] == 0.0:
+                        out.append(float(grid[j]))
+                    elif f[j + 1] != 0.0:
+                        root = bisect_root(lambda a: _slave_rates(self, a)[which, i], grid[j],
+                                           grid[j + 1])
+                        out.append(float(root))
+        return np.unique(np.mod(np.array(out), 2.0 * pi))
+
     def dead_centre_angles(self) -> tuple[float, float]:
         """Dead centres [rad] of the master cylinder, a centred crank-slider: 0 and π."""
         return self.master().dead_centre_angles()
@@ -516,6 +545,19 @@ def positions(mech: Articulated, alpha: ArrayLike) -> dict[str, NDArray[np.float
     f, fi = mech.rod_cg_from_pin / l, mech.slave_rod_cg_from_pin / li
     return {"A": A, "B": B, "G": B + f * (A - B), "Ai": Ai, "Bi": Bi, "Gi": Bi + fi * (Ai - Bi),
             "master_angle": np.angle(B - A), "slave_angle": np.angle(Ai - Bi)}
+
+
+def _slave_rates(mech: Articulated, alpha: float) -> NDArray[np.float64]:
+    """(3, z′): per slave its piston's X_i′, its rod's β_i′ and its link pin's relative rate
+    β_i′ + β′ at local angle α (the kernel's :func:`transient.core.articulated.slave`)."""
+    r, l = mech.crank_radius, mech.rod_length
+    mp = mech.pack()
+    ca, sa, cb, sb, db, ddb = core.master_rod(alpha, r, l)
+    out = np.empty((3, mech.n_slaves))
+    for i in range(mech.n_slaves):
+        _, X1, _, _, _, _, _, t1, _ = core.slave(mp, i, r, ca, sa, cb, sb, db, ddb)
+        out[:, i] = X1, t1, t1 + db
+    return out
 
 
 def slave_reach(mech: Articulated, samples: int = 4 * SAMPLES) -> NDArray[np.float64]:

@@ -46,6 +46,11 @@ def check_consistency(scene: Scene) -> None:
                                           f"{scene.mechanism.name} runs on the compiled methods "
                                           f"({', '.join(COMPILED_METHODS)}), not {sv.method!r} "
                                           f"(the reference path has the crank-slider's)")
+    if (any(p.model == "reaction" for p in scene.friction.pairs)
+            and sv.kinematics == "tabulated" and scene.mechanism.name != "crank-slider"):
+        raise SceneError("solver.kinematics", f"friction on the reactions of the "
+                                              f"{scene.mechanism.name!r} mechanism takes its "
+                                              f"exact kinematics; use kinematics = \"exact\"")
     if any(p.model == "table" for p in scene.friction.pairs) and not compiled:
         raise SceneError("solver.method", f"efficiency maps run on the compiled methods "
                                           f"({', '.join(COMPILED_METHODS)}), not {sv.method!r}")

@@ -13,7 +13,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..errors import SceneError
-from ..mechanisms import MECHANISMS
+from ..mechanisms import MECHANISMS, reaction_joints
+from ..mechanisms.articulated import slave_reach
 from ..units import ALL_SUFFIXES
 from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table
@@ -360,21 +361,25 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
         if model == "reaction":
             links = getattr(mech, "reaction_links", ())
             if not links:
-                raise SceneError(ps.key("model"), f"friction on the reactions is implemented for "
-                                                  f"the crank-slider only, not for {mech.name!r}; "
-                                                  f"use model = \"constant-eta\" here")
+                raise SceneError(ps.key("model"), f"friction on the reactions is not implemented "
+                                                  f"for {mech.name!r}; use model = "
+                                                  f"\"constant-eta\" here")
         hint = ""
         if model != "reaction" and getattr(mech, "reaction_links", ()):
             hint = (f" (pairs with model = \"reaction\" join "
                     f"{' – '.join(mech.reaction_links)})")
-        between = _between(ps, links, hint)
-        ia = links.index(between[0])
+        if model == "reaction" and hasattr(mech, "reaction_joints"):
+            between = _joint(ps, mech)
+            ia = mech.reaction_joints.index(between)
+        else:
+            between = _between(ps, links, hint)
+            ia = links.index(between[0])
         if ia in seen:
             raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
         seen[ia] = i
         name = ps.string("name", f"{between[0]}-{between[1]}")
         if model == "reaction":
-            pair = _reaction_pair(ps, between, name, slider=ia == len(links) - 2)
+            pair = _reaction_pair(ps, between, name, slider=between[1] == links[-1])
         elif model == "table":
             pair = _table_pair(ps, between, name, base_dir)
         else:
@@ -393,11 +398,42 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                                               f"with others (constant-eta and table pairs do)")
         models.append(model)
         pairs.append(pair)
-    order = getattr(mech, "reaction_links", ()) if "reaction" in models else mech.links
-    pairs.sort(key=lambda p: order.index(p.between[0]))
     if "reaction" in models:
-        _check_wedging(s, mech, pairs, raw)
+        joints = reaction_joints(mech)
+        pairs.sort(key=lambda p: joints.index(p.between))
+        if hasattr(mech, "reaction_joints"):
+            _check_wedging_articulated(s, mech, pairs, raw)
+        else:
+            _check_wedging(s, mech, pairs, raw)
+    else:
+        pairs.sort(key=lambda p: mech.links.index(p.between[0]))
     return Friction(policy, tuple(pairs))
+
+
+def _joint(ps: Section, mech) -> tuple[str, str]:
+    """The two links of a reaction pair of a mechanism whose joints do not form a chain (its
+    ``reaction_joints``), shaft side first."""
+    links, joints = mech.reaction_links, mech.reaction_joints
+    allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in joints)
+    ps.known.append("between")
+    between = ps.data.pop("between", None)
+    if (not isinstance(between, list) or len(between) != 2
+            or not all(isinstance(b, str) for b in between)):
+        raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
+                                            f"the joints are {allowed}")
+    for b in between:
+        if b not in links:
+            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links of "
+                                                f"{mech.name!r} are {', '.join(links)}, joined "
+                                                f"as {allowed}")
+    pair = (between[0], between[1])
+    if pair[::-1] in joints:
+        raise SceneError(ps.key("between"), f"give the shaft-side link first: "
+                                            f"[{pair[1]!r}, {pair[0]!r}]")
+    if pair not in joints:
+        raise SceneError(ps.key("between"), f"{pair[0]!r} and {pair[1]!r} are not joined in "
+                                            f"{mech.name!r}; the joints are {allowed}")
+    return pair
 
 
 def _between(ps: Section, links: tuple[str, ...], hint: str) -> tuple[str, str]:
@@ -507,6 +543,40 @@ def _check_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
                          f"the friction would wedge the mechanism: μ_slider·tan β_max + "
                          f"(μ·r of crankpin and pin)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; "
                          f"allowed below 1 (lubricated pairs are around 0.01)")
+
+
+def _check_wedging_articulated(s: Section, mech, pairs: list[Pair], raw: list) -> None:
+    """Friction must not wedge a rod of the articulated mechanism: as for the crank-slider
+    (:func:`_check_wedging`), each rod's equation in its piston's side force has a slope of at
+    least c (1 − q), q = μ_slider tan β_max + (μ r of its two pins)(1 + μ_slider)/c with
+    c = l cos β_max at its largest angle to its cylinder (the master rod: sin β_max = λ; slave
+    rod i: its link pin's largest offset from its axis over l_i, ``slave_reach``); q < 1 for
+    every rod keeps the row's equations solvable (``transient.core.articulated_friction``)."""
+    by_joint = {p.between: p for p in pairs}
+    joints = mech.reaction_joints
+
+    def mu_r(j: int) -> float:
+        p = by_joint.get(joints[j])
+        return p.mu * p.radius if p is not None else 0.0
+
+    slider = by_joint.get(joints[5])
+    mu_s = slider.mu if slider is not None else 0.0
+    rods = [(mech.rod_length, mech.crank_radius, mu_r(1) + mu_r(3), "master rod")]
+    rods += [(li, h, mu_r(2) + mu_r(4), f"slave rod {i + 1}")
+             for i, (li, h) in enumerate(zip(mech.slave_lengths, slave_reach(mech)))]
+    for length, reach, mr, rod in rods:
+        sin_b = reach / length
+        cos_b = math.sqrt(max(1.0 - sin_b * sin_b, 0.0))
+        c = length * cos_b
+        q = (mu_s * sin_b / cos_b + mr * (1.0 + mu_s) / c) if cos_b > 0.0 else math.inf
+        if q >= 1.0:
+            i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
+                     and item.get("between", [None])[-1] in ("cylinder", "piston", "slave rod",
+                                                              "master rod"))
+            raise SceneError(f"{s.key('pairs')}[{i}].mu",
+                             f"the friction would wedge the {rod}: μ_slider·tan β_max + (μ·r of "
+                             f"its pins)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; allowed "
+                             f"below 1 (lubricated pairs are around 0.01)")
 
 
 def _efficiency(s: Section, name: str) -> float:
