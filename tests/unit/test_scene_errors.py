@@ -552,6 +552,8 @@ RADIAL_REACTION_CASES = [
      "the friction would wedge the master rod"),
     ('[solver]', '[solver]\nkinematics = "tabulated"', "solver.kinematics",
      "friction on the reactions of the 'articulated' mechanism takes its exact kinematics"),
+    ('[solver]', '[solver]\nmethod = "scipy-RK45"', "solver.method",
+     "friction on the reactions of the 'articulated' mechanism runs on the compiled methods"),
 ]
 
 

@@ -42,10 +42,11 @@ def check_consistency(scene: Scene) -> None:
                                           "with policy \"paper\"")
     if (any(p.model == "reaction" for p in scene.friction.pairs) and not compiled
             and scene.mechanism.name != "crank-slider"):
-        raise SceneError("solver.method", f"friction on the reactions of a "
-                                          f"{scene.mechanism.name} runs on the compiled methods "
-                                          f"({', '.join(COMPILED_METHODS)}), not {sv.method!r} "
-                                          f"(the reference path has the crank-slider's)")
+        raise SceneError("solver.method", f"friction on the reactions of the "
+                                          f"{scene.mechanism.name!r} mechanism runs on the "
+                                          f"compiled methods ({', '.join(COMPILED_METHODS)}), not "
+                                          f"{sv.method!r} (the reference path has the "
+                                          f"crank-slider's)")
     if (any(p.model == "reaction" for p in scene.friction.pairs)
             and sv.kinematics == "tabulated" and scene.mechanism.name != "crank-slider"):
         raise SceneError("solver.kinematics", f"friction on the reactions of the "
