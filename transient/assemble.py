@@ -16,7 +16,7 @@ from .core import governor as gv
 from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
 from .core import variation as var
 from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_PAR, PAPER, PHI, POWER_FLOW,
+from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_RX_JOINTS, N_RX_PAR, PAPER, PHI, POWER_FLOW,
                           RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
                           TABULATED, Model, T, extras_of, work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
@@ -526,7 +526,8 @@ def chain_fields(scene) -> dict:
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
         link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
-        reaction=False, rx_par=np.zeros((4, N_RX_PAR)), rx_pair=np.full(4, -1, dtype=np.int64),
+        reaction=False, rx_par=np.zeros((N_RX_JOINTS, N_RX_PAR)),
+        rx_pair=np.full(N_RX_JOINTS, -1, dtype=np.int64),
         **eta_table_fields(friction.pairs))
 
 
@@ -569,13 +570,14 @@ def reaction_friction(scene) -> bool:
 
 
 def reaction_fields(scene) -> dict:
-    """The chain's part of the Model with reaction friction (:mod:`transient.core.joint_friction`):
-    no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
-    ``reaction_links`` (main bearing, crankpin, piston pin, slider) has its pair's coefficients
-    and reports as that pair."""
+    """The chain's part of the Model with reaction friction (:mod:`transient.core.reactions`):
+    no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j, the
+    one between links j and j + 1 of ``reaction_links`` (crank-slider: main bearing, crankpin,
+    piston pin, slider; swash plate: ``transient.core.swash_friction.J_*``), has its pair's
+    coefficients and reports as that pair."""
     mech, pairs = scene.mechanism, scene.friction.pairs
-    rx_par = np.zeros((4, N_RX_PAR))
-    rx_pair = np.full(4, -1, dtype=np.int64)
+    rx_par = np.zeros((N_RX_JOINTS, N_RX_PAR))
+    rx_pair = np.full(N_RX_JOINTS, -1, dtype=np.int64)
     for k, p in enumerate(pairs):
         j = mech.reaction_links.index(p.between[0])
         rx_pair[j] = k
@@ -595,8 +597,13 @@ def reaction_fields(scene) -> dict:
 def reaction_breakpoints(scene) -> NDArray[np.float64]:
     """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction):
     each piston's dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α),
-    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``)."""
+    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``).
+    A mechanism that lists its own (``joint_reversals``, the swash plate's pistons' dead centres)
+    gives them."""
     mech = scene.mechanism
+    own = getattr(mech, "joint_reversals", None)
+    if own is not None:
+        return np.unique(np.mod(np.asarray(own(), dtype=np.float64), mech.cycle))
     tdc, bdc = mech.dead_centre_angles()
     local = np.array([tdc, 0.5 * math.pi, bdc, 1.5 * math.pi])
     turns = np.arange(0.0, mech.cycle - 1e-9, 2.0 * math.pi)

@@ -17,7 +17,7 @@ from .layout import (COL_EPS, N_OUT_FIXED, N_SWITCHES, OMEGA, PHI, POWER_FLOW, S
                      SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY,
                      WK_J, WK_M, WK_S, WK_S_TRY, latch_index, n_state, work_array)
 from .eta_table import invert
-from .joint_friction import inverse_drive
+from .reactions import inverse_drive
 from .outputs import output_row, pair_rows
 from .rhs import pair_etas, split_subchains
 

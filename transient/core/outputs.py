@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from .jit import kernel
 
-from .joint_friction import loss_moment
+from .reactions import loss_moment
 from .forcing import command, cylinder_value, moments
 from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_ETA,
                      WK_FUEL, WK_S, cyl_index, gov_index, latch_index)
@@ -68,7 +68,7 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
 @kernel(inline=True)
 def pair_rows(m, w, w_loss, wk, out):
     """``PAIR_OUTPUTS`` of each pair from the rows η*, S of ``wk`` (with reaction friction its
-    loss moment, ``joint_friction``); ``w_loss``: energy lost so far."""
+    loss moment, ``reactions``); ``w_loss``: energy lost so far."""
     np_ = len(PAIR_OUTPUTS)
     for k in range(m.n_pairs):
         out[np_ * k] = wk[WK_S, k]

@@ -15,7 +15,7 @@ from .jit import kernel
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import governor as gv
 from . import eta_table as et
-from . import joint_friction as jf
+from . import reactions as rx
 from . import stuck as st
 from .forcing import command, cylinder_rates, governor_rates, moments
 from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T, W_GAS, W_LOAD,
@@ -57,7 +57,7 @@ def pair_etas(m, modes, eta_out):
 @kernel(inline=True)
 def acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)
-    or with the joints' reaction friction (``joint_friction``)."""
+    or with the joints' reaction friction (``reactions``)."""
     if extras is None or m.n_pairs == 0:
         return (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J
     return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
@@ -67,14 +67,14 @@ def acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
 def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
     and the pairs' η*, S in the rows of ``wk``. With reaction friction the pairs are joints of
-    one rigid chain: φ̈ and their η*, S and losses come from ``joint_friction``, in direction σ.
+    one rigid chain: φ̈ and their η*, S and losses come from ``reactions``, in direction σ.
     Stuck at rest (``stuck``): φ̈ = 0, and the holding margin in ``wk[WK_G]``."""
     if sw[SW_DIRECTION] == st.STUCK:
         if not m.reaction:
             split_subchains(m, J, dJ, M_gas, M_shaft, wk)
         return st.hold(m, J, M_gas, M_shaft, wk)
     if m.reaction:
-        return jf.reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]), wk)
+        return rx.acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]), wk)
     n = m.n_pairs
     split_subchains(m, J, dJ, M_gas, M_shaft, wk)
     if m.eta_table:  # η* depends on S: solved with the modes held (``eta_table``)
@@ -113,7 +113,7 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
         mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
         for k in range(m.n_pairs):
-            lk = jf.loss_moment(wk, k) if m.reaction else (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
+            lk = rx.loss_moment(wk, k) if m.reaction else (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
             out[W_LOSS0 + k] = lk * q
             loss += lk
             wk[WK_G_MIN, k] = min(wk[WK_G_MIN, k], wk[WK_G, k])
@@ -195,7 +195,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         sw[SW_MODES] = 0
         return UNIQUE
     if m.reaction:
-        sigma, _, status = jf.choose_direction(m, J, dJ, w, M_gas, M_load + M_starter, wk)
+        sigma, _, status = rx.choose_direction(m, J, dJ, w, M_gas, M_load + M_starter, wk)
         sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
         sw[SW_MODES] = 0
         return status

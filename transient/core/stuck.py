@@ -19,7 +19,7 @@ the acceleration by which the weaker of the two directions is held. a_σ is a co
 of the applied moments: for constant-η pairs it is the root of the chain's residual F(a), which
 is continuous and strictly decreasing in a (``chain``, the proof of uniqueness, with σ in place of
 ω), and so it is with efficiency maps under the scene check's requirement on them
-(``eta_table``); for reaction pairs it is the solution of the joints' equations (``joint_friction.solve``) at
+(``eta_table``); for reaction pairs it is the solution of the joints' equations (``reactions.acceleration``) at
 ω = 0, where every friction term is a magnitude that varies continuously with the forces. So g
 falls through zero at the instant the drive exceeds the holding moment in one direction, and the
 stepper locates that instant as it locates a pair's mode switch (a margin falling to zero, to the
@@ -43,7 +43,7 @@ from .jit import kernel
 from .chain import _best_candidate
 from . import eta_table as et
 from . import governor as gv
-from . import joint_friction as jf
+from . import reactions as rx
 from .layout import (LT_TIME, SW_LOAD, T, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S,
                      WK_SCRATCH)
 
@@ -56,9 +56,9 @@ def incipient(m, J, M_gas, M_shaft, sigma, wk):
     """φ̈ at ω = 0 with the pairs' friction opposing an incipient motion ``sigma``: for constant-η
     pairs (or mapped ones, ``eta_table.solve_auto``) the chain solved with the modes consistent
     with σ (the sub-chains' rows of ``wk`` split already, ``rhs.split_subchains``; their η*, S
-    left in ``wk``), for reaction pairs the joints' solve (``joint_friction.reaction_acceleration``, the rows of ``prepare`` at the state)."""
+    left in ``wk``), for reaction pairs the joints' solve (``reactions.acceleration``, the rows of ``prepare`` at the state)."""
     if m.reaction:
-        return jf.reaction_acceleration(m, J, 0.0, 0.0, M_gas, M_shaft, sigma, wk)
+        return rx.acceleration(m, J, 0.0, 0.0, M_gas, M_shaft, sigma, wk)
     n = m.n_pairs
     if m.eta_table:
         return et.solve_auto(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], 0.0,
@@ -83,7 +83,7 @@ def hold(m, J, M_gas, M_shaft, wk):
         wk[WK_S, k] = 0.0
         wk[WK_ETA, k] = 1.0
         if m.reaction:
-            wk[WK_RX + jf.R_LOSS, k] = 0.0
+            wk[WK_RX + rx.R_LOSS, k] = 0.0
     return 0.0
 
 
