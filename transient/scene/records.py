@@ -429,7 +429,7 @@ class Pair:
     """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).
 
     ``between``: the link on the shaft side first (a), then the far one (b), names from the
-    mechanism's ``links``. ``eta_forward`` = η_ba, the efficiency while a (the shaft side) drives;
+    mechanism's ``links`` (its ``reaction_links`` for the reaction model). ``eta_forward`` = η_ba, the efficiency while a (the shaft side) drives;
     ``eta_backward`` = η_ab, while b drives; both in (0, 1] [1].
     """
 
@@ -438,7 +438,8 @@ class Pair:
     eta_backward: float
     name: str = ""
     #: ``"constant-eta"`` (the efficiencies above) or ``"reaction"``: friction on the joint's
-    #: reaction (crank-slider only, :mod:`transient.core.joint_friction`; then η is unused, 1).
+    #: reaction (crank-slider and swash plate, :mod:`transient.core.reactions`; then η is
+    #: unused, 1).
     model: str = "constant-eta"
     #: Reaction model: friction coefficient μ [1] (journal: friction-circle μ·r·|R|; slider:
     #: μ·|N| on the side force).
