@@ -1022,7 +1022,7 @@ def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_pl
 
 
 def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
-                         sigma=None) -> SwashReactions:
+                         sigma=None, epsilon=None) -> SwashReactions:
     """φ̈ and the joint reactions with friction on them, closed by ``scipy.optimize.fsolve``.
 
     The friction laws, written out again: the main bearing's moment on the shaft
@@ -1034,7 +1034,9 @@ def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
 
     ``coefficients``: dict with ``main`` and ``plate`` = (μ, r, c) and ``pistons`` = (μ, F_ring,
     c_p, c). ``sigma``: the direction of motion (sign ω, needed at ω = 0). Signs of v_k and q
-    are taken at the state itself (off the dead centres).
+    are taken at the state itself (off the dead centres). With ``epsilon`` the motion is
+    prescribed (inverse dynamics): φ̈ is ``epsilon`` and the drive the shaft then needs,
+    J₀φ̈ − M_shaft + (what the shaft puts into the plates), is ``through[0]`` + J₀φ̈ − M_shaft.
     """
     from scipy.optimize import fsolve
 
@@ -1048,9 +1050,14 @@ def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
     scale_f = np.abs(P).max() + 1.0
     scale_m = scale_f * mech.joint_radius
 
+    def solve(m_o, m_f, fk):
+        if epsilon is None:
+            return swash_plate_reactions(mech, phi, omega, None, P, m_o, m_f, fk, J0, M_shaft)
+        return swash_plate_reactions(mech, phi, omega, epsilon, P, m_o, m_f, fk)
+
     def laws(y):
         m_o, m_f, fk = y[0] * scale_m, y[1] * scale_m, y[2:] * scale_f
-        r = swash_plate_reactions(mech, phi, omega, None, P, m_o, m_f, fk, J0, M_shaft)
+        r = solve(m_o, m_f, fk)
         law_o = sigma * mu_o * r_o * np.linalg.norm(r.main) + c_o * omega
         law_f = sigma * mu_p * r_p * np.linalg.norm(r.plate) - c_p * q_unit * omega
         law_s = (-np.sign(v_unit) * sigma * (mu_s * np.hypot(r.N[:, 0], r.N[:, 1]) + ring
@@ -1062,5 +1069,4 @@ def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
     y, info, _, _ = fsolve(laws, np.zeros(2 + mech.cylinders), xtol=1e-14, full_output=True)
     if not np.max(np.abs(info["fvec"])) <= 1e-13:  # relative to the forces' scale
         raise ArithmeticError(f"the friction laws are not closed: residual {info['fvec']}")
-    return swash_plate_reactions(mech, phi, omega, None, P, y[0] * scale_m, y[1] * scale_m,
-                                 y[2:] * scale_f, J0, M_shaft)
+    return solve(y[0] * scale_m, y[1] * scale_m, y[2:] * scale_f)

@@ -17,6 +17,7 @@ there, by ``scipy.optimize.fsolve``).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -134,6 +135,35 @@ def test_joint_reactions_and_losses_agree_with_newton_euler(name):
         S, L = wk[WK_S, :3], wk[WK_RX + sf.R_LOSS, :3]
         assert np.array_equal(wk[WK_ETA, :3], 1.0 - L / S)
     print(f"{name}: largest relative difference {worst:.1e}")
+
+
+def test_inverse_dynamics_gives_the_newton_euler_drive():
+    """At a prescribed φ̈ (the efficiency study's path, ``reactions.inverse_drive``) the drive the
+    shaft needs and the pairs' S, L equal the reference's with its friction closed at that φ̈."""
+    scene = load_scene(CASE)
+    pairs = tuple(replace(p, mu=mu, radius=r, viscous=c) for p, (mu, r, c) in
+                  zip(scene.friction.pairs[:2], (COEFFICIENTS["main"], COEFFICIENTS["plate"])))
+    mu, ring, share, c = COEFFICIENTS["pistons"]
+    pairs += (replace(scene.friction.pairs[2], mu=mu, ring_force=ring, ring_pressure=share,
+                      viscous=c),)
+    scene = replace(scene, friction=replace(scene.friction, pairs=pairs))
+    model, _, _ = build_model(scene)
+    mech = scene.mechanism
+    rng = np.random.default_rng(5)
+    for phi, w, P in states(13, 12, mech.cylinders):
+        eps = rng.uniform(-3e3, 3e3)
+        M_shaft = -100.0
+        wk = np.full((N_WK, 5), np.nan)
+        sf.prepare(model.mech, phi, w, phi, wk)
+        wk[WK_RX + sf.R_P, :4] = P
+        drive = sf.inverse_drive(model, eps, w, np.sign(w), M_shaft, wk)
+        ref = swash_plate_friction(mech, COEFFICIENTS, phi, w, P, model.J0, M_shaft, epsilon=eps)
+        want = ref.through[0] + model.J0 * eps - M_shaft
+        m = max(np.max(np.abs(ref.B)), np.max(np.abs(ref.plate))) * mech.joint_radius
+        assert abs(drive - want) <= 1e-12 * m, (phi, w, eps, drive, want)
+        assert np.max(np.abs(wk[WK_S, :3] - ref.through)) <= 1e-12 * m
+        assert np.max(np.abs(wk[WK_RX + sf.R_LOSS, :3] - ref.loss)) <= 1e-12 * m
+        assert np.min(np.abs(ref.loss)) > 1e-4 * m
 
 
 def test_reaction_pairs_survive_the_resolved_scene_and_report_per_joint():
