@@ -16,10 +16,16 @@ The joints with friction and their laws (as :mod:`.joint_friction` has them for 
   and sources of :mod:`.joint_friction`).
 
 The ball joints B_k (link 9 – rod) and D_k (rod – piston) and the Hooke joint's cross 13 are ideal
-here. (A rod between two ball joints is free to spin about its own axis: with friction in both
-joints that spin settles where their axial friction moments balance, a further implicit unknown
-per rod, which this solver does not carry; ideal ball joints pass forces only, so the rod's
-equation about its axis is 0 = 0 and its spin never enters.)
+here. Ideal ball joints pass forces only, so a rod's equation about its own axis is 0 = 0 and its
+spin about that axis, which nothing fixes, never enters. With friction in both joints (a moment
+μ r |R| about the direction of each joint's relative angular velocity, the friction circle's 3-D
+form) the spin is a further unknown per rod, set where the two joints' axial moments cancel (the
+rod has no inertia about its axis). That balance is single-valued only while the rod swings:
+where its swing turns, its rate across its axis e × ė vanishes (exactly, for a cylinder on the
+plane of symmetry of the swing), the balance becomes a stick–slip choice (the spin sticks to the
+piston's joint or slips in it) and the across-axis friction at D reverses; Newton's method on a
+balance that steep does not converge near those angles. A stick–slip treatment of the spin, with
+those angles as breakpoints, is what friction in the ball joints needs.
 
 Frame, kinematics and equation numbers are those of :mod:`.swash_plate` (Antonyuk et al. §2:
 (5), (6), (8), (10)); the reduced model is their (18)–(21), which the frictionless Newton–Euler
