@@ -23,9 +23,10 @@ form) the spin is a further unknown per rod, set where the two joints' axial mom
 rod has no inertia about its axis). That balance is single-valued only while the rod swings:
 where its swing turns, its rate across its axis e × ė vanishes (exactly, for a cylinder on the
 plane of symmetry of the swing), the balance becomes a stick–slip choice (the spin sticks to the
-piston's joint or slips in it) and the across-axis friction at D reverses; Newton's method on a
-balance that steep does not converge near those angles. A stick–slip treatment of the spin, with
-those angles as breakpoints, is what friction in the ball joints needs.
+piston's joint or slips in it) and the across-axis friction at D reverses. Near those angles the
+balance is a near-step in the spin, on which a Newton iteration carrying the spin with the other
+unknowns oscillates; friction in the ball joints needs the spin solved apart (bracketed, it is
+monotone) and those angles as breakpoints.
 
 Frame, kinematics and equation numbers are those of :mod:`.swash_plate` (Antonyuk et al. §2:
 (5), (6), (8), (10)); the reduced model is their (18)–(21), which the frictionless Newton–Euler
