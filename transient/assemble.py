@@ -595,11 +595,11 @@ def reaction_fields(scene) -> dict:
 
 
 def reaction_breakpoints(scene) -> NDArray[np.float64]:
-    """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction):
-    each piston's dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α),
-    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``).
-    A mechanism that lists its own (``joint_reversals``, the swash plate's pistons' dead centres)
-    gives them."""
+    """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction),
+    so that no step straddles a reversal of a friction force: a mechanism's own
+    ``joint_reversals`` (the swash plate's: its pistons' dead centres), else the crank-slider's,
+    each piston's dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α,
+    ``transient.core.joint_friction``)."""
     mech = scene.mechanism
     own = getattr(mech, "joint_reversals", None)
     if own is not None:
