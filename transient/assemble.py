@@ -596,12 +596,16 @@ def reaction_fields(scene) -> dict:
 
 
 def reaction_breakpoints(scene) -> NDArray[np.float64]:
-    """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction):
-    each piston's dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α),
-    so that no step straddles a reversal of a friction force (``transient.core.joint_friction``).
-    The articulated mechanism gives the local angles of a row where any of its joints reverses
-    (``Articulated.reaction_reversals``), repeated at each row's phase."""
+    """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction),
+    so that no step straddles a reversal of a friction force: a mechanism's own
+    ``joint_reversals`` (the swash plate's: its pistons' dead centres); the local angles of a row
+    where any joint of the articulated mechanism reverses (``Articulated.reaction_reversals``),
+    repeated at each row's phase; else the crank-slider's, each piston's dead centres (its speed)
+    and its local 90° and 270° (the rod's rate β̇ ∝ cos α, ``transient.core.joint_friction``)."""
     mech = scene.mechanism
+    own = getattr(mech, "joint_reversals", None)
+    if own is not None:
+        return np.unique(np.mod(np.asarray(own(), dtype=np.float64), mech.cycle))
     turns = np.arange(0.0, mech.cycle - 1e-9, 2.0 * math.pi)
     if hasattr(mech, "reaction_reversals"):
         local, phases = mech.reaction_reversals(), np.asarray(mech.row_phases)

@@ -1285,3 +1285,282 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
             L[5] -= F_s[k + 1 + i] * Sl["X1"]
     return ArticulatedForces(epsilon=float(eps), N=N, pin=pin, big_end=big, main=main,
                              throw_torque=T, S=S, L=L, iterations=it + 1)
+# Joint reactions of the swash plate by Newton–Euler, with friction on them
+
+
+@dataclass(frozen=True)
+class SwashReactions:
+    """The motion and the joint reactions of a swash-plate engine at one state, from
+    :func:`swash_plate_reactions` (half 1; vectors in the fixed frame of
+    :mod:`transient.core.swash_plate`) [rad/s², N, N·m].
+
+    Attributes
+    ----------
+    epsilon : φ̈.
+    main : force of the frame on the shaft (both halves).
+    plate : force of the plate on link 9 (F_P); ``plate_moment`` its reaction moment (⊥ n).
+    B, D : (z, 3) force of link 9 on rod k at B_k, of piston k on rod k at D_k.
+    N : (z, 2) the wall's side force on piston k (y, z).
+    f : (z,) the cylinder's axial friction force on piston k (along +x).
+    M_main, M_plate : the main bearing's friction moment on the shaft about x (opposing ω; the
+        shaft's equation has −M_main) and the plate bearing's on link 9 about n.
+    loss, through : (3,) per pair, main bearing, plate bearing, pistons (both halves): the power
+        lost over ω, and the power the shaft side puts into the joint over ω.
+    """
+
+    epsilon: float
+    main: NDArray[np.float64]
+    plate: NDArray[np.float64]
+    plate_moment: NDArray[np.float64]
+    B: NDArray[np.float64]
+    D: NDArray[np.float64]
+    N: NDArray[np.float64]
+    f: NDArray[np.float64]
+    M_main: float
+    M_plate: float
+    loss: NDArray[np.float64]
+    through: NDArray[np.float64]
+
+
+def _rodrigues(axis, angle):
+    """Rotation matrix by ``angle`` about the unit ``axis``."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
+
+
+def swash_plate_motion(mech, phi, omega, epsilon):
+    """The swash plate's bodies at a state, from positions and rotation matrices: link 9's
+    ω₉ = ω(x̂ + θ′n) and α₉ (Antonyuk (8), differentiated once more), each joint's B = Q₉ B₀ and
+    its acceleration α₉ × B + ω₉ × (ω₉ × B), D on its cylinder axis at distance ℓ from B (10),
+    ẋ_D, ẍ_D from |B − D|² = ℓ² differentiated twice, the rods' e, ė, ë and the cross's hinge
+    c = Q₉ c₀ with ψ̈ = α₉·a. Only θ(φ), θ′, θ″ come from :func:`transient.core.swash_plate.hooke`;
+    the Hooke constraint a·c = 0 is returned to be checked. A dict of arrays."""
+    from .core import swash_plate as core
+    from .mechanisms.swash_plate import HINGES
+
+    mp = mech.pack()
+    a_sw, R = mech.swash_angle, mech.joint_radius
+    x = np.array([1.0, 0.0, 0.0])
+    theta, d1, d2, _, _ = core.hooke(mp, phi)
+    n0 = np.array([math.cos(a_sw), math.sin(a_sw), 0.0])
+    Rx = _rodrigues(x, phi)
+    Q9 = Rx @ _rodrigues(n0, theta)
+    n = Rx @ n0
+    w9 = omega * (x + d1 * n)
+    al9 = epsilon * (x + d1 * n) + omega ** 2 * (d2 * n + d1 * np.cross(x, n))
+    hinge = np.array(HINGES[mech.hinge][1])
+    c0 = np.cross(n0, hinge)
+    c = Q9 @ (c0 / np.linalg.norm(c0))
+    z = mech.cylinders
+    m_in_plate = np.array([-math.sin(a_sw), math.cos(a_sw), 0.0])  # eq. (6) at argument 0
+    out = {k: np.zeros((z, 3)) for k in ("B", "aB", "D", "e", "de", "dde")}
+    out.update(xd1=np.zeros(z), xd2=np.zeros(z))
+    for k in range(z):
+        psi = 2.0 * math.pi * k / z
+        B = Q9 @ (R * (math.cos(psi) * m_in_plate + math.sin(psi) * np.array([0.0, 0.0, 1.0])))
+        vB = np.cross(w9, B)
+        aB = np.cross(al9, B) + np.cross(w9, vB)
+        yz = mech.cylinder_radius * np.array([math.cos(psi), math.sin(psi)])
+        lat = B[1:] - yz
+        D = np.array([B[0] - math.sqrt(mech.rod_length ** 2 - lat @ lat), *yz])
+        r = B - D
+        vD = (r @ vB) / r[0]  # (B − D)·(Ḃ − Ḋ) = 0, Ḋ = ẋ_D x̂
+        dv = vB - vD * x
+        aD = (r @ aB + dv @ dv) / r[0]
+        ell = mech.rod_length
+        out["B"][k], out["aB"][k], out["D"][k] = B, aB, D
+        out["e"][k], out["de"][k], out["dde"][k] = r / ell, dv / ell, (aB - aD * x) / ell
+        out["xd1"][k], out["xd2"][k] = vD, aD
+    out.update(n=n, w9=w9, al9=al9, a=hinge, c=c, dtheta=d1, hooke=float(hinge @ c))
+    return out
+
+
+def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_plate=0.0,
+                          f=None, J0=None, M_shaft=None) -> SwashReactions:
+    """The joint reactions of the swash plate by Newton–Euler, every body's equations one linear
+    system: the independent check of :mod:`transient.core.swash_friction` and, without friction,
+    of the reduced model (18).
+
+    Bodies (half 1; the mirror half of ``halves = 2`` is its mirror image, so it doubles the
+    torque on the shaft and adds its force mirrored, (−F_x, F_y, F_z), at the main bearing):
+    piston k (mass m_p on its axis; the gas force P_k and the friction f_k along +x, the wall's
+    N_k across), rod k (mass m at G = D + c e, inertia I_G across its axis; ball joints at both
+    ends, so its moment equation about G counts only across e), link 9 (centre at O, inertia
+    J_p about n and J_d across; forces from the plate bearing and the rods, moments from the plate
+    bearing (⊥ n, and the friction M_plate about n) and from the cross: −I₁₃ψ̈ a + λ (a × c), the
+    cross carrying no force), the shaft with the plates (J₀; the frame's force F_O, the friction
+    M_main, the drive M_shaft). Unknowns: φ̈ if ``J0`` is given (else ``epsilon`` is prescribed
+    and the shaft's moment equation is left out), per cylinder the forces at B and D and N, F_P,
+    the plate bearing's moment M_P (with M_P·n = 0), λ and F_O: 8z + 10 (+1) equations, solved by
+    ``numpy.linalg.solve``. Known friction: ``M_main``, ``M_plate``, ``f`` (z,).
+
+    Returns
+    -------
+    SwashReactions
+        Its loss and through are computed from the given friction (see
+        :func:`swash_plate_friction` for the friction laws closed on the reactions).
+    """
+    free = J0 is not None
+    kin = swash_plate_motion(mech, phi, omega, 0.0 if free else epsilon)
+    kin1 = swash_plate_motion(mech, phi, 0.0, 1.0)  # the accelerations' slopes in φ̈
+    z, h = mech.cylinders, mech.halves
+    f = np.zeros(z) if f is None else np.asarray(f, dtype=np.float64)
+    P = np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (z,))
+    m_p, m_r, ell, cg = mech.piston_mass, mech.rod_mass, mech.rod_length, mech.rod_cg_from_pin
+    i_g = mech.rod_inertia_cg if mech.rod_model == "rigid" else m_r * cg * (ell - cg)
+    n, a, c = kin["n"], kin["a"], kin["c"]
+    J9 = mech.link_diametral_inertia * np.eye(3) + (
+        mech.link_polar_inertia - mech.link_diametral_inertia) * np.outer(n, n)
+    ic = mech.cross_inertia
+    x = np.array([1.0, 0.0, 0.0])
+    size = 8 * z + 10 + (1 if free else 0)
+    E = 8 * z + 10  # column of φ̈
+    iF = lambda k: 8 * k  # noqa: E731 (column blocks)
+    iG = lambda k: 8 * k + 3  # noqa: E731
+    iN = lambda k: 8 * k + 6  # noqa: E731
+    iP, iM, iL, iO = 8 * z, 8 * z + 3, 8 * z + 6, 8 * z + 7
+    A = np.zeros((size, size))
+    rhs = np.zeros(size)
+    row = 0
+
+    def accel(key, k=None):
+        """(part at the given φ̈ or at φ̈ = 0, slope in φ̈) of a kinematic quantity."""
+        v0 = kin[key] if k is None else kin[key][k]
+        v1 = kin1[key] if k is None else kin1[key][k]
+        if free:
+            return v0, v1
+        return v0, 0.0 * v1
+
+    def put(eq_rows, known, slope):
+        """Move the φ̈ part of an equation's right-hand side to the left."""
+        nonlocal row
+        for j in range(len(eq_rows)):
+            rhs[row + j] = known[j]
+            if free:
+                A[row + j, E] = -slope[j]
+        row += len(eq_rows)
+
+    for k in range(z):
+        aD, aD1 = accel("xd2", k)
+        dde, dde1 = accel("dde", k)
+        e, B, D = kin["e"][k], kin["B"][k], kin["D"][k]
+        G = D + cg * e
+        aG, aG1 = aD * x + cg * dde, aD1 * x + cg * dde1
+        # piston: −G_k + (P + f) x̂ + (0, N) = m_p a_D x̂
+        for j in range(3):
+            A[row + j, iG(k) + j] = -1.0
+        A[row + 1, iN(k)], A[row + 2, iN(k) + 1] = 1.0, 1.0
+        put(range(3), m_p * aD * x - (P[k] + f[k]) * x, m_p * aD1 * x)
+        # rod: F + G = m a_G
+        for j in range(3):
+            A[row + j, iF(k) + j] = 1.0
+            A[row + j, iG(k) + j] = 1.0
+        put(range(3), m_r * aG, m_r * aG1)
+        # rod about G, across e: (B − G) × F + (D − G) × G_D = I_G e × ë
+        u1 = np.cross(e, [0.0, 0.0, 1.0] if abs(e[2]) < 0.9 else [0.0, 1.0, 0.0])
+        u1 /= np.linalg.norm(u1)
+        u2 = np.cross(e, u1)
+        for j, u in enumerate((u1, u2)):
+            # (r × F)·u = F·(u × r)
+            A[row + j, iF(k): iF(k) + 3] = np.cross(u, B - G)
+            A[row + j, iG(k): iG(k) + 3] = np.cross(u, D - G)
+        put(range(2), [i_g * np.cross(e, dde) @ u for u in (u1, u2)],
+            [i_g * np.cross(e, dde1) @ u for u in (u1, u2)])
+    # link 9, force: F_P − Σ F_k = 0 (its centre O does not move)
+    for j in range(3):
+        A[row + j, iP + j] = 1.0
+        for k in range(z):
+            A[row + j, iF(k) + j] = -1.0
+    put(range(3), np.zeros(3), np.zeros(3))
+    # link 9, moments about O: M_P + M_plate n − I₁₃ψ̈ a + λ (a × c) − Σ B_k × F_k = Ḣ₉
+    al9, al91 = accel("al9")
+    w9 = kin["w9"]
+    dH, dH1 = J9 @ al9 + np.cross(w9, J9 @ w9), J9 @ al91
+    psi2, psi21 = al9 @ a, al91 @ a
+    axc = np.cross(a, c)
+    for j in range(3):
+        A[row + j, iM + j] = 1.0
+        A[row + j, iL] = axc[j]
+    for k in range(z):
+        B = kin["B"][k]
+        Bx = np.array([[0.0, -B[2], B[1]], [B[2], 0.0, -B[0]], [-B[1], B[0], 0.0]])
+        A[row: row + 3, iF(k): iF(k) + 3] = -Bx
+    put(range(3), dH - M_plate * n + ic * psi2 * a, dH1 + ic * psi21 * a)
+    # M_P ⊥ n: the plate bearing passes no moment about n but its friction
+    A[row, iM: iM + 3] = n
+    put(range(1), [0.0], [0.0])
+    # shaft, forces: F_O = F_P (one half) or F_P + its mirror image
+    mirror = np.diag([-1.0, 1.0, 1.0])
+    for j in range(3):
+        A[row + j, iO + j] = 1.0
+    A[row: row + 3, iP: iP + 3] = -(np.eye(3) + (mirror if h == 2 else 0.0))
+    put(range(3), np.zeros(3), np.zeros(3))
+    if free:  # shaft about x: J₀ φ̈ = M_shaft − M_main − h x̂·(M_P + M_plate n)
+        A[row, iM] = h
+        put(range(1), [M_shaft - M_main - h * M_plate * n[0]], [-J0])
+    assert row == size
+    sol = np.linalg.solve(A, rhs)
+    eps = sol[E] if free else epsilon
+    M_P = sol[iM: iM + 3]
+    torque = h * (M_P[0] + M_plate * n[0])  # what the plates put into link 9, over ω
+    v = kin["xd1"] / omega if omega != 0.0 else swash_plate_motion(mech, phi, 1.0, 0.0)["xd1"]
+    piston_loss = -h * np.sum(f * v)
+    loss = np.array([M_main, -h * M_plate * kin["dtheta"], piston_loss])
+    through = np.array([M_main + torque, torque, piston_loss])
+    return SwashReactions(
+        epsilon=float(eps), main=sol[iO: iO + 3], plate=sol[iP: iP + 3], plate_moment=M_P,
+        B=np.array([sol[iF(k): iF(k) + 3] for k in range(z)]),
+        D=np.array([sol[iG(k): iG(k) + 3] for k in range(z)]),
+        N=np.array([sol[iN(k): iN(k) + 2] for k in range(z)]), f=f, M_main=float(M_main),
+        M_plate=float(M_plate), loss=loss, through=through)
+
+
+def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
+                         sigma=None, epsilon=None) -> SwashReactions:
+    """φ̈ and the joint reactions with friction on them, closed by ``scipy.optimize.fsolve``.
+
+    The friction laws, written out again: the main bearing's moment on the shaft
+    M_main = σ μ r |F_O| + c ω; the plate bearing's on link 9 about n, opposing link 9's rate on
+    the plate q = θ′ω, M_plate = −sign(q) μ r |F_P| − c q; the cylinder's axial force on piston k,
+    opposing its speed v_k = ẋ_D, f_k = −sign(v_k)(μ |N_k| + F_ring + c_p P_k⁺) − c v_k. The
+    unknowns (M_main, M_plate, f_1 … f_z) solve these, each evaluation solving
+    :func:`swash_plate_reactions` (with φ̈) for the forces they depend on.
+
+    ``coefficients``: dict with ``main`` and ``plate`` = (μ, r, c) and ``pistons`` = (μ, F_ring,
+    c_p, c). ``sigma``: the direction of motion (sign ω, needed at ω = 0). Signs of v_k and q
+    are taken at the state itself (off the dead centres). With ``epsilon`` the motion is
+    prescribed (inverse dynamics): φ̈ is ``epsilon`` and the drive the shaft then needs,
+    J₀φ̈ − M_shaft + (what the shaft puts into the plates), is ``through[0]`` + J₀φ̈ − M_shaft.
+    """
+    from scipy.optimize import fsolve
+
+    sigma = float(np.sign(omega)) if sigma is None else sigma
+    mu_o, r_o, c_o = coefficients["main"]
+    mu_p, r_p, c_p = coefficients["plate"]
+    mu_s, ring, share, c_s = coefficients["pistons"]
+    P = np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (mech.cylinders,))
+    kin = swash_plate_motion(mech, phi, 1.0, 0.0)
+    v_unit, q_unit = kin["xd1"], kin["dtheta"]  # per unit ω
+    scale_f = np.abs(P).max() + 1.0
+    scale_m = scale_f * mech.joint_radius
+
+    def solve(m_o, m_f, fk):
+        if epsilon is None:
+            return swash_plate_reactions(mech, phi, omega, None, P, m_o, m_f, fk, J0, M_shaft)
+        return swash_plate_reactions(mech, phi, omega, epsilon, P, m_o, m_f, fk)
+
+    def laws(y):
+        m_o, m_f, fk = y[0] * scale_m, y[1] * scale_m, y[2:] * scale_f
+        r = solve(m_o, m_f, fk)
+        law_o = sigma * mu_o * r_o * np.linalg.norm(r.main) + c_o * omega
+        law_f = sigma * mu_p * r_p * np.linalg.norm(r.plate) - c_p * q_unit * omega
+        law_s = (-np.sign(v_unit) * sigma * (mu_s * np.hypot(r.N[:, 0], r.N[:, 1]) + ring
+                                             + share * np.maximum(P, 0.0))
+                 - c_s * v_unit * omega)
+        return np.concatenate([[(law_o - m_o) / scale_m], [(law_f - m_f) / scale_m],
+                               (law_s - fk) / scale_f])
+
+    y, info, _, _ = fsolve(laws, np.zeros(2 + mech.cylinders), xtol=1e-14, full_output=True)
+    if not np.max(np.abs(info["fvec"])) <= 1e-13:  # relative to the forces' scale
+        raise ArithmeticError(f"the friction laws are not closed: residual {info['fvec']}")
+    return solve(y[0] * scale_m, y[1] * scale_m, y[2:] * scale_f)

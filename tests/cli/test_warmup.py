@@ -41,7 +41,8 @@ FEATURE_KERNELS = {
     "per-cylinder variation": ("variation.cycle_fuel", "variation.misfire_draw"),
     "tabulated loads": ("forcing.table_load", "forcing.speed_knot_segment"),
     "reaction friction": ("joint_friction.prepare", "joint_friction.solve",
-                          "joint_friction.reaction_acceleration"),
+                          "swash_friction.prepare", "swash_friction.solve",
+                          "reactions.acceleration"),
 }
 
 

@@ -511,22 +511,6 @@ def test_invalid_swash_plate_is_one_line_exit_2(tmp_path, capsys, command, old, 
     assert not (tmp_path / "res").exists()
 
 
-@pytest.mark.parametrize("case", ["swash_plate_4cyl.toml"])
-def test_reaction_friction_where_it_is_not_implemented_is_one_line_exit_2(tmp_path, capsys,
-                                                                          case):
-    """Friction on the reactions exists for the crank-slider and the articulated mechanism: a
-    swash plate's reaction pair is refused, naming what is allowed."""
-    text = (Path(__file__).resolve().parents[2] / "cases" / case).read_text()
-    text = text.split("\n[friction]")[0]
-    scene = tmp_path / "bad.toml"
-    scene.write_text(text + '\n[friction]\n\n[[friction.pairs]]\nbetween = ["shaft", "link"]\n'
-                            'model = "reaction"\nmu = 0.003\nradius_mm = 30\n', encoding="utf-8")
-    code, out, err = run_cli(["check", str(scene)], capsys)
-    assert code == 2
-    assert_one_line_error(err, scene, "friction.pairs[0].model",
-                          "friction on the reactions is not implemented for 'swash-plate'")
-
-
 # The radial with friction on its joints' reactions: one pair broken (the case's first, the main
 # bearing, unless said), or a key of the scene.
 RADIAL_REACTION = (CASES_DIR / "radial_5cyl_reaction_friction.toml").read_text()
@@ -564,6 +548,43 @@ def test_invalid_radial_reaction_pair_is_one_line_exit_2(tmp_path, capsys, old, 
     assert RADIAL_REACTION.count(old) == 1, old
     scene = tmp_path / "bad.toml"
     scene.write_text(RADIAL_REACTION.replace(old, new), encoding="utf-8")
+    code, out, err = run_cli(["check", str(scene)], capsys)
+    assert code == 2
+    assert_one_line_error(err, scene, key, fragment)
+
+
+SWASH_REACTION = (Path(__file__).resolve().parents[2] / "cases"
+                  / "swash_plate_4cyl_reaction_friction.toml").read_text()
+
+SWASH_REACTION_CASES = [
+    ("ball-joint-on-link", 'between = ["plate", "link"]', 'between = ["link", "rod"]',
+     "friction.pairs[1].between", "['link', 'rod'] (the ball joints B_k of the rods on link 9) "
+     "cannot have friction on its reactions: the swash-plate keeps them ideal; reaction pairs "
+     "join ['shaft', 'plate'], ['plate', 'link'], ['piston', 'cylinder']"),
+    ("ball-joint-on-piston", 'between = ["plate", "link"]', 'between = ["rod", "piston"]',
+     "friction.pairs[1].between", "(the ball joints D_k of the rods on the pistons)"),
+    ("constant-eta-link-name", 'between = ["shaft", "plate"]', 'between = ["shaft", "link"]',
+     "friction.pairs[0].between", "'shaft' and 'link' are not neighbours; a pair joins two "
+     "adjacent links of the chain shaft – plate – link – rod – piston – cylinder"),
+    ("plate-bearing-radius-missing", 'radius_mm = 70', '', "friction.pairs[1].radius",
+     "is missing"),
+    ("pistons-wedge", 'rod_length_mm = 300\n', 'rod_length_mm = 10\n',
+     "friction.pairs[2].mu", "the friction would wedge the pistons: μ·tan γ_max"),
+]
+
+
+@pytest.mark.parametrize("name, old, new, key, fragment", SWASH_REACTION_CASES,
+                         ids=[c[0] for c in SWASH_REACTION_CASES])
+def test_invalid_swash_reaction_pair_is_one_line_exit_2(tmp_path, capsys, name, old, new, key,
+                                                        fragment):
+    text = SWASH_REACTION
+    assert text.count(old) == 1, old
+    text = text.replace(old, new)
+    if name == "pistons-wedge":  # (a 10 mm rod swings to 70°; μ = 0.5 wedges it)
+        text = text.replace("mu = 0.03\n", "mu = 0.5\n").replace("cg_from_pin_mm = 150",
+                                                                "cg_from_pin_mm = 5")
+    scene = tmp_path / "bad.toml"
+    scene.write_text(text, encoding="utf-8")
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2
     assert_one_line_error(err, scene, key, fragment)

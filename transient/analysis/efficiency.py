@@ -201,7 +201,9 @@ def _cylinder_budget(traj, sel, losses, n_cyc: int, n_cylinders: int, v_cyl: flo
     rule over the samples and scale the pair's exact integral, so that the cylinders sum to it;
     ``cylinder_split_residual_<k>`` is the quadrature's relative mismatch of that integral, which
     finer output sampling makes smaller. Empty without those columns (constant-η and mapped pairs
-    join links that every cylinder shares: their loss has no split)."""
+    join links that every cylinder shares: their loss has no split); a pair whose columns are NaN
+    (the swash plate's bearings, which every cylinder loads) has none, and ``fmep_cyl<c>`` sums
+    the pairs that split."""
     if not losses or cylinder_loss_column(0, 0) not in traj:
         return {}
     out: dict[str, tuple[float, str]] = {}
@@ -210,6 +212,8 @@ def _cylinder_budget(traj, sel, losses, n_cyc: int, n_cylinders: int, v_cyl: flo
     for k, exact in enumerate(losses):
         quad = np.array([np.trapezoid(traj[cylinder_loss_column(k, c)][sel], t)
                          for c in range(n_cylinders)])
+        if np.isnan(quad).any():
+            continue
         whole = float(np.sum(quad))
         share = quad / whole if whole != 0.0 else np.zeros(n_cylinders)
         out[f"cylinder_split_residual_{k + 1}"] = (

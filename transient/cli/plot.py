@@ -63,7 +63,8 @@ def cmd_plot(args) -> int:
             labels = ["engine"] + [f"cylinder {c + 1}" for c in range(n)]
             suffixes += [f"_cyl{c + 1}" for c in range(n)]
         fig, ax = plt.subplots(figsize=(4 + 0.8 * len(labels), 4.5))
-        plots.friction_budget(ax, labels, [res.analysis[f"fmep_{k + 1}{s}"][0]
+        # (a pair every cylinder loads has no share per cylinder: the engine's bar alone)
+        plots.friction_budget(ax, labels, [res.analysis.get(f"fmep_{k + 1}{s}", (0.0,))[0]
                                            for k in range(len(names)) for s in suffixes], names)
         ax.set_title(f"{scene.name}: FMEP per pair (η_mech = "
                      f"{res.analysis['eta_mech_work'][0]:.4f})")

@@ -18,7 +18,6 @@ from . import cylinder as cyl
 from . import governor as gv
 from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
-from . import joint_friction as jf
 from . import reactions as rx
 from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, LT_ANGLE, LT_NONE, LT_SPEED, OMEGA, PHI,
                      SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_SLEEVE, SW_STARTER, T, TABULATED,
@@ -374,7 +373,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                     M_k *= m.var_par[k, PRESSURE]
                 M_gas += M_k
                 if extras is not None and m.reaction:  # each piston's force, for the joints
-                    wk[WK_RX + jf.R_P, k] = (m.gas_scale[k] * (p_k - m.gas_offset)
+                    wk[WK_RX + rx.R_P, k] = (m.gas_scale[k] * (p_k - m.gas_offset)
                                              * (m.var_par[k, PRESSURE] if m.var_on else 1.0))
         else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
@@ -384,7 +383,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                     M_k *= wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                 M_gas += M_k
                 if extras is not None and m.reaction:
-                    wk[WK_RX + jf.R_P, k] = (f * m.gas_scale[k] * (p_k - m.gas_offset)
+                    wk[WK_RX + rx.R_P, k] = (f * m.gas_scale[k] * (p_k - m.gas_offset)
                                              * (wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                                                 if m.var_on else 1.0))
             M_gas *= f
@@ -405,6 +404,6 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
     if extras is not None and m.reaction:
         if not m.has_gas:
             for k in range(m.ncyl):
-                wk[WK_RX + jf.R_P, k] = 0.0
+                wk[WK_RX + rx.R_P, k] = 0.0
         rx.prepare(m, phi, w, sel, wk)
     return J, dJ, w, M_gas, M_load, M_starter

@@ -58,7 +58,7 @@ relative rates keep the sign of ω. What remains non-smooth inside a step are th
 |·|: chiefly μ·|N| where a side force changes side, at angles that depend on the motion, which
 the step-size control meets as it meets any kink (they account for most of the extra steps of
 a run with a slider's μ). At rest (ω = 0) the chain's
-rule for the incipient motion applies unchanged (:func:`choose_direction`).
+rule for the incipient motion applies unchanged (``reactions.choose_direction``).
 
 Outputs per pair (the joints of all cylinders that one pair names): the loss moment L (the power
 lost over ω), the moment S the shaft side puts into the joint (its power over ω: the shaft into
@@ -67,7 +67,7 @@ piston for the piston pins, the piston into the wall for the slider) and η* = 1
 the loss is (1 − η*) S ω as for a constant-η pair: η* < 1 when the shaft side drives, > 1 when
 the far side does, 0 for the slider (the wall takes no power), NaN where S = 0.
 
-Shapes: ``jp`` = ``Model.rx_par`` float64[N_RX_JOINTS, N_RX_PAR]; the rows ``WK_RX + R_*`` of ``wk`` hold
+Shapes: ``jp`` = ``Model.rx_par`` float64[N_JOINTS, N_RX_PAR]; the rows ``WK_RX + R_*`` of ``wk`` hold
 one value per cylinder (``R_LOSS``: per pair).
 """
 from __future__ import annotations
@@ -78,7 +78,6 @@ import numpy as np
 
 from .jit import kernel
 
-from .chain import LOCKED, UNIQUE
 from .crank_slider import (E, I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, N_CYL, R,
                            ROD_CG, SIN0, rod_and_piston, rod_and_piston_second)
 from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
@@ -363,38 +362,6 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     for p in range(n_pairs):
         s = wk[WK_S, p]
         wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan
-
-
-@kernel(inline=True)
-def reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, wk):
-    """φ̈ of the crank-slider with reaction friction (:func:`solve`), from the frictionless
-    φ̈ = (M − ½J′ω²)/J; the rows of :func:`prepare` must hold the state's."""
-    return solve(m.mech, m.rx_par, m.rx_pair, m.J0, M_shaft,
-                 (M_gas + M_shaft - 0.5 * dJ * w * w) / J, w, sigma, m.n_pairs, wk)
-
-
-@kernel(inline=True)
-def loss_moment(wk, k):
-    """The loss moment of pair k (its power lost over ω) after :func:`solve`."""
-    return wk[WK_RX + R_LOSS, k]
-
-
-@kernel(inline=True)
-def choose_direction(m, J, dJ, w, M_gas, M_shaft, wk):
-    """``(σ, φ̈, status)`` at a start or a reversal: σ = sign ω while moving; at rest the
-    incipient motion decides, as for the chain (``transient.core.chain``): with the friction
-    opposing σ = +1, φ̈ > 0 starts forward; else with it opposing σ = −1, φ̈ < 0 starts backward;
-    else the joints' friction holds the applied moments (LOCKED, φ̈ = 0)."""
-    if w != 0.0:
-        sigma = 1.0 if w > 0.0 else -1.0
-        return sigma, reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, wk), UNIQUE
-    a = reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, 1.0, wk)
-    if a > 0.0:
-        return 1.0, a, UNIQUE
-    a = reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, -1.0, wk)
-    if a < 0.0:
-        return -1.0, a, UNIQUE
-    return 1.0, 0.0, LOCKED
 
 
 @kernel

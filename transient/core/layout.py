@@ -87,12 +87,13 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
  WK_SCRATCH) = range(20)
-#: With reaction friction (``Model.reaction``, :mod:`.joint_friction`) the rows from WK_RX on
-#: hold, per cylinder, the crank-slider's geometry and accelerations at the state, the gas force,
+#: With reaction friction (``Model.reaction``, :mod:`.reactions`) the rows from WK_RX on
+#: hold, per cylinder, the mechanism's geometry and accelerations at the state, the gas force,
 #: the joints' directions of sliding at the step's angle ``sel`` and the solve's iterates
-#: (``joint_friction.R_*`` are the offsets), and per pair the moment its losses reduce to.
+#: (``joint_friction.R_*``, ``swash_friction.S_*`` are the offsets), and per pair the moment its
+#: losses reduce to: as many rows as the mechanism that needs most (the swash plate's).
 WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
-N_WK_RX = 28
+N_WK_RX = 32
 #: The articulated mechanism's rows (:mod:`.articulated_friction`, ``A_*`` are the offsets): per
 #: cylinder its rods' geometry and accelerations, the directions and the solve's iterates; it
 #: shares the gas force's and the pairs' loss rows of WK_RX.
@@ -101,7 +102,7 @@ N_WK_AX = 39
 
 #: The joints of the crank-slider that reaction friction acts in (rows of ``Model.rx_par``): the
 #: main bearing (frame – throw), the crankpin (throw – rod), the piston pin (rod – piston) and the
-#: piston in its cylinder (the slider).
+#: piston in its cylinder (the slider). The swash plate's are ``swash_friction.J_*``.
 JOINT_MAIN, JOINT_CRANKPIN, JOINT_PIN, JOINT_SLIDER = range(4)
 #: Rows of ``Model.rx_par`` and ``Model.rx_pair``: the most joints of a mechanism's reaction
 #: friction (the articulated mechanism's six, ``articulated_friction.J_*``), so that the arrays
@@ -173,9 +174,8 @@ Model = namedtuple(
         "var_shifted",  # bool: some cylinder has a combustion offset
         "var_par",  # float64[ncyl, variation.N_VAR_PAR]: factors, cycle start, rate, offset
         "var_int",  # int64[ncyl, 2 + cycles listed]: misfire period, seed, misfiring cycles
-        # reaction friction in the joints (transient.core.reactions: the crank-slider's or the
-        # articulated mechanism's); the pairs are then the joints that have friction, and no
-        # sub-chain is cut
+        # reaction friction in the mechanism's joints (transient.core.reactions); the
+        # pairs are then the joints that have friction, and no sub-chain is cut
         "reaction",  # bool: the pairs' losses follow from the joint reactions
         "rx_par",  # float64[N_JOINTS, N_RX_PAR]: each joint's coefficients (zeros: ideal)
         "rx_pair",  # int64[N_JOINTS]: the pair each joint reports as, −1 for an ideal joint

@@ -1,7 +1,10 @@
-"""Friction on the joints' reactions, by mechanism: the one place that picks the solver of
-``Model.kind`` (:mod:`.joint_friction` for the crank-slider, :mod:`.articulated_friction` for
-master and articulated rods), for the right-hand side, the stuck mode, the inverse dynamics and
-the outputs. Each mechanism's module has the same functions; these branch and call them.
+"""Friction on the joints' reactions, whichever the mechanism: the one place that picks the
+mechanism's solver by ``Model.kind`` (:mod:`.joint_friction` for the crank-slider,
+:mod:`.articulated_friction` for master and articulated rods, :mod:`.swash_friction` for the
+swash plate), for the right-hand side, the stuck mode, the inverse dynamics and the output rows.
+Every solver fills the same rows of ``wk`` for its callers: each piston's gas force (``R_P``,
+filled by :func:`.forcing.moments`), the pairs' loss moments (``R_LOSS``), their η*, S
+(``WK_ETA``, ``WK_S``) and each cylinder's share of the losses (``WK_CYL_LOSS``).
 
 A scene with reaction pairs and tabulated kinematics keeps its mechanism's kind only if it is a
 crank-slider (``Model.kind`` is then TABULATED): the scene check refuses the others.
@@ -10,16 +13,23 @@ from __future__ import annotations
 
 from .jit import kernel
 
+from .chain import LOCKED, UNIQUE
 from . import articulated_friction as af
 from . import joint_friction as jf
-from .chain import LOCKED, UNIQUE
-from .layout import ARTICULATED, WK_RX
+from . import swash_friction as sf
+from .layout import ARTICULATED, SWASH_PLATE, WK_RX
+
+#: Rows (offsets from ``layout.WK_RX``) every mechanism's solver shares: the gas force on each
+#: piston, the pairs' loss moments.
+R_P, R_LOSS = jf.R_P, jf.R_LOSS
 
 
 @kernel(inline=True)
 def prepare(m, phi, w, sel, wk):
-    """The state's rows for the solve (and the joints' directions at ``sel``)."""
-    if m.kind == ARTICULATED:
+    """The mechanism's rows of the state (φ, ω) and of the step's angle ``sel``."""
+    if m.kind == SWASH_PLATE:
+        sf.prepare(m.mech, phi, w, sel, wk)
+    elif m.kind == ARTICULATED:
         af.prepare(m.mech, phi, w, sel, wk)
     else:
         jf.prepare(m.mech, phi, w, sel, wk)
@@ -27,15 +37,23 @@ def prepare(m, phi, w, sel, wk):
 
 @kernel(inline=True)
 def acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, wk):
-    """φ̈ with the joints' friction in direction σ, and the pairs' η*, S, L into ``wk``."""
+    """φ̈ with the joints' friction, in direction σ, from the frictionless φ̈ = (M − ½J′ω²)/J
+    (the rows of :func:`prepare` at the state); fills the pairs' η*, S, L."""
+    eps0 = (M_gas + M_shaft - 0.5 * dJ * w * w) / J
+    if m.kind == SWASH_PLATE:
+        return sf.solve(m.mech, m.rx_par, m.rx_pair, m.J0, M_shaft, eps0, w, sigma, m.n_pairs,
+                        wk)
     if m.kind == ARTICULATED:
-        return af.reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, wk)
-    return jf.reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, wk)
+        return af.solve(m.mech, m.rx_par, m.rx_pair, m.J0, M_shaft, eps0, w, sigma, m.n_pairs,
+                        wk)
+    return jf.solve(m.mech, m.rx_par, m.rx_pair, m.J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
 
 
 @kernel
 def inverse_drive(m, eps, w, sigma, M_shaft, wk):
-    """The drive torque on the shaft for a prescribed motion, with the joints' friction."""
+    """The drive torque on the shaft for a prescribed φ̈ = ``eps``, with the joints' friction."""
+    if m.kind == SWASH_PLATE:
+        return sf.inverse_drive(m, eps, w, sigma, M_shaft, wk)
     if m.kind == ARTICULATED:
         return af.inverse_drive(m, eps, w, sigma, M_shaft, wk)
     return jf.inverse_drive(m, eps, w, sigma, M_shaft, wk)
@@ -43,9 +61,8 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
 
 @kernel(inline=True)
 def loss_moment(wk, k):
-    """The loss moment of pair k (its power lost over ω) after the solve (both mechanisms keep
-    it in the same row)."""
-    return wk[WK_RX + jf.R_LOSS, k]
+    """The loss moment of pair k (its power lost over ω) after a solve."""
+    return wk[WK_RX + R_LOSS, k]
 
 
 @kernel(inline=True)

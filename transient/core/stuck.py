@@ -44,7 +44,6 @@ from .jit import kernel
 from .chain import _best_candidate
 from . import eta_table as et
 from . import governor as gv
-from . import joint_friction as jf
 from . import reactions as rx
 from .layout import (LT_TIME, SW_LOAD, T, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S,
                      WK_SCRATCH)
@@ -85,7 +84,7 @@ def hold(m, J, M_gas, M_shaft, wk):
         wk[WK_S, k] = 0.0
         wk[WK_ETA, k] = 1.0
         if m.reaction:
-            wk[WK_RX + jf.R_LOSS, k] = 0.0
+            wk[WK_RX + rx.R_LOSS, k] = 0.0
     return 0.0
 
 

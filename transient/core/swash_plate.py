@@ -127,6 +127,49 @@ def _cross(a, b):
 
 
 @kernel
+def link_motion(mp, phi):
+    """Link 9's motion per unit shaft rate at angle φ: cos/sin of φ and θ, the plate normal n,
+    w = ω₉/φ̇ = i + θ′ n and w′ = θ″ n + θ′ (i × n), eq. (8), and :func:`hooke`'s θ′, θ″, u₁₃, u₁₃′."""
+    ca = mp[COS_A]
+    sa = mp[SIN_A]
+    theta, d1, d2, u13, du13 = hooke(mp, phi)
+    c_phi = cos(phi)
+    s_phi = sin(phi)
+    n = (ca, sa * c_phi, sa * s_phi)
+    w = (1.0 + d1 * n[0], d1 * n[1], d1 * n[2])
+    dw = (d2 * n[0], d2 * n[1] - d1 * n[2], d2 * n[2] + d1 * n[1])
+    return c_phi, s_phi, cos(theta), sin(theta), n, w, dw, d1, d2, u13, du13
+
+
+@kernel
+def rod_motion(mp, k, c_phi, s_phi, c_theta, s_theta, w, dw):
+    """Joint B_k, its rod and piston per unit shaft rate: B, B′ = w × B, B″ = w′ × B + w × B′; the
+    rod's direction e = (B − D)/ℓ, e′, e″; x_D′, x_D″ (d/dφ) of its piston.
+
+    Eq. (10): x_D = x_B − s, s = √(ℓ² − 2q), q = ½ |lateral offset|², so s′ = −q′/s and
+    s″ = −(q″ + s′²)/s; D moves along x only, so e′ = (B′ − x_D′ x̂)/ℓ."""
+    ell = mp[ROD_L]
+    b = joint_b(mp, k, c_phi, s_phi, c_theta, s_theta)
+    b1 = _cross(w, b)
+    t1 = _cross(dw, b)
+    t2 = _cross(w, b1)
+    b2 = (t1[0] + t2[0], t1[1] + t2[1], t1[2] + t2[2])
+    dy = mp[CYL0 + CYL_STRIDE * k + Y_D] - b[1]
+    dz = mp[CYL0 + CYL_STRIDE * k + Z_D] - b[2]
+    s = sqrt(ell * ell - dy * dy - dz * dz)
+    q1 = -(dy * b1[1] + dz * b1[2])
+    q2 = b1[1] * b1[1] + b1[2] * b1[2] - (dy * b2[1] + dz * b2[2])
+    s1 = -q1 / s
+    s2 = -(q2 + s1 * s1) / s
+    x1 = b1[0] - s1
+    x2 = b2[0] - s2
+    e = (s / ell, -dy / ell, -dz / ell)
+    e1 = ((b1[0] - x1) / ell, b1[1] / ell, b1[2] / ell)
+    e2 = ((b2[0] - x2) / ell, b2[1] / ell, b2[2] / ell)
+    return b, b1, b2, x1, x2, e, e1, e2
+
+
+@kernel
 def swash_terms(mp, phi, u, du):
     """Reduced inertia of the moving parts except shaft and plates, eqs. (19), (21).
 
@@ -151,46 +194,17 @@ def swash_terms(mp, phi, u, du):
     J, dJ : float
         J(φ) [kg m²] and dJ/dφ [kg m²/rad].
     """
-    ca = mp[COS_A]
     sa = mp[SIN_A]
-    ell = mp[ROD_L]
     cg = mp[ROD_CG]
-    theta, d1, d2, u13, du13 = hooke(mp, phi)
+    c_phi, s_phi, c_theta, s_theta, n, w, dw, d1, d2, u13, du13 = link_motion(mp, phi)
     # Link 9: (ω·n)² J_p + (φ̇ sin α)² J_d, the reference's form of (15)–(17); cross 13 about a.
-    wn = ca + d1
+    wn = mp[COS_A] + d1
     J = mp[J_POLAR] * wn * wn + mp[J_DIAM] * sa * sa + mp[I_CROSS] * u13 * u13
     dJ = 2.0 * (mp[J_POLAR] * wn * d2 + mp[I_CROSS] * u13 * du13)
-    # w = ω₉/φ̇ = i + θ′ n and w′ = θ″ n + θ′ (i × n), eq. (8).
-    c_phi = cos(phi)
-    s_phi = sin(phi)
-    c_theta = cos(theta)
-    s_theta = sin(theta)
-    n = (ca, sa * c_phi, sa * s_phi)
-    w = (1.0 + d1 * n[0], d1 * n[1], d1 * n[2])
-    dw = (d2 * n[0], d2 * n[1] - d1 * n[2], d2 * n[2] + d1 * n[1])
     halves = mp[HALVES]
     for k in range(int(mp[N_CYL])):
-        b = joint_b(mp, k, c_phi, s_phi, c_theta, s_theta)
-        b1 = _cross(w, b)
-        t1 = _cross(dw, b)
-        t2 = _cross(w, b1)
-        b2 = (t1[0] + t2[0], t1[1] + t2[1], t1[2] + t2[2])
-        yd = mp[CYL0 + CYL_STRIDE * k + Y_D]
-        zd = mp[CYL0 + CYL_STRIDE * k + Z_D]
-        # Eq. (10): x_D = x_B − s, s = √(ℓ² − 2q), q = ½ |lateral offset|², so s′ = −q′/s and
-        # s″ = −(q″ + s′²)/s.
-        dy = yd - b[1]
-        dz = zd - b[2]
-        s = sqrt(ell * ell - dy * dy - dz * dz)
-        q1 = -(dy * b1[1] + dz * b1[2])
-        q2 = b1[1] * b1[1] + b1[2] * b1[2] - (dy * b2[1] + dz * b2[2])
-        s1 = -q1 / s
-        s2 = -(q2 + s1 * s1) / s
-        x1 = b1[0] - s1
-        x2 = b2[0] - s2
-        # Rod direction e = (B − D)/ℓ and centre of mass G = D + cg·e; D moves along x only.
-        e1 = ((b1[0] - x1) / ell, b1[1] / ell, b1[2] / ell)
-        e2 = ((b2[0] - x2) / ell, b2[1] / ell, b2[2] / ell)
+        _, _, _, x1, x2, _, e1, e2 = rod_motion(mp, k, c_phi, s_phi, c_theta, s_theta, w, dw)
+        # The rod's centre of mass G = D + cg·e; D moves along x only.
         g1x, g2x = x1 + cg * e1[0], x2 + cg * e2[0]
         e11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]
         e12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2]

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from math import cos, degrees, pi, sin
+from math import asin, cos, degrees, pi, sin
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
@@ -143,10 +143,34 @@ class SwashPlate:
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with the
     #: plates, and link 9 with cross 13, rods, pistons and gas forces (beyond plate bearing 11).
     links = ("shaft", "link")
+    #: Links for pairs with friction on their reactions (:mod:`transient.core.swash_friction`),
+    #: the shaft side first: the shaft with flywheel and load, the plate on it, link 9, the rods,
+    #: the pistons and the cylinders (the frame). So [shaft, plate] is the main bearing (the
+    #: plate carries the mechanism's forces into it), [plate, link] the plate bearing 11,
+    #: [link, rod] the ball joints B_k, [rod, piston] the ball joints D_k and [piston, cylinder]
+    #: the pistons in their cylinders.
+    reaction_links = ("shaft", "plate", "link", "rod", "piston", "cylinder")
+    #: The joints among them that stay ideal (named by their shaft-side link): the ball joints,
+    #: whose rods' spin about their own axes the solver does not carry.
+    ideal_reaction_joints = {"link": "the ball joints B_k of the rods on link 9",
+                             "rod": "the ball joints D_k of the rods on the pistons"}
 
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia of each link besides the shaft's: none here [kg m²]."""
         return (0.0, 0.0)
+
+    def max_rod_tilt(self) -> float:
+        """The largest angle [rad] of a rod to its cylinder axis over a turn (sampled,
+        :func:`max_offset`): asin(lateral offset/ℓ)."""
+        return asin(max_offset(self) / self.rod_length)
+
+    def joint_reversals(self) -> tuple[float, ...]:
+        """Shaft angles [rad] at which a joint with reaction friction reverses its relative
+        motion: every piston's dead centres (the main and plate bearings turn one way while ω
+        keeps its sign; ``transient.core.swash_friction``)."""
+        inner, outer = dead_centres(self)
+        return tuple(self.firing_angles) + tuple(
+            _snapped(a, 2.0 * pi * k / self.cylinders + pi) for k, a in enumerate(outer))
 
     @property
     def n_cylinders(self) -> int:

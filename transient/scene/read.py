@@ -374,6 +374,14 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
         else:
             between = _between(ps, links, hint)
             ia = links.index(between[0])
+        ideal = getattr(mech, "ideal_reaction_joints", {}) if model == "reaction" else {}
+        if between[0] in ideal:
+            allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in zip(links, links[1:])
+                                if a not in ideal)
+            raise SceneError(ps.key("between"),
+                             f"{list(between)} ({ideal[between[0]]}) cannot have friction on "
+                             f"its reactions: the {mech.name} keeps them ideal; reaction pairs "
+                             f"join {allowed}")
         if ia in seen:
             raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
         seen[ia] = i
@@ -403,6 +411,8 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
         pairs.sort(key=lambda p: joints.index(p.between))
         if hasattr(mech, "reaction_joints"):
             _check_wedging_articulated(s, mech, pairs, raw)
+        elif hasattr(mech, "max_rod_tilt"):
+            _check_piston_wedging(s, mech, pairs, raw)
         else:
             _check_wedging(s, mech, pairs, raw)
     else:
@@ -577,6 +587,23 @@ def _check_wedging_articulated(s: Section, mech, pairs: list[Pair], raw: list) -
                              f"the friction would wedge the {rod}: μ_slider·tan β_max + (μ·r of "
                              f"its pins)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; allowed "
                              f"below 1 (lubricated pairs are around 0.01)")
+def _check_piston_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
+    """Friction must not wedge a swash plate's pistons: each piston's friction equation has a
+    slope of at least 1 − μ tan γ in its friction force, γ the largest rod tilt to the cylinder
+    axis (:mod:`transient.core.swash_friction`); μ tan γ < 1 keeps it increasing, hence one
+    solution at every state."""
+    piston = next((p for p in pairs if p.between[0] == "piston"), None)
+    if piston is None:
+        return
+    tan_g = math.tan(mech.max_rod_tilt())
+    if piston.mu * tan_g >= 1.0:
+        i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
+                 and item.get("between", [None])[0] == "piston")
+        raise SceneError(f"{s.key('pairs')}[{i}].mu",
+                         f"the friction would wedge the pistons: μ·tan γ_max = "
+                         f"{piston.mu * tan_g:.3g} ≥ 1 at the largest rod tilt "
+                         f"γ_max = {math.degrees(math.atan(tan_g)):.3g}°; allowed "
+                         f"μ < {1.0 / tan_g:.3g}")
 
 
 def _efficiency(s: Section, name: str) -> float:

@@ -429,9 +429,12 @@ class Pair:
     """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).
 
     ``between``: the link on the shaft side first (a), then the far one (b), names from the
-    mechanism's ``links`` (reaction pairs: two links of one of its reaction joints,
-    ``transient.mechanisms.reaction_joints``). ``eta_forward`` = η_ba, the efficiency while a (the shaft side) drives;
-    ``eta_backward`` = η_ab, while b drives; both in (0, 1] [1].
+    mechanism's ``links``; for the reaction model two links of one of its reaction joints
+    (``transient.mechanisms.reaction_joints``): crank-slider ``shaft`` – ``crank`` – ``rod`` –
+    ``piston`` – ``cylinder``, swash plate ``shaft`` – ``plate`` – ``link`` – ``rod`` – ``piston``
+    – ``cylinder`` (its ball joints, ``["link", "rod"]`` and ``["rod", "piston"]``, stay ideal),
+    the articulated mechanism's joints by their links. ``eta_forward`` = η_ba, the efficiency
+    while a (the shaft side) drives; ``eta_backward`` = η_ab, while b drives; both in (0, 1] [1].
     """
 
     between: tuple[str, str]
@@ -439,13 +442,13 @@ class Pair:
     eta_backward: float
     name: str = ""
     #: ``"constant-eta"`` (the efficiencies above) or ``"reaction"``: friction on the joint's
-    #: reaction (crank-slider and articulated, :mod:`transient.core.reactions`; then η is
+    #: reaction (every mechanism, :mod:`transient.core.reactions`; then η is
     #: unused, 1).
     model: str = "constant-eta"
     #: Reaction model: friction coefficient μ [1] (journal: friction-circle μ·r·|R|; slider:
     #: μ·|N| on the side force).
     mu: float = 0.0
-    #: Reaction model, journals: the journal's or pin's radius r [m].
+    #: Reaction model, journals and bearings: the journal's, pin's or bearing's radius r [m].
     radius: float = 0.0
     #: Reaction model: viscous coefficient, journals on the relative angular speed [N m s/rad],
     #: the slider on the piston speed [N s/m].
