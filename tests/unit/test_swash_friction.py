@@ -171,7 +171,7 @@ def test_reaction_pairs_survive_the_resolved_scene_and_report_per_joint():
     back = load_scene("resolved.toml", text=to_toml(scene))
     assert back.friction == scene.friction
     model, _, _ = build_model(scene)
-    assert model.reaction and list(model.rx_pair) == [0, 1, -1, -1, 2]
+    assert model.reaction and list(model.rx_pair) == [0, 1, -1, -1, 2] + [-1] * (N_JOINTS - 5)
     assert model.rx_par[sf.J_PLATE, RX_RADIUS] == 0.070
 
 

@@ -120,3 +120,28 @@ def test_a_radials_cylinders_lose_ring_tension_over_their_own_strokes():
     print(strokes, [eff[f"W_loss_1_cyl{c + 1}_per_cycle"] for c in range(mech.n_cylinders)])
     for c, stroke in enumerate(strokes):
         assert eff[f"W_loss_1_cyl{c + 1}_per_cycle"] == pytest.approx(4.0 * F * stroke, rel=1e-3)
+
+
+def test_a_swash_plates_pistons_split_and_its_bearings_do_not():
+    """The swash plate's main and plate bearings carry every piston: their loss is the engine's
+    (NaN per cylinder, no entries); its pistons' loss splits, each cylinder's share summing to the
+    pair's at every sample and over the cycles."""
+    scene = load_scene(CASES / "swash_plate_4cyl_reaction_friction.toml")
+    scene = replace(scene, run=Run(revolutions=4.0), output=Output(samples_per_rev=720))
+    data = integrate(scene)
+    assert data.complete, data.message
+    tr, n = data.trajectory, scene.mechanism.n_cylinders
+    names = [p.name for p in scene.friction.pairs]
+    k = names.index("pistons")
+    parts = np.array([tr[cylinder_loss_column(k, c)] for c in range(n)])
+    total = tr[f"P_loss_{k + 1}"]
+    assert np.max(np.abs(parts.sum(axis=0) - total)) <= 1e-13 * np.max(np.abs(total))
+    bearings = [j for j in range(len(names)) if j != k]
+    assert bearings and all(np.isnan(tr[cylinder_loss_column(j, 0)]).all() for j in bearings)
+    cyc = scene.mechanism.cycle
+    eff = {key: v for key, (v, _) in mechanical_efficiency(
+        scene, tr, window=(scene.initial.phi + cyc, scene.initial.phi + 3 * cyc, 2)).items()}
+    split = [eff[f"W_loss_{k + 1}_cyl{c + 1}_per_cycle"] for c in range(n)]
+    assert sum(split) == pytest.approx(eff[f"W_loss_{k + 1}_per_cycle"], rel=1e-13)
+    assert all(f"fmep_{j + 1}_cyl1" not in eff for j in bearings)
+    assert eff["fmep_cyl1"] == eff[f"fmep_{k + 1}_cyl1"]
