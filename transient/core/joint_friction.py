@@ -54,11 +54,18 @@ The sign of each joint's relative speed is taken at the angle ``sel`` of the cur
 (cached per ``sel``) times the direction of motion σ: the piston's speed changes sign at the
 dead centres, the rod's rate β̇ at α = 90°, 270°, and ``transient.assemble`` makes those angles
 breakpoints, so no friction force reverses inside a step; the throw's and the crankpin's
-relative rates keep the sign of ω. What remains non-smooth inside a step are the kinks of the
-|·|: chiefly μ·|N| where a side force changes side, at angles that depend on the motion, which
-the step-size control meets as it meets any kink (they account for most of the extra steps of
-a run with a slider's μ). At rest (ω = 0) the chain's
-rule for the incipient motion applies unchanged (:func:`choose_direction`).
+relative rates keep the sign of ω. What remains non-smooth are the kinks of the |·|: chiefly
+μ·|N| where a side force changes side, at angles that depend on the motion (about two per
+cylinder and cycle away from the dead centres, and one just beside each dead centre, where N
+is the pins' friction moments over l). The stepper puts step ends on them: every stage's solve
+records its N (:func:`track_sides`), and a step that the error test rejects while its stages
+show an N changing side is retaken at once to end where they put N's root (:func:`side_change`),
+so that the kink lies between two steps instead of inside a shrinking sequence of them. The
+function integrated is unchanged (no side is held, nothing is lagged): where the step ends only
+decides the cost, and the error test judges every step as before. Beside a dead centre the kink
+is harmless (there N and the piston's speed are both near zero, so φ̈'s slope barely changes)
+and those steps pass the error test as they are. At rest (ω = 0) the chain's rule for the
+incipient motion applies unchanged (:func:`choose_direction`).
 
 Outputs per pair (the joints of all cylinders that one pair names): the loss moment L (the power
 lost over ω), the moment S the shaft side puts into the joint (its power over ω: the shaft into
@@ -93,6 +100,10 @@ from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU,
 (R_LCB, R_LSB, R_AX, R_AY, R_DB, R_DS, R_ABY0, R_ABY1, R_AAX0, R_AAX1, R_AAY0, R_AAY1, R_DX0,
  R_DX1, R_DY0, R_DY1, R_H0, R_H1, R_P, R_SA, R_SB, R_SS, R_SEL, R_N, R_LOSS, R_STEP,
  R_COUPLE, R_ILCB) = range(28)
+#: Rows of the side forces seen by a step attempt's stages (:func:`track_sides`): the largest
+#: abscissa with N ≥ 0 and N there, the least with N < 0 and N there, the largest with N < 0, the
+#: least with N ≥ 0 (and N at each).
+(R_XP_HI, R_NP_HI, R_XN_LO, R_NN_LO, R_XN_HI, R_NN_HI, R_XP_LO, R_NP_LO) = range(28, 36)
 
 #: Newton's method has converged when its corrections are below TOL of their scales; the
 #: correction is then applied and, convergence being quadratic with a constant of the order of
@@ -370,6 +381,60 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     for p in range(n_pairs):
         s = wk[WK_S, p]
         wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan
+
+
+@kernel
+def reset_sides(mp, wk):
+    """Before a step attempt: no stage has seen a side force yet (:func:`track_sides`)."""
+    c = WK_RX
+    for k in range(int(mp[N_CYL])):
+        wk[c + R_XP_HI, k] = -np.inf
+        wk[c + R_XN_HI, k] = -np.inf
+        wk[c + R_XN_LO, k] = np.inf
+        wk[c + R_XP_LO, k] = np.inf
+
+
+@kernel(inline=True)
+def track_sides(mp, x, wk):
+    """After a stage's solve at abscissa ``x``: each cylinder's N into the extremes of the
+    abscissae at which the step's stages saw it on either side (:func:`side_change`)."""
+    c = WK_RX
+    for k in range(int(mp[N_CYL])):
+        N = wk[c + R_N, k]
+        if N >= 0.0:
+            if x > wk[c + R_XP_HI, k]:
+                wk[c + R_XP_HI, k] = x
+                wk[c + R_NP_HI, k] = N
+            if x < wk[c + R_XP_LO, k]:
+                wk[c + R_XP_LO, k] = x
+                wk[c + R_NP_LO, k] = N
+        else:
+            if x > wk[c + R_XN_HI, k]:
+                wk[c + R_XN_HI, k] = x
+                wk[c + R_NN_HI, k] = N
+            if x < wk[c + R_XN_LO, k]:
+                wk[c + R_XN_LO, k] = x
+                wk[c + R_NN_LO, k] = N
+
+
+@kernel
+def side_change(mp, wk):
+    """The earliest abscissa at which a step attempt's stages show a side force changing side
+    (:func:`track_sides`), or ∞: where every stage with N on one side lies before every stage with
+    it on the other, N's root between the two nearest, by linear interpolation. Only where it
+    is: stages that alternate (two changes, or none in the ε of a stage state's error) show
+    none."""
+    c = WK_RX
+    first = np.inf
+    for k in range(int(mp[N_CYL])):
+        x0, x1 = wk[c + R_XP_HI, k], wk[c + R_XN_LO, k]  # positive, then negative
+        n0, n1 = wk[c + R_NP_HI, k], wk[c + R_NN_LO, k]
+        if not x0 < x1:
+            x0, x1 = wk[c + R_XN_HI, k], wk[c + R_XP_LO, k]  # negative, then positive
+            n0, n1 = wk[c + R_NN_HI, k], wk[c + R_NP_LO, k]
+        if x0 < x1 and np.isfinite(x0) and np.isfinite(x1):
+            first = min(first, x0 + (x1 - x0) * n0 / (n0 - n1))
+    return first
 
 
 @kernel(inline=True)

@@ -92,7 +92,7 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: the joints' directions of sliding at the step's angle ``sel`` and the solve's iterates
 #: (``joint_friction.R_*`` are the offsets), and per pair the moment its losses reduce to.
 WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
-N_WK_RX = 28
+N_WK_RX = 36
 N_WK = WK_RX + N_WK_RX
 
 #: The joints of the crank-slider that reaction friction acts in (rows of ``Model.rx_par``): the
