@@ -15,6 +15,10 @@ identities computed two ways, so to rounding (bound 1e-12 of the largest force, 
 The exact solve of the shaft's equation: at the compiled φ̈ the reference's throw torques leave
 J₀ φ̈ − M_shaft − Σ T = 0 to rounding; with every coefficient zero the solve gives the reduced
 model's φ̈ = (M − ½J′ω²)/J (Lagrange: J, J′ of :func:`transient.core.crank_slider.cylinder_terms`).
+
+Where a step's stages see a side force change side, the step end the stepper aims at is the
+root of N between the nearest stages of either side: exact for a linear N, checked against the
+root put in by hand.
 """
 from __future__ import annotations
 
@@ -240,13 +244,13 @@ def stage_abscissae(x0, h):
 
 def side_change_of(mech, x0, h, sides):
     """``jf.side_change`` after the stages of an attempt have seen N_k = sides[k](x)."""
-    mp = mech.pack()
-    wk = np.full((N_WK, max(mech.n_cylinders, 5)), np.nan)
-    jf.reset_sides(mp, wk)
+    n = mech.n_cylinders
+    wk = np.full((N_WK, max(n, 5)), np.nan)
+    jf.reset_sides(n, wk)
     for x in stage_abscissae(x0, h):
-        wk[WK_RX + jf.R_N, : mech.n_cylinders] = [side(x) for side in sides]
-        jf.track_sides(mp, x, wk)
-    return jf.side_change(mp, wk)
+        wk[WK_RX + jf.R_N, :n] = [side(x) for side in sides]
+        jf.track_sides(n, x, wk)
+    return jf.side_change(n, wk)
 
 
 def test_a_side_force_changing_side_in_the_stages_puts_the_step_end_on_its_root():

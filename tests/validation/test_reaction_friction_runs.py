@@ -123,13 +123,13 @@ def kinks_case(mu_pistons=None, rtol=None):
 
 
 def test_the_kinks_of_the_side_forces_cost_little_and_keep_the_tolerance():
-    """Where a piston's side force changes side, μ·|N| has a kink (about six per cylinder and
+    """Where a piston's side force changes side, μ·|N| has a kink (several per cylinder and
     cycle); a step rejected with one inside is retaken to end on it (``joint_friction``,
     *Directions and smoothness*). The evaluations of the spin-up stay within 20 % of the same
-    scene without the pistons' μ (whose side forces then bend nothing); stepping through the
-    kinks by rejections alone took about 55 % more. The speed stays within 1e-5 of a run at
-    rtol 1e-11 (rtol 1e-8, 60 turns: the error the steps accumulate, about 250 rtol, with a
-    factor 4 to spare)."""
+    scene without the pistons' μ, whose side forces then bend nothing (left to the error test
+    alone, the kinks cost over 50 % more). The speed stays within 1e-5 of a run at rtol 1e-11
+    (rtol 1e-8, 60 turns: the error the steps accumulate, about 250 rtol, with a factor 4 to
+    spare)."""
     run = kinks_case()
     smooth = kinks_case(mu_pistons=0.0)
     tight = kinks_case(rtol=1e-11)

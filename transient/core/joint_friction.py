@@ -55,17 +55,20 @@ The sign of each joint's relative speed is taken at the angle ``sel`` of the cur
 dead centres, the rod's rate β̇ at α = 90°, 270°, and ``transient.assemble`` makes those angles
 breakpoints, so no friction force reverses inside a step; the throw's and the crankpin's
 relative rates keep the sign of ω. What remains non-smooth are the kinks of the |·|: chiefly
-μ·|N| where a side force changes side, at angles that depend on the motion (about two per
-cylinder and cycle away from the dead centres, and one just beside each dead centre, where N
-is the pins' friction moments over l). The stepper puts step ends on them: every stage's solve
-records its N (:func:`track_sides`), and a step that the error test rejects while its stages
-show an N changing side is retaken at once to end where they put N's root (:func:`side_change`),
-so that the kink lies between two steps instead of inside a shrinking sequence of them. The
-function integrated is unchanged (no side is held, nothing is lagged): where the step ends only
-decides the cost, and the error test judges every step as before. Beside a dead centre the kink
-is harmless (there N and the piston's speed are both near zero, so φ̈'s slope barely changes)
-and those steps pass the error test as they are. At rest (ω = 0) the chain's rule for the
-incipient motion applies unchanged (:func:`choose_direction`).
+μ·|N| where a side force changes side, at angles that depend on the motion (several per
+cylinder and cycle: where the forces along the rod change sign, and beside the dead centres,
+where the rod stands along the cylinder). The stepper puts step ends on them: every stage's
+solve records its N (:func:`track_sides`), and a step that the error test rejects while its
+stages show an N changing side is retaken at once to end where they put N's root
+(:func:`side_change`), so that the kink lies between two steps instead of inside a run of
+rejected and shrinking ones. The function integrated is unchanged (no side is held, nothing is
+lagged): where a step ends decides only the cost, and the error test judges every step as
+before. Beside a dead centre, where the piston's speed is near zero, the slider's friction
+barely bends φ̈ and those steps pass the error test as they are. Holding each side over a step
+and switching it on a located state event would make every step smooth too, but an event costs
+more right-hand sides than such a kink does, and there are events beside every dead centre. At
+rest (ω = 0) the chain's rule for the incipient motion applies unchanged
+(:func:`choose_direction`).
 
 Outputs per pair (the joints of all cylinders that one pair names): the loss moment L (the power
 lost over ω), the moment S the shaft side puts into the joint (its power over ω: the shaft into
@@ -384,10 +387,11 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
 
 
 @kernel
-def reset_sides(mp, wk):
-    """Before a step attempt: no stage has seen a side force yet (:func:`track_sides`)."""
+def reset_sides(n, wk):
+    """Before a step attempt: no stage has seen the side force of any of the n cylinders yet
+    (:func:`track_sides`)."""
     c = WK_RX
-    for k in range(int(mp[N_CYL])):
+    for k in range(n):
         wk[c + R_XP_HI, k] = -np.inf
         wk[c + R_XN_HI, k] = -np.inf
         wk[c + R_XN_LO, k] = np.inf
@@ -395,11 +399,12 @@ def reset_sides(mp, wk):
 
 
 @kernel(inline=True)
-def track_sides(mp, x, wk):
-    """After a stage's solve at abscissa ``x``: each cylinder's N into the extremes of the
-    abscissae at which the step's stages saw it on either side (:func:`side_change`)."""
+def track_sides(n, x, wk):
+    """After a stage's solve at abscissa ``x``: the N of each of the n cylinders (row R_N) into
+    the extremes of the abscissae at which the step's stages saw it on either side
+    (:func:`side_change`)."""
     c = WK_RX
-    for k in range(int(mp[N_CYL])):
+    for k in range(n):
         N = wk[c + R_N, k]
         if N >= 0.0:
             if x > wk[c + R_XP_HI, k]:
@@ -418,7 +423,7 @@ def track_sides(mp, x, wk):
 
 
 @kernel
-def side_change(mp, wk):
+def side_change(n, wk):
     """The earliest abscissa at which a step attempt's stages show a side force changing side
     (:func:`track_sides`), or ∞: where every stage with N on one side lies before every stage with
     it on the other, N's root between the two nearest, by linear interpolation. Only where it
@@ -426,7 +431,7 @@ def side_change(mp, wk):
     none."""
     c = WK_RX
     first = np.inf
-    for k in range(int(mp[N_CYL])):
+    for k in range(n):
         x0, x1 = wk[c + R_XP_HI, k], wk[c + R_XN_LO, k]  # positive, then negative
         n0, n1 = wk[c + R_NP_HI, k], wk[c + R_NN_LO, k]
         if not x0 < x1:

@@ -113,7 +113,7 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
         mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
         if m.reaction and angle_mode:  # a side force changing side in a step shows here
-            jf.track_sides(m.mech, y[PHI], wk)
+            jf.track_sides(m.ncyl, y[PHI], wk)
         for k in range(m.n_pairs):
             lk = jf.loss_moment(wk, k) if m.reaction else (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
             out[W_LOSS0 + k] = lk * q

@@ -196,7 +196,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
         cut = at_segment_end
         for attempt in range(2):
             if kinked:
-                jf.reset_sides(m.mech, wk)
+                jf.reset_sides(m.ncyl, wk)
             _start_attempt(f, K, wk)
             _step(tab, m, extras, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
             finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
@@ -207,7 +207,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             # A side force changing side inside the step (a kink of the pistons' μ|N|): the
             # step is retaken at once to end where the stages put it, so that the kink lies
             # between two steps instead of inside a run of rejected ones (``joint_friction``).
-            x_kink = jf.side_change(m.mech, wk)
+            x_kink = jf.side_change(m.ncyl, wk)
             if not x + MIN_KINK_FRACTION * h < x_kink < x + h:
                 break
             ist[I_NREJECT] += 1
