@@ -57,9 +57,9 @@ breakpoints, so no friction force reverses inside a step; the throw's and the cr
 relative rates keep the sign of ω. What remains non-smooth are the kinks of the |·|: chiefly
 μ·|N| where a side force changes side, at angles that depend on the motion (several per
 cylinder and cycle: where the forces along the rod change sign, and beside the dead centres,
-where the rod stands along the cylinder). The stepper puts step ends on them: every stage's
-solve records its N (:func:`track_sides`), and a step that the error test rejects while its
-stages show an N changing side is retaken at once to end where they put N's root
+where the rod stands along the cylinder). In crank angle the stepper puts step ends on them:
+every stage's solve records its N (:func:`track_sides`), and a step that the error test rejects
+while its stages show an N changing side is retaken at once to end where they put N's root
 (:func:`side_change`), so that the kink lies between two steps instead of inside a run of
 rejected and shrinking ones. The function integrated is unchanged (no side is held, nothing is
 lagged): where a step ends decides only the cost, and the error test judges every step as
