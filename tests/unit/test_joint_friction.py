@@ -16,6 +16,10 @@ identities computed two ways, so to rounding (bound 1e-12 of the largest force, 
 The exact solve of the shaft's equation: at the compiled φ̈ the reference's throw torques leave
 J₀ φ̈ − M_shaft − Σ T = 0 to rounding; with every coefficient zero the solve gives the reduced
 model's φ̈ = (M − ½J′ω²)/J (Lagrange: J, J′ of :func:`transient.core.crank_slider.cylinder_terms`).
+
+Where a step's stages see a side force change side, the step end the stepper aims at is the
+root of N between the nearest stages of either side: exact for a linear N, checked against the
+root put in by hand.
 """
 from __future__ import annotations
 
@@ -196,3 +200,50 @@ def test_every_reversal_of_a_joint_is_a_breakpoint_where_the_derivative_jumps():
         assert min(gap[i], mech.cycle - gap[i]) <= 1e-12 * mech.cycle, angle
         assert model.bp_jump[i]
     assert model.reaction and list(model.rx_pair) == [0, 1, 2, 3] + [-1] * (N_JOINTS - 4)
+
+
+def stage_abscissae(x0, h):
+    """The abscissae at which a DOP853 attempt from x0 of size h evaluates the right-hand side:
+    its stages after the first (carried over) and the step's end."""
+    from transient.core.tableaus import TABLEAUS
+
+    tab = TABLEAUS["dop853"]
+    return x0 + h * tab.A[1: tab.n_stages + 1].sum(axis=1)
+
+
+def side_change_of(mech, x0, h, sides):
+    """``jf.side_change`` after the stages of an attempt have seen N_k = sides[k](x)."""
+    n = mech.n_cylinders
+    wk = np.full((N_WK, max(n, 5)), np.nan)
+    jf.reset_sides(n, wk)
+    for x in stage_abscissae(x0, h):
+        wk[WK_RX + jf.R_N, :n] = [side(x) for side in sides]
+        jf.track_sides(n, x, wk)
+    return jf.side_change(n, wk)
+
+
+def test_a_side_force_changing_side_in_the_stages_puts_the_step_end_on_its_root():
+    """Where a step's stages see a side force change side, the step is retaken to end at the
+    root that they bracket (linear between the nearest stages of either side): exact for an N
+    linear in the angle, whichever side it leaves, and the earliest of several cylinders'; a
+    cylinder whose N keeps its side, or changes it twice (stages on the same side at both
+    ends), puts no end."""
+    mech = MECHS["two-mass"]
+    assert mech.n_cylinders == 3
+    x0, h = 2.0, 0.3
+    a, b = x0 + 0.37 * h, x0 + 0.81 * h
+    falls = lambda x: -4e3 * (x - a)  # positive, then negative
+    rises = lambda x: 2e2 * (x - b)  # negative, then positive
+    keeps = lambda x: 50.0 + x
+    twice = lambda x: 1e3 * (x - x0 - 0.2 * h) * (x - x0 - 0.7 * h)
+    for sides, root in (([falls, keeps, keeps], a), ([keeps, rises, keeps], b),
+                        ([keeps, rises, falls], a), ([rises, keeps, falls], a)):
+        got = side_change_of(mech, x0, h, sides)
+        assert abs(got - root) <= 4 * np.finfo(float).eps * x0, (got, root)
+    # a curved N: the root lies between the nearest stages of either side
+    curved = lambda x: math.exp(3.0 * (x - a)) - 1.0
+    c = stage_abscissae(x0, h)
+    got = side_change_of(mech, x0, h, [keeps, curved, keeps])
+    assert c[c < a].max() < got < c[c > a].min()
+    assert side_change_of(mech, x0, h, [keeps, keeps, keeps]) == math.inf
+    assert side_change_of(mech, x0, h, [twice, keeps, keeps]) == math.inf

@@ -54,11 +54,21 @@ The sign of each joint's relative speed is taken at the angle ``sel`` of the cur
 (cached per ``sel``) times the direction of motion σ: the piston's speed changes sign at the
 dead centres, the rod's rate β̇ at α = 90°, 270°, and ``transient.assemble`` makes those angles
 breakpoints, so no friction force reverses inside a step; the throw's and the crankpin's
-relative rates keep the sign of ω. What remains non-smooth inside a step are the kinks of the
-|·|: chiefly μ·|N| where a side force changes side, at angles that depend on the motion, which
-the step-size control meets as it meets any kink (they account for most of the extra steps of
-a run with a slider's μ). At rest (ω = 0) the chain's
-rule for the incipient motion applies unchanged (``reactions.choose_direction``).
+relative rates keep the sign of ω. What remains non-smooth are the kinks of the |·|: chiefly
+μ·|N| where a side force changes side, at angles that depend on the motion (several per
+cylinder and cycle: where the forces along the rod change sign, and beside the dead centres,
+where the rod stands along the cylinder). In crank angle the stepper puts step ends on them:
+every stage's solve records its N (:func:`track_sides`), and a step that the error test rejects
+while its stages show an N changing side is retaken at once to end where they put N's root
+(:func:`side_change`), so that the kink lies between two steps instead of inside a run of
+rejected and shrinking ones. The function integrated is unchanged (no side is held, nothing is
+lagged): where a step ends decides only the cost, and the error test judges every step as
+before. Beside a dead centre, where the piston's speed is near zero, the slider's friction
+barely bends φ̈ and those steps pass the error test as they are. Holding each side over a step
+and switching it on a located state event would make every step smooth too, but an event costs
+more right-hand sides than such a kink does, and there are events beside every dead centre. At
+rest (ω = 0) the chain's rule for the incipient motion applies unchanged
+(``reactions.choose_direction``).
 
 Outputs per pair (the joints of all cylinders that one pair names): the loss moment L (the power
 lost over ω), the moment S the shaft side puts into the joint (its power over ω: the shaft into
@@ -88,11 +98,15 @@ from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU,
 #: crankpin's position r sin α, r cos α, β′, s′), then per acceleration its part at ε = 0 and its
 #: slope in ε (a_By, a_Ax, a_Ay, D_x, D_y, H), the gas force P, the signs of the crankpin's, the
 #: piston pin's and the piston's relative speed at ``sel`` per unit σ, the ``sel`` they are for
-#: ([0]), N's iterate, per pair the loss moment, and per cylinder the parts g/g′ and
-#: (∂g/∂ε)/g′ of its Newton correction.
+#: ([0]), N's iterate, per pair the loss moment, per cylinder the parts g/g′ and (∂g/∂ε)/g′ of
+#: its Newton correction, and 1/(l cos β) (the solve multiplies by it, a division here).
 (R_LCB, R_LSB, R_AX, R_AY, R_DB, R_DS, R_ABY0, R_ABY1, R_AAX0, R_AAX1, R_AAY0, R_AAY1, R_DX0,
  R_DX1, R_DY0, R_DY1, R_H0, R_H1, R_P, R_SA, R_SB, R_SS, R_SEL, R_N, R_LOSS, R_STEP,
- R_COUPLE) = range(27)
+ R_COUPLE, R_ILCB) = range(28)
+#: Rows of the side forces seen by a step attempt's stages (:func:`track_sides`): the largest
+#: abscissa with N ≥ 0 and N there, the least with N < 0 and N there, the largest with N < 0, the
+#: least with N ≥ 0 (and N at each).
+(R_XP_HI, R_NP_HI, R_XN_LO, R_NN_LO, R_XN_HI, R_NN_HI, R_XP_LO, R_NP_LO) = range(28, 36)
 
 #: Newton's method has converged when its corrections are below TOL of their scales; the
 #: correction is then applied and, convergence being quadratic with a constant of the order of
@@ -126,6 +140,7 @@ def prepare(mp, phi, w, sel, wk):
         ax, ay = r * sa, r * ca
         wk[c + R_LCB, k] = lcb
         wk[c + R_LSB, k] = lsb
+        wk[c + R_ILCB, k] = 1.0 / lcb
         wk[c + R_AX, k] = ax
         wk[c + R_AY, k] = ay
         wk[c + R_DB, k] = db
@@ -163,6 +178,14 @@ def _norm(x, y):
 
 
 @kernel(inline=True)
+def _inverse(norm):
+    """1/|F| for the slopes F̂·dF = (F·dF)/|F| (0 at F = 0, as :func:`_slope`)."""
+    if norm == 0.0:
+        return 0.0
+    return 1.0 / norm
+
+
+@kernel(inline=True)
 def _slope(fx, fy, dx, dy, norm):
     """d|F| for dF = (dx, dy): F̂·dF (0 at F = 0, where |F| has its kink)."""
     if norm == 0.0:
@@ -170,7 +193,7 @@ def _slope(fx, fy, dx, dy, norm):
     return (fx * dx + fy * dy) / norm
 
 
-@kernel
+@kernel(inline=True)
 def cylinder(mp, jp, wk, k, eps, w, sigma, N):
     """Cylinder k at φ̈ = ``eps`` and side force ``N``: the residual g of its rod equation, ∂g/∂N,
     ∂g/∂ε, the throw's torque T, ∂T/∂N, ∂T/∂ε and the scale of its forces."""
@@ -202,6 +225,9 @@ def cylinder(mp, jp, wk, k, eps, w, sigma, N):
     fax, fay = dx - N, py + dy
     fox, foy = fax + m_k * aax, fay + m_k * aay
     nb, na, no = _norm(fbx, fby), _norm(fax, fay), _norm(fox, foy)
+    # the unit vectors' factors: each |F| is differentiated twice (in N and in ε), so one
+    # division per force, not one per slope (divisions and square roots share one unit)
+    ib, ia, io = _inverse(nb), _inverse(na), _inverse(no)
     ka = jp[JOINT_CRANKPIN, RX_MU] * jp[JOINT_CRANKPIN, RX_RADIUS]
     kb = jp[JOINT_PIN, RX_MU] * jp[JOINT_PIN, RX_RADIUS]
     ko = jp[JOINT_MAIN, RX_MU] * jp[JOINT_MAIN, RX_RADIUS]
@@ -212,25 +238,25 @@ def cylinder(mp, jp, wk, k, eps, w, sigma, N):
     Mo = sigma * ko * no + jp[JOINT_MAIN, RX_VISCOUS] * w
     g = lcb * (N - dx) - lsb * (py + dy) - Ma - Mb + h
     T = -m_k * r * r * eps - Mo + Ma + (ax * fay - ay * fax)
-    # in N (dF/dN = (−1, dFs) for F_B, F_A, F_O alike)
-    dMa = -s_a * ka * _slope(fax, fay, -1.0, dFs, na)
-    dMb = -s_b * kb * _slope(fbx, fby, -1.0, dFs, nb)
-    dMo = sigma * ko * _slope(fox, foy, -1.0, dFs, no)
+    # in N (dF/dN = (−1, dFs) for F_B, F_A, F_O alike): d|F| = F̂·dF (:func:`_slope`)
+    dMa = -s_a * ka * (dFs * fay - fax) * ia
+    dMb = -s_b * kb * (dFs * fby - fbx) * ib
+    dMo = sigma * ko * (dFs * foy - fox) * io
     g_n = lcb - lsb * dFs - dMa - dMb
     T_n = -dMo + dMa + (ax * dFs + ay)
     # in ε at fixed N
     py1 = m_p * aby1
     fax1, fay1 = dx1, py1 + dy1
-    Ma1 = -s_a * ka * _slope(fax, fay, fax1, fay1, na)
-    Mb1 = -s_b * kb * _slope(fbx, fby, 0.0, py1, nb)
-    Mo1 = sigma * ko * _slope(fox, foy, fax1 + m_k * aax1, fay1 + m_k * aay1, no)
+    Ma1 = -s_a * ka * (fax * fax1 + fay * fay1) * ia
+    Mb1 = -s_b * kb * fby * py1 * ib
+    Mo1 = sigma * ko * (fox * (fax1 + m_k * aax1) + foy * (fay1 + m_k * aay1)) * io
     g_e = -lcb * dx1 - lsb * (py1 + dy1) - Ma1 - Mb1 + h1
     T_e = -m_k * r * r - Mo1 + Ma1 + (ax * fay1 - ay * fax1)
-    scale = abs(N) + abs(py) + abs(dx) + abs(dy) + abs(h) / lcb
+    scale = abs(N) + abs(py) + abs(dx) + abs(dy) + abs(h) * wk[c + R_ILCB, k]
     return g, g_n, g_e, T, T_n, T_e, scale
 
 
-@kernel
+@kernel(inline=True)
 def joint_terms(mp, jp, wk, k, eps, w, sigma, N):
     """Per joint of cylinder k at (ε, N): ``(S_main, S_crankpin, S_pin, S_slider, L_main, …)``,
     the moment the shaft side puts into the joint and the loss moment (powers over ω; module
@@ -266,7 +292,7 @@ def joint_terms(mp, jp, wk, k, eps, w, sigma, N):
             Mo, -Ma * (1.0 + db), -Mb * db, L_s)
 
 
-@kernel
+@kernel(inline=True)
 def start_n(mp, jp, wk, k, eps, w, sigma):
     """N of cylinder k at φ̈ = ``eps`` without the friction that depends on the forces (the rod
     equation is then linear in N): where Newton's method starts, so that its first step already
@@ -281,7 +307,7 @@ def start_n(mp, jp, wk, k, eps, w, sigma):
     dy = wk[c + R_DY0, k] + wk[c + R_DY1, k] * eps
     h = wk[c + R_H0, k] + wk[c + R_H1, k] * eps
     m_visc = -(jp[JOINT_CRANKPIN, RX_VISCOUS] * (1.0 + db) + jp[JOINT_PIN, RX_VISCOUS] * db) * w
-    return dx + (lsb * (py + dy) + m_visc - h) / lcb
+    return dx + (lsb * (py + dy) + m_visc - h) * wk[c + R_ILCB, k]
 
 
 @kernel
@@ -321,8 +347,9 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
         small = True
         for k in range(n):
             g, g_n, g_e, T, T_n, T_e, s = cylinder(mp, jp, wk, k, eps, w, sigma, wk[c + R_N, k])
-            r = g / g_n
-            q = g_e / g_n
+            i_n = 1.0 / g_n
+            r = g * i_n
+            q = g_e * i_n
             wk[c + R_STEP, k] = r
             wk[c + R_COUPLE, k] = q
             H += T_n * r - T
@@ -362,6 +389,62 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     for p in range(n_pairs):
         s = wk[WK_S, p]
         wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan
+
+
+@kernel
+def reset_sides(n, wk):
+    """Before a step attempt: no stage has seen the side force of any of the n cylinders yet
+    (:func:`track_sides`)."""
+    c = WK_RX
+    for k in range(n):
+        wk[c + R_XP_HI, k] = -np.inf
+        wk[c + R_XN_HI, k] = -np.inf
+        wk[c + R_XN_LO, k] = np.inf
+        wk[c + R_XP_LO, k] = np.inf
+
+
+@kernel(inline=True)
+def track_sides(n, x, wk):
+    """After a stage's solve at abscissa ``x``: the N of each of the n cylinders (row R_N) into
+    the extremes of the abscissae at which the step's stages saw it on either side
+    (:func:`side_change`)."""
+    c = WK_RX
+    for k in range(n):
+        N = wk[c + R_N, k]
+        if N >= 0.0:
+            if x > wk[c + R_XP_HI, k]:
+                wk[c + R_XP_HI, k] = x
+                wk[c + R_NP_HI, k] = N
+            if x < wk[c + R_XP_LO, k]:
+                wk[c + R_XP_LO, k] = x
+                wk[c + R_NP_LO, k] = N
+        else:
+            if x > wk[c + R_XN_HI, k]:
+                wk[c + R_XN_HI, k] = x
+                wk[c + R_NN_HI, k] = N
+            if x < wk[c + R_XN_LO, k]:
+                wk[c + R_XN_LO, k] = x
+                wk[c + R_NN_LO, k] = N
+
+
+@kernel
+def side_change(n, wk):
+    """The earliest abscissa at which a step attempt's stages show a side force changing side
+    (:func:`track_sides`), or ∞: where every stage with N on one side lies before every stage with
+    it on the other, N's root between the two nearest, by linear interpolation. Only where it
+    is: stages that alternate (two changes, or none in the ε of a stage state's error) show
+    none."""
+    c = WK_RX
+    first = np.inf
+    for k in range(n):
+        x0, x1 = wk[c + R_XP_HI, k], wk[c + R_XN_LO, k]  # positive, then negative
+        n0, n1 = wk[c + R_NP_HI, k], wk[c + R_NN_LO, k]
+        if not x0 < x1:
+            x0, x1 = wk[c + R_XN_HI, k], wk[c + R_XP_LO, k]  # negative, then positive
+            n0, n1 = wk[c + R_NN_HI, k], wk[c + R_NP_LO, k]
+        if x0 < x1 and np.isfinite(x0) and np.isfinite(x1):
+            first = min(first, x0 + (x1 - x0) * n0 / (n0 - n1))
+    return first
 
 
 @kernel

@@ -93,7 +93,7 @@ PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
 #: (``joint_friction.R_*``, ``swash_friction.S_*`` are the offsets), and per pair the moment its
 #: losses reduce to: as many rows as the mechanism that needs most (the swash plate's).
 WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
-N_WK_RX = 32
+N_WK_RX = 36
 #: The articulated mechanism's rows (:mod:`.articulated_friction`, ``A_*`` are the offsets): per
 #: cylinder its rods' geometry and accelerations, the directions and the solve's iterates; it
 #: shares the gas force's and the pairs' loss rows of WK_RX.

@@ -81,3 +81,11 @@ def choose_direction(m, J, dJ, w, M_gas, M_shaft, wk):
     if a < 0.0:
         return -1.0, a, UNIQUE
     return 1.0, 0.0, LOCKED
+
+
+@kernel(inline=True)
+def tracks_sides(m):
+    """Whether the stepper puts step ends where a side force changes side
+    (``joint_friction.track_sides``): the crank-slider's solve leaves each cylinder's N in the row
+    the tracking reads; the other mechanisms' solvers keep their side forces elsewhere."""
+    return m.kind != SWASH_PLATE and m.kind != ARTICULATED

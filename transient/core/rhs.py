@@ -15,6 +15,7 @@ from .jit import kernel
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import governor as gv
 from . import eta_table as et
+from . import joint_friction as jf
 from . import reactions as rx
 from . import stuck as st
 from .forcing import command, cylinder_rates, governor_rates, moments
@@ -112,6 +113,8 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     else:
         a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
         mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
+        if m.reaction and angle_mode and rx.tracks_sides(m):  # a side force changing side
+            jf.track_sides(m.ncyl, y[PHI], wk)  # in a step shows here
         for k in range(m.n_pairs):
             lk = rx.loss_moment(wk, k) if m.reaction else (1.0 - wk[WK_ETA, k]) * wk[WK_S, k]
             out[W_LOSS0 + k] = lk * q

@@ -12,8 +12,9 @@ changes the switches, the state or the independent variable (:func:`_switch_at_e
 
 Each turn of the loop in :func:`advance` is: the segment's end
 (:func:`.breakpoints._segment_end`) and the step size (:func:`_step_size`), a step attempt
-(:func:`_start_attempt`, the step, :func:`_judge_attempt`), its acceptance or rejection and the
-next step size, the retake for a breakpoint crossed in time, the event location
+(:func:`_start_attempt`, the step, :func:`_judge_attempt`; with reaction friction, retaken at
+once to end on a side force's change of side that its stages show where it fails the error
+test, ``joint_friction``), its acceptance or rejection and the next step size, the retake for a breakpoint crossed in time, the event location
 (:func:`.events._locate_events`), the output samples inside the step (:func:`_emit_step_samples`),
 and either the step taken whole (:func:`_take_step`) or the state moved to the event and the event
 acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`).
@@ -54,6 +55,8 @@ from .forcing import (generator_branch, governor_branch, inertia, load_segment, 
 from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND, WK_G,
                      WK_G_MIN, WK_SPEED, cyl_index, gov_index, n_state, work_array)
 from .rhs import choose_modes, derivative, margins_at, release
+from . import joint_friction as jf
+from . import reactions as rx
 from . import stuck as st
 from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
 from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL, C_T_END,
@@ -64,7 +67,8 @@ from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_EN
                          F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
                          I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_DIRECTION, I_F_VALID,
                          I_FLIPPED, I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES,
-                         I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NSTEPS,
+                         I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NREJECT,
+                         I_NSTEPS,
                          I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED,
                          I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
                          _emit_row, _emit_samples, _finish, _locked, _out_spacing,
@@ -77,6 +81,9 @@ STIFF_COUNT, NONSTIFF_RESET = 15, 6
 # State events closer together than this (rad in crank angle; × the output spacing in time) count
 # as no progress; this many in a row is chattering, which is reported, never looped on.
 CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
+# A rejected step whose stages show a side force changing side after this fraction of it is
+# retaken to end there (reaction friction: the kink of μ|N|); nearer its start, shrunk as usual.
+MIN_KINK_FRACTION = 0.05
 
 
 def buffers(m, tab, n: int) -> tuple:
@@ -185,11 +192,32 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             sel = y[PHI] + 0.5 * h * y[OMEGA]
 
         # The step attempt, its acceptance and the next step size.
-        _start_attempt(f, K, wk)
-        _step(tab, m, extras, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
-        finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
-                                                      rtol, atol, g0, g1, c0,
-                                                      at_segment_end and x_end == corner, corner)
+        kinked = (extras is not None and m.reaction and rx.tracks_sides(m) and angle_mode
+                  and not fixed)
+        on_corner = at_segment_end and x_end == corner
+        cut = at_segment_end
+        for attempt in range(2):
+            if kinked:
+                jf.reset_sides(m.ncyl, wk)
+            _start_attempt(f, K, wk)
+            _step(tab, m, extras, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+            finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
+                                                          rtol, atol, g0, g1, c0, on_corner,
+                                                          corner)
+            if attempt > 0 or not (kinked and finite and err > 1.0):
+                break
+            # A side force changing side inside the step (a kink of the pistons' μ|N|): the
+            # step is retaken at once to end where the stages put it, so that the kink lies
+            # between two steps instead of inside a run of rejected ones (``joint_friction``).
+            x_kink = jf.side_change(m.ncyl, wk)
+            if not x + MIN_KINK_FRACTION * h < x_kink < x + h:
+                break
+            ist[I_NREJECT] += 1
+            ist[I_NREDO] = 0  # (as for a rejection: no longer ends where a retake aimed)
+            h = x_kink - x
+            sel = x + 0.5 * h
+            at_segment_end = on_corner = False
+            cut = True  # sized afterwards as a step cut short for a breakpoint
         if not finite:
             # A trial step may leave the physical region (K < 0 in a stage): shrink it; only a
             # non-finite value that persists at small steps is a failure.
@@ -208,7 +236,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             steps_here += 1
             rejected = True
             continue
-        h_next = _accepted_size(tab, err, h, h_planned, at_segment_end, rejected, fst)
+        h_next = _accepted_size(tab, err, h, h_planned, cut, rejected, fst)
         rejected = False
         if not fixed and _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
             # the run so far is kept; the state is the accepted step's start
