@@ -823,6 +823,23 @@ def test_efficiency_study_and_budget_with_reaction_friction(tmp_path, capsys):
     assert (tmp_path / "reaction_4400_budget.png").stat().st_size > 10_000
 
 
+def test_efficiency_study_above_the_governors_cut_off(tmp_path, capsys):
+    """Above a droop governor's zero-fuel speed no work comes in: that point's η_mech and shares
+    are not numbers, and the study still writes its table and charts (it divided by W_in = 0)."""
+    scene = CASES / "swash_plate_4cyl_friction.toml"  # fuel reaches 0 at 60 rad/s, 573 rpm
+    code, out, err = cli(capsys, "efficiency", scene, "--rpm", "400,700", "--fuel", "1",
+                         "-o", tmp_path)
+    assert (code, err) == (0, "")
+    csv = (tmp_path / "swash_plate_4cyl_friction_efficiency.csv").read_text().splitlines()
+    header = csv[0].split(",")
+    rows = {float(r["rpm"]): r for r in (dict(zip(header, line.split(","))) for line in csv[1:])}
+    assert float(rows[400.0]["W_in_per_cycle"]) > 0.0 and 0.0 < float(
+        rows[400.0]["eta_mech_work"]) < 1.0
+    assert float(rows[700.0]["W_in_per_cycle"]) == 0.0
+    assert math.isnan(float(rows[700.0]["eta_mech_work"]))
+    assert (tmp_path / "swash_plate_4cyl_friction_efficiency.png").stat().st_size > 10_000
+
+
 def test_efficiency_study_refuses_a_figure_before_the_study(tmp_path, capsys, monkeypatch):
     """A figure that exists is refused (exit 2) before any point is run, not after the study."""
     import transient.study.efficiency as study

@@ -240,7 +240,7 @@ def _printed(traj, sel, guard: float) -> dict[str, tuple[float, str]]:
     drive = traj["M_drive"][sel] if "M_drive" in traj else 0.0
     P_in = (traj["M_gas"][sel] + traj["M_starter"][sel]) * w
     P_out = -(traj["M_load"][sel] + drive) * w
-    keep = np.abs(P_in) >= guard * np.mean(np.abs(P_in))
+    keep = np.abs(P_in) > guard * np.mean(np.abs(P_in))  # (none where no power comes in)
     dt = np.gradient(traj["t"][sel]) if w.size > 1 else np.ones(1)
     if not keep.any():
         return {}

@@ -431,14 +431,6 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     return total
 
 
-@kernel(inline=True)
-def reaction_acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, wk):
-    """φ̈ of the articulated mechanism with reaction friction (:func:`solve`) from the
-    frictionless φ̈ = (M − ½J′ω²)/J; the rows of :func:`prepare` must hold the state's."""
-    return solve(m.mech, m.rx_par, m.rx_pair, m.J0, M_shaft,
-                 (M_gas + M_shaft - 0.5 * dJ * w * w) / J, w, sigma, m.n_pairs, wk)
-
-
 @kernel
 def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     """The drive torque on the shaft for a prescribed motion (φ̈ = ``eps``), with the joints'

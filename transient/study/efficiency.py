@@ -91,8 +91,10 @@ def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
     for k in range(n_pairs):
         artists += ax_loss.plot(n, [100 * r[f"loss_share_{k + 1}"] for r in sel], "o-",
                                 label=f"loss, {names[k]}")
+        # (no work in, above a governor's cut-off: no share to plot there)
         artists += twin.plot(n, [r[f"W_circulated_{k + 1}_per_cycle"] / r["W_in_per_cycle"]
-                                 for r in sel], "s:", label=f"circulated, {names[k]}")
+                                 if r["W_in_per_cycle"] > 0.0 else math.nan for r in sel], "s:",
+                             label=f"circulated, {names[k]}")
     ax_loss.set_xlabel("speed [rpm]")
     ax_loss.set_ylabel(f"loss [% of W_in] ({policy}, fuel {fuel:g})")
     twin.set_ylabel("energy circulated through the pair [× W_in]")
