@@ -85,9 +85,10 @@ from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0
                           SLAVE_I, SLAVE_L, SLAVE_PISTON, SLAVE_ROD, SLAVE_STRIDE, master_rod,
                           row0, slave)
 from .crank_slider import I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, R, ROD_CG
-from .joint_friction import MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope
+from .joint_friction import (MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope, clear_pairs,
+                             pair_efficiencies)
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_AX,
-                     WK_CYL_LOSS, WK_ETA, WK_RX, WK_S)
+                     WK_CYL_LOSS, WK_RX, WK_S)
 
 #: The joints (rows of ``Model.rx_par``): main bearing, master crankpin, link pins, master piston
 #: pin, slave piston pins, pistons in their cylinders.
@@ -417,17 +418,11 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     """S, L and η* = 1 − L/S of each pair, summed over the rows, and each cylinder's share of
     L in the rows ``WK_CYL_LOSS``; returns Σ T."""
     n = int(mp[N_ROWS]) * (1 + int(mp[N_SLAVES]))
-    for p in range(n_pairs):
-        wk[WK_S, p] = 0.0
-        wk[WK_RX + R_LOSS, p] = 0.0
-        for k in range(n):
-            wk[WK_CYL_LOSS + p, k] = 0.0
+    clear_pairs(wk, n_pairs, n, 0.0)
     total = 0.0
     for j in range(int(mp[N_ROWS])):
         total += _row(mp, jp, pair_of, wk, j, eps, w, sigma, True, True)[0]
-    for p in range(n_pairs):
-        s = wk[WK_S, p]
-        wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan
+    pair_efficiencies(wk, n_pairs)
     return total
 
 

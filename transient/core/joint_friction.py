@@ -373,11 +373,7 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     """S, L and η* = 1 − L/S of each pair, summed over the cylinders, into ``wk``; each
     cylinder's share of L in the rows ``WK_CYL_LOSS``."""
     n = int(mp[N_CYL])
-    for p in range(n_pairs):
-        wk[WK_S, p] = 0.0
-        wk[WK_RX + R_LOSS, p] = 0.0
-        for k in range(n):
-            wk[WK_CYL_LOSS + p, k] = 0.0
+    clear_pairs(wk, n_pairs, n, 0.0)
     for k in range(n):
         t = joint_terms(mp, jp, wk, k, eps, w, sigma, wk[WK_RX + R_N, k])
         for j in range(4):
@@ -386,6 +382,24 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
                 wk[WK_S, p] += t[j]
                 wk[WK_RX + R_LOSS, p] += t[4 + j]
                 wk[WK_CYL_LOSS + p, k] += t[4 + j]
+    pair_efficiencies(wk, n_pairs)
+
+
+@kernel(inline=True)
+def clear_pairs(wk, n_pairs, n_cyl, split):
+    """Before a mechanism's joints add their S and L to their pairs': every pair's S and L 0,
+    each cylinder's share ``split`` (0, or NaN for a pair whose loss no cylinder owns)."""
+    for p in range(n_pairs):
+        wk[WK_S, p] = 0.0
+        wk[WK_RX + R_LOSS, p] = 0.0
+        for k in range(n_cyl):
+            wk[WK_CYL_LOSS + p, k] = split
+
+
+@kernel(inline=True)
+def pair_efficiencies(wk, n_pairs):
+    """η* = 1 − L/S of each pair from its S and L (NaN where S = 0), as every mechanism's
+    reaction pairs report it (module docstring)."""
     for p in range(n_pairs):
         s = wk[WK_S, p]
         wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan

@@ -104,9 +104,10 @@ import numpy as np
 
 from .jit import kernel
 
-from .joint_friction import MAX_ITER, R_LOSS, R_P, R_SEL, TOL, _norm, _slope
+from .joint_friction import (MAX_ITER, R_LOSS, R_P, R_SEL, TOL, _norm, _slope, clear_pairs,
+                             pair_efficiencies)
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
-                     WK_CYL_LOSS, WK_ETA, WK_RX, WK_S)
+                     WK_CYL_LOSS, WK_RX, WK_S)
 from .swash_plate import (COS_A, HALVES, HINGE_PHASE, I_CROSS, I_ROD, J_DIAM, J_POLAR, M_PISTON,
                           M_ROD, N_CYL, ROD_CG, ROD_L, SIN_A, link_motion, rod_motion)
 
@@ -390,11 +391,7 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     piston) in the rows ``WK_CYL_LOSS``, NaN for the bearings, which every cylinder loads
     (their loss is the engine's, no cylinder's)."""
     n = int(mp[N_CYL])
-    for p in range(n_pairs):
-        wk[WK_S, p] = 0.0
-        wk[WK_RX + R_LOSS, p] = 0.0
-        for k in range(n):
-            wk[WK_CYL_LOSS + p, k] = np.nan
+    clear_pairs(wk, n_pairs, n, np.nan)
     t = joint_terms(mp, jp, wk, eps, w, sigma)
     for i in range(3):
         p = pair_of[(J_MAIN, J_PLATE, J_SLIDER)[i]]
@@ -405,9 +402,7 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     if p >= 0:
         for k in range(n):
             wk[WK_CYL_LOSS + p, k] = -mp[HALVES] * wk[WK_RX + S_F, k] * wk[WK_RX + S_X1, k]
-    for p in range(n_pairs):
-        s = wk[WK_S, p]
-        wk[WK_ETA, p] = 1.0 - wk[WK_RX + R_LOSS, p] / s if s != 0.0 else np.nan
+    pair_efficiencies(wk, n_pairs)
 
 
 @kernel
