@@ -353,7 +353,8 @@ class ReferenceModel:
 
     def select(self, a: float, b: float) -> None:
         """Table pieces for the segment of shaft angle (a, b) between two breakpoints."""
-        mid = 0.5 * (a + b) if math.isfinite(a) and math.isfinite(b) else (a if math.isfinite(a) else b)
+        mid = (0.5 * (a + b) if math.isfinite(a) and math.isfinite(b)
+               else (a if math.isfinite(a) else b))
         self.mid = mid  # (the joints' directions of reaction friction are taken here too)
         if self.table is None:
             return

@@ -77,8 +77,8 @@ piston for the piston pins, the piston into the wall for the slider) and η* = 1
 the loss is (1 − η*) S ω as for a constant-η pair: η* < 1 when the shaft side drives, > 1 when
 the far side does, 0 for the slider (the wall takes no power), NaN where S = 0.
 
-Shapes: ``jp`` = ``Model.rx_par`` float64[N_JOINTS, N_RX_PAR]; the rows ``WK_RX + R_*`` of ``wk`` hold
-one value per cylinder (``R_LOSS``: per pair).
+Shapes: ``jp`` = ``Model.rx_par`` float64[N_JOINTS, N_RX_PAR]; the rows ``WK_RX + R_*`` of
+``wk`` hold one value per cylinder (``R_LOSS``: per pair).
 """
 from __future__ import annotations
 

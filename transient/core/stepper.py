@@ -14,10 +14,11 @@ Each turn of the loop in :func:`advance` is: the segment's end
 (:func:`.breakpoints._segment_end`) and the step size (:func:`_step_size`), a step attempt
 (:func:`_start_attempt`, the step, :func:`_judge_attempt`; with reaction friction, retaken at
 once to end on a side force's change of side that its stages show where it fails the error
-test, ``joint_friction``), its acceptance or rejection and the next step size, the retake for a breakpoint crossed in time, the event location
-(:func:`.events._locate_events`), the output samples inside the step (:func:`_emit_step_samples`),
-and either the step taken whole (:func:`_take_step`) or the state moved to the event and the event
-acted on (:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`).
+test, ``joint_friction``), its acceptance or rejection and the next step size, the retake for a
+breakpoint crossed in time, the event location (:func:`.events._locate_events`), the output
+samples inside the step (:func:`_emit_step_samples`), and either the step taken whole
+(:func:`_take_step`) or the state moved to the event and the event acted on
+(:func:`_move_to_event`, :func:`_record_event`, :func:`_switch_at_event`).
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks

@@ -20,10 +20,10 @@ the acceleration by which the weaker of the two directions is held. a_σ is a co
 of the applied moments: for constant-η pairs it is the root of the chain's residual F(a), which
 is continuous and strictly decreasing in a (``chain``, the proof of uniqueness, with σ in place of
 ω), and so it is with efficiency maps under the scene check's requirement on them
-(``eta_table``); for reaction pairs it is the solution of the joints' equations (``reactions.acceleration``) at
-ω = 0, where every friction term is a magnitude that varies continuously with the forces. So g
-falls through zero at the instant the drive exceeds the holding moment in one direction, and the
-stepper locates that instant as it locates a pair's mode switch (a margin falling to zero, to the
+(``eta_table``); for reaction pairs it is the solution of the joints' equations
+(``reactions.acceleration``) at ω = 0, where every friction term is a magnitude that varies
+continuously with the forces. So g falls through zero at the instant the drive exceeds the
+holding moment in one direction, and the stepper locates that instant as it locates a pair's mode switch (a margin falling to zero, to the
 root finder's accuracy on the dense output); the pair margins' slot 0 carries g, the others a
 constant 1 that never falls. At the release the direction is the one whose margin crossed (the
 lower of −a₊, a₋) and the modes are chosen afresh for it.
@@ -57,7 +57,8 @@ def incipient(m, J, M_gas, M_shaft, sigma, wk):
     """φ̈ at ω = 0 with the pairs' friction opposing an incipient motion ``sigma``: for constant-η
     pairs (or mapped ones, ``eta_table.solve_auto``) the chain solved with the modes consistent
     with σ (the sub-chains' rows of ``wk`` split already, ``rhs.split_subchains``; their η*, S
-    left in ``wk``), for reaction pairs the joints' solve (``reactions.acceleration``, the rows of ``prepare`` at the state)."""
+    left in ``wk``), for reaction pairs the joints' solve (``reactions.acceleration``, the rows
+    of ``prepare`` at the state)."""
     if m.reaction:
         return rx.acceleration(m, J, 0.0, 0.0, M_gas, M_shaft, sigma, wk)
     n = m.n_pairs
