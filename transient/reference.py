@@ -176,6 +176,36 @@ class ReactionNumpy(ChainNumpy):
         return eps, S, eta, L
 
 
+class ArticulatedReactionNumpy(ReactionNumpy):
+    """Friction on the articulated mechanism's joint reactions for the reference path: φ̈ and the
+    joints' forces by its own Newton–Euler (:func:`articulated_joint_forces`, the shaft's equation
+    closing the linear system, the friction a fixed point on its forces), not by the kernels'
+    Newton solve; directions at the segment's angle ``sel``, as the compiled path holds them."""
+
+    def solve(self, inputs, w, sigma):
+        """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after."""
+        phi, M_shaft, P, sel = inputs
+        n_cyl = self.mech.n_cylinders
+        try:
+            f = articulated_joint_forces(self.mech, phi, w, P, self.jp, sigma=sigma, J0=self.J0,
+                                         M_shaft=M_shaft, sel=sel)
+        except (np.linalg.LinAlgError, FloatingPointError):
+            f = None
+        if f is None or not np.isfinite(f.epsilon):
+            nan = np.full(self.n, np.nan)
+            return np.nan, nan, nan, nan
+        S, L = np.zeros(self.n), np.zeros(self.n)
+        self.cylinder_losses = np.zeros((self.n, n_cyl))
+        for j, p in enumerate(self.pair_of[:6]):
+            if p >= 0:
+                S[p] += f.S[j]
+                L[p] += f.L[j]
+                self.cylinder_losses[p] += f.L_cyl[j]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            eta = np.where(S != 0.0, 1.0 - L / S, np.nan)
+        return f.epsilon, S, eta, L
+
+
 class CylindersNumpy:
     """The cylinder pressures of the closed part with wall heat transfer (``[gas.woschni]``),
     from the scalar functions of :mod:`transient.forces.woschni` and
@@ -321,7 +351,10 @@ class ReferenceModel:
         self.chain = None  # the non-ideal pairs: a serial chain, or the joints' reactions
         if scene.friction.pairs:
             reaction = any(p.model == "reaction" for p in scene.friction.pairs)
-            self.chain = ReactionNumpy(scene, self.model) if reaction else ChainNumpy(scene)
+            articulated = scene.mechanism.name == "articulated"
+            self.chain = (ChainNumpy(scene) if not reaction else
+                          ArticulatedReactionNumpy(scene, self.model) if articulated else
+                          ReactionNumpy(scene, self.model))
         self.sigma = 1.0 if w0 >= 0 else -1.0
         m = self.model
         # the load schedule's segment and the generator's branch, switched at terminal events
@@ -477,7 +510,7 @@ class ReferenceModel:
             latched = [] if self.latched is None else list(self.latched)
             g = self.governor.g
             split = (list(self.chain.cylinder_losses.ravel() * w)
-                     if isinstance(self.chain, ReactionNumpy) else [])
+                     if isinstance(self.chain, ReactionNumpy) else [])  # (and its subclass)
             out.append([ti, p, w, a, J, dJ, Mg, Ml, Ms, self.command(w, yi), *yi[2:5], *pc, *pairs,
                         *yi[g:g + self.n_gov], *latched, *split])
         return np.asarray(out)
@@ -990,6 +1023,8 @@ class ArticulatedForces:
         pistons) summed over the rows: the moment the shaft side puts into the joint and the
         loss moment [N m] (powers over ω, as ``transient.core.articulated_friction`` defines
         them).
+    L_cyl : (6, n_cyl) the loss moments per joint and cylinder, a row's main bearing and
+        crankpin counted as its master cylinder's; they sum to L.
     iterations : fixed-point turns taken by the friction.
     """
 
@@ -1001,6 +1036,7 @@ class ArticulatedForces:
     throw_torque: NDArray[np.float64]
     S: NDArray[np.float64]
     L: NDArray[np.float64]
+    L_cyl: NDArray[np.float64]
     iterations: int
 
 
@@ -1253,7 +1289,8 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
                                      + sl_p * max(P[k + 1 + i], 0.0)) - sl_c * xi * omega)
     # throw torques and each joint's S, L
     T = np.empty(rows)
-    S, L = np.zeros(6), np.zeros(6)
+    S = np.zeros(6)
+    L_cyl = np.zeros((6, nc))  # a row's main bearing and crankpin count as its master cylinder's
     for j in range(rows):
         o = j * per_row
         k = j * (1 + ns)
@@ -1264,14 +1301,14 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
         fa = complex(*big[:, k])
         fb = complex(*pin[:, k])
         S[0] += x[o + 2]
-        L[0] -= M_O[j]
+        L_cyl[0, k] -= M_O[j]
         S[1] += fa.real * Ap.real + fa.imag * Ap.imag + M_A[j]
-        L[1] -= M_A[j] * (t0 - 1.0)
+        L_cyl[1, k] -= M_A[j] * (t0 - 1.0)
         x0 = K["B"][1].real
         S[3] += fb.real * x0 - M_B0[j] * t0
-        L[3] -= M_B0[j] * t0
+        L_cyl[3, k] -= M_B0[j] * t0
         S[5] -= F_s[k] * x0
-        L[5] -= F_s[k] * x0
+        L_cyl[5, k] -= F_s[k] * x0
         for i in range(ns):
             Sl = K["slaves"][i]
             ti = Sl["t"][0]
@@ -1279,13 +1316,16 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
             fb = complex(*pin[:, k + 1 + i])
             Aip, Bip = Sl["A"][1], Sl["B"][1]
             S[2] += fa.real * Aip.real + fa.imag * Aip.imag + M_L[j, i] * t0
-            L[2] -= M_L[j, i] * (ti - t0)
+            L_cyl[2, k + 1 + i] -= M_L[j, i] * (ti - t0)
             S[4] += fb.real * Bip.real + fb.imag * Bip.imag - M_Bs[j, i] * ti
-            L[4] -= M_Bs[j, i] * ti
+            L_cyl[4, k + 1 + i] -= M_Bs[j, i] * ti
             S[5] -= F_s[k + 1 + i] * Sl["X1"]
-            L[5] -= F_s[k + 1 + i] * Sl["X1"]
+            L_cyl[5, k + 1 + i] -= F_s[k + 1 + i] * Sl["X1"]
+    L = L_cyl.sum(axis=1)
     return ArticulatedForces(epsilon=float(eps), N=N, pin=pin, big_end=big, main=main,
-                             throw_torque=T, S=S, L=L, iterations=it + 1)
+                             throw_torque=T, S=S, L=L, L_cyl=L_cyl, iterations=it + 1)
+
+
 # Joint reactions of the swash plate by Newton–Euler, with friction on them
 
 

@@ -536,8 +536,6 @@ RADIAL_REACTION_CASES = [
      "the friction would wedge the master rod"),
     ('[solver]', '[solver]\nkinematics = "tabulated"', "solver.kinematics",
      "friction on the reactions of the 'articulated' mechanism takes its exact kinematics"),
-    ('[solver]', '[solver]\nmethod = "scipy-RK45"', "solver.method",
-     "friction on the reactions of the 'articulated' mechanism runs on the compiled methods"),
 ]
 
 
@@ -570,6 +568,8 @@ SWASH_REACTION_CASES = [
      "is missing"),
     ("pistons-wedge", 'rod_length_mm = 300\n', 'rod_length_mm = 10\n',
      "friction.pairs[2].mu", "the friction would wedge the pistons: μ·tan γ_max"),
+    ("reference-path", '[run]', '[solver]\nmethod = "scipy-RK45"\n\n[run]', "solver.method",
+     "friction on the reactions of the 'swash-plate' mechanism runs on the compiled methods"),
 ]
 
 
