@@ -164,16 +164,22 @@ class ReactionNumpy(ChainNumpy):
         final = crank_slider_joint_forces(mech, phi, w, eps, (P + f_s)[:, None],
                                           moments[:, :, None])
         loss, through = crank_slider_joint_powers(mech, phi, w, final, moments, f_s)
+        return (eps, *self.pairs(through.sum(axis=1), loss))
+
+    def pairs(self, S_joints, L_cylinders):
+        """(S_k, η*_k, L_k) of the pairs from each joint's S and its loss in each cylinder (rows:
+        the joints in ``rx_pair``'s order); each pair's loss per cylinder into
+        ``self.cylinder_losses``."""
         S, L = np.zeros(self.n), np.zeros(self.n)
-        self.cylinder_losses = np.zeros((self.n, n_cyl))
-        for j, p in enumerate(self.pair_of):
+        self.cylinder_losses = np.zeros((self.n, self.mech.n_cylinders))
+        for j, p in enumerate(self.pair_of[:len(S_joints)]):
             if p >= 0:
-                S[p] += np.sum(through[j])
-                L[p] += np.sum(loss[j])
-                self.cylinder_losses[p] += loss[j]
+                S[p] += S_joints[j]
+                L[p] += np.sum(L_cylinders[j])
+                self.cylinder_losses[p] += L_cylinders[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             eta = np.where(S != 0.0, 1.0 - L / S, np.nan)
-        return eps, S, eta, L
+        return S, eta, L
 
 
 class ArticulatedReactionNumpy(ReactionNumpy):
@@ -185,7 +191,6 @@ class ArticulatedReactionNumpy(ReactionNumpy):
     def solve(self, inputs, w, sigma):
         """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after."""
         phi, M_shaft, P, sel = inputs
-        n_cyl = self.mech.n_cylinders
         try:
             f = articulated_joint_forces(self.mech, phi, w, P, self.jp, sigma=sigma, J0=self.J0,
                                          M_shaft=M_shaft, sel=sel)
@@ -194,16 +199,7 @@ class ArticulatedReactionNumpy(ReactionNumpy):
         if f is None or not np.isfinite(f.epsilon):
             nan = np.full(self.n, np.nan)
             return np.nan, nan, nan, nan
-        S, L = np.zeros(self.n), np.zeros(self.n)
-        self.cylinder_losses = np.zeros((self.n, n_cyl))
-        for j, p in enumerate(self.pair_of[:6]):
-            if p >= 0:
-                S[p] += f.S[j]
-                L[p] += f.L[j]
-                self.cylinder_losses[p] += f.L_cyl[j]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            eta = np.where(S != 0.0, 1.0 - L / S, np.nan)
-        return f.epsilon, S, eta, L
+        return (f.epsilon, *self.pairs(f.S, f.L_cyl))
 
 
 class CylindersNumpy:
