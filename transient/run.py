@@ -527,11 +527,12 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         msg = data.message if data is not None and data.message else (
             str(exc) if isinstance(exc, SimulationError) else f"{type(exc).__name__}: {exc}")
         with _signals_deferred():
+            writes.shutdown()
             writer.finish(False, msg, status_of(exc), data.solver if data is not None else None)
         raise
-    finally:
-        writes.shutdown()
+    # (the write-behind's end inside the deferral too: a stop there would skip the finish)
     with _signals_deferred():
+        writes.shutdown()
         writer.finish(data.complete, data.message, data.status, data.solver, summary,
                       data.warnings)
 
