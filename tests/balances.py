@@ -41,3 +41,18 @@ def dense_spin_up(make):
     assert data.complete, data.message
     assert "to_angle_domain" not in data.events
     return scene, data
+
+
+def without_friction(pairs):
+    """Reaction pairs with every coefficient 0: the same joints, losing nothing."""
+    return tuple(replace(p, mu=0.0, viscous=0.0, ring_force=0.0, ring_pressure=0.0)
+                 for p in pairs)
+
+
+def loss_is_share_of_transmitted(tr, k) -> None:
+    """Pair k's loss is (1 − η*) S ω at every sample where η* is defined, as for a constant-η
+    pair (rounding)."""
+    P, S, eta = tr[f"P_loss_{k}"], tr[f"S_{k}"], tr[f"eta_{k}"]
+    ok = np.isfinite(eta)
+    assert np.allclose(P[ok], (1.0 - eta[ok]) * S[ok] * tr["omega"][ok], rtol=1e-12,
+                       atol=1e-9 * np.max(np.abs(P))), k
