@@ -420,23 +420,28 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
     return Friction(policy, tuple(pairs))
 
 
-def _joint(ps: Section, mech) -> tuple[str, str]:
-    """The two links of a reaction pair of a mechanism whose joints do not form a chain (its
-    ``reaction_joints``), shaft side first."""
-    links, joints = mech.reaction_links, mech.reaction_joints
-    allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in joints)
+def _link_names(ps: Section, links, allowed: str, known: str) -> tuple[str, str]:
+    """The key ``between``: two names of ``links``; ``allowed`` ends the message of a malformed
+    value, ``known`` that of an unknown link."""
     ps.known.append("between")
     between = ps.data.pop("between", None)
     if (not isinstance(between, list) or len(between) != 2
             or not all(isinstance(b, str) for b in between)):
         raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
-                                            f"the joints are {allowed}")
+                                            f"{allowed}")
     for b in between:
         if b not in links:
-            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links of "
-                                                f"{mech.name!r} are {', '.join(links)}, joined "
-                                                f"as {allowed}")
-    pair = (between[0], between[1])
+            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; {known}")
+    return between[0], between[1]
+
+
+def _joint(ps: Section, mech) -> tuple[str, str]:
+    """The two links of a reaction pair of a mechanism whose joints do not form a chain (its
+    ``reaction_joints``), shaft side first."""
+    links, joints = mech.reaction_links, mech.reaction_joints
+    allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in joints)
+    pair = _link_names(ps, links, f"the joints are {allowed}",
+                       f"the links of {mech.name!r} are {', '.join(links)}, joined as {allowed}")
     if pair[::-1] in joints:
         raise SceneError(ps.key("between"), f"give the shaft-side link first: "
                                             f"[{pair[1]!r}, {pair[0]!r}]")
@@ -450,16 +455,7 @@ def _between(ps: Section, links: tuple[str, ...], hint: str) -> tuple[str, str]:
     """The pair's two links, neighbours in ``links``, shaft side first (``hint`` ends the message
     of an unknown link)."""
     chain = " – ".join(links)
-    ps.known.append("between")
-    between = ps.data.pop("between", None)
-    if (not isinstance(between, list) or len(between) != 2
-            or not all(isinstance(b, str) for b in between)):
-        raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
-                                            f"the links are {chain}")
-    for b in between:
-        if b not in links:
-            raise SceneError(ps.key("between"), f"unknown link {show_value(b)}; the links "
-                                                f"are {chain}{hint}")
+    between = _link_names(ps, links, f"the links are {chain}", f"the links are {chain}{hint}")
     ia, ib = links.index(between[0]), links.index(between[1])
     if abs(ia - ib) != 1:
         raise SceneError(ps.key("between"),
