@@ -15,10 +15,6 @@ import numpy as np
 
 from .errors import SimulationError
 
-#: Signals that stop a command as Ctrl-C (SIGINT) does, so that a run stopped by ``timeout``, a
-#: batch scheduler's preemption or a closed terminal keeps its partial result marked incomplete
-#: (status "interrupted").
-INTERRUPTING_SIGNALS = ("SIGTERM", "SIGHUP")
 
 #: Every status a run ends with, and what it means (README, "Result files"); a run the stepper
 #: ends as ``stiff`` is run again by an implicit method and ends with one of these.

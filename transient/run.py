@@ -7,12 +7,9 @@ Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
 from __future__ import annotations
 
 import math
-import signal
-import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from concurrent.futures import wait as futures_wait
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable
 
@@ -26,12 +23,13 @@ from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
-from .outcome import (FINISHED, INTERRUPTING_SIGNALS, RunStopped, Watch, code_status,
+from .outcome import (FINISHED, RunStopped, Watch, code_status,
                       failure_cause, judge, status_of)
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
 from .scene.records import COMPILED_METHODS, runs_compiled
+from .stopping import deferred
 
 BUFFER_ROWS = 8192
 EVENT_ROWS = 2048
@@ -526,38 +524,12 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         writes.settle()
         msg = data.message if data is not None and data.message else (
             str(exc) if isinstance(exc, SimulationError) else f"{type(exc).__name__}: {exc}")
-        with _signals_deferred():
+        with deferred():
             writes.shutdown()
             writer.finish(False, msg, status_of(exc), data.solver if data is not None else None)
         raise
     # (the write-behind's end inside the deferral too: a stop there would skip the finish)
-    with _signals_deferred():
+    with deferred():
         writes.shutdown()
         writer.finish(data.complete, data.message, data.status, data.solver, summary,
                       data.warnings)
-
-
-#: The signals that stop a command: Ctrl-C and :data:`.outcome.INTERRUPTING_SIGNALS`.
-_STOPPING = tuple(getattr(signal, name) for name in ("SIGINT", *INTERRUPTING_SIGNALS)
-                  if hasattr(signal, name))
-
-
-@contextmanager
-def _signals_deferred():
-    """The signals that stop a command wait until the block ends, then act as they would have:
-    the result file's last step moves the run into its layout, and stopped halfway it would leave
-    neither the finished file nor the interrupted one (in the main thread only, where Python
-    handles signals)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught = []
-    kept = {sig: signal.signal(sig, lambda signum, frame: caught.append(signum))
-            for sig in _STOPPING}
-    try:
-        yield
-    finally:
-        for sig, handler in kept.items():
-            signal.signal(sig, handler)
-        if caught:
-            signal.raise_signal(caught[0])

@@ -110,6 +110,8 @@ def test_killed_runs_keep_a_prefix_and_resume_bit_identically(tmp_path, case, ru
         killed += sig == signal.SIGKILL
         terms += sig == signal.SIGTERM
         left = partial_path(result) if sig == signal.SIGKILL else result
+        if not left.exists():
+            pytest.fail(f"{what}: it left no {left.name}: {proc.stderr.read().decode()}")
         part = open_result(left)
         _check_prefix(part, full, what)
         assert part.attrs["status"] == ("running" if sig == signal.SIGKILL else "interrupted")
@@ -164,3 +166,46 @@ def test_a_stop_during_the_last_write_waits_until_the_file_is_whole(tmp_path, mo
         simulate(scene, result)
     assert open_result(result).complete
     assert not partial_path(result).exists()
+
+
+#: A child that runs ``transient run`` and sends itself SIGTERM from inside llvmlite's object-cache
+#: callback, through which numba loads a cached kernel, once the partial file exists: where the
+#: random kills above landed now and then, and where an exception crashed the process (SIGSEGV).
+_STOP_IN_KERNEL_LOAD = """
+import os, signal, sys
+from pathlib import Path
+from llvmlite.binding import executionengine
+
+partial, argv = Path(sys.argv[1]), sys.argv[2:]
+real = executionengine.ExecutionEngine._raw_object_cache_getbuffer
+sent = []
+
+def getbuffer(self, data):
+    if not sent and partial.exists():
+        sent.append(True)
+        os.kill(os.getpid(), signal.SIGTERM)
+    return real(self, data)
+
+executionengine._getbuffer_c_hook = executionengine._ObjectCacheGetBufferFunc(getbuffer)
+from transient.cli import main
+code = main(argv)
+print("sent" if sent else "never sent", file=sys.stderr)
+sys.exit(code)
+"""
+
+
+def test_a_stop_while_a_kernel_loads_interrupts_the_run_after_the_load(tmp_path):
+    """A SIGTERM inside numba's kernel loading (an LLVM callback into Python) waits until the
+    load is done, then interrupts the run as anywhere else: exit 1, the result under its name,
+    marked interrupted (an exception raised there crashed the process and left only the partial
+    file)."""
+    scene_file = _scene_file(tmp_path, "coasting_single", {"revolutions": 4})
+    out = tmp_path / "out"
+    result = out / "coasting_single.h5"
+    proc = subprocess.run([sys.executable, "-c", _STOP_IN_KERNEL_LOAD, str(partial_path(result)),
+                           "run", str(scene_file), "-o", str(out), "-q"],
+                          capture_output=True, text=True, cwd=REPO)
+    assert "never sent" not in proc.stderr, "no kernel was loaded after the partial file appeared"
+    assert proc.returncode == 1, proc.stderr
+    res = open_result(result)
+    assert not res.complete and res.status == "interrupted", proc.stderr

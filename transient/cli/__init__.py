@@ -12,14 +12,11 @@ from __future__ import annotations
 
 import argparse
 import gc
-import signal
-import threading
-from contextlib import contextmanager
 import os
 import sys
 
 from ..errors import SceneError, SimulationError, WriteFailed
-from ..outcome import INTERRUPTING_SIGNALS
+from ..stopping import interrupting
 from . import efficiency, kinematics, loads, orders, plot, run, sweep, verify
 from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE, OptionParser
 
@@ -59,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     or an interrupt → 1. Options are checked as scene keys are, each error one line."""
     try:
         args = _parser().parse_args(argv)
-        with _signals_interrupt():
+        with interrupting():
             return args.func(args)
     except SceneError as exc:
         print(exc.line(), file=sys.stderr)
@@ -79,25 +76,6 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_FAILED
 
 
-
-
-@contextmanager
-def _signals_interrupt():
-    """While a command runs, :data:`INTERRUPTING_SIGNALS` raise KeyboardInterrupt as SIGINT
-    does (in the main thread only: elsewhere Python cannot install handlers)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    kept = {}
-    for name in INTERRUPTING_SIGNALS:
-        sig = getattr(signal, name, None)
-        if sig is not None:
-            kept[sig] = signal.signal(sig, signal.default_int_handler)
-    try:
-        yield
-    finally:
-        for sig, handler in kept.items():
-            signal.signal(sig, handler)
 
 
 def _parser() -> argparse.ArgumentParser:
