@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
-from concurrent.futures import wait as futures_wait
 from pathlib import Path
 from typing import Callable
 
@@ -400,14 +399,19 @@ class _WriteBehind:
 
     def start(self, fn, *args) -> None:
         """Begin ``fn(*args)`` after the write in progress has ended."""
-        self.wait()
-        self._pending = self._pool.submit(fn, *args)
+        with deferred():
+            self._wait()
+            self._pending = self._pool.submit(fn, *args)
 
     def wait(self) -> None:
-        """Wait for the write in progress, raising what it raised. (A Ctrl-C while waiting
-        leaves it in progress, to be waited for again.)"""
+        """Wait for the write in progress, raising what it raised. A stop signal meanwhile acts
+        once the wait is over: raised inside the futures' locks, it could leave one of them held
+        and the writing thread blocked on it for ever."""
+        with deferred():
+            self._wait()
+
+    def _wait(self) -> None:
         if self._pending is not None:
-            futures_wait([self._pending])
             pending, self._pending = self._pending, None
             pending.result()
 

@@ -199,7 +199,8 @@ def test_a_stop_while_a_kernel_loads_interrupts_the_run_after_the_load(tmp_path)
     load is done, then interrupts the run as anywhere else: exit 1, the result under its name,
     marked interrupted (an exception raised there crashed the process and left only the partial
     file)."""
-    scene_file = _scene_file(tmp_path, "coasting_single", {"revolutions": 4})
+    # (a run far longer than the stop's wait, so that the stop lands in it)
+    scene_file = _scene_file(tmp_path, "coasting_single", {"revolutions": 100_000})
     out = tmp_path / "out"
     result = out / "coasting_single.h5"
     proc = subprocess.run([sys.executable, "-c", _STOP_IN_KERNEL_LOAD, str(partial_path(result)),
