@@ -66,8 +66,8 @@ def dynamic_scenes():
     run on the compiled methods only (their independent check is scipy's interpolator at every
     sample, ``tests/validation/test_eta_table_runs.py``), nor those with friction on the joints'
     reactions, whose reference (the Newton–Euler forces with the friction closed on them at
-    every evaluation) is too slow for these runs: :func:`test_reaction_friction_agrees_with_reference` runs shorter
-    ones."""
+    every evaluation) is too slow for these runs:
+    :func:`test_reaction_friction_agrees_with_reference` runs shorter ones."""
     names = []
     for path in sorted(CASES.glob("*.toml")):
         scene = load_scene(path)
