@@ -12,7 +12,10 @@ The joint forces of a crank-slider (:func:`crank_slider_joint_forces`) are that 
 reactions by Newton–Euler, body by body, for a prescribed motion: what the analyses' force
 relations and the reduced model's torque are checked against. Those of the articulated mechanism
 (:func:`articulated_joint_forces`) add the friction on its joints and may solve for φ̈: what its
-compiled reaction-friction solve is checked against.
+compiled reaction-friction solve is checked against; those of the swash plate
+(:func:`swash_plate_reactions`, every body's equations one linear system) likewise, the friction
+closed on them by ``fsolve`` (:func:`swash_plate_friction`). The reference path's reaction
+friction runs on these (:class:`ReactionNumpy` and its subclasses).
 """
 from __future__ import annotations
 
@@ -33,6 +36,7 @@ from .core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, R
                            RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
 from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
+from .mechanisms import reaction_joints
 from .mechanisms.articulated import positions
 
 
@@ -166,16 +170,17 @@ class ReactionNumpy(ChainNumpy):
         loss, through = crank_slider_joint_powers(mech, phi, w, final, moments, f_s)
         return (eps, *self.pairs(through.sum(axis=1), loss))
 
-    def pairs(self, S_joints, L_cylinders):
+    def pairs(self, S_joints, L_cylinders, L_joints=None):
         """(S_k, η*_k, L_k) of the pairs from each joint's S and its loss in each cylinder (rows:
         the joints in ``rx_pair``'s order); each pair's loss per cylinder into
-        ``self.cylinder_losses``."""
+        ``self.cylinder_losses``. ``L_joints``: each joint's loss, where a joint's loss in the
+        cylinders is NaN (a loss no cylinder owns), else their sum."""
         S, L = np.zeros(self.n), np.zeros(self.n)
         self.cylinder_losses = np.zeros((self.n, self.mech.n_cylinders))
         for j, p in enumerate(self.pair_of[:len(S_joints)]):
             if p >= 0:
                 S[p] += S_joints[j]
-                L[p] += np.sum(L_cylinders[j])
+                L[p] += np.sum(L_cylinders[j]) if L_joints is None else L_joints[j]
                 self.cylinder_losses[p] += L_cylinders[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             eta = np.where(S != 0.0, 1.0 - L / S, np.nan)
@@ -200,6 +205,44 @@ class ArticulatedReactionNumpy(ReactionNumpy):
             nan = np.full(self.n, np.nan)
             return np.nan, nan, nan, nan
         return (f.epsilon, *self.pairs(f.S, f.L_cyl))
+
+
+class SwashReactionNumpy(ReactionNumpy):
+    """Friction on the swash plate's joint reactions for the reference path: φ̈ and the reactions
+    by its Newton–Euler of every body as one linear system, the friction laws closed on them by
+    ``scipy.optimize.fsolve`` (:func:`swash_plate_friction`), not by the kernels' Newton solve;
+    the pistons' directions at the segment's angle ``sel``, as the compiled path holds them. The
+    bearings' losses are the engine's, no cylinder's: their columns per cylinder are NaN."""
+
+    def __init__(self, scene, model) -> None:
+        super().__init__(scene, model)
+        joints = reaction_joints(self.mech)
+        self.rows = [joints.index(j) for j in (("shaft", "plate"), ("plate", "link"),
+                                               ("piston", "cylinder"))]
+        main, plate, pistons = (self.jp[j] for j in self.rows)
+        self.coefficients = dict(
+            main=(main[RX_MU], main[RX_RADIUS], main[RX_VISCOUS]),
+            plate=(plate[RX_MU], plate[RX_RADIUS], plate[RX_VISCOUS]),
+            pistons=(pistons[RX_MU], pistons[RX_RING_FORCE], pistons[RX_RING_PRESSURE],
+                     pistons[RX_VISCOUS]))
+        self.n_joints = len(joints)
+
+    def solve(self, inputs, w, sigma):
+        """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after."""
+        phi, M_shaft, P, sel = inputs
+        try:
+            r = swash_plate_friction(self.mech, self.coefficients, phi, w, P, self.J0, M_shaft,
+                                     sigma=sigma, sel=sel)
+        except (ArithmeticError, np.linalg.LinAlgError):
+            r = None  # (a trial stage far off: solve_ivp retakes it shorter)
+        if r is None or not np.isfinite(r.epsilon):
+            nan = np.full(self.n, np.nan)
+            return np.nan, nan, nan, nan
+        S, L = np.zeros(self.n_joints), np.zeros(self.n_joints)
+        L_cyl = np.full((self.n_joints, self.mech.n_cylinders), np.nan)
+        S[self.rows], L[self.rows] = r.through, r.loss
+        L_cyl[self.rows[2]] = r.piston_loss
+        return (r.epsilon, *self.pairs(S, L_cyl, L))
 
 
 class CylindersNumpy:
@@ -347,10 +390,9 @@ class ReferenceModel:
         self.chain = None  # the non-ideal pairs: a serial chain, or the joints' reactions
         if scene.friction.pairs:
             reaction = any(p.model == "reaction" for p in scene.friction.pairs)
-            articulated = scene.mechanism.name == "articulated"
+            own = {"articulated": ArticulatedReactionNumpy, "swash-plate": SwashReactionNumpy}
             self.chain = (ChainNumpy(scene) if not reaction else
-                          ArticulatedReactionNumpy(scene, self.model) if articulated else
-                          ReactionNumpy(scene, self.model))
+                          own.get(scene.mechanism.name, ReactionNumpy)(scene, self.model))
         self.sigma = 1.0 if w0 >= 0 else -1.0
         m = self.model
         # the load schedule's segment and the generator's branch, switched at terminal events
@@ -1343,6 +1385,8 @@ class SwashReactions:
         shaft's equation has −M_main) and the plate bearing's on link 9 about n.
     loss, through : (3,) per pair, main bearing, plate bearing, pistons (both halves): the power
         lost over ω, and the power the shaft side puts into the joint over ω.
+    piston_loss : (z,) the pistons' loss over ω in each cylinder (both halves' piston), whose
+        sum is ``loss[2]``; the bearings' losses are no cylinder's (every cylinder loads them).
     """
 
     epsilon: float
@@ -1357,6 +1401,14 @@ class SwashReactions:
     M_plate: float
     loss: NDArray[np.float64]
     through: NDArray[np.float64]
+    piston_loss: NDArray[np.float64]
+
+
+def _cross3(a, b) -> NDArray[np.float64]:
+    """a × b of two 3-vectors (numpy's general ``cross`` is ten times slower on one pair, and
+    the swash plate's reactions take thousands per evaluation of the reference path)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
 
 
 def _rodrigues(axis, angle):
@@ -1384,9 +1436,9 @@ def swash_plate_motion(mech, phi, omega, epsilon):
     Q9 = Rx @ _rodrigues(n0, theta)
     n = Rx @ n0
     w9 = omega * (x + d1 * n)
-    al9 = epsilon * (x + d1 * n) + omega ** 2 * (d2 * n + d1 * np.cross(x, n))
+    al9 = epsilon * (x + d1 * n) + omega ** 2 * (d2 * n + d1 * _cross3(x, n))
     hinge = np.array(HINGES[mech.hinge][1])
-    c0 = np.cross(n0, hinge)
+    c0 = _cross3(n0, hinge)
     c = Q9 @ (c0 / np.linalg.norm(c0))
     z = mech.cylinders
     m_in_plate = np.array([-math.sin(a_sw), math.cos(a_sw), 0.0])  # eq. (6) at argument 0
@@ -1395,8 +1447,8 @@ def swash_plate_motion(mech, phi, omega, epsilon):
     for k in range(z):
         psi = 2.0 * math.pi * k / z
         B = Q9 @ (R * (math.cos(psi) * m_in_plate + math.sin(psi) * np.array([0.0, 0.0, 1.0])))
-        vB = np.cross(w9, B)
-        aB = np.cross(al9, B) + np.cross(w9, vB)
+        vB = _cross3(w9, B)
+        aB = _cross3(al9, B) + _cross3(w9, vB)
         yz = mech.cylinder_radius * np.array([math.cos(psi), math.sin(psi)])
         lat = B[1:] - yz
         D = np.array([B[0] - math.sqrt(mech.rod_length ** 2 - lat @ lat), *yz])
@@ -1413,7 +1465,7 @@ def swash_plate_motion(mech, phi, omega, epsilon):
 
 
 def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_plate=0.0,
-                          f=None, J0=None, M_shaft=None) -> SwashReactions:
+                          f=None, J0=None, M_shaft=None, motion=None) -> SwashReactions:
     """The joint reactions of the swash plate by Newton–Euler, every body's equations one linear
     system: the independent check of :mod:`transient.core.swash_friction` and, without friction,
     of the reduced model (18).
@@ -1429,7 +1481,9 @@ def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_pl
     M_main, the drive M_shaft). Unknowns: φ̈ if ``J0`` is given (else ``epsilon`` is prescribed
     and the shaft's moment equation is left out), per cylinder the forces at B and D and N, F_P,
     the plate bearing's moment M_P (with M_P·n = 0), λ and F_O: 8z + 10 (+1) equations, solved by
-    ``numpy.linalg.solve``. Known friction: ``M_main``, ``M_plate``, ``f`` (z,).
+    ``numpy.linalg.solve``. Known friction: ``M_main``, ``M_plate``, ``f`` (z,). ``motion``:
+    :func:`swash_plate_motion` at (φ, ω, ``epsilon`` or 0 with ``J0``) and at (φ, 0, 1), for a
+    caller that solves one state again and again.
 
     Returns
     -------
@@ -1438,8 +1492,8 @@ def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_pl
         :func:`swash_plate_friction` for the friction laws closed on the reactions).
     """
     free = J0 is not None
-    kin = swash_plate_motion(mech, phi, omega, 0.0 if free else epsilon)
-    kin1 = swash_plate_motion(mech, phi, 0.0, 1.0)  # the accelerations' slopes in φ̈
+    kin, kin1 = motion or (swash_plate_motion(mech, phi, omega, 0.0 if free else epsilon),
+                           swash_plate_motion(mech, phi, 0.0, 1.0))  # (kin1: slopes in φ̈)
     z, h = mech.cylinders, mech.halves
     f = np.zeros(z) if f is None else np.asarray(f, dtype=np.float64)
     P = np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (z,))
@@ -1494,15 +1548,15 @@ def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_pl
             A[row + j, iG(k) + j] = 1.0
         put(range(3), m_r * aG, m_r * aG1)
         # rod about G, across e: (B − G) × F + (D − G) × G_D = I_G e × ë
-        u1 = np.cross(e, [0.0, 0.0, 1.0] if abs(e[2]) < 0.9 else [0.0, 1.0, 0.0])
+        u1 = _cross3(e, [0.0, 0.0, 1.0] if abs(e[2]) < 0.9 else [0.0, 1.0, 0.0])
         u1 /= np.linalg.norm(u1)
-        u2 = np.cross(e, u1)
+        u2 = _cross3(e, u1)
         for j, u in enumerate((u1, u2)):
             # (r × F)·u = F·(u × r)
-            A[row + j, iF(k): iF(k) + 3] = np.cross(u, B - G)
-            A[row + j, iG(k): iG(k) + 3] = np.cross(u, D - G)
-        put(range(2), [i_g * np.cross(e, dde) @ u for u in (u1, u2)],
-            [i_g * np.cross(e, dde1) @ u for u in (u1, u2)])
+            A[row + j, iF(k): iF(k) + 3] = _cross3(u, B - G)
+            A[row + j, iG(k): iG(k) + 3] = _cross3(u, D - G)
+        put(range(2), [i_g * _cross3(e, dde) @ u for u in (u1, u2)],
+            [i_g * _cross3(e, dde1) @ u for u in (u1, u2)])
     # link 9, force: F_P − Σ F_k = 0 (its centre O does not move)
     for j in range(3):
         A[row + j, iP + j] = 1.0
@@ -1512,9 +1566,9 @@ def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_pl
     # link 9, moments about O: M_P + M_plate n − I₁₃ψ̈ a + λ (a × c) − Σ B_k × F_k = Ḣ₉
     al9, al91 = accel("al9")
     w9 = kin["w9"]
-    dH, dH1 = J9 @ al9 + np.cross(w9, J9 @ w9), J9 @ al91
+    dH, dH1 = J9 @ al9 + _cross3(w9, J9 @ w9), J9 @ al91
     psi2, psi21 = al9 @ a, al91 @ a
-    axc = np.cross(a, c)
+    axc = _cross3(a, c)
     for j in range(3):
         A[row + j, iM + j] = 1.0
         A[row + j, iL] = axc[j]
@@ -1541,19 +1595,19 @@ def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_pl
     M_P = sol[iM: iM + 3]
     torque = h * (M_P[0] + M_plate * n[0])  # what the plates put into link 9, over ω
     v = kin["xd1"] / omega if omega != 0.0 else swash_plate_motion(mech, phi, 1.0, 0.0)["xd1"]
-    piston_loss = -h * np.sum(f * v)
-    loss = np.array([M_main, -h * M_plate * kin["dtheta"], piston_loss])
-    through = np.array([M_main + torque, torque, piston_loss])
+    piston_loss = -h * f * v
+    loss = np.array([M_main, -h * M_plate * kin["dtheta"], np.sum(piston_loss)])
+    through = np.array([M_main + torque, torque, loss[2]])
     return SwashReactions(
         epsilon=float(eps), main=sol[iO: iO + 3], plate=sol[iP: iP + 3], plate_moment=M_P,
         B=np.array([sol[iF(k): iF(k) + 3] for k in range(z)]),
         D=np.array([sol[iG(k): iG(k) + 3] for k in range(z)]),
         N=np.array([sol[iN(k): iN(k) + 2] for k in range(z)]), f=f, M_main=float(M_main),
-        M_plate=float(M_plate), loss=loss, through=through)
+        M_plate=float(M_plate), loss=loss, through=through, piston_loss=piston_loss)
 
 
 def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
-                         sigma=None, epsilon=None) -> SwashReactions:
+                         sigma=None, epsilon=None, sel=None) -> SwashReactions:
     """φ̈ and the joint reactions with friction on them, closed by ``scipy.optimize.fsolve``.
 
     The friction laws, written out again: the main bearing's moment on the shaft
@@ -1564,8 +1618,10 @@ def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
     :func:`swash_plate_reactions` (with φ̈) for the forces they depend on.
 
     ``coefficients``: dict with ``main`` and ``plate`` = (μ, r, c) and ``pistons`` = (μ, F_ring,
-    c_p, c). ``sigma``: the direction of motion (sign ω, needed at ω = 0). Signs of v_k and q
-    are taken at the state itself (off the dead centres). With ``epsilon`` the motion is
+    c_p, c). ``sigma``: the direction of motion (sign ω, needed at ω = 0). The sign of q is σ's
+    opposite (θ′ < 0); those of v_k are taken at the state itself (off the dead centres), or at
+    the angle ``sel`` if given, where a run holds them between the pistons' dead centres (its
+    breakpoints) so that no friction force flips inside a step. With ``epsilon`` the motion is
     prescribed (inverse dynamics): φ̈ is ``epsilon`` and the drive the shaft then needs,
     J₀φ̈ − M_shaft + (what the shaft puts into the plates), is ``through[0]`` + J₀φ̈ − M_shaft.
     """
@@ -1578,21 +1634,25 @@ def swash_plate_friction(mech, coefficients, phi, omega, gas_force, J0, M_shaft,
     P = np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (mech.cylinders,))
     kin = swash_plate_motion(mech, phi, 1.0, 0.0)
     v_unit, q_unit = kin["xd1"], kin["dtheta"]  # per unit ω
+    sliding = np.sign(v_unit if sel is None else swash_plate_motion(mech, sel, 1.0, 0.0)["xd1"])
     scale_f = np.abs(P).max() + 1.0
     scale_m = scale_f * mech.joint_radius
+    motion = (swash_plate_motion(mech, phi, omega, 0.0 if epsilon is None else epsilon),
+              swash_plate_motion(mech, phi, 0.0, 1.0))
 
     def solve(m_o, m_f, fk):
         if epsilon is None:
-            return swash_plate_reactions(mech, phi, omega, None, P, m_o, m_f, fk, J0, M_shaft)
-        return swash_plate_reactions(mech, phi, omega, epsilon, P, m_o, m_f, fk)
+            return swash_plate_reactions(mech, phi, omega, None, P, m_o, m_f, fk, J0, M_shaft,
+                                         motion=motion)
+        return swash_plate_reactions(mech, phi, omega, epsilon, P, m_o, m_f, fk, motion=motion)
 
     def laws(y):
         m_o, m_f, fk = y[0] * scale_m, y[1] * scale_m, y[2:] * scale_f
         r = solve(m_o, m_f, fk)
         law_o = sigma * mu_o * r_o * np.linalg.norm(r.main) + c_o * omega
         law_f = sigma * mu_p * r_p * np.linalg.norm(r.plate) - c_p * q_unit * omega
-        law_s = (-np.sign(v_unit) * sigma * (mu_s * np.hypot(r.N[:, 0], r.N[:, 1]) + ring
-                                             + share * np.maximum(P, 0.0))
+        law_s = (-sliding * sigma * (mu_s * np.hypot(r.N[:, 0], r.N[:, 1]) + ring
+                                     + share * np.maximum(P, 0.0))
                  - c_s * v_unit * omega)
         return np.concatenate([[(law_o - m_o) / scale_m], [(law_f - m_f) / scale_m],
                                (law_s - fk) / scale_f])

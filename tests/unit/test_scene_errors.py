@@ -16,6 +16,8 @@ import pytest
 from scene_texts import MIXED_CYCLE, SMALL
 
 from transient.cli import main
+from transient.run import integrate
+from transient.scene import load_scene
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
@@ -568,8 +570,6 @@ SWASH_REACTION_CASES = [
      "is missing"),
     ("pistons-wedge", 'rod_length_mm = 300\n', 'rod_length_mm = 10\n',
      "friction.pairs[2].mu", "the friction would wedge the pistons: μ·tan γ_max"),
-    ("reference-path", '[run]', '[solver]\nmethod = "scipy-RK45"\n\n[run]', "solver.method",
-     "friction on the reactions of the 'swash-plate' mechanism runs on the compiled methods"),
 ]
 
 
@@ -588,6 +588,27 @@ def test_invalid_swash_reaction_pair_is_one_line_exit_2(tmp_path, capsys, name, 
     code, out, err = run_cli(["check", str(scene)], capsys)
     assert code == 2
     assert_one_line_error(err, scene, key, fragment)
+
+
+def test_swash_reaction_pairs_run_on_the_reference_path(tmp_path, capsys):
+    """The reference path has the swash plate's reaction friction
+    (:class:`transient.reference.SwashReactionNumpy`): the scene passes the check with a scipy-*
+    method and runs there, every pair losing energy (the agreement with the compiled path is
+    ``tests/validation/test_reference_path.py``'s)."""
+    text = SWASH_REACTION
+    for old, new in (('[run]', '[solver]\nmethod = "scipy-RK45"\n\n[run]'),
+                     ("t_end = 8.0", "t_end = 0.02")):
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    path = tmp_path / "swash.toml"
+    path.write_text(text, encoding="utf-8")
+    code, out, err = run_cli(["check", str(path)], capsys)
+    assert code == 0 and err == "", err
+    data = integrate(load_scene(path))
+    assert data.complete and data.solver["method"] == "scipy-RK45", data.message
+    assert data.trajectory["t"][-1] == 0.02
+    for k in range(1, 4):
+        assert data.trajectory[f"W_loss_{k}"][-1] > 0.0
 
 
 def test_reduced_inertia_reaching_zero_is_rejected(tmp_path, capsys):

@@ -40,13 +40,6 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("solver.method", "the reference path (scipy-*) follows the power-flow "
                                           "policy only; use method = \"dop853\" or \"dopri5\" "
                                           "with policy \"paper\"")
-    if (any(p.model == "reaction" for p in scene.friction.pairs) and not compiled
-            and scene.mechanism.name == "swash-plate"):
-        raise SceneError("solver.method", f"friction on the reactions of the "
-                                          f"{scene.mechanism.name!r} mechanism runs on the "
-                                          f"compiled methods ({', '.join(COMPILED_METHODS)}), not "
-                                          f"{sv.method!r} (the reference path has the "
-                                          f"crank-slider's and the articulated mechanism's)")
     if (any(p.model == "reaction" for p in scene.friction.pairs)
             and sv.kinematics == "tabulated" and scene.mechanism.name != "crank-slider"):
         raise SceneError("solver.kinematics", f"friction on the reactions of the "
