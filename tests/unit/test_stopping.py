@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -47,6 +48,8 @@ def test_in_llvmlite_looks_along_the_callers():
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_stop_inside_llvmlite_comes_back_outside(signum):
+    # (handlers are installed, and signals handled, in the main thread only)
+    assert threading.current_thread() is threading.main_thread()
     callback = _llvmlite_callback()
     with interrupting():
         try:
@@ -60,5 +63,5 @@ def test_a_stop_inside_llvmlite_comes_back_outside(signum):
 
 def test_a_stop_elsewhere_interrupts_at_once():
     with interrupting(), pytest.raises(KeyboardInterrupt):
-        os.kill(os.getpid(), signal.SIGTERM)
+        os.kill(os.getpid(), signal.SIGINT)
         time.sleep(10.0)
