@@ -9,10 +9,16 @@ never run the stepper (runs belong in ``tests/validation``), so they go last: th
 share is unit tests, which it runs while the first compiles. The stress tests go first, so that
 their longest ones start early rather than end the run. A serial run keeps
 pytest's own order.
+
+The fixture ``ctrl_c`` makes SIGINT raise KeyboardInterrupt during a test that sends it, as in an
+interactive Python: a suite started in the background inherits SIGINT ignored.
 """
 from __future__ import annotations
 
+import signal
 from pathlib import Path
+
+import pytest
 
 TESTS = Path(__file__).resolve().parent
 PARALLEL_ORDER = ("stress", "validation", "cli", "unit")
@@ -27,3 +33,10 @@ def pytest_collection_modifyitems(config, items):
         return PARALLEL_ORDER.index(folder) if folder in PARALLEL_ORDER else len(PARALLEL_ORDER)
 
     items.sort(key=rank)  # (stable: each folder keeps pytest's order)
+
+
+@pytest.fixture
+def ctrl_c():
+    kept = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, kept)

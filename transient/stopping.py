@@ -60,13 +60,20 @@ def _in_main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+def _heeded() -> list[int]:
+    """The stopping signals not ignored: one that the process was started ignoring (``nohup``
+    ignores SIGHUP, a shell SIGINT for a job in the background) stays ignored."""
+    return [sig for sig in STOPPING if signal.getsignal(sig) is not signal.SIG_IGN]
+
+
 @contextmanager
 def interrupting():
-    """While the block runs, every stopping signal raises KeyboardInterrupt (:func:`interrupt`)."""
+    """While the block runs, every stopping signal not ignored raises KeyboardInterrupt
+    (:func:`interrupt`)."""
     if not _in_main_thread():
         yield
         return
-    kept = {sig: signal.signal(sig, interrupt) for sig in STOPPING}
+    kept = {sig: signal.signal(sig, interrupt) for sig in _heeded()}
     try:
         yield
     finally:
@@ -84,7 +91,7 @@ def deferred():
         return
     caught = []
     kept = {sig: signal.signal(sig, lambda signum, frame: caught.append(signum))
-            for sig in STOPPING}
+            for sig in _heeded()}
     try:
         yield
     finally:

@@ -123,7 +123,8 @@ def test_killed_runs_keep_a_prefix_and_resume_bit_identically(tmp_path, case, ru
     assert resumed_from_middle >= kills // 2  # most after some blocks, not before the first
 
 
-def test_a_stop_while_the_last_block_is_written_still_finishes_the_file(tmp_path, monkeypatch):
+def test_a_stop_while_the_last_block_is_written_still_finishes_the_file(tmp_path, monkeypatch,
+                                                                        ctrl_c):
     """A stop signal that arrives after the run, while the last block's write behind it ends,
     acts once the file is whole: complete, under its name, and the stop still stops the command
     (before, the stop skipped the file's last step and left only the partial file)."""
@@ -147,7 +148,8 @@ def test_a_stop_while_the_last_block_is_written_still_finishes_the_file(tmp_path
     assert not partial_path(result).exists()
 
 
-def test_a_stop_during_the_last_write_waits_until_the_file_is_whole(tmp_path, monkeypatch):
+def test_a_stop_during_the_last_write_waits_until_the_file_is_whole(tmp_path, monkeypatch,
+                                                                    ctrl_c):
     """A stop signal that arrives while the result file's last step moves the run into its layout
     acts once that step is done: the file is whole and complete, and the stop still stops the
     command (the signal comes from inside that step here, so it cannot land anywhere else)."""

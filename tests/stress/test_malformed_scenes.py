@@ -354,7 +354,8 @@ def test_sigkill_during_writing_leaves_an_incomplete_file(tmp_path):
 def _run_until_a_block(scene: Path, out: Path) -> subprocess.Popen:
     """``transient run scene -o out`` in a new process, once its result holds a block."""
     proc = subprocess.Popen([sys.executable, "-m", "transient", "run", str(scene), "-o", str(out),
-                             "-q"], cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                             "-q"], cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            preexec_fn=_heeding_signals)
     part = out / f".{scene.stem}.h5.part"
     deadline = time.monotonic() + 600.0  # (a cold cache compiles the stepper first)
     while proc.poll() is None and not _holds_a_block(part):
@@ -362,6 +363,13 @@ def _run_until_a_block(scene: Path, out: Path) -> subprocess.Popen:
         time.sleep(0.05)
     assert proc.poll() is None, proc.stderr.read().decode()
     return proc
+
+
+def _heeding_signals() -> None:
+    """preexec_fn: SIGHUP and SIGINT as a terminal's command has them, not ignored as under
+    ``nohup`` or in a background job, whose ignored signals a command keeps ignoring."""
+    for sig in (signal.SIGHUP, signal.SIGINT):
+        signal.signal(sig, signal.SIG_DFL)
 
 
 @pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])

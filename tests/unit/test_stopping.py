@@ -13,7 +13,7 @@ from pathlib import Path
 import llvmlite
 import pytest
 
-from transient.stopping import in_llvmlite, interrupting
+from transient.stopping import in_llvmlite, interrupt, interrupting
 
 #: A function whose code says it is llvmlite's, as a callback from LLVM is.
 _LLVMLITE_FILE = str(Path(llvmlite.__file__).resolve().parent / "binding" / "executionengine.py")
@@ -47,7 +47,7 @@ def test_in_llvmlite_looks_along_the_callers():
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
-def test_a_stop_inside_llvmlite_comes_back_outside(signum):
+def test_a_stop_inside_llvmlite_comes_back_outside(signum, ctrl_c):
     # (handlers are installed, and signals handled, in the main thread only)
     assert threading.current_thread() is threading.main_thread()
     callback = _llvmlite_callback()
@@ -61,7 +61,18 @@ def test_a_stop_inside_llvmlite_comes_back_outside(signum):
             time.sleep(10.0)  # the signal, sent again, interrupts here
 
 
-def test_a_stop_elsewhere_interrupts_at_once():
+def test_a_stop_elsewhere_interrupts_at_once(ctrl_c):
     with interrupting(), pytest.raises(KeyboardInterrupt):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(10.0)
+
+
+def test_a_signal_the_process_ignores_stays_ignored():
+    """``nohup`` starts a command with SIGHUP ignored: closing the terminal must not stop it."""
+    kept = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        with interrupting():
+            assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+            assert signal.getsignal(signal.SIGTERM) is interrupt
+    finally:
+        signal.signal(signal.SIGHUP, kept)

@@ -79,7 +79,7 @@ def test_result_files_hold_a_bounded_chunk_cache(tmp_path):
 
 
 @pytest.mark.parametrize("waits_in", ["wait", "start"])
-def test_a_stop_while_waiting_for_a_write_acts_when_the_write_has_ended(waits_in):
+def test_a_stop_while_waiting_for_a_write_acts_when_the_write_has_ended(waits_in, ctrl_c):
     """A Ctrl-C (or SIGTERM, handled alike) that lands while the caller waits for the write acts after the
     write: raised inside the future's locks it could leave one held, and the writing thread
     then blocks on it for ever (a hung process)."""
