@@ -126,7 +126,7 @@ def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@kernel
+@kernel(inline=True)  # (on every evaluation: its unused results must cost nothing)
 def link_motion(mp, phi):
     """Link 9's motion per unit shaft rate at angle φ: cos/sin of φ and θ, the plate normal n,
     w = ω₉/φ̇ = i + θ′ n and w′ = θ″ n + θ′ (i × n), eq. (8), and :func:`hooke`'s θ′, θ″, u₁₃, u₁₃′."""
@@ -141,7 +141,7 @@ def link_motion(mp, phi):
     return c_phi, s_phi, cos(theta), sin(theta), n, w, dw, d1, d2, u13, du13
 
 
-@kernel
+@kernel(inline=True)
 def rod_motion(mp, k, c_phi, s_phi, c_theta, s_theta, w, dw):
     """Joint B_k, its rod and piston per unit shaft rate: B, B′ = w × B, B″ = w′ × B + w × B′; the
     rod's direction e = (B − D)/ℓ, e′, e″; x_D′, x_D″ (d/dφ) of its piston.
