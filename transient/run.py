@@ -22,8 +22,8 @@ from .core.inverse import inverse_dynamics
 from .core.layout import n_outputs, n_state
 from .core.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
-from .outcome import (FINISHED, RunStopped, Watch, code_status,
-                      failure_cause, judge, status_of)
+from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge,
+                      status_of)
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
