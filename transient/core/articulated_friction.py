@@ -86,7 +86,7 @@ from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0
                           row0, slave)
 from .crank_slider import I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, R, ROD_CG
 from .joint_friction import (MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope, clear_pairs,
-                             pair_efficiencies)
+                             newton_step, pair_efficiencies)
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_AX,
                      WK_CYL_LOSS, WK_RX, WK_S)
 
@@ -401,12 +401,10 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             den -= T_q
             scale += abs(T)
             small = small and conv
-        if not np.isfinite(H):
+        step = newton_step(wk, WK_AX + A_N, WK_AX + A_RS, WK_AX + A_QS, n, H, den)
+        if not np.isfinite(step):
             return np.nan
-        step = H / den
         eps -= step
-        for k in range(n):
-            wk[WK_AX + A_N, k] -= wk[WK_AX + A_RS, k] - wk[WK_AX + A_QS, k] * step
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps

@@ -262,7 +262,6 @@ def joint_terms(mp, jp, wk, k, eps, w, sigma, N):
     the moment the shaft side puts into the joint and the loss moment (powers over ω; module
     docstring), as :func:`cylinder` computes its forces."""
     c = WK_RX
-    lcb, lsb = wk[c + R_LCB, k], wk[c + R_LSB, k]
     ax, ay = wk[c + R_AX, k], wk[c + R_AY, k]
     db, ds = wk[c + R_DB, k], wk[c + R_DS, k]
     aby = wk[c + R_ABY0, k] + wk[c + R_ABY1, k] * eps
@@ -298,7 +297,7 @@ def start_n(mp, jp, wk, k, eps, w, sigma):
     equation is then linear in N): where Newton's method starts, so that its first step already
     has the side force's sign."""
     c = WK_RX
-    lcb, lsb, db, ds = wk[c + R_LCB, k], wk[c + R_LSB, k], wk[c + R_DB, k], wk[c + R_DS, k]
+    lsb, db, ds = wk[c + R_LSB, k], wk[c + R_DB, k], wk[c + R_DS, k]
     P = wk[c + R_P, k]
     f0 = jp[JOINT_SLIDER, RX_RING_FORCE] + jp[JOINT_SLIDER, RX_RING_PRESSURE] * max(P, 0.0)
     py = (mp[M_PISTON] * (wk[c + R_ABY0, k] + wk[c + R_ABY1, k] * eps) + P
@@ -356,12 +355,10 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             den -= T_e - T_n * q
             scale += abs(T)
             small = small and abs(r) <= TOL * s
-        if not np.isfinite(H):
+        step = newton_step(wk, c + R_N, c + R_STEP, c + R_COUPLE, n, H, den)
+        if not np.isfinite(step):
             return np.nan
-        step = H / den
         eps -= step
-        for k in range(n):
-            wk[c + R_N, k] -= wk[c + R_STEP, k] - wk[c + R_COUPLE, k] * step
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps
@@ -383,6 +380,21 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
                 wk[WK_RX + R_LOSS, p] += t[4 + j]
                 wk[WK_CYL_LOSS + p, k] += t[4 + j]
     pair_efficiencies(wk, n_pairs)
+
+
+@kernel(inline=True)
+def newton_step(wk, row_x, row_r, row_q, n, num, den):
+    """The step of φ̈ in a Newton iteration on (φ̈, x_1 … x_n) whose Jacobian is an arrowhead,
+    each x_k's own row eliminated already into x_k's step r_k − q_k δφ̈ (rows ``row_r``,
+    ``row_q`` of ``wk``): δφ̈ = num/den, and every x_k (row ``row_x``) moved by its step; NaN,
+    with nothing moved, when the residual ``num`` is not finite. The three mechanisms' solvers
+    share it."""
+    if not np.isfinite(num):
+        return np.nan
+    step = num / den
+    for k in range(n):
+        wk[row_x, k] -= wk[row_r, k] - wk[row_q, k] * step
+    return step
 
 
 @kernel(inline=True)

@@ -105,7 +105,7 @@ import numpy as np
 from .jit import kernel
 
 from .joint_friction import (MAX_ITER, R_LOSS, R_P, R_SEL, TOL, _norm, _slope, clear_pairs,
-                             pair_efficiencies)
+                             newton_step, pair_efficiencies)
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
                      WK_CYL_LOSS, WK_RX, WK_S)
 from .swash_plate import (COS_A, HALVES, HINGE_PHASE, I_CROSS, I_ROD, J_DIAM, J_POLAR, M_PISTON,
@@ -360,12 +360,10 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             wk[c + S_STEP, k] = r
             wk[c + S_COUPLE, k] = q
             small = small and abs(r) <= TOL * (nn + abs(f) + abs(wk[c + R_P, k]) + f0)
-        if not np.isfinite(num):
+        step = newton_step(wk, c + S_F, c + S_STEP, c + S_COUPLE, n, num, den)
+        if not np.isfinite(step):
             return np.nan
-        step = num / den
         eps -= step
-        for k in range(n):
-            wk[c + S_F, k] -= wk[c + S_STEP, k] - wk[c + S_COUPLE, k] * step
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps
