@@ -35,8 +35,7 @@ from transient.core import joint_friction as jf
 from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_JOINTS,
                                    N_RX_PAR, N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE,
                                    RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
-from transient.reference import (crank_slider_friction, crank_slider_joint_forces,
-                                 crank_slider_joint_signs)
+from transient.reference import crank_slider_friction, crank_slider_joint_signs
 from transient.scene import load_scene, to_toml
 
 from engines import MECHS

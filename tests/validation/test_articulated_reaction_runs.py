@@ -29,10 +29,11 @@ from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
 from transient.run import integrate, prescribed
 from transient.reference import articulated_joint_forces
-from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
+from transient.scene import Gas, Initial, Output, Run, Starter, load_scene
 
-from balances import (closure, dense_spin_up, loss_is_share_of_transmitted, losses_nonnegative,
-                      without_friction)
+from balances import (check_release_at_holds, check_zero_friction_is_ideal, closure,
+                      dense_spin_up, gas_forces_at_rest, loss_is_share_of_transmitted,
+                      losses_nonnegative)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 CASE = CASES / "radial_5cyl_reaction_friction.toml"
@@ -62,19 +63,7 @@ def test_the_work_energy_balance_closes_and_every_loss_is_a_loss(spin_up):
 
 
 def test_without_friction_the_motion_is_the_ideal_one():
-    base = reaction_case(run=Run(revolutions=20.0))
-    zero = integrate(replace(base, friction=Friction("power-flow",
-                                                     without_friction(base.friction.pairs))))
-    ideal = integrate(replace(base, friction=Friction()))
-    assert zero.complete and ideal.complete
-    tr = zero.trajectory
-    for k in range(1, N_PAIRS + 1):
-        assert np.all(tr[f"P_loss_{k}"] == 0.0) and np.all(tr[f"W_loss_{k}"] == 0.0)
-    phi = np.linspace(tr["phi"][0], tr["phi"][-1], 2001)
-    w1 = np.interp(phi, tr["phi"], tr["omega"])
-    w0 = np.interp(phi, ideal.trajectory["phi"], ideal.trajectory["omega"])
-    print(f"max |Δω| / max ω = {np.max(np.abs(w1 - w0)) / np.max(w0):.1e}")
-    assert np.max(np.abs(w1 - w0)) <= 1e-6 * np.max(w0)
+    check_zero_friction_is_ideal(reaction_case(run=Run(revolutions=20.0)), "phi")
 
 
 def test_the_case_budget_closes_and_names_the_pistons():
@@ -100,11 +89,6 @@ def static_hold(scene, phi, P, sigma):
     return -float(ref.throw_torque.sum())
 
 
-def drive(d0, d1, t1):
-    """A drive on the shaft from d0 at t = 0 to d1 at t1 [N m] (a schedule on a negative load)."""
-    return Load(torque=-1.0, schedule_time=(0.0, t1), schedule_scale=(d0, d1))
-
-
 @pytest.mark.parametrize("gas", [True, False])
 def test_the_joints_release_the_radial_at_the_newton_euler_hold(gas):
     """With the gas (the pressures at rest depend on the angle only: the probe's) or without,
@@ -115,35 +99,13 @@ def test_the_joints_release_the_radial_at_the_newton_euler_hold(gas):
     if not gas:
         base = replace(base, gas=Gas(model="none"))
     base = replace(base, solver=replace(base.solver, rtol=1e-10, atol=1e-10))
-    mech = base.mechanism
-    P = np.zeros(mech.n_cylinders)
+    P = gas_forces_at_rest(base) if gas else np.zeros(base.mechanism.n_cylinders)
     if gas:
-        probe = integrate(replace(base, load=Load(), friction=Friction(), run=Run(t_end=1e-6)))
-        P = np.array([(probe.trajectory[f"p_{k + 1}"][0] - base.gas.p0) * mech.piston_area
-                      for k in range(mech.n_cylinders)])
         assert np.max(np.abs(P)) > 1e3
     hold_fwd, hold_bwd = static_hold(base, phi0, P, 1.0), static_hold(base, phi0, P, -1.0)
     print(f"gas forces {np.round(P)} N; holds {hold_fwd:.9g} N m forward, {hold_bwd:.9g} N m "
           f"backward")
-    assert hold_bwd < hold_fwd
-    mid = 0.5 * (hold_fwd + hold_bwd)
-    width = hold_fwd - hold_bwd
-    for target, sign in ((hold_fwd, 1.0), (hold_bwd, -1.0)):
-        end = mid + sign * width  # reached at t = 1 s
-        scene = replace(base, load=drive(mid, end, 1.0), run=Run(t_end=0.8))
-        data = integrate(scene)
-        assert data.complete, data.message
-        ev, tr = data.events, data.trajectory
-        t_rel = ev["released"][0, 0]
-        t_star = (target - mid) / (end - mid)
-        print(f"σ = {sign:+g}: release at {t_rel!r}, Newton–Euler {t_star!r}")
-        assert ev["stuck"][0, 0] == 0.0 and ev["released"].shape[0] == 1
-        assert abs(t_rel - t_star) * abs(end - mid) <= 1e-8 * abs(hold_fwd)
-        held = tr["t"] <= t_rel
-        assert np.all(tr["omega"][held] == 0.0) and np.all(tr["phi"][held] == phi0)
-        after = tr["t"] > t_rel + 0.05
-        assert np.all(sign * tr["omega"][after][:5] > 0.0)
-        losses_nonnegative(scene, tr)
+    check_release_at_holds(base, hold_fwd, hold_bwd)
 
 
 def test_prescribed_speed_drive_is_the_newton_euler_torque():

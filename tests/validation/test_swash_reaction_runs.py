@@ -31,8 +31,8 @@ from transient.reference import swash_plate_motion
 from transient.run import integrate
 from transient.scene import Friction, Gas, Governor, Initial, Load, Output, Run, Starter, load_scene
 
-from balances import (closure, dense_spin_up, loss_is_share_of_transmitted, losses_nonnegative,
-                      without_friction)
+from balances import (check_zero_friction_is_ideal, closure, dense_spin_up,
+                      loss_is_share_of_transmitted, losses_nonnegative)
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "swash_plate_4cyl_reaction_friction.toml"
 
@@ -60,19 +60,7 @@ def test_the_work_energy_balance_closes_with_nonnegative_losses(halves):
 
 
 def test_without_friction_the_motion_is_the_ideal_one():
-    base = reaction_case(run=Run(t_end=1.0))
-    zero = integrate(replace(base, friction=Friction("power-flow",
-                                                     without_friction(base.friction.pairs))))
-    ideal = integrate(replace(base, friction=Friction()))
-    assert zero.complete and ideal.complete
-    tr = zero.trajectory
-    for k in range(1, 4):
-        assert np.all(tr[f"P_loss_{k}"] == 0.0) and np.all(tr[f"W_loss_{k}"] == 0.0)
-    t = np.linspace(0.0, 1.0, 2001)
-    w1 = np.interp(t, tr["t"], tr["omega"])
-    w0 = np.interp(t, ideal.trajectory["t"], ideal.trajectory["omega"])
-    print(f"max |Δω| / max ω = {np.max(np.abs(w1 - w0)) / np.max(w0):.1e}")
-    assert np.max(np.abs(w1 - w0)) <= 1e-6 * np.max(w0)
+    check_zero_friction_is_ideal(reaction_case(run=Run(t_end=1.0)), "t")
 
 
 def test_the_case_names_the_pistons_as_losing_most(tmp_path):
