@@ -1124,7 +1124,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
     sel = phi if sel is None else sel
     ns, rows = mech.n_slaves, mech.rows
     nc = rows * (1 + ns)
-    r, l = mech.crank_radius, mech.rod_length
+    l = mech.rod_length
     P = np.broadcast_to(np.asarray(gas_force, dtype=np.float64), (nc,))
     m_k, m_p = mech.crank_mass, mech.piston_mass
     m0, c0 = mech.rod_mass, mech.rod_cg_from_pin
@@ -1405,8 +1405,8 @@ class SwashReactions:
 
 
 def _cross3(a, b) -> NDArray[np.float64]:
-    """a × b of two 3-vectors (numpy's general ``cross`` is ten times slower on one pair, and
-    the swash plate's reactions take thousands per evaluation of the reference path)."""
+    """a × b of two 3-vectors, written out: numpy's general ``cross`` costs far more on a single
+    pair, and the swash plate's reactions take thousands per evaluation of the reference path."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                      a[0] * b[1] - a[1] * b[0]])
 
