@@ -401,10 +401,9 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             den -= T_q
             scale += abs(T)
             small = small and conv
-        step = newton_step(wk, WK_AX + A_N, WK_AX + A_RS, WK_AX + A_QS, n, H, den)
-        if not np.isfinite(step):
+        if not np.isfinite(H):
             return np.nan
-        eps -= step
+        eps -= newton_step(wk, WK_AX + A_N, WK_AX + A_RS, WK_AX + A_QS, n, H, den)
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps

@@ -355,10 +355,9 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             den -= T_e - T_n * q
             scale += abs(T)
             small = small and abs(r) <= TOL * s
-        step = newton_step(wk, c + R_N, c + R_STEP, c + R_COUPLE, n, H, den)
-        if not np.isfinite(step):
+        if not np.isfinite(H):
             return np.nan
-        eps -= step
+        eps -= newton_step(wk, c + R_N, c + R_STEP, c + R_COUPLE, n, H, den)
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps
@@ -386,11 +385,8 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
 def newton_step(wk, row_x, row_r, row_q, n, num, den):
     """The step of φ̈ in a Newton iteration on (φ̈, x_1 … x_n) whose Jacobian is an arrowhead,
     each x_k's own row eliminated already into x_k's step r_k − q_k δφ̈ (rows ``row_r``,
-    ``row_q`` of ``wk``): δφ̈ = num/den, and every x_k (row ``row_x``) moved by its step; NaN,
-    with nothing moved, when the residual ``num`` is not finite. The three mechanisms' solvers
-    share it."""
-    if not np.isfinite(num):
-        return np.nan
+    ``row_q`` of ``wk``): δφ̈ = num/den, and every x_k (row ``row_x``) moved by its step. The
+    three mechanisms' solvers share it."""
     step = num / den
     for k in range(n):
         wk[row_x, k] -= wk[row_r, k] - wk[row_q, k] * step

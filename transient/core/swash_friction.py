@@ -360,10 +360,9 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             wk[c + S_STEP, k] = r
             wk[c + S_COUPLE, k] = q
             small = small and abs(r) <= TOL * (nn + abs(f) + abs(wk[c + R_P, k]) + f0)
-        step = newton_step(wk, c + S_F, c + S_STEP, c + S_COUPLE, n, num, den)
-        if not np.isfinite(step):
+        if not np.isfinite(num):
             return np.nan
-        eps -= step
+        eps -= newton_step(wk, c + S_F, c + S_STEP, c + S_COUPLE, n, num, den)
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps
