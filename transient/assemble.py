@@ -17,8 +17,9 @@ from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms,
 from .core import variation as var
 from .core.variation import cycle_fuel
 from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER, PHI,
-                          POWER_FLOW, RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
-                          TABULATED, Model, T, extras_of, work_array)
+                          POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS, RX_RING_FORCE,
+                          RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T, extras_of,
+                          work_array)
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .mechanisms import reaction_joints
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
@@ -566,7 +567,8 @@ def pack_maps(maps) -> tuple:
 
 
 def reaction_friction(scene) -> bool:
-    """Whether the scene's pairs have friction on their reactions (one model for all pairs)."""
+    """Whether the scene's pairs have friction on their reactions (then all do, but for a
+    constant-η pair at the shaft's coupling)."""
     return any(p.model == "reaction" for p in scene.friction.pairs)
 
 
@@ -574,7 +576,8 @@ def reaction_fields(scene) -> dict:
     """The chain's part of the Model with reaction friction (:mod:`transient.core.reactions`):
     no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
     the mechanism's ``reaction_joints`` (:func:`transient.mechanisms.reaction_joints`) has its
-    pair's coefficients and reports as that pair."""
+    pair's coefficients and reports as that pair; a constant-η pair among them (at the shaft's
+    coupling, the scene check allows no other) has its efficiencies there instead."""
     mech, pairs = scene.mechanism, scene.friction.pairs
     joints = reaction_joints(mech)
     rx_par = np.zeros((N_JOINTS, N_RX_PAR))
@@ -582,6 +585,10 @@ def reaction_fields(scene) -> dict:
     for k, p in enumerate(pairs):
         j = joints.index(tuple(p.between))
         rx_pair[j] = k
+        if p.model != "reaction":
+            rx_par[j, RX_ETA_FWD] = p.eta_forward
+            rx_par[j, RX_ETA_BWD] = p.eta_backward
+            continue
         rx_par[j, RX_MU] = p.mu
         rx_par[j, RX_RADIUS] = p.radius
         rx_par[j, RX_VISCOUS] = p.viscous

@@ -134,12 +134,47 @@ class ReactionNumpy(ChainNumpy):
         self.pair_of = model.rx_pair
         self.n = len(scene.friction.pairs)
         self.J0 = scene.inertia.total
+        # a constant-η pair at the main bearings: (its index, η_fwd, η_bwd)
+        self.coupling = next(((k, p.eta_forward, p.eta_backward)
+                              for k, p in enumerate(scene.friction.pairs)
+                              if p.model == "constant-eta"), None)
 
     def inputs(self, phi, J, dJ, M_gas, M_shaft, forces, sel):
         return phi, M_shaft, forces, sel
 
     def solve(self, inputs, w, sigma):
-        """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after."""
+        """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after.
+
+        With a constant-η pair at the main bearings the throws receive η* of the moment
+        S = M_shaft − J₀ φ̈ the shaft puts in: both modes are solved, η* = η_fwd and 1/η_bwd, and
+        the one whose S has its sign (S σ ≥ 0 forward, ≤ 0 backward) taken, forward at a tie."""
+        if self.coupling is None:
+            return self.solve_mode(inputs, w, sigma, 1.0)
+        k, eta_f, eta_b = self.coupling
+        fwd = self.solve_mode(inputs, w, sigma, eta_f)
+        cylinder_losses = self.cylinder_losses
+        bwd = self.solve_mode(inputs, w, sigma, 1.0 / eta_b)
+        if not fwd[1][k] * sigma >= 0.0 and bwd[1][k] * sigma <= 0.0:
+            return bwd
+        self.cylinder_losses = cylinder_losses
+        return fwd
+
+    def coupled(self, eta, S, eta_pairs, L):
+        """The pairs' (S, η*, L) of :meth:`pairs` with the constant-η pair at the main bearings
+        (if any) passing η* = ``eta``: the joint's S there is what the throws receive, η* of
+        the pair's; its loss belongs to no cylinder."""
+        if self.coupling is None:
+            return S, eta_pairs, L
+        k = self.coupling[0]
+        S[k] /= eta
+        L[k] = (1.0 - eta) * S[k]
+        eta_pairs[k] = eta
+        self.cylinder_losses[k] = np.nan
+        return S, eta_pairs, L
+
+    def solve_mode(self, inputs, w, sigma, eta):
+        """:meth:`solve` with the pair at the main bearings (if any) passing η* = ``eta``: the
+        shaft's equation J₀ φ̈ = M_shaft + T/η*."""
         phi, M_shaft, P, sel = inputs
         mech, n_cyl = self.mech, self.mech.n_cylinders
         signs = crank_slider_joint_signs(mech, sel) * sigma
@@ -149,7 +184,7 @@ class ReactionNumpy(ChainNumpy):
             both = crank_slider_joint_forces(mech, phi, w, np.array([0.0, 1.0]),
                                              (P + f_s)[:, None], moments[:, :, None])
             T0, T1 = both.throw_torque[:, 0], both.throw_torque[:, 1]
-            eps_new = (M_shaft + np.sum(T0)) / (self.J0 - np.sum(T1 - T0))
+            eps_new = (M_shaft + np.sum(T0) / eta) / (self.J0 - np.sum(T1 - T0) / eta)
             forces = _at_acceleration(both, eps_new)
             new_moments, new_f_s = crank_slider_friction_laws(mech, self.jp, phi, w, forces, P,
                                                               signs)
@@ -168,7 +203,7 @@ class ReactionNumpy(ChainNumpy):
         final = crank_slider_joint_forces(mech, phi, w, eps, (P + f_s)[:, None],
                                           moments[:, :, None])
         loss, through = crank_slider_joint_powers(mech, phi, w, final, moments, f_s)
-        return (eps, *self.pairs(through.sum(axis=1), loss))
+        return (eps, *self.coupled(eta, *self.pairs(through.sum(axis=1), loss)))
 
     def pairs(self, S_joints, L_cylinders, L_joints=None):
         """(S_k, η*_k, L_k) of the pairs from each joint's S and its loss in each cylinder (rows:
@@ -193,18 +228,19 @@ class ArticulatedReactionNumpy(ReactionNumpy):
     closing the linear system, the friction a fixed point on its forces), not by the kernels'
     Newton solve; directions at the segment's angle ``sel``, as the compiled path holds them."""
 
-    def solve(self, inputs, w, sigma):
-        """(φ̈, S_k, η*_k, L_k) per pair; ``self.cylinder_losses`` (pairs × cylinders) after."""
+    def solve_mode(self, inputs, w, sigma, eta):
+        """:meth:`ReactionNumpy.solve_mode`: the shaft's equation, which closes the linear
+        system, J₀ φ̈ = M_shaft + T/η*, passed as η* J₀ and η* M_shaft."""
         phi, M_shaft, P, sel = inputs
         try:
-            f = articulated_joint_forces(self.mech, phi, w, P, self.jp, sigma=sigma, J0=self.J0,
-                                         M_shaft=M_shaft, sel=sel)
+            f = articulated_joint_forces(self.mech, phi, w, P, self.jp, sigma=sigma,
+                                         J0=self.J0 * eta, M_shaft=M_shaft * eta, sel=sel)
         except (np.linalg.LinAlgError, FloatingPointError):
             f = None
         if f is None or not np.isfinite(f.epsilon):
             nan = np.full(self.n, np.nan)
             return np.nan, nan, nan, nan
-        return (f.epsilon, *self.pairs(f.S, f.L_cyl))
+        return (f.epsilon, *self.coupled(eta, *self.pairs(f.S, f.L_cyl)))
 
 
 class SwashReactionNumpy(ReactionNumpy):

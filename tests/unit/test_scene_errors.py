@@ -80,11 +80,31 @@ REACTION_CASES = [  # (id, scene text, key, fragment), part of CASES below
     ("constant-eta-on-piston", pair(between='["rod", "piston"]'), "friction.pairs[0].between",
      "unknown link 'piston'; the links are shaft – crank – rod (pairs with model = \"reaction\" "
      "join shaft – crank – rod – piston – cylinder)"),
-    ("reaction-mixed-with-constant-eta",
+    ("reaction-mixed-with-constant-eta-off-the-main-bearings",
      reaction(extra='\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
                     'eta_backward = 0.9\n'),
-     "friction.pairs[1].model", "reaction pairs do not mix with others (constant-eta and table "
-                                "pairs do)"),
+     "friction.pairs[1].between", "a constant-eta pair among reaction pairs joins ['shaft', "
+                                  "'crank'] (the main bearings), not ['crank', 'rod']"),
+    ("reaction-mixed-with-table",
+     reaction(between='["crank", "rod"]',
+              extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\nmodel = "table"\n'
+                    'speed_rpm = [0, 3000]\ntorque = [0, 100]\n'
+                    'eta_forward = [[0.97, 0.98], [0.96, 0.97]]\n'
+                    'eta_backward = [[0.97, 0.98], [0.96, 0.97]]\n'),
+     "friction.pairs[1].model", "'table' among reaction pairs; the one pair of another model "
+                                "they take is a \"constant-eta\" one between ['shaft', 'crank'] "
+                                "(the main bearings)"),
+    ("reaction-mixed-under-paper",
+     reaction(between='["crank", "rod"]',
+              extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\neta_forward = 0.9\n'
+                    'eta_backward = 0.9\n').replace("[friction]\n",
+                                                      '[friction]\npolicy = "paper"\n'),
+     "friction.policy", "'paper' with a constant-eta pair among reaction pairs; their mix "
+                        "follows the \"power-flow\" policy"),
+    ("reaction-and-constant-eta-on-one-joint",
+     reaction(extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\neta_forward = 0.9\n'
+                    'eta_backward = 0.9\n'),
+     "friction.pairs[1].between", "the same pair as friction.pairs[0]"),
 ]
 
 
@@ -570,6 +590,11 @@ SWASH_REACTION_CASES = [
      "is missing"),
     ("pistons-wedge", 'rod_length_mm = 300\n', 'rod_length_mm = 10\n',
      "friction.pairs[2].mu", "the friction would wedge the pistons: μ·tan γ_max"),
+    ("constant-eta-among-reaction-pairs", '[[friction.pairs]]\nname = "pistons"',
+     '[[friction.pairs]]\nbetween = ["shaft", "link"]\neta_forward = 0.98\n'
+     'eta_backward = 0.98\n\n[[friction.pairs]]\nname = "pistons"',
+     "friction.pairs[2].model", "'constant-eta' among reaction pairs: the swash-plate's reaction "
+     "pairs do not mix with others; give every pair model = \"reaction\", or none"),
 ]
 
 

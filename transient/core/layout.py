@@ -115,9 +115,11 @@ N_WK = WK_CYL_LOSS + N_JOINTS
 #: Columns of ``Model.rx_par``: the friction coefficient μ [1], the journal's radius r [m], the
 #: viscous coefficient (journal: N m s/rad on the relative angular speed; slider: N s/m on the
 #: piston speed), the rings' tension friction force [N] and the share of the gas force that
-#: presses the rings to the wall times their μ [1] (slider only).
-RX_MU, RX_RADIUS, RX_VISCOUS, RX_RING_FORCE, RX_RING_PRESSURE = range(5)
-N_RX_PAR = 5
+#: presses the rings to the wall times their μ [1] (slider only); the efficiencies η_fwd, η_bwd
+#: of a constant-η pair at the joint that couples the shaft to the mechanism (row 0, the main
+#: bearings; ``reactions.acceleration``), 0 in every other row and without such a pair.
+RX_MU, RX_RADIUS, RX_VISCOUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_ETA_FWD, RX_ETA_BWD = range(7)
+N_RX_PAR = 7
 
 Model = namedtuple(
     "Model",

@@ -75,7 +75,8 @@ def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
             split_subchains(m, J, dJ, M_gas, M_shaft, wk)
         return st.hold(m, J, M_gas, M_shaft, wk)
     if m.reaction:
-        return rx.acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]), wk)
+        return rx.acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]),
+                               sw[SW_MODES], wk)
     n = m.n_pairs
     split_subchains(m, J, dJ, M_gas, M_shaft, wk)
     if m.eta_table:  # η* depends on S: solved with the modes held (``eta_table``)
@@ -149,9 +150,13 @@ def mode_margins(m, sw, wk):
     sigma = sw[SW_DIRECTION]
     if sigma == st.STUCK:  # the holding margin, left by chain_acceleration
         return
-    if m.reaction:  # no modes: the joints' directions change on breakpoints only
-        for k in range(m.n_pairs):
+    if m.reaction:  # no modes: the joints' directions change on breakpoints only, but for
+        for k in range(m.n_pairs):  # a constant-η pair at the main bearings (``reactions``)
             wk[WK_G, k] = 1.0
+        if rx.coupled(m):
+            k = m.rx_pair[0]
+            v = wk[WK_S, k] * sigma
+            wk[WK_G, k] = -v if (sw[SW_MODES] >> k) & 1 else v
         return
     upstream = 0.0
     for k in range(m.n_pairs):
@@ -200,7 +205,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
     if m.reaction:
         sigma, _, status = rx.choose_direction(m, J, dJ, w, M_gas, M_load + M_starter, wk)
         sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
-        sw[SW_MODES] = 0
+        sw[SW_MODES] = rx.mode_mask(m, wk)
         return status
     split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
     if m.eta_table:
@@ -229,7 +234,7 @@ def release(m, extras, y, sel, sw, wk):
         split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
     sigma = st.release_direction(m, J, M_gas, M_load + M_starter, wk)
     sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
-    sw[SW_MODES] = 0 if m.reaction else _mode_mask(m, sw[SW_DIRECTION], wk)
+    sw[SW_MODES] = rx.mode_mask(m, wk) if m.reaction else _mode_mask(m, sw[SW_DIRECTION], wk)
 
 
 @kernel

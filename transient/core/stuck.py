@@ -60,7 +60,7 @@ def incipient(m, J, M_gas, M_shaft, sigma, wk):
     left in ``wk``), for reaction pairs the joints' solve (``reactions.acceleration``, the rows
     of ``prepare`` at the state)."""
     if m.reaction:
-        return rx.acceleration(m, J, 0.0, 0.0, M_gas, M_shaft, sigma, wk)
+        return rx.acceleration(m, J, 0.0, 0.0, M_gas, M_shaft, sigma, rx.AUTO, wk)
     n = m.n_pairs
     if m.eta_table:
         return et.solve_auto(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], 0.0,

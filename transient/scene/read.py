@@ -370,10 +370,8 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                     f"{' – '.join(mech.reaction_links)})")
         if model == "reaction" and hasattr(mech, "reaction_joints"):
             between = _joint(ps, mech)
-            ia = mech.reaction_joints.index(between)
         else:
             between = _between(ps, links, hint)
-            ia = links.index(between[0])
         ideal = getattr(mech, "ideal_reaction_joints", {}) if model == "reaction" else {}
         if between[0] in ideal:
             allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in zip(links, links[1:])
@@ -382,9 +380,10 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                              f"{list(between)} ({ideal[between[0]]}) cannot have friction on "
                              f"its reactions: the {mech.name} keeps them ideal; reaction pairs "
                              f"join {allowed}")
-        if ia in seen:
-            raise SceneError(ps.key("between"), f"the same pair as {s.key('pairs')}[{seen[ia]}]")
-        seen[ia] = i
+        if tuple(between) in seen:
+            raise SceneError(ps.key("between"), f"the same pair as "
+                                                f"{s.key('pairs')}[{seen[tuple(between)]}]")
+        seen[tuple(between)] = i
         name = ps.string("name", f"{between[0]}-{between[1]}")
         if model == "reaction":
             pair = _reaction_pair(ps, between, name, slider=between[1] == links[-1])
@@ -400,13 +399,10 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                                              f"{s.key('pairs')}[{twin}] "
                                              f"too; give each pair its own name (it labels the "
                                              f"pair's result columns and reports)")
-        if models and (model == "reaction") != (models[0] == "reaction"):
-            raise SceneError(ps.key("model"), f"{model!r} after {models[0]!r} in "
-                                              f"{s.key('pairs')}[0]; reaction pairs do not mix "
-                                              f"with others (constant-eta and table pairs do)")
         models.append(model)
         pairs.append(pair)
     if "reaction" in models:
+        _check_mixed(s, mech, policy, pairs)
         joints = reaction_joints(mech)
         pairs.sort(key=lambda p: joints.index(p.between))
         if hasattr(mech, "reaction_joints"):
@@ -418,6 +414,35 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
     else:
         pairs.sort(key=lambda p: mech.links.index(p.between[0]))
     return Friction(policy, tuple(pairs))
+
+
+def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
+    """Among reaction pairs, a pair of another model only where the mechanism's solver takes it
+    (``transient.core.reactions``, *A constant-η pair at the main bearings*): constant-η, at
+    the joint that couples the shaft to the mechanism, under the power-flow policy."""
+    coupling = getattr(mech, "shaft_coupling", None)
+    for i, p in enumerate(pairs):
+        if p.model == "reaction":
+            continue
+        key = f"{s.key('pairs')}[{i}]"
+        if coupling is None:
+            raise SceneError(f"{key}.model", f"{p.model!r} among reaction pairs: the "
+                                             f"{mech.name}'s reaction pairs do not mix with "
+                                             f"others; give every pair model = \"reaction\", or "
+                                             f"none")
+        where = f"[{coupling[0]!r}, {coupling[1]!r}]"
+        if p.model != "constant-eta":
+            raise SceneError(f"{key}.model", f"{p.model!r} among reaction pairs; the one pair "
+                                             f"of another model they take is a \"constant-eta\" "
+                                             f"one between {where} (the main bearings)")
+        if tuple(p.between) != coupling:
+            raise SceneError(f"{key}.between", f"a constant-eta pair among reaction pairs joins "
+                                               f"{where} (the main bearings), not "
+                                               f"{list(p.between)}")
+        if policy != "power-flow":
+            raise SceneError(s.key("policy"), f"{policy!r} with a constant-eta pair among "
+                                              f"reaction pairs; their mix follows the "
+                                              f"\"power-flow\" policy")
 
 
 def _link_names(ps: Section, links, allowed: str, known: str) -> tuple[str, str]:
