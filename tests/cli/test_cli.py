@@ -937,9 +937,13 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert not cold["cold"] and cold["compile_s"] >= 0 and cold["run_wall_s"] > 0
     assert "(quick: caches warm)" in targets and "## Cold compile profile" in targets
     lines = verdicts(res)
-    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 1 + 2 \
+    assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 1 + 1 + 2 \
         + len(BENCH_SCENES) * len(ADAPTIVE) + 2
     assert res["reaction"]["constant_s"] > 0 and res["reaction"]["reaction_s"] > 0
+    (models,) = res["models"]  # (quick: the plain scene only)
+    assert models["this_s"] > 0 and models["left_out_s"] > 0
+    assert models["nfev"] == models["nfev_left_out"]  # (unused, the models change no step)
+    assert "## Friction models left out" in targets
     for target, case, measured, verdict in lines:
         assert verdict in ("met", "met at the baseline's best error", "**missed**",
                            "**not measured**")

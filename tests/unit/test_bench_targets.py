@@ -157,3 +157,23 @@ def test_the_record_extrapolates_to_1e_6_rad_only_from_near_it():
     far = [_row("a", RK45, 1e-8, 10.0, 0.65), _row("a", RK45, 1e-7, 5.0, 10.0)]
     wall, how = at_target(far, "a", RK45)
     assert math.isnan(wall) and how == "not reached (best 6.5e-01 rad)"
+
+
+def test_the_models_left_out_copy_matches_the_sources(tmp_path):
+    """Every pattern of the build without the friction models matches the compiled core as often
+    as :data:`transient.verify.models_out.LEFT_OUT` says, and the copy leaves no test of a
+    reaction pair, a map or the stuck mode in the hot path; the rest of the package is copied
+    unchanged."""
+    import re
+
+    from transient.verify import models_out
+
+    copy = models_out.left_out_copy(tmp_path) / "transient"
+    for name in {f for f, *_ in models_out.LEFT_OUT}:
+        text = (copy / "core" / name).read_text(encoding="utf-8")
+        assert not re.search(r"(?<!False and )\bm\.(reaction|eta_table)\b", text), name
+        assert "== st.STUCK" not in text, name
+    original = models_out.PACKAGE / "core" / "chain.py"
+    assert (copy / "core" / "chain.py").read_text(encoding="utf-8") == original.read_text(
+        encoding="utf-8")
+

@@ -9,7 +9,9 @@ measured, how, and whether it is met or by how much it is missed.
   last cycle, independent calls (throughput) and chained ones (latency, as a step's stages are);
 * the bare scene (equation (18) alone) against a kernel written by hand for that equation
   (within 5 %), and the bare scene against itself carrying unused options (no measurable change);
-* friction on the joints' reactions on three pairs against constant efficiencies (≤ 2×);
+* friction on the joints' reactions on three pairs against constant efficiencies (≤ 2×), and
+  scenes without friction against a build without the friction models (no measurable change:
+  :mod:`transient.verify.models_out`);
 * warm start (≤ 1 s process wall of ``transient run``) and scale (wall time per revolution at 10⁶
   revolutions within 10 % of 10³, peak memory independent of the length), each in new processes;
 * cold start, each in new processes on an empty cache: the first ``transient run`` of the default
@@ -359,6 +361,16 @@ def reaction_cost(repeat=5, revolutions=1000.0) -> dict:
             "per_call_ratio": (w_r / r["nfev"]) / (w_c / c["nfev"])}
 
 
+def models_cost(quick=False) -> list[dict]:
+    """The bench scenes without friction against a build without the friction models
+    (:func:`transient.verify.models_out.friction_models_cost`)."""
+    from .models_out import friction_models_cost
+
+    q = dict(scenes=("coasting_single",), rounds=1, repeat=2, revolutions=10.0) if quick else {}
+    with tempfile.TemporaryDirectory() as tmp:
+        return friction_models_cost(DEFAULT_SCENE.parent, Path(tmp), **q)
+
+
 # ------------------------------------------------------------------------------------------------
 # new processes: warm start, scale
 
@@ -551,6 +563,8 @@ def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     progress("targets: bare scene")
     res["reaction"] = reaction_cost(**({"repeat": 1, "revolutions": 10.0} if quick else {}))
     progress("targets: reaction friction")
+    res["models"] = models_cost(quick)
+    progress("targets: friction models left out")
     res["warm_start"] = warm_start(repeat=1 if quick else 5)
     progress("targets: warm start")
     res["scale"] = scale((10.0, 100.0) if quick else (1e3, 2e5, 1e6))
@@ -599,6 +613,12 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
                       f"{rx['constant_s']:.3f} s; {rx['reaction_nfev']} against "
                       f"{rx['constant_nfev']} RHS calls, {rx['per_call_ratio']:.2f}× per call)",
                       _missed(rx["ratio"], REACTION_TARGET)))
+    for r in res.get("models", []):  # (none in a record from before it was measured)
+        if "no friction" in r["what"]:
+            lines.append(("a scene without friction pays nothing for the friction models "
+                          "(within its runs' IQR)", f"{r['scene']} ({r['what']})",
+                          f"{r['change']:+.1%} (IQR {r['iqr']:.1%})",
+                          _missed(abs(r["change"]), r["iqr"])))
     w = res["warm_start"]
     lines.append((f"warm start ≤ {WARM_TARGET_S:g} s", w["scene"],
                   f"{w['median_s']:.2f} s (interpreter alone {w['python_alone_s']:.2f} s)",
@@ -640,6 +660,21 @@ def _cold_verdicts(c) -> list[tuple[str, str, str, str]]:
             (f"cold compile of every kernel ≤ {COLD_ALL_TARGET_S:g} s",
              f"transient warmup {' '.join(c['warmup_scenes'])}{how}",
              f"{c['warmup_wall_s']:.1f} s", _missed(c["warmup_wall_s"], COLD_ALL_TARGET_S))]
+
+
+def _models_section(rows) -> list[str]:
+    """Each scene against the build without the friction models."""
+    if not rows:
+        return []
+    return ["", "## Friction models left out", "",
+            "Integration wall (1000 revolutions, rtol 1e-8, atol 1e-11) of this build against a "
+            "copy whose compiled core leaves out the reaction pairs, efficiency maps and stuck "
+            "mode (`transient/verify/models_out.py`), medians of alternating processes.", "",
+            "| scene | | this build [s] | models left out [s] | change | IQR | RHS calls |",
+            "|---|---|---|---|---|---|---|",
+            *(f"| {r['scene']} | {r['what']} | {r['this_s']:.4g} | {r['left_out_s']:.4g} | "
+              f"{r['change']:+.1%} | {r['iqr']:.1%} | {r['nfev']} / {r['nfev_left_out']} |"
+              for r in rows)]
 
 
 def _profile_section(c) -> list[str]:
@@ -695,6 +730,7 @@ def write_targets(res, out: Path) -> Path:
            "|---|---|---|",
            *(f"| {s['revolutions']:g} | {s['wall_per_1000_s']:.4g} | {s['peak_mb']:.1f} |"
              for s in res["scale"])]
+    md += _models_section(res.get("models"))
     md += _profile_section(res.get("cold_start"))
     path = out / "targets.md"
     path.write_text("\n".join(md) + "\n", encoding="utf-8")
