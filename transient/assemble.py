@@ -577,7 +577,8 @@ def reaction_fields(scene) -> dict:
     no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
     the mechanism's ``reaction_joints`` (:func:`transient.mechanisms.reaction_joints`) has its
     pair's coefficients and reports as that pair; a constant-η pair among them (at the shaft's
-    coupling, the scene check allows no other) has its efficiencies there instead."""
+    coupling, the scene check allows no other) has its efficiencies there instead, a mapped one
+    NaN (its maps are the ``et_*`` fields)."""
     mech, pairs = scene.mechanism, scene.friction.pairs
     joints = reaction_joints(mech)
     rx_par = np.zeros((N_JOINTS, N_RX_PAR))
@@ -586,8 +587,9 @@ def reaction_fields(scene) -> dict:
         j = joints.index(tuple(p.between))
         rx_pair[j] = k
         if p.model != "reaction":
-            rx_par[j, RX_ETA_FWD] = p.eta_forward
-            rx_par[j, RX_ETA_BWD] = p.eta_backward
+            mapped = p.model == "table"
+            rx_par[j, RX_ETA_FWD] = np.nan if mapped else p.eta_forward
+            rx_par[j, RX_ETA_BWD] = np.nan if mapped else p.eta_backward
             continue
         rx_par[j, RX_MU] = p.mu
         rx_par[j, RX_RADIUS] = p.radius

@@ -85,15 +85,13 @@ REACTION_CASES = [  # (id, scene text, key, fragment), part of CASES below
                     'eta_backward = 0.9\n'),
      "friction.pairs[1].between", "a constant-eta pair among reaction pairs joins ['shaft', "
                                   "'crank'] (the main bearings), not ['crank', 'rod']"),
-    ("reaction-mixed-with-table",
-     reaction(between='["crank", "rod"]',
-              extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\nmodel = "table"\n'
+    ("reaction-mixed-with-table-off-the-main-bearings",
+     reaction(extra='\n[[friction.pairs]]\nbetween = ["crank", "rod"]\nmodel = "table"\n'
                     'speed_rpm = [0, 3000]\ntorque = [0, 100]\n'
                     'eta_forward = [[0.97, 0.98], [0.96, 0.97]]\n'
                     'eta_backward = [[0.97, 0.98], [0.96, 0.97]]\n'),
-     "friction.pairs[1].model", "'table' among reaction pairs; the one pair of another model "
-                                "they take is a \"constant-eta\" one between ['shaft', 'crank'] "
-                                "(the main bearings)"),
+     "friction.pairs[1].between", "a table pair among reaction pairs joins ['shaft', 'crank'] "
+                                  "(the main bearings), not ['crank', 'rod']"),
     ("reaction-mixed-under-paper",
      reaction(between='["crank", "rod"]',
               extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\neta_forward = 0.9\n'

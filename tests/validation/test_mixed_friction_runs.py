@@ -16,6 +16,10 @@ reactions`, *A constant-η pair at the main bearings*), checked against what is 
   moment −G for η_bwd ≤ s ≤ 1/η_fwd (the chain's static reaction ratio of one pair): a drive
   ramp releases the shaft where it reaches either end, to 1e-8 of the drive.
 * **The study**: η_mech falls with speed and with load, and every point closes its budget.
+* **A mapped pair at the main bearings** (``eta_table``): a map of one point is the constant pair
+  bit for bit; with the joints frictionless the mix is the chain of its one mapped pair (whose
+  maps ``eta_table`` solves its own way), to the solver's tolerance where the map's kinks lie
+  inside steps; with every friction on, the balance closes and every loss is ≥ 0.
 """
 from __future__ import annotations
 
@@ -51,7 +55,18 @@ def radial_mixed(**changes):
 
 
 def coupling(scene) -> Pair:
-    return next(p for p in scene.friction.pairs if p.model == "constant-eta")
+    return next(p for p in scene.friction.pairs if p.model != "reaction")
+
+
+def with_main_bearings(scene, pair: Pair):
+    """``scene`` with ``pair`` at its main bearings."""
+    return replace(scene, friction=Friction("power-flow", tuple(
+        pair if tuple(p.between) == ("shaft", "crank") else p for p in scene.friction.pairs)))
+
+
+def mapped_main_bearings() -> Pair:
+    """The main bearings' efficiency map of ``cases/gots_diesel_eta_map.toml``."""
+    return load_scene(CASES / "gots_diesel_eta_map.toml").friction.pairs[0]
 
 
 def frictionless_joints(scene):
@@ -162,3 +177,35 @@ def test_eta_mech_falls_with_speed_and_load_and_every_point_closes(study):
     tr = prescribed(point_scene(mixed_case(), 4400 * RPM, "power-flow", 720), 0.5).trajectory
     for k in range(1, 5):
         assert tr[f"P_loss_{k}"].min() >= -1e-12 * tr[f"P_loss_{k}"].max(), k
+
+
+def test_a_mapped_pair_at_the_main_bearings():
+    base = mixed_case(run=Run(revolutions=30.0), output=Output(samples_per_rev=8))
+    base = replace(base, solver=replace(base.solver, rtol=1e-12, atol=1e-14))
+    main, mapped = coupling(base), mapped_main_bearings()
+    assert mapped.model == "table" and len(mapped.speed) > 1 and len(mapped.torque) > 1
+    one_point = replace(mapped, speed=(0.0,), torque=(0.0,),
+                        eta_forward_map=((main.eta_forward,),),
+                        eta_backward_map=((main.eta_backward,),))
+    a, b = integrate(base), integrate(with_main_bearings(base, one_point))
+    assert all(np.array_equal(a.trajectory[k], b.trajectory[k], equal_nan=True)
+               for k in a.trajectory)
+
+    mix = integrate(frictionless_joints(with_main_bearings(base, mapped)))
+    chain = integrate(one_pair_chain(with_main_bearings(base, mapped)))
+    x, y = mix.trajectory, chain.trajectory
+    print(f"{mix.events['pair_mode'].shape[0]} mode switches; final ω {x['omega'][-1]!r} against "
+          f"{y['omega'][-1]!r}; W_loss_1 {x['W_loss_1'][-1]!r} against {y['W_loss_1'][-1]!r}")
+    assert mix.events["pair_mode"].shape[0] == chain.events["pair_mode"].shape[0] > 50
+    assert x["omega"][-1] == pytest.approx(y["omega"][-1], rel=1e-8)
+    assert x["W_loss_1"][-1] == pytest.approx(y["W_loss_1"][-1], rel=1e-7)
+    assert np.nanmax(np.abs(x["eta_1"] - y["eta_1"])) <= 1e-8
+
+    full = with_main_bearings(mixed_case(run=Run(revolutions=60.0)), mapped)
+    tr = integrate(full).trajectory
+    assert closure(full, tr) <= 1e-8
+    losses_nonnegative(full, tr)
+    rows = [efficiency_study(sc, [3000.0], [0.6], samples_per_rev=720)[0]
+            for sc in (frictionless_joints(full), one_pair_chain(full))]
+    assert rows[0]["eta_mech_work"] == pytest.approx(rows[1]["eta_mech_work"], rel=1e-10)
+

@@ -117,7 +117,8 @@ N_WK = WK_CYL_LOSS + N_JOINTS
 #: piston speed), the rings' tension friction force [N] and the share of the gas force that
 #: presses the rings to the wall times their μ [1] (slider only); the efficiencies η_fwd, η_bwd
 #: of a constant-η pair at the joint that couples the shaft to the mechanism (row 0, the main
-#: bearings; ``reactions.acceleration``), 0 in every other row and without such a pair.
+#: bearings; ``reactions.acceleration``), NaN for a mapped pair there (its η from the ``et_*``
+#: fields), 0 in every other row and without such a pair.
 RX_MU, RX_RADIUS, RX_VISCOUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_ETA_FWD, RX_ETA_BWD = range(7)
 N_RX_PAR = 7
 

@@ -9,8 +9,8 @@ filled by :func:`.forcing.moments`), the pairs' loss moments (``R_LOSS``), their
 A scene with reaction pairs and tabulated kinematics keeps its mechanism's kind only if it is a
 crank-slider (``Model.kind`` is then TABULATED): the scene check refuses the others.
 
-A constant-η pair at the main bearings among reaction pairs
-----------------------------------------------------------
+A constant-η or mapped pair at the main bearings among reaction pairs
+---------------------------------------------------------------------
 The crank-slider's and the articulated mechanism's main bearings join the shaft (inertia J₀, the
 moments M_shaft of load and starter) to the mechanism, whose throws put the torque T = Σ T_k on
 it: their solvers close on the shaft's equation J₀ ε = M_shaft + T. Given constant efficiencies
@@ -33,6 +33,14 @@ stepper switches it on a located event: φ̈ has a kink there, which no step str
 S, η* and loss (1 − η*) S are those of the chain's pair; its loss belongs to no cylinder (NaN per
 cylinder), as a chain pair's. The swash plate's main bearing sits in the shaft's equation
 itself, so there the scene check refuses the mix.
+
+A mapped pair there (``eta_table``) has η* = e(|S|) in each mode: the solve at η* gives S(η*),
+and η* is the fixed point of η ↦ e(|S(η)|). Differentiating the shaft's equation,
+dS/dη* = −J₀ S/(η* J₀ + |T′|), so the iteration contracts by less than |S e′(|S|)|/η*, which
+the scene check's condition on maps keeps below 1 (``eta_table``, *Existence and uniqueness*);
+each turn is a solve started from the last φ̈, and it stops when η* moves by at most
+``eta_table.ROUNDING`` of itself (NaN after ``eta_table.MAX_ITER`` turns). A map of one point
+stops at the first turn, on the constant pair's result bit for bit.
 """
 from __future__ import annotations
 
@@ -42,6 +50,7 @@ from .jit import kernel
 
 from .chain import LOCKED, UNIQUE
 from . import articulated_friction as af
+from . import eta_table as et
 from . import joint_friction as jf
 from . import swash_friction as sf
 from .layout import (ARTICULATED, RX_ETA_BWD, RX_ETA_FWD, SWASH_PLATE, WK_CYL_LOSS, WK_ETA, WK_RX,
@@ -70,24 +79,24 @@ AUTO = -1
 
 @kernel(inline=True)
 def coupled(m):
-    """Whether a constant-η pair sits at the main bearings among the reaction pairs."""
+    """Whether a constant-η or mapped pair sits at the main bearings among the reaction pairs."""
     return m.rx_par[0, RX_ETA_FWD] != 0.0
 
 
 @kernel(inline=True)
 def acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, modes, wk):
     """φ̈ with the joints' friction, in direction σ, from the frictionless φ̈ = (M − ½J′ω²)/J
-    (the rows of :func:`prepare` at the state); fills the pairs' η*, S, L. A constant-η pair at
-    the main bearings passes power in the mode ``modes`` holds for it (bit k set: pair k
-    backward), or in its consistent one (:data:`AUTO`; module docstring)."""
+    (the rows of :func:`prepare` at the state); fills the pairs' η*, S, L. A constant-η or
+    mapped pair at the main bearings passes power in the mode ``modes`` holds for it (bit k
+    set: pair k backward), or in its consistent one (:data:`AUTO`; module docstring)."""
     eps0 = (M_gas + M_shaft - 0.5 * dJ * w * w) / J
     if not coupled(m):
         return _solve(m, m.J0, M_shaft, eps0, w, sigma, wk)
     if modes == AUTO or (modes >> m.rx_pair[0]) & 1 == 0:
-        eps = _coupled_solve(m, m.rx_par[0, RX_ETA_FWD], M_shaft, eps0, w, sigma, wk)
+        eps = _coupled_mode(m, False, M_shaft, eps0, w, sigma, wk)
         if modes != AUTO or wk[WK_S, m.rx_pair[0]] * sigma >= 0.0:
             return eps
-    return _coupled_solve(m, 1.0 / m.rx_par[0, RX_ETA_BWD], M_shaft, eps0, w, sigma, wk)
+    return _coupled_mode(m, True, M_shaft, eps0, w, sigma, wk)
 
 
 @kernel(inline=True)
@@ -98,6 +107,29 @@ def _solve(m, J0, M_shaft, eps0, w, sigma, wk):
     if m.kind == ARTICULATED:
         return af.solve(m.mech, m.rx_par, m.rx_pair, J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
     return jf.solve(m.mech, m.rx_par, m.rx_pair, J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
+
+
+@kernel
+def _coupled_mode(m, backward, M_shaft, eps0, w, sigma, wk):
+    """φ̈ with the pair at the main bearings in one mode: at its constant η*, or at the η* its
+    map gives at the S that the solve at that η* gives (a fixed point, module docstring); NaN if
+    that does not settle."""
+    if not m.eta_table:
+        eta = 1.0 / m.rx_par[0, RX_ETA_BWD] if backward else m.rx_par[0, RX_ETA_FWD]
+        return _coupled_solve(m, eta, M_shaft, eps0, w, sigma, wk)
+    k = m.rx_pair[0]
+    w_abs = abs(w)
+    eps = eps0
+    eta = et.transfer(m.et_speed, m.et_torque, m.et_size, m.et_eta, k, backward, w_abs,
+                      M_shaft - m.J0 * eps0)[0]
+    for _ in range(et.MAX_ITER):
+        eps = _coupled_solve(m, eta, M_shaft, eps, w, sigma, wk)
+        new = et.transfer(m.et_speed, m.et_torque, m.et_size, m.et_eta, k, backward, w_abs,
+                          wk[WK_S, k])[0]
+        if abs(new - eta) <= et.ROUNDING * eta:
+            return eps
+        eta = new
+    return np.nan
 
 
 @kernel(inline=True)
@@ -111,9 +143,9 @@ def _coupled_solve(m, eta, M_shaft, eps0, w, sigma, wk):
 
 @kernel(inline=True)
 def _couple(m, eta, wk):
-    """The constant-η pair at the main bearings passing η* = ``eta``, from the moment −T the
-    mechanism's solve left as its S (what the throws receive, η* S): its S, η*, loss (1 − η*) S,
-    and no cylinder's share."""
+    """The pair at the main bearings passing η* = ``eta``, from the moment −T the mechanism's
+    solve left as its S (what the throws receive, η* S): its S, η*, loss (1 − η*) S, and no
+    cylinder's share."""
     k = m.rx_pair[0]
     s = wk[WK_S, k] / eta
     wk[WK_S, k] = s
@@ -124,10 +156,10 @@ def _couple(m, eta, wk):
 
 
 @kernel(inline=True)
-def mode_mask(m, wk):
+def mode_mask(m, sigma, wk):
     """The mode bits after a solve in the consistent mode: the pair at the main bearings'
-    (backward where its η* is not η_fwd), no other pair's."""
-    if coupled(m) and wk[WK_ETA, m.rx_pair[0]] != m.rx_par[0, RX_ETA_FWD]:
+    (backward where its S σ < 0), no other pair's."""
+    if coupled(m) and wk[WK_S, m.rx_pair[0]] * sigma < 0.0:
         return 1 << m.rx_pair[0]
     return 0
 
@@ -135,8 +167,8 @@ def mode_mask(m, wk):
 @kernel
 def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     """The drive torque on the shaft for a prescribed φ̈ = ``eps``, with the joints' friction;
-    with a constant-η pair at the main bearings, its mode from the sign of the power it passes
-    (S = −T/η*, forward where −T σ ≥ 0; module docstring)."""
+    with a constant-η or mapped pair at the main bearings, S with h(S) = η*(|S|) S = −T, its
+    mode from the sign of the power it passes (forward where −T σ ≥ 0; module docstring)."""
     if m.kind == SWASH_PLATE:
         drive = sf.inverse_drive(m, eps, w, sigma, M_shaft, wk)
     elif m.kind == ARTICULATED:
@@ -145,10 +177,16 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
         drive = jf.inverse_drive(m, eps, w, sigma, M_shaft, wk)
     if not coupled(m):
         return drive
+    k = m.rx_pair[0]
     T = m.J0 * eps - M_shaft - drive
-    eta = m.rx_par[0, RX_ETA_FWD] if T * sigma <= 0.0 else 1.0 / m.rx_par[0, RX_ETA_BWD]
+    backward = T * sigma > 0.0
+    if m.eta_table:
+        eta = et.invert(m.et_speed, m.et_torque, m.et_size, m.et_eta, m.et_min, k, backward,
+                        abs(w), -T)[1]
+    else:
+        eta = 1.0 / m.rx_par[0, RX_ETA_BWD] if backward else m.rx_par[0, RX_ETA_FWD]
     _couple(m, eta, wk)
-    return m.J0 * eps - M_shaft - T / eta
+    return m.J0 * eps - M_shaft + wk[WK_S, k]
 
 
 @kernel(inline=True)

@@ -205,7 +205,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
     if m.reaction:
         sigma, _, status = rx.choose_direction(m, J, dJ, w, M_gas, M_load + M_starter, wk)
         sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
-        sw[SW_MODES] = rx.mode_mask(m, wk)
+        sw[SW_MODES] = rx.mode_mask(m, sigma, wk)
         return status
     split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
     if m.eta_table:
@@ -234,7 +234,8 @@ def release(m, extras, y, sel, sw, wk):
         split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
     sigma = st.release_direction(m, J, M_gas, M_load + M_starter, wk)
     sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
-    sw[SW_MODES] = rx.mode_mask(m, wk) if m.reaction else _mode_mask(m, sw[SW_DIRECTION], wk)
+    sw[SW_MODES] = (rx.mode_mask(m, sigma, wk) if m.reaction
+                    else _mode_mask(m, sw[SW_DIRECTION], wk))
 
 
 @kernel

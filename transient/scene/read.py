@@ -418,8 +418,8 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
 
 def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
     """Among reaction pairs, a pair of another model only where the mechanism's solver takes it
-    (``transient.core.reactions``, *A constant-η pair at the main bearings*): constant-η, at
-    the joint that couples the shaft to the mechanism, under the power-flow policy."""
+    (``transient.core.reactions``, *A constant-η pair at the main bearings*): constant-η or
+    mapped, at the joint that couples the shaft to the mechanism, under the power-flow policy."""
     coupling = getattr(mech, "shaft_coupling", None)
     for i, p in enumerate(pairs):
         if p.model == "reaction":
@@ -431,16 +431,12 @@ def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
                                              f"others; give every pair model = \"reaction\", or "
                                              f"none")
         where = f"[{coupling[0]!r}, {coupling[1]!r}]"
-        if p.model != "constant-eta":
-            raise SceneError(f"{key}.model", f"{p.model!r} among reaction pairs; the one pair "
-                                             f"of another model they take is a \"constant-eta\" "
-                                             f"one between {where} (the main bearings)")
         if tuple(p.between) != coupling:
-            raise SceneError(f"{key}.between", f"a constant-eta pair among reaction pairs joins "
+            raise SceneError(f"{key}.between", f"a {p.model} pair among reaction pairs joins "
                                                f"{where} (the main bearings), not "
                                                f"{list(p.between)}")
         if policy != "power-flow":
-            raise SceneError(s.key("policy"), f"{policy!r} with a constant-eta pair among "
+            raise SceneError(s.key("policy"), f"{policy!r} with a {p.model} pair among "
                                               f"reaction pairs; their mix follows the "
                                               f"\"power-flow\" policy")
 

@@ -443,7 +443,7 @@ class Pair:
     name: str = ""
     #: ``"constant-eta"`` (the efficiencies above) or ``"reaction"``: friction on the joint's
     #: reaction (every mechanism, :mod:`transient.core.reactions`; then η is
-    #: unused, 1). Among reaction pairs, a constant-eta pair only at the main bearings
+    #: unused, 1). Among reaction pairs, a constant-eta or table pair only at the main bearings
     #: (``["shaft", "crank"]``, crank-slider and articulated), under the power-flow policy.
     model: str = "constant-eta"
     #: Reaction model: friction coefficient μ [1] (journal: friction-circle μ·r·|R|; slider:
