@@ -568,7 +568,7 @@ def pack_maps(maps) -> tuple:
 
 def reaction_friction(scene) -> bool:
     """Whether the scene's pairs have friction on their reactions (then all do, but for a
-    constant-η pair at the shaft's coupling)."""
+    constant-η or mapped pair at the shaft's coupling)."""
     return any(p.model == "reaction" for p in scene.friction.pairs)
 
 

@@ -151,7 +151,7 @@ def mode_margins(m, sw, wk):
     if sigma == st.STUCK:  # the holding margin, left by chain_acceleration
         return
     if m.reaction:  # no modes: the joints' directions change on breakpoints only, but for
-        for k in range(m.n_pairs):  # a constant-η pair at the main bearings (``reactions``)
+        for k in range(m.n_pairs):  # a constant-η or mapped pair at the main bearings
             wk[WK_G, k] = 1.0
         if rx.coupled(m):
             k = m.rx_pair[0]

@@ -140,8 +140,8 @@ class Articulated:
     #: pins and the pistons in their cylinders (every cylinder of every row that the joint has).
     reaction_joints = (("shaft", "crank"), ("crank", "master rod"), ("master rod", "slave rod"),
                        ("master rod", "piston"), ("slave rod", "piston"), ("piston", "cylinder"))
-    #: The reaction joint that may have a constant-η pair among reaction pairs: the main
-    #: bearings, which couple the shaft to the mechanism (:mod:`transient.core.reactions`).
+    #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
+    #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.reactions`).
     shaft_coupling = ("shaft", "crank")
 
     # -- sizes and constants ---------------------------------------------------------------------

@@ -90,8 +90,8 @@ class CrankSlider:
     #: the piston is a link of its own and the cylinder (the frame) the last, so the pairs are
     #: the main bearings, the crankpins, the piston pins and the pistons in their cylinders.
     reaction_links = ("shaft", "crank", "rod", "piston", "cylinder")
-    #: The reaction joint that may have a constant-η pair among reaction pairs: the main
-    #: bearings, which couple the shaft to the mechanism (:mod:`transient.core.reactions`).
+    #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
+    #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.reactions`).
     shaft_coupling = ("shaft", "crank")
 
     @property

@@ -418,8 +418,8 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
 
 def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
     """Among reaction pairs, a pair of another model only where the mechanism's solver takes it
-    (``transient.core.reactions``, *A constant-η pair at the main bearings*): constant-η or
-    mapped, at the joint that couples the shaft to the mechanism, under the power-flow policy."""
+    (``transient.core.reactions``, *A constant-η or mapped pair at the main bearings*): at the
+    joint that couples the shaft to the mechanism, under the power-flow policy."""
     coupling = getattr(mech, "shaft_coupling", None)
     for i, p in enumerate(pairs):
         if p.model == "reaction":

@@ -362,8 +362,8 @@ def reaction_cost(repeat=5, revolutions=1000.0) -> dict:
 
 
 def models_cost(quick=False) -> list[dict]:
-    """The bench scenes without friction against a build without the friction models
-    (:func:`transient.verify.models_out.friction_models_cost`)."""
+    """Scenes without friction, and one with constant-η pairs, against a build without the
+    friction models (:func:`transient.verify.models_out.friction_models_cost`)."""
     from .models_out import friction_models_cost
 
     q = dict(scenes=("coasting_single",), rounds=1, repeat=2, revolutions=10.0) if quick else {}
