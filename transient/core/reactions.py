@@ -32,7 +32,10 @@ S σ (forward) or −S σ (backward) watched at every stage (``rhs.mode_margins`
 stepper switches it on a located event: φ̈ has a kink there, which no step straddles. The pair's
 S, η* and loss (1 − η*) S are those of the chain's pair; its loss belongs to no cylinder (NaN per
 cylinder), as a chain pair's. The swash plate's main bearing sits in the shaft's equation
-itself, so there the scene check refuses the mix.
+itself, so there the scene check refuses the mix. So it does on an inner joint: a chain pair
+between the throws and the rods loses a share of the power all cylinders pass together, which
+among the joints' forces would have to be split over the cylinders' crankpins by an assumption
+neither model makes.
 
 A mapped pair there (``eta_table``) has η* = e(|S|) in each mode: the solve at η* gives S(η*),
 and η* is the fixed point of η ↦ e(|S(η)|). Differentiating the shaft's equation,
