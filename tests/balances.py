@@ -124,3 +124,22 @@ def check_release_at_holds(base, hold_fwd: float, hold_bwd: float) -> None:
         after = tr["t"] > t_rel + 0.05
         assert np.all(sign * tr["omega"][after][:5] > 0.0)
         losses_nonnegative(scene, tr)
+
+
+def with_main_bearings(scene, pair):
+    """``scene`` with ``pair`` at its main bearings (``["shaft", "crank"]``), power-flow policy."""
+    from transient.scene import Friction
+
+    return replace(scene, friction=Friction("power-flow", tuple(
+        pair if tuple(p.between) == ("shaft", "crank") else p for p in scene.friction.pairs)))
+
+
+def constant_main_bearings(scene):
+    """``scene`` with its main bearings a constant-η pair (the efficiencies of
+    ``cases/gots_diesel_friction.toml``), named as the pair it replaces."""
+    from transient.scene import Pair
+
+    name = next(p.name for p in scene.friction.pairs if tuple(p.between) == ("shaft", "crank"))
+    return with_main_bearings(scene, Pair(between=("shaft", "crank"), eta_forward=0.985,
+                                          eta_backward=0.98, name=name))
+

@@ -67,18 +67,24 @@ def _heeded() -> list[int]:
 
 
 @contextmanager
-def interrupting():
-    """While the block runs, every stopping signal not ignored raises KeyboardInterrupt
-    (:func:`interrupt`)."""
+def _handled_by(handler):
+    """While the block runs, every stopping signal not ignored goes to ``handler``; the handlers
+    before it come back after (in the main thread only, where Python handles signals)."""
     if not _in_main_thread():
         yield
         return
-    kept = {sig: signal.signal(sig, interrupt) for sig in _heeded()}
+    kept = {sig: signal.signal(sig, handler) for sig in _heeded()}
     try:
         yield
     finally:
-        for sig, handler in kept.items():
-            signal.signal(sig, handler)
+        for sig, kept_handler in kept.items():
+            signal.signal(sig, kept_handler)
+
+
+def interrupting():
+    """While the block runs, every stopping signal not ignored raises KeyboardInterrupt
+    (:func:`interrupt`)."""
+    return _handled_by(interrupt)
 
 
 @contextmanager
@@ -86,16 +92,10 @@ def deferred():
     """The stopping signals wait until the block ends, then act as they would have: a result
     file's last step moves the run into its layout, and stopped halfway it would leave neither
     the finished file nor the interrupted one."""
-    if not _in_main_thread():
-        yield
-        return
     caught = []
-    kept = {sig: signal.signal(sig, lambda signum, frame: caught.append(signum))
-            for sig in _heeded()}
     try:
-        yield
+        with _handled_by(lambda signum, frame: caught.append(signum)):
+            yield
     finally:
-        for sig, handler in kept.items():
-            signal.signal(sig, handler)
         if caught:
             signal.raise_signal(caught[0])

@@ -33,8 +33,9 @@ from transient.run import integrate, prescribed
 from transient.scene import Friction, Initial, Load, Output, Pair, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study, point_scene
 
-from balances import (check_release_at_holds, closure, dense_spin_up,
-                      loss_is_share_of_transmitted, losses_nonnegative, without_friction)
+from balances import (check_release_at_holds, closure, constant_main_bearings, dense_spin_up,
+                      loss_is_share_of_transmitted, losses_nonnegative, with_main_bearings,
+                      without_friction)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = np.pi / 30.0
@@ -48,20 +49,11 @@ def radial_mixed(**changes):
     """The radial case's reaction pairs with its main bearings as a constant-η pair (the
     efficiencies of the diesel's case)."""
     base = load_scene(CASES / "radial_5cyl_reaction_friction.toml")
-    pairs = tuple(Pair(between=("shaft", "crank"), eta_forward=0.985, eta_backward=0.98,
-                       name=p.name) if tuple(p.between) == ("shaft", "crank") else p
-                  for p in base.friction.pairs)
-    return replace(base, friction=Friction("power-flow", pairs), **changes)
+    return replace(constant_main_bearings(base), **changes)
 
 
 def coupling(scene) -> Pair:
     return next(p for p in scene.friction.pairs if p.model != "reaction")
-
-
-def with_main_bearings(scene, pair: Pair):
-    """``scene`` with ``pair`` at its main bearings."""
-    return replace(scene, friction=Friction("power-flow", tuple(
-        pair if tuple(p.between) == ("shaft", "crank") else p for p in scene.friction.pairs)))
 
 
 def mapped_main_bearings() -> Pair:

@@ -118,8 +118,7 @@ def _coupled_mode(m, backward, M_shaft, eps0, w, sigma, wk):
     map gives at the S that the solve at that η* gives (a fixed point, module docstring); NaN if
     that does not settle."""
     if not m.eta_table:
-        eta = 1.0 / m.rx_par[0, RX_ETA_BWD] if backward else m.rx_par[0, RX_ETA_FWD]
-        return _coupled_solve(m, eta, M_shaft, eps0, w, sigma, wk)
+        return _coupled_solve(m, _constant_eta(m, backward), M_shaft, eps0, w, sigma, wk)
     k = m.rx_pair[0]
     w_abs = abs(w)
     eps = eps0
@@ -133,6 +132,12 @@ def _coupled_mode(m, backward, M_shaft, eps0, w, sigma, wk):
             return eps
         eta = new
     return np.nan
+
+
+@kernel(inline=True)
+def _constant_eta(m, backward):
+    """η* of a constant-η pair at the main bearings: η_fwd forward, 1/η_bwd backward."""
+    return 1.0 / m.rx_par[0, RX_ETA_BWD] if backward else m.rx_par[0, RX_ETA_FWD]
 
 
 @kernel(inline=True)
@@ -187,7 +192,7 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
         eta = et.invert(m.et_speed, m.et_torque, m.et_size, m.et_eta, m.et_min, k, backward,
                         abs(w), -T)[1]
     else:
-        eta = 1.0 / m.rx_par[0, RX_ETA_BWD] if backward else m.rx_par[0, RX_ETA_FWD]
+        eta = _constant_eta(m, backward)
     _couple(m, eta, wk)
     return m.J0 * eps - M_shaft + wk[WK_S, k]
 

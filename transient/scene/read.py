@@ -353,7 +353,7 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
     raw = s.data.pop("pairs", [])
     if not isinstance(raw, list):
         raise SceneError(s.key("pairs"), "must be an array of tables ([[friction.pairs]])")
-    pairs, seen, models = [], {}, []
+    pairs, seen = [], {}
     for i, item in enumerate(raw):
         ps = Section(item, f"{s.key('pairs')}[{i}]")
         model = ps.string("model", "constant-eta", choices=PAIR_MODELS)
@@ -399,9 +399,8 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                                              f"{s.key('pairs')}[{twin}] "
                                              f"too; give each pair its own name (it labels the "
                                              f"pair's result columns and reports)")
-        models.append(model)
         pairs.append(pair)
-    if "reaction" in models:
+    if any(p.model == "reaction" for p in pairs):
         _check_mixed(s, mech, policy, pairs)
         joints = reaction_joints(mech)
         pairs.sort(key=lambda p: joints.index(p.between))

@@ -43,6 +43,8 @@ LEFT_OUT = [
 SCENES = {"coasting_single": "plain variant, no friction",
           "gots_diesel_pi": "full variant, no friction",
           "gots_diesel_governed": "constant-η pairs"}
+#: Those of :data:`SCENES` without friction pairs, which are to pay nothing for the models.
+WITHOUT_FRICTION = ("coasting_single", "gots_diesel_pi")
 
 _TIMING = """
 import json, sys

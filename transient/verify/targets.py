@@ -49,6 +49,7 @@ from ..core.rhs import derivative
 from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
+from .models_out import WITHOUT_FRICTION, friction_models_cost
 
 #: Right-hand sides per DOP853 step. The stepper picks each cylinder's gas table piece once per
 #: step (``model.select_pieces``, keyed by the step's ``sel``): the timing loop keeps ``sel`` for
@@ -364,8 +365,6 @@ def reaction_cost(repeat=5, revolutions=1000.0) -> dict:
 def models_cost(quick=False) -> list[dict]:
     """Scenes without friction, and one with constant-η pairs, against a build without the
     friction models (:func:`transient.verify.models_out.friction_models_cost`)."""
-    from .models_out import friction_models_cost
-
     q = dict(scenes=("coasting_single",), rounds=1, repeat=2, revolutions=10.0) if quick else {}
     with tempfile.TemporaryDirectory() as tmp:
         return friction_models_cost(DEFAULT_SCENE.parent, Path(tmp), **q)
@@ -614,7 +613,7 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
                       f"{rx['constant_nfev']} RHS calls, {rx['per_call_ratio']:.2f}× per call)",
                       _missed(rx["ratio"], REACTION_TARGET)))
     for r in res.get("models", []):  # (none in a record from before it was measured)
-        if "no friction" in r["what"]:
+        if r["scene"] in WITHOUT_FRICTION:
             lines.append(("a scene without friction pays nothing for the friction models "
                           "(within its runs' IQR)", f"{r['scene']} ({r['what']})",
                           f"{r['change']:+.1%} (IQR {r['iqr']:.1%})",
