@@ -9,7 +9,7 @@ instantaneous ratio whose denominator crosses zero):
   W_in = W_out + Σ W_loss,k and η = 1 − Σ W_loss,k / W_in. A **driven machine** (a compressor, a
   motored engine), where both are negative, takes its power the other way, from the load or the
   drive (a motor) into its gas: there W_in = ∫(M_load + M_drive) ω dt and
-  W_out = −∫(M_gas + M_starter) ω dt, so that η = W_gas/W_motor, and ``driven`` is 1.
+  W_out = −∫(M_gas + M_starter) ω dt, so that η = W_gas/W_motor, and ``driven`` is stored (1).
 * ``eta_mech_printed`` — (30) as printed, the time average of the instantaneous ratio
   P_out/P_in. P_in crosses zero twice per compression stroke, so the ratio is singular there; the
   samples with |P_in| below ``guard`` × mean |P_in| are left out and the share of the time left out
@@ -160,7 +160,6 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
     out = {
         "steady_phi_start": (a, "rad"),
         "steady_cycles": (float(n_cyc), "1"),
-        "driven": (float(driven), "1"),
         "W_in_per_cycle": (W_in / n_cyc, "J"),
         "W_out_per_cycle": (W_out / n_cyc, "J"),
         "eta_mech_work": (W_out / W_in if W_in > 0 else math.nan, "1"),
@@ -171,6 +170,8 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         "bmep": (W_shaft / n_cyc / v_d, "Pa"),
         "fmep": (sum(losses) / n_cyc / v_d, "Pa"),
     }
+    if driven:
+        out["driven"] = (1.0, "1")
     if events is not None and n_pairs:
         switches = np.asarray(events.get("pair_mode", np.zeros((0, 2))))
         inside = (switches[:, 1] >= a) & (switches[:, 1] < b) if switches.size else []

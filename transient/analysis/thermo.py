@@ -254,10 +254,9 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     W = np.array([integrals_between(phi, np.asarray(traj[f"p_{k + 1}"], float)[part] * vol.dV[k],
                                     marks, cuts[k]) for k in range(n)])
     w = np.asarray(traj["omega"], float)[part]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # (a start from rest has ω = 0 at its first sample, where only the mark φ0 falls, which
-        # is read off that sample: the derivative there is never used)
-        inv_w = 1.0 / w
+    # dt/dφ = 1/ω; NaN where ω = 0, the first sample of a start from rest, where only the mark
+    # φ0 falls, read off that sample: the derivative there is never used
+    inv_w = np.divide(1.0, w, out=np.full_like(w, np.nan), where=w != 0.0)
     t_marks = _at_marks(traj, part, "t", marks, inv_w)
     period = np.diff(t_marks)
     swept = vol.swept
