@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scene_texts import SMALL, check_text
+from scene_texts import COMPRESSOR_GAS, SMALL, check_text
 from scipy.integrate import quad
 
 from transient.assemble import cycle_figures, gas_is_force, gas_tables
@@ -143,14 +143,7 @@ def test_the_builder_refuses_a_cycle_that_cannot_work(changes, key, fragment):
 # The scene keys
 
 #: SMALL as a 2-stroke (one cycle a turn) single-cylinder air compressor.
-COMPRESSOR = SMALL.replace("bore_mm = 88\n", "bore_mm = 88\nstrokes = 2\n") + """
-[gas]
-model = "compressor"
-p_suction_bar = 1
-p_discharge_bar = 8
-n = 1.3
-clearance_ratio = 0.05
-"""
+COMPRESSOR = SMALL.replace("bore_mm = 88\n", "bore_mm = 88\nstrokes = 2\n") + COMPRESSOR_GAS
 
 #: The last line of COMPRESSOR, after which tables are appended.
 TAIL = "clearance_ratio = 0.05\n"

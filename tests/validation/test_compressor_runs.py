@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from balances import closure
-from scene_texts import SMALL
+from scene_texts import COMPRESSOR_GAS, SMALL
 
 from transient.analysis.summary import summarize
 from transient.assemble import gas_phases, gas_table
@@ -83,14 +83,7 @@ AIR_COMPRESSOR = SMALL.replace("bore_mm = 88\n", "bore_mm = 88\nstrokes = 2\ncyl
     "[initial]\nomega_rpm = 1000\n", "").replace(
     "[run]\nrevolutions = 2\n", '[run]\nmode = "prescribed-speed"\nspeed_rpm = 1500\n'
                                 "revolutions = 3\n").replace(
-    "samples_per_rev = 12", "samples_per_rev = 7200") + """
-[gas]
-model = "compressor"
-p_suction_bar = 1
-p_discharge_bar = 8
-n = 1.3
-clearance_ratio = 0.05
-"""
+    "samples_per_rev = 12", "samples_per_rev = 7200") + COMPRESSOR_GAS
 
 
 def test_the_mean_drive_at_a_held_speed_is_the_closed_form_work_over_2pi():
