@@ -83,10 +83,12 @@ MFB_LEVELS = (0.1, 0.5, 0.9)
 
 
 def clearance(scene) -> float:
-    """V_c [m³] of the scene's compression ratio (the cycle models), else 0: a gas table gives no
-    clearance, and V is then the swept part A·s only (the indicated work does not depend on it)."""
-    ratio = getattr(scene.gas, "compression_ratio", 0.0)
-    return scene.mechanism.swept_volume() / (ratio - 1.0) if ratio > 1.0 else 0.0
+    """V_c [m³] of the scene's cycle model (:func:`transient.assemble.clearance_volume`), else 0:
+    a gas table gives no clearance, and V is then the swept part A·s only (the indicated work
+    does not depend on it)."""
+    from ..assemble import clearance_volume
+
+    return clearance_volume(scene)
 
 
 @dataclass(frozen=True)
@@ -252,7 +254,10 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     W = np.array([integrals_between(phi, np.asarray(traj[f"p_{k + 1}"], float)[part] * vol.dV[k],
                                     marks, cuts[k]) for k in range(n)])
     w = np.asarray(traj["omega"], float)[part]
-    t_marks = _at_marks(traj, part, "t", marks, 1.0 / w)
+    # dt/dφ = 1/ω; NaN where ω = 0, the first sample of a start from rest, where only the mark
+    # φ0 falls, read off that sample: the derivative there is never used
+    inv_w = np.divide(1.0, w, out=np.full_like(w, np.nan), where=w != 0.0)
+    t_marks = _at_marks(traj, part, "t", marks, inv_w)
     period = np.diff(t_marks)
     swept = vol.swept
     total = float(swept.sum())
@@ -270,7 +275,8 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
                     if "M_drive" in traj else None)
     W_loss = np.zeros(marks.size - 1)
     for k in range(len(scene.friction.pairs)):
-        W_loss += delta(f"W_loss_{k + 1}", np.asarray(traj[f"P_loss_{k + 1}"], float)[part] / w)
+        W_loss += delta(f"W_loss_{k + 1}", np.asarray(traj[f"P_loss_{k + 1}"], float)[part]
+                        * inv_w)
     J = np.asarray(traj["J"], float)[part]
     K = 0.5 * J * w * w
     dK_dphi = 0.5 * np.asarray(traj["dJ_dphi"], float)[part] * w * w \

@@ -41,6 +41,7 @@ def register(sub) -> None:
 
 
 def cmd_check(args) -> int:
+    from ..assemble import cycle_figures
     from ..scene import load_scene
 
     scene = load_scene(args.scene)
@@ -51,6 +52,7 @@ def cmd_check(args) -> int:
           f"{scene.mechanism.n_cylinders} cylinder(s), gas {scene.gas.model}, "
           f"run {scene.run.mode}{friction})")
     _print_mechanism(scene.mechanism)
+    _print_figures(cycle_figures(scene))
     return EXIT_OK
 
 
@@ -60,6 +62,11 @@ def _print_mechanism(mech) -> None:
     exact values), each as ``name = value unit`` under the name and SI unit the API gives it."""
     figures = mech.geometry()
     figures.update(mech.analysis_summary())
+    _print_figures(figures)
+
+
+def _print_figures(figures: dict) -> None:
+    """``name = value unit``, one a line."""
     for name, (value, unit) in figures.items():
         print(f"  {name} = {value:.9g} {unit}")
 
@@ -185,9 +192,10 @@ def _print_efficiency(v: dict, names=()) -> None:
     pairs labelled by ``names`` (default: their numbers)."""
     if "eta_mech_work" not in v:
         return
+    source = " from the load and drive into the gas" if v.get("driven") else ""
     print(f"  mechanical efficiency over {v['steady_cycles']:.0f} steady cycle(s): "
           f"η = W_out/W_in = {v['eta_mech_work']:.6f} (work ratio; W_in = "
-          f"{v['W_in_per_cycle']:.6g} J/cycle; energy balance residual "
+          f"{v['W_in_per_cycle']:.6g} J/cycle{source}; energy balance residual "
           f"{v['energy_balance_residual']:.2e})")
     if "eta_mech_printed" in v:
         print(f"    (30) as printed, time average of P_out/P_in: {v['eta_mech_printed']:.6g} "

@@ -46,6 +46,7 @@ __all__ = [
     "table_from_function",
     "table_from_points",
     "volume_at",
+    "wrapped_pieces",
 ]
 
 #: Default knot spacing of :func:`table_from_function` [rad] (0.125°). Measured on the Gots
@@ -806,14 +807,14 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         v_0 = volume_at(volume, 0.0)
         v_end = volume_at(volume, period)
         work += p_intake * (v_a - v_0) + p_exhaust * (v_end - v_b)
-    funcs, corners = _wrapped_pieces(starts, period)
+    funcs, corners = wrapped_pieces(starts, period)
     table, err = table_from_function(funcs, period, corners, step)
     return MixedCycle(knots=table.knots, coef=table.coef, piece_knot=table.piece_knot,
                       period=period, work=work, p_c=p_c, p_b=p_b, angle_z=angle_z, v_c=v_c,
                       v_a=v_a, v_z=v_z, v_b=v_b, strokes=strokes, interpolation_error=err)
 
 
-def _wrapped_pieces(starts: list[tuple[float, PieceFunction]], period: float
+def wrapped_pieces(starts: list[tuple[float, PieceFunction]], period: float
                     ) -> tuple[list[PieceFunction], list[float]]:
     """Pieces given by the angles where they start, as :func:`table_from_function` takes them:
     the functions in order over [0, period) and the interior corners. A start off [0, period)

@@ -67,6 +67,10 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("governor.model", f"a prescribed-speed run integrates no governor state; "
                                            f"use model = \"none\" or \"droop\", not "
                                            f"{scene.governor.model!r}")
+    if scene.gas.model == "compressor" and scene.governor.model != "none":
+        raise SceneError("governor.model", f"a compressor has no fuel for a governor to set; use "
+                                           f"model = \"none\", not {scene.governor.model!r} (a "
+                                           f"speed is held by the motor or a prescribed speed)")
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
@@ -102,7 +106,8 @@ def check_gas_table(scene: Scene, section: Section) -> None:
     try:
         gas_table(scene)
     except SceneError as exc:
-        if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi"):
+        if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi",
+                                                     "gas.force"):
             exc.key = "gas.file"
         raise section.rename(exc) from None
     if scene.gas.woschni is not None:
@@ -142,7 +147,9 @@ def check_analysis(scene: Scene) -> None:
         if name not in columns + derived:
             raise SceneError("analysis.orders", f"unknown signal {show_value(name)}; allowed: "
                                                 f"{', '.join(columns + derived)}")
-    if a.thermodynamics and scene.gas.model in ("none", "trapezoid"):
+    from ..assemble import gas_is_force
+
+    if a.thermodynamics and (scene.gas.model == "none" or gas_is_force(scene)):
         raise SceneError("analysis.thermodynamics",
                          f"gas model {show_value(scene.gas.model)} applies no cylinder pressure "
                          f"(∮p dV needs one); allowed with it: false")

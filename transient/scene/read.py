@@ -167,21 +167,24 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
 
 def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: int) -> Gas:
     gas = _read_gas_model(s, base_dir, strokes)
-    cylinders = _read_cylinders(s, n_cylinders)
+    cylinders = _read_cylinders(s, n_cylinders, burns=gas.model != "compressor")
     if gas.model == "none":
         if cylinders:
             raise SceneError(s.key("cylinders"), "varies the gas force of cylinders that have "
                                                  "none; give a gas model (gas.model) or leave "
                                                  "[[gas.cylinders]] out")
         return gas
+    if gas.model == "compressor":  # no fuel: nothing to inject
+        return replace(gas, cylinders=cylinders)
     cycle = 2.0 * math.pi * strokes / 2
     return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle),
                    cylinders=cylinders)
 
 
-def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
+def _read_cylinders(s: Section, n_cylinders: int, burns: bool = True) -> tuple[Cylinder, ...]:
     """The [[gas.cylinders]] entries: per cylinder its fuel and pressure factors, cut-out and
-    misfires (:class:`~.records.Cylinder`), sorted by cylinder."""
+    misfires (:class:`~.records.Cylinder`), sorted by cylinder. A model that ``burns`` no fuel
+    (a compressor) takes the pressure factor only."""
     s.known.append("cylinders")
     raw = s.data.pop("cylinders", [])
     if not isinstance(raw, list):
@@ -190,6 +193,12 @@ def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
     top = MAX_CYLINDER_FACTOR
     for i, item in enumerate(raw):
         cs = Section(item, f"{s.key('cylinders')}[{i}]")
+        other = [k for k in (item if isinstance(item, dict) else ())
+                 if k not in ("cylinder", "pressure")]
+        if not burns and other:
+            raise SceneError(cs.key(other[0]), "a compressor burns no fuel: its "
+                                               "[[gas.cylinders]] entries take 'cylinder' and "
+                                               "'pressure' only")
         k = cs.integer("cylinder", ge=1, le=n_cylinders)
         if k in seen:
             raise SceneError(cs.key("cylinder"), f"cylinder {k} has an entry already "
@@ -223,25 +232,24 @@ def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
 
 def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
     model = s.string("model", "none",
-                     choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe"))
+                     choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe", "compressor"))
     if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
         return Gas(model="trapezoid", p0=0.0, amplitude=s.number("amplitude", ge=0.0),
                    ramp=s.number("ramp", "angle", gt=0.0),
                    duration=s.number("duration", "angle", math.pi, gt=0.0))
+    if model == "table":
+        return _read_gas_table(s, base_dir)
     p0 = s.number("p0", "pressure", 1.0e5, ge=0.0)
     if model == "none":
         return Gas(model="none", p0=p0)
-    if model == "table":
-        if s.has("file"):
-            phi, p = _read_pressure_csv(s, base_dir)
-        else:
-            phi = s.numbers("phi", "angle")
-            p = s.numbers("p", "pressure")
-        corners = s.numbers("corners", "angle", ())
-        interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
-        return Gas(model="table", p0=p0, phi=phi, p=p, corners=corners, interpolation=interp)
     if model == "wiebe":
         return _read_wiebe(s, p0, strokes)
+    if model == "compressor":  # p_discharge > p_suction and the clearance: forces.compressor
+        n = s.number("n", gt=1.0)
+        return Gas(model="compressor", p0=p0, p_suction=s.number("p_suction", "pressure", gt=0.0),
+                   p_discharge=s.number("p_discharge", "pressure", gt=0.0), n=n,
+                   n_reexpansion=s.number("n_reexpansion", default=n, gt=1.0),
+                   clearance_ratio=s.number("clearance_ratio", gt=0.0))
     return Gas(
         model="mixed-cycle", p0=p0,
         compression_ratio=s.number("compression_ratio", gt=1.0),
@@ -249,6 +257,34 @@ def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
         p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
         n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
         p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+
+
+def _read_gas_table(s: Section, base_dir: Path) -> Gas:
+    """``model = "table"``: absolute pressures ``p`` (with the crankcase's ``p0``) or forces on
+    each piston ``force`` (applied as they are: no ``p0``) at the local angles ``phi``, inline or
+    from a CSV ``file``."""
+    if s.has("file"):
+        phi, column, values = _read_diagram_csv(s, base_dir)
+        force = column in FORCE_COLUMNS
+    else:
+        phi = s.numbers("phi", "angle")
+        values = s.numbers("force", "force", ())
+        force = bool(values)
+        if force and s.has("p", "pressure"):
+            raise SceneError(s.key("force"), "is given with 'p'; a table holds the pressure in "
+                                             "the cylinder or the force on its piston: give one "
+                                             "of them")
+        if not force and not s.has("p", "pressure"):
+            s.numbers("p", "pressure", ())  # (a 'p' with a wrong unit suffix is named first)
+            raise SceneError(s.key("p"), "is missing; give the pressures 'p' (or 'p_bar', "
+                                         "'p_MPa') or the forces on the piston 'force' (or "
+                                         "'force_kN'), one per angle")
+        values = values or s.numbers("p", "pressure")
+    p0 = 0.0 if force else s.number("p0", "pressure", 1.0e5, ge=0.0)
+    corners = s.numbers("corners", "angle", ())
+    interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
+    return Gas(model="table", p0=p0, phi=phi, p=() if force else values,
+               force=values if force else (), corners=corners, interpolation=interp)
 
 
 def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
@@ -292,16 +328,18 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
                p_exhaust=p_ex, wiebe=wiebe, woschni=woschni)
 
 
-#: Column names of a pressure table (CSV) and their factors to SI.
+#: Column names of a pressure or force table (CSV) and their factors to SI.
 ANGLE_COLUMNS = {"phi_deg": math.pi / 180.0, "phi": 1.0}
 PRESSURE_COLUMNS = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
+FORCE_COLUMNS = {"force": 1.0, "force_N": 1.0, "force_kN": 1e3}
 
 
-def _read_pressure_csv(s: Section, base_dir: Path):
-    """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
-    (_, phi), (_, p) = _read_csv(s, base_dir, {"angle": ANGLE_COLUMNS,
-                                               "pressure": PRESSURE_COLUMNS})
-    return phi, p
+def _read_diagram_csv(s: Section, base_dir: Path):
+    """Indicator diagram (or force diagram) from a CSV with an angle column and a pressure or a
+    force column (units in names): the angles, the name of that column and its values."""
+    (_, phi), (column, values) = _read_csv(s, base_dir, {
+        "angle": ANGLE_COLUMNS, "pressure or force": {**PRESSURE_COLUMNS, **FORCE_COLUMNS}})
+    return phi, column, values
 
 
 def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):

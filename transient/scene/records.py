@@ -138,8 +138,15 @@ class Gas:
     ``rho`` [1], ``p_intake`` and ``p_exhaust`` [Pa]), ``"trapezoid"`` (the swash-plate paper's
     force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]) or
     ``"wiebe"`` (single-zone Wiebe combustion, :class:`Wiebe`; with ``compression_ratio``, ``p_a``
-    [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]). ``p0`` is the
-    crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33).
+    [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]) or
+    ``"compressor"`` (the ideal reciprocating compressor cycle of a compressor or pump,
+    :mod:`transient.forces.compressor`: ``p_suction`` and ``p_discharge`` [Pa], polytropic
+    exponents ``n`` of the compression and ``n_reexpansion`` of the clearance gas [1], clearance
+    ratio ``clearance_ratio`` = V_c/V_s [1]; one cycle a turn, local angle 0 at the top dead
+    centre; no fuel: no governor, no fuel factors, misfires or injection). ``p0`` is the
+    crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33). A ``"table"`` may give
+    ``force`` [N] on each piston instead of ``p``: then the force is applied as it is (no
+    piston area, no p0), as the trapezoid's.
 
     **Fuel command.** The governor's fuel f ∈ [0, 1] (1 without a governor) sets the cylinder
     pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot). For
@@ -153,7 +160,8 @@ class Gas:
     engine of ``cases/gots_diesel_wiebe.toml`` with γ = 1.38 − 1e-4·(T − 300 K), 1.1 % of the
     full-load p_max between 0 and 0.02 g and 2.1 % between 0 and 0.031 g (at f = 0.5; the
     indicated work at f = 0.25 is then 7.6 % low). Use a constant γ where part load matters.
-    The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"``).
+    The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"`` and
+    a force table).
 
     **Per-cylinder variation.** ``cylinders``: the ``[[gas.cylinders]]`` entries
     (:class:`Cylinder`), a cylinder's fuel and pressure factors, its cut-out and its misfires;
@@ -182,6 +190,12 @@ class Gas:
     amplitude: float = 0.0
     ramp: float = 0.0
     duration: float = math.pi
+    force: tuple[float, ...] = ()
+    p_suction: float = 0.0
+    p_discharge: float = 0.0
+    n: float = 0.0
+    n_reexpansion: float = 0.0
+    clearance_ratio: float = 0.0
     wiebe: Wiebe | None = None
     injection: float | None = None
     woschni: Woschni | None = None

@@ -63,9 +63,13 @@ def to_toml(scene: Scene) -> str:
 def _gas_section(gas: Gas) -> list[str]:
     keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation"),
             "trapezoid": ("model", "amplitude", "ramp", "duration"),
-            "wiebe": ("model", "p0", "compression_ratio", "p_a", "p_intake", "p_exhaust")}
+            "wiebe": ("model", "p0", "compression_ratio", "p_a", "p_intake", "p_exhaust"),
+            "compressor": ("model", "p0", "p_suction", "p_discharge", "n", "n_reexpansion",
+                           "clearance_ratio")}
     names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
                                  "n2", "p_intake", "p_exhaust"))
+    if gas.force:  # a force table: no pressure, no p0
+        names = ("model", "phi", "force", "corners", "interpolation")
     if gas.injection is not None:
         names = (*names, "injection")
     lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
@@ -80,7 +84,8 @@ def _gas_section(gas: Gas) -> list[str]:
         lines += ["", "[[gas.cylinders]]"] + [
             f"{f.name} = {toml_value(list(v) if isinstance(v, tuple) else v)}"
             for f in fields(c) for v in [getattr(c, f.name)]
-            if not (f.name == "fuel" and c.cut_out)]
+            if not (f.name == "fuel" and c.cut_out)
+            and (gas.model != "compressor" or f.name in ("cylinder", "pressure"))]
     return lines
 
 
