@@ -274,10 +274,6 @@ def cmd_info(args) -> int:
     a = res.attrs
     print(f"{res.path}: scene {a['scene']!r}, transient {a['version']}, format {a['format']}, "
           f"created {a['created']}, complete = {bool(a['complete'])}, status = {res.status}")
-    _print_provenance(a)
-    if text:
-        print(f"  scene file: {escaped(file)} ({len(text.splitlines())} lines, comments "
-              f"included, stored in /scene/source: `transient info --source` prints them)")
     if a.get("message"):
         print(f"  message: {a['message']}")
     for warning in res.warnings:
@@ -293,6 +289,10 @@ def cmd_info(args) -> int:
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
         if s.get("stiff_rerun"):
             print(f"  {s['stiff_rerun']}")
+    _print_provenance(a)
+    if text:
+        print(f"  scene file: {escaped(file)} ({len(text.splitlines())} lines, comments "
+              f"included, stored in /scene/source: `transient info --source` prints them)")
     values = {k: v for k, (v, _) in res.analysis.items()}
     _print_response(values)
     # (the pairs' names are in the resolved scene, read only when there are pairs)

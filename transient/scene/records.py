@@ -403,7 +403,14 @@ class Solver:
 
 @dataclass(frozen=True)
 class Output:
-    """Output sampling: ``samples_per_rev`` in crank angle; in time mode every ``dt`` [s]."""
+    """Output sampling. In crank angle (forwards, above the switch speed) a sample every
+    360°/``samples_per_rev``. In time (below the switch speed, whenever the shaft turns
+    backwards, ``solver.domain = "time"``) a sample every ``dt`` [s] (0: the angle spacing at
+    1.5 × the switch speed), and besides wherever the shaft angle crosses a multiple of
+    360°/``samples_per_rev``, either way, and at every speed reversal (the turning point, ω = 0):
+    so a rocking or reversing shaft is sampled as densely in angle as one turning forwards, and
+    ``dt`` bounds the time between the samples of a slow one. (The reference path, scipy-*,
+    writes its own steps.)"""
 
     samples_per_rev: int = 72
     dt: float = 0.0  # 0: Δφ / switch_speed
