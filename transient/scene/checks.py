@@ -137,7 +137,7 @@ def _torques(scene: Scene, lever: float, gas_table) -> dict[str, tuple[float, st
         exchange = max((scene.gas.p_intake, "gas.p_intake"), (scene.gas.p_exhaust, "gas.p_exhaust"))
         key = {"trapezoid": "gas.amplitude", "table": "gas.p", "wiebe": "gas.wiebe.fuel_mass",
                "mixed-cycle": "gas.p_z"}[scene.gas.model]
-        if exchange[0] >= float(np.max(p)):
+        if scene.gas.model in ("mixed-cycle", "wiebe") and exchange[0] >= float(np.max(p)):
             key = exchange[1]
         out["gas.p0" if offset > float(np.max(p)) else key] = (
             force * lever, f"{what}, on their lever Σ max|dx/dφ| = {lever:.3g} m)")
