@@ -473,7 +473,8 @@ def _in_memory(scene, progress) -> Result:
     data = integrate(scene, progress=progress)
     summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
                else {})
-    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary)
+    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary,
+                           (scene.source_file, scene.source_text))
     if res.status != FINISHED:
         raise SimulationError(f"{data.message} (status = {res.status})", res)
     return res
@@ -491,7 +492,8 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         raise SceneError("solver.method", f"{scene.solver.method!r}: only runs of the compiled "
                          f"stepper (DOP853, DOPRI5) can be resumed; run it again with --force")
     writer = ResultWriter(path, scene.name, to_toml(scene), output_columns(scene),
-                          EVENT_NAMES, force=force, resume=resume)
+                          EVENT_NAMES, force=force, resume=resume,
+                          scene_source=(scene.source_file, scene.source_text))
     writes = _WriteBehind()
     data = None
     try:

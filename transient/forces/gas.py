@@ -766,11 +766,14 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                          f"{deg_text(x_tdc)}) give V_a/V_c = {ratio:.10g}, not the "
                          f"compression_ratio {compression_ratio:.10g}; the clearance volume "
                          f"must be the swept volume/(ε − 1)")
-    p_c = p_a * ratio ** n1
+    try:
+        p_c = p_a * ratio ** n1
+    except OverflowError:  # (an absurd ε or n1: a p_c beyond a double, which p_z cannot reach)
+        p_c = math.inf
     if p_z < p_c:
         raise SceneError("gas.p_z", f"p_z = {p_z / 1e6:.6g} MPa is below the compression end "
-                                    f"p_c = p_a·ε^n1 = {p_c / 1e6:.6g} MPa; the mixed cycle needs "
-                                    "p_z ≥ p_c")
+                                    f"p_c = p_a·ε^n1 = {p_c / 1e6:.6g} MPa (ε = {ratio:.6g}, n1 = "
+                                    f"{n1:g}); the mixed cycle needs p_z ≥ p_c")
     v_z = rho * v_c
     if not (np.isfinite(rho) and 1.0 <= rho and v_z < v_b):
         raise SceneError("gas.rho", f"ρ = {rho!r}; it must satisfy 1 ≤ ρ < V_b/V_c = "

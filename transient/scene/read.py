@@ -17,15 +17,15 @@ from ..mechanisms import MECHANISMS, reaction_joints
 from ..mechanisms.articulated import slave_reach
 from ..units import ALL_SUFFIXES
 from .budget import check_work
-from .checks import check_analysis, check_consistency, check_gas_table
+from .checks import check_analysis, check_consistency, check_gas_table, check_magnitudes
 from .files import parse_toml, read_text, table_number, table_rows
 from .eta_map import check_map, grid_from_points
 from .reader import MISSING, Section, finite_number, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
-                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
-                      MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction, Gas,
-                      Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
+                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_GAMMA, MAX_SAMPLES_PER_REV,
+                      METHODS, MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction,
+                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
                       Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
@@ -35,7 +35,17 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     path = Path(source)
     if text is None:
         text = read_text(path, "scene")
-    return scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
+    scene = scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
+    return replace(scene, source_file=str(path), source_text=text)
+
+
+class SweepNotScene(SceneError):
+    """A sweep file (a ``[sweep]`` table and no ``[mechanism]``: :mod:`transient.sweeps.spec`)
+    given where a scene is read; ``transient check`` checks it as a sweep instead."""
+
+    def __init__(self, file: str) -> None:
+        super().__init__("[sweep]", "this is a sweep file, not a scene: run it with `transient "
+                                    "sweep`, check it with `transient check`", file=file)
 
 
 def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
@@ -76,10 +86,12 @@ def _unsuffixed(key: str) -> str:
 def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
     """Build and validate a scene from parsed TOML. Raises :class:`SceneError`."""
     base_dir = base_dir or Path.cwd()
+    if isinstance(data.get("sweep"), dict) and "mechanism" not in data:
+        raise SweepNotScene(file)
     try:
         root = Section(data, "")
         head = root.sub("scene")
-        name = head.string("name", Path(file).stem if file else "scene")
+        name = _label(head, Path(file).stem if file else "scene")
         if not name.strip():
             raise SceneError(head.key(head.written.get("name", "name")),
                              "must not be empty; it names the result (leave it out to use the "
@@ -149,8 +161,14 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sa.finish()
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
-        check_consistency(scene)
-        check_gas_table(scene, sg)
+        least_inertia, lever = check_consistency(scene)
+        table = check_gas_table(scene, sg)
+        try:
+            check_magnitudes(scene, least_inertia, lever, table)
+        except SceneError as exc:  # (reported under the key as written: omega_rpm, p_z_MPa, …)
+            for section in (s0, sg, sl, ss, sr):
+                section.rename(exc)
+            raise
         check_analysis(scene)
         try:
             check_work(scene)
@@ -163,6 +181,20 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         exc.file = exc.file or file
         exc.args = (exc.line(),)
         raise
+
+
+def _label(s: Section, default: str) -> str:
+    """The ``name`` of a table (the scene's, a pair's): it labels terminal lines, figures and
+    result files, so a character a terminal would act on (an escape sequence, a newline) is
+    refused, not printed."""
+    name = s.string("name", default)
+    bad = next((c for c in name if not c.isprintable()), None)
+    if bad is not None:
+        raise SceneError(s.key(s.written.get("name", "name")),
+                         f"holds the control character {show_value(bad)} (character "
+                         f"{name.index(bad) + 1}); a name labels terminal lines, figures and "
+                         f"results: give printable text")
+    return name
 
 
 def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: int) -> Gas:
@@ -250,13 +282,32 @@ def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
                    p_discharge=s.number("p_discharge", "pressure", gt=0.0), n=n,
                    n_reexpansion=s.number("n_reexpansion", default=n, gt=1.0),
                    clearance_ratio=s.number("clearance_ratio", gt=0.0))
+    p_in, p_ex = _gas_exchange(s, strokes, gt=0.0)
     return Gas(
         model="mixed-cycle", p0=p0,
         compression_ratio=s.number("compression_ratio", gt=1.0),
         p_a=s.number("p_a", "pressure", gt=0.0), n1=s.number("n1", gt=1.0),
         p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
-        n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
-        p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+        n2=s.number("n2", gt=1.0), p_intake=p_in, p_exhaust=p_ex)
+
+
+def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, float]:
+    """``p_intake`` and ``p_exhaust`` [Pa], the constant pressures of a 4-stroke's intake and
+    exhaust strokes (required, within ``bounds``, :meth:`Section.number`'s). A 2-stroke has no
+    such strokes: the cycle models scavenge it to p_a at bottom dead centre, so the keys would
+    mean nothing and are refused (0 in the record)."""
+    if strokes == 4:
+        return (s.number("p_intake", "pressure", **bounds),
+                s.number("p_exhaust", "pressure", **bounds))
+    for name in ("p_intake", "p_exhaust"):
+        if s.has(name, "pressure"):
+            s.number(name, "pressure")  # (taken off the table: its key as written)
+            raise SceneError(s.key(s.written[name]), "a two-stroke cycle (mechanism.strokes = "
+                                                     "2) has no intake or exhaust stroke: it is "
+                                                     "scavenged to p_a at bottom dead centre; "
+                                                     "leave p_intake and p_exhaust out (they "
+                                                     "are for strokes = 4)")
+    return 0.0, 0.0
 
 
 def _read_gas_table(s: Section, base_dir: Path) -> Gas:
@@ -297,17 +348,14 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
     d = Wiebe()
     ratio = s.number("compression_ratio", gt=1.0)
     p_a = s.number("p_a", "pressure", gt=0.0)
-    # A 2-stroke is scavenged to p_a: it has no intake or exhaust stroke.
-    need = MISSING if strokes == 4 else 0.0
-    p_in = s.number("p_intake", "pressure", need, ge=0.0)
-    p_ex = s.number("p_exhaust", "pressure", need, ge=0.0)
+    p_in, p_ex = _gas_exchange(s, strokes, ge=0.0)
     w = s.sub("wiebe", required=True)
     wiebe = Wiebe(
         start=w.number("start", "angle"), duration=w.number("duration", "angle", gt=0.0),
         fuel_mass=w.number("fuel_mass", ge=0.0), a=w.number("a", default=d.a, gt=0.0),
         m=w.number("m", default=d.m, gt=-1.0), lhv=w.number("lhv", default=d.lhv, gt=0.0),
         efficiency=w.number("efficiency", default=d.efficiency, gt=0.0, le=1.0),
-        gamma=w.number("gamma", default=d.gamma, gt=1.0),
+        gamma=w.number("gamma", default=d.gamma, gt=1.0, le=MAX_GAMMA),
         gamma_slope=w.number("gamma_slope", default=d.gamma_slope),
         gamma_t_ref=w.number("gamma_t_ref", default=d.gamma_t_ref, gt=0.0),
         t_a=w.number("t_a", default=d.t_a, gt=0.0),
@@ -422,7 +470,7 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
             raise SceneError(ps.key("between"), f"the same pair as "
                                                 f"{s.key('pairs')}[{seen[tuple(between)]}]")
         seen[tuple(between)] = i
-        name = ps.string("name", f"{between[0]}-{between[1]}")
+        name = _label(ps, f"{between[0]}-{between[1]}")
         if model == "reaction":
             pair = _reaction_pair(ps, between, name, slider=between[1] == links[-1])
         elif model == "table":

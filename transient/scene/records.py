@@ -34,7 +34,8 @@ class Wiebe:
     burned per cycle and cylinder at full load (governor fuel 1); 0 runs the engine motored.
     ``a``, ``m`` [1]: Wiebe efficiency parameter and shape exponent. ``lhv`` [J/kg]: lower heating
     value; ``efficiency`` [1]: combustion efficiency η_c, the share of m_f·LHV released.
-    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K].
+    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K];
+    at most 5/3, a monatomic ideal gas's.
     ``t_a`` [K]: gas temperature at intake closing. ``intake_closing``, ``exhaust_opening`` [rad]:
     ends of the closed part (None: the BDCs around the firing TDC). ``step`` [rad] and
     ``tolerance`` [1]: largest knot spacing and target relative error of the tables.
@@ -135,7 +136,9 @@ class Gas:
     table and every corner is a breakpoint), ``"mixed-cycle"`` (Gots App. 2,
     Trinkler–Sabathé: ``compression_ratio`` [1], ``p_a`` [Pa] at the start of compression,
     polytropic exponents ``n1`` and ``n2`` [1], peak pressure ``p_z`` [Pa], pre-expansion ratio
-    ``rho`` [1], ``p_intake`` and ``p_exhaust`` [Pa]), ``"trapezoid"`` (the swash-plate paper's
+    ``rho`` [1] and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]; a 2-stroke, scavenged
+    to ``p_a`` at bottom dead centre, has no gas-exchange strokes and refuses them),
+    ``"trapezoid"`` (the swash-plate paper's
     force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]) or
     ``"wiebe"`` (single-zone Wiebe combustion, :class:`Wiebe`; with ``compression_ratio``, ``p_a``
     [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]) or
@@ -414,11 +417,27 @@ class Solver:
 
 @dataclass(frozen=True)
 class Output:
-    """Output sampling: ``samples_per_rev`` in crank angle; in time mode every ``dt`` [s]."""
+    """Output sampling. In crank angle (forwards, above the switch speed) a sample every
+    360°/``samples_per_rev``. In time (below the switch speed, whenever the shaft turns
+    backwards, ``solver.domain = "time"``) a sample every ``dt`` [s] (0: the angle spacing at
+    1.5 × the switch speed), and besides wherever the shaft angle crosses a multiple of
+    360°/``samples_per_rev``, either way, and at every speed reversal (the turning point, ω = 0):
+    so a rocking or reversing shaft is sampled as densely in angle as one turning forwards, and
+    ``dt`` bounds the time between the samples of a slow one. (The reference path, scipy-*,
+    writes its own steps.)"""
 
     samples_per_rev: int = 72
     dt: float = 0.0  # 0: Δφ / switch_speed
 
+
+#: A speed no piston machine reaches [rad/s] (about 955 000 rpm): beyond it a run ran away
+#: (status ``runaway``), and a scene that would start there, or whose torques would drive its
+#: least inertia there within a revolution, is refused (``checks.check_magnitudes``).
+RUNAWAY_SPEED = 1e5
+
+#: The largest ratio of specific heats of an ideal gas, a monatomic one's (γ = 1 + 2/f, f ≥ 3
+#: degrees of freedom): the Wiebe cycle's ``gamma`` is at most this.
+MAX_GAMMA = 5.0 / 3.0
 
 #: Output samples per revolution at most (0.00036° apart).
 MAX_SAMPLES_PER_REV = 1_000_000
@@ -542,7 +561,12 @@ DETREND = ("auto", "ramp", "none")
 class Scene:
     """A validated scene: what :func:`transient.scene.load_scene` returns, one record per TOML
     table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
-    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`."""
+    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`.
+
+    ``source_file`` and ``source_text``: the file the scene was read from and its text as read,
+    comments included (where each number comes from), which a result stores beside the resolved
+    scene; empty for a scene built in code. Not part of what the scene is: two scenes that differ
+    only there are equal."""
 
     name: str
     description: str
@@ -558,6 +582,8 @@ class Scene:
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
     analysis: Analysis = field(default_factory=Analysis)
+    source_file: str = field(default="", compare=False, repr=False)
+    source_text: str = field(default="", compare=False, repr=False)
 
     def geometry(self) -> dict[str, tuple[float, str]]:
         """What the mechanism's geometry implies, without a run, name → (value, unit) in SI
