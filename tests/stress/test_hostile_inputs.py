@@ -563,6 +563,25 @@ def test_an_absurd_magnitude_or_a_control_character_gives_its_exact_line(tmp_pat
     assert one_line(capsys, ["check", scene]) == f"{scene}: {message}"
 
 
+def test_a_compressor_beyond_any_machine_is_refused_by_its_discharge(tmp_path, capsys):
+    """The magnitude bound covers the compressor cycle, whose largest pressure is the discharge:
+    3e19 Pa on the A/C compressor's pistons (a clearance small enough to deliver at that ratio)."""
+    from pathlib import Path
+
+    case = (Path(__file__).resolve().parents[2] / "cases" / "ac_compressor_7cyl.toml").read_text(
+        encoding="utf-8")
+    lines = {"p_discharge_MPa = ": "p_discharge_MPa = 3e13", "clearance_ratio = ":
+             "clearance_ratio = 1e-14"}
+    scene = tmp_path / "c.toml"
+    write(scene, "\n".join(next((v for k, v in lines.items() if line.startswith(k)), line)
+                           for line in case.splitlines()) + "\n")
+    line = one_line(capsys, ["check", scene])
+    assert line.startswith(f"{scene}: gas.p_discharge_MPa: gives a torque of 2.35e+15 N m (the "
+                           f"pressure difference p − p0 up to 3e+19 Pa on pistons of ")
+    assert line.endswith("faster than any piston machine turns, within one revolution; allowed "
+                         "up to J_min·ω²/(4π) = 7.66e+06 N m")
+
+
 def test_a_wiebe_cycle_no_gas_has_is_refused(tmp_path, capsys):
     """γ above a monatomic gas's 5/3 is refused by its key; a heat release no double holds, by
     the Wiebe table that cannot be integrated (one line, no traceback, no numpy warning)."""

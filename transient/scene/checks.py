@@ -129,18 +129,22 @@ def _torques(scene: Scene, lever: float, gas_table) -> dict[str, tuple[float, st
     if load.table is not None:
         out["load.table.torque"] = (scale * max(map(abs, load.table.torque)), "")
     if gas_table is not None:
-        offset = 0.0 if scene.gas.model == "trapezoid" else scene.gas.p0
+        from ..assemble import gas_is_force
+
+        is_force = gas_is_force(scene)
+        offset = 0.0 if is_force else scene.gas.p0
         p = np.asarray(gas_table.coef)[:, 0]
         force = float(np.max(np.abs(p - offset)))
         what = f" (a force up to {force:.3g} N per piston"
-        if scene.gas.model != "trapezoid":
+        if not is_force:
             what = (f" (the pressure difference p − p0 up to {force:.3g} Pa on pistons of "
                     f"{scene.mechanism.piston_area:.3g} m²")
             force *= scene.mechanism.piston_area
         # (the key of the largest pressure: the crankcase's, a gas exchange's, the model's peak)
         exchange = max((scene.gas.p_intake, "gas.p_intake"), (scene.gas.p_exhaust, "gas.p_exhaust"))
-        key = {"trapezoid": "gas.amplitude", "table": "gas.p", "wiebe": "gas.wiebe.fuel_mass",
-               "mixed-cycle": "gas.p_z"}[scene.gas.model]
+        key = {"trapezoid": "gas.amplitude", "table": "gas.force" if is_force else "gas.p",
+               "wiebe": "gas.wiebe.fuel_mass", "mixed-cycle": "gas.p_z",
+               "compressor": "gas.p_discharge"}[scene.gas.model]
         if scene.gas.model in ("mixed-cycle", "wiebe") and exchange[0] >= float(np.max(p)):
             key = exchange[1]
         out["gas.p0" if offset > float(np.max(p)) else key] = (
