@@ -8,8 +8,8 @@
   cylinders' work per turn over 2π: for identical cylinders z times the closed form
   n/(n − 1)·p_s·V_s·η_v·((p_d/p_s)^((n−1)/n) − 1).
 
-The mixed cycle's loop work and the mean indicated torque of the Gots engine are in
-:mod:`.gots`.
+* **The ideal mixed cycle** of the Gots engine (:mod:`.gots`): its closed-form loop work
+  against a quadrature and against the gas table, and the mean indicated torque of a run.
 """
 from __future__ import annotations
 
@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 from balances import closure
 from scene_texts import COMPRESSOR_GAS, SMALL
+from sample_integrals import sample_integral_impl
 from scipy.integrate import quad
 
 from transient.analysis.summary import summarize
@@ -32,7 +33,7 @@ from transient.run import integrate
 from transient.scene import load_scene
 from transient.scene.read import scene_from_dict
 
-from . import Comparison, Tolerance, case
+from . import Comparison, Tolerance, case, gots
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -159,3 +160,60 @@ def compressor_energy():
                    "½J(φ)ω² − ½J₀ω₀² = W_gas + W_load − Σ W_loss", "formula", None,
                    closure(scene, tr), "", allowed),
     ]
+
+
+@case("validation/test_mixed_cycle.py::test_loop_work")
+def mixed_cycle_work():
+    """The loop work of the ideal mixed cycle (``MixedCycle.work``, closed form) against an
+    adaptive quadrature of the closed-form pressures and against ∮p dV of the tabulated
+    pressure, for ρ = 1.671 (the isobar of П2.1) and the printed ρ = 1.699."""
+    out = []
+    for rho in (1.671, 1.699):
+        mc = gots.cycle(rho)
+        ends = mc.corners
+        w_quad = sum(quad(lambda x: float(gots.exact_pressure(mc, x)) * float(gots.dvolume(x)),
+                          a, b, epsabs=1e-12, epsrel=1e-13, limit=200)[0]
+                     for a, b in zip(ends[:-1], ends[1:]))
+        out += [
+            Comparison(f"loop work ∮p dV, closed form, ρ = {rho}", "adaptive quadrature of the "
+                       "cycle's polytropes (scipy quad)", "independent", w_quad, mc.work, "J",
+                       Tolerance(rel=1e-11, why="the quadrature's tolerance")),
+            Comparison(f"loop work of the gas table, ρ = {rho}", "the closed form", "formula",
+                       mc.work, gots.table_loop_work(mc), "J",
+                       Tolerance(rel=1e-8, why="the table's interpolation error ≤ 10⁻⁹ p_z")),
+            Comparison(f"mean torque of one cylinder, ρ = {rho}", "W/4π", "formula",
+                       mc.work / (4 * math.pi), mc.mean_torque, "N·m",
+                       Tolerance(rel=1e-15, why="rounding")),
+        ]
+        if rho == 1.671:
+            digest = "an independent computation of the same cycle (not in the book)"
+            out += [Comparison("mean torque of three cylinders, ρ = 1.671", digest, "independent",
+                               205.7, 3 * mc.mean_torque, "N·m",
+                               Tolerance(abs=0.1, why="given to 0.1 N·m")),
+                    Comparison("mean indicated pressure p_i′, ρ = 1.671", digest, "independent",
+                               1.507, mc.mean_pressure / gots.MPA, "MPa",
+                               Tolerance(abs=1e-3, why="given to 1 kPa"))]
+    return out
+
+
+@case("validation/test_gots_tables.py::test_mean_indicated_torque_of_the_ideal_cycle")
+def mean_indicated_torque():
+    """Through the stepper: the mean of −M_drive over a cycle of ``cases/gots_diesel_4400.toml``
+    (inverse dynamics at the held 4400 rpm) is 3·W/(4π), W the closed-form loop work: the inertia
+    torque ½J′ω² averages to zero over a turn and ∮p₀ dV = 0. The mean is taken with a
+    local-polynomial rule between the breakpoints (the table's corners), where the torque has
+    kinks: a plain trapezoid on the 0.25° grid is off by 4.5·10⁻⁶."""
+    scene = load_scene(gots.SCENE)
+    table = gas_table(scene)
+    _, bp, _ = build_model(scene)
+    tr = integrate(scene).trajectory
+    period = 4.0 * math.pi
+    if tr["phi"][-1] < period:
+        raise AssertionError("the run ends before a whole cycle")
+    mean = sample_integral_impl(tr["phi"], -tr["M_drive"],
+                                np.concatenate([[0.0, period], bp])) / period
+    return [Comparison("mean indicated torque of a run at 4400 rpm, 3 cylinders",
+                       "3W/4π, W the mixed cycle's closed-form loop work", "formula",
+                       3.0 * table.work / period, mean, "N·m",
+                       Tolerance(rel=1e-6, why="the run's tables to 10⁻⁹, the quadrature "
+                                               "of its samples to ~10⁻¹³"))]

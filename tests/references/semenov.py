@@ -3,15 +3,15 @@
 M. V. Semenov, *Кинематический анализ механизмов авиационных двигателей* (Kinematic analysis
 of aircraft engine mechanisms), LKVVIA, Leningrad, 1947. Its dimensions: r = 95, l = 313,
 r_i = 75, l_i = 238 mm (r_i + l_i = l, eq. (5) at δ = 0° and 180°); λ = r/l, printed 0.304.
-The text prints λ_i at δ_i = 0° and 180° (with an errata slip: "90°" is 0°) and the ratio of
+The text prints λᵢ at δᵢ = 0° and 180° (with an errata slip: "90°" is 0°) and the ratio of
 the largest slave to master accelerations; everything else it gives as formulas. Where a test
 needs a number the text does not print, it is an *independent* computation from the exact
 geometry (an FFT of the positions written in plain numpy, made for the tests), named as such.
 
-Misprints found: the ratio max|W_Bi|/max|W_B| at δ_i = 180° is printed 1.27, but the text's own
-λ_i gives (1 + 0.686)/(1 + 0.304) = 1.293 and the exact geometry 1.2935; the 3rd-harmonic
+Misprints found: the ratio max|W_Bi|/max|W_B| at δᵢ = 180° is printed 1.27, but the text's own
+λᵢ gives (1 + 0.686)/(1 + 0.304) = 1.293 and the exact geometry 1.2935; the 3rd-harmonic
 coefficients n₃, m₃ of (43) leave out the −⅛ sin⁴β_i term of the same order, so (45)
-underestimates Rickert's 3rd harmonic (ψ_i ≠ δ_i) by about a factor of three.
+underestimates Rickert's 3rd harmonic (ψᵢ ≠ δᵢ) by about a factor of three.
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ BOOK = "Semenov §4, fig. 19"
 
 
 def radial(banks_deg, psi_deg=None, **changes) -> art.Articulated:
-    """Semenov's master and slaves at ``banks_deg`` (link angles ψ_i = δ_i unless given), with
+    """Semenov's master and slaves at ``banks_deg`` (link angles ψᵢ = δᵢ unless given), with
     masses for a complete mechanism (the kinematics do not depend on them)."""
     banks = tuple(np.radians(banks_deg))
     psi = banks if psi_deg is None else tuple(np.radians(psi_deg))
@@ -91,18 +91,18 @@ def slave_strokes():
         Comparison("strokes of the master and the slaves at δ = 0°, 180°",
                    "Semenov (5), (20): 2r", "formula", np.full(3, 2 * R), at_ends, "m",
                    Tolerance(rel=1e-13, why="exact: rounding")),
-        Comparison("slave stroke beyond 2r at δ = 72°, 144°", "exact geometry (independent; "
-                   "the text gives the method (55)–(58), no number)", "independent",
+        Comparison("slave stroke beyond 2r at δ = 72°, 144°", "exact geometry (the text gives "
+                   "the method (55)–(58), no number)", "independent",
                    np.array([0.393651e-3, 1.435197e-3]), excess, "m",
                    Tolerance(rel=1e-5, why="the independent values' six digits"),
-                   at=np.array([72.0, 144.0]), at_name="δ_i [°]"),
+                   at=np.array([72.0, 144.0]), at_name="δᵢ [°]"),
     ]
 
 
 @case("unit/test_articulated.py::test_slave_dead_centres_are_roots_of_the_velocity")
 def slave_dead_centres():
     """(55)–(57) solved exactly: the velocity vanishes at both dead centres, and the TDC lies a
-    few degrees after δ_i, symmetric for δ ↦ 360° − δ."""
+    few degrees after δᵢ, symmetric for δ ↦ 360° − δ."""
     mech = radial(FIVE)
     tdc, bdc = art.dead_centres(mech)
     speed = max(float(np.max(np.abs(np.diag(art.axial_positions(mech, a)[1]))))
@@ -112,17 +112,17 @@ def slave_dead_centres():
         Comparison("piston velocity at the dead centres, |dX/dφ|", "Semenov (55)–(57): zero",
                    "formula", None, speed, "m", Tolerance(high=1e-12 * R,
                                                           why="a root to rounding (10⁻¹² r)")),
-        Comparison("slave TDC after its bank angle δ_i", "exact geometry (independent; not in "
-                   "the text)", "independent", np.array([2.8102, 3.6714, -3.6714, -2.8102]),
-                   lag, "°", Tolerance(abs=1e-4, why="the independent values' digits"),
-                   at=np.array(FIVE, float), at_name="δ_i [°]"),
+        Comparison("slave TDC after its bank angle δᵢ", "exact geometry (not in the text)",
+                   "independent", np.array([2.8102, 3.6714, -3.6714, -2.8102]), lag, "°",
+                   Tolerance(abs=1e-4, why="the independent values' digits"),
+                   at=np.array(FIVE, float), at_name="δᵢ [°]"),
     ]
 
 
 @case("unit/test_articulated.py::test_psi_equal_delta_has_no_odd_harmonics_above_the_first")
 def no_third_harmonic():
-    """(46)–(47): with ψ_i = δ_i, p_i = 0 and "the 3rd-order harmonics are absent"; exactly, no
-    odd order ≥ 3 at all, and the first harmonic is r cos(φ − δ_i)."""
+    """(46)–(47): with ψᵢ = δᵢ, p_i = 0 and "the 3rd-order harmonics are absent"; exactly, no
+    odd order ≥ 3 at all, and the first harmonic is r cos(φ − δᵢ)."""
     hs = art.harmonics(radial([40, 72, 144, 200, 288]), orders=9)
     odd = max(float(np.hypot(*h.exact[0][3::2].T).max() / math.hypot(*h.exact[0][1]))
               for h in hs)
@@ -133,23 +133,23 @@ def no_third_harmonic():
                    "formula", None, odd, "", Tolerance(high=1e-12, why="zero to rounding")),
         Comparison("slave displacement, first-order amplitude", "Semenov (47), (59): r",
                    "formula", np.full(5, R), first, "m", Tolerance(rel=1e-13, why="rounding"),
-                   at=banks, at_name="δ_i [°]"),
+                   at=banks, at_name="δᵢ [°]"),
     ]
 
 
 @case("unit/test_articulated.py::test_psi_unequal_delta_has_a_third_harmonic_beside_semenov")
 def rickert_third_harmonic():
-    """Rickert's case ψ_i ≠ δ_i (δ = 72°, ψ = 67°): the 3rd harmonic appears. (45)'s n₃, m₃ miss
+    """Rickert's case ψᵢ ≠ δᵢ (δ = 72°, ψ = 67°): the 3rd harmonic appears. (45)'s n₃, m₃ miss
     the −⅛ sin⁴β_i term of the same order, so the printed series gives a third of it."""
     h = art.harmonics(radial([72], [67]))[0]
     exact, series = h.exact[0][3], h.series[0][3]
     c = math.cos(math.radians(72))
     half = Tolerance(abs=0.05e-6, why="half a unit of the independent values' last digit")
-    src = "exact geometry (independent)"
+    src = "exact geometry"
     return [
-        Comparison("3rd-order cosine coefficient of x_Bi, exact", src, "independent", -0.0249e-3,
+        Comparison("3rd-order cosine coefficient of x_Bᵢ, exact", src, "independent", -0.0249e-3,
                    exact[0] * c, "m", half),
-        Comparison("3rd-order cosine coefficient of x_Bi by (45)", "Semenov (45), evaluated "
+        Comparison("3rd-order cosine coefficient of x_Bᵢ by (45)", "Semenov (45), evaluated "
                    "independently", "formula", -0.0088e-3, series[0] * c, "m", half,
                    note="(43)'s n₃, m₃ are incomplete: a third of the exact value"),
         Comparison("3rd-order coefficients (a₃, b₃) of the slave travel S, exact", src,
@@ -161,34 +161,34 @@ def rickert_third_harmonic():
 
 @case("unit/test_articulated.py::test_slave_dynamic_parameter")
 def slave_dynamic_parameter():
-    """λ_i, the 2nd-harmonic amplitude of the slave's acceleration over rω², by Semenov's (61)
-    and exactly; and the largest slave acceleration at δ_i = 180° over the master's."""
+    """λᵢ, the 2nd-harmonic amplitude of the slave's acceleration over rω², by Semenov's (61)
+    and exactly; and the largest slave acceleration at δᵢ = 180° over the master's."""
     h0, h180 = art.harmonics(radial([0, 180]))
     W = art.axial_positions(radial([180]), np.linspace(0, 2 * math.pi, 20001))[2]
     ratio = float(np.abs(W[:, 1]).max() / np.abs(W[:, 0]).max())
     return [
-        Comparison("λ_i at δ_i = 0° by (61)", f"{BOOK}: λ_i = λ = 0.304 (errata: 0° for '90°')",
+        Comparison("λᵢ at δᵢ = 0° by (61)", f"{BOOK}: λᵢ = λ = 0.304 (errata: 0° for '90°')",
                    "formula", LAM, h0.lam_semenov, "", Tolerance(rel=1e-12, why="(61) reduces "
                                                                   "to r/l there: rounding")),
-        Comparison("λ_i at δ_i = 180° by (61)", BOOK, "printed", 0.686, h180.lam_semenov, "",
+        Comparison("λᵢ at δᵢ = 180° by (61)", BOOK, "printed", 0.686, h180.lam_semenov, "",
                    Tolerance(abs=5e-4, why="printed to three digits")),
-        Comparison("λ_i at δ_i = 0°, exact 2nd harmonic", "exact geometry (independent)",
+        Comparison("λᵢ at δᵢ = 0°, exact 2nd harmonic", "exact geometry",
                    "independent", 0.31082, h0.lam, "", Tolerance(abs=1e-5, why="the independent "
                                                                     "value's digits")),
-        Comparison("λ_i at δ_i = 180°, exact 2nd harmonic", "exact geometry (independent)",
+        Comparison("λᵢ at δᵢ = 180°, exact 2nd harmonic", "exact geometry",
                    "independent", 0.73043, h180.lam, "",
                    Tolerance(abs=1e-5, why="the independent value's digits"),
                    note="(61) truncates at λ²: 6 % low here"),
-        Comparison("largest slave acceleration at δ_i = 180° over the master's",
-                   "exact geometry (independent)", "independent", 1.2935, ratio, "",
+        Comparison("largest slave acceleration at δᵢ = 180° over the master's",
+                   "exact geometry", "independent", 1.2935, ratio, "",
                    Tolerance(abs=1e-4, why="the independent value's digits"),
-                   note=f"{BOOK} prints 1.27, a misprint: its own λ_i give (1 + 0.686)/(1 + "
+                   note=f"{BOOK} prints 1.27, a misprint: its own λᵢ give (1 + 0.686)/(1 + "
                         "0.304) = 1.293"),
     ]
 
 
 def lambda_curves(banks_deg):
-    """(exact λ_i, Semenov's (61)) of slaves at ``banks_deg`` (ψ_i = δ_i), for the figure."""
+    """(exact λᵢ, Semenov's (61)) of slaves at ``banks_deg`` (ψᵢ = δᵢ), for the figure."""
     hs = art.harmonics(radial(list(banks_deg)))
     return np.array([h.lam for h in hs]), np.array([h.lam_semenov for h in hs])
 
@@ -210,7 +210,7 @@ def master_series():
     x_b = order_spectrum((l + r) - slider_arrays(phi, r, l, 0.0)[0], n, 2 * math.pi).coef[0].real
     lam = 0.304
     b_series = (lam * (1 + lam**2 / 8), -lam**3 / 24)  # (33)
-    fft = "exact geometry, FFT (independent)"
+    fft = "exact geometry, FFT"
     return [
         Comparison("piston acceleration W, amplitudes over rω²", fft, "independent",
                    np.array([1.0, 0.3113, 0.0075, 0.0002]), w_amp, "",

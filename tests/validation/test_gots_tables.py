@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from references import check_all, gots, read_table
+from references import check_all, closed_forms, gots, read_table
 
 from transient.assemble import gas_phases
 from transient.core import crank_slider as core
@@ -78,7 +78,7 @@ def test_mean_indicated_torque_of_the_ideal_cycle():
     M_e = 153.05. The ideal polytropes here (ρ = 1.671, with pumping) give p_i′ ≈ 1.507 MPa and
     205.7 N·m; the book needs M_ср·η_m (59) to get from there to M_e.
     """
-    (mean,) = gots.mean_indicated_torque()
+    (mean,) = closed_forms.mean_indicated_torque()
     mean.check()
     assert mean.computed == pytest.approx(205.77, abs=0.01)
     grid_mean = float(np.mean(read_table("gots_P4_2_torque.csv")["M_sum_N_m"][:-1]))  # 0…690°

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from references import check_all, gots
+from references import check_all, closed_forms, gots
 from references.gots import CYCLE, EPS, RHO_GEO, V_C, V_H, exact_pressure, left, table_loop_work
 
 from transient.errors import SceneError
@@ -68,7 +68,7 @@ def test_corners(cycles):
 def test_loop_work():
     """The closed form against an adaptive quadrature of the closed forms (checks the formula)
     and against the table's ∮p dV, for ρ = 1.671 and 1.699; the mean torque W/4π."""
-    check_all(gots.mixed_cycle_work())
+    check_all(closed_forms.mixed_cycle_work())
 
 
 def test_interpolation_error(cycles):
