@@ -162,7 +162,7 @@ def _row(c, why: int, test_entry=None):
 
 
 HEADERS = ("Quantity", "Reference from", "Reference → model", "Deviation, allowed", "Test")
-WIDTHS = (24, 20, 20, 18, 18)
+WIDTHS = (23, 19, 20, 18, 20)
 
 
 class ValidationTable(SphinxDirective):
