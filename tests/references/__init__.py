@@ -64,6 +64,11 @@ class Tolerance:
     def on_deviation(self) -> bool:
         return self.abs is not None or self.rel is not None
 
+    @property
+    def bound(self) -> float:
+        """The largest deviation allowed (abs or rel)."""
+        return self.abs if self.abs is not None else self.rel
+
 
 @dataclass(frozen=True)
 class Comparison:
@@ -85,7 +90,6 @@ class Comparison:
     at: np.ndarray | None = None
     at_name: str = "φ [°]"
     test: str = ""  # set by :func:`case`
-    case: str = ""
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -122,21 +126,20 @@ class Comparison:
     def holds(self) -> bool:
         t, s = self.tolerance, self.statistic
         if t.on_deviation:
-            return s <= (t.abs if t.abs is not None else t.rel)
+            return s <= t.bound
         return (t.low is None or s >= t.low) and (t.high is None or s <= t.high)
 
     @property
     def ratio(self) -> float:
         """The deviation as a share of its tolerance (≤ 1 holds); NaN for bounds."""
         t = self.tolerance
-        if not t.on_deviation:
-            return math.nan
-        return self.statistic / (t.abs if t.abs is not None else t.rel)
+        return self.statistic / t.bound if t.on_deviation else math.nan
 
     @property
     def failure(self) -> str:
         """What failed and where, for an assertion's message."""
-        where = f" at {self.at_name} = {self.at[self.worst]:g}" if self.at is not None else ""
+        where = (f" at {self.at_name} = {self.at[self.worst]:g}"
+                 if self.at is not None and np.size(self.computed) > 1 else "")
         t = self.tolerance
         limit = (f"≤ {t.abs:g} {self.unit}" if t.abs is not None else
                  f"≤ {t.rel:g} relative" if t.rel is not None else
@@ -148,7 +151,7 @@ class Comparison:
 
 
 #: Every case, by its qualified name ``module.function``: what the page renders.
-CASES: dict[str, Callable[[], list[Comparison]]] = {}
+CASES: dict[str, Callable[[], tuple[Comparison, ...]]] = {}
 
 
 def case(test: str):
@@ -162,7 +165,7 @@ def case(test: str):
         @functools.wraps(fn)
         @functools.cache
         def build() -> tuple[Comparison, ...]:
-            return tuple(replace(c, test=test, case=name) for c in fn())
+            return tuple(replace(c, test=test) for c in fn())
 
         build.test = test
         CASES[name] = build

@@ -167,9 +167,10 @@ def loads_as_printed():
 
 
 def _column(quantity, source, reference, computed, unit, tolerance, note="", kind="printed"):
+    """A comparison over the rows of П4.1's 30° grid (or of one number drawn from them)."""
     return Comparison(quantity=quantity, source=source, kind=kind, reference=reference,
                       computed=computed, unit=unit, tolerance=tolerance, note=note,
-                      at=p41()["phi_deg"])
+                      at=p41()["phi_deg"] if np.size(computed) > 1 else None)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -37,6 +37,10 @@ def test_13_normal_hinge_is_the_printed_form():
     np.testing.assert_allclose(w13[:, 2], u13, rtol=0, atol=1e-10)
     np.testing.assert_allclose(w13[:, :2], 0.0, atol=1e-10)  # the cross turns about its hinge only
     np.testing.assert_allclose(sp.kinematics_table(g, PHI)["u13"], u13, rtol=0, atol=1e-13)
+    # (1) tan φ₉,₀ = tan φ₀,₀ cos α with φ₀,₀ = −φ.
+    theta = sp.positions(g, PHI)["theta"]
+    np.testing.assert_allclose(np.sin(theta) * np.cos(PHI),
+                               -np.cos(ALPHA) * np.sin(PHI) * np.cos(theta), atol=1e-15)
 
 
 def test_13_in_plane_hinge_is_a_quarter_turn_on():
