@@ -57,4 +57,4 @@ docs: $(DOCS_STAMP)
 
 clean:
 	rm -rf $(VENV) results/*.h5 results/*.png docs/_build docs/generated docs/auto_examples \
-		docs/guide/_generated
+		docs/guide/_generated docs/_generated
