@@ -523,7 +523,7 @@ def efficiency_sweep(quick: bool, ctx: Context) -> Outcome:
     for eta in etas:
         r = run_scene(friction(eta=(eta, eta))(quick), f"eta-{eta:g}", ctx)
         n = len(o.notes)
-        check_run(r, o, "complete|stalled")  # low η may lose more than the gas gives
+        check_run(r, o, "complete|stalled|not-started")  # low η may lose more than gas gives
         o.notes[n:] = [f"η = {eta:g}: {s}" for s in o.notes[n:]]
         finals[eta] = (r.trajectory["t"][-1], r.trajectory["omega"][-1])
     d = friction()(quick)
@@ -862,7 +862,7 @@ def catalogue() -> list[Case]:
                           eta=(0.05, 0.05), starter={"torque": 500.0, "noload_speed_rpm": 600.0,
                                                      "cutout_speed_rpm": 400.0},
                           initial={"omega": 0.0}, run={"t_end": 2.0})},
-                     "complete|stalled|locked")),
+                     "complete|stalled|not-started|locked")),
         Case("efficiency-0.3-to-1", "η from 0.3 to 1 on both pairs; η = 1 equals no pairs",
              efficiency_sweep),
         Case("tolerance-ladder", "rtol 1e-3 … 1e-12 (quick: … 1e-9): the largest error of t and "
