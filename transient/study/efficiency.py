@@ -59,8 +59,8 @@ def efficiency_study(scene, rpm, fuels=(1.0,), policies=None, samples_per_rev: i
         row = {"policy": policy, "fuel": fuel, "rpm": n,
                "inconsistent_samples": data.solver["inconsistent_samples"]}
         row.update({k: v for k, (v, _) in eff.items()})
-        row["note"] = "; ".join(f"{k}: {nan_reason(k, row)}" for k in NAN_SAID
-                                if nan_reason(k, row))
+        reasons = ((k, nan_reason(k, row)) for k in NAN_SAID)
+        row["note"] = "; ".join(f"{k}: {why}" for k, why in reasons if why)
         rows.append(row)
         if progress:
             progress((i + 1) / len(points))
