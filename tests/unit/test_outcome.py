@@ -225,9 +225,9 @@ def test_a_resumed_watch_that_took_the_run_before_says_the_same():
     cut = np.searchsorted(t, 0.3)
     w = Watch(scene(t_end=0.55), columns=3)
     early = events["speed_reversal"][:, 0] < t[cut]
-    w.take({k: v[:cut] for k, v in run.items()}, {"speed_reversal": events["speed_reversal"][early]})
-    w.observe({k: v[cut:] for k, v in run.items()}, {"speed_reversal":
-                                                     events["speed_reversal"][~early]})
+    reversals = events["speed_reversal"]
+    w.take({k: v[:cut] for k, v in run.items()}, {"speed_reversal": reversals[early]})
+    w.observe({k: v[cut:] for k, v in run.items()}, {"speed_reversal": reversals[~early]})
     assert w.verdict("finished", "") == whole
     assert w.summary()["speed_reversals"] == (11.0, "1")
 

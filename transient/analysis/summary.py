@@ -112,8 +112,9 @@ def nan_reason(name: str, values: dict[str, float]) -> str:
         return ("the cycle-mean speed never reached 90 % of the final speed, or was past it at "
                 "the first whole cycle")
     if name == "spin_up_settling_s":
-        return (f"the cycle-mean speed is outside its ±{values.get('spin_up_band_pct', math.nan):.3g}"
-                f" % band at the end, or in it from the first whole cycle")
+        band = values.get("spin_up_band_pct", math.nan)
+        return (f"the cycle-mean speed is outside its ±{band:.3g} % band at the end, or in it "
+                f"from the first whole cycle")
     if value is None:
         return "not in this run's summary (transient info lists what it holds)"
     return "NaN in the run's summary"
