@@ -748,6 +748,11 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
                 return yy[1]
             rest.terminal, rest.direction = True, -np.sign(y[1]) or -ref.sigma
             evs.append(("rest", rest))
+        elif math.isfinite(run.t_end):  # (recorded as it passes, as the compiled path does)
+            def through_zero(t, yy):
+                return yy[1]
+            through_zero.terminal, through_zero.direction = False, 0
+            evs.append(("through_zero", through_zero))
         m = ref.model
         if ref.seg < m.load_x.size:  # the next corner of the load schedule, and the one behind
             evs.append(("load_up", _level_crossing(m.load_comp == T, m.load_x[ref.seg], 1)))
@@ -778,15 +783,21 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
         t, y = sol.t[-1], sol.y[:, -1].copy()
         if progress:
             progress(min(1.0, max(t / t_end, (y[0] - scene.initial.phi) / (phi_end - scene.initial.phi))))
+        for (name, _), te, ye in zip(evs, sol.t_events or (), sol.y_events or ()):
+            if name == "through_zero":  # (not at the segment's start, where ω may be 0)
+                events.setdefault("speed_reversal", []).extend(
+                    (tz, yz[0]) for tz, yz in zip(te, ye) if tz > sol.t[0])
         if sol.status == 0:
             break
-        hit = [name for (name, _), te in zip(evs, sol.t_events) if te.size]
+        hit = [name for (name, e), te in zip(evs, sol.t_events) if te.size and e.terminal]
         if "end" in hit:
             break
-        if "stall" in hit:
-            raise SimulationError(f"stalled: the speed reached zero at t = {t:.9g} s, "
-                                  f"φ = {y[0]:.9g} rad before the {run.revolutions:g} revolutions "
-                                  f"the run ends by; give run.t_end to follow the motion")
+        if "stall" in hit:  # (judged as the compiled path's stall: transient.outcome)
+            events.setdefault("speed_reversal", []).append((t, y[0]))
+            message = (f"stalled: the speed reached zero at t = {t:.9g} s, φ = {y[0]:.9g} rad "
+                       f"({math.degrees(y[0]):.6g}°) before the {run.revolutions:g} revolutions "
+                       f"the run ends by; give run.t_end to follow the motion after a stall")
+            break
         if "rest" in hit:
             y[1] = 0.0
             events.setdefault("speed_reversal", []).append((t, y[0]))

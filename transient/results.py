@@ -42,8 +42,9 @@ FORMAT = 1
 @dataclass
 class RunData:
     """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics;
-    ``status`` says what the run did (:data:`transient.outcome.STATUSES`; "" until judged) and
-    ``warnings`` what a finished run must not be read without."""
+    ``status`` says what the run did (:data:`transient.outcome.STATUSES`; "" until judged),
+    ``warnings`` what a finished run must not be read without and ``summary`` what its judge
+    found over the whole run for the end-of-run summary (name → (value, unit))."""
 
     trajectory: dict[str, np.ndarray]
     events: dict[str, np.ndarray]
@@ -52,6 +53,7 @@ class RunData:
     message: str = ""
     status: str = ""
     warnings: list[str] = field(default_factory=list)
+    summary: dict[str, tuple[float, str]] = field(default_factory=dict)
 
 
 class ResultExists(FileExistsError):
@@ -374,10 +376,17 @@ def _logged_events(g: h5py.Group, count: int | None = None, t_from: float = -np.
             lo = mid + 1
         else:
             hi = mid
-    rows = log[lo:n]
-    names = [str(name) for name in log.attrs["names"]]
+    return _decoded(log[lo:n], log.attrs["names"])
+
+
+#: Samples :meth:`ResultWriter.written_blocks` reads at a time, at least.
+READ_ROWS = 1 << 18
+
+
+def _decoded(rows: np.ndarray, names) -> dict[str, np.ndarray]:
+    """Rows (name index, t, φ) of an event log as name → (n, 2) of (t, φ)."""
     codes = rows[:, 0].astype(np.int64)
-    return {names[c]: rows[codes == c, 1:] for c in np.unique(codes)}
+    return {str(names[c]): rows[codes == c, 1:] for c in np.unique(codes)}
 
 
 def _extend(ds: h5py.Dataset, values) -> None:
@@ -535,6 +544,19 @@ class ResultWriter:
         n = self.datasets["t"].shape[0]
         start = 0 if last is None else max(0, n - last)
         return {name: ds[start:] for name, ds in self.datasets.items()}
+
+    def written_blocks(self):
+        """The run written so far in the order it streamed, (columns, events) of consecutive
+        checkpoints at a time, about :data:`READ_ROWS` samples each: what a resumed run did
+        before, in bounded memory."""
+        log, index = self.checkpoints["events"], self.checkpoints["index"][()]
+        rows = logged = 0
+        for k, (end, *_, end_logged) in enumerate(index):
+            if end - rows < READ_ROWS and k < len(index) - 1:
+                continue
+            yield ({name: ds[rows:end] for name, ds in self.datasets.items()},
+                   _decoded(log[logged:end_logged], log.attrs["names"]))
+            rows, logged = int(end), int(end_logged)
 
     def read_events(self, t_from: float = -np.inf) -> dict[str, np.ndarray]:
         """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ); only the

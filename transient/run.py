@@ -338,12 +338,15 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     return RunData(traj, {}, solver)
 
 
-def integrate(scene, on_block=None, progress=None, keep=True, start=None) -> RunData:
+def integrate(scene, on_block=None, progress=None, keep=True, start=None, before=()) -> RunData:
     """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
-    for ``keep`` and ``start``. The run comes back judged (:func:`transient.outcome.judge`); a
-    run that outgrows its output budget or stops advancing raises
+    for ``keep`` and ``start``, and ``before`` the (block, events) the run continued from
+    ``start`` wrote before it. The run comes back judged (:func:`transient.outcome.judge`) over
+    all of it; a run that outgrows its output budget or stops advancing raises
     :class:`~transient.outcome.RunStopped` after its blocks so far went to ``on_block``."""
     watch = Watch(scene, len(output_columns(scene)))
+    for block, events in before:
+        watch.take(block, events)
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
@@ -471,8 +474,8 @@ def _in_memory(scene, progress) -> Result:
     from .scene import to_toml
 
     data = integrate(scene, progress=progress)
-    summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
-               else {})
+    summary = {**(summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
+                  else {}), **data.summary}
     res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary,
                            (scene.source_file, scene.source_text))
     if res.status != FINISHED:
@@ -505,7 +508,7 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
             writes.start(writer.block, block, ev, *state)
 
         data = integrate(scene, on_block=on_block, progress=progress, keep=False,
-                         start=writer.checkpoint)
+                         start=writer.checkpoint, before=writer.written_blocks())
         writes.wait()
         if not streamed or "stiff_rerun" in data.solver:  # written whole, not resumable
             writer.block(data.trajectory, data.events, np.zeros(0), np.zeros(0, np.int64), False,
@@ -514,7 +517,7 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         # memory stays bounded however long the run (steady state, efficiency are found there).
         tail = writer.read_trajectory(last=SUMMARY_SAMPLES)
         events = writer.read_events(t_from=tail["t"][0] if tail["t"].size else -math.inf)
-        summary = summarize(scene, tail, events) if tail["t"].size else {}
+        summary = {**(summarize(scene, tail, events) if tail["t"].size else {}), **data.summary}
     except BaseException as exc:
         writes.settle()
         msg = data.message if data is not None and data.message else (

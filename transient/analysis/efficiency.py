@@ -52,6 +52,7 @@ engine's FMEP to hold a scene's against.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from numpy.typing import NDArray
@@ -61,6 +62,13 @@ from .irregularity import cycle_boundaries, cycle_means, steady_state_time
 
 #: |P_in| below this fraction of its mean is left out of (30) as printed.
 PRINTED_GUARD = 1e-3
+#: The names of the values :func:`mechanical_efficiency` gives (absent together where a run has
+#: no steady whole cycle to take them over).
+EFFICIENCY_VALUES = re.compile(
+    r"(steady_phi_start|steady_cycles|W_(in|out)_per_cycle|eta_mech_\w+|"
+    r"energy_balance_residual|displacement|[ib]mep|fmep(_\w+)?|pair_mode_switches_per_cycle|"
+    r"W_(loss|transmitted|circulated)_\w+|loss_share_\d+|backward_share_\d+|"
+    r"mode_against_power_\w+|cylinder_split_residual_\d+)")
 
 
 def steady_window(scene, traj, rtol: float = 1e-4, cycles: int = 3):

@@ -50,6 +50,9 @@ def cmd_efficiency(args) -> int:
     figures += ["efficiency_map"] * (len(set(rpm)) > 1 and len(set(fuels)) > 1)
     for path in [out / f"{stem}_efficiency.csv"] + [out / f"{stem}_{f}.png" for f in figures]:
         check_output_file(path, args.force)  # refused before the study, not after it
+    if scene.governor.model != "none":
+        print(f"the scene's {scene.governor.model} governor is left out: each point holds its "
+              f"speed and its fuel (--fuel)")
     rows = efficiency_study(scene, rpm, fuels, policies, args.samples_per_rev)
     with output_file(out / f"{stem}_efficiency.csv", args.force) as fh:
         write_csv(rows, fh)
@@ -63,6 +66,9 @@ def cmd_efficiency(args) -> int:
               f"{r.get('eta_mech_printed', math.nan):9.5f} {r['imep'] / 1e3:7.5g} "
               f"{r['fmep'] / 1e3:6.4g}  {pairs}")
     print("  (mean effective pressures in kPa: imep = W_in/V_d, fmep = Σ W_loss/V_d)")
+    for r in rows:
+        if r["note"]:
+            print(f"  NaN at {r['rpm']:g} rpm, fuel {r['fuel']:g} ({r['policy']}): {r['note']}")
     plt = pyplot()
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     plot_study(a1, a2, rows, len(names), names)

@@ -149,6 +149,7 @@ def _print_summary(summary, solver, names=()) -> None:
     v = {k: val for k, (val, _) in summary.items()}
     print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
           f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
+    _print_stops(v)
     if math.isfinite(v["mean_omega_last_cycle"]):
         print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
               f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
@@ -181,6 +182,13 @@ def _print_summary(summary, solver, names=()) -> None:
           f"compile/cache load)")
     if solver.get("stiff_rerun"):
         print(f"  {solver['stiff_rerun']}")
+
+
+def _print_stops(v: dict) -> None:
+    """How often the speed went through zero over the whole run, and where first."""
+    if "speed_reversals" in v:
+        print(f"  speed through zero: {v['speed_reversals']:.0f} time(s), first at t = "
+              f"{v['speed_reversal_first_t']:.9g} s, φ = {v['speed_reversal_first_phi']:.9g} rad")
 
 
 def _print_response(v: dict) -> None:
@@ -302,6 +310,7 @@ def cmd_info(args) -> int:
         print(f"  scene file: {escaped(file)} ({len(text.splitlines())} lines, comments "
               f"included, stored in /scene/source: `transient info --source` prints them)")
     values = {k: v for k, (v, _) in res.analysis.items()}
+    _print_stops(values)
     _print_response(values)
     # (the pairs' names are in the resolved scene, read only when there are pairs)
     _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())

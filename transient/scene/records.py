@@ -366,11 +366,13 @@ class Run:
     """What to run: ``dynamic`` (integrate (18)) or ``prescribed-speed`` (inverse dynamics).
 
     The run ends at ``t_end`` [s] or after ``revolutions`` of the shaft, whichever comes first
-    (``inf`` = not set). For prescribed speed: ``speed`` [rad/s] constant, or a table ``time`` [s],
-    ``speed_table`` [rad/s] interpolated by ``interpolation``: ``"linear"`` (the default: a table
-    with corners, a ramp to a plateau, is followed exactly, with ε jumping at each point) or
-    ``"pchip"`` (monotone cubic, C¹: it never overshoots the table's speeds);
-    :mod:`transient.forces.load_table`.
+    (``inf`` = not set); it did what they ask if the shaft turned the revolutions, or with
+    ``t_end`` alone runs forwards at the end (status ``finished``; ``t_end`` first is
+    ``out-of-time``: :data:`transient.outcome.STATUSES`). For prescribed speed: ``speed``
+    [rad/s] constant, or a table ``time`` [s], ``speed_table`` [rad/s] interpolated by
+    ``interpolation``: ``"linear"`` (the default: a table with corners, a ramp to a plateau, is
+    followed exactly, with ε jumping at each point) or ``"pchip"`` (monotone cubic, C¹: it never
+    overshoots the table's speeds); :mod:`transient.forces.load_table`.
 
     Budgets (:mod:`.budget`), so that a mistyped end or limit is refused before any work instead
     of filling the disk or running for ever: ``max_output_bytes`` [bytes], the trajectory a run

@@ -56,7 +56,7 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
         out["trajectory"] = keep
         out["complete"] = data.complete
         if data.complete:
-            out["summary"] = summarize(scene, data.trajectory, data.events)
+            out["summary"] = {**summarize(scene, data.trajectory, data.events), **data.summary}
         out["status"] = data.status
         out["message"] = data.message
     except Exception as exc:  # noqa: BLE001 (this run failed: say so, the sweep goes on)

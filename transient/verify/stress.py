@@ -130,7 +130,7 @@ class Outcome:
 
     ok: bool = True  # every check held so far (the outcome is decided by run_case)
     outcome: str = ""  # "pass", "FAIL", "known failure"
-    status: str = ""  # complete, stalled, locked, chattering, interrupted, failed, timeout, error
+    status: str = ""  # complete, a result's status (stalled, locked, …), timeout, error
     error: float = math.nan  # the invariant's error (the balance residual unless said otherwise)
     tolerance: float = math.nan
     steps: int = 0
@@ -174,20 +174,12 @@ class Run:
     events: dict  # name -> (n, 2) of (t, φ)
     solver: dict
     wall_s: float
-    said: str = ""  # the result's status attribute (``finished``, ``stalled``, …)
+    result_status: str  # the result's (transient.outcome.STATUSES)
 
     @property
     def status(self) -> str:
-        if self.complete:
-            return "complete"
-        for word in ("stalled", "locked", "chattering", "interrupted"):
-            if self.message.startswith(word):
-                return word
-        if self.message.startswith("integration failed"):
-            return "failed"
-        # (any other status the result states, rather than "error": a run that ended as its
-        # status says is no crash of the case)
-        return self.said if self.said not in ("", "finished", "failed", "running") else "error"
+        """The result's status, ``complete`` for a run that did what its scene asks."""
+        return "complete" if self.result_status == "finished" else self.result_status
 
     def count(self, event: str) -> int:
         return int(self.events.get(event, np.zeros((0, 2))).shape[0])
@@ -531,7 +523,7 @@ def efficiency_sweep(quick: bool, ctx: Context) -> Outcome:
     for eta in etas:
         r = run_scene(friction(eta=(eta, eta))(quick), f"eta-{eta:g}", ctx)
         n = len(o.notes)
-        check_run(r, o, "complete|stalled")  # low η may lose more than the gas gives
+        check_run(r, o, "complete|stalled|not-started")  # low η may lose more than gas gives
         o.notes[n:] = [f"η = {eta:g}: {s}" for s in o.notes[n:]]
         finals[eta] = (r.trajectory["t"][-1], r.trajectory["omega"][-1])
     d = friction()(quick)
@@ -875,8 +867,8 @@ def _did_not_start(run: Run, o: Outcome) -> bool:
     rev = run.events.get("speed_reversal", np.zeros((0, 2)))
     tr = run.trajectory
     at_rest = all(np.any((tr["t"] == t) & (tr["omega"] == 0.0)) for t, _ in rev)
-    o.notes.append(f"status {run.said}, {len(rev)} reversal(s); {run.message[:160]}")
-    ok = run.said != "finished" and "did not start" in run.message and at_rest
+    o.notes.append(f"status {run.result_status}, {len(rev)} reversal(s); {run.message[:160]}")
+    ok = run.result_status != "finished" and "did not start" in run.message and at_rest
     if not ok:
         o.notes.append("expected a status other than finished, saying it did not start"
                        + ("" if at_rest else "; a reversal is not a sample at rest"))
@@ -923,7 +915,7 @@ def _steps_at_their_revolutions(run: Run, o: Outcome) -> bool:
     ok = got.size == 2 and bool(np.all(np.abs(got - want) <= 1e-9 * want))
     o.notes.append(f"load steps at φ = {', '.join(f'{g:.12g}' for g in got)} rad (want "
                    f"{', '.join(f'{w:.12g}' for w in want)})")
-    return ok and run.said == "finished"
+    return ok and run.result_status == "finished"
 
 
 SWEEP_SCRIPT = """\
@@ -978,14 +970,14 @@ def catalogue() -> list[Case]:
              single(from_rest, extra=_from_rest_extra, name="start-from-rest")),
         Case("stall-overload", f"load torque {OVERLOAD:g} N m, about 3× what the engine carries; "
                                f"the run ends by revolutions",
-             single(overload, "stalled", _stall_extra, "stall-overload")),
+             single(overload, "not-started", _stall_extra, "stall-overload")),
         Case("reversal-by-load", "the same overload with an end time: the load drives the shaft "
                                  "backwards through the gas cycle",
-             single(lambda q: overload(q, t_end=0.4), "complete", _reversal_extra,
+             single(lambda q: overload(q, t_end=0.4), "reversed", _reversal_extra,
                     "reversal-by-load")),
         Case("through-zero-rocking", "weak starter against compression: ω through zero many "
                                      "times",
-             single(rocking, extra=_rocking_extra, name="through-zero-rocking")),
+             single(rocking, "not-started", _rocking_extra, "through-zero-rocking")),
         Case("lambda-0.9", "λ = r/l = 0.9 (crank angle and time domain); λ = 0.75",
              several({"lambda-0.9": long_rod_ratio(0.9), "lambda-0.9-time":
                       long_rod_ratio(0.9, "time"), "lambda-0.75": long_rod_ratio(0.75)})),
@@ -1031,7 +1023,7 @@ def catalogue() -> list[Case]:
                           eta=(0.05, 0.05), starter={"torque": 500.0, "noload_speed_rpm": 600.0,
                                                      "cutout_speed_rpm": 400.0},
                           initial={"omega": 0.0}, run={"t_end": 2.0})},
-                     "complete|stalled|locked")),
+                     "complete|stalled|not-started|locked")),
         Case("efficiency-0.3-to-1", "η from 0.3 to 1 on both pairs; η = 1 equals no pairs",
              efficiency_sweep),
         Case("tolerance-ladder", "rtol 1e-3 … 1e-12 (quick: … 1e-9): the largest error of t and "
@@ -1044,7 +1036,7 @@ def catalogue() -> list[Case]:
         Case("backward-revolutions-only", "starter weaker than a constant load, from rest, the "
                                           "run ending by revolutions only: the shaft turns "
                                           "backwards and can never reach them",
-             single(backward_from_rest, "stalled|locked", name="backward-revolutions-only"),
+             single(backward_from_rest, "not-started|locked", name="backward-revolutions-only"),
              time_limit=10.0),
         Case("runaway", "inputs that would run without bound (t_end, revolutions 1e30, …) "
                         "refused naming their key; a run over its output budget stopped, kept",
