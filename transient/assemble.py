@@ -614,7 +614,8 @@ def reaction_fields(scene) -> dict:
     n = len(pairs)
     return dict(n_pairs=n, eta_fwd=np.ones(n), eta_bwd=np.ones(n),
                 policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
-                **link_fields(mech, [0] * len(mech.links)), reaction=True, rx_par=rx_par, rx_pair=rx_pair, **eta_table_fields(pairs))
+                **link_fields(mech, [0] * len(mech.links)),
+                reaction=True, rx_par=rx_par, rx_pair=rx_pair, **eta_table_fields(pairs))
 
 
 def reaction_breakpoints(scene) -> NDArray[np.float64]:

@@ -57,6 +57,10 @@ class ChainNumpy:
         self.sub = [sum(c < i for c in cuts) for i in range(len(mech.links))]
         self.link_J = mech.link_inertias()
         self.laws = mech.link_laws
+        self.rest = self.laws.index(LINK_REST)
+        # the links whose own inertia a pair cuts from the rods' (elsewhere it is in the rest)
+        self.own = [i for i, law in enumerate(self.laws) if law in (LINK_PISTONS, LINK_SWASH)
+                    and self.sub[i] != self.sub[self.rest]]
         self.piston_mass = mech.piston_link_mass
         self.terms = mech.reference_terms()
         self.mp = mech.pack()
@@ -67,20 +71,22 @@ class ChainNumpy:
         return self.split(phi, J, dJ, M_gas, M_shaft)
 
     def split(self, phi, J, dJ, M_gas, M_shaft):
-        """(J_k, J′_k, M_k) per sub-chain from every link's own inertia, always computed: the
-        shaft's J0, the constant ones, the pistons' m Σ u_k² (from the twin's u, u′), the swash
-        plate's link 9 and crosses (its kernel's Python code), and the rest of J(φ), J′(φ) for
-        the rods; the load and starter act on the shaft, the gas on the last link."""
+        """(J_k, J′_k, M_k) per sub-chain from each link's inertia: the shaft's J0, the constant
+        ones, where a pair cuts them from the rods the pistons' m Σ u_k² (from the twin's u, u′)
+        and the swash plate's link 9 and crosses (its kernel's Python code), and the rest of
+        J(φ), J′(φ) for the rods; the load and starter act on the shaft, the gas on the last
+        link."""
         Ji = np.array(self.link_J, dtype=float)
         dJi = np.zeros(len(self.laws))
         Ji[0] = self.J0
-        _, _, u, du = self.terms(phi)
-        for i, law in enumerate(self.laws):
-            if law == LINK_PISTONS:
+        if self.own:
+            _, _, u, du = self.terms(phi)
+        for i in self.own:
+            if self.laws[i] == LINK_PISTONS:
                 Ji[i], dJi[i] = self.piston_mass * u @ u, 2.0 * self.piston_mass * u @ du
-            elif law == LINK_SWASH:
+            else:
                 Ji[i], dJi[i] = swash_link_terms.py_func(self.mp, phi)
-        rest = self.laws.index(LINK_REST)
+        rest = self.rest
         Ji[rest] = J - (np.sum(Ji) - Ji[rest])
         dJi[rest] = dJ - (np.sum(dJi) - dJi[rest])
         Jk, dJk, Mk = np.zeros(self.n + 1), np.zeros(self.n + 1), np.zeros(self.n + 1)
