@@ -53,6 +53,17 @@ p_intake_MPa = 0.165
 p_exhaust_MPa = 0.182
 """
 
+#: An air compressor's ideal cycle, 1 → 8 bar (``model = "compressor"``), as a [gas] table for a
+#: mechanism whose cycle is one turn (appended to SMALL made a 2-stroke).
+COMPRESSOR_GAS = """
+[gas]
+model = "compressor"
+p_suction_bar = 1
+p_discharge_bar = 8
+n = 1.3
+clearance_ratio = 0.05
+"""
+
 
 def check_text(tmp_path, capsys, text: str):
     """``transient check`` on ``text`` written to ``tmp_path/bad.toml``: (path, exit code,

@@ -21,6 +21,7 @@ from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_P
                           RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T, extras_of,
                           work_array)
 from .core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
+from .forces.compressor import compressor_cycle
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .mechanisms import reaction_joints
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
@@ -48,16 +49,48 @@ def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
         return None, None
     if gas.model == "trapezoid":  # a force per piston [N] (Antonyuk §4)
         return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration), None
-    if gas.model == "table":
-        return table_from_points(np.asarray(gas.phi), np.asarray(gas.p), mech.cycle,
+    if gas.model == "table":  # pressures [Pa], or forces per piston [N]
+        return table_from_points(np.asarray(gas.phi), np.asarray(gas.force or gas.p), mech.cycle,
                                  corners=gas.corners, interpolation=gas.interpolation), None
     if gas.model == "wiebe":
         tables = wiebe_levels(mech, gas)
         return tables[-1], tables[0]
+    if gas.model == "compressor":  # no fuel: the one cycle at every command
+        return compressor_cycle(mech.volume_function(clearance_volume(scene)),
+                                p_suction=gas.p_suction, p_discharge=gas.p_discharge, n=gas.n,
+                                n_reexpansion=gas.n_reexpansion,
+                                clearance_ratio=gas.clearance_ratio, strokes=mech.strokes,
+                                dead_centres=mech.dead_centre_angles()), None
     return mixed_cycle(mech.volume_function(clearance_volume(scene)), compression_ratio=gas.compression_ratio,
                        p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
                        p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes,
                        dead_centres=mech.dead_centre_angles()), None
+
+
+def cycle_figures(scene) -> dict[str, tuple[float, str]]:
+    """What the scene's gas cycle implies, without a run, name → (value, unit) in SI: for a
+    cycle with a loop work (mixed, Wiebe, compressor) ∮p dV per cylinder and cycle and the mean
+    moment all cylinders put on the shaft (signed as ``M_gas``); for a compressor also the work
+    done on the gas, the volumetric efficiency, the volume drawn in and the local angles where
+    the valves open; at a constant prescribed speed the indicated power, and the mean drive
+    moment that speed needs without friction. Empty for the other models."""
+    from .forces.gas import IndicatedCycle
+
+    table = gas_table(scene)
+    if not isinstance(table, IndicatedCycle):
+        return {}
+    n = scene.mechanism.n_cylinders
+    out = {"cycle_work": (table.work, "J"), "mean_gas_torque": (n * table.mean_torque, "N m")}
+    if scene.gas.model == "compressor":
+        out.update(indicated_work=(table.indicated_work, "J"),
+                   volumetric_efficiency=(table.volumetric_efficiency, "1"),
+                   suction_volume=(table.suction_volume, "m^3"),
+                   suction_opens=(table.angle_suction, "rad"),
+                   discharge_opens=(table.angle_discharge, "rad"))
+    if scene.run.mode == "prescribed-speed" and not scene.run.time:
+        out["indicated_power"] = (n * table.mean_torque * scene.run.speed, "W")
+        out["mean_drive_torque_ideal"] = (-n * table.mean_torque, "N m")
+    return out
 
 
 @lru_cache(maxsize=8)
@@ -96,13 +129,17 @@ def wiebe_levels(mech, gas) -> tuple:
 
 
 def clearance_volume(scene) -> float:
-    """V_c = V_h/(ε − 1) of the cycle's compression ratio ε (mixed cycle, Wiebe) [m³]."""
-    return scene.mechanism.swept_volume() / (scene.gas.compression_ratio - 1.0)
+    """V_c [m³]: c·V_h of a compressor's clearance ratio c, V_h/(ε − 1) of a cycle's compression
+    ratio ε (mixed cycle, Wiebe); 0 for a model that gives neither (a table, a force)."""
+    gas, swept = scene.gas, scene.mechanism.swept_volume()
+    if gas.model == "compressor":
+        return gas.clearance_ratio * swept
+    return swept / (gas.compression_ratio - 1.0) if gas.compression_ratio > 1.0 else 0.0
 
 
 def gas_is_force(scene) -> bool:
     """True when the gas table holds a force per piston [N] rather than a pressure [Pa]."""
-    return scene.gas.model == "trapezoid"
+    return scene.gas.model == "trapezoid" or bool(scene.gas.force)
 
 
 def gas_phases(scene) -> NDArray[np.float64]:

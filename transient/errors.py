@@ -12,8 +12,14 @@ QUOTE_LIMIT = 40
 def clip(text: str, limit: int = QUOTE_LIMIT) -> str:
     """``text`` with control characters escaped and cut to ``limit`` characters ("..." marks the
     cut), so that a quoted token can neither break the line nor fill the screen."""
-    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    text = escaped(text)
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def escaped(text: str) -> str:
+    """``text`` with every character a terminal would act on rather than show (a control,
+    format or separator character: not ``str.isprintable``) written as its Python escape."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def show_value(value: Any) -> str:

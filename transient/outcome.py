@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .errors import SimulationError
+from .scene.records import RUNAWAY_SPEED
 
 
 #: Every status a run ends with, and what it means (README, "Result files"); a run the stepper
@@ -35,8 +36,6 @@ STATUSES = {
 }
 #: The status of a run that did what its scene describes; every other one exits 1.
 FINISHED = "finished"
-#: A speed no piston machine reaches [rad/s] (about 955 000 rpm): beyond it a run ran away.
-RUNAWAY_SPEED = 1e5
 #: Consecutive chunks of the stepper (each its chunk of step attempts) that bring no new sample
 #: and no new event before a run is stopped as making no progress.
 IDLE_CHUNKS = 50

@@ -74,7 +74,8 @@ DESCRIPTIONS = {
     "sleeve_speed": "the flyweight governor's sleeve speed, d(sleeve_lift)/dt",
     "fuel_{k}": "fuel command latched by cylinder {k} at its last injection",
     "M_drive": "drive moment the prescribed speed needs on the shaft, positive driving it forward",
-    "W_drive": "work of M_drive on the shaft since the start (trapezoidal over the samples)",
+    "W_drive": "work of M_drive on the shaft since the start, ∫M_drive ω dt (to the solver's "
+               "tolerance, at any output spacing)",
 }
 
 

@@ -925,15 +925,15 @@ def crank_slider_joint_forces(mech, phi, omega, epsilon, gas_force=None,
     independent check of the analyses' force relations (Gots (34)–(41)) and of the reduced model.
 
     Each cylinder is three bodies in its own plane — the throw (its unbalanced mass m_k at the
-    crankpin A, turning with the shaft), the rod (mass m at G, l₁ from the pin, inertia I_G about
-    G; a two-mass rod is the rigid one with I_G = m l₁(l − l₁), the inertia of its end masses),
-    the piston (mass m_p at the pin B, sliding along the axis at the offset e) — and the eight
-    unknowns: the bearing's force on the throw (2), the shaft's moment on the throw, the throw's
-    force on the rod at A (2), the rod's force on the piston at B (2) and the wall's force N. The
-    throw's and the rod's Newton and Euler equations and the piston's Newton equation are eight
-    linear equations, solved per sample (``numpy.linalg.solve``). The kinematics are written out
-    here from the loop x_B = e: sin β = (r sin α − e)/l, β̇ = r cos α ω/(l cos β), β̈ and ÿ_B by
-    differentiating once more.
+    crankpin A, turning with the shaft; half of it where two cylinders share the throw), the rod
+    (mass m at G, l₁ from the pin, inertia I_G about G; a two-mass rod is the rigid one with I_G = m
+    l₁(l − l₁), the inertia of its end masses), the piston (mass m_p at the pin B, sliding along the
+    axis at the offset e) — and the eight unknowns: the bearing's force on the throw (2), the
+    shaft's moment on the throw, the throw's force on the rod at A (2), the rod's force on the
+    piston at B (2) and the wall's force N. The throw's and the rod's Newton and Euler equations and
+    the piston's Newton equation are eight linear equations, solved per sample
+    (``numpy.linalg.solve``). The kinematics are written out here from the loop x_B = e: sin β = (r
+    sin α − e)/l, β̇ = r cos α ω/(l cos β), β̈ and ÿ_B by differentiating once more.
 
     Parameters
     ----------
@@ -985,7 +985,7 @@ def crank_slider_joint_forces(mech, phi, omega, epsilon, gas_force=None,
     # throw → rod, F_B (x, y) rod → piston, N.
     A = np.zeros(shape + (8, 8))
     rhs = np.zeros(shape + (8,))
-    m_k, m_p = mech.crank_mass, mech.piston_mass
+    m_k, m_p = mech.crank_mass_per_cylinder, mech.piston_mass  # its share of a shared throw
     # Throw: F_O − F_A = m_k a_A; about O: M + A × (−F_A) − M_A = I_O·(−ε), I_O = m_k r².
     A[..., 0, 0], A[..., 0, 3] = 1.0, -1.0
     A[..., 1, 1], A[..., 1, 4] = 1.0, -1.0

@@ -15,7 +15,6 @@ from typing import Callable
 import numpy as np
 
 from .assemble import build_model, initial_governor
-from .forces.load_table import interpolant
 from .core import forcing, layout, stepper
 from .core import stepper_io as sio
 from .core.inverse import inverse_dynamics
@@ -26,6 +25,7 @@ from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, j
                       status_of)
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
+from .prescribed_work import Motion, work_columns
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
 from .scene.records import COMPILED_METHODS, runs_compiled
 from .stopping import deferred
@@ -284,7 +284,8 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     (the textbook analysis at given ω). ``fuel`` sets the pressure between the motored and the
     full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot the
     crankcase pressure p0, or zero force, for the models without a motored curve): the tables'
-    cubics are blended, so the ``p_<k>`` columns hold the pressure applied."""
+    cubics are blended, so the ``p_<k>`` columns hold the pressure applied. The work columns are
+    integrated over the motion to the scene's tolerance (:mod:`.prescribed_work`)."""
     model, _, _ = build_model(scene)
     coef = model.coef.copy()
     if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.layout.Model)
@@ -296,16 +297,14 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     run = scene.run
     phi0 = scene.initial.phi
     dphi = 2.0 * math.pi / scene.output.samples_per_rev
+    motion = Motion.of(scene)
     if run.time:
         # ω(t) as the scene interpolates it (linear or monotone cubic: neither overshoots the
-        # table's speeds); φ its exact integral, ε its derivative (at a corner of a linear
-        # table, the slope after it)
-        speed = interpolant(run.time, run.speed_table, run.interpolation)
-        angle = speed.antiderivative()
+        # table's speeds); φ its exact integral, ε its derivative
         t_end = min(run.t_end, run.time[-1])
-        n = int(math.ceil((angle(t_end) - angle(run.time[0])) / dphi)) + 1
+        n = int(math.ceil((motion.at(np.array([t_end]))[0][0] - phi0) / dphi)) + 1
         t = np.linspace(run.time[0], t_end, max(n, 2))
-        omega, eps, phi = speed(t), speed(t, 1), phi0 + angle(t) - angle(run.time[0])
+        phi, omega, eps = motion.at(t)
         stop = phi <= phi0 + 2 * math.pi * run.revolutions
         t, omega, eps, phi = t[stop], omega[stop], eps[stop], phi[stop]
     else:
@@ -327,26 +326,16 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     names = list(output_columns(scene))
     traj = {name: rows[:, j].copy() for j, name in enumerate(names) if name not in ("M_drive", "W_drive")}
     traj["M_drive"] = drive
-    _work_columns(traj, len(scene.friction.pairs))
-    solver = {"method": "prescribed", "rtol": 0.0, "atol": 0.0, "nfev": int(phi.size),
-              "nsteps": 0, "nreject": 0, "wall_s": time.perf_counter() - t0,
-              "compile_s": compile_s, "ambiguous_samples": int(np.count_nonzero(n_ok > 1)),
-              "inconsistent_samples": int(np.count_nonzero(n_ok == 0))}
+    sv = scene.solver
+    works, counts = work_columns(model, motion, t, phi, names, len(scene.friction.pairs),
+                                 sv.rtol, sv.atol)
+    traj.update(works)
+    solver = {"method": "prescribed", "rtol": sv.rtol, "atol": sv.atol,
+              "nfev": int(phi.size) + counts["quadrature_evaluations"], "nsteps": 0,
+              "nreject": 0, "wall_s": time.perf_counter() - t0, "compile_s": compile_s,
+              "ambiguous_samples": int(np.count_nonzero(n_ok > 1)),
+              "inconsistent_samples": int(np.count_nonzero(n_ok == 0)), **counts}
     return RunData(traj, {}, solver)
-
-
-def _work_columns(traj: dict, n_pairs: int) -> None:
-    """Work integrals of a prescribed run, by the trapezoidal rule over its samples [J]
-    (a dynamic run integrates them with the motion instead). Written out (the arithmetic of
-    scipy's ``cumulative_trapezoid``) because importing scipy.integrate (which imports
-    scipy.linalg and scipy.optimize) costs a noticeable part of a warm ``transient run``'s
-    process wall."""
-    t, w = traj["t"], traj["omega"]
-    dt = np.diff(t)
-    for name, power in (("W_gas", traj["M_gas"] * w), ("W_load", traj["M_load"] * w),
-                        ("W_starter", traj["M_starter"] * w), ("W_drive", traj["M_drive"] * w),
-                        *((f"W_loss_{k + 1}", traj[f"P_loss_{k + 1}"]) for k in range(n_pairs))):
-        traj[name] = np.concatenate([[0.0], np.cumsum(dt * (power[1:] + power[:-1]) / 2.0)])
 
 
 def integrate(scene, on_block=None, progress=None, keep=True, start=None) -> RunData:
@@ -484,7 +473,8 @@ def _in_memory(scene, progress) -> Result:
     data = integrate(scene, progress=progress)
     summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
                else {})
-    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary)
+    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary,
+                           (scene.source_file, scene.source_text))
     if res.status != FINISHED:
         raise SimulationError(f"{data.message} (status = {res.status})", res)
     return res
@@ -502,7 +492,8 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         raise SceneError("solver.method", f"{scene.solver.method!r}: only runs of the compiled "
                          f"stepper (DOP853, DOPRI5) can be resumed; run it again with --force")
     writer = ResultWriter(path, scene.name, to_toml(scene), output_columns(scene),
-                          EVENT_NAMES, force=force, resume=resume)
+                          EVENT_NAMES, force=force, resume=resume,
+                          scene_source=(scene.source_file, scene.source_text))
     writes = _WriteBehind()
     data = None
     try:

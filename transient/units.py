@@ -9,5 +9,6 @@ SUFFIXES: dict[str, dict[str, float]] = {
     "speed": {"rpm": pi / 30.0},
     "length": {"mm": 1e-3},
     "pressure": {"bar": 1e5, "MPa": 1e6},
+    "force": {"kN": 1e3},
 }
 ALL_SUFFIXES = sorted({s for kind in SUFFIXES.values() for s in kind})

@@ -37,6 +37,7 @@ SELECTORS = ("type", "model", "mode")
 EXTRA_TABLES = (
     ("gas", {"model": "table", "phi_deg": [0.0, 720.0], "p_bar": [1.0, 1.0]}),
     ("gas", {"model": "table", "file": "diagram.csv"}),
+    ("gas", {"model": "table", "phi_deg": [0.0, 360.0], "force": [0.0, 1.0]}),
     ("run", {"mode": "prescribed-speed", "t_end": 1.0, "time": [0.0, 1.0],
              "speed_table_rpm": [1000, 1000]}),
     ("load", {"table": {"speed_rpm": [0.0, 1000.0], "torque": [0.0, 1.0]}}),
@@ -48,7 +49,7 @@ EXTRA_TABLES = (
 TYPES = {"number": "number", "numbers": "list of numbers", "integer": "whole number",
          "integers": "list of whole numbers", "flag": "true or false", "string": "string",
          "strings": "list of strings", "sub": "table"}
-SI_UNIT = {"angle": "rad", "speed": "rad/s", "length": "m", "pressure": "Pa"}
+SI_UNIT = {"angle": "rad", "speed": "rad/s", "length": "m", "pressure": "Pa", "force": "N"}
 
 
 class _Missing(Exception):

@@ -558,12 +558,16 @@ def test_prescribed_speed_run_writes_drive_torque(tmp_path, capsys):
     mean_gas = np.trapezoid(tr["M_gas"], tr["phi"]) / cycle
     assert mean_drive < 0
     assert mean_drive == pytest.approx(-mean_gas, rel=1e-9)
-    assert res.analysis["mean_drive_torque_last_cycle"][0] == pytest.approx(mean_drive, rel=1e-9)
-    # the work columns (written out for start-up time) are scipy's cumulative trapezoid
-    from scipy.integrate import cumulative_trapezoid
-    for name, torque in (("W_gas", "M_gas"), ("W_drive", "M_drive")):
-        np.testing.assert_array_equal(
-            tr[name], cumulative_trapezoid(tr[torque] * tr["omega"], tr["t"], initial=0.0))
+    # the summary's mean is the drive's work over the cycle (the work columns are integrated to
+    # the solver's tolerance: tests/validation/test_prescribed_work.py), which the trapezoid
+    # over the 5° samples misses by the pressure's corners between them
+    W_drive = tr["W_drive"][-1] - tr["W_drive"][0]
+    assert res.analysis["mean_drive_torque_last_cycle"][0] == pytest.approx(W_drive / cycle,
+                                                                           rel=1e-12)
+    assert W_drive / cycle == pytest.approx(mean_drive, rel=1e-2)
+    kinetic = 0.5 * tr["J"] * tr["omega"] ** 2
+    balance = tr["W_drive"] + tr["W_gas"] + tr["W_load"] - (kinetic - kinetic[0])
+    assert np.abs(balance).max() <= 1e-9 * np.abs(tr["W_gas"]).max()
 
 
 # ----------------------------------------------------------------------------------------------

@@ -191,8 +191,8 @@ CASES = [
      "held at −P/ω_min (finite at rest); give 'generator_min_speed' or "
      "'generator_min_speed_rpm' > 0"),
     ("missing-csv-columns", table_gas('file = "empty.csv"\n'),
-     "gas.file: empty.csv: needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, "
-     "p_MPa, p_Pa); header is []"),
+     "gas.file: empty.csv: needs an angle column (phi_deg, phi) and a pressure or force column "
+     "(p, p_bar, p_MPa, p_Pa, force, force_N, force_kN); header is []"),
     ("csv-text-row", table_gas('file = "text.csv"\n'),
      "gas.file: text.csv: line 3, column phi_deg: 'abc' is not a number"),
     ("csv-not-utf8", table_gas('file = "latin1.csv"\n'),  # was a bug: a traceback

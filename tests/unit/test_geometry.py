@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from transient.assemble import cycle_figures
 from transient.cli import main
 from transient.core import crank_slider as cs_core
 from transient.mechanisms import articulated as art
@@ -209,15 +210,16 @@ def guide_table() -> dict[str, str]:
 @pytest.mark.parametrize("case", ["gots_diesel_4400", "radial_5cyl", "swash_plate_4cyl"])
 def test_check_prints_the_geometry_under_the_api_names_the_guide_lists(case, capsys):
     """``transient check`` prints every figure of ``scene.geometry()`` (and the stored figures
-    of ``analysis_summary()``) as ``name = value unit``, with the API's name and unit, and the
-    user guide's table names every geometry figure with that unit."""
+    of ``analysis_summary()``, and the gas cycle's of ``cycle_figures``) as ``name = value
+    unit``, with the API's name and unit, and the user guide's table names every geometry figure
+    with that unit."""
     path = CASES / f"{case}.toml"
     assert main(["check", str(path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     printed = dict(line.strip().split(" = ") for line in lines[1:])
     scene = load_scene(path)
     geometry = scene.geometry()
-    expected = {**geometry, **scene.mechanism.analysis_summary()}
+    expected = {**geometry, **scene.mechanism.analysis_summary(), **cycle_figures(scene)}
     assert printed == {name: f"{value:.9g} {unit}" for name, (value, unit) in expected.items()}
     assert {"stroke", "swept_volume", "displacement"} <= set(geometry)
     table = guide_table()

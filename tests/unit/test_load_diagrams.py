@@ -210,8 +210,7 @@ def test_crank_slider_diagrams(gots):
     rays, sums = d.crankpin_wear
     np.testing.assert_allclose(sums, _wear_by_hand(np.arctan2(d.crankpin_y, d.crankpin_x),
                                                    full.R[1][mask], w), rtol=1e-12)
-    # in line: running torques and main journals, the most loaded one by its peak
-    assert d.inline
+    # running torques and main journals, the most loaded one by its peak
     mj = main_journal_loads(scene.mechanism, full, traj["omega"], traj["epsilon"])
     peaks = [np.hypot(mj.x[j][mask], mj.y[j][mask]).max() for j in range(mj.x.shape[0])]
     assert d.most_loaded == int(np.argmax(peaks))
@@ -229,15 +228,19 @@ def test_crank_slider_diagrams(gots):
 
 
 def test_crank_slider_diagrams_of_a_v_engine(gots):
-    """Bank angles that differ: no main journals nor running torques (in-line only)."""
+    """Bank angles that differ (a throw per cylinder): main journals and running torques too,
+    the journals those of :func:`main_journal_loads` (``tests/unit/test_v_engines.py`` checks
+    them against an independent computation)."""
     from transient.analysis.loads.diagrams import crank_slider_diagrams
 
     scene, traj = gots
     v = replace(scene, mechanism=replace(scene.mechanism, bank_angles=(0.0, 0.5, 0.0)))
     d = crank_slider_diagrams(v, traj, cylinder=1)
-    assert not d.inline
-    assert d.main_journals is None and d.journal_wear is None and d.most_loaded is None
-    assert d.crankpin_wear[1].shape == (36,)
+    mj = main_journal_loads(v.mechanism, d.loads, d.window.columns["omega"],
+                            d.window.columns["epsilon"])
+    np.testing.assert_array_equal(d.main_journals.x, mj.x)
+    assert d.journal_torques.shape == (4, d.window.samples)
+    assert d.crankpin_wear[1].shape == (36,) and d.journal_wear[1].shape == (36,)
 
 
 def test_crank_slider_diagrams_refuse(gots):

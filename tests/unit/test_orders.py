@@ -25,9 +25,9 @@ import pytest
 from scipy.integrate import quad
 
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.analysis.orders import (odd_harmonic_report, order_spectrum, piston_acceleration,
-                                       piston_inertia_force, resample_angle,
-                                       rod_angular_acceleration, to_angle_grid)
+from transient.analysis.orders import (cycle_spectra, odd_harmonic_report, order_spectrum,
+                                       piston_acceleration, piston_inertia_force,
+                                       resample_angle, rod_angular_acceleration, to_angle_grid)
 
 R, L = 0.047, 0.148  # cases/gots_diesel_4400.toml (Gots App. 1)
 LAM = R / L
@@ -137,6 +137,101 @@ def test_cut_keeps_a_corner_out_and_a_repeated_angle_splits_a_jump():
     for d in (dj, None):
         err = np.abs(resample_angle(xj, vj, g, d) - exact).max()
         assert err <= 2 * 5 * h ** 4 * M4 / 384
+
+
+def on_output_grid(cycles: int, extra: int = 36, per_rev: int = 72):
+    """Sample angles j·Δφ as a crank-angle run writes them, past the end of ``cycles`` turns,
+    and the breakpoint at that end as the stepper computes it (k·Φ + 0): for these counts the
+    sample there is one ulp below it."""
+    phi = np.arange(per_rev * cycles + extra + 1) * (TWO_PI / per_rev)
+    end = cycles * TWO_PI
+    k = per_rev * cycles
+    assert phi[k] < end and phi[k + 1] > end and end - phi[k] <= 2 * np.spacing(end)
+    return phi, k, end
+
+
+@pytest.mark.parametrize("dv", [True, False], ids=["hermite", "spline"])
+@pytest.mark.parametrize("where", [-1, 0, 1], ids=["ulp-below", "on", "ulp-above"])
+def test_a_sample_within_rounding_of_a_breakpoint_is_on_it(where, dv):
+    """v = f(φ) + B·max(φ − c, 0)²: its second derivative jumps at the breakpoint c, each side
+    is smooth. The sample at c, an ulp off it to either side as the output grid rounds, counts
+    as on c: the grid point c takes it (to rounding, from either side) and the points around
+    it stay within the interpolant's bound of the side they are on (h⁴/384·M₄ Hermite,
+    2·(5/384)·h⁴·M₄ spline, M₄ the smooth part's), never extrapolated across c."""
+    phi, k, c = on_output_grid(13)
+    phi[k] = {-1: np.nextafter(c, 0.0), 0: c, 1: np.nextafter(c, np.inf)}[where]
+    B = 40.0
+
+    def v(x):
+        return f(x) + B * np.maximum(x - c, 0.0) ** 2
+
+    def dvdx(x):
+        return df(x) + 2.0 * B * np.maximum(x - c, 0.0)
+
+    h = TWO_PI / 72
+    g = np.linspace(c - 3 * h, c + 3 * h, 601)
+    bound = h ** 4 * M4 / 384 if dv else 2 * 5 * h ** 4 * M4 / 384
+    d = dvdx(phi) if dv else None
+    for side in ("left", "right"):
+        at_c = resample_angle(phi, v(phi), np.array([c]), d, cuts=[c], side=side)[0]
+        assert abs(at_c - v(c)) <= 1e-12, (side, at_c - v(c))
+        err = np.abs(resample_angle(phi, v(phi), g, d, cuts=[c], side=side) - v(g)).max()
+        print(f"{side}: at c {at_c - v(c):.1e}, around it {err:.2e} (bound {bound:.2e})")
+        assert err <= bound
+
+
+@pytest.mark.parametrize("dv", [True, False], ids=["hermite", "spline"])
+def test_a_jump_on_a_breakpoint_is_taken_from_the_side_asked(dv):
+    """A jump J (value and slope) at c written as two samples an ulp either side of it (the left
+    limit, then the right): ``side="left"`` at c gives the left function's value there and
+    ``side="right"`` the right one's, each to rounding; the closing point of a whole-cycle grid
+    ending on c (``to_angle_grid(closed=True)``) is the left limit, its points after c the
+    right function, and none is taken across c."""
+    phi, k, c = on_output_grid(13)
+    phi = np.concatenate([phi[:k], [np.nextafter(c, 0.0), np.nextafter(c, np.inf)],
+                          phi[k + 1:]])
+    J, S = 0.5, 2.0
+    right = phi > c
+    v = f(phi) + np.where(right, J + S * (phi - c), 0.0)
+    d = df(phi) + np.where(right, S, 0.0) if dv else None
+    h = TWO_PI / 72
+    bound = h ** 4 * M4 / 384 if dv else 2 * 5 * h ** 4 * M4 / 384
+    left_c = resample_angle(phi, v, np.array([c]), d, cuts=[c], side="left")[0]
+    right_c = resample_angle(phi, v, np.array([c]), d, cuts=[c], side="right")[0]
+    assert abs(left_c - f(c)) <= 1e-12 and abs(right_c - (f(c) + J)) <= 1e-12
+    for side in ("left", "right"):
+        g = np.linspace(c - 3 * h, c + 3 * h, 601)
+        g = g[g != c]
+        exact = f(g) + np.where(g > c, J + S * (g - c), 0.0)
+        err = np.abs(resample_angle(phi, v, g, d, cuts=[c], side=side) - exact).max()
+        assert err <= bound, (side, err)
+    names = {"phi": phi, "v": v}
+    derivs = {"v": d} if dv else {}
+    grid, cols = to_angle_grid(names, ["v"], 720, TWO_PI, cycles=1, cuts=[c], closed=True,
+                               derivatives=derivs)
+    assert grid[-1] == c and abs(cols["v"][-1] - f(c)) <= 1e-12
+
+
+def test_closing_sample_on_a_breakpoint_adds_no_false_orders():
+    """ω = ω₀(1 + a cos 2φ), even orders only, sampled every 5° as a crank-angle run writes it
+    (j·Δφ), with breakpoints every 30° as the stepper computes them (k·2π + m·π/6) and the
+    data going on past the last whole cycle, whose end sample is an ulp below its breakpoint:
+    with the ramp detrend the odd orders stay at rounding (≤ 1e-10 of order 2), the closing
+    point being the cycle's own left limit, not an extrapolation from the next cycle's side."""
+    phi, _, end = on_output_grid(13)
+    omega, eps, t = prescribed_motion(2.0, phi)
+    cuts = (np.arange(14)[:, None] * TWO_PI + np.arange(12)[None, :] * (TWO_PI / 12)).ravel()
+    assert end in cuts
+    traj = {"t": t, "phi": phi, "omega": omega, "epsilon": eps}
+    _, spec = cycle_spectra(traj, "omega", 720, TWO_PI, cuts=cuts, detrend="ramp")
+    amp = spec.amplitude[-1]
+    odd = np.arange(amp.size) % 2 == 1
+    print(f"order 2 {amp[2]:.6g} rad/s, odd orders ≤ {amp[odd].max():.2e} rad/s, last drift "
+          f"{spec.drift[-1]:.2e}")
+    h = TWO_PI / 72  # the grid's 10 points per sample interval: Hermite's h⁴/384·|ω⁽⁴⁾|
+    assert abs(amp[2] - W0 * A) <= h ** 4 / 384 * 16 * W0 * A
+    assert amp[odd].max() <= 1e-10 * amp[2]
+    assert abs(spec.drift[-1]) <= 1e-12 * W0
 
 
 # ------------------------------------------------------------------------------------------------

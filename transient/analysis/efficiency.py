@@ -6,7 +6,10 @@ instantaneous ratio whose denominator crosses zero):
 * ``eta_mech_work`` — the ratio of the work integrals over the same whole cycles,
   η = W_out / W_in, W_in = ∫(M_gas + M_starter) ω dt, W_out = −∫(M_load + M_drive) ω dt. This is
   the well-posed form: in steady state the kinetic energy returns to its value, so
-  W_in = W_out + Σ W_loss,k and η = 1 − Σ W_loss,k / W_in.
+  W_in = W_out + Σ W_loss,k and η = 1 − Σ W_loss,k / W_in. A **driven machine** (a compressor, a
+  motored engine), where both are negative, takes its power the other way, from the load or the
+  drive (a motor) into its gas: there W_in = ∫(M_load + M_drive) ω dt and
+  W_out = −∫(M_gas + M_starter) ω dt, so that η = W_gas/W_motor, and ``driven`` is stored (1).
 * ``eta_mech_printed`` — (30) as printed, the time average of the instantaneous ratio
   P_out/P_in. P_in crosses zero twice per compression stroke, so the ratio is singular there; the
   samples with |P_in| below ``guard`` × mean |P_in| are left out and the share of the time left out
@@ -147,8 +150,10 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         return {}
     n_pairs = len(scene.friction.pairs)
     a, b, n_cyc = window
-    W_in = _delta(traj, "W_gas", a, b) + _delta(traj, "W_starter", a, b)
-    W_out = -(_delta(traj, "W_load", a, b) + _delta(traj, "W_drive", a, b))
+    W_gas = _delta(traj, "W_gas", a, b) + _delta(traj, "W_starter", a, b)
+    W_shaft = -(_delta(traj, "W_load", a, b) + _delta(traj, "W_drive", a, b))
+    driven = W_gas < 0.0 and W_shaft < 0.0  # (the power flows from the load or drive to the gas)
+    W_in, W_out = (-W_shaft, -W_gas) if driven else (W_gas, W_shaft)
     losses = [_delta(traj, f"W_loss_{k + 1}", a, b) for k in range(n_pairs)]
     dK = _delta({"phi": traj["phi"], "K": 0.5 * traj["J"] * traj["omega"] ** 2}, "K", a, b)
     v_d = displacement(scene.mechanism)
@@ -161,16 +166,18 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         "energy_balance_residual": ((dK - (W_in - W_out - sum(losses))) / max(abs(W_in), 1e-300),
                                     "1"),
         "displacement": (v_d, "m^3"),
-        "imep": (W_in / n_cyc / v_d, "Pa"),
-        "bmep": (W_out / n_cyc / v_d, "Pa"),
+        "imep": (W_gas / n_cyc / v_d, "Pa"),
+        "bmep": (W_shaft / n_cyc / v_d, "Pa"),
         "fmep": (sum(losses) / n_cyc / v_d, "Pa"),
     }
+    if driven:
+        out["driven"] = (1.0, "1")
     if events is not None and n_pairs:
         switches = np.asarray(events.get("pair_mode", np.zeros((0, 2))))
         inside = (switches[:, 1] >= a) & (switches[:, 1] < b) if switches.size else []
         out["pair_mode_switches_per_cycle"] = (float(np.sum(inside)) / n_cyc, "1")
     sel = (traj["phi"] >= a - 1e-12) & (traj["phi"] <= b + 1e-12)
-    out.update(_printed(traj, sel, guard))
+    out.update(_printed(traj, sel, guard, driven))
     t, w = traj["t"][sel], traj["omega"][sel]
     for k in range(n_pairs):
         P = traj[f"S_{k + 1}"][sel] * w
@@ -234,12 +241,15 @@ def _time_share(t, flag) -> float:
     return float(np.sum(dt[flag]) / np.sum(dt))
 
 
-def _printed(traj, sel, guard: float) -> dict[str, tuple[float, str]]:
-    """(30) as printed: the time average of P_out/P_in, leaving out |P_in| < guard·mean|P_in|."""
+def _printed(traj, sel, guard: float, driven: bool = False) -> dict[str, tuple[float, str]]:
+    """(30) as printed: the time average of P_out/P_in, leaving out |P_in| < guard·mean|P_in|
+    (``driven``: the power in from the load and drive, out to the gas)."""
     w = traj["omega"][sel]
     drive = traj["M_drive"][sel] if "M_drive" in traj else 0.0
     P_in = (traj["M_gas"][sel] + traj["M_starter"][sel]) * w
     P_out = -(traj["M_load"][sel] + drive) * w
+    if driven:
+        P_in, P_out = -P_out, -P_in
     keep = np.abs(P_in) > guard * np.mean(np.abs(P_in))  # (none where no power comes in)
     dt = np.gradient(traj["t"][sel]) if w.size > 1 else np.ones(1)
     if not keep.any():

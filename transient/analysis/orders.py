@@ -92,22 +92,33 @@ _ORDER_TOL = 1e-9
 # Resampling onto a crank-angle grid
 
 
-def _pieces(x: NDArray[np.float64], cuts: NDArray[np.float64]) -> list[tuple[int, int, float]]:
+def _coincidence(x: NDArray[np.float64], h: float) -> float:
+    """Distance [rad] within which two angles of a run are one point: 1e-9 of its sample spacing
+    ``h`` (an error of at most 1e-9·h·|dv/dφ| where a sample is taken for the point), and at
+    least 16 ulp of its largest angle, for the rounding of angles computed two ways (an output
+    sample j·Δφ and a breakpoint k·Φ + φ_b)."""
+    return max(1e-9 * h, 16.0 * float(np.spacing(np.max(np.abs(x)))))
+
+
+def _pieces(x: NDArray[np.float64], cuts: NDArray[np.float64], tol: float
+            ) -> list[tuple[int, int, float]]:
     """Split the non-decreasing abscissae ``x`` into runs that are interpolated on their own.
 
     A run ends at a repeated abscissa (a sample written on both sides of a jump: the left run
-    takes the first, the right run the second) and at a cut (a corner of the signal): a cut
-    between two samples ends one run there and starts the next after it; a cut on a sample makes
-    that sample the last of one run and the first of the next. Returns (start, stop, left
-    boundary) per run; a grid point belongs to the last run whose left boundary is ≤ it.
+    takes the first, the right run the second) and at a cut (a corner of the signal). Samples
+    within ``tol`` of a cut are on it: one such sample is the last of one run and the first of
+    the next (the signal is continuous there, so it holds both sides' value); two or more split as
+    a repeated abscissa does; with none, one run ends at the last sample before the cut and the
+    next starts at the first after it. Returns (start, stop, left boundary) per run; a grid point
+    belongs to the last run whose left boundary is ≤ it (see :func:`_run_of`).
     """
     breaks = [(float(x[i + 1]), i + 1, i + 1) for i in np.nonzero(np.diff(x) == 0.0)[0]]
     for c in cuts:
-        k = int(np.searchsorted(x, c, side="left"))  # first sample ≥ c
-        if 0 < k < x.size - 1 and x[k] == c and x[k + 1] > c and x[k - 1] < c:
-            breaks.append((float(c), k + 1, k))  # on a sample: shared by both runs
-        elif 0 < k < x.size and x[k] > c:
-            breaks.append((float(c), k, k))
+        lo = int(np.searchsorted(x, c - tol, side="left"))  # first sample on or after the cut
+        hi = int(np.searchsorted(x, c + tol, side="right"))  # first sample after it
+        if lo == 0 or hi == x.size:
+            continue  # nothing on one side of it: the data end there
+        breaks.append((float(c), lo + 1 if hi > lo else lo, max(lo, hi - 1)))
     breaks.sort()
     out, start, left = [], 0, -math.inf
     for bound, stop, nxt in breaks:
@@ -117,6 +128,18 @@ def _pieces(x: NDArray[np.float64], cuts: NDArray[np.float64]) -> list[tuple[int
         left = bound
     out.append((start, x.size, left))
     return out
+
+
+def _run_of(lefts: NDArray[np.float64], grid: NDArray[np.float64], tol: float, side: str
+            ) -> NDArray[np.intp]:
+    """Index of the run (left boundaries ``lefts``) each grid point is taken from: a point within
+    ``tol`` of a boundary is on it, and takes the run after it (``side="right"``) or the one
+    before (``"left"``)."""
+    if side == "right":
+        return np.searchsorted(lefts, grid + tol, side="right") - 1
+    if side == "left":
+        return np.searchsorted(lefts, grid - tol, side="left") - 1
+    raise ValueError(f"side {side!r}: allowed 'left', 'right'")
 
 
 def _hermite(x, v, d, g):
@@ -141,7 +164,8 @@ def _spline(x, v, g):
 
 
 def resample_angle(phi: ArrayLike, values: ArrayLike, grid: ArrayLike,
-                   dvalues: ArrayLike | None = None, cuts: ArrayLike = ()) -> NDArray[np.float64]:
+                   dvalues: ArrayLike | None = None, cuts: ArrayLike = (), side: str = "right"
+                   ) -> NDArray[np.float64]:
     """Values of a trajectory column at the crank angles ``grid``.
 
     Parameters
@@ -160,10 +184,18 @@ def resample_angle(phi: ArrayLike, values: ArrayLike, grid: ArrayLike,
         Angles [rad] at which the signal has a corner or a jump (the run's breakpoints, e.g.
         ``data.events["breakpoint"][:, 1]``). No interval is interpolated across a cut: grid points
         between the last sample before it and the cut are extrapolated from the samples before,
-        those after from the samples after. A cut on a sample ends one piece and starts the next
-        there (the spline sides are then independent; the Hermite interpolant has only the one
-        derivative that sample holds, so a corner exactly on a sample keeps an O(h·jump) error
-        on one side).
+        those after from the samples after. A sample within rounding of a cut is on it (a
+        crank-angle run's output sample j·Δφ falls an ulp or two to either side of a breakpoint
+        k·Φ + φ_b that it equals in exact arithmetic): it ends one piece and starts the next
+        (the spline sides are then independent; the Hermite interpolant has only the one
+        derivative that sample holds, so where dv/dφ jumps on a sample one side keeps an
+        O(h·jump) error, and a value that jumps there needs the sample written twice, left and
+        right, as a repeated angle).
+    side : ``"right"`` or ``"left"``
+        Which limit a grid point on a cut or on a repeated angle (within rounding) takes: the
+        piece after it (default: a point that starts an interval, as a cycle's first point) or
+        the piece before it (a point that ends one, as a cycle's end). A grid point is never
+        taken from the piece on its other side.
 
     Returns
     -------
@@ -173,7 +205,8 @@ def resample_angle(phi: ArrayLike, values: ArrayLike, grid: ArrayLike,
     -----
     When every grid angle coincides with a sample (a run integrated in crank angle whose output
     spacing divides the grid's, from the same origin; coincidence within 1e-9 of the sample
-    spacing, which leaves an error ≤ 1e-9·h·|dv/dφ|) the samples are returned: no interpolation.
+    spacing or 16 ulp of the angles, which leaves an error ≤ that times |dv/dφ|) the samples are
+    returned: no interpolation. The same distance puts a sample on a cut.
 
     Accuracy otherwise, h the largest sample spacing near the grid point, v⁽⁴⁾ = d⁴v/dφ⁴:
 
@@ -206,20 +239,16 @@ def resample_angle(phi: ArrayLike, values: ArrayLike, grid: ArrayLike,
     if d is not None and d.shape != phi.shape:
         raise ValueError(f"dvalues must have the shape of phi {phi.shape}, got {d.shape}")
 
-    # Coinciding grids: take the samples themselves.
-    k = np.clip(np.searchsorted(phi, grid), 0, phi.size - 1)
-    k_left = np.clip(k - 1, 0, phi.size - 1)
-    near = np.where(np.abs(phi[k_left] - grid) < np.abs(phi[k] - grid), k_left, k)
-    h = step[step > 0].min() if np.any(step > 0) else 1.0
-    if np.all(np.abs(phi[near] - grid) <= 1e-9 * h):
-        # at a repeated angle take the later sample (the right-hand limit), as the interpolants do
-        last = np.searchsorted(phi, phi[near], side="right") - 1
-        return values[last].copy()
+    tol = _coincidence(phi, step[step > 0].min() if np.any(step > 0) else 1.0)
+    # Coinciding grids: take the samples themselves; of a repeated angle, the side's (the last
+    # sample at or before each point for "right", the first at or after it for "left").
+    near = np.clip(_run_of(phi, grid, tol, side) + (side == "left"), 0, phi.size - 1)
+    if np.all(np.abs(phi[near] - grid) <= tol):
+        return values[near].copy()
 
     out = np.empty(grid.shape)
-    pieces = _pieces(phi, np.sort(np.asarray(cuts, dtype=float).ravel()))
-    lefts = np.array([p[2] for p in pieces])
-    which = np.searchsorted(lefts, grid, side="right") - 1
+    pieces = _pieces(phi, np.sort(np.asarray(cuts, dtype=float).ravel()), tol)
+    which = _run_of(np.array([p[2] for p in pieces]), grid, tol, side)
     for j, (a, b, _) in enumerate(pieces):
         sel = which == j
         if not np.any(sel):
@@ -281,7 +310,8 @@ def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
         not-a-knot spline.
     closed : bool
         Add one point, the end of the last cycle (for the ramp of :func:`order_spectrum`'s
-        ``detrend``: its ``end``).
+        ``detrend``: its ``end``), taken from inside that cycle (``side="left"`` of
+        :func:`resample_angle`); every other point starts an interval and takes the right side.
 
     Returns
     -------
@@ -323,7 +353,9 @@ def to_angle_grid(traj: Mapping[str, NDArray[np.float64]], names: Sequence[str],
             d = np.asarray(traj["epsilon"], dtype=float)[part] / v
         else:
             d = None
-        out[name] = resample_angle(phi, v, grid, d, cuts)
+        out[name] = resample_angle(phi, v, grid[:grid.size - int(closed)], d, cuts)
+        if closed:  # the last cycle's end: the limit from inside that cycle
+            out[name] = np.append(out[name], resample_angle(phi, v, grid[-1:], d, cuts, "left"))
     return grid, out
 
 
@@ -688,8 +720,8 @@ def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float = 0.0,
     phi, w = np.asarray(traj["phi"], float)[part], np.asarray(traj["omega"], float)[part]
     eps = np.asarray(traj["epsilon"], float)[part]
     ends = grid[::n] + cycle
-    t_end = resample_angle(phi, np.asarray(traj["t"], float)[part], ends, 1.0 / w, cuts)
-    w_end = resample_angle(phi, w, ends, eps / w, cuts)
+    t_end = resample_angle(phi, np.asarray(traj["t"], float)[part], ends, 1.0 / w, cuts, "left")
+    w_end = resample_angle(phi, w, ends, eps / w, cuts, "left")
     t_start = cols["t"][::n]
     omega_mean = cycle / (t_end - t_start)
     wc = cols["omega"].reshape(n_cyc, n)
@@ -705,7 +737,7 @@ def odd_harmonic_report(traj: Mapping[str, NDArray[np.float64]], r: float = 0.0,
     spec_c = order_spectrum(W_const, n, cycle)
     # the last cycle's drift from its own end (the next cycle's start is not on the grid)
     drift = spec.drift.copy()
-    eps_end = resample_angle(phi, eps, ends[-1:], None, cuts)
+    eps_end = resample_angle(phi, eps, ends[-1:], None, cuts, "left")
     ds_e, dds_e = kinematics(ends[-1:])
     drift[-1] = float(w_end[-1] ** 2 * dds_e[0] + eps_end[0] * ds_e[0] - W[-n])
     return OddHarmonicReport(spec.orders, grid[::n].copy(), omega_mean, delta, spec.coef,

@@ -23,9 +23,10 @@ Stored names (n: cylinders, N: ``samples_per_cycle``, C: whole cycles, K: orders
   ``loads_N``, ``loads_S``, ``loads_K``, ``loads_T`` (Gots (34)–(37)), the crankpin load
   ``loads_R_K``, ``loads_R_T``, ``loads_R`` ((40)/(41) as vectors), each (n, N) [N];
   ``loads_torque`` (n, N) and ``loads_engine_torque`` (N,) [N m]; ``loads_crankpin_R_max`` (n,)
-  [N]; in-line engines also the running torques ``loads_journal_torque`` (n+1, N),
-  ``loads_crankpin_torque`` (n, N) [N m] (§2.8) and the main journals by (58), ``loads_main_x``,
-  ``loads_main_y`` (n+1, N) and ``loads_main_R_max`` (n+1,) [N] (frame of crank 1).
+  [N]; the running torques ``loads_journal_torque`` (m+1, N), ``loads_crankpin_torque`` (m, N)
+  [N m] (§2.8) and the main journals by the split beam of (58), ``loads_main_x``,
+  ``loads_main_y`` (m+1, N) and ``loads_main_R_max`` (m+1,) [N] (frame of crank 1), m the
+  throws (n, or n/2 where two rods share a crankpin).
 * ``loads = true``, articulated (radial, V; :mod:`transient.analysis.loads.articulated`), the
   same grid and ``loads_phi``: per cylinder ``loads_P``, ``loads_N``, ``loads_S`` (n, N) [N] and
   ``loads_torque`` = P u (n, N) [N m]; per row (its crankpin, ρ rows) ``loads_K``, ``loads_T``,
@@ -168,22 +169,21 @@ def _stored_record(ld, grid, forces) -> dict[str, tuple[Any, str]]:
 
 
 def _stored_crank_slider_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
-    """Crank-slider (:mod:`transient.analysis.loads.crank_slider`): per cylinder and crankpin; an
-    in-line engine also its running torques (§2.8) and main journals by (58)."""
+    """Crank-slider (:mod:`transient.analysis.loads.crank_slider`): per cylinder and crankpin,
+    the running torques (§2.8) and the main journals by the split beam of (58)."""
     from .loads.crank_slider import loads_from_trajectory, main_journal_loads, running_torques
 
     mech = scene.mechanism
     ld = loads_from_trajectory(scene, traj)
     out = _stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R"))
     out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
-    if np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12:  # in-line: (58), §2.8
-        journals, pins = running_torques(mech, ld)
-        mj = main_journal_loads(mech, ld, traj["omega"], traj["epsilon"])
-        out["loads_journal_torque"] = (journals, "N m")
-        out["loads_crankpin_torque"] = (pins, "N m")
-        out["loads_main_x"] = (mj.x, "N")
-        out["loads_main_y"] = (mj.y, "N")
-        out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
+    journals, pins = running_torques(mech, ld)
+    mj = main_journal_loads(mech, ld, traj["omega"], traj["epsilon"])
+    out["loads_journal_torque"] = (journals, "N m")
+    out["loads_crankpin_torque"] = (pins, "N m")
+    out["loads_main_x"] = (mj.x, "N")
+    out["loads_main_y"] = (mj.y, "N")
+    out["loads_main_R_max"] = (mj.magnitude.max(axis=1), "N")
     return out
 
 

@@ -7,7 +7,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .efficiency import mechanical_efficiency
-from .irregularity import cycle_means, fluctuation, last_cycle_ranges, steady_state_time
+from .irregularity import (cycle_boundaries, cycle_means, fluctuation, last_cycle_ranges,
+                           steady_state_time)
+from .orders import resample_angle
 from .requested import requested_analyses
 from .transient_response import load_step_times, run_response
 
@@ -44,9 +46,10 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
         out.update(response)
     out.update(last_cycle_ranges(traj, cycle))
     if "M_drive" in traj and means.size:
-        last = (t >= ends[-1] - cycle / means[-1]) & (t <= ends[-1])
-        out["mean_drive_torque_last_cycle"] = (float(np.trapezoid(traj["M_drive"][last],
-                                                                  phi[last]) / cycle), "N m")
+        # the drive's work over the last cycle (dW_drive/dφ = M_drive), over the cycle angle
+        marks = cycle_boundaries(t, phi, cycle, phi0)[1][-2:]
+        work = resample_angle(phi, traj["W_drive"], marks, traj["M_drive"])
+        out["mean_drive_torque_last_cycle"] = (float(work[1] - work[0]) / cycle, "N m")
     if scene.gas.model != "none":
         out.update(mechanical_efficiency(scene, traj, events))
     out.update(stuck)

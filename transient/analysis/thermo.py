@@ -83,10 +83,12 @@ MFB_LEVELS = (0.1, 0.5, 0.9)
 
 
 def clearance(scene) -> float:
-    """V_c [m³] of the scene's compression ratio (the cycle models), else 0: a gas table gives no
-    clearance, and V is then the swept part A·s only (the indicated work does not depend on it)."""
-    ratio = getattr(scene.gas, "compression_ratio", 0.0)
-    return scene.mechanism.swept_volume() / (ratio - 1.0) if ratio > 1.0 else 0.0
+    """V_c [m³] of the scene's cycle model (:func:`transient.assemble.clearance_volume`), else 0:
+    a gas table gives no clearance, and V is then the swept part A·s only (the indicated work
+    does not depend on it)."""
+    from ..assemble import clearance_volume
+
+    return clearance_volume(scene)
 
 
 @dataclass(frozen=True)
@@ -219,13 +221,14 @@ def _corner_cuts(scene, phi_lo: float, phi_hi: float, events) -> list[NDArray[np
     return out
 
 
-def _at_marks(traj, part, name, marks, derivative=None):
+def _at_marks(traj, part, name, marks, cuts, derivative=None):
     """Column ``name`` at the cycle marks: the samples there in crank angle, else the cubic
-    Hermite interpolant with dv/dφ = ``derivative`` (:func:`.orders.resample_angle`)."""
+    Hermite interpolant with dv/dφ = ``derivative``, not across the run's breakpoints ``cuts``
+    (a cycle mark is often one) (:func:`.orders.resample_angle`)."""
     phi = np.asarray(traj["phi"], float)[part]
     v = np.asarray(traj[name], float)[part]
     d = None if derivative is None else np.asarray(derivative, float)[part]
-    return resample_angle(phi, v, marks, d)
+    return resample_angle(phi, v, marks, d, cuts)
 
 
 def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=None
@@ -252,7 +255,11 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     W = np.array([integrals_between(phi, np.asarray(traj[f"p_{k + 1}"], float)[part] * vol.dV[k],
                                     marks, cuts[k]) for k in range(n)])
     w = np.asarray(traj["omega"], float)[part]
-    t_marks = _at_marks(traj, part, "t", marks, 1.0 / w)
+    # dt/dφ = 1/ω; NaN where ω = 0, the first sample of a start from rest, where only the mark
+    # φ0 falls, read off that sample: the derivative there is never used
+    inv_w = np.divide(1.0, w, out=np.full_like(w, np.nan), where=w != 0.0)
+    shaft_cuts = np.asarray((events or {}).get("breakpoint", np.zeros((0, 2))))[:, 1]
+    t_marks = _at_marks(traj, part, "t", marks, shaft_cuts, inv_w)
     period = np.diff(t_marks)
     swept = vol.swept
     total = float(swept.sum())
@@ -260,7 +267,7 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     def delta(name, derivative=None):
         if name not in traj:
             return np.zeros(marks.size - 1)
-        return np.diff(_at_marks(traj, part, name, marks, derivative))
+        return np.diff(_at_marks(traj, part, name, marks, shaft_cuts, derivative))
 
     M = {c: np.asarray(traj[c], float)[part] for c in ("M_gas", "M_load", "M_starter")}
     W_gas = delta("W_gas", M["M_gas"])
@@ -270,12 +277,13 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
                     if "M_drive" in traj else None)
     W_loss = np.zeros(marks.size - 1)
     for k in range(len(scene.friction.pairs)):
-        W_loss += delta(f"W_loss_{k + 1}", np.asarray(traj[f"P_loss_{k + 1}"], float)[part] / w)
+        W_loss += delta(f"W_loss_{k + 1}", np.asarray(traj[f"P_loss_{k + 1}"], float)[part]
+                        * inv_w)
     J = np.asarray(traj["J"], float)[part]
     K = 0.5 * J * w * w
     dK_dphi = 0.5 * np.asarray(traj["dJ_dphi"], float)[part] * w * w \
         + J * np.asarray(traj["epsilon"], float)[part]
-    dK = np.diff(resample_angle(phi, K, marks, dK_dphi))
+    dK = np.diff(resample_angle(phi, K, marks, dK_dphi, shaft_cuts))
     W_ind = W.sum(axis=0)
     residual = (W_ind + W_starter + W_drive + W_load - W_loss - dK) / np.where(
         W_ind != 0.0, np.abs(W_ind), 1.0)

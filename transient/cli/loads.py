@@ -81,45 +81,41 @@ def _crank_slider_loads(args, res, scene) -> int:
     from .. import plots
 
     written = []
-    ncols = 2 if d.inline else 1
-    fig, axes = plt.subplots(1, ncols, figsize=(6 * ncols, 5.5), squeeze=False)
+    best = d.most_loaded
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.5), squeeze=False)
     plots.polar_load(axes[0, 0], d.crankpin_x, d.crankpin_y)
     axes[0, 0].set_xlabel("R_T = T + T_rш [kN] (direction of rotation)")
     axes[0, 0].set_ylabel("−R_K = −(K + K_rш) [kN] (crank outward)")
-    axes[0, 0].set_title(f"crankpin {args.cylinder}, crank frame", fontsize=9)
-    if d.inline:
-        best = d.most_loaded
-        plots.polar_load(axes[0, 1], d.journal_x, d.journal_y)
-        axes[0, 1].set_xlabel("R_x [kN] (along T₁, direction of rotation)")
-        axes[0, 1].set_ylabel("−R_y [kN] (crank 1 outward)")
-        axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
-                             f"(split beam, (58))", fontsize=9)
+    axes[0, 0].set_title(f"{_pin(mech, k)}, crank frame", fontsize=9)
+    plots.polar_load(axes[0, 1], d.journal_x, d.journal_y)
+    axes[0, 1].set_xlabel("R_x [kN] (along T₁, direction of rotation)")
+    axes[0, 1].set_ylabel("−R_y [kN] (crank 1 outward)")
+    axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
+                         f"(split beam, (58))", fontsize=9)
     fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle")
     written.append(save(fig, out / f"{stem}_loads_polar.png", args.force, res))
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for j in range(n_cyl):
-        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin {j + 1}")
+        plots.load_against_angle(ax, deg, loads.R[j], label=_pin(mech, j))
     ax.legend(fontsize=8)
     ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
     written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force, res))
 
     rays, sums = d.crankpin_wear
-    fig, axes = plt.subplots(1, ncols, figsize=(5.5 * ncols, 5.5), squeeze=False)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.5), squeeze=False)
     plots.wear_diagram(axes[0, 0], rays, sums)
-    axes[0, 0].set_title(f"crankpin {args.cylinder} (frame of its polar diagram)", fontsize=9)
-    if d.inline:
-        plots.wear_diagram(axes[0, 1], *d.journal_wear)
-        axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
+    axes[0, 0].set_title(f"{_pin(mech, k)} (frame of its polar diagram)", fontsize=9)
+    plots.wear_diagram(axes[0, 1], *d.journal_wear)
+    axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
     fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6: each load wears ±60° around its "
                  f"direction)", fontsize=10)
     written.append(save(fig, out / f"{stem}_loads_wear.png", args.force, res))
 
-    if d.inline:
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
-        ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
-        written.append(save(fig, out / f"{stem}_loads_running_torques.png", args.force, res))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
+    ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
+    written.append(save(fig, out / f"{stem}_loads_running_torques.png", args.force, res))
 
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
@@ -128,13 +124,12 @@ def _crank_slider_loads(args, res, scene) -> int:
             cols[f"{CSV_NAMES.get(name, name)}_{j + 1}_N"] = getattr(loads, name)[j]
         cols[f"M_{j + 1}_Nm"] = loads.torque[j]
     cols["M_engine_Nm"] = d.engine_torque
-    if d.inline:
-        for j in range(d.journal_torques.shape[0]):
-            cols[f"M_journal_{j + 1}_Nm"] = d.journal_torques[j]
-        for j in range(d.crankpin_torques.shape[0]):
-            cols[f"M_crankpin_{j + 1}_Nm"] = d.crankpin_torques[j]
-        for j in range(d.main_journals.x.shape[0]):
-            cols[f"R_main_{j + 1}_N"] = d.main_journals.magnitude[j]
+    for j in range(d.journal_torques.shape[0]):
+        cols[f"M_journal_{j + 1}_Nm"] = d.journal_torques[j]
+    for j in range(d.crankpin_torques.shape[0]):
+        cols[f"M_crankpin_{j + 1}_Nm"] = d.crankpin_torques[j]
+    for j in range(d.main_journals.x.shape[0]):
+        cols[f"R_main_{j + 1}_N"] = d.main_journals.magnitude[j]
     csv = out / f"{stem}_loads.csv"
     write_columns(csv, cols, args.force)
     written.append(csv)
@@ -145,7 +140,7 @@ def _crank_slider_loads(args, res, scene) -> int:
           f"{start + mech.cycle:.6g} rad, {d.window.samples} samples)")
     for j in range(n_cyl):
         i = int(np.argmax(loads.R[j]))
-        print(f"  crankpin {j + 1}: |R| max {loads.R[j][i] / 1e3:.6g} kN "
+        print(f"  {_pin(mech, j)}: |R| max {loads.R[j][i] / 1e3:.6g} kN "
               f"({loads.R[j][i] / area / 1e6:.4g} MPa on the piston area) at "
               f"{deg[i]:.4g}° of the cycle, mean {np.mean(loads.R[j]) / 1e3:.6g} kN, "
               f"min {loads.R[j].min() / 1e3:.6g} kN")
@@ -157,23 +152,27 @@ def _crank_slider_loads(args, res, scene) -> int:
     m = d.engine_torque
     print(f"  engine torque Σ T r: mean {np.mean(m):.6g} N m (sample mean), from "
           f"{m.min():.6g} to {m.max():.6g} N m")
-    if d.inline:
-        for j in range(d.main_journals.x.shape[0]):
-            print(f"  main journal {j + 1}: |R| max {d.main_journals.magnitude[j].max() / 1e3:.6g} kN")
-        for j in range(1, d.journal_torques.shape[0]):
-            print(f"  running torque journal {j + 1}: max |M| "
-                  f"{np.abs(d.journal_torques[j]).max():.6g} N m")
-        for j in range(d.crankpin_torques.shape[0]):
-            print(f"  running torque crankpin {j + 1}: max |M| "
-                  f"{np.abs(d.crankpin_torques[j]).max():.6g} N m")
-    else:
-        print("  main journals and running torques: in-line engines only (skipped)")
-    print(f"  wear diagram of crankpin {args.cylinder}: least loaded ray at "
+    for j in range(d.main_journals.x.shape[0]):
+        print(f"  main journal {j + 1}: |R| max {d.main_journals.magnitude[j].max() / 1e3:.6g} kN")
+    for j in range(1, d.journal_torques.shape[0]):
+        print(f"  running torque journal {j + 1}: max |M| "
+              f"{np.abs(d.journal_torques[j]).max():.6g} N m")
+    for j in range(d.crankpin_torques.shape[0]):
+        print(f"  running torque crankpin {j + 1}: max |M| "
+              f"{np.abs(d.crankpin_torques[j]).max():.6g} N m")
+    print(f"  wear diagram of {_pin(mech, k)}: least loaded ray at "
           f"{rays[np.argmin(sums)]:g}° (counter-clockwise from the direction of rotation, "
           f"crank up)")
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
+
+
+def _pin(mech, k: int) -> str:
+    """Where cylinder k's (0-based) rod bears: its crankpin, or a crankpin two rods share."""
+    if mech.cylinders_per_throw == 1:
+        return f"crankpin {k + 1}"
+    return f"rod {k + 1} on crankpin {mech.throw_of_cylinder()[k] + 1}"
 
 
 def _radial_loads(args, res, scene) -> int:

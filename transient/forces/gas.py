@@ -46,6 +46,7 @@ __all__ = [
     "table_from_function",
     "table_from_points",
     "volume_at",
+    "wrapped_pieces",
 ]
 
 #: Default knot spacing of :func:`table_from_function` [rad] (0.125°). Measured on the Gots
@@ -765,11 +766,14 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                          f"{deg_text(x_tdc)}) give V_a/V_c = {ratio:.10g}, not the "
                          f"compression_ratio {compression_ratio:.10g}; the clearance volume "
                          f"must be the swept volume/(ε − 1)")
-    p_c = p_a * ratio ** n1
+    try:
+        p_c = p_a * ratio ** n1
+    except OverflowError:  # (an absurd ε or n1: a p_c beyond a double, which p_z cannot reach)
+        p_c = math.inf
     if p_z < p_c:
         raise SceneError("gas.p_z", f"p_z = {p_z / 1e6:.6g} MPa is below the compression end "
-                                    f"p_c = p_a·ε^n1 = {p_c / 1e6:.6g} MPa; the mixed cycle needs "
-                                    "p_z ≥ p_c")
+                                    f"p_c = p_a·ε^n1 = {p_c / 1e6:.6g} MPa (ε = {ratio:.6g}, n1 = "
+                                    f"{n1:g}); the mixed cycle needs p_z ≥ p_c")
     v_z = rho * v_c
     if not (np.isfinite(rho) and 1.0 <= rho and v_z < v_b):
         raise SceneError("gas.rho", f"ρ = {rho!r}; it must satisfy 1 ≤ ρ < V_b/V_c = "
@@ -806,14 +810,14 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         v_0 = volume_at(volume, 0.0)
         v_end = volume_at(volume, period)
         work += p_intake * (v_a - v_0) + p_exhaust * (v_end - v_b)
-    funcs, corners = _wrapped_pieces(starts, period)
+    funcs, corners = wrapped_pieces(starts, period)
     table, err = table_from_function(funcs, period, corners, step)
     return MixedCycle(knots=table.knots, coef=table.coef, piece_knot=table.piece_knot,
                       period=period, work=work, p_c=p_c, p_b=p_b, angle_z=angle_z, v_c=v_c,
                       v_a=v_a, v_z=v_z, v_b=v_b, strokes=strokes, interpolation_error=err)
 
 
-def _wrapped_pieces(starts: list[tuple[float, PieceFunction]], period: float
+def wrapped_pieces(starts: list[tuple[float, PieceFunction]], period: float
                     ) -> tuple[list[PieceFunction], list[float]]:
     """Pieces given by the angles where they start, as :func:`table_from_function` takes them:
     the functions in order over [0, period) and the interior corners. A start off [0, period)

@@ -1,7 +1,17 @@
 """Crank-slider engines (in-line, V, offset): geometry, masses, validation and the kinematics table.
 
 The compiled kinematics live in :mod:`transient.core.crank_slider`; this module holds the scene-side
-description (SI units) and packs it for the kernel.
+description (SI units) and packs it for the kernel; :mod:`.throws` reads how the cylinders sit
+on the crank.
+
+Two cylinders on one throw (a V engine) are two crank-sliders at their own local angles, as every
+cylinder is: the kernel sums the cylinders and needs nothing else. The throw's unbalanced mass is
+counted once: each of its cylinders carries half of it
+(:attr:`CrankSlider.crank_mass_per_cylinder`), at its own crankpin, which is the same mass at the
+same place unless the pins are split. The rods' arrangement on the pin does not enter J(φ): the
+motion is planar, and where along the pin a rod runs changes no velocity. It places the rods'
+forces along the shaft, which the main-journal loads and running torques of
+:mod:`transient.analysis.loads.crank_slider` use.
 """
 from __future__ import annotations
 
@@ -17,6 +27,7 @@ from ..core import crank_slider as core
 from ..core.layout import CRANK_SLIDER, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..tomlout import toml_value
+from .throws import ANGLE_TOL, SHARED, SINGLE, equal_angles, read_crank, wrap_angle
 from .twins import CrankSliderNumpy
 
 if TYPE_CHECKING:
@@ -59,6 +70,19 @@ class CrankSlider:
         central mechanism), in [0, cycle).
     bank_angles : tuple of float
         Cylinder-axis angles [rad] from the reference axis, in the direction of rotation (V engines).
+        Each cylinder's crankpin stands (bank − firing) ahead of the shaft's reference line
+        (:meth:`pin_angles`).
+    rod_arrangement : str
+        ``"single"``: every cylinder has a throw of its own; ``"side-by-side"`` or
+        ``"fork-and-blade"``: cylinders 2t − 1 and 2t share throw t (numbered from the nose),
+        their two big ends next to each other along the pin (2t − 1 nearer the nose) or in one
+        plane, one rod forked around the other.
+    rod_spacing : float
+        Side-by-side rods: distance along the pin between the two big ends' middle planes [m]
+        (0 otherwise).
+    journal_spacing : float
+        Side-by-side rods: distance between the two main journals beside a throw [m], the span
+        of the split beam the main-journal loads use (0 otherwise).
     """
 
     crank_radius: float
@@ -74,6 +98,9 @@ class CrankSlider:
     strokes: int
     firing_angles: tuple[float, ...]
     bank_angles: tuple[float, ...]
+    rod_arrangement: str = SINGLE
+    rod_spacing: float = 0.0
+    journal_spacing: float = 0.0
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "crank-slider"
@@ -103,10 +130,63 @@ class CrankSlider:
     def n_cylinders(self) -> int:
         return len(self.firing_angles)
 
+    @property
+    def cylinders_per_throw(self) -> int:
+        """1, or 2 where two rods share a crankpin."""
+        return 1 if self.rod_arrangement == SINGLE else 2
+
+    @property
+    def n_throws(self) -> int:
+        return self.n_cylinders // self.cylinders_per_throw
+
+    @property
+    def crank_mass_per_cylinder(self) -> float:
+        """Each cylinder's share of its throw's unbalanced mass [kg]: all of it, or half where
+        two cylinders share the throw (at its own pin where the pins are split)."""
+        return self.crank_mass / self.cylinders_per_throw
+
+    @property
+    def ideal_reaction_joints(self) -> dict[str, str]:
+        """Joints that cannot have friction on their reactions (``scene.read``): the crankpin of
+        fork-and-blade rods, where the blade turns on the fork's big end, which carries both
+        rods' forces: the per-rod journal of the reaction model is not that bearing."""
+        if self.rod_arrangement == "fork-and-blade":
+            return {"crank": "the crankpin of fork-and-blade rods, where the blade turns on the "
+                             "fork's big end, which carries both rods' forces"}
+        return {}
+
+    def throw_of_cylinder(self) -> NDArray[np.intp]:
+        """The throw (0-based, from the nose) each cylinder rides on."""
+        return np.arange(self.n_cylinders) // self.cylinders_per_throw
+
+    def pin_angles(self) -> NDArray[np.float64]:
+        """Each cylinder's crankpin angle ahead of the shaft's reference line, in the direction
+        of rotation [rad], in [0, 2π): bank − firing (the crankpin stands at φ + this)."""
+        return np.mod(np.asarray(self.bank_angles, dtype=np.float64)
+                      - np.asarray(self.firing_angles, dtype=np.float64), 2.0 * pi)
+
+    def axial_positions(self) -> NDArray[np.float64]:
+        """Where each cylinder's rod bears along the shaft: its big end's middle plane from its
+        throw's middle, toward the rear, over the journal spacing [1]; 0 but for side-by-side
+        rods, which sit at ∓ rod_spacing / (2 journal_spacing)."""
+        if self.rod_arrangement != "side-by-side":
+            return np.zeros(self.n_cylinders)
+        half = 0.5 * self.rod_spacing / self.journal_spacing
+        return np.where(np.arange(self.n_cylinders) % 2 == 0, -half, half)
+
+    def throw_angles(self) -> tuple[tuple[float, ...], float]:
+        """Each throw's angle ahead of the shaft's reference line [rad] (the middle of its
+        pins) and the split of its pins (the even cylinder's pin ahead of the odd one's) [rad]."""
+        pins = self.pin_angles()
+        if self.cylinders_per_throw == 1:
+            return tuple(float(a) for a in pins), 0.0
+        split = float(wrap_angle(pins[1] - pins[0]))
+        return tuple(float(np.mod(a + split / 2.0, 2.0 * pi)) for a in pins[::2]), split
+
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia of each link besides the shaft's [kg m²]: the crank throws'
-        n·m_crank·r²; the rods' and the pistons' vary with φ (``link_laws``)."""
-        return (0.0, self.n_cylinders * self.crank_mass * self.crank_radius ** 2, 0.0, 0.0, 0.0)
+        n_throws·m_crank·r²; the rods' and the pistons' vary with φ (``link_laws``)."""
+        return (0.0, self.n_throws * self.crank_mass * self.crank_radius ** 2, 0.0, 0.0, 0.0)
 
     @property
     def piston_link_mass(self) -> float:
@@ -141,15 +221,7 @@ class CrankSlider:
         if sorted(order) != list(range(1, n + 1)):
             raise SceneError(s.key("firing_order"),
                              f"must list each cylinder 1 … {n} once, got {list(order)}")
-        even = [0.0] * n
-        for j, c in enumerate(order):
-            even[c - 1] = j * cycle / n
-        firing = s.numbers("firing", "angle", tuple(even))
-        banks = s.numbers("bank", "angle", (0.0,) * n)
-        for key, values in (("firing", firing), ("bank", banks)):
-            if len(values) != n:
-                raise s.rename(SceneError(s.key(key), f"has {len(values)} entries; must have "
-                                                      f"one per cylinder ({n})"))
+        crank = read_crank(s, n, cycle, order)
         rod = s.sub("rod", required=True)
         model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
         mech = cls(
@@ -158,7 +230,7 @@ class CrankSlider:
             crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
             rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
             rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
-            strokes=strokes, firing_angles=firing, bank_angles=banks)
+            strokes=strokes, **crank)
         rod.finish()
         try:
             mech.validate()
@@ -207,6 +279,47 @@ class CrankSlider:
                 raise SceneError("mechanism.firing",
                                  f"{degrees(a):g}° is outside the cycle; allowed 0 ≤ angle < "
                                  f"{degrees(self.cycle):g}°")
+        self._validate_throws()
+
+    def _validate_throws(self) -> None:
+        """Two cylinders on a throw: an even count, on two banks, one pin for fork-and-blade
+        rods and one split for every throw, side-by-side rods between the journals."""
+        n, arrangement = self.n_cylinders, self.rod_arrangement
+        if len(self.bank_angles) != n:
+            raise SceneError("mechanism.bank", f"has {len(self.bank_angles)} entries; must have "
+                                               f"one per cylinder ({n})")
+        if arrangement not in (SINGLE, *SHARED):
+            raise SceneError("mechanism.rod_arrangement",
+                             f"unknown arrangement {arrangement!r}; allowed: "
+                             f"{', '.join(map(repr, (SINGLE, *SHARED)))}")
+        spacing = (self.rod_spacing, self.journal_spacing)
+        if arrangement != "side-by-side" and spacing != (0.0, 0.0):
+            raise SceneError("mechanism.rod_spacing",
+                             f"applies to side-by-side rods only; with rod_arrangement = "
+                             f"{arrangement!r} it and journal_spacing must be 0")
+        if arrangement == SINGLE:
+            return
+        if n % 2:
+            raise SceneError("mechanism.rod_arrangement",
+                             f"two cylinders per throw need an even count, got {n}")
+        banks = np.asarray(self.bank_angles)
+        if np.any(np.abs(wrap_angle(banks[1::2] - banks[::2])) <= ANGLE_TOL):
+            raise SceneError("mechanism.bank", "the two cylinders of a throw must sit on two "
+                                               "banks")
+        pins = self.pin_angles()
+        splits = wrap_angle(pins[1::2] - pins[::2])
+        if arrangement == "fork-and-blade" and np.any(np.abs(splits) > ANGLE_TOL):
+            raise SceneError("mechanism.pin_split", "must be 0 for fork-and-blade rods, which "
+                                                    "share one pin")
+        if np.ptp(splits) > ANGLE_TOL:
+            raise SceneError("mechanism.pin_split",
+                             f"the throws' pins are split by {np.degrees(splits).round(6)}°; "
+                             f"a crank has one split for every throw")
+        if arrangement == "side-by-side" and not 0.0 < self.rod_spacing < self.journal_spacing:
+            raise SceneError("mechanism.rod_spacing",
+                             f"{self.rod_spacing * 1e3:g} mm must be > 0 and less than the "
+                             f"journal spacing ({self.journal_spacing * 1e3:g} mm): both big "
+                             f"ends run between the throw's journals")
 
     def pack(self) -> NDArray[np.float64]:
         """Parameter array for :func:`transient.core.crank_slider.crank_slider_terms`."""
@@ -217,7 +330,7 @@ class CrankSlider:
         mp[core.L] = l
         mp[core.E] = self.offset
         mp[core.M_PISTON] = self.piston_mass
-        mp[core.M_CRANK] = self.crank_mass
+        mp[core.M_CRANK] = self.crank_mass_per_cylinder
         if self.rod_model == "two-mass":  # Gots (20): m₁ = m(l − l₁)/l at the pin, m₂ = m l₁/l
             mp[core.M_PIN] = self.rod_mass * (l - self.rod_cg_from_pin) / l
             mp[core.M_CRANKPIN] = self.rod_mass * self.rod_cg_from_pin / l
@@ -239,11 +352,26 @@ class CrankSlider:
                 "piston_mass": self.piston_mass, "crank_mass": self.crank_mass,
                 "strokes": self.strokes, "cylinders": self.n_cylinders,
                 "firing": list(self.firing_angles), "bank": list(self.bank_angles)}
+        keys.update(self._crank_keys())
         rod = {"model": self.rod_model, "mass": self.rod_mass, "cg_from_pin": self.rod_cg_from_pin}
         if self.rod_model == "rigid":
             rod["inertia_cg"] = self.rod_inertia_cg
         return (["[mechanism]"] + [f"{k} = {toml_value(v)}" for k, v in keys.items()]
                 + ["", "[mechanism.rod]"] + [f"{k} = {toml_value(v)}" for k, v in rod.items()])
+
+    def _crank_keys(self) -> dict:
+        """The keys that place a V engine's cylinders on the crank (:mod:`.throws`); none for an
+        in-line engine, whose firing gives its crank."""
+        if self.rod_arrangement == SINGLE and equal_angles(self.bank_angles):
+            return {}
+        throws, split = self.throw_angles()
+        keys = {"throws": list(throws)}
+        if self.rod_arrangement != SINGLE:
+            keys["rod_arrangement"] = self.rod_arrangement
+        if self.rod_arrangement == "side-by-side":
+            keys.update(pin_split=split, rod_spacing=self.rod_spacing,
+                        journal_spacing=self.journal_spacing)
+        return keys
 
     def tdc_angle(self) -> float:
         """Local crank angle of the true top dead centre, Gots (9): sin φ₁ = e/(l + r)."""

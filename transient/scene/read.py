@@ -17,15 +17,15 @@ from ..mechanisms import MECHANISMS, reaction_joints
 from ..mechanisms.articulated import slave_reach
 from ..units import ALL_SUFFIXES
 from .budget import check_work
-from .checks import check_analysis, check_consistency, check_gas_table
+from .checks import check_analysis, check_consistency, check_gas_table, check_magnitudes
 from .files import parse_toml, read_text, table_number, table_rows
 from .eta_map import check_map, grid_from_points
 from .reader import MISSING, Section, finite_number, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
-                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
-                      MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction, Gas,
-                      Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
+                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_GAMMA, MAX_SAMPLES_PER_REV,
+                      METHODS, MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction,
+                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
                       Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
@@ -35,7 +35,17 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     path = Path(source)
     if text is None:
         text = read_text(path, "scene")
-    return scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
+    scene = scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
+    return replace(scene, source_file=str(path), source_text=text)
+
+
+class SweepNotScene(SceneError):
+    """A sweep file (a ``[sweep]`` table and no ``[mechanism]``: :mod:`transient.sweeps.spec`)
+    given where a scene is read; ``transient check`` checks it as a sweep instead."""
+
+    def __init__(self, file: str) -> None:
+        super().__init__("[sweep]", "this is a sweep file, not a scene: run it with `transient "
+                                    "sweep`, check it with `transient check`", file=file)
 
 
 def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
@@ -76,10 +86,12 @@ def _unsuffixed(key: str) -> str:
 def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
     """Build and validate a scene from parsed TOML. Raises :class:`SceneError`."""
     base_dir = base_dir or Path.cwd()
+    if isinstance(data.get("sweep"), dict) and "mechanism" not in data:
+        raise SweepNotScene(file)
     try:
         root = Section(data, "")
         head = root.sub("scene")
-        name = head.string("name", Path(file).stem if file else "scene")
+        name = _label(head, Path(file).stem if file else "scene")
         if not name.strip():
             raise SceneError(head.key(head.written.get("name", "name")),
                              "must not be empty; it names the result (leave it out to use the "
@@ -149,8 +161,14 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sa.finish()
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
-        check_consistency(scene)
-        check_gas_table(scene, sg)
+        least_inertia, lever = check_consistency(scene)
+        table = check_gas_table(scene, sg)
+        try:
+            check_magnitudes(scene, least_inertia, lever, table)
+        except SceneError as exc:  # (reported under the key as written: omega_rpm, p_z_MPa, …)
+            for section in (s0, sg, sl, ss, sr):
+                section.rename(exc)
+            raise
         check_analysis(scene)
         try:
             check_work(scene)
@@ -165,23 +183,40 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         raise
 
 
+def _label(s: Section, default: str) -> str:
+    """The ``name`` of a table (the scene's, a pair's): it labels terminal lines, figures and
+    result files, so a character a terminal would act on (an escape sequence, a newline) is
+    refused, not printed."""
+    name = s.string("name", default)
+    bad = next((c for c in name if not c.isprintable()), None)
+    if bad is not None:
+        raise SceneError(s.key(s.written.get("name", "name")),
+                         f"holds the control character {show_value(bad)} (character "
+                         f"{name.index(bad) + 1}); a name labels terminal lines, figures and "
+                         f"results: give printable text")
+    return name
+
+
 def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: int) -> Gas:
     gas = _read_gas_model(s, base_dir, strokes)
-    cylinders = _read_cylinders(s, n_cylinders)
+    cylinders = _read_cylinders(s, n_cylinders, burns=gas.model != "compressor")
     if gas.model == "none":
         if cylinders:
             raise SceneError(s.key("cylinders"), "varies the gas force of cylinders that have "
                                                  "none; give a gas model (gas.model) or leave "
                                                  "[[gas.cylinders]] out")
         return gas
+    if gas.model == "compressor":  # no fuel: nothing to inject
+        return replace(gas, cylinders=cylinders)
     cycle = 2.0 * math.pi * strokes / 2
     return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle),
                    cylinders=cylinders)
 
 
-def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
+def _read_cylinders(s: Section, n_cylinders: int, burns: bool = True) -> tuple[Cylinder, ...]:
     """The [[gas.cylinders]] entries: per cylinder its fuel and pressure factors, cut-out and
-    misfires (:class:`~.records.Cylinder`), sorted by cylinder."""
+    misfires (:class:`~.records.Cylinder`), sorted by cylinder. A model that ``burns`` no fuel
+    (a compressor) takes the pressure factor only."""
     s.known.append("cylinders")
     raw = s.data.pop("cylinders", [])
     if not isinstance(raw, list):
@@ -190,6 +225,12 @@ def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
     top = MAX_CYLINDER_FACTOR
     for i, item in enumerate(raw):
         cs = Section(item, f"{s.key('cylinders')}[{i}]")
+        other = [k for k in (item if isinstance(item, dict) else ())
+                 if k not in ("cylinder", "pressure")]
+        if not burns and other:
+            raise SceneError(cs.key(other[0]), "a compressor burns no fuel: its "
+                                               "[[gas.cylinders]] entries take 'cylinder' and "
+                                               "'pressure' only")
         k = cs.integer("cylinder", ge=1, le=n_cylinders)
         if k in seen:
             raise SceneError(cs.key("cylinder"), f"cylinder {k} has an entry already "
@@ -223,32 +264,78 @@ def _read_cylinders(s: Section, n_cylinders: int) -> tuple[Cylinder, ...]:
 
 def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
     model = s.string("model", "none",
-                     choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe"))
+                     choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe", "compressor"))
     if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
         return Gas(model="trapezoid", p0=0.0, amplitude=s.number("amplitude", ge=0.0),
                    ramp=s.number("ramp", "angle", gt=0.0),
                    duration=s.number("duration", "angle", math.pi, gt=0.0))
+    if model == "table":
+        return _read_gas_table(s, base_dir)
     p0 = s.number("p0", "pressure", 1.0e5, ge=0.0)
     if model == "none":
         return Gas(model="none", p0=p0)
-    if model == "table":
-        if s.has("file"):
-            phi, p = _read_pressure_csv(s, base_dir)
-        else:
-            phi = s.numbers("phi", "angle")
-            p = s.numbers("p", "pressure")
-        corners = s.numbers("corners", "angle", ())
-        interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
-        return Gas(model="table", p0=p0, phi=phi, p=p, corners=corners, interpolation=interp)
     if model == "wiebe":
         return _read_wiebe(s, p0, strokes)
+    if model == "compressor":  # p_discharge > p_suction and the clearance: forces.compressor
+        n = s.number("n", gt=1.0)
+        return Gas(model="compressor", p0=p0, p_suction=s.number("p_suction", "pressure", gt=0.0),
+                   p_discharge=s.number("p_discharge", "pressure", gt=0.0), n=n,
+                   n_reexpansion=s.number("n_reexpansion", default=n, gt=1.0),
+                   clearance_ratio=s.number("clearance_ratio", gt=0.0))
+    p_in, p_ex = _gas_exchange(s, strokes, gt=0.0)
     return Gas(
         model="mixed-cycle", p0=p0,
         compression_ratio=s.number("compression_ratio", gt=1.0),
         p_a=s.number("p_a", "pressure", gt=0.0), n1=s.number("n1", gt=1.0),
         p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
-        n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
-        p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+        n2=s.number("n2", gt=1.0), p_intake=p_in, p_exhaust=p_ex)
+
+
+def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, float]:
+    """``p_intake`` and ``p_exhaust`` [Pa], the constant pressures of a 4-stroke's intake and
+    exhaust strokes (required, within ``bounds``, :meth:`Section.number`'s). A 2-stroke has no
+    such strokes: the cycle models scavenge it to p_a at bottom dead centre, so the keys would
+    mean nothing and are refused (0 in the record)."""
+    if strokes == 4:
+        return (s.number("p_intake", "pressure", **bounds),
+                s.number("p_exhaust", "pressure", **bounds))
+    for name in ("p_intake", "p_exhaust"):
+        if s.has(name, "pressure"):
+            s.number(name, "pressure")  # (taken off the table: its key as written)
+            raise SceneError(s.key(s.written[name]), "a two-stroke cycle (mechanism.strokes = "
+                                                     "2) has no intake or exhaust stroke: it is "
+                                                     "scavenged to p_a at bottom dead centre; "
+                                                     "leave p_intake and p_exhaust out (they "
+                                                     "are for strokes = 4)")
+    return 0.0, 0.0
+
+
+def _read_gas_table(s: Section, base_dir: Path) -> Gas:
+    """``model = "table"``: absolute pressures ``p`` (with the crankcase's ``p0``) or forces on
+    each piston ``force`` (applied as they are: no ``p0``) at the local angles ``phi``, inline or
+    from a CSV ``file``."""
+    if s.has("file"):
+        phi, column, values = _read_diagram_csv(s, base_dir)
+        force = column in FORCE_COLUMNS
+    else:
+        phi = s.numbers("phi", "angle")
+        values = s.numbers("force", "force", ())
+        force = bool(values)
+        if force and s.has("p", "pressure"):
+            raise SceneError(s.key("force"), "is given with 'p'; a table holds the pressure in "
+                                             "the cylinder or the force on its piston: give one "
+                                             "of them")
+        if not force and not s.has("p", "pressure"):
+            s.numbers("p", "pressure", ())  # (a 'p' with a wrong unit suffix is named first)
+            raise SceneError(s.key("p"), "is missing; give the pressures 'p' (or 'p_bar', "
+                                         "'p_MPa') or the forces on the piston 'force' (or "
+                                         "'force_kN'), one per angle")
+        values = values or s.numbers("p", "pressure")
+    p0 = 0.0 if force else s.number("p0", "pressure", 1.0e5, ge=0.0)
+    corners = s.numbers("corners", "angle", ())
+    interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
+    return Gas(model="table", p0=p0, phi=phi, p=() if force else values,
+               force=values if force else (), corners=corners, interpolation=interp)
 
 
 def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
@@ -261,17 +348,14 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
     d = Wiebe()
     ratio = s.number("compression_ratio", gt=1.0)
     p_a = s.number("p_a", "pressure", gt=0.0)
-    # A 2-stroke is scavenged to p_a: it has no intake or exhaust stroke.
-    need = MISSING if strokes == 4 else 0.0
-    p_in = s.number("p_intake", "pressure", need, ge=0.0)
-    p_ex = s.number("p_exhaust", "pressure", need, ge=0.0)
+    p_in, p_ex = _gas_exchange(s, strokes, ge=0.0)
     w = s.sub("wiebe", required=True)
     wiebe = Wiebe(
         start=w.number("start", "angle"), duration=w.number("duration", "angle", gt=0.0),
         fuel_mass=w.number("fuel_mass", ge=0.0), a=w.number("a", default=d.a, gt=0.0),
         m=w.number("m", default=d.m, gt=-1.0), lhv=w.number("lhv", default=d.lhv, gt=0.0),
         efficiency=w.number("efficiency", default=d.efficiency, gt=0.0, le=1.0),
-        gamma=w.number("gamma", default=d.gamma, gt=1.0),
+        gamma=w.number("gamma", default=d.gamma, gt=1.0, le=MAX_GAMMA),
         gamma_slope=w.number("gamma_slope", default=d.gamma_slope),
         gamma_t_ref=w.number("gamma_t_ref", default=d.gamma_t_ref, gt=0.0),
         t_a=w.number("t_a", default=d.t_a, gt=0.0),
@@ -292,16 +376,18 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
                p_exhaust=p_ex, wiebe=wiebe, woschni=woschni)
 
 
-#: Column names of a pressure table (CSV) and their factors to SI.
+#: Column names of a pressure or force table (CSV) and their factors to SI.
 ANGLE_COLUMNS = {"phi_deg": math.pi / 180.0, "phi": 1.0}
 PRESSURE_COLUMNS = {"p": 1.0, "p_bar": 1e5, "p_MPa": 1e6, "p_Pa": 1.0}
+FORCE_COLUMNS = {"force": 1.0, "force_N": 1.0, "force_kN": 1e3}
 
 
-def _read_pressure_csv(s: Section, base_dir: Path):
-    """Indicator diagram from a CSV with an angle column and a pressure column (units in names)."""
-    (_, phi), (_, p) = _read_csv(s, base_dir, {"angle": ANGLE_COLUMNS,
-                                               "pressure": PRESSURE_COLUMNS})
-    return phi, p
+def _read_diagram_csv(s: Section, base_dir: Path):
+    """Indicator diagram (or force diagram) from a CSV with an angle column and a pressure or a
+    force column (units in names): the angles, the name of that column and its values."""
+    (_, phi), (column, values) = _read_csv(s, base_dir, {
+        "angle": ANGLE_COLUMNS, "pressure or force": {**PRESSURE_COLUMNS, **FORCE_COLUMNS}})
+    return phi, column, values
 
 
 def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
@@ -391,7 +477,7 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
             raise SceneError(ps.key("between"), f"the same pair as "
                                                 f"{s.key('pairs')}[{seen[tuple(between)]}]")
         seen[tuple(between)] = i
-        name = ps.string("name", f"{between[0]}-{between[1]}")
+        name = _label(ps, f"{between[0]}-{between[1]}")
         if model == "reaction":
             pair = _reaction_pair(ps, between, name, slider=between[1] == links[-1])
         elif model == "table":

@@ -34,7 +34,8 @@ class Wiebe:
     burned per cycle and cylinder at full load (governor fuel 1); 0 runs the engine motored.
     ``a``, ``m`` [1]: Wiebe efficiency parameter and shape exponent. ``lhv`` [J/kg]: lower heating
     value; ``efficiency`` [1]: combustion efficiency η_c, the share of m_f·LHV released.
-    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K].
+    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K];
+    at most 5/3, a monatomic ideal gas's.
     ``t_a`` [K]: gas temperature at intake closing. ``intake_closing``, ``exhaust_opening`` [rad]:
     ends of the closed part (None: the BDCs around the firing TDC). ``step`` [rad] and
     ``tolerance`` [1]: largest knot spacing and target relative error of the tables.
@@ -135,11 +136,20 @@ class Gas:
     table and every corner is a breakpoint), ``"mixed-cycle"`` (Gots App. 2,
     Trinkler–Sabathé: ``compression_ratio`` [1], ``p_a`` [Pa] at the start of compression,
     polytropic exponents ``n1`` and ``n2`` [1], peak pressure ``p_z`` [Pa], pre-expansion ratio
-    ``rho`` [1], ``p_intake`` and ``p_exhaust`` [Pa]), ``"trapezoid"`` (the swash-plate paper's
+    ``rho`` [1] and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]; a 2-stroke, scavenged
+    to ``p_a`` at bottom dead centre, has no gas-exchange strokes and refuses them),
+    ``"trapezoid"`` (the swash-plate paper's
     force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]) or
     ``"wiebe"`` (single-zone Wiebe combustion, :class:`Wiebe`; with ``compression_ratio``, ``p_a``
-    [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]). ``p0`` is the
-    crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33).
+    [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]) or
+    ``"compressor"`` (the ideal reciprocating compressor cycle of a compressor or pump,
+    :mod:`transient.forces.compressor`: ``p_suction`` and ``p_discharge`` [Pa], polytropic
+    exponents ``n`` of the compression and ``n_reexpansion`` of the clearance gas [1], clearance
+    ratio ``clearance_ratio`` = V_c/V_s [1]; one cycle a turn, local angle 0 at the top dead
+    centre; no fuel: no governor, no fuel factors, misfires or injection). ``p0`` is the
+    crankcase pressure [Pa]: piston force (p − p0)·F_p, Gots (33). A ``"table"`` may give
+    ``force`` [N] on each piston instead of ``p``: then the force is applied as it is (no
+    piston area, no p0), as the trapezoid's.
 
     **Fuel command.** The governor's fuel f ∈ [0, 1] (1 without a governor) sets the cylinder
     pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot). For
@@ -153,7 +163,8 @@ class Gas:
     engine of ``cases/gots_diesel_wiebe.toml`` with γ = 1.38 − 1e-4·(T − 300 K), 1.1 % of the
     full-load p_max between 0 and 0.02 g and 2.1 % between 0 and 0.031 g (at f = 0.5; the
     indicated work at f = 0.25 is then 7.6 % low). Use a constant γ where part load matters.
-    The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"``).
+    The result columns ``p_<k>`` hold the pressure so applied (the force, for ``"trapezoid"`` and
+    a force table).
 
     **Per-cylinder variation.** ``cylinders``: the ``[[gas.cylinders]]`` entries
     (:class:`Cylinder`), a cylinder's fuel and pressure factors, its cut-out and its misfires;
@@ -182,6 +193,12 @@ class Gas:
     amplitude: float = 0.0
     ramp: float = 0.0
     duration: float = math.pi
+    force: tuple[float, ...] = ()
+    p_suction: float = 0.0
+    p_discharge: float = 0.0
+    n: float = 0.0
+    n_reexpansion: float = 0.0
+    clearance_ratio: float = 0.0
     wiebe: Wiebe | None = None
     injection: float | None = None
     woschni: Woschni | None = None
@@ -400,11 +417,27 @@ class Solver:
 
 @dataclass(frozen=True)
 class Output:
-    """Output sampling: ``samples_per_rev`` in crank angle; in time mode every ``dt`` [s]."""
+    """Output sampling. In crank angle (forwards, above the switch speed) a sample every
+    360°/``samples_per_rev``. In time (below the switch speed, whenever the shaft turns
+    backwards, ``solver.domain = "time"``) a sample every ``dt`` [s] (0: the angle spacing at
+    1.5 × the switch speed), and besides wherever the shaft angle crosses a multiple of
+    360°/``samples_per_rev``, either way, and at every speed reversal (the turning point, ω = 0):
+    so a rocking or reversing shaft is sampled as densely in angle as one turning forwards, and
+    ``dt`` bounds the time between the samples of a slow one. (The reference path, scipy-*,
+    writes its own steps.)"""
 
     samples_per_rev: int = 72
     dt: float = 0.0  # 0: Δφ / switch_speed
 
+
+#: A speed no piston machine reaches [rad/s] (about 955 000 rpm): beyond it a run ran away
+#: (status ``runaway``), and a scene that would start there, or whose torques would drive its
+#: least inertia there within a revolution, is refused (``checks.check_magnitudes``).
+RUNAWAY_SPEED = 1e5
+
+#: The largest ratio of specific heats of an ideal gas, a monatomic one's (γ = 1 + 2/f, f ≥ 3
+#: degrees of freedom): the Wiebe cycle's ``gamma`` is at most this.
+MAX_GAMMA = 5.0 / 3.0
 
 #: Output samples per revolution at most (0.00036° apart).
 MAX_SAMPLES_PER_REV = 1_000_000
@@ -532,7 +565,12 @@ DETREND = ("auto", "ramp", "none")
 class Scene:
     """A validated scene: what :func:`transient.scene.load_scene` returns, one record per TOML
     table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
-    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`."""
+    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`.
+
+    ``source_file`` and ``source_text``: the file the scene was read from and its text as read,
+    comments included (where each number comes from), which a result stores beside the resolved
+    scene; empty for a scene built in code. Not part of what the scene is: two scenes that differ
+    only there are equal."""
 
     name: str
     description: str
@@ -548,6 +586,8 @@ class Scene:
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
     analysis: Analysis = field(default_factory=Analysis)
+    source_file: str = field(default="", compare=False, repr=False)
+    source_text: str = field(default="", compare=False, repr=False)
 
     def geometry(self) -> dict[str, tuple[float, str]]:
         """What the mechanism's geometry implies, without a run, name → (value, unit) in SI

@@ -64,24 +64,34 @@ Multi-cylinder engines
 ----------------------
 Cylinder k sits at local angle α_k = φ − ``firing_angles[k]`` (its crank is at the cylinder axis
 at ``firing_angles[k]``). Its gas table is read at φ − :func:`transient.assemble.gas_phases`
-(local 0 = gas-exchange TDC of a 4-stroke). For an in-line engine (one cylinder per throw,
-cylinders numbered from the nose) crank k leads crank 1 by γ_k = ``firing_angles[0]`` −
-``firing_angles[k]`` (mod 2π) in the direction of rotation (Gots §2.7.1: clockwise seen from
-the nose).
+(local 0 = gas-exchange TDC of a 4-stroke). Its crankpin stands θ_k = δ_k − ``firing_angles[k]``
+ahead of the shaft's reference line (δ_k its bank; ``CrankSlider.pin_angles``), so crankpin k
+leads crankpin 1 by γ_k = θ_k − θ_1 (mod 2π) in the direction of rotation (Gots §2.7.1:
+clockwise seen from the nose); in an in-line engine γ_k = ``firing_angles[0]`` −
+``firing_angles[k]``. Throws are numbered from the nose: one per cylinder, or, in a V engine
+with two rods on a pin, cylinders 2k − 1 and 2k on throw k (:mod:`transient.mechanisms.throws`).
+Each cylinder's record carries its share of its throw's unbalanced mass (K_rk, T_rk): all of it,
+or half where two cylinders share the throw.
 
 * **Engine torque**: Σ T_k r (Gots §2.8, table П4.2), :attr:`CylinderLoads.engine_torque`.
 * **Running torques** (§2.8, П4.4/П4.5): journal j carries the torque of the throws ahead of it
-  (journal 1 at the nose carries none, the last one the total), crankpin k carries the journal
-  ahead of it plus half its own cylinder's torque. With ε ≠ 0 a throw passes to the shaft
+  (journal 1 at the nose carries none, the last one the total), a crankpin the journal ahead of
+  it plus what its throw adds up to its middle: half of a rod's torque at the middle (one rod,
+  or fork-and-blade rods), the whole of a side-by-side rod ahead of the middle and none of the
+  one behind it, and half of the crank's own term. With ε ≠ 0 a throw passes to the shaft
   r(T + T_rш + T_rk), not T r: the rotating masses ahead of a journal need torque to be
   accelerated; :func:`running_torques` includes it unless told not to (at ε = 0 it is the same).
-* **Main journals**, tabular method (58) for symmetric throws on a split beam: each support
-  carries half of each adjacent throw's load R_k = R + K_rk (+ counterweight) (42)/(43). In the
-  frame of crank 1 (y along K₁, toward the axis; x along T₁, the direction of rotation — the axes
-  Gots' positive K and T map onto, §2.7.3), throw i contributes
-  x: ½(T_Σ cos γ_i − K_Σ sin γ_i), y: ½(T_Σ sin γ_i + K_Σ cos γ_i), which is (58) with the
-  constant reactions R_iK, R_iT of §2.7.1 equal to half the throw's centrifugal (and, with ε,
-  tangential) forces.
+* **Main journals**, the split beam of (58): the crank is cut at every main journal, and each
+  throw is a beam simply supported on the two journals beside it, so a force at the distance
+  a behind the front journal of a span L puts F(L − a)/L on that journal and F a/L on the one
+  behind (the lever rule). The throw's unbalanced mass and a counterweight sit symmetrically:
+  half to each journal (42)/(43). A rod's force R = K + K_rш, T + T_rш acts in its big end's
+  middle plane: in the throw's middle for one rod or fork-and-blade rods (half to each
+  journal, (58) exactly), at ∓ b/2 from it for side-by-side rods b apart (½ ± b/(2L)), so the
+  couple of the two rods' offset is carried by the journals as a difference of their loads. In
+  the frame of crank 1 (y along K₁, toward the axis; x along T₁, the direction of rotation — the
+  axes Gots' positive K and T map onto, §2.7.3), a force with radial K_Σ and tangential T_Σ
+  at a crankpin γ ahead of crank 1 has x: T_Σ cos γ − K_Σ sin γ, y: T_Σ sin γ + K_Σ cos γ.
 
 Units: SI (N, N·m, rad). Divide by :attr:`CylinderLoads.area` for Gots' specific forces.
 """
@@ -142,8 +152,9 @@ def slider_arrays(alpha: ArrayLike, r: float, l: float, e: float = 0.0
 class CylinderLoads(CrankpinLoads):
     """Forces of every cylinder along a trajectory (module docstring: derivations and signs).
 
-    A :class:`~.common.CrankpinLoads` with one crankpin per cylinder: every array has the shape
-    ``(n_cylinders, n_samples)``; forces in N, torques in N·m.
+    A :class:`~.common.CrankpinLoads` with a row per cylinder: every array has the shape
+    ``(n_cylinders, n_samples)`` (the crankpin's rows are its rod's load on it: a pin that two
+    rods share carries the rows of both); forces in N, torques in N·m.
 
     Attributes
     ----------
@@ -158,7 +169,8 @@ class CylinderLoads(CrankpinLoads):
         direction of rotation): P cos(α+β)/cos β (36), P sin(α+β)/cos β (37).
     K_rod, T_rod : d'Alembert force of the rod's rotating mass m₂: −m₂ r ω² (K_rш, (32)) and
         −m₂ r ε (tangential, only when the speed varies).
-    K_crank, T_crank : the same for the crank throw's unbalanced mass m_k (Gots (28)): K_rk, T_rk.
+    K_crank, T_crank : the same for the cylinder's share of its throw's unbalanced mass m_k (Gots
+        (28)): K_rk, T_rk.
     R_K, R_T, R : crankpin load K + K_rш, T + T_rш and its magnitude (40)/(41) as vectors.
     R_axial, R_normal : the crankpin load in the rod frame (big-end bearing), see the module
         docstring.
@@ -214,7 +226,8 @@ def crank_slider_loads(mech, phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLik
     K = rod * cab - h * sa
     T = rod * sab + h * ca
     k_rod, t_rod = rotating_inertia_rows(m2, r, w, eps, alpha.shape)
-    k_crank, t_crank = rotating_inertia_rows(mech.crank_mass, r, w, eps, alpha.shape)
+    k_crank, t_crank = rotating_inertia_rows(mech.crank_mass_per_cylinder, r, w, eps,
+                                             alpha.shape)
     r_k = K + k_rod
     r_t = T + t_rod
     return CylinderLoads(
@@ -232,24 +245,15 @@ def loads_from_trajectory(scene, traj) -> CylinderLoads:
     return along_trajectory(crank_slider_loads, scene, traj)
 
 
-def _check_inline(mech) -> None:
-    banks = np.asarray(mech.bank_angles, dtype=np.float64)
-    if banks.size and np.ptp(banks) > 1e-12:
-        raise ValueError("running torques and main-journal loads are implemented for in-line "
-                         "engines (one cylinder per throw, all bank angles equal); got bank "
-                         f"angles {np.degrees(banks).tolist()}°")
-
-
 def running_torques(mech, loads: CylinderLoads, include_rotating: bool = True
                     ) -> tuple[Array, Array]:
-    """Running (cumulative) torques of an in-line engine (Gots §2.8, tables П4.4 and П4.5).
+    """Running (cumulative) torques along the crank (Gots §2.8, tables П4.4 and П4.5).
 
-    Cylinders (throws) are numbered from the nose; journal 1 is ahead of throw 1.
+    Throws are numbered from the nose; journal 1 is ahead of throw 1.
 
     Parameters
     ----------
     mech : CrankSlider
-        In-line (all bank angles equal).
     loads : CylinderLoads
     include_rotating : bool
         Use the throw torque r(T + T_rш + T_rk) (default; the torque in the shaft when ω varies)
@@ -257,32 +261,42 @@ def running_torques(mech, loads: CylinderLoads, include_rotating: bool = True
 
     Returns
     -------
-    journals : ndarray, shape (n_cylinders + 1, n)
-        M_кш,j = Σ_{k<j} M_k: 0 at journal 1, the engine torque at the last journal [N·m].
-    crankpins : ndarray, shape (n_cylinders, n)
-        M_шш,k = M_кш,k + ½ M_k [N·m].
+    journals : ndarray, shape (n_throws + 1, n)
+        M_кш,j = Σ of the throws ahead: 0 at journal 1, the engine torque at the last [N·m].
+    crankpins : ndarray, shape (n_throws, n)
+        M_шш,k = M_кш,k + what throw k adds up to its middle (module docstring); with one rod per
+        throw M_кш,k + ½ M_k [N·m].
     """
-    _check_inline(mech)
-    m = loads.throw_torque if include_rotating else loads.torque
-    journals = np.concatenate([np.zeros((1, m.shape[1])), np.cumsum(m, axis=0)], axis=0)
-    return journals, journals[:-1] + 0.5 * m
+    throw = mech.throw_of_cylinder()
+    rods = loads.torque + (loads.T_rod * loads.r if include_rotating else 0.0)
+    crank = loads.T_crank * loads.r if include_rotating else np.zeros_like(rods)
+    ahead = 0.5 - 0.5 * np.sign(mech.axial_positions())[:, None]  # ½ in the middle plane
+    journals = np.zeros((mech.n_throws + 1, rods.shape[1]))
+    np.add.at(journals, throw + 1, rods + crank)
+    middle = np.zeros((mech.n_throws, rods.shape[1]))
+    np.add.at(middle, throw, ahead * rods + 0.5 * crank)
+    journals = np.cumsum(journals, axis=0)
+    return journals, journals[:-1] + middle
 
 
 @dataclass(frozen=True)
 class MainJournalLoads:
-    """Main-journal loads of an in-line engine, shape ``(n_cylinders + 1, n)`` [N].
+    """Main-journal loads, shape ``(n_throws + 1, n)`` [N].
 
-    The force with which journal j presses on its bearing (the sum of half the loads of the two
-    throws beside it, (43)), in the frame of crank 1 as Gots' (58) — ``x`` along T₁ (direction of
-    rotation at crankpin 1), ``y`` along K₁ (from crankpin 1 toward the axis) — and in the
-    cylinder block's frame: ``side`` along the cylinder frame's +x, ``down`` along the cylinder
-    axis away from the head (the sense of P).
+    The force with which journal j presses on its bearing (its shares of the loads of the two
+    throws beside it, (43), by the lever rule of the split beam), in the frame of crank 1 as
+    Gots' (58) — ``x`` along T₁ (direction of rotation at crankpin 1), ``y`` along K₁ (from
+    crankpin 1 toward the axis) — and in the block's frame: ``side`` perpendicular to the
+    reference axis (bank angle 0), toward where the crankpins pass at the top, ``down`` along it
+    away from the heads (for an in-line engine on bank 0, the cylinder frame's +x and the sense
+    of P).
 
     Attributes
     ----------
     x, y : components in the frame of crank 1 [N].
     side, down : components in the block frame [N].
-    gamma : angle of each crank ahead of crank 1 in the direction of rotation [rad], (n_cylinders,).
+    gamma : angle of each cylinder's crankpin ahead of crankpin 1 in the direction of rotation
+        [rad], (n_cylinders,).
     """
 
     x: Array
@@ -300,40 +314,44 @@ class MainJournalLoads:
 def main_journal_loads(mech, loads: CylinderLoads, omega: ArrayLike, epsilon: ArrayLike,
                        counterweight_mass: float = 0.0, counterweight_angle: float = math.pi
                        ) -> MainJournalLoads:
-    """Main-journal loads by the tabular method (58) for symmetric throws (split beam).
+    """Main-journal loads by the split beam of (58): each throw on the two journals beside it.
 
-    Throw i loads its two supports equally with R_k,i = R_i + K_rk + the counterweight's force
-    (Gots (42), (43)): radial K_Σ = K + K_rш + K_rk + K_cw and tangential T_Σ = T + T_rш + T_rk +
-    T_cw (the tangential d'Alembert terms only when ε ≠ 0).
+    A rod's load R = K + K_rш, T + T_rш acts in its big end's middle plane and is shared by the
+    lever rule (half each in the throw's middle); the throw's unbalanced mass and counterweight
+    half each (Gots (42), (43)); the tangential d'Alembert terms only when ε ≠ 0.
 
     Parameters
     ----------
     mech : CrankSlider
-        In-line engine; throws numbered from the nose like the cylinders.
+        Throws and cylinders numbered from the nose.
     loads : CylinderLoads
         From :func:`crank_slider_loads` with the same ``omega``, ``epsilon``.
     omega, epsilon : array_like
         Speed [rad/s] and angular acceleration [rad/s²] of the samples (for the counterweights).
     counterweight_mass : float
         Counterweight mass per throw reduced to the crank radius [kg] (both webs together, placed
-        symmetrically so the throw stays symmetric), 0 for none.
+        symmetrically so the throw stays symmetric), 0 for none; with split pins half of it
+        turns with each pin, as the crank mass does.
     counterweight_angle : float
         Its angle ahead of the crank in the direction of rotation [rad]; π: opposite the crank.
     """
-    _check_inline(mech)
-    firing = np.asarray(mech.firing_angles, dtype=np.float64)
-    gamma = np.mod(firing[0] - firing, 2.0 * math.pi)
-    k_cw, t_cw = rotating_inertia_force(counterweight_mass, mech.crank_radius, omega, epsilon,
-                                        counterweight_angle)
-    k_sum = loads.R_K + loads.K_crank + k_cw
-    t_sum = loads.R_T + loads.T_crank + t_cw
+    gamma = np.mod(mech.pin_angles() - mech.pin_angles()[0], 2.0 * math.pi)
+    k_cw, t_cw = rotating_inertia_force(counterweight_mass / mech.cylinders_per_throw,
+                                        mech.crank_radius, omega, epsilon, counterweight_angle)
     cg, sg = np.cos(gamma)[:, None], np.sin(gamma)[:, None]
-    half_x = 0.5 * (t_sum * cg - k_sum * sg)  # (58), each throw's half
-    half_y = 0.5 * (t_sum * sg + k_sum * cg)
-    n = half_x.shape[1]
-    z = np.zeros((1, n))
-    x = np.concatenate([half_x, z]) + np.concatenate([z, half_x])
-    y = np.concatenate([half_y, z]) + np.concatenate([z, half_y])
-    a1 = loads.alpha[0][None, :]
-    ca, sa = np.cos(a1), np.sin(a1)
-    return MainJournalLoads(x=x, y=y, side=x * ca - y * sa, down=x * sa + y * ca, gamma=gamma)
+
+    def crank1(k, t):  # (58): a load at crankpin γ in the frame of crank 1
+        return t * cg - k * sg, t * sg + k * cg
+
+    rod_x, rod_y = crank1(loads.R_K, loads.R_T)
+    mass_x, mass_y = crank1(loads.K_crank + k_cw, loads.T_crank + t_cw)
+    zeta = mech.axial_positions()[:, None]
+    throw = mech.throw_of_cylinder()
+    x = np.zeros((mech.n_throws + 1, rod_x.shape[1]))
+    y = np.zeros_like(x)
+    for journal, lever in ((throw, 0.5 - zeta), (throw + 1, 0.5 + zeta)):  # ahead, behind
+        np.add.at(x, journal, lever * rod_x + 0.5 * mass_x)
+        np.add.at(y, journal, lever * rod_y + 0.5 * mass_y)
+    psi = loads.alpha[0][None, :] + mech.bank_angles[0]  # crank 1 from the reference axis
+    cp, sp = np.cos(psi), np.sin(psi)
+    return MainJournalLoads(x=x, y=y, side=x * cp - y * sp, down=x * sp + y * cp, gamma=gamma)

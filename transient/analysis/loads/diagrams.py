@@ -1,6 +1,6 @@
 """The loads of a run's last whole cycle as the load diagrams show them: the crankpin load in
 its crank's frame (the polar diagram), the wear diagram's rays, the most loaded main journal
-and the running torques of an in-line engine (Gots §2.6–§2.8), and the crankpin and link-pin
+and the running torques of a crank-slider engine (Gots §2.6–§2.8), and the crankpin and link-pin
 loads of an articulated engine.
 
 The last whole cycle is counted from φ0 as :mod:`.irregularity` counts cycles, so the diagrams
@@ -82,19 +82,17 @@ class CrankSliderDiagrams:
         Its load in its crank's frame [N].
     crankpin_wear : (rays [deg], sums [N])
         Its wear diagram (:func:`~.wear.wear_rays`, 36 rays).
-    inline : bool
-        All bank angles equal: main journals and running torques apply.
-    journal_torques : (n_cylinders + 1, n) array or None
-        Running torques of the main journals [N m] (in-line only).
-    crankpin_torques : (n_cylinders, n) array or None
-        Running torques of the crankpins [N m] (in-line only).
-    main_journals : MainJournalLoads or None
-        Loads of every main journal (in-line only).
-    most_loaded : int or None
-        Index (0-based) of the main journal with the largest peak load (in-line only).
-    journal_x, journal_y : (n,) arrays or None
+    journal_torques : (n_throws + 1, n) array
+        Running torques of the main journals [N m].
+    crankpin_torques : (n_throws, n) array
+        Running torques of the crankpins, in each throw's middle [N m].
+    main_journals : MainJournalLoads
+        Loads of every main journal.
+    most_loaded : int
+        Index (0-based) of the main journal with the largest peak load.
+    journal_x, journal_y : (n,) arrays
         That journal's load in the frame of crank 1 [N].
-    journal_wear : (rays [deg], sums [N]) or None
+    journal_wear : (rays [deg], sums [N])
         Its wear diagram.
     """
 
@@ -105,14 +103,13 @@ class CrankSliderDiagrams:
     crankpin_x: Array
     crankpin_y: Array
     crankpin_wear: tuple[Array, Array]
-    inline: bool
-    journal_torques: Array | None = None
-    crankpin_torques: Array | None = None
-    main_journals: MainJournalLoads | None = None
-    most_loaded: int | None = None
-    journal_x: Array | None = None
-    journal_y: Array | None = None
-    journal_wear: tuple[Array, Array] | None = None
+    journal_torques: Array
+    crankpin_torques: Array
+    main_journals: MainJournalLoads
+    most_loaded: int
+    journal_x: Array
+    journal_y: Array
+    journal_wear: tuple[Array, Array]
 
 
 def crank_slider_diagrams(scene, traj: Mapping[str, Array], cylinder: int = 1
@@ -141,20 +138,16 @@ def crank_slider_diagrams(scene, traj: Mapping[str, Array], cylinder: int = 1
     k = cylinder - 1
     x, y = loads.R_T[k], -loads.R_K[k]
     weight = angle_weights(win["phi"])
-    common = dict(window=window, loads=loads, engine_torque=loads.engine_torque,
-                  cylinder=cylinder, crankpin_x=x, crankpin_y=y,
-                  crankpin_wear=wear_rays(np.arctan2(y, x), loads.R[k], weight))
-    inline = n_cyl == 1 or np.ptp(np.asarray(mech.bank_angles, dtype=float)) <= 1e-12
-    if not inline:
-        return CrankSliderDiagrams(inline=False, **common)
     journals, crankpins = running_torques(mech, loads)
     mj = main_journal_loads(mech, loads, win["omega"], win["epsilon"])
     best = int(np.argmax(mj.magnitude.max(axis=1)))
     jx, jy = mj.x[best], -mj.y[best]
     return CrankSliderDiagrams(
-        inline=True, journal_torques=journals, crankpin_torques=crankpins, main_journals=mj,
+        window=window, loads=loads, engine_torque=loads.engine_torque, cylinder=cylinder,
+        crankpin_x=x, crankpin_y=y, crankpin_wear=wear_rays(np.arctan2(y, x), loads.R[k], weight),
+        journal_torques=journals, crankpin_torques=crankpins, main_journals=mj,
         most_loaded=best, journal_x=jx, journal_y=jy,
-        journal_wear=wear_rays(np.arctan2(jy, jx), mj.magnitude[best], weight), **common)
+        journal_wear=wear_rays(np.arctan2(jy, jx), mj.magnitude[best], weight))
 
 
 @dataclass(frozen=True)
