@@ -20,6 +20,7 @@ from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_P
                           POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS, RX_RING_FORCE,
                           RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T, extras_of,
                           work_array)
+from .core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
 from .forces.compressor import compressor_cycle
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .mechanisms import reaction_joints
@@ -557,17 +558,31 @@ def chain_fields(scene) -> dict:
     if reaction_friction(scene):
         return reaction_fields(scene)
     cut_after = [mech.links.index(p.between[0]) for p in friction.pairs]
-    link_sub = np.array([sum(c < i for c in cut_after) for i in range(len(mech.links))],
-                        dtype=np.int64)
+    link_sub = [sum(c < i for c in cut_after) for i in range(len(mech.links))]
     return dict(
         n_pairs=len(friction.pairs),
         eta_fwd=np.array([p.eta_forward for p in friction.pairs], dtype=np.float64),
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
-        link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
+        **link_fields(mech, link_sub),
         reaction=False, rx_par=np.zeros((N_JOINTS, N_RX_PAR)),
         rx_pair=np.full(N_JOINTS, -1, dtype=np.int64),
         **eta_table_fields(friction.pairs))
+
+
+def link_fields(mech, link_sub: list[int]) -> dict:
+    """The links' part of the Model (``transient.core.rhs.split_subchains``): the sub-chain of
+    each, their constant inertias, the link with the rest of J(φ), and the law of each link
+    whose φ-dependent inertia a pair cuts from the rest's sub-chain (elsewhere it stays in the
+    rest: a chain cut only where the links' inertias are constant adds nothing to compute)."""
+    laws = mech.link_laws
+    rest = laws.index(LINK_REST)
+    own = [law if law in (LINK_PISTONS, LINK_SWASH) and link_sub[i] != link_sub[rest]
+           else LINK_FIXED for i, law in enumerate(laws)]
+    mass = [mech.piston_link_mass if law == LINK_PISTONS else 0.0 for law in laws]
+    return dict(link_sub=np.array(link_sub, dtype=np.int64),
+                link_J=np.array(mech.link_inertias(), dtype=np.float64), link_rest=rest,
+                link_own=np.array(own, dtype=np.int64), link_mass=np.array(mass))
 
 
 def eta_table_fields(pairs) -> dict:
@@ -636,8 +651,7 @@ def reaction_fields(scene) -> dict:
     n = len(pairs)
     return dict(n_pairs=n, eta_fwd=np.ones(n), eta_bwd=np.ones(n),
                 policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
-                link_sub=np.zeros(len(mech.links), dtype=np.int64),
-                link_J=np.array(mech.link_inertias(), dtype=np.float64),
+                **link_fields(mech, [0] * len(mech.links)),
                 reaction=True, rx_par=rx_par, rx_pair=rx_pair, **eta_table_fields(pairs))
 
 

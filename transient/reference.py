@@ -34,6 +34,8 @@ from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
 from .core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
                            RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
+from .core.layout import LINK_PISTONS, LINK_REST, LINK_SWASH
+from .core.swash_plate import link_terms as swash_link_terms
 from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
 from .mechanisms import reaction_joints
@@ -54,20 +56,42 @@ class ChainNumpy:
         cuts = [mech.links.index(p.between[0]) for p in pairs]
         self.sub = [sum(c < i for c in cuts) for i in range(len(mech.links))]
         self.link_J = mech.link_inertias()
+        self.laws = mech.link_laws
+        self.rest = self.laws.index(LINK_REST)
+        # the links whose own inertia a pair cuts from the rods' (elsewhere it is in the rest)
+        self.own = [i for i, law in enumerate(self.laws) if law in (LINK_PISTONS, LINK_SWASH)
+                    and self.sub[i] != self.sub[self.rest]]
+        self.piston_mass = mech.piston_link_mass
+        self.terms = mech.reference_terms()
+        self.mp = mech.pack()
         self.J0 = scene.inertia.total
 
     def inputs(self, phi, J, dJ, M_gas, M_shaft, forces, sel):
         """What :meth:`solve` and :meth:`start_direction` take at a state: the sub-chains."""
-        return self.split(J, dJ, M_gas, M_shaft)
+        return self.split(phi, J, dJ, M_gas, M_shaft)
 
-    def split(self, J, dJ, M_gas, M_shaft):
-        """(J_k, J′_k, M_k) per sub-chain: shaft link, constant middle links, the rest last."""
+    def split(self, phi, J, dJ, M_gas, M_shaft):
+        """(J_k, J′_k, M_k) per sub-chain from each link's inertia: the shaft's J0, the constant
+        ones, where a pair cuts them from the rods the pistons' m Σ u_k² (from the twin's u, u′)
+        and the swash plate's link 9 and crosses (its kernel's Python code), and the rest of
+        J(φ), J′(φ) for the rods; the load and starter act on the shaft, the gas on the last
+        link."""
+        Ji = np.array(self.link_J, dtype=float)
+        dJi = np.zeros(len(self.laws))
+        Ji[0] = self.J0
+        if self.own:
+            _, _, u, du = self.terms(phi)
+        for i in self.own:
+            if self.laws[i] == LINK_PISTONS:
+                Ji[i], dJi[i] = self.piston_mass * u @ u, 2.0 * self.piston_mass * u @ du
+            else:
+                Ji[i], dJi[i] = swash_link_terms.py_func(self.mp, phi)
+        rest = self.rest
+        Ji[rest] = J - (np.sum(Ji) - Ji[rest])
+        dJi[rest] = dJ - (np.sum(dJi) - dJi[rest])
         Jk, dJk, Mk = np.zeros(self.n + 1), np.zeros(self.n + 1), np.zeros(self.n + 1)
-        Jk[self.sub[0]] += self.J0
-        for i in range(1, len(self.sub) - 1):
-            Jk[self.sub[i]] += self.link_J[i]
-        Jk[self.sub[-1]] += J - self.J0 - sum(self.link_J[1:-1])
-        dJk[self.sub[-1]] += dJ
+        np.add.at(Jk, self.sub, Ji)
+        np.add.at(dJk, self.sub, dJi)
         Mk[self.sub[0]] += M_shaft
         Mk[self.sub[-1]] += M_gas
         return Jk, dJk, Mk
@@ -484,7 +508,7 @@ class ReferenceModel:
 
     def moments(self, phi: float, w: float, y):
         m = self.model
-        J, dJ, u = self.mechanism_terms(phi)
+        J, dJ, u, _ = self.mechanism_terms(phi)
         J += m.J0
         M_gas = 0.0
         p = np.zeros(m.ncyl)

@@ -82,8 +82,9 @@ def dynamic_scenes():
 SCENES = dynamic_scenes()
 #: The scenes whose reference runs (the diesel's mixed cycle with governors, pairs, load steps,
 #: Wiebe or wall heat: plain-Python right-hand sides over many short steps) make the test slow.
-SLOW_SCENES = {"gots_diesel_friction", "gots_diesel_governed", "gots_diesel_load_steps",
-               "gots_diesel_pi", "gots_diesel_wiebe", "gots_diesel_woschni"}
+SLOW_SCENES = {"gots_diesel_friction", "gots_diesel_chain_friction", "gots_diesel_governed",
+               "gots_diesel_load_steps", "gots_diesel_pi", "gots_diesel_wiebe",
+               "gots_diesel_woschni"}
 
 
 def shortened(name, method):

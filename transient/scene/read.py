@@ -154,7 +154,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["output"] = Output(spr, dt)
         so.finish()
         sf = root.sub("friction")
-        sections["friction"] = _read_friction(sf, mech, base_dir)
+        sections["friction"] = _read_friction(sf, mech, base_dir, sections["gas"].model)
         sf.finish()
         sa = root.sub("analysis")
         sections["analysis"] = _read_analysis(sa)
@@ -431,9 +431,11 @@ def _table_column(rows, index: int, column: str, factor: float) -> tuple[float, 
     return tuple(out)
 
 
-def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
+def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction:
     """The [friction] table: a policy and an array of [[friction.pairs]] between neighbouring
-    links of the mechanism (shaft side first), each with its friction model."""
+    links of the mechanism (shaft side first), each with its friction model; a constant-η or
+    mapped pair into the cylinders (the last link, ``gas_model`` its gas) needs gas forces to
+    pass on."""
     policy = s.string("policy", "power-flow", choices=POLICIES)
     s.known.append("pairs")
     raw = s.data.pop("pairs", [])
@@ -451,13 +453,18 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                                                   f"for {mech.name!r}; use model = "
                                                   f"\"constant-eta\" here")
         hint = ""
-        if model != "reaction" and getattr(mech, "reaction_links", ()):
+        if model != "reaction" and getattr(mech, "reaction_links", links) != links:
             hint = (f" (pairs with model = \"reaction\" join "
                     f"{' – '.join(mech.reaction_links)})")
         if model == "reaction" and hasattr(mech, "reaction_joints"):
             between = _joint(ps, mech)
         else:
             between = _between(ps, links, hint)
+        if model != "reaction" and between[1] == links[-1] and gas_model == "none":
+            raise SceneError(ps.key("between"), f"{list(between)} passes on the gas forces' "
+                                                f"work, and this scene has none (gas.model = "
+                                                f"\"none\"); give a gas model, or join other "
+                                                f"links of {' – '.join(links)}")
         ideal = getattr(mech, "ideal_reaction_joints", {}) if model == "reaction" else {}
         if between[0] in ideal:
             allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in zip(links, links[1:])

@@ -464,7 +464,11 @@ class Pair:
     """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).
 
     ``between``: the link on the shaft side first (a), then the far one (b), names from the
-    mechanism's ``links``; for the reaction model two links of one of its reaction joints
+    mechanism's ``links`` (crank-slider and articulated ``shaft`` – ``crank`` – ``rod`` –
+    ``piston`` – ``cylinder``, swash plate ``shaft`` – ``link`` – ``rod`` – ``piston`` –
+    ``cylinder``; any number of pairs, each couple of neighbours once, gaps allowed; a pair into
+    the ``cylinder`` passes on the gas forces' work, so it needs a gas model); for the reaction
+    model two links of one of its reaction joints
     (``transient.mechanisms.reaction_joints``): crank-slider ``shaft`` – ``crank`` – ``rod`` –
     ``piston`` – ``cylinder``, swash plate ``shaft`` – ``plate`` – ``link`` – ``rod`` – ``piston``
     – ``cylinder`` (its ball joints, ``["link", "rod"]`` and ``["rod", "piston"]``, stay ideal),
