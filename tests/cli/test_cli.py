@@ -145,6 +145,7 @@ strokes = 4
 cylinders = 2
 firing_deg = [0, 270]
 bank_deg = [0, 90]
+throws_deg = [0, 180]   # (one throw per cylinder)
 
 [mechanism.rod]
 model = "rigid"

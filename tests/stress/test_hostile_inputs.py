@@ -188,16 +188,20 @@ TABLE_CASES = [
     ("short-row", "phi_deg,p_bar\n0,1\n720\n",
      "line 3 has 1 field(s); column p_bar is field 2"),
     ("semicolons", "phi_deg;p_bar\n0;1\n720;1\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is ['phi_deg;p_bar']"),
     ("many-unknown-columns", ",".join(f"c{i}" for i in range(60)) + "\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is ['c0', 'c1', 'c2', 'c3', 'c4', 'c5', ..."),
     ("pressure-unit-unknown", "phi_deg,p_psi\n0,1\n720,1\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is ['phi_deg', 'p_psi']"),
     ("comments-only", "# nothing measured yet\n\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is []"),
 ]
 
