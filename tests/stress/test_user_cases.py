@@ -1,15 +1,15 @@
 """The stress suite's cases a user would try (``transient.verify.stress``: an in-line six, a
-two-stroke, a weak starter from rest, a light flywheel, load steps at revolution counts, a sweep
-from a script), each run as ``transient stress`` runs it — a forked child with a time bound —
-and each must pass: no traceback, and the status that says what happened. A run whose shaft
-never did what its scene asked must not end ``finished`` and must say it did not start."""
+V8, a two-stroke, a weak starter from rest, a light flywheel, load steps at revolution counts, a
+sweep from a script), each run as ``transient stress`` runs it — a forked child with a time
+bound — and each must pass: no traceback, and the status that says what happened. A run whose
+shaft never did what its scene asked must not end ``finished`` and must say it did not start."""
 from __future__ import annotations
 
 import pytest
 
 from transient.verify.stress import catalogue, run_case, warm_up
 
-USER_CASES = ("in-line-six", "two-stroke", "weak-starter-from-rest", "light-flywheel",
+USER_CASES = ("in-line-six", "v8", "two-stroke", "weak-starter-from-rest", "light-flywheel",
               "load-steps-at-revolutions", "sweep-from-script")
 
 

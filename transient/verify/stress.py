@@ -816,6 +816,24 @@ def inline_six(quick: bool) -> dict:
     return put(d, "load", fan=2 * 9.692e-4)
 
 
+def v8(quick: bool) -> dict:
+    """The cross-plane V8 (cases/v8_cross_plane.toml: two cylinders on each of four throws, side
+    by side, crank_mass per throw), spinning up from 1500 rpm."""
+    return put(base("v8_cross_plane"), "run", revolutions=10 if quick else 200)
+
+
+def _v8_journals(run: Run, o: Outcome) -> bool:
+    """The loads analysis gives the V8 its five main journals (four throws), finite and loaded."""
+    from ..analysis.requested import stored_loads
+
+    cuts = run.events.get("breakpoint", np.zeros((0, 2)))[:, 1]
+    x = np.asarray(stored_loads(run.scene, run.trajectory, cuts)["loads_main_x"][0])
+    ok = x.shape[0] == 5 and bool(np.all(np.isfinite(x))) and float(np.max(np.abs(x))) > 0.0
+    if not ok:
+        o.notes.append(f"main journals: {x.shape[0]} of 5, finite {np.all(np.isfinite(x))}")
+    return ok
+
+
 def two_stroke(quick: bool) -> dict:
     """The Gots engine as a two-stroke (firing 120° apart over a 360° cycle), scavenged to p_a
     at bottom dead centre: no gas-exchange pressures (a scene that gives them is refused)."""
@@ -1046,6 +1064,9 @@ def catalogue() -> list[Case]:
              kill_and_resume, time_limit=120.0, full_time_limit=600.0),
         Case("in-line-six", "the Gots cylinder as an in-line six (1-5-3-6-2-4), spinning up",
              single(inline_six, name="in-line-six")),
+        Case("v8", "the cross-plane V8, two cylinders on each of four throws, spinning up; "
+                   "its five main journals loaded",
+             single(v8, extra=_v8_journals, name="v8")),
         Case("two-stroke", "the Gots engine as a two-stroke; the same scene with p_intake is "
                            "refused, naming the key",
              single(two_stroke, extra=_refuses_exchange_pressures, name="two-stroke")),
