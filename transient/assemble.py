@@ -44,8 +44,9 @@ def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
     (:func:`~transient.forces.gas.mixed_cycle`), for ``"wiebe"`` the cycle without fuel (both
     from one :func:`~transient.forces.wiebe.wiebe_tables`; with ``fuel_mass = 0`` both are that
     cycle), for ``"table"`` the user's ``motored_p`` at the table's angles. It is None for a
-    force pulse (``"trapezoid"``, whose motored force is 0) and for a table without
-    ``motored_p``, which cannot burn less than full-load fuel (:func:`part_load_refusal`).
+    force pulse (``"trapezoid"``, whose motored force is 0), and for a table without
+    ``motored_p`` and a compressor, which cannot burn less than full-load fuel
+    (:func:`part_load_refusal`).
     """
     gas = scene.gas
     mech = scene.mechanism
@@ -54,9 +55,7 @@ def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
     if gas.model == "trapezoid":  # a force per piston [N] (Antonyuk §4)
         return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration), None
     if gas.model == "table":  # pressures [Pa] (and the motored ones), or forces per piston [N]
-        if gas.force:
-            return _points_table(scene, gas.force, "gas.p"), None
-        return (_points_table(scene, gas.p, "gas.p"),
+        return (_points_table(scene, gas.force or gas.p, "gas.p"),
                 _points_table(scene, gas.motored_p, "gas.motored_p") if gas.motored_p else None)
     if gas.model == "wiebe":
         tables = wiebe_levels(mech, gas)

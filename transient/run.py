@@ -284,12 +284,13 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     (the textbook analysis at given ω). ``fuel`` sets the pressure between the motored and the
     full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot zero
     force for a force pulse): the tables' cubics are blended, so the ``p_<k>`` columns hold the
-    pressure applied. A fuel below 1 on a pressure table without its motored curve is a
-    SceneError (:func:`transient.assemble.part_load_refusal`). The work columns are integrated
-    over the motion to the scene's tolerance (:mod:`.prescribed_work`)."""
+    pressure applied. A fuel below 1 for a model that cannot burn less (a table without its
+    motored curve, a compressor: :func:`transient.assemble.part_load_refusal`) is a SceneError.
+    The work columns are integrated over the motion to the scene's tolerance
+    (:mod:`.prescribed_work`)."""
     why = part_load_refusal(scene) if fuel != 1.0 else None
     if why:
-        raise SceneError("gas.motored_p", f"fuel {fuel:g}: {why}")
+        raise SceneError("fuel", f"{fuel:g}: {why}")
     model, _, _ = build_model(scene, part_load=fuel != 1.0)
     coef = model.coef.copy()
     if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.layout.Model)

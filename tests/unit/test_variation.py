@@ -285,7 +285,7 @@ def test_part_load_study_on_a_table_without_motored_curve(tmp_path, capsys):
     from transient.run import prescribed
 
     scene = scene_from_dict(table_data())
-    with pytest.raises(SceneError, match=r"^gas.motored_p: fuel 0.5: a fuel below 1"):
+    with pytest.raises(SceneError, match=r"^fuel: 0.5: a fuel below 1"):
         prescribed(scene.replace(run={"mode": "prescribed-speed", "speed_rpm": 2000,
                                       "revolutions": 2}), 0.5)
     path = tmp_path / "table.toml"

@@ -636,7 +636,7 @@ class MixedCycle(IndicatedCycle):
     interpolation_error : float
         Relative tabulation error estimate returned by :func:`table_from_function`.
     motored : PressureTable
-        The motored cycle (no fuel) on the same knots and corners: the closed part on the
+        The motored cycle (no fuel) on the same corners: the closed part on the
         compression polytrope both ways, p_a·(V_a/V)^n1, and the same gas exchange
         (:func:`mixed_cycle`, *Part load*).
     """
@@ -748,7 +748,7 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         + (p_z V_z - p_b V_b)/(n2 - 1) + p_ex(V_c - V_b)`` (polytrope work
         ``(p1 V1 - p2 V2)/(n - 1)``; the intake and exhaust terms are the pumping loop, absent
         for a 2-stroke), p_c, p_b, the isobar end angle and the motored cycle on the same
-        knots.
+        corners.
 
     Raises
     ------
@@ -821,7 +821,7 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
             + (p_z * v_z - p_b * v_b) / (n2 - 1.0))
     # Each piece from the angle where it starts; the exhaust ends at the period's end (4π ≡ 0).
     # (the motored cycle's closed part is the compression polytrope throughout, on the same
-    # pieces so that both tables share their knots)
+    # pieces so that both tables share their corners)
     closed: list[tuple[float, PieceFunction]] = [(x_start, compression), (x_tdc, p_z),
                                                  (angle_z, expansion)]
     if not has_isobar:
