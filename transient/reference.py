@@ -439,8 +439,9 @@ class ReferenceModel:
     def __init__(self, scene) -> None:
         self.scene = scene
         self.model, self.bp, self.table = build_model(scene)
-        # The motored curve (None: the constant p0) between which and the table the fuel
-        # interpolates, as PressureTable objects rather than the model's arrays.
+        # The motored curve (None: gas_offset, a force pulse's zero, or a table's that runs at
+        # full fuel only) between which and the table the fuel interpolates, as PressureTable
+        # objects rather than the model's arrays.
         self.motored = gas_tables(scene)[1]
         self.mechanism_terms = scene.mechanism.reference_terms()
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
@@ -516,7 +517,7 @@ class ReferenceModel:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
             f = (self.latched if self.latched is not None else self.command(w, y)) * self.factors
             p_full = self.table.evaluate(local, self.pieces)[0]
-            # p = p_mot + f·(p_full − p_mot); the motored curve is p0 without a motored table
+            # p = p_mot + f·(p_full − p_mot); gas_offset without a motored table
             p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
                      if self.motored is not None else m.gas_offset)
             if self.shift is None:

@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from .assemble import build_model, initial_governor
+from .assemble import build_model, initial_governor, part_load_refusal
 from .core import forcing, layout, stepper
 from .core import stepper_io as sio
 from .core.inverse import inverse_dynamics
@@ -282,11 +282,16 @@ def _kinematics_attrs(scene) -> dict:
 def prescribed(scene, fuel: float = 1.0) -> RunData:
     """Inverse dynamics at a prescribed speed: the drive torque on the shaft that the chain needs
     (the textbook analysis at given ω). ``fuel`` sets the pressure between the motored and the
-    full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot the
-    crankcase pressure p0, or zero force, for the models without a motored curve): the tables'
-    cubics are blended, so the ``p_<k>`` columns hold the pressure applied. The work columns are
-    integrated over the motion to the scene's tolerance (:mod:`.prescribed_work`)."""
-    model, _, _ = build_model(scene)
+    full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot zero
+    force for a force pulse): the tables' cubics are blended, so the ``p_<k>`` columns hold the
+    pressure applied. A fuel below 1 for a model that cannot burn less (a table without its
+    motored curve, a compressor: :func:`transient.assemble.part_load_refusal`) is a SceneError.
+    The work columns are integrated over the motion to the scene's tolerance
+    (:mod:`.prescribed_work`)."""
+    why = part_load_refusal(scene) if fuel != 1.0 else None
+    if why:
+        raise SceneError("fuel", f"{fuel:g}: {why}")
+    model, _, _ = build_model(scene, part_load=fuel != 1.0)
     coef = model.coef.copy()
     if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.layout.Model)
         coef[:, :4] = coef[:, 4:] + fuel * (coef[:, :4] - coef[:, 4:])

@@ -138,3 +138,93 @@ def test_rho_one_has_no_isobar():
                                atol=0)
     assert mc(2 * math.pi) == pytest.approx(CYCLE["p_z"], rel=1e-14)
     assert abs(table_loop_work(mc) / mc.work - 1) <= 1e-8
+
+
+# ------------------------------------------------------------------------------------------------
+# The motored cycle and part load (mixed_cycle, *Part load*)
+
+N1 = CYCLE["n1"]
+
+
+@pytest.mark.parametrize("strokes", [4, 2])
+def test_motored_cycle_is_the_compression_polytrope_both_ways(strokes):
+    """The motored curve against the closed form p_a·(V_a/V)^n1 over the whole closed part
+    (4-stroke: π to 3π; 2-stroke: the whole turn) and the full-load table's gas exchange, on the
+    same knots; its loop work is the pumping loop alone, (p_intake − p_exhaust)·V_h (0 for a
+    2-stroke), by Gauss–Legendre over the table."""
+    args = dict(CYCLE, rho=1.671, strokes=strokes)
+    if strokes == 2:
+        args.update(p_intake=None, p_exhaust=None)
+    mc = mixed_cycle(volume, **args)
+    mot = mc.motored
+    np.testing.assert_array_equal(mot.corners, mc.corners)
+    x = mot.interior_points(4)
+    closed = (x > math.pi) & (x < 3 * math.pi) if strokes == 4 else np.ones(x.size, bool)
+    polytrope = CYCLE["p_a"] * (V_C * EPS / volume(x)) ** N1
+    np.testing.assert_allclose(mot(x)[closed], polytrope[closed], rtol=2e-9)
+    np.testing.assert_array_equal(mot(x)[~closed], mc(x)[~closed])
+    # at the firing TDC the compression end p_c = p_a·ε^n1, continuous (no heat, no jump)
+    tdc = 2 * math.pi if strokes == 4 else 0.0
+    assert mot(tdc) == pytest.approx(CYCLE["p_a"] * EPS ** N1, rel=1e-12)
+    assert left(mot, tdc + mot.period * (strokes == 2)) == pytest.approx(mot(tdc), rel=1e-12)
+    pumping = (CYCLE["p_intake"] - CYCLE["p_exhaust"]) * V_H if strokes == 4 else 0.0
+    assert table_loop_work(mot) == pytest.approx(pumping, abs=1e-9 * mc.work)
+
+
+def first_law_part_load(mc, f, x_out):
+    """p at the local angles ``x_out`` (in the closed part, 4-stroke) of the cycle that burns f
+    times the full-load heat at every angle, by integrating the first law of one ideal-gas
+    zone with k = n1, V dp/dx = (k − 1)·f·dQ/dx − k·p·dV/dx, from p_a at the BDC (solve_ivp).
+    The full-load heat release is the cycle's own, from its closed forms: none on the
+    compression, V_c(p_z − p_c)/(k − 1) at the firing TDC, k/(k − 1)·p_z dV on the isobar and
+    (k − n2)/(k − 1)·p_full dV on the expansion, p_full = p_z(V_z/V)^n2."""
+    from scipy.integrate import solve_ivp
+
+    k, n2, p_z = N1, CYCLE["n2"], CYCLE["p_z"]
+    v_z = mc.v_z
+
+    def dq(x):  # full-load dQ/dx (compression: 0)
+        if x < 2 * math.pi:
+            return 0.0
+        if x < mc.angle_z:
+            return k / (k - 1) * p_z * float(dvolume(x))
+        return (k - n2) / (k - 1) * p_z * (v_z / float(volume(x))) ** n2 * float(dvolume(x))
+
+    def rate(x, p):
+        return [((k - 1) * f * dq(x) - k * p[0] * float(dvolume(x))) / float(volume(x))]
+
+    out = np.empty(x_out.size)
+    p0 = CYCLE["p_a"]
+    for a, b, jump in ((math.pi, 2 * math.pi, True), (2 * math.pi, mc.angle_z, False),
+                       (mc.angle_z, 3 * math.pi, False)):
+        sel = (x_out > a) & (x_out < b)
+        sol = solve_ivp(rate, (a, b), [p0], t_eval=np.sort(np.append(x_out[sel], b)),
+                        method="DOP853", rtol=1e-12, atol=1e-6)
+        out[sel] = sol.y[0][:-1]
+        p0 = sol.y[0][-1]
+        if jump:  # the isochoric heat f·Q_v at the TDC: Δp = (k − 1)·f·Q_v/V_c
+            q_v = V_C * (p_z - p0) / (k - 1)
+            p0 = p0 + (k - 1) * f * q_v / V_C
+    return out
+
+
+@pytest.mark.parametrize("f", [0.0, 0.3, 0.8, 1.0])
+def test_part_load_is_the_cycle_burning_f_times_the_heat(cycles, f):
+    """p_mot + f·(p_full − p_mot) from the two tables against the first law integrated with f
+    times the heat at every angle (:func:`first_law_part_load`): to 1e-9 of p_z (the tables'
+    interpolation); its peak p_c + f·(p_z − p_c) at the firing TDC; and the pressure along the
+    heat addition to V = ρ·V_c falling from it (an isobar at f = 1 only)."""
+    mc = cycles[1.671]
+    x = np.linspace(math.pi, 3 * math.pi, 721)[1:-1]
+    x = x[np.abs(x - 2 * math.pi) > 1e-9]
+    table = mc.motored(x) + f * (mc(x) - mc.motored(x))
+    ode = first_law_part_load(mc, f, x)
+    err = np.max(np.abs(table - ode)) / CYCLE["p_z"]
+    print(f"\nf = {f}: interpolated tables against the first law, {err:.1e} of p_z")
+    assert err <= 1e-9
+    peak = mc.motored(2 * math.pi) + f * (mc(2 * math.pi) - mc.motored(2 * math.pi))
+    assert peak == pytest.approx(mc.p_c + f * (CYCLE["p_z"] - mc.p_c), rel=1e-12)
+    along = (x > 2 * math.pi) & (x < mc.angle_z)
+    assert np.all(table[along] <= peak * (1 + 1e-12))
+    if 0.0 < f < 1.0:
+        assert np.all(np.diff(table[along]) < 0.0)

@@ -28,6 +28,7 @@ def register(sub) -> None:
 
 
 def cmd_efficiency(args) -> int:
+    from ..assemble import part_load_refusal
     from ..scene import POLICIES, load_scene
     from ..study.efficiency import (efficiency_study, plot_budget, plot_map, plot_study,
                                     write_csv)
@@ -43,6 +44,9 @@ def cmd_efficiency(args) -> int:
     if scene.gas.model == "none":
         raise SceneError("gas.model", "an efficiency study needs gas forces (the input power)",
                          file=args.scene)
+    why = part_load_refusal(scene)
+    if why and any(f != 1.0 for f in fuels):
+        raise SceneError("--fuel", why, file=args.scene)
     out = output_folder(args.output, Path("results"))  # (before the study: -o is checked first)
     stem = Path(args.scene).stem
     names = [p.name for p in scene.friction.pairs]

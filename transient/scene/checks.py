@@ -76,6 +76,7 @@ def check_consistency(scene: Scene) -> tuple[float, float]:
         raise SceneError("governor.model", f"a compressor has no fuel for a governor to set; use "
                                            f"model = \"none\", not {scene.governor.model!r} (a "
                                            f"speed is held by the motor or a prescribed speed)")
+    check_part_load(scene)
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
@@ -152,6 +153,22 @@ def _torques(scene: Scene, lever: float, gas_table) -> dict[str, tuple[float, st
     return out
 
 
+def check_part_load(scene: Scene) -> None:
+    """What would burn less than full-load fuel (a ``[[gas.cylinders]]`` entry that changes the
+    combustion, a governor) needs a gas model that can: a motored curve to scale the combustion
+    above (:func:`transient.assemble.part_load_refusal`)."""
+    from ..assemble import part_load_refusal
+
+    why = part_load_refusal(scene)
+    if why is None:
+        return
+    for i, c in enumerate(scene.gas.cylinders):
+        if c.combustion_keys:
+            raise SceneError(f"gas.cylinders[{i}].{c.combustion_keys[0]}", why)
+    if scene.governor.model != "none":
+        raise SceneError("governor.model", f"the governor's fuel command: {why}")
+
+
 def check_woschni(scene: Scene) -> None:
     """Wall heat transfer makes each cylinder's pressure a state of the ODE (built for the
     crank-slider's exact cylinder volume, integrated by the compiled and the reference paths)."""
@@ -183,7 +200,7 @@ def check_gas_table(scene: Scene, section: Section):
         table = gas_table(scene)
     except SceneError as exc:
         if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi",
-                                                     "gas.force"):
+                                                     "gas.force", "gas.motored_p"):
             exc.key = "gas.file"
         raise section.rename(exc) from None
     if scene.gas.woschni is not None:

@@ -311,11 +311,11 @@ def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, flo
 
 
 def _read_gas_table(s: Section, base_dir: Path) -> Gas:
-    """``model = "table"``: absolute pressures ``p`` (with the crankcase's ``p0``) or forces on
-    each piston ``force`` (applied as they are: no ``p0``) at the local angles ``phi``, inline or
-    from a CSV ``file``."""
+    """``model = "table"``: absolute pressures ``p`` (with the crankcase's ``p0`` and optionally
+    the motored ``motored_p``) or forces on each piston ``force`` (applied as they are: no
+    ``p0``) at the local angles ``phi``, inline or from a CSV ``file``."""
     if s.has("file"):
-        phi, column, values = _read_diagram_csv(s, base_dir)
+        phi, column, values, motored = _read_diagram_csv(s, base_dir)
         force = column in FORCE_COLUMNS
     else:
         phi = s.numbers("phi", "angle")
@@ -331,11 +331,17 @@ def _read_gas_table(s: Section, base_dir: Path) -> Gas:
                                          "'p_MPa') or the forces on the piston 'force' (or "
                                          "'force_kN'), one per angle")
         values = values or s.numbers("p", "pressure")
+        motored = s.numbers("motored_p", "pressure", ())
+    if force and motored:
+        key = "file" if "file" in s.written else s.written.get("motored_p", "motored_p")
+        raise SceneError(s.key(key), "gives motored pressures with forces on the piston; the "
+                                     "motored curve goes with the pressures 'p' it lies under")
     p0 = 0.0 if force else s.number("p0", "pressure", 1.0e5, ge=0.0)
     corners = s.numbers("corners", "angle", ())
     interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
     return Gas(model="table", p0=p0, phi=phi, p=() if force else values,
-               force=values if force else (), corners=corners, interpolation=interp)
+               force=values if force else (), motored_p=motored, corners=corners,
+               interpolation=interp)
 
 
 def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
@@ -384,16 +390,21 @@ FORCE_COLUMNS = {"force": 1.0, "force_N": 1.0, "force_kN": 1e3}
 
 def _read_diagram_csv(s: Section, base_dir: Path):
     """Indicator diagram (or force diagram) from a CSV with an angle column and a pressure or a
-    force column (units in names): the angles, the name of that column and its values."""
-    (_, phi), (column, values) = _read_csv(s, base_dir, {
-        "angle": ANGLE_COLUMNS, "pressure or force": {**PRESSURE_COLUMNS, **FORCE_COLUMNS}})
-    return phi, column, values
+    force column (units in names): the angles, the name of that column and its values, and the
+    values of a motored pressure column (``motored_p_bar`` …) if it has one, else ()."""
+    motored_columns = {f"motored_{c}": f for c, f in PRESSURE_COLUMNS.items()}
+    (_, phi), (column, values), (_, motored) = _read_csv(s, base_dir, {
+        "angle": ANGLE_COLUMNS, "pressure or force": {**PRESSURE_COLUMNS, **FORCE_COLUMNS},
+        "motored pressure": motored_columns}, optional=("motored pressure",))
+    return phi, column, values, motored
 
 
-def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
+def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]],
+              optional: tuple[str, ...] = ()):
     """The CSV file named by the key ``file`` of ``s`` (relative to the scene): for each group
     of column names (what it is → {column name: factor to SI}) the first column of the header
-    in it, as ``(name, values in SI)``. Every error names the file under the key ``file``."""
+    in it, as ``(name, values in SI)``; a group in ``optional`` that the header lacks gives
+    ``(None, ())``. Every error names the file under the key ``file``."""
     name = s.string("file")
     try:
         path = (base_dir / name).resolve()
@@ -408,12 +419,13 @@ def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
         header = [h.strip() for h in rows[0][1]] if rows else []
         found = {what: next((c for c in header if c in columns), None)
                  for what, columns in groups.items()}
-        if None in found.values():
+        if any(c is None and what not in optional for what, c in found.items()):
             needs = " and ".join(f"{'an' if what[0] in 'aeiou' else 'a'} {what} column "
-                                 f"({', '.join(columns)})" for what, columns in groups.items())
+                                 f"({', '.join(columns)})" for what, columns in groups.items()
+                                 if what not in optional)
             raise SceneError("(line)", f"needs {needs}; header is {show_value(header)}")
         out = [(c, _table_column(rows[1:], header.index(c), c, groups[what][c]))
-               for what, c in found.items()]
+               if c is not None else (None, ()) for what, c in found.items()]
     except SceneError as exc:  # (placed here: the message names the table, the key the scene's)
         raise SceneError(s.key("file"), f"{path.name}: {exc.message}") from None
     return out

@@ -90,28 +90,31 @@ class Cylinder:
     ``cylinder`` [1]: its number, 1 to the mechanism's cylinder count. ``fuel`` [1]: its fuel
     factor φ_k, multiplying the governor's command, so that its pressure is
     p_mot + φ_k·f·(p_full − p_mot) (:class:`Gas`; for ``"wiebe"`` with ``[gas.woschni]`` the
-    heat released); ``cut_out``: no fuel in any cycle (φ_k = 0, the motored curve). ``pressure``
+    heat released); ``cut_out``: no fuel in any cycle (φ_k = 0, the motored curve: the
+    model's compression and expansion without heat release; for ``"trapezoid"`` no force).
+    A pressure table needs its ``motored_p`` curve for these and the misfires below. ``pressure``
     [1]: its pressure factor β_k, multiplying its pressure above p0 where it acts on the piston,
     p0 + β_k·(p − p0) (a leaking cylinder, or an indicator's calibration): the gas force, the
     ``p_<k>`` column and the work all see it. Both in [0, 2].
 
     ``combustion_offset`` δ_k [rad] (``combustion_offset_deg``), within ±30°: its combustion
     happens δ_k later (earlier if negative),
-    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x. For
-    ``"table"``, ``"mixed-cycle"`` and ``"trapezoid"``, whose motored curve is p0, that moves the whole curve (the table holds no other account of the
-    combustion); for ``"wiebe"`` the combustion's part only, the motored compression staying
-    with the piston; with ``[gas.woschni]`` the heat release and Woschni's combustion term of
-    the closed part, which must then still lie inside it.
+    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x: the
+    combustion's part only, the motored compression staying with the piston (for
+    ``"trapezoid"``, whose motored force is 0, the whole pulse); with ``[gas.woschni]`` the heat
+    release and Woschni's combustion term of the closed part, which must then still lie inside
+    it.
 
     **Misfire.** In a misfiring cycle the cylinder burns nothing (its fuel is 0 for that whole
-    cycle). A cylinder's cycles begin at its local angle 0 (the gas-exchange TDC of a 4-stroke)
-    or π (the BDC of a 2-stroke, so that no combustion straddles two cycles); cycle 1 is the
-    one in progress at the initial angle. ``misfire_cycles``: the cycles that misfire (each
-    ≥ 1); ``misfire_every`` n [1]: cycles n, 2n, 3n, … misfire (0: none); ``misfire_rate`` [1]
-    in [0, 1]: each cycle misfires with this probability, drawn from ``misfire_seed`` (a
-    counter-based generator, :func:`transient.core.variation.misfire_draw`, the same draws for the
-    same seed, cylinder and cycle in every run and on every machine). A cycle misfires if any
-    of the three says so.
+    cycle): it follows the motored curve, compressing and expanding. A cylinder's cycles begin
+    at its local angle 0 (the gas-exchange TDC of a 4-stroke) or π (the BDC of a 2-stroke, so
+    that no combustion straddles two cycles); cycle 1 is the one in progress at the initial
+    angle. ``misfire_cycles``: the cycles that misfire (each ≥ 1); ``misfire_every`` n [1]:
+    cycles n, 2n, 3n, … misfire (0: none); ``misfire_rate`` [1] in [0, 1]: each cycle misfires
+    with this probability, drawn from ``misfire_seed`` (a counter-based generator,
+    :func:`transient.core.variation.misfire_draw`, the same draws for the same seed, cylinder
+    and cycle in every run and on every machine). A cycle misfires if any of the three says
+    so.
     """
 
     cylinder: int
@@ -124,6 +127,17 @@ class Cylinder:
     misfire_seed: int = 0
     combustion_offset: float = 0.0
 
+    @property
+    def combustion_keys(self) -> tuple[str, ...]:
+        """The keys of this entry that change its combustion (the fuel it burns, or when), which
+        act on the pressure above the motored curve; empty if it only scales the pressure."""
+        keys = (("cut_out", self.cut_out), ("fuel", self.fuel != 1.0 and not self.cut_out),
+                ("misfire_cycles", bool(self.misfire_cycles)),
+                ("misfire_every", self.misfire_every > 0),
+                ("misfire_rate", self.misfire_rate > 0.0),
+                ("combustion_offset", self.combustion_offset != 0.0))
+        return tuple(k for k, on in keys if on)
+
 
 @dataclass(frozen=True)
 class Gas:
@@ -133,7 +147,8 @@ class Gas:
     local angles ``phi`` [rad] over one cycle, local angle 0 = gas-exchange TDC for a 4-stroke,
     firing TDC for a 2-stroke; ``corners`` [rad] where the curve may jump or kink, also between
     samples; ``interpolation`` ``"pchip"``, ``"spline"`` or ``"linear"``; every angle of the
-    table and every corner is a breakpoint), ``"mixed-cycle"`` (Gots App. 2,
+    table and every corner is a breakpoint; ``motored_p``: the motored pressures [Pa] at the same
+    angles, optional), ``"mixed-cycle"`` (Gots App. 2,
     Trinkler–Sabathé: ``compression_ratio`` [1], ``p_a`` [Pa] at the start of compression,
     polytropic exponents ``n1`` and ``n2`` [1], peak pressure ``p_z`` [Pa], pre-expansion ratio
     ``rho`` [1] and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]; a 2-stroke, scavenged
@@ -152,9 +167,16 @@ class Gas:
     piston area, no p0), as the trapezoid's.
 
     **Fuel command.** The governor's fuel f ∈ [0, 1] (1 without a governor) sets the cylinder
-    pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot). For
-    ``"table"`` and ``"mixed-cycle"`` the motored curve is the constant p0, so the gas force is
-    f·(p − p0)·F_p (for ``"trapezoid"``, f times the force). For ``"wiebe"`` it is the cycle with
+    pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot):
+    the fuel scales the combustion, never the compression. For ``"mixed-cycle"`` p_mot is the
+    cycle without heat release, the compression polytrope n1 both ways, and p_mot + f·(p_full −
+    p_mot) is exactly the cycle that burns f times the heat at every angle
+    (:func:`transient.forces.gas.mixed_cycle`, *Part load*). For ``"table"`` it is ``motored_p``,
+    the user's motored curve: a table holds no account of which part of it is compression, so
+    without ``motored_p`` a fuel below 1 (a governor, a fuel factor, a misfire or cut-out, a
+    combustion offset) is refused. ``"trapezoid"`` is a force pulse without thermodynamics
+    whose amplitude the governor sets (Antonyuk §4): f times the force, no force at f = 0.
+    For ``"wiebe"`` p_mot is the cycle with
     no fuel and p_full the cycle with ``fuel_mass``: with a constant γ the single-zone pressure is
     linear in the fuel mass, so this is exactly the cycle burning f·fuel_mass. With
     ``gamma_slope`` ≠ 0 (γ(T)) it is not, and the pressure at part load is only approximately
@@ -180,6 +202,7 @@ class Gas:
     p0: float = 1.0e5
     phi: tuple[float, ...] = ()
     p: tuple[float, ...] = ()
+    motored_p: tuple[float, ...] = ()
     corners: tuple[float, ...] = ()
     interpolation: str = "pchip"
     compression_ratio: float = 0.0

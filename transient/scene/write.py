@@ -72,6 +72,8 @@ def _gas_section(gas: Gas, strokes: int) -> list[str]:
         names = tuple(n for n in names if n not in ("p_intake", "p_exhaust"))
     if gas.force:  # a force table: no pressure, no p0
         names = ("model", "phi", "force", "corners", "interpolation")
+    if gas.motored_p:
+        names = (*names, "motored_p")
     if gas.injection is not None:
         names = (*names, "injection")
     lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
