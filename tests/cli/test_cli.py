@@ -886,6 +886,7 @@ def test_long_runs_stream_events_and_summarise_the_tail(tmp_path, capsys, monkey
     assert res.analysis["revolutions"][0] == pytest.approx(4.0, rel=1e-12)
 
 
+@pytest.mark.slow  # (the benchmark's runs, its reference included)
 def test_bench_quick_writes_a_consistent_record(tmp_path):
     """The harness end to end on 3 revolutions (CI's smoke test: outputs and error measures,
     never timings): every scene and method has rows, errors are finite, the compiled paths'
