@@ -23,6 +23,11 @@ TIGHTER = 100.0
 #: Two results of the same physics that took other steps differ by at most the sum of their
 #: errors; each error is one run's estimate, so it is counted twice.
 AGREE = 2.0
+#: How many times its error a value of one scene may move where the steps differ (another CPU's
+#: rounding): runs with numba, numpy and OpenBLAS built for other CPUs moved every value of every
+#: scene in ``cases/`` by at most 1.2 times its error, apart from rounding noise in values that are
+#: zero in exact arithmetic (which a floor of rtol times their scale covers).
+MOVE = 10.0
 
 
 def tightened(scene):
@@ -43,6 +48,17 @@ def errors(scene, data, columns) -> dict[str, float]:
         assert x.shape == y.shape, (c, x.shape, y.shape)
         out[c] = float(np.nanmax(np.abs(x - y), initial=0.0))
     return out
+
+
+def assert_reproduces(scene, data, recorded: dict[str, float]) -> None:
+    """The end values of ``data`` (a run of ``scene``) are the ``recorded`` ones, each to
+    :data:`MOVE` times its error (:func:`errors`) plus one step's tolerance, rtol·|x| + atol."""
+    err = errors(scene, data, recorded)
+    rtol, atol = scene.solver.rtol, scene.solver.atol
+    for name, value in recorded.items():
+        x = float(data.trajectory[name][-1])
+        bound = MOVE * err[name] + rtol * abs(value) + atol
+        assert abs(x - value) <= bound, (name, x, value, bound)
 
 
 def assert_agree(scene_a, a, scene_b, b, columns) -> None:

@@ -10,23 +10,22 @@ Regenerate (after a change meant to alter results, and review ``git diff tests/d
 What is kept per scene: the end of the run (t, φ, ω), every scalar the run stored under
 ``/analysis`` with its unit, ω at 17 samples spread over the run, the sample count, the scene's
 rtol and atol, and the *error* of each of these values: how far the same scene run at a hundredth
-of its rtol and atol puts it (:data:`REFERENCE_TIGHTER`).
+of its rtol and atol puts it (``tests/own_error.py``).
 
-Why the error, and not bit-reproducibility: compiled code rounds differently on another CPU (other
-instructions, another libm path), a last-bit difference flips an accepted step into a rejected one
-or moves an event's root by an ulp, and from there the steps differ. A value is then off by the
-difference of two integration errors of the same size, each what the scene's tolerance admits —
-which the run at the tighter tolerance measures, value by value: an end state after hundreds of
-revolutions has accumulated far more than one step's error, and a loss through a map's kinks (which
-rtol does not control) more still. :func:`compare` holds each value to :data:`ERROR_FACTOR` times its
-error, with a floor of the scene's rtol times the value's scale (:func:`tolerances`): a value that is
-zero in exact arithmetic (an energy-balance residual, an overshoot of a monotone spin-up) is
-rounding noise whose error says nothing, and is held to the tolerance of the quantity it is a
-residual of. Step counts are not kept: they follow the step sequence.
+Why the error, and not bit-reproducibility: compiled code and linear algebra round differently on
+another CPU, a last-bit difference flips an accepted step into a rejected one or moves an event's
+root by an ulp, and from there the steps differ. A value is then off by the difference of two
+integration errors of the same size, each what the scene's tolerance admits — which the run at
+the tighter tolerance measures, value by value: an end state after hundreds of revolutions has
+accumulated far more than one step's error, and a loss through a map's kinks (which rtol does not
+control) more still. :func:`compare` holds each value to ``MOVE`` times its error, with a floor
+of the scene's rtol times the value's scale (:func:`tolerances`): a value that is zero in exact
+arithmetic (an energy-balance residual, the overshoot of a monotone spin-up) is rounding noise
+whose error says nothing, and is held to the tolerance of the quantity it is a residual of. Step
+counts are not kept: they follow the step sequence.
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import sys
@@ -39,17 +38,13 @@ REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"
 GOLDEN = REPO / "tests" / "data" / "golden"
 SAMPLES = 17
-#: The reference run's rtol and atol are the scene's divided by this: its own error is then
-#: negligible (a fifth- or eighth-order method's error falls by 100^(5/6) or more), so the
-#: difference from it is the value's error at the scene's tolerance.
-REFERENCE_TIGHTER = 100.0
-#: How many times its error a value may move. Runs on other CPUs (numba compiling for the x86-64
-#: baseline and for AVX2 without AVX-512, numpy without its AVX-512 paths) moved the values of
-#: every scene by at most 1.2 times that error, apart from rounding noise the floor covers.
-ERROR_FACTOR = 10.0
 #: The scale below which a dimensionless value or a percentage is a fraction of a whole: a
 #: residual or a share relative to 1, a percentage of 100.
 WHOLE = {"1": 1.0, "%": 100.0}
+
+# (what the tests share is on pytest's path, pyproject; as a script this file puts it there)
+sys.path.insert(0, str(REPO / "tests"))
+from own_error import MOVE, tightened  # noqa: E402
 
 
 def scenes() -> list[Path]:
@@ -113,7 +108,7 @@ def with_errors(values: dict, reference: dict) -> dict:
 
 
 def tolerances(want: dict) -> dict:
-    """How far each value of ``want`` may move: :data:`ERROR_FACTOR` times its error, plus the
+    """How far each value of ``want`` may move: ``MOVE`` times its error, plus the
     scene's rtol times its scale, plus atol for the states (t, φ, ω).
 
     The scale: |t| and |φ| for the end's; the largest |ω| of the samples for ω (a run that rocks
@@ -143,7 +138,7 @@ def tolerances(want: dict) -> dict:
              "end omega": rtol * omega + atol}
     floor.update({f"omega sample {i}": rtol * omega + atol for i in range(len(want["omega"]))})
     floor.update({f"analysis {name}": rtol * scale(name) for name in units})
-    return {name: ERROR_FACTOR * err + floor[name] for name, err in want["error"].items()}
+    return {name: MOVE * err + floor[name] for name, err in want["error"].items()}
 
 
 def compare(got: dict, want: dict) -> list[str]:
@@ -171,15 +166,12 @@ def compare(got: dict, want: dict) -> list[str]:
 
 
 def reference_scene(scene: Path, folder: Path) -> Path:
-    """``scene`` with its rtol and atol divided by :data:`REFERENCE_TIGHTER`, written in
-    ``folder`` under the same name (the resolved scene, its tables inline)."""
+    """``scene`` at the tighter tolerance (``tests/own_error.py``), written in ``folder`` under
+    the same name (the resolved scene, its tables inline)."""
     from transient.scene import load_scene, to_toml
 
-    s = load_scene(scene)
-    tight = dataclasses.replace(s.solver, rtol=s.solver.rtol / REFERENCE_TIGHTER,
-                                atol=s.solver.atol / REFERENCE_TIGHTER)
     path = folder / scene.name
-    path.write_text(to_toml(dataclasses.replace(s, solver=tight)))
+    path.write_text(to_toml(tightened(load_scene(scene))))
     return path
 
 

@@ -10,7 +10,8 @@ import math
 
 import pytest
 
-from golden import ERROR_FACTOR, GOLDEN, capture, compare, run, scenes, tolerances, with_errors
+from golden import GOLDEN, capture, compare, run, scenes, tolerances, with_errors
+from own_error import MOVE
 
 
 @pytest.mark.parametrize("scene", scenes(), ids=lambda p: p.stem)
@@ -63,7 +64,7 @@ def test_the_errors_are_the_distances_from_the_tighter_run():
 def test_each_value_is_held_to_its_error_and_the_solvers_floor():
     tol = tolerances(_base())
     # ω: ten times its error, plus rtol times the largest |ω| of the samples, plus atol
-    assert tol["end omega"] == pytest.approx(ERROR_FACTOR * 1e-6 + 1e-8 * 300.0 + 1e-10)
+    assert tol["end omega"] == pytest.approx(MOVE * 1e-6 + 1e-8 * 300.0 + 1e-10)
     assert tol["omega sample 0"] == pytest.approx(1e-8 * 300.0 + 1e-10)  # (|ω| = 100 there)
     assert tol["end t"] == pytest.approx(1e-8 + 1e-10)
     # a residual that is rounding noise: held to rtol of the whole it is a fraction of
@@ -71,7 +72,7 @@ def test_each_value_is_held_to_its_error_and_the_solvers_floor():
     assert tol["analysis overshoot_pct"] == pytest.approx(1e-8 * 100.0)
     assert tol["analysis steady_cycles"] == pytest.approx(1e-8 * 40.0)  # (a count: itself)
     # a loss: its own error, or rtol of the largest energy of the run (the work it is part of)
-    assert tol["analysis W_loss_1_per_cycle"] == pytest.approx(ERROR_FACTOR * 1e-5 + 2000e-8)
+    assert tol["analysis W_loss_1_per_cycle"] == pytest.approx(MOVE * 1e-5 + 2000e-8)
     assert tol["samples"] == 0.0
 
 
