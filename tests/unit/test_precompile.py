@@ -5,9 +5,7 @@ into the shared numba cache while the stepper is compiled, started only where it
 ``tests/validation/test_compile_helper.py``: that needs the stepper compiled.)"""
 from __future__ import annotations
 
-import importlib.util
 import pickle
-import sys
 from pathlib import Path
 
 from numba import config, types
@@ -47,20 +45,13 @@ def test_a_helper_process_compiles_into_the_shared_cache_for_this_processs_cpu(t
     assert [key[1][1:] for key in entries] == [("generic", "")], list(entries)  # (CPU, features)
 
 
-def test_a_function_saved_for_another_cpu_is_not_cached_for_this_one(tmp_path, monkeypatch):
+def test_a_function_saved_for_another_cpu_is_not_cached_for_this_one(kern, monkeypatch):
     """``is_cached`` asks numba's index for the whole key numba loads by: a cache folder that
     other CPUs' processes share may hold the signature compiled for another CPU only."""
-    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path / "numba"))
-    source = tmp_path / "kern.py"
-    source.write_text("def double(x):\n    return 2 * x\n")
-    spec = importlib.util.spec_from_file_location("kern", source)
-    module = importlib.util.module_from_spec(spec)
-    monkeypatch.setitem(sys.modules, "kern", module)
-    spec.loader.exec_module(module)
     sig = (types.int64,)
-    assert not precompile.is_cached(jit.compiled(module.double), sig)
-    assert jit.compiled(module.double)(2) == 4  # (compiled, and saved)
-    fresh = jit.compiled(module.double)  # (another process's view: nothing compiled in it)
+    assert not precompile.is_cached(jit.compiled(kern.double), sig)
+    assert jit.compiled(kern.double)(2) == 4  # (compiled, and saved)
+    fresh = jit.compiled(kern.double)  # (another process's view: nothing compiled in it)
     assert not fresh.overloads and precompile.is_cached(fresh, sig)
     codegen = type(fresh.targetctx.codegen())
     host = codegen.magic_tuple
