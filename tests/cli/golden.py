@@ -144,6 +144,9 @@ def tolerances(want: dict) -> dict:
 def compare(got: dict, want: dict) -> list[str]:
     """What differs between a capture and the golden values, one line each (empty when they
     agree), each value against its tolerance (:func:`tolerances`)."""
+    lacking = sorted({"solver", "units", "error"} - want.keys())
+    if lacking:
+        return [f"the golden values lack {lacking}: regenerate them (tests/cli/golden.py)"]
     diffs = []
     if got["solver"] != want["solver"]:
         diffs.append(f"solver: {got['solver']} against {want['solver']}")

@@ -112,6 +112,10 @@ def test_compare_names_what_is_in_one_capture_only():
     del missing["analysis"]["W_out_per_cycle"]
     del missing["units"]["W_out_per_cycle"]
     assert compare(missing, base) == ["analysis W_out_per_cycle: present in only one of them"]
+    old_format = {k: v for k, v in base.items() if k not in ("solver", "units", "error")}
+    assert compare(missing, old_format) == [
+        "the golden values lack ['error', 'solver', 'units']: regenerate them "
+        "(tests/cli/golden.py)"]
     other = copy.deepcopy(base)
     other.pop("error")
     other["solver"]["rtol"] = 1e-9
