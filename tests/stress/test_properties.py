@@ -255,6 +255,7 @@ def check(d):
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @settings.get_profile(PROFILE)
 @given(crank_slider_scenes())
 def test_random_crank_slider_scenes(d):
@@ -262,6 +263,7 @@ def test_random_crank_slider_scenes(d):
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @settings.get_profile(PROFILE)
 @given(swash_plate_scenes())
 def test_random_swash_plate_scenes(d):
@@ -269,6 +271,7 @@ def test_random_swash_plate_scenes(d):
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @settings.get_profile(PROFILE)
 @given(articulated_scenes())
 def test_random_articulated_scenes(d):

@@ -208,6 +208,7 @@ def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch
     assert e_w <= E_SAMPLES and e_t <= E_SAMPLES
 
 
+@pytest.mark.slow  # (the reference closes the joints' friction in Python at every evaluation)
 @pytest.mark.parametrize("case, revolutions, mix",
                          [("gots_diesel_reaction_friction", 2.0, None),
                           ("radial_5cyl_reaction_friction", 1.0, None),

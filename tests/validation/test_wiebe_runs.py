@@ -32,6 +32,7 @@ from transient.forces.wiebe import wiebe_tables
 from transient.scene import Friction, Governor, Initial, Output, Run, load_scene
 from transient.run import integrate
 
+
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
 DEG = math.pi / 180.0
