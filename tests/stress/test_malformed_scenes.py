@@ -208,7 +208,7 @@ CASES = [
      "gas.phi_deg: needs at least 2 finite angles from 0° to 720°, got 0"),
     ("empty-pair", VALID + "\n[friction]\n\n[[friction.pairs]]\n",
      "friction.pairs[0].between: must be two link names, got None; the links are shaft – crank "
-     "– rod"),
+     "– rod – piston – cylinder"),
     ("empty-scene-name", sub('name = "small"', 'name = ""'),  # was a bug: accepted
      "scene.name: must not be empty; it names the result (leave it out to use the file's name)"),
     # duplicate names and abscissae

@@ -55,7 +55,10 @@ def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
     Each keyword names a table (``scene``, ``mechanism``, ``inertia``, ``load``, …) and gives
     its keys as a TOML file would, unit suffixes included, sub-tables as nested dicts:
     ``scene.replace(inertia={"flywheel": 0.5}, initial={"omega_rpm": 1500})``. A key given with
-    another unit replaces the scene's own (``omega_rpm`` replaces ``omega``).
+    another unit replaces the scene's own (``omega_rpm`` replaces ``omega``). A key given as
+    None is taken out, in whatever unit the scene has it (TOML has no null): a 4-stroke scene
+    made a 2-stroke drops its gas-exchange pressures with ``gas={"p_intake": None,
+    "p_exhaust": None}``.
     """
     data = parse_toml(to_toml(scene), "(replace)")
     for table, keys in tables.items():
@@ -75,7 +78,10 @@ def _merge(base: dict, changes: dict) -> None:
         stem = _unsuffixed(key)
         for other in [k for k in base if k != key and _unsuffixed(k) == stem]:
             del base[other]
-        base[key] = value
+        if value is None:
+            base.pop(key, None)
+        else:
+            base[key] = value
 
 
 def _unsuffixed(key: str) -> str:
