@@ -35,7 +35,7 @@ def gas_table(scene) -> PressureTable | None:
 
 def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
     """``(full, motored)``: the full-load table and the motored one, between which the governor's
-    fuel f interpolates, p = p_mot + f·(p_full − p_mot) (:class:`transient.scene.Gas`).
+    fuel f interpolates, p = p_mot + f·(p_full − p_mot) (:class:`transient.scene.records.Gas`).
 
     ``motored`` is None when the motored curve is the constant crankcase pressure p0 (table,
     mixed cycle; a force model's zero), so that such a scene's model holds one table only. For

@@ -1,5 +1,5 @@
-"""Errors that reach the user, each with what the CLI needs to print it, and :func:`show_value`,
-the one way a message quotes what the user gave."""
+"""Errors that reach the user, each with what the CLI needs to print it, and
+:func:`~transient.errors.show_value`, the one way a message quotes what the user gave."""
 from __future__ import annotations
 
 from typing import Any
@@ -41,7 +41,8 @@ class SceneError(ValueError):
         super().__init__(self.line())
 
     def line(self) -> str:
-        """The one line the CLI prints; a key the user wrote is quoted as :func:`clip` does
+        """The one line the CLI prints; a key the user wrote is quoted as
+        :func:`~transient.errors.clip` does
         (a TOML key may hold any character), and no part may start a second line."""
         prefix = f"{self.file}: " if self.file else ""
         line = f"{prefix}{clip(self.key, 4 * QUOTE_LIMIT)}: {self.message}"

@@ -13,7 +13,7 @@ leaves a file that opens (read in SWMR mode, :func:`open_file`). After each bloc
 appends a *checkpoint* — the trajectory's and the events' lengths and the stepper's state — once
 the block's data are flushed; a reader of an unfinished file takes the trajectory up to the last
 checkpoint only (every block completed before it, never a torn tail), and a run resumes from it
-bit-identically (:func:`read_checkpoint`, :meth:`ResultWriter.resume`).
+bit-identically (:func:`resumable`, and :class:`ResultWriter` with ``resume=True``).
 """
 from __future__ import annotations
 
@@ -663,8 +663,8 @@ class _Columns(Mapping):
 
 @dataclass
 class Result:
-    """A run's result, from its file (:func:`open_result`, or :func:`transient.simulate` with a
-    path) or in memory (:func:`transient.simulate` without one); the same either way.
+    """A run's result, from its file (:func:`~transient.open_result`, or :func:`transient.simulate`
+    with a path) or in memory (:func:`transient.simulate` without one); the same either way.
 
     Attributes
     ----------
@@ -758,8 +758,8 @@ def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dic
 
 
 def open_result(path: str | Path) -> Result:
-    """Read a result file into a :class:`Result`: complete, incomplete, or the partial file
-    (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint."""
+    """Read a result file into a :class:`~transient.Result`: complete, incomplete, or the partial
+    file (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint."""
     path = Path(path)
     with open_file(path) as f:
         if f.attrs.get("creator") != CREATOR:

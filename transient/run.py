@@ -1,6 +1,7 @@
 """Drive a run: the compiled stepper chunk by chunk (or the reference path), streaming to HDF5.
 
-:func:`integrate` returns the run as :class:`RunData`; :func:`simulate`, the public entry,
+:func:`integrate` returns the run as :class:`~transient.results.RunData`;
+:func:`transient.simulate`, the public entry,
 returns a :class:`~transient.results.Result`, of a run kept in memory or written to a file.
 Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
 """

@@ -1,10 +1,12 @@
 """The applied terms of the reduced model at a state: the mechanism's inertia and transfer
 functions, the cylinders' gas values (tables, or pressure states with wall heat transfer), the
 governors' fuel command and branches, the load with its schedule and generator, the starter, and
-their sum into the reduced moments (:func:`moments`).
+their sum into the reduced moments
+(:func:`~transient.core.forcing.moments`).
 
-These are the physics the right-hand side (:mod:`.rhs`), the output rows (:mod:`.outputs`) and the
-inverse dynamics (:mod:`.inverse`) share; the discrete branches (governor, load segment,
+These are the physics the right-hand side (:mod:`.rhs`), the output rows
+(:mod:`transient.core.outputs`) and
+the inverse dynamics (:mod:`.inverse`) share; the discrete branches (governor, load segment,
 generator) are chosen here too, because each is the same formula the term evaluates, held fixed
 over a step so that the right-hand side is smooth inside it.
 """

@@ -1,7 +1,7 @@
 """Reading a scene: TOML text or a parsed dict → a validated :class:`~.records.Scene`.
 
-:func:`load_scene` parses the file; :func:`scene_from_dict` reads one table at a time through a
-:class:`~.reader.Section` (the ``[mechanism]`` table by the class that
+:func:`transient.load_scene` parses the file; :func:`scene_from_dict` reads one table at a time
+through a :class:`~.reader.Section` (the ``[mechanism]`` table by the class that
 :data:`transient.mechanisms.MECHANISMS` names for its ``type``), then runs the checks across
 tables (:mod:`.checks`). Every error is one :class:`~transient.errors.SceneError` naming the file
 and the key as written.
@@ -40,7 +40,7 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
 
 def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
     """A copy of ``scene`` with keys of its tables changed, validated exactly as a scene file is
-    (the same one-line :class:`SceneError`, naming the key).
+    (the same one-line :class:`~transient.SceneError`, naming the key).
 
     Each keyword names a table (``scene``, ``mechanism``, ``inertia``, ``load``, …) and gives
     its keys as a TOML file would, unit suffixes included, sub-tables as nested dicts:
@@ -74,7 +74,8 @@ def _unsuffixed(key: str) -> str:
 
 
 def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
-    """Build and validate a scene from parsed TOML. Raises :class:`SceneError`."""
+    """Build and validate a scene from parsed TOML. Raises
+    :class:`~transient.SceneError`."""
     base_dir = base_dir or Path.cwd()
     try:
         root = Section(data, "")
@@ -292,7 +293,7 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
 
     Ranges of single keys are checked here; what needs several of them (the combustion inside
     the closed part, γ(T) > 1 at intake closing) by :mod:`transient.forces.wiebe` when the table
-    is built, still inside :func:`load_scene` (:func:`~.checks.check_gas_table`).
+    is built, still inside :func:`~transient.load_scene` (:func:`~.checks.check_gas_table`).
     """
     d = Wiebe()
     ratio = s.number("compression_ratio", gt=1.0)

@@ -388,7 +388,8 @@ class Run:
 
 @dataclass(frozen=True)
 class Solver:
-    """Integration settings. ``method``: one of :data:`METHODS`; ``rtol`` [1] and ``atol`` (in the
+    """Integration settings. ``method``: one of
+    :data:`~transient.scene.records.METHODS`; ``rtol`` [1] and ``atol`` (in the
     units of each state) as scipy's; ``max_step`` [rad] in crank angle.
     ``switch_speed`` [rad/s]: below it time is the independent variable;
     ``domain``: ``"auto"`` (crank angle above the switch speed) or ``"time"`` (time throughout,
@@ -429,6 +430,7 @@ MIN_OUTPUT_DT = 1e-8
 
 #: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
 COMPILED_METHODS = ("dop853", "dopri5")
+#: Every ``[solver] method``: the compiled ones, then the reference path's.
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 
 
@@ -540,7 +542,7 @@ DETREND = ("auto", "ramp", "none")
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene: what :func:`transient.scene.load_scene` returns, one record per TOML
+    """A validated scene: what :func:`transient.load_scene` returns, one record per TOML
     table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
     ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`."""
 

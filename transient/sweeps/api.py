@@ -1,4 +1,4 @@
-"""Sweeps from code: :func:`sweep` runs a scene over parameter axes with the engine of
+"""Sweeps from code: :func:`transient.sweep` runs a scene over parameter axes with the engine of
 ``transient sweep``, from a sweep file it writes beside its results, ``<name>.sweep.toml``
 (validated, stored and mended exactly as a sweep file given to the command is), into
 ``<name>.sweep.h5`` and ``<name>.sweep_summary.csv``.
@@ -56,7 +56,7 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
           output: str | Path | None = None, client=None, scheduler: str | None = None,
           workers: int | None = None, force: bool = False,
           progress: Callable[[int, int], None] | None = None) -> SweepResult:
-    """Run ``base`` (a :class:`~transient.scene.Scene`) over ``axes`` and collect quantities of
+    """Run ``base`` (a :class:`~transient.Scene`) over ``axes`` and collect quantities of
     every run, as ``transient sweep`` does.
 
     Parameters
@@ -67,7 +67,7 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
         Dotted scene key → values, e.g. ``{"load.torque": [50, 100], "inertia.flywheel":
         [0.1, 0.2]}``; unit suffixes allowed (``"initial.omega_rpm"``).
     collect
-        Quantities of each run for the table (:data:`transient.sweeps.QUANTITIES` or any
+        Quantities of each run for the table (:data:`transient.sweeps.spec.QUANTITIES` or any
         ``/analysis`` entry).
     method
         ``"grid"``: every combination of the axes; ``"list"``: their i-th values together.

@@ -15,9 +15,9 @@ Every case ends in one of three ways, and the report says which:
   (``Case.known``): it stays in the report, marked, never hidden.
 
 Scenes are built from the ``cases/*.toml`` files as dicts (:func:`base`), changed in code and
-validated by :func:`transient.scene.scene_from_dict`, exactly as a scene file would be. A case
-runs as ``transient run`` does (:func:`transient.run.simulate` into
-``DIR/stress/<case>.h5``, read back with :func:`transient.results.open_result`), in a forked
+validated by :func:`transient.scene.read.scene_from_dict`, exactly as a scene file would be. A case
+runs as ``transient run`` does (:func:`transient.simulate` into
+``DIR/stress/<case>.h5``, read back with :func:`transient.open_result`), in a forked
 child process that is killed when the case's time bound passes; the long runs stream through
 :func:`transient.run.integrate` without keeping the trajectory.
 
@@ -189,7 +189,7 @@ class Run:
 
 
 def run_scene(d: dict, name: str, ctx: Context) -> Run:
-    """Run a scene dict as ``transient run`` would (:func:`transient.run.simulate` to
+    """Run a scene dict as ``transient run`` would (:func:`transient.simulate` to
     ``ctx.out/<name>.h5``) and read the file back, complete or not."""
     from ..errors import SimulationError
     from ..results import open_result
