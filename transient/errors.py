@@ -32,6 +32,15 @@ class SceneError(ValueError):
         What is wrong and what is allowed, in one line.
     file
         The scene file, filled in by the loader if the raiser does not know it.
+
+    Examples
+    --------
+    >>> import transient
+    >>> try:
+    ...     transient.Scene.from_dict({"mechanism": {"type": "crank-slider"}, "run": {}})
+    ... except transient.SceneError as exc:
+    ...     print(exc.key)
+    mechanism.crank_radius
     """
 
     def __init__(self, key: str, message: str, file: str = "") -> None:
@@ -51,7 +60,25 @@ class SceneError(ValueError):
 
 class SimulationError(RuntimeError):
     """The integration failed; carries where (time, angle, state), and ``result``, the run up to
-    there (a :class:`transient.results.Result`, when there is one)."""
+    there (a :class:`transient.Result`, when there is one).
+
+    Examples
+    --------
+    A load larger than the engine stalls it before the revolutions the run asks for:
+
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> try:
+    ...     transient.simulate(scene.replace(load={"torque": 500.0}, run={"revolutions": 50}))
+    ... except transient.SimulationError as exc:
+    ...     print(exc.result.status, exc.result.complete)
+    stalled False
+    """
 
     def __init__(self, message: str, result=None) -> None:
         super().__init__(message)

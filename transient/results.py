@@ -685,6 +685,23 @@ class Result:
         Name → (value, unit) of the end-of-run summary and the analyses the scene asked for.
     scene_toml
         The resolved scene (every default filled in); :meth:`scene` rebuilds it.
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> res = transient.simulate(scene)
+    >>> res.complete, res.path is None  # held in memory
+    (True, True)
+    >>> [name for name in res.trajectory][:4]
+    ['t', 'phi', 'omega', 'epsilon']
+    >>> res.scene() == scene
+    True
     """
 
     path: Path | None
@@ -759,7 +776,40 @@ def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dic
 
 def open_result(path: str | Path) -> Result:
     """Read a result file into a :class:`~transient.Result`: complete, incomplete, or the partial
-    file (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint."""
+    file (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint.
+
+    Parameters
+    ----------
+    path : str or Path
+        The result file (HDF5) that :func:`transient.simulate` or ``transient run`` wrote.
+
+    Returns
+    -------
+    Result
+        The run; its trajectory's columns are read from the file when first used.
+
+    Raises
+    ------
+    ValueError
+        The file is HDF5 but not a result of transient.
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "single.h5"
+    ...     written = transient.simulate(scene, path)
+    ...     res = transient.open_result(path)
+    ...     print(res.status, res.path.name, res.scene() == scene)
+    finished single.h5 True
+    """
     path = Path(path)
     with open_file(path) as f:
         if f.attrs.get("creator") != CREATOR:

@@ -31,7 +31,50 @@ from .write import to_toml
 
 
 def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
-    """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
+    """Read and validate a scene file (or TOML ``text``, with ``source`` naming it).
+
+    Parameters
+    ----------
+    source : str or Path
+        The scene file (TOML); the files a scene names (pressure tables, maps) are read relative
+        to its folder.
+    text : str, optional
+        The scene as TOML, read instead of the file; ``source`` then only names it.
+
+    Returns
+    -------
+    Scene
+        The validated scene in SI units, every default filled in; its ``name`` is the file's
+        stem unless ``[scene] name`` says otherwise.
+
+    Raises
+    ------
+    transient.SceneError
+        The file cannot be read or a key is wrong: one line naming the file, the key, what is
+        wrong and what is allowed.
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.load_scene("single.toml", text='''
+    ... [mechanism]
+    ... type = "crank-slider"
+    ... crank_radius_mm = 47
+    ... rod_length_mm = 148
+    ... bore_mm = 88
+    ... piston_mass = 1.52
+    ... crank_mass = 0.912
+    ... rod = {model = "two-mass", mass = 1.752, cg_from_pin_mm = 107.3}
+    ... [initial]
+    ... omega_rpm = 1000
+    ... [run]
+    ... revolutions = 2
+    ... ''')
+    >>> scene.name
+    'single'
+    >>> scene.mechanism.crank_radius  # [m]: keys are read into SI
+    0.047
+    """
     path = Path(source)
     if text is None:
         text = read_text(path, "scene")
@@ -46,6 +89,19 @@ def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
     its keys as a TOML file would, unit suffixes included, sub-tables as nested dicts:
     ``scene.replace(inertia={"flywheel": 0.5}, initial={"omega_rpm": 1500})``. A key given with
     another unit replaces the scene's own (``omega_rpm`` replaces ``omega``).
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> heavier = scene.replace(inertia={"flywheel": 0.5})
+    >>> heavier.inertia.flywheel, scene.inertia.flywheel
+    (0.5, 0.0)
     """
     data = parse_toml(to_toml(scene), "(replace)")
     for table, keys in tables.items():
@@ -74,8 +130,22 @@ def _unsuffixed(key: str) -> str:
 
 
 def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
-    """Build and validate a scene from parsed TOML. Raises
-    :class:`~transient.SceneError`."""
+    """Build and validate a scene from parsed TOML: one dict per table, keys as a scene file
+    writes them. Raises :class:`~transient.SceneError`; ``file`` names the scene in its message,
+    ``base_dir`` is where the files it names are read from (default the working folder).
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> scene.mechanism.bore  # [m]
+    0.088
+    """
     base_dir = base_dir or Path.cwd()
     try:
         root = Section(data, "")

@@ -544,7 +544,27 @@ DETREND = ("auto", "ramp", "none")
 class Scene:
     """A validated scene: what :func:`transient.load_scene` returns, one record per TOML
     table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
-    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`."""
+    ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`.
+
+    A scene is frozen: :meth:`~transient.Scene.replace` makes a changed copy, validated as a
+    file is; :meth:`~transient.Scene.to_toml` writes it back as TOML that
+    :func:`transient.load_scene` reads to an equal scene.
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> stroke, unit = scene.geometry()["stroke"]  # twice the crank radius
+    >>> print(f"{stroke:.3f} {unit}")
+    0.094 m
+    >>> transient.load_scene("copy.toml", text=scene.to_toml()) == scene
+    True
+    """
 
     name: str
     description: str

@@ -61,30 +61,50 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
 
     Parameters
     ----------
-    base
+    base : Scene
         The scene every run starts from.
-    axes
+    axes : dict
         Dotted scene key → values, e.g. ``{"load.torque": [50, 100], "inertia.flywheel":
         [0.1, 0.2]}``; unit suffixes allowed (``"initial.omega_rpm"``).
-    collect
+    collect : sequence of str
         Quantities of each run for the table (:data:`transient.sweeps.spec.QUANTITIES` or any
         ``/analysis`` entry).
-    method
+    method : {"grid", "list"}
         ``"grid"``: every combination of the axes; ``"list"``: their i-th values together.
-    name
+    name : str, optional
         The sweep's name (its file's stem; a sweep of the same name in ``output`` is mended:
         unchanged runs reused). Default: the base scene's name.
-    columns
+    columns : sequence of str, optional
         Trajectory columns to keep of each run (default all).
-    output
+    output : str or Path, optional
         Folder of the sweep file and its summary CSV; default a temporary folder.
-    client, scheduler, workers
-        A ``dask.distributed.Client`` to run on, or a scheduler's address, or ``"serial"``;
+    client, scheduler, workers : Client, str, int, optional
+        A :class:`distributed.Client` to run on, or a scheduler's address, or ``"serial"``;
         default a local cluster of ``workers`` processes (one per core).
-    force
+    force : bool
         Replace a sweep file of another sweep of this name.
-    progress
+    progress : callable, optional
         Called with (runs done, runs in all) after each run.
+
+    Returns
+    -------
+    SweepResult
+        The summary table (one row per run) and each run's result.
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
+    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
+    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
+    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> swept = transient.sweep(scene, {"inertia.flywheel": [0.0, 0.5]}, scheduler="serial")
+    >>> swept.table.columns["inertia.flywheel"].tolist(), swept.table.columns["status"].tolist()
+    ([0.0, 0.5], ['finished', 'finished'])
+    >>> swept.run(1).scene().inertia.flywheel
+    0.5
     """
     if not isinstance(axes, dict) or not axes:
         raise SceneError("axes", "give a dict of dotted scene keys and their values, e.g. "
