@@ -1,4 +1,5 @@
-"""Result files (HDF5, format 1; DESIGN §4): the layout, a streaming writer and a reader.
+"""Result files (HDF5, format 1; docs/guide/results.md): the layout, a streaming writer and a
+reader.
 
 The layout of a run — header attributes, ``scene/toml``, ``trajectory/<column>``,
 ``events/<name>/{t,phi}``, ``solver`` attributes, ``analysis/<name>`` — is written by the

@@ -1,12 +1,13 @@
 """The ``transient`` command's own argument parser, for sphinx-argparse (docs/guide/cli.md).
 
 Help strings are plain text; a ``|`` in them (``|R|``, an absolute value) would be read by reST
-as a substitution reference, so it is escaped. Nothing else is changed."""
+as a substitution reference, so it is escaped. The examples that end ``transient --help`` (a plain
+text table there) become a table of the commands, and each command's example a literal."""
 from __future__ import annotations
 
 import argparse
 
-from transient.cli import _parser
+from transient.cli import EXAMPLES, _parser
 
 
 def _escape(parser: argparse.ArgumentParser) -> None:
@@ -24,7 +25,19 @@ def _escape(parser: argparse.ArgumentParser) -> None:
                 _escape(sub)
 
 
+def _with_examples(p: argparse.ArgumentParser) -> None:
+    sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction))
+    rows = [".. list-table:: The commands, one example each", "   :header-rows: 1",
+            "   :widths: 12 40 48", "", "   * - command", "     - what it does", "     - example"]
+    for choice in sub._choices_actions:
+        name = choice.dest
+        rows += [f"   * - ``{name}``", f"     - {choice.help}", f"     - ``{EXAMPLES[name]}``"]
+        sub.choices[name].epilog = f"Example: ``{EXAMPLES[name]}``"
+    p.epilog = "\n".join(rows)
+
+
 def parser() -> argparse.ArgumentParser:
     p = _parser()
     _escape(p)
+    _with_examples(p)
     return p

@@ -1,6 +1,7 @@
 """The analyses a scene asks for in its ``[analysis]`` table
 (:class:`transient.scene.records.Analysis`),
-computed at the end of a run and stored under ``/analysis/<name>`` with a unit each (DESIGN §4).
+computed at the end of a run and stored under ``/analysis/<name>`` with a unit each
+(docs/guide/analyses.md).
 
 Nothing here runs unless the scene asks. :func:`requested_analyses` returns name → (value, unit)
 like the end-of-run summary (:func:`transient.analysis.summary.summarize`, which calls it);

@@ -72,7 +72,8 @@ def gas_value(m, extras, k, phi, sel, wk):
     """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
-    ends exactly on a corner keeps using the piece it integrates over (DESIGN §2, breakpoints).
+    ends exactly on a corner keeps using the piece it integrates over (docs/theory.md, Events and
+    breakpoints).
     The piece is the one :func:`select_pieces` left in ``wk`` for it. With combustion offsets
     the value is the curve's δ_k later, p_full(x − δ_k) (:func:`shifted`).
     """

@@ -26,7 +26,8 @@ from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T,
 
 @kernel(inline=True)
 def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
-    """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
+    """J_k, J′_k and M_k of every sub-chain into ``wk`` (docs/theory.md, The serial chain;
+    :mod:`transient.core.chain`).
 
     Links in order: the shaft (J0 with flywheel and load; load and starter act on it), middle links
     of constant reduced inertia ``link_J`` (the crank), and the last link with the rest of the
