@@ -31,6 +31,7 @@ extensions = [
     "scene_keys",
     "plain_docstrings",
     "public_api",
+    "citations",
 ]
 
 # Every cross-reference must resolve (``make docs`` runs with -n -W): a dead or ambiguous link
@@ -60,6 +61,7 @@ intersphinx_mapping = {
 bibtex_bibfiles = ["references.bib"]
 bibtex_default_style = "plain"
 bibtex_reference_style = "author_year"
+bibtex_cite_id = "cite-{key}"  # stable anchors: references.html#cite-gots2006
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 exclude_patterns = ["_build", "_intersphinx", "examples/README.txt", "**/GALLERY_HEADER.rst"]
