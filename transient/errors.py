@@ -37,10 +37,10 @@ class SceneError(ValueError):
     --------
     >>> import transient
     >>> try:
-    ...     transient.Scene.from_dict({"mechanism": {"type": "crank-slider"}, "run": {}})
+    ...     transient.Scene.from_dict({"mechanism": {}})
     ... except transient.SceneError as exc:
     ...     print(exc.key)
-    mechanism.crank_radius
+    mechanism.type
     """
 
     def __init__(self, key: str, message: str, file: str = "") -> None:
@@ -67,14 +67,21 @@ class SimulationError(RuntimeError):
     A load larger than the engine stalls it before the revolutions the run asks for:
 
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
+    >>> stalls = scene.replace(load={"torque": 500.0},
+    ...                        run={"revolutions": 50})
     >>> try:
-    ...     transient.simulate(scene.replace(load={"torque": 500.0}, run={"revolutions": 50}))
+    ...     transient.simulate(stalls)
     ... except transient.SimulationError as exc:
     ...     print(exc.result.status, exc.result.complete)
     stalled False

@@ -690,11 +690,16 @@ class Result:
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
     >>> res = transient.simulate(scene)
     >>> res.complete, res.path is None  # held in memory
@@ -797,11 +802,16 @@ def open_result(path: str | Path) -> Result:
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
     >>> import tempfile, pathlib
     >>> with tempfile.TemporaryDirectory() as folder:

@@ -455,18 +455,25 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
     >>> res = transient.simulate(scene)
     >>> res.status
     'finished'
     >>> res.units["omega"], res.summary()["revolutions"]
     ('rad/s', 2.0)
-    >>> float(res.trajectory["omega"][0]) == 1000 * 2 * 3.141592653589793 / 60
+    >>> import math
+    >>> omega0 = res.trajectory["omega"][0]  # [rad/s]
+    >>> math.isclose(omega0, 1000 * 2 * math.pi / 60)
     True
     """
     if path is None:

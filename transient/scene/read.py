@@ -64,7 +64,10 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     ... bore_mm = 88
     ... piston_mass = 1.52
     ... crank_mass = 0.912
-    ... rod = {model = "two-mass", mass = 1.752, cg_from_pin_mm = 107.3}
+    ... [mechanism.rod]
+    ... model = "two-mass"
+    ... mass = 1.752
+    ... cg_from_pin_mm = 107.3
     ... [initial]
     ... omega_rpm = 1000
     ... [run]
@@ -93,11 +96,16 @@ def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
     >>> heavier = scene.replace(inertia={"flywheel": 0.5})
     >>> heavier.inertia.flywheel, scene.inertia.flywheel
@@ -137,11 +145,16 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
     >>> scene.mechanism.bore  # [m]
     0.088

@@ -553,16 +553,22 @@ class Scene:
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
-    >>> stroke, unit = scene.geometry()["stroke"]  # twice the crank radius
+    >>> stroke, unit = scene.geometry()["stroke"]
     >>> print(f"{stroke:.3f} {unit}")
     0.094 m
-    >>> transient.load_scene("copy.toml", text=scene.to_toml()) == scene
+    >>> text = scene.to_toml()
+    >>> transient.load_scene("copy.toml", text=text) == scene
     True
     """
 

@@ -94,15 +94,24 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
     Examples
     --------
     >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
     >>> scene = transient.Scene.from_dict({
-    ...     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
-    ...                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912,
-    ...                   "rod": {"model": "two-mass", "mass": 1.752, "cg_from_pin_mm": 107.3}},
-    ...     "inertia": {"shaft": 0.02}, "initial": {"omega_rpm": 1000},
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
-    >>> swept = transient.sweep(scene, {"inertia.flywheel": [0.0, 0.5]}, scheduler="serial")
-    >>> swept.table.columns["inertia.flywheel"].tolist(), swept.table.columns["status"].tolist()
-    ([0.0, 0.5], ['finished', 'finished'])
+    >>> axes = {"inertia.flywheel": [0.0, 0.5]}
+    >>> swept = transient.sweep(scene, axes, scheduler="serial")
+    >>> columns = swept.table.columns
+    >>> columns["inertia.flywheel"].tolist()
+    [0.0, 0.5]
+    >>> columns["status"].tolist()
+    ['finished', 'finished']
     >>> swept.run(1).scene().inertia.flywheel
     0.5
     """
