@@ -5,7 +5,7 @@ STAMP := $(VENV)/.installed
 DEFAULT_SCENE := cases/swash_plate_4cyl.toml
 DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
-.PHONY: run test bench docs install clean
+.PHONY: run test test-stress test-cpu bench docs install clean
 
 # Bytecode is written at install: where PYTHONDONTWRITEBYTECODE is set, each run would otherwise
 # compile transient's sources again, a noticeable part of a warm start.
@@ -25,12 +25,34 @@ run: $(STAMP)
 	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
 	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results --force
 
-# The import contracts first (pyproject.toml, [tool.importlinter]), then the suite: one pytest
-# worker per core, at most 4 (a process compiling the stepper holds about a gigabyte); worksteal
-# moves queued tests from a busy worker to an idle one (the first runs compile for minutes).
+# The suite's tiers (docs/developer/testing.md): `make test` the import contracts
+# (pyproject.toml, [tool.importlinter]) and every test but the long stress; `make test-stress`
+# that stress (marker `stress`); `make test-cpu` the runs again with the code built for another
+# CPU. A fast loop: $(PY) -m pytest -m "not slow" -n 2 tests/unit (or any folder).
+# One pytest worker per core, at most 4 (a process compiling the stepper holds about a gigabyte);
+# worksteal moves queued tests from a busy worker to an idle one (the first runs compile for
+# minutes).
+PYTEST := $(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
+
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
-	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
+	$(PYTEST) -m "not stress"
+
+# Kill-and-resume, random scenes of every mechanism, `transient stress --quick`.
+test-stress: $(STAMP)
+	$(PYTEST) -m stress
+
+# The tests that run the stepper and compare its results, with numba compiling for the x86-64
+# baseline (`generic`), numpy's SIMD loops and OpenBLAS's kernels at theirs: compiled code and
+# linear algebra round differently on another CPU, the steps differ from there, and every
+# comparison must still hold at the tolerance it states. Its own cache folder: its kernels and
+# Wiebe tables are the baseline's, not the host's. The slow tests (reference paths) are left out:
+# the stepper they check runs in the rest too.
+CPU_CACHE := $(or $(TRANSIENT_CACHE_DIR),$(or $(XDG_CACHE_HOME),$(HOME)/.cache)/transient)-generic
+test-cpu: $(STAMP)
+	NUMBA_CPU_NAME=generic NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR" \
+		OPENBLAS_CORETYPE=Prescott TRANSIENT_CACHE_DIR=$(CPU_CACHE) \
+		$(PYTEST) -m "not slow and not stress" tests/validation tests/cli/test_golden.py
 
 # The work-precision record and its targets in results/benchmarks/ (about twenty minutes; the
 # record says how long). CyRK, the compiled peer, comes with the optional `bench` extra.
@@ -57,4 +79,4 @@ docs: $(DOCS_STAMP)
 
 clean:
 	rm -rf $(VENV) results/*.h5 results/*.png docs/_build docs/generated docs/auto_examples \
-		docs/guide/_generated
+		docs/guide/_generated docs/_generated

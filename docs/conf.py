@@ -30,6 +30,7 @@ extensions = [
     "sphinxarg.ext",
     "scene_keys",
     "plain_docstrings",
+    "validation_pages",
     "public_api",
     "citations",
 ]
@@ -74,7 +75,7 @@ html_theme_options = {
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
 }
-html_sidebars = {"changelog": [], "performance": []}
+html_sidebars = {"changelog": [], "performance": [], "validation": []}
 
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3

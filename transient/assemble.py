@@ -20,6 +20,8 @@ from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_P
                           POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS, RX_RING_FORCE,
                           RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T, extras_of,
                           work_array)
+from .core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
+from .errors import SceneError
 from .forces.compressor import compressor_cycle
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
 from .mechanisms import reaction_joints
@@ -34,13 +36,18 @@ def gas_table(scene) -> PressureTable | None:
 
 
 def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
-    """``(full, motored)``: the full-load table and the motored one, between which the governor's
-    fuel f interpolates, p = p_mot + f·(p_full − p_mot) (:class:`transient.scene.records.Gas`).
+    """``(full, motored)``: the full-load table and the motored one, between which the fuel f
+    interpolates, p = p_mot + f·(p_full − p_mot): the fuel scales the combustion, never the
+    compression (:class:`transient.scene.records.Gas`).
 
-    ``motored`` is None when the motored curve is the constant crankcase pressure p0 (table,
-    mixed cycle; a force model's zero), so that such a scene's model holds one table only. For
-    ``"wiebe"`` it is the cycle without fuel, on the same knots as the full-load one (both from one
-    :func:`~transient.forces.wiebe.wiebe_tables`); with ``fuel_mass = 0`` both are that cycle.
+    ``motored`` is the cycle without fuel on the same corners as the full-load one: for
+    ``"mixed-cycle"`` the compression polytrope both ways
+    (:func:`~transient.forces.gas.mixed_cycle`), for ``"wiebe"`` the cycle without fuel (both
+    from one :func:`~transient.forces.wiebe.wiebe_tables`; with ``fuel_mass = 0`` both are that
+    cycle), for ``"table"`` the user's ``motored_p`` at the table's angles. It is None for a
+    force pulse (``"trapezoid"``, whose motored force is 0), and for a table without
+    ``motored_p`` and a compressor, which cannot burn less than full-load fuel
+    (:func:`part_load_refusal`).
     """
     gas = scene.gas
     mech = scene.mechanism
@@ -48,9 +55,9 @@ def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
         return None, None
     if gas.model == "trapezoid":  # a force per piston [N] (Antonyuk §4)
         return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration), None
-    if gas.model == "table":  # pressures [Pa], or forces per piston [N]
-        return table_from_points(np.asarray(gas.phi), np.asarray(gas.force or gas.p), mech.cycle,
-                                 corners=gas.corners, interpolation=gas.interpolation), None
+    if gas.model == "table":  # pressures [Pa] (and the motored ones), or forces per piston [N]
+        return (_points_table(scene, gas.force or gas.p, "gas.p"),
+                _points_table(scene, gas.motored_p, "gas.motored_p") if gas.motored_p else None)
     if gas.model == "wiebe":
         tables = wiebe_levels(mech, gas)
         return tables[-1], tables[0]
@@ -60,10 +67,51 @@ def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
                                 n_reexpansion=gas.n_reexpansion,
                                 clearance_ratio=gas.clearance_ratio, strokes=mech.strokes,
                                 dead_centres=mech.dead_centre_angles()), None
-    return mixed_cycle(mech.volume_function(clearance_volume(scene)), compression_ratio=gas.compression_ratio,
-                       p_a=gas.p_a, n1=gas.n1, p_z=gas.p_z, rho=gas.rho, n2=gas.n2,
-                       p_intake=gas.p_intake, p_exhaust=gas.p_exhaust, strokes=mech.strokes,
-                       dead_centres=mech.dead_centre_angles()), None
+    cycle = mixed_cycle(mech.volume_function(clearance_volume(scene)),
+                        compression_ratio=gas.compression_ratio, p_a=gas.p_a, n1=gas.n1,
+                        p_z=gas.p_z, rho=gas.rho, n2=gas.n2, p_intake=gas.p_intake,
+                        p_exhaust=gas.p_exhaust, strokes=mech.strokes,
+                        dead_centres=mech.dead_centre_angles())
+    return cycle, cycle.motored
+
+
+def _points_table(scene, values, key: str) -> PressureTable:
+    """The table through ``values`` (pressures or forces) at the scene's table angles, its errors
+    on the values reported under ``key``."""
+    gas = scene.gas
+    try:
+        return table_from_points(np.asarray(gas.phi), np.asarray(values), scene.mechanism.cycle,
+                                 corners=gas.corners, interpolation=gas.interpolation)
+    except SceneError as exc:
+        if exc.key == "gas.p":
+            exc.key = key
+        raise
+
+
+def burns_part_load(scene) -> bool:
+    """Whether a cylinder of the scene can burn less than full-load fuel in a run: under a
+    governor's command, or by a ``[[gas.cylinders]]`` entry that changes its combustion
+    (:attr:`transient.scene.records.Cylinder.combustion_keys`). Only then does the model pair
+    the motored curve with the full-load one: at full fuel throughout the pressure is the
+    full-load table's, and the kernels keep their one-table path."""
+    return (scene.governor.model != "none"
+            or any(c.combustion_keys for c in scene.gas.cylinders))
+
+
+def part_load_refusal(scene) -> str | None:
+    """Why the scene's gas model cannot burn less than full-load fuel, or None. A fuel below 1
+    scales the combustion only, so a model needs its motored curve for it: a table of pressures
+    or forces holds no account of which part of it is compression (unless the motored
+    pressures come with it), and a compressor burns nothing."""
+    gas = scene.gas
+    if gas.model == "compressor":
+        return "a compressor burns no fuel: its cycle is the same at every fuel"
+    if gas.model != "table" or gas.motored_p:
+        return None
+    return ("a fuel below 1 scales the combustion only, p_mot + f·(p_full − p_mot), and a "
+            f"{'force' if gas.force else 'pressure'} table holds no account of which part of it "
+            "is compression; give the pressures with the motored ones at the table's angles, "
+            "gas.motored_p (or a motored_p column of its file)")
 
 
 def cycle_figures(scene) -> dict[str, tuple[float, str]]:
@@ -308,10 +356,16 @@ def load_table_curve(scene) -> LoadCurve | None:
                       scene.mechanism.cycle if table.abscissa == "angle" else 0.0)
 
 
-def build_model(scene) -> tuple[Model, NDArray[np.float64], PressureTable | None]:
-    """The compiled model, its breakpoints and the (full-load) pressure table of a scene."""
+def build_model(scene, part_load: bool = False
+                ) -> tuple[Model, NDArray[np.float64], PressureTable | None]:
+    """The compiled model, its breakpoints and the (full-load) pressure table of a scene.
+
+    The motored curve is paired where the scene can burn less than full-load fuel
+    (:func:`burns_part_load`) or ``part_load`` asks for it (a study at a fixed fuel)."""
     mech = scene.mechanism
     table, motored = gas_tables(scene)
+    if not (part_load or burns_part_load(scene)):
+        motored = None
     phases = gas_phases(scene)
     period = mech.cycle
     n = mech.n_cylinders
@@ -557,17 +611,31 @@ def chain_fields(scene) -> dict:
     if reaction_friction(scene):
         return reaction_fields(scene)
     cut_after = [mech.links.index(p.between[0]) for p in friction.pairs]
-    link_sub = np.array([sum(c < i for c in cut_after) for i in range(len(mech.links))],
-                        dtype=np.int64)
+    link_sub = [sum(c < i for c in cut_after) for i in range(len(mech.links))]
     return dict(
         n_pairs=len(friction.pairs),
         eta_fwd=np.array([p.eta_forward for p in friction.pairs], dtype=np.float64),
         eta_bwd=np.array([p.eta_backward for p in friction.pairs], dtype=np.float64),
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
-        link_sub=link_sub, link_J=np.array(mech.link_inertias(), dtype=np.float64),
+        **link_fields(mech, link_sub),
         reaction=False, rx_par=np.zeros((N_JOINTS, N_RX_PAR)),
         rx_pair=np.full(N_JOINTS, -1, dtype=np.int64),
         **eta_table_fields(friction.pairs))
+
+
+def link_fields(mech, link_sub: list[int]) -> dict:
+    """The links' part of the Model (``transient.core.rhs.split_subchains``): the sub-chain of
+    each, their constant inertias, the link with the rest of J(φ), and the law of each link
+    whose φ-dependent inertia a pair cuts from the rest's sub-chain (elsewhere it stays in the
+    rest: a chain cut only where the links' inertias are constant adds nothing to compute)."""
+    laws = mech.link_laws
+    rest = laws.index(LINK_REST)
+    own = [law if law in (LINK_PISTONS, LINK_SWASH) and link_sub[i] != link_sub[rest]
+           else LINK_FIXED for i, law in enumerate(laws)]
+    mass = [mech.piston_link_mass if law == LINK_PISTONS else 0.0 for law in laws]
+    return dict(link_sub=np.array(link_sub, dtype=np.int64),
+                link_J=np.array(mech.link_inertias(), dtype=np.float64), link_rest=rest,
+                link_own=np.array(own, dtype=np.int64), link_mass=np.array(mass))
 
 
 def eta_table_fields(pairs) -> dict:
@@ -636,8 +704,7 @@ def reaction_fields(scene) -> dict:
     n = len(pairs)
     return dict(n_pairs=n, eta_fwd=np.ones(n), eta_bwd=np.ones(n),
                 policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
-                link_sub=np.zeros(len(mech.links), dtype=np.int64),
-                link_J=np.array(mech.link_inertias(), dtype=np.float64),
+                **link_fields(mech, [0] * len(mech.links)),
                 reaction=True, rx_par=rx_par, rx_pair=rx_pair, **eta_table_fields(pairs))
 
 

@@ -12,8 +12,14 @@ QUOTE_LIMIT = 40
 def clip(text: str, limit: int = QUOTE_LIMIT) -> str:
     """``text`` with control characters escaped and cut to ``limit`` characters ("..." marks the
     cut), so that a quoted token can neither break the line nor fill the screen."""
-    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    text = escaped(text)
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def escaped(text: str) -> str:
+    """``text`` with every character a terminal would act on rather than show (a control,
+    format or separator character: not ``str.isprintable``) written as its Python escape."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def show_value(value: Any) -> str:
@@ -64,7 +70,8 @@ class SimulationError(RuntimeError):
 
     Examples
     --------
-    A load larger than the engine stalls it before the revolutions the run asks for:
+    A load torque brakes the coasting shaft to a stop two revolutions in, long before the
+    50 revolutions the run asks for:
 
     >>> import transient
     >>> rod = {"model": "two-mass", "mass": 1.752,
@@ -78,7 +85,7 @@ class SimulationError(RuntimeError):
     ...     "inertia": {"shaft": 0.02},
     ...     "initial": {"omega_rpm": 1000},
     ...     "run": {"revolutions": 2}})
-    >>> stalls = scene.replace(load={"torque": 500.0},
+    >>> stalls = scene.replace(load={"torque": 10.0},
     ...                        run={"revolutions": 50})
     >>> try:
     ...     transient.simulate(stalls)

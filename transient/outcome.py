@@ -3,10 +3,13 @@
 a one-line message with the time, angle and speed where it happened, and warnings; and the
 watch over a run's blocks that stops a run exceeding its output budget or no longer advancing.
 
-A run that integrated to its end can still have failed the scene: a shaft that stopped, or was
-driven backwards by a load larger than the engine (``t_end`` lets the integration go on), or
-ran away. Those are read off the blocks as they stream past (:class:`Watch`), since a long run
-keeps only its last block in memory.
+A run that integrated to its end can still have failed the scene: a shaft that never started,
+stopped, or was driven backwards by a load larger than the engine (``t_end`` lets the
+integration go on), ran out of time before its revolutions, or ran away. Those are read off the
+blocks as they stream past (:class:`Watch`), since a long run keeps only its last block in
+memory: the speed's passages through zero (the ``speed_reversal`` events, which every path
+records where ω crosses or reaches zero) bound the angles the shaft swung between, since φ is
+monotone between two of them.
 """
 from __future__ import annotations
 
@@ -15,17 +18,24 @@ import math
 import numpy as np
 
 from .errors import SimulationError
+from .scene.records import RUNAWAY_SPEED
 
 
-#: Every status a run ends with, and what it means (README, "Result files"); a run the stepper
-#: ends as ``stiff`` is run again by an implicit method and ends with one of these.
+#: Every status a run ends with, and what it means (user guide, Result files: Statuses); a run
+#: the stepper ends as ``stiff`` is run again by an implicit method and ends with one of these.
 STATUSES = {
-    "finished": "ran to its end as the scene describes",
+    "finished": "did what the scene asks: turned its run.revolutions; with run.t_end alone, "
+                "followed the motion to t_end with the shaft running forwards at the end",
+    "out-of-time": "reached run.t_end before the run.revolutions the scene asks for, the shaft "
+                   "running forwards at the end (a prescribed speed table's end is its motion's "
+                   "end, not this)",
+    "not-started": "did not start: the shaft stopped, rocked or turned backwards before it had "
+                   "ever turned a whole revolution forwards, and did not run again",
     "interrupted": "stopped by Ctrl-C, SIGTERM or SIGHUP",
-    "stalled": "the speed fell to zero and the shaft did not run again (it ends slower than "
-               "the switch speed)",
-    "reversed": "the shaft was driven backwards and turned backwards at the end (faster than "
-                "the switch speed)",
+    "stalled": "the shaft ran, then its speed reached zero and it did not run again (at rest, "
+               "creeping or rocking, whichever way it turns at the end)",
+    "reversed": "the shaft was driven backwards: at the end it turns backwards, faster than the "
+                "switch speed, beyond every angle it had swung back to before",
     "locked": "at rest, the friction of the non-ideal pairs holds the machine and nothing can "
               "release it",
     "chattering": "pair modes or other switches flip without progress",
@@ -36,8 +46,9 @@ STATUSES = {
 }
 #: The status of a run that did what its scene describes; every other one exits 1.
 FINISHED = "finished"
-#: A speed no piston machine reaches [rad/s] (about 955 000 rpm): beyond it a run ran away.
-RUNAWAY_SPEED = 1e5
+#: How far past its starting angle the shaft must have turned forwards [rad] to have started: a
+#: whole revolution, in which every piston passes its top dead centre.
+STARTED = 2.0 * math.pi
 #: Consecutive chunks of the stepper (each its chunk of step attempts) that bring no new sample
 #: and no new event before a run is stopped as making no progress.
 IDLE_CHUNKS = 50
@@ -101,9 +112,11 @@ class Watch:
         self.idle = 0
         self.reach = (-math.inf, -math.inf)  # the furthest (t, φ) a sample or event reached
         self.last: dict[str, float] = {}
-        self.stop: tuple[float, float] | None = None  # (t, φ) where the speed first reached 0
-        self.running = self.scene.initial.omega > 0.0
         self.fastest = abs(self.scene.initial.omega)
+        self.stops = 0  # passages of the speed through zero (speed_reversal events)
+        self.first_stop: tuple[float, float] | None = None  # (t, φ)
+        self.last_stop: tuple[float, float] | None = None
+        self.stop_range = (math.inf, -math.inf)  # the least and largest φ at a stop
         self.loss_range: dict[str, tuple[float, float]] = {}  # P_loss_k: (least, largest |·|)
         self.seen = False
 
@@ -135,9 +148,11 @@ class Watch:
 
     def take(self, block: dict[str, np.ndarray], ev: dict[str, np.ndarray]) -> None:
         """Take in a block (or a whole run held in memory) without judging its progress."""
-        t, phi, omega = block["t"], block["phi"], block["omega"]
+        t, omega = block["t"], block["omega"]
         self.seen = True
-        self._speeds(t, phi, omega, ev.get("speed_reversal"))
+        if omega.size:
+            self.fastest = max(self.fastest, float(np.max(np.abs(omega))))
+        self._stops(ev.get("speed_reversal"))
         if t.size:
             self.last = {k: float(v[-1]) for k, v in block.items()}
             for k, v in block.items():
@@ -147,18 +162,16 @@ class Watch:
                                           max(high, float(np.abs(v).max())))
         self.samples += t.size
 
-    def _speeds(self, t, phi, omega, reversal) -> None:
-        """Where the speed first reached zero, and the largest speed."""
-        if omega.size:
-            self.fastest = max(self.fastest, float(np.max(np.abs(omega))))
-        if self.stop is None and reversal is not None and len(reversal) and self.running:
-            self.stop = (float(reversal[0][0]), float(reversal[0][1]))
-        if self.stop is None and omega.size:
-            was = np.concatenate([[1.0 if self.running else 0.0], omega[:-1]])
-            down = np.flatnonzero((was > 0.0) & (omega <= 0.0))
-            if down.size:
-                self.stop = (float(t[down[0]]), float(phi[down[0]]))
-        self.running = self.running or bool(np.any(omega > 0.0))
+    def _stops(self, rows) -> None:
+        """Count the speed's passages through zero and keep the angles they bound."""
+        if rows is None or not len(rows):
+            return
+        rows = np.asarray(rows, dtype=float).reshape(-1, 2)
+        self.stops += rows.shape[0]
+        self.first_stop = self.first_stop or (float(rows[0, 0]), float(rows[0, 1]))
+        self.last_stop = (float(rows[-1, 0]), float(rows[-1, 1]))
+        low, high = self.stop_range
+        self.stop_range = (min(low, float(rows[:, 1].min())), max(high, float(rows[:, 1].max())))
 
     def _progress(self, t, phi, ev) -> None:
         """Count the blocks in a row that reach no further than those before."""
@@ -179,36 +192,109 @@ class Watch:
         s = self.last
         return where(s["t"], s["phi"], s["omega"]) if s else "the start"
 
+    def motion(self) -> str:
+        """How the shaft moved, from where it stopped and where it ended: ``running`` (never
+        stopped, or running again forwards past every angle it reached before its last stop),
+        ``reversed`` (turning backwards past every angle it reached since its first stop),
+        ``not-started`` (else, if it never turned :data:`STARTED` past its start) or
+        ``stalled``. Between two stops φ is monotone, so the stops' angles and the start bound
+        every angle reached before the last stop; a swing of a rocking shaft reaches no further
+        than the one before it, driven motion does (a shaft turning backwards from the start
+        stopped there)."""
+        w, phi = self.last["omega"], self.last["phi"]
+        ws, phi0 = self.scene.solver.switch_speed, self.scene.initial.phi
+        if self.stops == 0 and w > 0.0:
+            return "running"
+        low, high = self.stop_range
+        high = max(high, phi0)
+        if self.stops == 0:  # (turning backwards from the start)
+            low = phi0
+        if w >= ws and phi > high:
+            return "running"
+        if w <= -ws and phi < low:
+            return "reversed"
+        return "not-started" if max(high, phi) - phi0 < STARTED else "stalled"
+
     def verdict(self, status: str, message: str) -> tuple[str, str]:
-        """The run's status and message, given those the integration ended with: a finished
-        run that stopped, reversed or ran away, and a failure at a runaway speed, are said."""
+        """The run's status and message, given those the integration ended with: a run that
+        ended by its end time before its revolutions, or did not start, stalled, reversed or ran
+        away, is said, with the speed's passages through zero (:data:`STATUSES`)."""
         if status == "failed" and self.fastest > RUNAWAY_SPEED:
             return "runaway", f"runaway: the speed reached {self.fastest:.3g} rad/s; {message}"
-        if status != FINISHED or not self.last:
+        if status == "locked" and self.last:
+            never = self._never_turned()
+            return status, message + self._stops_said("; ") + (f"; it did not start: {never}"
+                                                                if never else "")
+        if status not in (FINISHED, "stalled") or not self.last:
             return status, message
         end = self._last_where()
         if self.fastest > RUNAWAY_SPEED:
             return "runaway", (f"runaway: the speed reached {self.fastest:.3g} rad/s (beyond "
                                f"{RUNAWAY_SPEED:g}); at the end {end}")
-        omega, ws = self.last["omega"], self.scene.solver.switch_speed
-        if omega <= -ws:  # (slower than the switch speed, either way, is rocking at rest)
-            return "reversed", (f"reversed: the shaft was driven backwards{self._stopped()} "
-                                f"and turned backwards at the end, {end}")
-        if (self.stop is not None or omega < 0.0) and omega < ws:
-            return "stalled", (f"stalled: the speed reached zero{self._stopped()} and the "
-                               f"shaft did not run again; at the end {end}")
-        return status, message
+        reached = self._reached()
+        motion = "running" if reached else self.motion()
+        stops = self._stops_said("; ")
+        if status == "stalled":  # (the stepper stopped a run that ends by revolutions only)
+            if motion == "not-started":
+                return motion, (f"did not start: {self._never_turned()}; "
+                                f"{message.removeprefix('stalled: ')}")
+            return status, message
+        if motion == "running":
+            run = self.scene.run
+            if reached or not math.isfinite(run.revolutions) or (
+                    run.time and self.last["t"] >= run.time[-1]):  # (a speed table's end)
+                return status, message
+            revs = (self.last["phi"] - self.scene.initial.phi) / (2.0 * math.pi)
+            return "out-of-time", (f"out of time: run.t_end = {self.scene.run.t_end:g} s came "
+                                   f"after {revs:.6g} of the {self.scene.run.revolutions:g} "
+                                   f"revolutions the scene asks for{stops}; at the end {end}")
+        if motion == "reversed":
+            return motion, (f"reversed: the shaft was driven backwards{stops}; at the end it "
+                            f"turned backwards, {end}")
+        if motion == "not-started":
+            return motion, f"did not start: {self._never_turned()}{stops}; at the end {end}"
+        return motion, (f"stalled: the speed reached zero and the shaft did not run "
+                        f"again{stops}; at the end {end}")
 
-    def _stopped(self) -> str:
-        if self.stop is None:
+    def _reached(self) -> bool:
+        """Whether the shaft turned the revolutions the scene asks for (the end is found to the
+        solver's tolerance)."""
+        target = self.scene.initial.phi + 2.0 * math.pi * self.scene.run.revolutions
+        return (math.isfinite(target)
+                and target - self.last["phi"] <= self.scene.solver.rtol * max(1.0, abs(target)))
+
+    def _stops_said(self, lead: str) -> str:
+        """The speed's passages through zero after ``lead``, for a message: how many, the first
+        and the last ("" if none)."""
+        if not self.stops:
+            return (f"{lead}it turned backwards from the start"
+                    if self.last.get("omega", 0.0) < 0.0 else "")
+        t, phi = self.first_stop
+        text = (f"{lead}the speed went through zero {self.stops} time{'s' * (self.stops > 1)}, "
+                f"first at t = {t:.9g} s, φ = {phi:.9g} rad ({math.degrees(phi):.6g}°)")
+        if self.stops > 1:
+            t, phi = self.last_stop
+            text += f", last at t = {t:.9g} s, φ = {phi:.9g} rad ({math.degrees(phi):.6g}°)"
+        return text
+
+    def _never_turned(self) -> str:
+        """That the shaft never turned :data:`STARTED` forwards (rocking, if its speed went
+        through zero twice or more), and how far it got; "" if it did."""
+        phi0 = self.scene.initial.phi
+        furthest = max(self.stop_range[1], phi0, self.last.get("phi", phi0)) - phi0
+        if furthest >= STARTED:
             return ""
-        t, phi = self.stop
-        return f" (it stopped at t = {t:.9g} s, φ = {phi:.9g} rad ({math.degrees(phi):.6g}°))"
+        return (f"the shaft {'rocked and ' * (self.stops > 1)}never turned a whole revolution "
+                f"forwards (at most {furthest:.6g} rad, {math.degrees(furthest):.6g}°, past its "
+                f"start at φ = {phi0:.9g} rad)")
 
     def warnings(self) -> list[str]:
-        """What a finished run should not be read without: pairs that reported negative losses
+        """What a finished run should not be read without: the speed's passages through zero
+        (the shaft stopped on the way and ran again), and pairs that reported negative losses
         (policy ``"paper"``: criterion (25) can hold a mode against the power it transmits)."""
         out = []
+        if self.stops:
+            out.append(f"the shaft stopped on the way and ran again: {self._stops_said('')}")
         if self.scene.friction.policy != "paper":  # (the power-flow policy has none by design)
             return out
         for k, pair in enumerate(self.scene.friction.pairs):
@@ -220,6 +306,16 @@ class Watch:
                            f"\"power-flow\" keeps every loss ≥ 0")
         return out
 
+    def summary(self) -> dict[str, tuple[float, str]]:
+        """The speed's passages through zero over the whole run, for the end-of-run summary:
+        ``speed_reversals`` [1] and the first one's ``speed_reversal_first_t`` [s] and
+        ``speed_reversal_first_phi`` [rad]; nothing if the speed never went through zero."""
+        if not self.stops:
+            return {}
+        return {"speed_reversals": (float(self.stops), "1"),
+                "speed_reversal_first_t": (self.first_stop[0], "s"),
+                "speed_reversal_first_phi": (self.first_stop[1], "rad")}
+
 
 def judge(data, watch: Watch):
     """``data`` (a :class:`~transient.results.RunData`) with its status, message and warnings
@@ -229,6 +325,7 @@ def judge(data, watch: Watch):
     status = data.status or (FINISHED if data.complete else status_in(data.message))
     data.status, data.message = watch.verdict(status, data.message)
     data.warnings = watch.warnings() if data.status == FINISHED else []
+    data.summary = watch.summary()
     return data
 
 

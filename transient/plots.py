@@ -117,6 +117,7 @@ def _cycle_samples(traj, scene, cylinder, cycles):
 
     starts = own_cycles(scene, traj, cylinder)
     phi = traj["phi"]
+    fuel = _cycle_fuel(scene)
     out = []
     for c in cycles:
         if not -starts.size <= c < starts.size:
@@ -124,26 +125,53 @@ def _cycle_samples(traj, scene, cylinder, cycles):
                              f"{starts.size} whole cycle(s) in the run (allowed "
                              f"{-starts.size} … {starts.size - 1})")
         a = starts[c]
-        out.append((f"{c % starts.size + 1} of {starts.size}",
+        note = fuel(cylinder, a + 0.5 * scene.mechanism.cycle)
+        out.append((f"{c % starts.size + 1} of {starts.size}{note}",
                     (phi >= a) & (phi <= a + scene.mechanism.cycle), a))
     return out
 
 
-def run_indicator_phi(ax, traj, scene, cylinders=None, cycles=(-1,), table=None):
+def _cycle_fuel(scene):
+    """``note(cylinder, φ)``: how the ``[[gas.cylinders]]`` entries set the fuel of the
+    cylinder's cycle at the shaft angle φ, for a label: ", misfire", ", cut out", ", fuel 0.8"
+    or ""."""
+    if not scene.gas.cylinders:
+        return lambda cylinder, phi: ""
+    from .assemble import build_model
+    from .core.variation import FUEL, cycle_fuel
+
+    model = build_model(scene)[0]
+
+    def note(cylinder, phi):
+        f = cycle_fuel(model, cylinder - 1, phi)
+        if f == 1.0:
+            return ""
+        if f != 0.0:
+            return f", fuel {f:g}"
+        return ", cut out" if model.var_par[cylinder - 1, FUEL] == 0.0 else ", misfire"
+    return note
+
+
+def run_indicator_phi(ax, traj, scene, cylinders=None, cycles=(-1,), table=None, motored=None):
     """The pressure the run applied [MPa] against each cylinder's own (local) angle [deg], over
     its whole cycles ``cycles`` (−1: the last), for ``cylinders`` (1-based; None: all).
-    ``table``: the input table (a :class:`~transient.forces.gas.PressureTable`) drawn dashed
-    for comparison. Returns the artists."""
+    ``table``, ``motored``: the full-load and motored curves (each a
+    :class:`~transient.forces.gas.PressureTable`, or None) drawn dashed and dotted for
+    comparison: a misfiring cycle lies on the motored one. Returns the artists."""
     traj = _columns(traj)
+    from .analysis.thermo import local_angle
+
     artists = []
     for k in _cylinders(scene, cylinders):
         for c, sel, a in _cycle_samples(traj, scene, k, cycles):
-            artists += ax.plot(np.degrees(traj["phi"][sel] - a), traj[f"p_{k}"][sel] / 1e6,
-                               lw=1.0, label=f"cylinder {k}, cycle {c}")
-    if table is not None:
-        x = np.linspace(0.0, table.period, 2881)
-        artists += ax.plot(np.degrees(x), table(x) / 1e6, lw=0.8, ls="--", color="0.5",
-                           label="input table, full fuel")
+            artists += ax.plot(np.degrees(local_angle(scene, traj["phi"][sel], a)),
+                               traj[f"p_{k}"][sel] / 1e6, lw=1.0, label=f"cylinder {k}, cycle {c}")
+    x = local_angle(scene, np.linspace(0.0, scene.mechanism.cycle, 2881), 0.0)
+    for curve, style, label in ((table, "--", "input table, full fuel"),
+                                (motored, ":", "motored (no fuel)")):
+        if curve is not None:
+            artists += ax.plot(np.degrees(x), curve(x) / 1e6, lw=0.8, ls=style, color="0.4",
+                               label=label)
     ax.set_xlabel("cylinder's own crank angle [deg]")
     ax.set_ylabel("p [MPa]")
     ax.grid(True, alpha=0.3)

@@ -102,9 +102,19 @@ def stepper_is_cached(model, tab) -> bool:
     """Whether the stepper, in the kernels' variant for ``model``
     (:func:`.core.layout.extras_of`), is compiled in this process or saved in numba's cache: a
     cache that holds only the other variant leaves this one to compile."""
-    sig = signature(STEPPER, model, tab)
-    return sig in STEPPER.overloads or any(
-        key[0] == sig for key in STEPPER._cache._cache_file._load_index())
+    return is_cached(STEPPER, signature(STEPPER, model, tab))
+
+
+def is_cached(dispatcher, sig: tuple) -> bool:
+    """Whether ``dispatcher`` is compiled for ``sig`` in this process, or saved in its cache for
+    this process's CPU: numba's index keys an entry by the signature, the CPU name and features
+    the code was compiled for (``NUMBA_CPU_NAME``, ``NUMBA_CPU_FEATURES``) and the function's
+    bytecode, and loads only an entry whose whole key matches, so a cache folder shared with
+    another CPU's processes may hold the signature and still leave it to compile."""
+    if sig in dispatcher.overloads:
+        return True
+    key = dispatcher._cache._index_key(sig, dispatcher.targetctx.codegen())
+    return key in dispatcher._cache._cache_file._load_index()
 
 
 def _cores() -> int:
@@ -125,7 +135,8 @@ def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
     try:
         helper = subprocess.Popen(
             [sys.executable, "-c", f"import {__name__} as p; p.helper_main()"],
-            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            env=helper_environment())
         with helper.stdin:
             pickle.dump((model, tab, [(fn.__module__, fn.__name__) for fn in callees]),
                         helper.stdin)
@@ -133,6 +144,22 @@ def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
         stop_helper(helper)
         return None
     return helper
+
+
+def helper_environment() -> dict:
+    """This process's environment with the numba settings its own compile uses: the cache folder
+    and the CPU to compile for. numba reads them from the environment at import, and a program
+    may have set them in ``numba.config`` since (the cache folder is transient's own,
+    :mod:`transient.core`); a helper compiling for another CPU, or into another folder, would
+    save code the stepper's compile cannot load."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": config.CACHE_DIR}
+    for name, value in (("NUMBA_CPU_NAME", config.CPU_NAME),
+                        ("NUMBA_CPU_FEATURES", config.CPU_FEATURES)):
+        if value is None:  # (the host's)
+            env.pop(name, None)
+        else:
+            env[name] = value
+    return env
 
 
 def stop_helper(helper: subprocess.Popen | None) -> None:

@@ -34,6 +34,8 @@ from .core import governor as gv
 from .core.forcing import generator_branch, load_segment
 from .core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
                            RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
+from .core.layout import LINK_PISTONS, LINK_REST, LINK_SWASH
+from .core.swash_plate import link_terms as swash_link_terms
 from .core.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
 from .mechanisms import reaction_joints
@@ -54,21 +56,43 @@ class ChainNumpy:
         cuts = [mech.links.index(p.between[0]) for p in pairs]
         self.sub = [sum(c < i for c in cuts) for i in range(len(mech.links))]
         self.link_J = mech.link_inertias()
+        self.laws = mech.link_laws
+        self.rest = self.laws.index(LINK_REST)
+        # the links whose own inertia a pair cuts from the rods' (elsewhere it is in the rest)
+        self.own = [i for i, law in enumerate(self.laws) if law in (LINK_PISTONS, LINK_SWASH)
+                    and self.sub[i] != self.sub[self.rest]]
+        self.piston_mass = mech.piston_link_mass
+        self.terms = mech.reference_terms()
+        self.mp = mech.pack()
         self.J0 = scene.inertia.total
 
     def inputs(self, phi, J, dJ, M_gas, M_shaft, forces, sel):
         """What :meth:`solve` and :meth:`~transient.reference.ChainNumpy.start_direction` take
         at a state: the sub-chains."""
-        return self.split(J, dJ, M_gas, M_shaft)
+        return self.split(phi, J, dJ, M_gas, M_shaft)
 
-    def split(self, J, dJ, M_gas, M_shaft):
-        """(J_k, J′_k, M_k) per sub-chain: shaft link, constant middle links, the rest last."""
+    def split(self, phi, J, dJ, M_gas, M_shaft):
+        """(J_k, J′_k, M_k) per sub-chain from each link's inertia: the shaft's J0, the constant
+        ones, where a pair cuts them from the rods the pistons' m Σ u_k² (from the twin's u, u′)
+        and the swash plate's link 9 and crosses (its kernel's Python code), and the rest of
+        J(φ), J′(φ) for the rods; the load and starter act on the shaft, the gas on the last
+        link."""
+        Ji = np.array(self.link_J, dtype=float)
+        dJi = np.zeros(len(self.laws))
+        Ji[0] = self.J0
+        if self.own:
+            _, _, u, du = self.terms(phi)
+        for i in self.own:
+            if self.laws[i] == LINK_PISTONS:
+                Ji[i], dJi[i] = self.piston_mass * u @ u, 2.0 * self.piston_mass * u @ du
+            else:
+                Ji[i], dJi[i] = swash_link_terms.py_func(self.mp, phi)
+        rest = self.rest
+        Ji[rest] = J - (np.sum(Ji) - Ji[rest])
+        dJi[rest] = dJ - (np.sum(dJi) - dJi[rest])
         Jk, dJk, Mk = np.zeros(self.n + 1), np.zeros(self.n + 1), np.zeros(self.n + 1)
-        Jk[self.sub[0]] += self.J0
-        for i in range(1, len(self.sub) - 1):
-            Jk[self.sub[i]] += self.link_J[i]
-        Jk[self.sub[-1]] += J - self.J0 - sum(self.link_J[1:-1])
-        dJk[self.sub[-1]] += dJ
+        np.add.at(Jk, self.sub, Ji)
+        np.add.at(dJk, self.sub, dJi)
         Mk[self.sub[0]] += M_shaft
         Mk[self.sub[-1]] += M_gas
         return Jk, dJk, Mk
@@ -416,8 +440,9 @@ class ReferenceModel:
     def __init__(self, scene) -> None:
         self.scene = scene
         self.model, self.bp, self.table = build_model(scene)
-        # The motored curve (None: the constant p0) between which and the table the fuel
-        # interpolates, as PressureTable objects rather than the model's arrays.
+        # The motored curve (None: gas_offset, a force pulse's zero, or a table's that runs at
+        # full fuel only) between which and the table the fuel interpolates, as PressureTable
+        # objects rather than the model's arrays.
         self.motored = gas_tables(scene)[1]
         self.mechanism_terms = scene.mechanism.reference_terms()
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
@@ -485,7 +510,7 @@ class ReferenceModel:
 
     def moments(self, phi: float, w: float, y):
         m = self.model
-        J, dJ, u = self.mechanism_terms(phi)
+        J, dJ, u, _ = self.mechanism_terms(phi)
         J += m.J0
         M_gas = 0.0
         p = np.zeros(m.ncyl)
@@ -493,7 +518,7 @@ class ReferenceModel:
             local = np.mod(self.mid - m.gas_phase, m.period) + (phi - self.mid)
             f = (self.latched if self.latched is not None else self.command(w, y)) * self.factors
             p_full = self.table.evaluate(local, self.pieces)[0]
-            # p = p_mot + f·(p_full − p_mot); the motored curve is p0 without a motored table
+            # p = p_mot + f·(p_full − p_mot); gas_offset without a motored table
             p_mot = (self.motored.evaluate(local, self.motored_pieces)[0]
                      if self.motored is not None else m.gas_offset)
             if self.shift is None:
@@ -749,6 +774,11 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
                 return yy[1]
             rest.terminal, rest.direction = True, -np.sign(y[1]) or -ref.sigma
             evs.append(("rest", rest))
+        elif math.isfinite(run.t_end):  # (recorded as it passes, as the compiled path does)
+            def through_zero(t, yy):
+                return yy[1]
+            through_zero.terminal, through_zero.direction = False, 0
+            evs.append(("through_zero", through_zero))
         m = ref.model
         if ref.seg < m.load_x.size:  # the next corner of the load schedule, and the one behind
             evs.append(("load_up", _level_crossing(m.load_comp == T, m.load_x[ref.seg], 1)))
@@ -779,15 +809,21 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
         t, y = sol.t[-1], sol.y[:, -1].copy()
         if progress:
             progress(min(1.0, max(t / t_end, (y[0] - scene.initial.phi) / (phi_end - scene.initial.phi))))
+        for (name, _), te, ye in zip(evs, sol.t_events or (), sol.y_events or ()):
+            if name == "through_zero":  # (not at the segment's start, where ω may be 0)
+                events.setdefault("speed_reversal", []).extend(
+                    (tz, yz[0]) for tz, yz in zip(te, ye) if tz > sol.t[0])
         if sol.status == 0:
             break
-        hit = [name for (name, _), te in zip(evs, sol.t_events) if te.size]
+        hit = [name for (name, e), te in zip(evs, sol.t_events) if te.size and e.terminal]
         if "end" in hit:
             break
-        if "stall" in hit:
-            raise SimulationError(f"stalled: the speed reached zero at t = {t:.9g} s, "
-                                  f"φ = {y[0]:.9g} rad before the {run.revolutions:g} revolutions "
-                                  f"the run ends by; give run.t_end to follow the motion")
+        if "stall" in hit:  # (judged as the compiled path's stall: transient.outcome)
+            events.setdefault("speed_reversal", []).append((t, y[0]))
+            message = (f"stalled: the speed reached zero at t = {t:.9g} s, φ = {y[0]:.9g} rad "
+                       f"({math.degrees(y[0]):.6g}°) before the {run.revolutions:g} revolutions "
+                       f"the run ends by; give run.t_end to follow the motion after a stall")
+            break
         if "rest" in hit:
             y[1] = 0.0
             events.setdefault("speed_reversal", []).append((t, y[0]))

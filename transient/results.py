@@ -43,8 +43,9 @@ FORMAT = 1
 @dataclass
 class RunData:
     """A run in memory: trajectory columns, events (name → (n, 2) of t, φ), solver statistics;
-    ``status`` says what the run did (:data:`transient.outcome.STATUSES`; "" until judged) and
-    ``warnings`` what a finished run must not be read without."""
+    ``status`` says what the run did (:data:`transient.outcome.STATUSES`; "" until judged),
+    ``warnings`` what a finished run must not be read without and ``summary`` what its judge
+    found over the whole run for the end-of-run summary (name → (value, unit))."""
 
     trajectory: dict[str, np.ndarray]
     events: dict[str, np.ndarray]
@@ -53,6 +54,7 @@ class RunData:
     message: str = ""
     status: str = ""
     warnings: list[str] = field(default_factory=list)
+    summary: dict[str, tuple[float, str]] = field(default_factory=dict)
 
 
 class ResultExists(FileExistsError):
@@ -167,11 +169,17 @@ def write_header(node: h5py.Group, **attrs: Any) -> None:
                       **provenance(), **attrs)
 
 
+#: The packages besides the numerical core whose versions a result records: the sweeps' (Dask),
+#: the figures' (matplotlib) and the tables' (pandas, optional).
+RECORDED_PACKAGES = ("dask", "distributed", "matplotlib", "pandas")
+
+
 @functools.cache
 def provenance() -> dict[str, str]:
     """How a result was made: transient's git commit when it runs from a checkout (``+dirty``
-    with uncommitted changes; empty otherwise), the versions of Python and the numerical
-    libraries, the command or call, the CPU."""
+    with uncommitted changes; empty otherwise), the versions of Python, the numerical libraries
+    and :data:`RECORDED_PACKAGES` ("not installed" for one that is not), the command or call,
+    the CPU."""
     import platform
     import sys
 
@@ -181,8 +189,20 @@ def provenance() -> dict[str, str]:
     return {"git_commit": _git_commit(), "python": platform.python_version(),
             "numpy": np.__version__, "scipy": scipy.__version__, "numba": numba.__version__,
             "h5py": h5py.__version__, "hdf5": h5py.version.hdf5_version,
+            **{name: _installed_version(name) for name in RECORDED_PACKAGES},
             "command": " ".join([Path(sys.argv[0]).name, *sys.argv[1:]]) if sys.argv else "",
             "cpu": _cpu_name(), "platform": platform.platform()}
+
+
+def _installed_version(package: str) -> str:
+    """The installed version of ``package`` from its metadata (not imported: a run need not load
+    matplotlib or pandas to say which it would use), or "not installed"."""
+    from importlib import metadata
+
+    try:
+        return metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return "not installed"
 
 
 def _git_commit() -> str:
@@ -212,15 +232,21 @@ def _cpu_name() -> str:
 
 
 def write_layout(node: h5py.Group, scene_toml: str, units: dict[str, str],
-                 trajectory: dict[str, np.ndarray] | None = None) -> dict[str, h5py.Dataset]:
-    """A result's groups under ``node``: ``scene/toml``, one column a unit in ``trajectory``
-    (empty, or holding ``trajectory[name]``), and ``events``, ``solver``, ``analysis``. Returns
-    the columns' datasets.
+                 trajectory: dict[str, np.ndarray] | None = None,
+                 scene_source: tuple[str, str] = ("", "")) -> dict[str, h5py.Dataset]:
+    """A result's groups under ``node``: ``scene/toml``, with ``scene_source`` (the file the scene
+    was read from and its text, comments included) ``scene/source`` and its attribute ``file``,
+    one column a unit in ``trajectory`` (empty, or holding ``trajectory[name]``), and ``events``,
+    ``solver``, ``analysis``. Returns the columns' datasets.
 
     The columns are extendable in chunks of :data:`CHUNK_ROWS` whether streamed or written whole,
     so that a stored column is one kind of dataset wherever it was written (and an empty one can
     still be chunked)."""
-    node.create_group("scene").create_dataset("toml", data=scene_toml)
+    scene = node.create_group("scene")
+    scene.create_dataset("toml", data=scene_toml)
+    file, text = scene_source
+    if text:
+        scene.create_dataset("source", data=text).attrs["file"] = file
     traj = node.create_group("trajectory")
     columns = {}
     for name, unit in units.items():
@@ -351,10 +377,17 @@ def _logged_events(g: h5py.Group, count: int | None = None, t_from: float = -np.
             lo = mid + 1
         else:
             hi = mid
-    rows = log[lo:n]
-    names = [str(name) for name in log.attrs["names"]]
+    return _decoded(log[lo:n], log.attrs["names"])
+
+
+#: Samples :meth:`ResultWriter.written_blocks` reads at a time, at least.
+READ_ROWS = 1 << 18
+
+
+def _decoded(rows: np.ndarray, names) -> dict[str, np.ndarray]:
+    """Rows (name index, t, φ) of an event log as name → (n, 2) of (t, φ)."""
     codes = rows[:, 0].astype(np.int64)
-    return {names[c]: rows[codes == c, 1:] for c in np.unique(codes)}
+    return {str(names[c]): rows[codes == c, 1:] for c in np.unique(codes)}
 
 
 def _extend(ds: h5py.Dataset, values) -> None:
@@ -376,12 +409,13 @@ class ResultWriter:
 
     def __init__(self, path: Path, scene_name: str, scene_toml: str,
                  columns: dict[str, str], event_names=(), force: bool = False,
-                 resume: bool = False) -> None:
+                 resume: bool = False, scene_source: tuple[str, str] = ("", "")) -> None:
         self.path = Path(path)
         self.force = force
         self.tmp = partial_path(self.path)
         self.done = self.tmp.with_name(f".{self.path.name}.done")
         self.scene_name, self.scene_toml = scene_name, scene_toml
+        self.scene_source = scene_source
         self.columns, self.event_names = columns, tuple(event_names)
         self.checkpoint: Checkpoint | None = None
         if resume:
@@ -409,7 +443,8 @@ class ResultWriter:
             write_header(self.f, scene=self.scene_name, complete=False, status="running")
             # The columns' datasets stay open for the file's life: a dataset object freed after
             # a failed write would make HDF5 retry it (and print its failure) on closing.
-            self.datasets = write_layout(self.f, self.scene_toml, self.columns)
+            self.datasets = write_layout(self.f, self.scene_toml, self.columns,
+                                         scene_source=self.scene_source)
             # Opened once: a lookup by path per block would cost more than writing the block.
             self.checkpoints = _checkpoint_datasets(self.f, self.event_names)
             self.f.flush()
@@ -511,6 +546,19 @@ class ResultWriter:
         start = 0 if last is None else max(0, n - last)
         return {name: ds[start:] for name, ds in self.datasets.items()}
 
+    def written_blocks(self):
+        """The run written so far in the order it streamed, (columns, events) of consecutive
+        checkpoints at a time, about :data:`READ_ROWS` samples each: what a resumed run did
+        before, in bounded memory."""
+        log, index = self.checkpoints["events"], self.checkpoints["index"][()]
+        rows = logged = 0
+        for k, (end, *_, end_logged) in enumerate(index):
+            if end - rows < READ_ROWS and k < len(index) - 1:
+                continue
+            yield ({name: ds[rows:end] for name, ds in self.datasets.items()},
+                   _decoded(log[logged:end_logged], log.attrs["names"]))
+            rows, logged = int(end), int(end_logged)
+
     def read_events(self, t_from: float = -np.inf) -> dict[str, np.ndarray]:
         """Events written so far at t ≥ ``t_from``, name → (n, 2) array of (t, φ); only the
         log's tail is read (a long run has millions of breakpoint events)."""
@@ -604,8 +652,7 @@ def _resume_point(source: Path, scene_toml: str) -> Checkpoint | None:
     """The last checkpoint of ``source`` (None if it has none yet), after checking that it is a
     run of the same scene."""
     with open_file(source) as f:
-        toml = f["scene"]["toml"][()]
-        if (toml.decode() if isinstance(toml, bytes) else str(toml)) != scene_toml:
+        if _text(f["scene"]["toml"][()]) != scene_toml:
             raise NotWritable(f"{source}: written from another scene (its /scene/toml differs); "
                               f"resume with the same scene, or use --force to start afresh")
         if CHECKPOINTS not in f:
@@ -686,6 +733,9 @@ class Result:
         Name → (value, unit) of the end-of-run summary and the analyses the scene asked for.
     scene_toml
         The resolved scene (every default filled in); :meth:`scene` rebuilds it.
+    scene_source
+        The file the scene was read from and its text, comments included (``("", "")`` for a
+        scene built in code).
 
     Examples
     --------
@@ -718,6 +768,7 @@ class Result:
     solver: dict[str, Any]
     analysis: dict[str, tuple[Any, str]]
     scene_toml: str
+    scene_source: tuple[str, str] = ("", "")
 
     @property
     def complete(self) -> bool:
@@ -741,10 +792,14 @@ class Result:
         return [w for w in str(self.attrs.get("warnings", "")).splitlines() if w]
 
     def scene(self):
-        """Rebuild the scene from ``/scene/toml``."""
+        """Rebuild the scene from ``/scene/toml`` (with the source it was read from)."""
+        from dataclasses import replace
+
         from .scene import load_scene
 
-        return load_scene(f"{self.path or '(in memory)'}:/scene/toml", text=self.scene_toml)
+        scene = load_scene(f"{self.path or '(in memory)'}:/scene/toml", text=self.scene_toml)
+        file, text = self.scene_source
+        return replace(scene, source_file=file, source_text=text) if text else scene
 
     def summary(self) -> dict[str, Any]:
         """The end-of-run summary's values by name (units in ``analysis``): final and mean speed,
@@ -765,7 +820,8 @@ class Result:
 
 
 def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dict[str, str],
-                     analysis: dict[str, tuple[Any, str]]) -> Result:
+                     analysis: dict[str, tuple[Any, str]],
+                     scene_source: tuple[str, str] = ("", "")) -> Result:
     """The :class:`Result` of a run held in memory (judged: ``data.status``), as its file would
     read back."""
     attrs = {"creator": CREATOR, "version": __version__, "format": FORMAT, "created": now(),
@@ -777,7 +833,8 @@ def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dic
               for name, rows in data.events.items() if rows.size}
     return Result(path=None, attrs=attrs, trajectory=dict(data.trajectory),
                   units={c: units.get(c, "") for c in data.trajectory}, events=events,
-                  solver=dict(data.solver), analysis=dict(analysis), scene_toml=scene_toml)
+                  solver=dict(data.solver), analysis=dict(analysis), scene_toml=scene_toml,
+                  scene_source=scene_source)
 
 
 def open_result(path: str | Path) -> Result:
@@ -854,11 +911,18 @@ def read_run(node: h5py.Group, path: Path) -> Result:
         analysis[k] = (value.decode() if isinstance(value, bytes) else value,
                        str(ds.attrs.get("unit", "")))
     toml = node["scene"]["toml"][()]
+    source = node["scene"].get("source")
     if attrs.get("status") == "running":
         attrs["message"] = _stopped_message(node["trajectory"], rows)
     return Result(path=path, attrs=attrs, trajectory=traj, units=units, events=events,
-                  solver=dict(node["solver"].attrs), analysis=analysis,
-                  scene_toml=toml.decode() if isinstance(toml, bytes) else str(toml))
+                  solver=dict(node["solver"].attrs), analysis=analysis, scene_toml=_text(toml),
+                  scene_source=("", "") if source is None else (str(source.attrs.get("file", "")),
+                                                                _text(source[()])))
+
+
+def _text(value) -> str:
+    """A string dataset's value as str (h5py gives bytes)."""
+    return value.decode() if isinstance(value, bytes) else str(value)
 
 
 def _stopped_message(columns: h5py.Group, rows: slice) -> str:

@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from .assemble import build_model, initial_governor
+from .assemble import build_model, initial_governor, part_load_refusal
 from .core import forcing, layout, stepper
 from .core import stepper_io as sio
 from .core.inverse import inverse_dynamics
@@ -283,11 +283,16 @@ def _kinematics_attrs(scene) -> dict:
 def prescribed(scene, fuel: float = 1.0) -> RunData:
     """Inverse dynamics at a prescribed speed: the drive torque on the shaft that the chain needs
     (the textbook analysis at given ω). ``fuel`` sets the pressure between the motored and the
-    full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot the
-    crankcase pressure p0, or zero force, for the models without a motored curve): the tables'
-    cubics are blended, so the ``p_<k>`` columns hold the pressure applied. The work columns are
-    integrated over the motion to the scene's tolerance (:mod:`.prescribed_work`)."""
-    model, _, _ = build_model(scene)
+    full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot zero
+    force for a force pulse): the tables' cubics are blended, so the ``p_<k>`` columns hold the
+    pressure applied. A fuel below 1 for a model that cannot burn less (a table without its
+    motored curve, a compressor: :func:`transient.assemble.part_load_refusal`) is a SceneError.
+    The work columns are integrated over the motion to the scene's tolerance
+    (:mod:`.prescribed_work`)."""
+    why = part_load_refusal(scene) if fuel != 1.0 else None
+    if why:
+        raise SceneError("fuel", f"{fuel:g}: {why}")
+    model, _, _ = build_model(scene, part_load=fuel != 1.0)
     coef = model.coef.copy()
     if model.has_motored:  # columns 0–3 full load, 4–7 motored (core.layout.Model)
         coef[:, :4] = coef[:, 4:] + fuel * (coef[:, :4] - coef[:, 4:])
@@ -339,12 +344,15 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     return RunData(traj, {}, solver)
 
 
-def integrate(scene, on_block=None, progress=None, keep=True, start=None) -> RunData:
+def integrate(scene, on_block=None, progress=None, keep=True, start=None, before=()) -> RunData:
     """Run a scene by the method it names (compiled, reference or prescribed); see run_compiled
-    for ``keep`` and ``start``. The run comes back judged (:func:`transient.outcome.judge`); a
-    run that outgrows its output budget or stops advancing raises
+    for ``keep`` and ``start``, and ``before`` the (block, events) the run continued from
+    ``start`` wrote before it. The run comes back judged (:func:`transient.outcome.judge`) over
+    all of it; a run that outgrows its output budget or stops advancing raises
     :class:`~transient.outcome.RunStopped` after its blocks so far went to ``on_block``."""
     watch = Watch(scene, len(output_columns(scene)))
+    for block, events in before:
+        watch.take(block, events)
     if scene.run.mode == "prescribed-speed":
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
@@ -504,9 +512,10 @@ def _in_memory(scene, progress) -> Result:
     from .scene import to_toml
 
     data = integrate(scene, progress=progress)
-    summary = (summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
-               else {})
-    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary)
+    summary = {**(summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
+                  else {}), **data.summary}
+    res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary,
+                           (scene.source_file, scene.source_text))
     if res.status != FINISHED:
         raise SimulationError(f"{data.message} (status = {res.status})", res)
     return res
@@ -524,7 +533,8 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         raise SceneError("solver.method", f"{scene.solver.method!r}: only runs of the compiled "
                          f"stepper (DOP853, DOPRI5) can be resumed; run it again with --force")
     writer = ResultWriter(path, scene.name, to_toml(scene), output_columns(scene),
-                          EVENT_NAMES, force=force, resume=resume)
+                          EVENT_NAMES, force=force, resume=resume,
+                          scene_source=(scene.source_file, scene.source_text))
     writes = _WriteBehind()
     data = None
     try:
@@ -536,7 +546,7 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
             writes.start(writer.block, block, ev, *state)
 
         data = integrate(scene, on_block=on_block, progress=progress, keep=False,
-                         start=writer.checkpoint)
+                         start=writer.checkpoint, before=writer.written_blocks())
         writes.wait()
         if not streamed or "stiff_rerun" in data.solver:  # written whole, not resumable
             writer.block(data.trajectory, data.events, np.zeros(0), np.zeros(0, np.int64), False,
@@ -545,7 +555,7 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         # memory stays bounded however long the run (steady state, efficiency are found there).
         tail = writer.read_trajectory(last=SUMMARY_SAMPLES)
         events = writer.read_events(t_from=tail["t"][0] if tail["t"].size else -math.inf)
-        summary = summarize(scene, tail, events) if tail["t"].size else {}
+        summary = {**(summarize(scene, tail, events) if tail["t"].size else {}), **data.summary}
     except BaseException as exc:
         writes.settle()
         msg = data.message if data is not None and data.message else (

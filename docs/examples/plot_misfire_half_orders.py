@@ -8,6 +8,12 @@ in every tenth of its cycles (``[[gas.cylinders]]``). Each cycle's order spectru
 the half orders ½, 1, 1½ …, larger in the cycles of a misfire. Linearised about the mean speed,
 J̄·ω̄·dω/dφ = ΔM(φ), so a gas-torque component M_q of order q makes a speed component
 ω_q = M_q/(J̄·ω̄·q): the dots are that estimate, from each cycle's gas torque.
+
+A fuel factor or a misfire scales the combustion only: a misfiring cylinder still compresses and
+expands, on the mixed cycle's motored curve (the compression polytrope both ways, peaking at
+p_c = p_a·ε^n1 = 7.488 MPa), and the weak cylinder burns 80 % of the heat at every angle
+(peaking at p_c + 0.8·(p_z − p_c)). The second figure shows both against the full-load and
+motored curves. What the orders see is the missing combustion, not a missing compression.
 """
 from pathlib import Path
 
@@ -16,6 +22,9 @@ import numpy as np
 
 import transient
 from transient.analysis.orders import order_spectrum, to_angle_grid
+from transient.analysis.thermo import own_cycles
+from transient.assemble import gas_tables
+from transient.plots import run_indicator_phi
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"
 scene = transient.load_scene(CASES / "diesel_4cyl_misfire.toml")
@@ -50,4 +59,23 @@ ax.set_ylabel("amplitude of ω [rad/s]")
 ax.grid(True, alpha=0.3)
 ax.legend()
 ax.set_title("Half orders of the speed: cylinder 2 at 80 %, cylinder 3 misfires every 10th cycle")
+plt.show()
+
+# %%
+# The last two whole cycles of cylinder 3 (its cycle 100 misfires) and the last of cylinder 2,
+# against their own crank angle around the firing TDC (360°).
+full, motored = gas_tables(scene)
+fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
+run_indicator_phi(ax, result, scene, cylinders=[3], cycles=(-2, -1), table=full,
+                  motored=motored)
+run_indicator_phi(ax, result, scene, cylinders=[2], cycles=(-1,))
+ax.set_xlim(270, 480)
+ax.set_title("A misfire on the motored curve, 80 % fuel between it and full load")
+phi = df["phi"].to_numpy()
+for k, c in ((3, -2), (3, -1), (2, -1)):
+    a = own_cycles(scene, result.trajectory, k)[c]
+    inside = (phi >= a) & (phi < a + cycle)
+    print(f"cylinder {k}, its cycle from φ = {np.degrees(a):.0f}°: peak "
+          f"{df[f'p_{k}'].to_numpy()[inside].max() / 1e6:.3f} MPa")
+print(f"motored compression end p_c = {motored(2 * np.pi)[()] / 1e6:.3f} MPa")
 plt.show()

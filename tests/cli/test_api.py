@@ -52,7 +52,7 @@ def test_the_summary_and_a_dataframe(small):
 
 
 def test_a_failed_run_raises_with_the_run_up_to_there(small):
-    stalls = small.replace(load={"torque": 500.0}, run={"revolutions": 50})
+    stalls = small.replace(load={"torque": 5.0}, run={"revolutions": 50})  # (after 5 turns)
     with pytest.raises(SimulationError) as info:
         simulate(stalls)
     res = info.value.result

@@ -55,3 +55,41 @@ def test_a_sweep_on_a_given_dask_client(small):
         moved = cluster.scheduler.transition_counter - before
     assert list(done.to_dataframe()["status"]) == ["finished", "finished"]
     assert moved >= 2 * 3  # each run's task went through that scheduler (at least 3 states)
+
+
+def test_a_nan_in_a_sweep_comes_with_its_reason(tmp_path):
+    """The Gots diesel with friction for 1, 8 and 600 revolutions: 1 holds no whole cycle (a
+    cycle is 2 revolutions), 8 no steady state, 600 runs into it. η_mech is NaN in the first
+    two, δ and the mean speed in the first; each row's note says why, as the run's own summary
+    shows, and the CSV carries it."""
+    from pathlib import Path
+
+    base = load_scene(Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_friction.toml")
+    done = sweep(base, {"run.revolutions": [1.0, 8.0, 600.0]},
+                 collect=["mean_speed_rpm", "delta", "eta_mech"], scheduler="serial",
+                 output=tmp_path)
+    df = done.to_dataframe()
+    assert list(df["status"]) == ["finished"] * 3
+    assert np.isnan(df["eta_mech"][:2]).all() and np.isfinite(df["eta_mech"][2])
+    no_cycle = ("the run holds no whole cycle turned forwards (1 revolutions from its start)")
+    assert df["note"][0] == (f"mean_speed_rpm: {no_cycle}; delta: {no_cycle}; eta_mech: "
+                             f"{no_cycle}")
+    assert df["note"][1] == ("eta_mech: no steady cycles to take it over: no steady state: the "
+                             "cycle-mean speed still changed by 1e-4 or more from cycle to cycle")
+    assert df["note"][2] == ""
+    first, second, third = (done.run(i).analysis for i in range(3))
+    assert "eta_mech_work" not in first and np.isnan(first["mean_omega_last_cycle"][0])
+    assert "eta_mech_work" not in second and np.isnan(second["steady_state_t"][0])
+    assert df["eta_mech"][2] == third["eta_mech_work"][0]
+    csv = (tmp_path / "gots-diesel-friction.sweep_summary.csv").read_text().splitlines()
+    assert csv[0].endswith(",note,message") and no_cycle in csv[1] and "steady" in csv[2]
+
+
+def test_a_run_that_did_not_finish_says_so_in_the_note(small):
+    done = sweep(small, {"load.torque": [0.0, 500.0]}, collect=["final_speed_rpm"],
+                 scheduler="serial")
+    df = done.to_dataframe()
+    assert list(df["status"]) == ["finished", "not-started"]
+    assert list(df["note"]) == ["", "not collected: the run ended not-started (its message says "
+                                    "how)"]
+    assert df["message"][1].startswith("did not start: the shaft never turned a whole revolution")

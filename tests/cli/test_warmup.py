@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"
 
@@ -52,6 +54,7 @@ def cached_kernels(cache: Path) -> set[str]:
     return {path.name.split("-")[0] for path in cache.rglob("*.nbi")}
 
 
+@pytest.mark.slow  # (it compiles every kernel cold, in a cache of its own)
 def test_warmup_compiles_what_runs_then_load(tmp_path):
     env = {**os.environ, "TRANSIENT_CACHE_DIR": str(tmp_path / "cache")}
     env.pop("NUMBA_CACHE_DIR", None)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 
 import pytest
-from scene_texts import SMALL
+from scene_texts import MIXED_CYCLE, SMALL
 
 from transient.cli import main
 from transient.scene.files import MAX_INPUT_BYTES
@@ -110,7 +110,7 @@ SCENE_CASES = [
     ("long-pair-link", SMALL + f'\n[[friction.pairs]]\nbetween = ["shaft", "{LONG}"]\n'
                                "eta_forward = 0.9\neta_backward = 0.9\n",
      "friction.pairs[0].between: unknown link '" + "x" * 36 + "...; the links are shaft – crank – "
-     "rod (pairs with model = \"reaction\" join shaft – crank – rod – piston – cylinder)"),
+     "rod – piston – cylinder"),
     ("long-pair-name", SMALL + f'\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\n'
                                f'name = "{LONG}"\neta_forward = 0.9\neta_backward = 0.9\n'
                                f'\n[[friction.pairs]]\nbetween = ["crank", "rod"]\n'
@@ -188,16 +188,20 @@ TABLE_CASES = [
     ("short-row", "phi_deg,p_bar\n0,1\n720\n",
      "line 3 has 1 field(s); column p_bar is field 2"),
     ("semicolons", "phi_deg;p_bar\n0;1\n720;1\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is ['phi_deg;p_bar']"),
     ("many-unknown-columns", ",".join(f"c{i}" for i in range(60)) + "\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is ['c0', 'c1', 'c2', 'c3', 'c4', 'c5', ..."),
     ("pressure-unit-unknown", "phi_deg,p_psi\n0,1\n720,1\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is ['phi_deg', 'p_psi']"),
     ("comments-only", "# nothing measured yet\n\n",
-     "needs an angle column (phi_deg, phi) and a pressure column (p, p_bar, p_MPa, p_Pa); header "
+     "needs an angle column (phi_deg, phi) and a pressure or force column (p, p_bar, p_MPa, p_Pa, "
+     "force, force_N, force_kN); header "
      "is []"),
 ]
 
@@ -495,3 +499,127 @@ def test_the_suite_is_large_and_distinct():
     assert sum(map(len, groups)) >= 100
     for group in groups:
         assert len({c[0] for c in group}) == len(group)
+
+
+# ------------------------------------------------------------------------------------------------
+# Absurd magnitudes that passed the checks and failed at the first step, and names a terminal
+# would act on: (id, file content, the line after "{scene}: "). The bounds follow from the speed
+# no piston machine reaches (RUNAWAY_SPEED): SMALL's least reduced inertia is 0.0248 kg m², so a
+# torque may be up to 0.0248·(1e5)²/(4π) = 1.98e7 N m (it would otherwise take the machine from
+# rest past 1e5 rad/s within one revolution).
+
+RUNAWAY = ("which would take the machine (least reduced inertia 0.0248 kg m²) from rest past "
+           "100000 rad/s, faster than any piston machine turns, within one revolution; allowed "
+           "up to J_min·ω²/(4π) = 1.98e+07 N m")
+GAS = SMALL + MIXED_CYCLE.format(cr=18)
+SPEED = ("rad/s is beyond 100000 rad/s (9.55e+05 rpm), faster than any piston machine turns (a "
+         "run reaching it ends as a runaway); give a speed up to that")
+
+MAGNITUDE_CASES = [
+    ("initial-speed-beyond-any-machine", SMALL.replace("omega_rpm = 1000", "omega = 1e300"),
+     f"initial.omega: 1e+300 {SPEED}"),
+    ("initial-speed-in-rpm", SMALL.replace("omega_rpm = 1000", "omega_rpm = -1e7"),
+     f"initial.omega_rpm: 1.05e+06 {SPEED}"),
+    ("load-torque", insert("shaft = 0.02", "\n[load]\ntorque = 1e300"),
+     f"load.torque: gives a torque of 1e+300 N m, {RUNAWAY}"),
+    ("load-driving", insert("shaft = 0.02", "\n[load]\ntorque = -1e30"),
+     f"load.torque: gives a torque of 1e+30 N m, {RUNAWAY}"),
+    ("fan-at-the-initial-speed", insert("shaft = 0.02", "\n[load]\nfan = 1e300"),
+     f"load.fan: gives a torque of 1.1e+304 N m at the initial speed, {RUNAWAY}"),
+    ("starter", insert("shaft = 0.02", "\n[starter]\ntorque = 1e300"),
+     f"starter.torque: gives a torque of 1e+300 N m, {RUNAWAY}"),
+    ("crankcase-pressure", GAS.replace("p_a_MPa = 0.1436", "p_a_MPa = 0.1436\np0 = 1e306"),
+     "gas.p0: gives a torque of 3e+302 N m (the pressure difference p − p0 up to 1e+306 Pa on "
+     "pistons of 0.00608 m², on their lever Σ max|dx/dφ| = 0.0493 m), " + RUNAWAY),
+    ("peak-pressure", GAS.replace("p_z_MPa = 10.5", "p_z_MPa = 1e300"),
+     "gas.p_z_MPa: gives a torque of 3e+302 N m (the pressure difference p − p0 up to 1e+306 Pa "
+     "on pistons of 0.00608 m², on their lever Σ max|dx/dφ| = 0.0493 m), " + RUNAWAY),
+    ("intake-pressure", GAS.replace("p_intake_MPa = 0.165", "p_intake_MPa = 1e300"),
+     "gas.p_intake_MPa: gives a torque of 3e+302 N m (the pressure difference p − p0 up to "
+     "1e+306 Pa on pistons of 0.00608 m², on their lever Σ max|dx/dφ| = 0.0493 m), " + RUNAWAY),
+    ("bore-of-a-kilometre", GAS.replace("bore_mm = 88", "bore_mm = 1e6"),
+     "gas.p_z_MPa: gives a torque of 4.03e+11 N m (the pressure difference p − p0 up to "
+     "1.04e+07 Pa on pistons of 7.85e+05 m², on their lever Σ max|dx/dφ| = 0.0493 m), "
+     + RUNAWAY),
+    ("compression-exponent", GAS.replace("n1 = 1.368", "n1 = 1e300"),
+     "gas.p_z_MPa: p_z = 10.5 MPa is below the compression end p_c = p_a·ε^n1 = inf MPa (ε = 18, "
+     "n1 = 1e+300); the mixed cycle needs p_z ≥ p_c"),
+    ("control-character-in-the-name", SMALL.replace('name = "small"', 'name = "sm\\u001b[2Jall"'),
+     "scene.name: holds the control character '\\x1b' (character 3); a name labels terminal "
+     "lines, figures and results: give printable text"),
+    ("newline-in-the-name", SMALL.replace('name = "small"', 'name = "sm\\nall"'),
+     "scene.name: holds the control character '\\n' (character 3); a name labels terminal lines, "
+     "figures and results: give printable text"),
+    ("control-character-in-a-pair-name",
+     SMALL + '\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\nname = "main\\u0007"\n'
+             'eta_forward = 0.9\neta_backward = 0.9\n',
+     "friction.pairs[0].name: holds the control character '\\x07' (character 5); a name labels "
+     "terminal lines, figures and results: give printable text"),
+]
+
+
+@pytest.mark.parametrize("content, message",
+                         [pytest.param(c, m, id=i) for i, c, m in MAGNITUDE_CASES])
+def test_an_absurd_magnitude_or_a_control_character_gives_its_exact_line(tmp_path, capsys,
+                                                                         content, message):
+    scene = tmp_path / "bad.toml"
+    write(scene, content)
+    assert one_line(capsys, ["check", scene]) == f"{scene}: {message}"
+
+
+def test_a_compressor_beyond_any_machine_is_refused_by_its_discharge(tmp_path, capsys):
+    """The magnitude bound covers the compressor cycle, whose largest pressure is the discharge:
+    3e19 Pa on the A/C compressor's pistons (a clearance small enough to deliver at that ratio)."""
+    from pathlib import Path
+
+    case = (Path(__file__).resolve().parents[2] / "cases" / "ac_compressor_7cyl.toml").read_text(
+        encoding="utf-8")
+    lines = {"p_discharge_MPa = ": "p_discharge_MPa = 3e13", "clearance_ratio = ":
+             "clearance_ratio = 1e-14"}
+    scene = tmp_path / "c.toml"
+    write(scene, "\n".join(next((v for k, v in lines.items() if line.startswith(k)), line)
+                           for line in case.splitlines()) + "\n")
+    line = one_line(capsys, ["check", scene])
+    assert line.startswith(f"{scene}: gas.p_discharge_MPa: gives a torque of 2.35e+15 N m (the "
+                           f"pressure difference p − p0 up to 3e+19 Pa on pistons of ")
+    assert line.endswith("faster than any piston machine turns, within one revolution; allowed "
+                         "up to J_min·ω²/(4π) = 7.66e+06 N m")
+
+
+def test_a_wiebe_cycle_no_gas_has_is_refused(tmp_path, capsys):
+    """γ above a monatomic gas's 5/3 is refused by its key; a heat release no double holds, by
+    the Wiebe table that cannot be integrated (one line, no traceback, no numpy warning)."""
+    from pathlib import Path
+
+    wiebe = (Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_wiebe.toml").read_text(
+        encoding="utf-8")
+    scene = tmp_path / "w.toml"
+    write(scene, "\n".join("gamma = 1.7" if line.startswith("gamma = ") else line
+                           for line in wiebe.splitlines()) + "\n")
+    assert one_line(capsys, ["check", scene]) == (f"{scene}: gas.wiebe.gamma: must be ≤ 1.66667, "
+                                                  f"got 1.7")
+    assert "\ngamma = " in wiebe and "\nfuel_mass = " in wiebe
+    write(scene, "\n".join("fuel_mass = 1e300" if line.startswith("fuel_mass = ") else line
+                           for line in wiebe.splitlines()) + "\n")
+    line = one_line(capsys, ["check", scene])
+    assert line.startswith(f"{scene}: gas.wiebe: the cycle's pressure cannot be integrated from ")
+    assert line.endswith("its inputs give no physical gas; check fuel_mass, lhv, m, gamma, "
+                         "gamma_slope and p_a, and their units")
+
+
+def test_the_bound_lets_the_shipped_scenes_through():
+    """Every scene of cases/ loads: the bounds refuse no machine the project models."""
+    from pathlib import Path
+
+    from transient.scene import load_scene
+
+    for path in sorted((Path(__file__).resolve().parents[2] / "cases").glob("*.toml")):
+        load_scene(path)
+
+
+def test_a_sweep_name_with_a_control_character(tmp_path, capsys):
+    write(tmp_path / "base.toml", SMALL)
+    sweep = tmp_path / "s.toml"
+    write(sweep, SWEEP.replace("[sweep]\n", '[sweep]\nname = "a\\u001bb"\n'))
+    assert one_line(capsys, ["check", sweep]) == (f"{sweep}: sweep.name: holds a control "
+                                                  f"character ('a\\x1bb'); give printable text")

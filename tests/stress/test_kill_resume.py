@@ -81,6 +81,7 @@ def _check_prefix(part, full, what: str) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @pytest.mark.parametrize("case, run, kills", CASES)
 def test_killed_runs_keep_a_prefix_and_resume_bit_identically(tmp_path, case, run, kills):
     scene_file = _scene_file(tmp_path, case, run)

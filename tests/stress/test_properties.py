@@ -1,10 +1,11 @@
 """Property-based tests over random valid scenes of every mechanism.
 
 For each random scene (crank-slider: 1–4 cylinders, 2/4 strokes, λ 0.2–0.6, offset up to half
-its limit, rigid or two-mass rod, no gas / trapezoid pulses / a table, a load, up to two
-non-ideal pairs, either domain; swash plate: 1–6 cylinders, swash angle 8–40°, trapezoid pulses,
-a droop governor or none, plate bearing non-ideal or not; articulated: radials of 2–9 cylinders
-and fork-and-blade V-twins, λ 0.22–0.4, no gas or the mixed cycle, up to two non-ideal pairs):
+its limit, rigid or two-mass rod, no gas / trapezoid pulses / a table, a load, any set of
+non-ideal pairs along its links, either domain; swash plate: 1–6 cylinders, swash angle 8–40°,
+trapezoid pulses, a droop governor or none, any set of pairs along its links; articulated:
+radials of 2–9 cylinders and fork-and-blade V-twins, λ 0.22–0.4, no gas or the mixed cycle,
+any set of pairs along its links):
 
 * the compiled run raises nothing and stores no non-finite value; it completes, or stops with a
   diagnosis naming time and angle (a random load may stall the machine, a random pair set lock it);
@@ -116,10 +117,7 @@ def swash_plate_scenes(draw):
     put(d, "gas", amplitude=draw(st.floats(0.0, 12000.0)), ramp_deg=draw(st.floats(5.0, 60.0)))
     if draw(st.booleans()):
         del d["governor"]
-    if draw(st.booleans()):
-        d["friction"] = {"pairs": [{"between": ["shaft", "link"],
-                                    "eta_forward": draw(st.floats(0.5, 1.0)),
-                                    "eta_backward": draw(st.floats(0.5, 1.0))}]}
+    chain_pairs(draw, d, ["shaft", "link", "rod", "piston", "cylinder"])
     put(d, "inertia", shaft=draw(st.floats(0.2, 2.0)))
     common(draw, d, omega=(5.0, 80.0))
     return d
@@ -159,14 +157,19 @@ def articulated_scenes(draw):
 
 
 def crank_pairs(draw, d):
-    """Up to two non-ideal pairs on a crank mechanism's links (shaft – crank – rod)."""
-    n_pairs = draw(st.integers(0, 2))
-    links = [("shaft", "crank"), ("crank", "rod")]
-    if n_pairs:
-        d["friction"] = {"pairs": [{"between": list(links[k]),
-                                    "eta_forward": draw(st.floats(0.5, 1.0)),
+    """Non-ideal pairs between any neighbours of a crank mechanism's links (shaft – crank – rod –
+    piston – cylinder; the pair into the cylinders only with gas forces to pass on)."""
+    links = ["shaft", "crank", "rod", "piston", "cylinder"]
+    chain_pairs(draw, d, links if d["gas"].get("model") != "none" else links[:-1])
+
+
+def chain_pairs(draw, d, links):
+    """Any subset of the pairs between neighbouring ``links``, gaps included."""
+    pairs = [[a, b] for a, b in zip(links, links[1:]) if draw(st.booleans())]
+    if pairs:
+        d["friction"] = {"pairs": [{"between": p, "eta_forward": draw(st.floats(0.5, 1.0)),
                                     "eta_backward": draw(st.floats(0.5, 1.0))}
-                                   for k in range(n_pairs)]}
+                                   for p in pairs]}
 
 
 def common(draw, d, omega=(30.0, 400.0)):
@@ -252,6 +255,7 @@ def check(d):
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @settings.get_profile(PROFILE)
 @given(crank_slider_scenes())
 def test_random_crank_slider_scenes(d):
@@ -259,6 +263,7 @@ def test_random_crank_slider_scenes(d):
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @settings.get_profile(PROFILE)
 @given(swash_plate_scenes())
 def test_random_swash_plate_scenes(d):
@@ -266,6 +271,7 @@ def test_random_swash_plate_scenes(d):
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 @settings.get_profile(PROFILE)
 @given(articulated_scenes())
 def test_random_articulated_scenes(d):

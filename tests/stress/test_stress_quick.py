@@ -9,6 +9,7 @@ from transient.verify.stress import catalogue
 
 
 @pytest.mark.slow
+@pytest.mark.stress
 def test_stress_quick(tmp_path, capsys):
     code = main(["stress", "--quick", "-o", str(tmp_path)])
     out = capsys.readouterr().out

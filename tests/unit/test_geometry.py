@@ -106,6 +106,7 @@ def axial(mech, alpha, i: int) -> float | np.ndarray:
     return (p["Bi"][:, i - 1] * np.exp(-1j * mech.slave_banks[i - 1])).real
 
 
+@pytest.mark.slow  # (the extremes searched in plain Python, one position at a time)
 @pytest.mark.parametrize("name", sorted(ARTICULATED))
 def test_articulated_geometry_against_a_search_of_the_piston_positions(name):
     """Each piston's dead centres are the extremes of X(α) from the plain-numpy positions, its
@@ -164,6 +165,7 @@ SWASH = {"z3": sp.antonyuk_example(cylinders=3),
          "z5_normal_hinge": sp.antonyuk_example(cylinders=5, hinge="normal")}
 
 
+@pytest.mark.slow  # (the extremes searched in plain Python, one position at a time)
 @pytest.mark.parametrize("name", sorted(SWASH))
 def test_swash_plate_geometry_against_a_search_of_the_piston_joints(name):
     """Each cylinder's dead centres are the extremes of its piston joint's x_D(φ) (positions),

@@ -40,12 +40,13 @@ def test_reference_twin_agrees_with_the_kernel(name):
     table = mech.kinematics_table(phi)
     terms = mech.reference_terms()
     for j, p in enumerate(phi):
-        J, dJ, u = terms(p)
+        J, dJ, u, du = terms(p)
         scale = np.max(np.abs(table["J"]))
         assert J == pytest.approx(table["J"][j], rel=1e-12, abs=1e-12 * scale)
         assert dJ == pytest.approx(table["dJ_dphi"][j], rel=1e-9, abs=1e-9 * scale)
         for k in range(mech.n_cylinders):
             assert u[k] == pytest.approx(table[f"u_{k + 1}"][j], rel=1e-9, abs=1e-12)
+            assert du[k] == pytest.approx(table[f"du_{k + 1}"][j], rel=1e-9, abs=1e-12)
 
 
 def test_loads_storers_are_keyed_by_registered_names():

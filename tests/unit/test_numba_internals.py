@@ -8,7 +8,6 @@ off (plain ``njit(cache=True)``); that fallback is tested here too."""
 from __future__ import annotations
 
 import ast
-import importlib.util
 import inspect
 import os
 import subprocess
@@ -356,8 +355,7 @@ def test_compile_lock_runs_under_numbas_reentrant_compiler_lock():
         ACROSS_PROCESSES, "numba.core.compiler_lock.global_compiler_lock being reentrant")
 
 
-def test_compile_lock_is_per_function_because_numba_saves_by_read_modify_write(tmp_path,
-                                                                               monkeypatch):
+def test_compile_lock_is_per_function_because_numba_saves_by_read_modify_write(kern):
     assert _statements(caching.IndexDataCacheFile.save) == _code("""
         overloads = self._load_index()
         try:
@@ -373,14 +371,7 @@ def test_compile_lock_is_per_function_because_numba_saves_by_read_modify_write(t
         self._save_data(data_name, data)
         """), _relies(ACROSS_PROCESSES, "numba.core.caching.IndexDataCacheFile.save being a "
                       "read-modify-write of the function's index (why the lock is per function)")
-    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba"))
-    source = tmp_path / "kern.py"
-    source.write_text("def double(x):\n    return 2 * x\n")
-    spec = importlib.util.spec_from_file_location("kern", source)
-    module = importlib.util.module_from_spec(spec)
-    monkeypatch.setitem(sys.modules, "kern", module)
-    spec.loader.exec_module(module)
-    cache = caching.FunctionCache(module.double)
+    cache = caching.FunctionCache(kern.double)
     assert isinstance(cache._cache_path, str) and isinstance(cache._impl.filename_base, str), \
         _relies(ACROSS_PROCESSES, "numba.core.caching.Cache._cache_path and "
                 "_impl.filename_base (where the lock file goes, and its name)")
@@ -395,17 +386,10 @@ def test_compile_lock_is_per_function_because_numba_saves_by_read_modify_write(t
 # transient.precompile
 
 
-def test_compile_helper_reads_numbas_cache_index(tmp_path, monkeypatch):
+def test_compile_helper_reads_numbas_cache_index(kern):
     """``precompile.stepper_is_cached`` (and the helper's tests) read a function's saved
     signatures from its index."""
-    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba"))
-    source = tmp_path / "kern.py"
-    source.write_text("def double(x):\n    return 2 * x\n")
-    spec = importlib.util.spec_from_file_location("kern", source)
-    module = importlib.util.module_from_spec(spec)
-    monkeypatch.setitem(sys.modules, "kern", module)
-    spec.loader.exec_module(module)
-    double = jit.compiled(module.double)
+    double = jit.compiled(kern.double)
     assert double._cache._cache_file._load_index() == {}, _relies(
         HELPER, "numba.core.caching.IndexDataCacheFile._load_index() ({} when nothing is saved)")
     assert double(2) == 4
@@ -413,6 +397,12 @@ def test_compile_helper_reads_numbas_cache_index(tmp_path, monkeypatch):
     assert [key[0] for key in keys] == [(types.int64,)], _relies(
         HELPER, "numba.core.caching.IndexDataCacheFile._load_index() keyed by (signature, ...)"
         f" (found {keys})")
+    codegen = double.targetctx.codegen()
+    assert keys == [double._cache._index_key((types.int64,), codegen)], _relies(
+        HELPER, "numba.core.caching.Cache._index_key(sig, codegen), the key numba loads by")
+    assert keys[0][1] == codegen.magic_tuple() and keys[0][1][1] == codegen._get_host_cpu_name(), \
+        _relies(HELPER, "numba's index key holding codegen.magic_tuple(): (triple, CPU name, "
+                "features)")
 
 
 # ----------------------------------------------------------------------------------------------

@@ -25,8 +25,10 @@ GEOMETRIES = [  # (r, l, e) [m]: the Gots diesel, offsets both ways, one near th
 
 def scene_text(offset_mm: float, strokes: int = 4) -> str:
     mech = f"bore_mm = 88\noffset_mm = {offset_mm}\nstrokes = {strokes}"
-    text = SMALL.replace("bore_mm = 88", mech) + MIXED
-    return text  # (a 2-stroke takes the gas-exchange pressures and does not use them)
+    gas = MIXED
+    if strokes == 2:  # (a 2-stroke has no gas-exchange strokes: it refuses their pressures)
+        gas = gas.replace("p_intake_MPa = 0.165\n", "").replace("p_exhaust_MPa = 0.182\n", "")
+    return SMALL.replace("bore_mm = 88", mech) + gas
 
 
 def mechanism(r: float, l: float, e: float):

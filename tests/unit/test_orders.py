@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 import pytest
+from references import check_all, semenov
 from scipy.integrate import quad
 
 from transient.analysis.loads.crank_slider import slider_arrays
@@ -340,26 +341,12 @@ def test_rod_angle_only_odd_orders():
 
 
 def test_semenov_printed_fft_numbers():
-    """Semenov §2, series (9) and (31)–(35), to the digits below. λ = 0.304: W amplitudes in units
-    of rω² 1, 0.3113, 0.0075, 0.0002 (orders 1, 2, 4, 6); β = 0.30764 sin φ − 0.001235 sin 3φ + …
+    """Semenov §2, series (9) and (31)–(35), to the digits of an independent FFT of the exact
+    geometry (``tests/references/semenov.py``): λ = 0.304: W amplitudes in units of rω² 1,
+    0.3113, 0.0075, 0.0002 (orders 1, 2, 4, 6); β = 0.30764 sin φ − 0.001235 sin 3φ + …
     r = 95, l = 313 mm: x_B = r cos φ + l cos β has the mean 305.662 mm and the coefficients 95,
-    7.3821, −0.0446, 0.0005 mm (orders 1, 2, 4, 6); s = (l + r) − x_B."""
-    n = 720
-    phi = grid(n)
-    a = order_spectrum(piston_acceleration(phi, 1.0, 0.0, 0.304, 1.0), n, TWO_PI).amplitude[0]
-    a /= 0.304
-    for k, printed in ((1, 1.0), (2, 0.3113), (4, 0.0075), (6, 0.0002)):
-        assert a[k] == pytest.approx(printed, abs=0.5e-4)
-    c = order_spectrum(slider_arrays(phi, 0.304, 1.0, 0.0)[3], n, TWO_PI).coef[0]
-    # β = b1 sin φ + b3 sin 3φ: coef = b·e^{−iπ/2}
-    assert (1j * c[1]).real == pytest.approx(0.30764, abs=0.5e-5)
-    assert (1j * c[3]).real == pytest.approx(-0.001235, abs=0.5e-6)
-    r, l = 95.0, 313.0
-    x_b = order_spectrum((l + r) - slider_arrays(phi, r, l, 0.0)[0], n, TWO_PI).coef[0].real
-    for k, printed, half in ((0, 305.662, 0.5e-3), (1, 95.0, 1e-9), (2, 7.3821, 0.5e-4),
-                             (4, -0.0446, 0.5e-4), (6, 0.0005, 0.5e-4)):
-        assert x_b[k] == pytest.approx(printed, abs=half)
-    assert np.abs(x_b[3::2]).max() <= 1e-12 * r
+    7.3821, −0.0446, 0.0005 mm (orders 1, 2, 4, 6); s = (l + r) − x_B; no odd order ≥ 3."""
+    check_all(semenov.master_series())
 
 
 def test_offset_adds_odd_orders_at_constant_speed():

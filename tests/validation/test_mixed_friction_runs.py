@@ -4,8 +4,9 @@ reactions`, *A constant-η pair at the main bearings*), checked against what is 
 * **The chain of one pair**: with every reaction pair's coefficients zero, the mix is the serial
   chain of its one constant-η pair (Antonyuk et al. (22)–(25), ``transient.core.chain``), a
   model written apart from the joints' Newton–Euler: the same mode switches at the same angles,
-  the same motion and the same loss, to ~ the solver's tolerance, for the crank-slider and the
-  articulated mechanism; and at prescribed speeds (the efficiency study's inverse dynamics) the
+  the same motion and the same loss, to the sum of the two runs' own errors (each measured
+  against its run at a hundredth of the tolerance, ``tests/own_error.py``), for the
+  crank-slider and the articulated mechanism; and at prescribed speeds (the efficiency study's inverse dynamics) the
   same η_mech and loss.
 * **Work–energy balance** in a spin-up of ``cases/gots_diesel_mixed_friction.toml`` with every
   friction on: W_gas + W_load − Σ W_loss,k = ΔK to 1e-8 of the throughput (the bound of the
@@ -18,8 +19,9 @@ reactions`, *A constant-η pair at the main bearings*), checked against what is 
 * **The study**: η_mech falls with speed and with load, and every point closes its budget.
 * **A mapped pair at the main bearings** (``eta_table``): a map of one point is the constant pair
   bit for bit; with the joints frictionless the mix is the chain of its one mapped pair (whose
-  maps ``eta_table`` solves its own way), to the solver's tolerance where the map's kinks lie
-  inside steps; with every friction on, the balance closes and every loss is ≥ 0.
+  maps ``eta_table`` solves its own way), to the sum of their own errors, which the map's
+  kinks inside steps make larger than the tolerance; with every friction on, the balance
+  closes and every loss is ≥ 0.
 """
 from __future__ import annotations
 
@@ -36,6 +38,7 @@ from transient.study.efficiency import efficiency_study, point_scene
 from balances import (check_release_at_holds, closure, constant_main_bearings, dense_spin_up,
                       loss_is_share_of_transmitted, losses_nonnegative, with_main_bearings,
                       without_friction)
+from own_error import assert_agree
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = np.pi / 30.0
@@ -73,9 +76,12 @@ def one_pair_chain(scene):
 
 @pytest.mark.parametrize("make", [mixed_case, radial_mixed], ids=["crank-slider", "radial"])
 def test_with_frictionless_joints_the_mix_is_the_chain_of_its_one_pair(make):
+    """The two models take their own steps, so over 30 revolutions they agree to the sum of
+    their own errors (``tests/own_error.py``), not to one step's tolerance."""
     base = make(run=Run(revolutions=30.0), output=Output(samples_per_rev=8))
     base = replace(base, solver=replace(base.solver, rtol=1e-10, atol=1e-12))
-    mix, chain = integrate(frictionless_joints(base)), integrate(one_pair_chain(base))
+    scenes = frictionless_joints(base), one_pair_chain(base)
+    mix, chain = (integrate(s) for s in scenes)
     assert mix.complete and chain.complete, (mix.message, chain.message)
     a, b = mix.trajectory, chain.trajectory
     switches_mix, switches_chain = mix.events["pair_mode"], chain.events["pair_mode"]
@@ -83,9 +89,7 @@ def test_with_frictionless_joints_the_mix_is_the_chain_of_its_one_pair(make):
           f"{b['omega'][-1]!r}, W_loss_1 {a['W_loss_1'][-1]!r} against {b['W_loss_1'][-1]!r}")
     assert switches_mix.shape[0] == switches_chain.shape[0] > 50
     assert np.max(np.abs(switches_mix[:, 1] - switches_chain[:, 1])) <= 1e-6
-    assert a["t"][-1] == pytest.approx(b["t"][-1], rel=1e-8)
-    assert a["omega"][-1] == pytest.approx(b["omega"][-1], rel=1e-8)
-    assert a["W_loss_1"][-1] == pytest.approx(b["W_loss_1"][-1], rel=1e-7)
+    assert_agree(scenes[0], mix, scenes[1], chain, ("t", "omega", "W_loss_1"))
     assert np.allclose(a["eta_1"], b["eta_1"], rtol=0.0, atol=1e-15)  # the same modes
     for k in range(2, len(base.friction.pairs) + 1):
         assert np.all(a[f"W_loss_{k}"] == 0.0), k
@@ -172,8 +176,11 @@ def test_eta_mech_falls_with_speed_and_load_and_every_point_closes(study):
 
 
 def test_a_mapped_pair_at_the_main_bearings():
+    """The one-point map is the constant pair bit for bit (one process, one CPU: the same
+    arithmetic). The mix and the chain of a mapped pair meet the map's kinks inside their own
+    steps, so they agree to the sum of their own errors (``tests/own_error.py``)."""
     base = mixed_case(run=Run(revolutions=30.0), output=Output(samples_per_rev=8))
-    base = replace(base, solver=replace(base.solver, rtol=1e-12, atol=1e-14))
+    base = replace(base, solver=replace(base.solver, rtol=1e-10, atol=1e-12))
     main, mapped = coupling(base), mapped_main_bearings()
     assert mapped.model == "table" and len(mapped.speed) > 1 and len(mapped.torque) > 1
     one_point = replace(mapped, speed=(0.0,), torque=(0.0,),
@@ -183,15 +190,14 @@ def test_a_mapped_pair_at_the_main_bearings():
     assert all(np.array_equal(a.trajectory[k], b.trajectory[k], equal_nan=True)
                for k in a.trajectory)
 
-    mix = integrate(frictionless_joints(with_main_bearings(base, mapped)))
-    chain = integrate(one_pair_chain(with_main_bearings(base, mapped)))
+    scenes = (frictionless_joints(with_main_bearings(base, mapped)),
+              one_pair_chain(with_main_bearings(base, mapped)))
+    mix, chain = (integrate(s) for s in scenes)
     x, y = mix.trajectory, chain.trajectory
     print(f"{mix.events['pair_mode'].shape[0]} mode switches; final ω {x['omega'][-1]!r} against "
           f"{y['omega'][-1]!r}; W_loss_1 {x['W_loss_1'][-1]!r} against {y['W_loss_1'][-1]!r}")
     assert mix.events["pair_mode"].shape[0] == chain.events["pair_mode"].shape[0] > 50
-    assert x["omega"][-1] == pytest.approx(y["omega"][-1], rel=1e-8)
-    assert x["W_loss_1"][-1] == pytest.approx(y["W_loss_1"][-1], rel=1e-7)
-    assert np.nanmax(np.abs(x["eta_1"] - y["eta_1"])) <= 1e-8
+    assert_agree(scenes[0], mix, scenes[1], chain, ("omega", "W_loss_1", "eta_1"))
 
     full = with_main_bearings(mixed_case(run=Run(revolutions=60.0)), mapped)
     tr = integrate(full).trajectory

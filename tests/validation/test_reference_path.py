@@ -82,8 +82,9 @@ def dynamic_scenes():
 SCENES = dynamic_scenes()
 #: The scenes whose reference runs (the diesel's mixed cycle with governors, pairs, load steps,
 #: Wiebe or wall heat: plain-Python right-hand sides over many short steps) make the test slow.
-SLOW_SCENES = {"gots_diesel_friction", "gots_diesel_governed", "gots_diesel_load_steps",
-               "gots_diesel_pi", "gots_diesel_wiebe", "gots_diesel_woschni"}
+SLOW_SCENES = {"gots_diesel_friction", "gots_diesel_chain_friction", "gots_diesel_governed",
+               "gots_diesel_load_steps", "gots_diesel_pi", "gots_diesel_wiebe",
+               "gots_diesel_woschni"}
 
 
 def shortened(name, method):
@@ -207,6 +208,7 @@ def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch
     assert e_w <= E_SAMPLES and e_t <= E_SAMPLES
 
 
+@pytest.mark.slow  # (the reference closes the joints' friction in Python at every evaluation)
 @pytest.mark.parametrize("case, revolutions, mix",
                          [("gots_diesel_reaction_friction", 2.0, None),
                           ("radial_5cyl_reaction_friction", 1.0, None),

@@ -103,7 +103,7 @@ def test_where_chunks_end_changes_nothing(monkeypatch):
     the samples per turn. What a chunk leaves (the derivative carried over, the pairs' margins,
     the step-size control's memory of a rejection) the next takes up as it is: the governed
     diesel with two friction pairs, at one sample per turn in a buffer that never fills and at
-    72 in one that fills every ~1.4 turns (400 rows, 300 of them kept free), takes the same steps
+    72 in one that fills every ~1.4 turns (700 rows, 600 of them kept free), takes the same steps
     to the same bits. (A chunk that recomputed the derivative with the table piece ahead of the
     shaft angle, or forgot a rejection, would make the steps depend on the output.)
     """
@@ -117,7 +117,7 @@ def test_where_chunks_end_changes_nothing(monkeypatch):
                         output=replace(base.output, samples_per_rev=samples))
         return integrate(scene)
 
-    one, many = run(1, 10_000), run(72, 400)
+    one, many = run(1, 10_000), run(72, 700)
     assert one.solver["nsteps"] == many.solver["nsteps"]
     assert one.solver["nreject"] == many.solver["nreject"]
     assert one.solver["mode_switches"] == many.solver["mode_switches"] > 1000

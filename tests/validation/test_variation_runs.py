@@ -10,9 +10,10 @@ torque component M_q of order q (per revolution) makes a speed component
 ω_q = M_q/(J̄·ω̄·q). J(φ) of a four-cylinder holds orders 0, 2, 4 … and its ½J′ω² the same, so at
 the half orders the excess torque is the gas torque's alone. The estimate leaves out the
 fan's damping (2Kω̄/(q·J̄·ω̄) = 2.8 % at q = ½: 0.04 % of the amplitude), the product of the
-speed's order-2 ripple with J′ (δ ≈ 3 %) and J(φ)'s own variation (≈ 3 % of J̄), which mix the
-orders 2 ± q into q: measured 0.4 % at q = ½, 2.2 % at q = 1½, 5.3 % at q = 2½ on this engine at
-4400 rpm. Hence the stated tolerances 1 % at ½ and 3 % at 1½.
+speed's order-2 ripple with J′ (δ ≈ 3 %) and J(φ)'s own variation (4.5 % of J̄ at order 2), which
+mix the orders 2 ± q into q: measured 0.14 % at q = ½, 1.3 % at q = 1½, 6.4 % at q = 2½ on this
+engine at 4400 rpm (the weak cylinder lacks its combustion only, whose 1½ order is a quarter of
+its ½). Hence the stated tolerances 1 % at ½ and 3 % at 1½.
 """
 from __future__ import annotations
 
@@ -71,7 +72,7 @@ def test_half_orders_of_a_weak_cylinder_match_the_linearised_estimate(index, tol
         amplitude = abs(speed.coef[cycle, index])
         estimate = abs(torque.coef[cycle, index]) / (J_mean * w_mean * q)
         assert amplitude == pytest.approx(estimate, rel=tol)
-    assert abs(speed.coef[-1, index]) > 0.2  # rad/s: plainly there
+    assert abs(speed.coef[-1, index]) > 0.1  # rad/s: plainly there (0.58 and 0.14)
 
 
 def test_balanced_engine_has_no_half_orders():
@@ -90,25 +91,58 @@ def misfire_run():
     return scene, columns(simulate(scene))
 
 
-def test_misfire_every_tenth_cycle_and_the_work_energy_balance():
+GAS_EXCHANGE_TDC = np.radians([0.0, 540.0, 180.0, 360.0])  # firing_deg − 360°, cylinders 1–4
+
+
+def case_fuel(k: int, phi):
+    """The fuel of cylinder k (0-based) at the shaft angles φ by the case's [[gas.cylinders]]:
+    cylinder 2 at 0.8, cylinder 3 burning nothing in its cycles 10, 20 …, counted from the one in
+    progress at φ0 = 0, a cycle from its gas-exchange TDC."""
+    if k == 1:
+        return np.full(phi.size, 0.8)
+    if k == 2:
+        n = np.floor((phi - GAS_EXCHANGE_TDC[2]) / (4 * math.pi)) + 2
+        return np.where(n % 10 == 0, 0.0, 1.0)
+    return np.ones(phi.size)
+
+
+def test_misfire_follows_the_motored_cycle_and_the_fired_cylinders_their_tables(gots_cycle):
+    """Every cylinder's stored pressure against the mixed cycle's closed forms at its fuel
+    (``GotsCycle.pressure``, away from the corners, where a sample may hold either limit): to
+    2e-9 of p_z, the tables' interpolation. The fired cylinders' pressure is the full-load
+    table's to rounding; a misfiring cycle peaks at the motored compression end
+    p_c = p_a·ε^n1; and the work–energy balance closes."""
+    from transient.assemble import gas_tables
+
     scene, traj = misfire_run()
-    P = scene.mechanism.cycle
-    model_phase = (np.radians(540.0) - 2 * math.pi) % P  # cylinder 3's gas-exchange TDC
-    peaks = []
-    for n in range(1, 40):  # cylinder 3's cycles (cycle 1: the one in progress at φ0 = 0)
-        a = model_phase - P + (n - 1) * P
-        # (a sample on a cycle's first angle ends the step before it: the previous cycle's)
-        inside = (traj["phi"] > a) & (traj["phi"] < a + P)
-        if a >= traj["phi"][0] and a + P <= traj["phi"][-1]:  # whole cycles only
-            peaks.append((n, traj["p_3"][inside].max()))
-    fired = {n: p for n, p in peaks}
-    for n, p in fired.items():
-        if n % 10 == 0:
-            assert p == 0.1e6  # motored: the mixed cycle's motored curve is p0
-        else:
-            assert p == pytest.approx(10.5e6, rel=1e-6)
-    assert any(n % 10 == 0 for n in fired)
-    assert traj["p_2"].max() == pytest.approx(0.1e6 + 0.8 * (10.5e6 - 0.1e6), rel=1e-6)
+    phi = traj["phi"]
+    full = gas_tables(scene)[0]
+    worst = 0.0
+    for k in range(4):
+        x = phi - GAS_EXCHANGE_TDC[k]
+        fuel = case_fuel(k, phi)
+        expected, near = gots_cycle.pressure(x, fuel)
+        p = traj[f"p_{k + 1}"]
+        assert near.mean() < 0.02
+        err = np.max(np.abs(p[~near] - expected[~near])) / gots_cycle.P_Z
+        worst = max(worst, err)
+        assert err <= 2e-9, (k, err)
+        # to rounding: of the pressure, and of its local angle from the shaft's (|φ| up to 400π)
+        # times its slope
+        fired = ~near & (fuel == 1.0)
+        value, slope = full.evaluate(x[fired])
+        eps = np.finfo(float).eps
+        bound = 8 * eps * (np.abs(value) + np.abs(phi[fired] * slope))
+        assert np.all(np.abs(p[fired] - value) <= bound), k
+    print(f"\nthe run's pressures against the closed forms: {worst:.1e} of p_z at most")
+    peaks = 0
+    for n in range(10, 101, 10):  # cylinder 3's misfiring cycles held whole by the run
+        a = GAS_EXCHANGE_TDC[2] + (n - 2) * 4 * math.pi
+        if a + 4 * math.pi <= phi[-1]:
+            inside = (phi > a) & (phi < a + 4 * math.pi)
+            assert traj["p_3"][inside].max() == pytest.approx(gots_cycle.P_C, rel=1e-9)
+            peaks += 1
+    assert peaks == 10
     J, w = traj["J"], traj["omega"]
     kinetic = 0.5 * J * w ** 2
     balance = kinetic - kinetic[0] - (traj["W_gas"] + traj["W_load"] + traj["W_starter"])
@@ -118,10 +152,12 @@ def test_misfire_every_tenth_cycle_and_the_work_energy_balance():
 def test_misfire_case_half_orders_match_the_linearised_estimate_in_every_cycle():
     """The case as it stands: cylinder 2 at 80 % and cylinder 3 misfiring every tenth cycle.
     After 60 cycles the pattern repeats every ten; each of the last 40 cycles is analysed on
-    its own, ω with its ramp taken out (the recovery after a misfire, time constant
-    J̄/(2Kω̄) ≈ 5.5 cycles, drifts ω by up to 1.5 rad/s a cycle), so the estimate holds less
-    tightly than in steady running: measured 2.0 % at ½ and 4.4 % at 1½ in the cycles
-    around a misfire, 0.5 % and 3 % elsewhere."""
+    its own, ω with its ramp taken out. The recovery after a misfire (time constant
+    J̄/(2Kω̄) ≈ 5.5 cycles, drifting ω by up to 1.5 rad/s a cycle) is no ramp, and what the
+    detrend leaves of it leaks into every order by an amount that decays with the recovery:
+    at ½ (0.58 rad/s, 2.3 in a misfire's cycle) it is small beside the order (0.42 % at
+    most); at 1½ (0.13 rad/s) it is 9.3 % in the misfire's cycle, falling to 1.2 % nine cycles
+    on."""
     scene, traj = misfire_run()
     P = scene.mechanism.cycle
     _, grid = to_angle_grid(traj, ("omega", "M_gas", "J"), N, P, phi0=scene.initial.phi,
@@ -132,7 +168,7 @@ def test_misfire_case_half_orders_match_the_linearised_estimate_in_every_cycle()
     J_mean = grid["J"].mean()
     w_mean = w[:-1].reshape(-1, N).mean(axis=1)
     last = slice(-40, None)
-    for index, tol in ((1, 0.025), (3, 0.05)):
+    for index, tol in ((1, 0.01), (3, 0.10)):
         q = speed.orders[index]
         amplitude = np.abs(speed.coef[last, index])
         estimate = np.abs(torque.coef[last, index]) / (J_mean * w_mean[last] * q)
@@ -157,12 +193,12 @@ def test_factors_of_one_are_bit_identical_to_no_variation():
         assert np.array_equal(a[name], b[name]), name
 
 
-def test_cut_out_is_a_fuel_factor_of_zero():
+def test_cut_out_is_a_fuel_factor_of_zero(gots_cycle):
     scene = base().replace(run={"revolutions": 12})
     a, b = run_pair(scene, [{"cylinder": 4, "cut_out": True}], [{"cylinder": 4, "fuel": 0.0}])
     for name in a:
         assert np.array_equal(a[name], b[name]), name
-    assert a["p_4"].max() < 0.9e6  # no combustion
+    assert a["p_4"].max() == pytest.approx(gots_cycle.P_C, rel=1e-9)  # compression, no heat
 
 
 def test_pressure_factor_scales_the_pressure_above_p0():

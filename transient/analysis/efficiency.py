@@ -52,6 +52,7 @@ engine's FMEP to hold a scene's against.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from numpy.typing import NDArray
@@ -61,6 +62,13 @@ from .irregularity import cycle_boundaries, cycle_means, steady_state_time
 
 #: |P_in| below this fraction of its mean is left out of (30) as printed.
 PRINTED_GUARD = 1e-3
+#: The names of the values :func:`mechanical_efficiency` gives (absent together where a run has
+#: no steady whole cycle to take them over).
+EFFICIENCY_VALUES = re.compile(
+    r"(steady_phi_start|steady_cycles|W_(in|out)_per_cycle|eta_mech_\w+|"
+    r"energy_balance_residual|displacement|[ib]mep|fmep(_\w+)?|pair_mode_switches_per_cycle|"
+    r"W_(loss|transmitted|circulated)_\w+|loss_share_\d+|backward_share_\d+|"
+    r"mode_against_power_\w+|cylinder_split_residual_\d+)")
 
 
 def steady_window(scene, traj, rtol: float = 1e-4, cycles: int = 3):
@@ -163,8 +171,8 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         "W_in_per_cycle": (W_in / n_cyc, "J"),
         "W_out_per_cycle": (W_out / n_cyc, "J"),
         "eta_mech_work": (W_out / W_in if W_in > 0 else math.nan, "1"),
-        "energy_balance_residual": ((dK - (W_in - W_out - sum(losses))) / max(abs(W_in), 1e-300),
-                                    "1"),
+        "energy_balance_residual": ((dK - (W_in - W_out - sum(losses)))
+                                    / _throughput(W_in, W_out, dK, losses), "1"),
         "displacement": (v_d, "m^3"),
         "imep": (W_gas / n_cyc / v_d, "Pa"),
         "bmep": (W_shaft / n_cyc / v_d, "Pa"),
@@ -239,6 +247,12 @@ def _time_share(t, flag) -> float:
     """Share of the time span of ``t`` during which ``flag`` holds (sample weights dt)."""
     dt = np.gradient(t) if t.size > 1 else np.ones(1)
     return float(np.sum(dt[flag]) / np.sum(dt))
+
+
+def _throughput(W_in: float, W_out: float, dK: float, losses) -> float:
+    """The largest energy the balance moves, which its residual is relative to: W_in for an
+    engine, the load's work or ΔK where no gas or starter works (a machine coasting or driven)."""
+    return max(abs(W_in), abs(W_out), abs(dK), sum(abs(x) for x in losses), 1e-300)
 
 
 def _printed(traj, sel, guard: float, driven: bool = False) -> dict[str, tuple[float, str]]:

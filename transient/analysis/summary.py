@@ -6,7 +6,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from .efficiency import mechanical_efficiency
+from .efficiency import EFFICIENCY_VALUES, mechanical_efficiency
 from .irregularity import (cycle_boundaries, cycle_means, fluctuation, last_cycle_ranges,
                            steady_state_time)
 from .orders import resample_angle
@@ -77,3 +77,49 @@ def stuck_phases(events: dict, t_last: float) -> dict[str, tuple[float, str]]:
     return {"stuck_phases": (float(stuck.shape[0]), "1"), "stuck_time": (float(total), "s"),
             "stuck_first_t": (float(stuck[0, 0]), "s"),
             "stuck_first_phi": (float(stuck[0, 1]), "rad")}
+
+
+def nan_reason(name: str, values: dict[str, float]) -> str:
+    """Why the value ``name`` of a run's summary ``values`` (name → number, as stored under
+    ``/analysis``) is NaN or absent, in a clause read off the other values; "" if it is a
+    number. A study's or a sweep's table says it beside the NaN."""
+    value = values.get(name)
+    if value is not None and not math.isnan(value):
+        return ""
+    revolutions = values.get("revolutions", math.nan)
+    no_cycle = (f"the run holds no whole cycle turned forwards ({revolutions:.4g} revolutions "
+                f"from its start)")
+    if name in ("mean_omega_last_cycle", "delta_last_cycle"):
+        return no_cycle
+    if name == "steady_state_t":
+        return NOT_STEADY
+    if EFFICIENCY_VALUES.fullmatch(name):
+        if "eta_mech_work" not in values:  # (none of them was taken)
+            if math.isnan(values.get("mean_omega_last_cycle", math.nan)):
+                return no_cycle
+            if math.isnan(values.get("steady_state_t", 0.0)):
+                return f"no steady cycles to take it over: {NOT_STEADY}"
+            return (f"fewer than one whole cycle after the steady state at t = "
+                    f"{values['steady_state_t']:.6g} s")
+        w_in = values.get("W_in_per_cycle", math.nan)
+        if w_in <= 0.0:
+            return f"no work in over the steady cycles (W_in = {w_in:.6g} J per cycle)"
+    if name.startswith("load_change_") and name.endswith("_recovery_s"):
+        band = values.get(name.removesuffix("recovery_s") + "band_pct", math.nan)
+        return (f"the cycle-mean speed is not back in its ±{band:.3g} % band by the end of the "
+                f"step's segment")
+    if name == "spin_up_t90_s":
+        return ("the cycle-mean speed never reached 90 % of the final speed, or was past it at "
+                "the first whole cycle")
+    if name == "spin_up_settling_s":
+        band = values.get("spin_up_band_pct", math.nan)
+        return (f"the cycle-mean speed is outside its ±{band:.3g} % band at the end, or in it "
+                f"from the first whole cycle")
+    if value is None:
+        return "not in this run's summary (transient info lists what it holds)"
+    return "NaN in the run's summary"
+
+
+#: Why there is no steady state (:func:`~.irregularity.steady_state_time` at its defaults).
+NOT_STEADY = ("no steady state: the cycle-mean speed still changed by 1e-4 or more from cycle to "
+              "cycle")

@@ -3,8 +3,17 @@ mean effective pressure from the pressure the run applied, the brake and frictio
 pressures from the shaft's work integrals, the peak pressures, and for the combustion models the
 apparent heat-release rate and the burned-mass-fraction angles.
 
-**Indicated work.** W_i,k = ∮ p_k dV_k over a whole engine cycle (cycles counted from φ0, as
-:mod:`.irregularity` counts them), evaluated as ∫ p_k(φ) V′_k(φ) dφ with the stored pressure
+**Cycles.** The engine's figures are taken over its cycles, counted from φ0 as
+:mod:`.irregularity` counts them; each cylinder's over its own cycles, from its own local angle
+0 (a 4-stroke's gas-exchange TDC) or π (a 2-stroke's BDC), where ``[[gas.cylinders]]`` begins
+its cycles too (:func:`transient.assemble.cycle_begin`), so that a misfire's cycle is one of
+its cycles and not two halves. Column j of a cylinder's figures is its cycle that ends in
+engine cycle j, its cycle j + 1 as ``[[gas.cylinders]]`` counts them; NaN where that cycle
+began before the run (or before its last backward motion), ``thermo_cylinder_cycle_start`` its
+first angle.
+
+**Indicated work.** W_i,k = ∮ p_k dV_k over a whole cycle, evaluated as
+∫ p_k(φ) V′_k(φ) dφ with the stored pressure
 ``p_<k>`` and the exact volume V_k(φ) = V_c + A_k·s_k(φ) of the mechanism (s_k the piston's travel
 from its top dead centre, A_k the area its pressure acts on: F_p, twice that for the opposed
 pistons of a two-half swash plate). The quadrature is interpolatory of degree
@@ -13,8 +22,8 @@ pressure curve (a jump written as two samples at one angle splits it too), so th
 interpolated across a corner. A pressure table is a C² cubic between its knots, across which any
 rule converges as h⁴ only, so the cylinders' work meets the gas torque's to what the output
 spacing allows (the bounds per spacing: tests/validation/test_thermo_runs.py).
-IMEP_k = W_i,k/V_d,k, V_d,k the cylinder's exact swept volume; the engine's IMEP is
-ΣW_i,k/ΣV_d,k.
+IMEP_k = W_i,k/V_d,k over the cylinder's own cycle, V_d,k its exact swept volume; the
+engine's IMEP is ΣW_i,k/ΣV_d,k with every W_i,k over the engine's cycle.
 
 **Brake and friction.** From the work integrals the stepper integrates with the motion
 (``W_load``, ``W_loss_<k>``, ``W_gas``: :mod:`transient.core.layout`), read at the cycle ends:
@@ -28,8 +37,9 @@ zero in steady state without starter and prescribed drive; ``thermo_balance_resi
 left of it per cycle, relative to ΣW_i,k (solver tolerance plus the quadrature's error). Powers
 are the works over the cycle time.
 
-**Peak pressure.** The largest stored sample of each cylinder per cycle and the cylinder's own
-(local) angle there, in [0, Φ) as its gas table counts it (the output spacing is its resolution).
+**Peak pressure.** The largest stored sample of each cylinder in each of its own cycles and its
+local angle there, in [0, Φ) as its gas table counts it (the output spacing is its resolution);
+``thermo_last_p_max`` is the largest of every cylinder's samples in the last engine cycle.
 
 **Heat release** (``wiebe``; with ``[gas.woschni]`` the apparent, net of the wall heat): the
 single-zone first law with constant γ (Heywood, *Internal Combustion Engine Fundamentals*, 1988,
@@ -40,8 +50,9 @@ reaches 10, 50, 90 %. For a Wiebe cycle without wall heat and with constant γ t
 law itself, x_b = 1 − exp(−a((θ − θ_s)/Δθ)^(m+1)) (Heywood eq. (9.31)), so the angles can be
 checked against θ_s + Δθ·(−ln(1 − x)/a)^(1/(m+1)).
 
-Stored names (n cylinders, C whole cycles): ``thermo_cycle_start`` (C,) [rad],
-``thermo_cycle_omega_mean`` (C,) [rad/s], ``thermo_swept_volume`` (n,) [m^3],
+Stored names (n cylinders, C whole engine cycles): ``thermo_cycle_start`` (C,) [rad],
+``thermo_cycle_omega_mean`` (C,) [rad/s], ``thermo_cylinder_cycle_start`` (n, C) [rad],
+``thermo_swept_volume`` (n,) [m^3],
 ``thermo_W_indicated`` (n, C) [J], ``thermo_imep`` (n, C) [Pa], ``thermo_P_indicated`` (n, C)
 [W], ``thermo_p_max`` (n, C) [Pa], ``thermo_p_max_angle`` (n, C) [rad]; engine:
 ``thermo_imep_engine``, ``thermo_bmep``, ``thermo_fmep`` (C,) [Pa],
@@ -150,6 +161,19 @@ def _interval_integrals(xs, fs, lo, hi, degree):
     return out
 
 
+def _apart(nodes: NDArray[np.float64], tol: float) -> NDArray[np.float64]:
+    """Sorted ``nodes`` (a segment's ends first and last) without an inner node within ``tol``
+    of the one before it or of the segment's end: a sample on a mark to rounding. Between two
+    such nodes the interpolatory rule, scaled to the interval, is all rounding — whatever the
+    linear solve's kernel makes of the stencil's Vandermonde matrix at 10¹³ interval widths. A
+    mark so dropped is found at its neighbour (:func:`integrals_between` looks marks up within
+    ``tol``)."""
+    gap = np.diff(nodes) > tol
+    keep = np.concatenate([[True], gap[:-1], [True]])
+    keep[-2] &= gap[-1] or nodes.size == 2
+    return nodes[keep]
+
+
 def integrals_between(x: ArrayLike, f: ArrayLike, marks: ArrayLike, cuts: ArrayLike = (),
                       degree: int = QUAD_DEGREE) -> NDArray[np.float64]:
     """∫ f dx between consecutive ``marks`` from samples (x, f), x non-decreasing.
@@ -182,7 +206,8 @@ def integrals_between(x: ArrayLike, f: ArrayLike, marks: ArrayLike, cuts: ArrayL
             continue  # joined to the next segment
         xs, fs = x[keep], f[keep]
         inside = marks[(marks > lo) & (marks < hi)]
-        nodes = np.unique(np.concatenate([[lo, hi], xs[(xs > lo) & (xs < hi)], inside]))
+        nodes = _apart(np.unique(np.concatenate([[lo, hi], xs[(xs > lo) & (xs < hi)], inside])),
+                       tol)
         if xs.size:
             parts.append(_interval_integrals(xs, fs, nodes[:-1], nodes[1:], degree))
             ends.append(nodes[1:])
@@ -252,13 +277,25 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
         raise NoWholeCycle("the run holds no whole cycle")
     vol = cylinder_volumes(scene, phi)
     cuts = _corner_cuts(scene, float(phi[0]), float(phi[-1]), events)
-    W = np.array([integrals_between(phi, np.asarray(traj[f"p_{k + 1}"], float)[part] * vol.dV[k],
-                                    marks, cuts[k]) for k in range(n)])
+    starts = cylinder_cycle_starts(scene, marks, float(phi[0]))
     w = np.asarray(traj["omega"], float)[part]
     # dt/dφ = 1/ω; NaN where ω = 0, the first sample of a start from rest, where only the mark
     # φ0 falls, read off that sample: the derivative there is never used
     inv_w = np.divide(1.0, w, out=np.full_like(w, np.nan), where=w != 0.0)
     shaft_cuts = np.asarray((events or {}).get("breakpoint", np.zeros((0, 2))))[:, 1]
+    W_engine = np.zeros(marks.size - 1)  # Σ_k ∮p_k dV_k over the engine's cycles
+    W = np.full((n, marks.size - 1), np.nan)  # each over its own cycles
+    P_ind = np.full_like(W, np.nan)
+    for k in range(n):
+        f = np.asarray(traj[f"p_{k + 1}"], float)[part] * vol.dV[k]
+        W_engine += integrals_between(phi, f, marks, cuts[k])
+        whole = np.isfinite(starts[k])  # (a suffix: only its first cycles may begin too early)
+        if not whole.any():
+            continue
+        own = np.append(starts[k][whole], starts[k][-1] + cycle)
+        W[k, whole] = integrals_between(phi, f, own, cuts[k])
+        t_own = _at_marks(traj, part, "t", own, shaft_cuts, inv_w)
+        P_ind[k, whole] = W[k, whole] / np.diff(t_own)
     t_marks = _at_marks(traj, part, "t", marks, shaft_cuts, inv_w)
     period = np.diff(t_marks)
     swept = vol.swept
@@ -284,18 +321,19 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     dK_dphi = 0.5 * np.asarray(traj["dJ_dphi"], float)[part] * w * w \
         + J * np.asarray(traj["epsilon"], float)[part]
     dK = np.diff(resample_angle(phi, K, marks, dK_dphi, shaft_cuts))
-    W_ind = W.sum(axis=0)
+    W_ind = W_engine
     residual = (W_ind + W_starter + W_drive + W_load - W_loss - dK) / np.where(
         W_ind != 0.0, np.abs(W_ind), 1.0)
 
-    p_max, p_arg = _peaks(scene, phi, traj, part, marks)
+    p_max, p_arg = _peaks(scene, phi, traj, part, starts)
     out: dict[str, tuple[Any, str]] = {
         "thermo_cycle_start": (marks[:-1], "rad"),
         "thermo_cycle_omega_mean": (cycle / period, "rad/s"),
+        "thermo_cylinder_cycle_start": (starts, "rad"),
         "thermo_swept_volume": (swept, "m^3"),
         "thermo_W_indicated": (W, "J"),
         "thermo_imep": (W / swept[:, None], "Pa"),
-        "thermo_P_indicated": (W / period[None, :], "W"),
+        "thermo_P_indicated": (P_ind, "W"),
         "thermo_p_max": (p_max, "Pa"),
         "thermo_p_max_angle": (p_arg, "rad"),
         "thermo_imep_engine": (W_ind / total, "Pa"),
@@ -311,31 +349,47 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
         "thermo_balance_residual": (residual, "1"),
     }
     if scene.gas.model == "wiebe":
-        out.update(heat_release(scene, phi, traj, part, marks, vol))
+        out.update(heat_release(scene, phi, traj, part, starts, vol))
     for name in ("imep_engine", "bmep", "fmep", "P_indicated_engine", "P_brake", "P_friction",
                  "balance_residual"):
         value, unit = out[f"thermo_{name}"]
         out[f"thermo_last_{name}"] = (float(value[-1]), unit)
-    out["thermo_last_p_max"] = (float(p_max[:, -1].max()), "Pa")
+    last = (phi >= marks[-2]) & (phi <= marks[-1])
+    out["thermo_last_p_max"] = (max(float(np.asarray(traj[f"p_{k + 1}"], float)[part][last].max())
+                                    for k in range(n)), "Pa")
     return out
 
 
-def _peaks(scene, phi, traj, part, marks):
-    """Largest stored pressure of each cylinder in each cycle and its local angle in [0, Φ)."""
+def cylinder_cycle_starts(scene, marks: NDArray[np.float64], phi_first: float
+                          ) -> NDArray[np.float64]:
+    """(n, C): the shaft angle where each cylinder's own cycle that ends in engine cycle j
+    (between ``marks[j]`` and ``marks[j + 1]``, its end included) begins; NaN where that is
+    before ``phi_first``, the run's first angle (module docstring, *Cycles*). A cylinder whose
+    cycle begins within rounding of the engine's has the engine's marks themselves."""
+    from ..assemble import cycle_begin, gas_phases
+
+    cycle = scene.mechanism.cycle
+    d = np.mod(gas_phases(scene) + cycle_begin(scene.mechanism) - marks[0], cycle)
+    d = np.where(cycle - d <= 1e-12 * cycle, 0.0, d)  # (its cycle ends on the engine's)
+    starts = marks[None, :-1] + np.where(d > 0.0, d - cycle, 0.0)[:, None]
+    return np.where(starts >= phi_first - 1e-12 * max(1.0, abs(phi_first)), starts, np.nan)
+
+
+def _peaks(scene, phi, traj, part, starts):
+    """Largest stored pressure of each cylinder in each of its own cycles (``starts``, NaN: not
+    held) and its local angle in [0, Φ)."""
     from ..assemble import gas_phases
 
     cycle = scene.mechanism.cycle
-    c = np.searchsorted(marks, phi, side="right") - 1
-    inside = (c >= 0) & (c < marks.size - 1)
-    n_c = marks.size - 1
-    p_max = np.full((scene.mechanism.n_cylinders, n_c), np.nan)
+    p_max = np.full(starts.shape, np.nan)
     p_arg = np.full_like(p_max, np.nan)
     for k, phase in enumerate(gas_phases(scene)):
         p = np.asarray(traj[f"p_{k + 1}"], float)[part]
-        for j in range(n_c):
-            sel = np.nonzero(inside & (c == j))[0]
-            if sel.size:
-                i = sel[np.argmax(p[sel])]
+        for j in np.flatnonzero(np.isfinite(starts[k])):
+            # the samples from its first angle on, up to its end (the next cycle's first angle)
+            lo, hi = np.searchsorted(phi, [starts[k, j], starts[k, j] + cycle])
+            if hi > lo:
+                i = lo + int(np.argmax(p[lo:hi]))
                 p_max[k, j] = p[i]
                 p_arg[k, j] = (phi[i] - phase) % cycle
     return p_max, p_arg
@@ -371,10 +425,19 @@ def _release(gamma, phi, p, V, dV, a, b):
     return x, rate, q
 
 
-def heat_release(scene, phi, traj, part, marks, vol) -> dict[str, tuple[Any, str]]:
-    """Apparent heat released per cylinder over the closed part that starts in each cycle
-    (Heywood (9.25), module docstring) and the MFB angles; ``thermo_heat_release_skipped`` if γ
-    varies with temperature."""
+def _closed_window(scene, start: float, ivc: float, evo: float) -> tuple[float, float]:
+    """Shaft angles of intake closing and exhaust opening (local ``ivc``, ``evo``) in the
+    cylinder's own cycle that begins at the shaft angle ``start``."""
+    from ..assemble import cycle_begin
+
+    a = start + (ivc - cycle_begin(scene.mechanism)) % scene.mechanism.cycle
+    return a, a + (evo - ivc)
+
+
+def heat_release(scene, phi, traj, part, starts, vol) -> dict[str, tuple[Any, str]]:
+    """Apparent heat released per cylinder over the closed part of each of its own cycles
+    (``starts``, NaN: not held; Heywood (9.25), module docstring) and the MFB angles;
+    ``thermo_heat_release_skipped`` if γ varies with temperature."""
     from ..assemble import gas_phases
 
     closed = _closed_part(scene)
@@ -383,16 +446,12 @@ def heat_release(scene, phi, traj, part, marks, vol) -> dict[str, tuple[Any, str
                                                 "")}
     g, ivc, evo = closed
     cycle = scene.mechanism.cycle
-    n = scene.mechanism.n_cylinders
-    n_c = marks.size - 1
-    Q = np.full((n, n_c), np.nan)
-    mfb = np.full((len(MFB_LEVELS), n, n_c), np.nan)
+    Q = np.full(starts.shape, np.nan)
+    mfb = np.full((len(MFB_LEVELS),) + starts.shape, np.nan)
     for k, phase in enumerate(gas_phases(scene)):
         p = np.asarray(traj[f"p_{k + 1}"], float)[part]
-        for j in range(n_c):
-            # the closed part of cylinder k that starts in cycle j
-            a = phase + cycle * math.ceil((marks[j] - phase - ivc) / cycle) + ivc
-            b = a + (evo - ivc)
+        for j in np.flatnonzero(np.isfinite(starts[k])):
+            a, b = _closed_window(scene, starts[k, j], ivc, evo)
             got = None if b > phi[-1] else _release(g, phi, p, vol.V[k], vol.dV[k], a, b)
             if got is None:
                 continue
@@ -423,15 +482,15 @@ def heat_release_rate(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: 
     g, ivc, evo = closed
     part = _increasing_part(traj)
     phi = np.asarray(traj["phi"], float)[part]
-    if start + evo > phi[-1]:
+    a, b = _closed_window(scene, start, ivc, evo)
+    if b > phi[-1]:
         return None
-    window = (phi > start + ivc - 1e-6) & (phi < start + evo + 1e-6)
+    window = (phi > a - 1e-6) & (phi < b + 1e-6)
     x = phi[window]
     vol = cylinder_volumes(scene, x)
     p = np.asarray(traj[f"p_{cylinder}"], float)[part][window]
-    got = _release(g, x, p, vol.V[cylinder - 1], vol.dV[cylinder - 1], start + ivc,
-                   start + evo)
-    return None if got is None else (got[0] - start, got[1])
+    got = _release(g, x, p, vol.V[cylinder - 1], vol.dV[cylinder - 1], a, b)
+    return None if got is None else (local_angle(scene, got[0], start), got[1])
 
 
 # ------------------------------------------------------------------------------------------------
@@ -441,12 +500,22 @@ def heat_release_rate(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: 
 def own_cycles(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int
                ) -> NDArray[np.float64]:
     """Shaft angles [rad] at which the whole cycles of ``cylinder`` (1-based) in the run start:
-    its local angle 0 (as its gas table counts it), cycles whose end the run reaches, after its
-    last backward motion. Raises ValueError for a cylinder out of range."""
-    from ..assemble import gas_phases
+    its own cycles (module docstring, *Cycles*) whose end the run reaches, after its last
+    backward motion. Raises ValueError for a cylinder out of range."""
+    from ..assemble import cycle_begin, gas_phases
 
     n = scene.mechanism.n_cylinders
     if not 1 <= cylinder <= n:
         raise ValueError(f"cylinder {cylinder} is out of range; allowed: 1 … {n}")
     phi = np.asarray(traj["phi"], float)[_increasing_part(traj)]
-    return cycle_marks(phi, scene.mechanism.cycle, float(gas_phases(scene)[cylinder - 1]))[:-1]
+    begin = float(gas_phases(scene)[cylinder - 1]) + cycle_begin(scene.mechanism)
+    return cycle_marks(phi, scene.mechanism.cycle, begin)[:-1]
+
+
+def local_angle(scene, phi: ArrayLike, start: float) -> NDArray[np.float64]:
+    """A cylinder's local angle (as its gas table counts it) at the shaft angles ``phi`` of its
+    own cycle that begins at ``start`` (:func:`own_cycles`), increasing through the whole cycle
+    (a 2-stroke's, begun at π, runs on past 2π)."""
+    from ..assemble import cycle_begin
+
+    return cycle_begin(scene.mechanism) + (np.asarray(phi, dtype=float) - start)

@@ -28,6 +28,7 @@ def register(sub) -> None:
 
 
 def cmd_efficiency(args) -> int:
+    from ..assemble import part_load_refusal
     from ..scene import POLICIES, load_scene
     from ..study.efficiency import (efficiency_study, plot_budget, plot_map, plot_study,
                                     write_csv)
@@ -43,6 +44,9 @@ def cmd_efficiency(args) -> int:
     if scene.gas.model == "none":
         raise SceneError("gas.model", "an efficiency study needs gas forces (the input power)",
                          file=args.scene)
+    why = part_load_refusal(scene)
+    if why and any(f != 1.0 for f in fuels):
+        raise SceneError("--fuel", why, file=args.scene)
     out = output_folder(args.output, Path("results"))  # (before the study: -o is checked first)
     stem = Path(args.scene).stem
     names = [p.name for p in scene.friction.pairs]
@@ -50,6 +54,9 @@ def cmd_efficiency(args) -> int:
     figures += ["efficiency_map"] * (len(set(rpm)) > 1 and len(set(fuels)) > 1)
     for path in [out / f"{stem}_efficiency.csv"] + [out / f"{stem}_{f}.png" for f in figures]:
         check_output_file(path, args.force)  # refused before the study, not after it
+    if scene.governor.model != "none":
+        print(f"the scene's {scene.governor.model} governor is left out: each point holds its "
+              f"speed and its fuel (--fuel)")
     rows = efficiency_study(scene, rpm, fuels, policies, args.samples_per_rev)
     with output_file(out / f"{stem}_efficiency.csv", args.force) as fh:
         write_csv(rows, fh)
@@ -63,6 +70,9 @@ def cmd_efficiency(args) -> int:
               f"{r.get('eta_mech_printed', math.nan):9.5f} {r['imep'] / 1e3:7.5g} "
               f"{r['fmep'] / 1e3:6.4g}  {pairs}")
     print("  (mean effective pressures in kPa: imep = W_in/V_d, fmep = Σ W_loss/V_d)")
+    for r in rows:
+        if r["note"]:
+            print(f"  NaN at {r['rpm']:g} rpm, fuel {r['fuel']:g} ({r['policy']}): {r['note']}")
     plt = pyplot()
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     plot_study(a1, a2, rows, len(names), names)

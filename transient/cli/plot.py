@@ -25,7 +25,7 @@ def cmd_plot(args) -> int:
     from .. import plots
     import numpy as np
 
-    from ..assemble import gas_is_force, gas_table
+    from ..assemble import gas_is_force, gas_tables
 
     if len(args.result) > 1:
         return _plot_comparison(args)
@@ -84,11 +84,11 @@ def cmd_plot(args) -> int:
         plots.cylinder_torque_curves(ax, traj, scene)
         ax.set_title(f"{scene.name}: each cylinder's gas torque over the last cycle")
         written.append(save(fig, out / f"{stem}_cylinder_torques.png", args.force, res))
-    table = gas_table(scene)
+    table, motored = gas_tables(scene)
     if table is not None and not gas_is_force(scene) and held:
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8))
         plots.run_indicator_phi(a1, traj, scene, args.cylinder, args.cycles or [-1],
-                                table=table)
+                                table=table, motored=motored)
         # a gas table gives no clearance volume: V is then the swept part F_p·s
         plots.run_indicator_pv(a2, traj, scene, args.cylinder, args.cycles or [-1],
                                log=scene.gas.model != "table")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError, SimulationError
+from ..errors import SceneError, SimulationError, escaped
 from ..outcome import FINISHED
 from .common import EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, read_result
 
@@ -28,6 +28,9 @@ def register(sub) -> None:
     c.set_defaults(func=cmd_check)
     i = sub.add_parser("info", help="summarise a result file")
     i.add_argument("result")
+    i.add_argument("--source", action="store_true",
+                   help="print the text of the scene file the run was read from, comments "
+                        "included, as the result stores it (/scene/source)")
     i.set_defaults(func=cmd_info)
     w = sub.add_parser("warmup", help="compile the kernels ahead of a first run",
                        description="Compile (or load from the cache) every kernel a run needs, "
@@ -43,8 +46,12 @@ def register(sub) -> None:
 def cmd_check(args) -> int:
     from ..assemble import cycle_figures
     from ..scene import load_scene
+    from ..scene.read import SweepNotScene
 
-    scene = load_scene(args.scene)
+    try:
+        scene = load_scene(args.scene)
+    except SweepNotScene:
+        return _check_sweep(args.scene)
     pairs = scene.friction.pairs
     friction = (f", {len(pairs)} non-ideal pair(s) ({', '.join(p.name for p in pairs)}; "
                 f"policy {scene.friction.policy})" if pairs else "")
@@ -53,6 +60,20 @@ def cmd_check(args) -> int:
           f"run {scene.run.mode}{friction})")
     _print_mechanism(scene.mechanism)
     _print_figures(cycle_figures(scene))
+    return EXIT_OK
+
+
+def _check_sweep(path: str) -> int:
+    """``transient check`` of a sweep file: the file and every scene it resolves to
+    (:func:`~transient.sweeps.load_sweep`), what it holds in one line."""
+    from ..sweeps import load_sweep
+
+    sweep = load_sweep(path)
+    base = sweep.runs[0].scene
+    axes = ", ".join(f"{a.key} ({len(a.values)} values)" for a in sweep.axes)
+    print(f"{path}: ok (sweep {sweep.name}: {len(sweep.runs)} run(s), method {sweep.method}, "
+          f"axes {axes}; base scene {base.name}: {type(base.mechanism).__name__}, "
+          f"{base.mechanism.n_cylinders} cylinder(s)); run it with `transient sweep {path}`")
     return EXIT_OK
 
 
@@ -128,6 +149,7 @@ def _print_summary(summary, solver, names=()) -> None:
     v = {k: val for k, (val, _) in summary.items()}
     print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
           f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
+    _print_stops(v)
     if math.isfinite(v["mean_omega_last_cycle"]):
         print(f"  last cycle: mean ω = {v['mean_omega_last_cycle']:.6g} rad/s "
               f"({v['mean_omega_last_cycle'] * rpm:.6g} rpm), δ = {v['delta_last_cycle']:.4g}")
@@ -160,6 +182,13 @@ def _print_summary(summary, solver, names=()) -> None:
           f"compile/cache load)")
     if solver.get("stiff_rerun"):
         print(f"  {solver['stiff_rerun']}")
+
+
+def _print_stops(v: dict) -> None:
+    """How often the speed went through zero over the whole run, and where first."""
+    if "speed_reversals" in v:
+        print(f"  speed through zero: {v['speed_reversals']:.0f} time(s), first at t = "
+              f"{v['speed_reversal_first_t']:.9g} s, φ = {v['speed_reversal_first_phi']:.9g} rad")
 
 
 def _print_response(v: dict) -> None:
@@ -197,7 +226,10 @@ def _print_efficiency(v: dict, names=()) -> None:
           f"η = W_out/W_in = {v['eta_mech_work']:.6f} (work ratio; W_in = "
           f"{v['W_in_per_cycle']:.6g} J/cycle{source}; energy balance residual "
           f"{v['energy_balance_residual']:.2e})")
-    if "eta_mech_printed" in v:
+    if "eta_mech_printed" in v and "W_loss_1_per_cycle" in v:
+        # (30) approximates η by the time average of P_out/P_in. Without non-ideal pairs η is 1
+        # by construction and the average measures only the power the inertia stores and returns
+        # within the cycle, so the line is printed where pairs lose power.
         print(f"    (30) as printed, time average of P_out/P_in: {v['eta_mech_printed']:.6g} "
               f"(ill-posed where P_in crosses zero; {100 * v['eta_mech_printed_excluded']:.3g} % "
               f"of the time left out)")
@@ -247,6 +279,14 @@ def _print_thermodynamics(v: dict) -> None:
 
 def cmd_info(args) -> int:
     res = read_result(args.result)
+    file, text = res.scene_source
+    if args.source:
+        if not text:
+            raise SceneError("--source", "the result stores no scene file (its scene was built "
+                                         "in code, or the file predates the record); its "
+                                         "resolved scene is /scene/toml", file=str(res.path))
+        print(text, end="" if text.endswith("\n") else "\n")
+        return EXIT_OK
     a = res.attrs
     print(f"{res.path}: scene {a['scene']!r}, transient {a['version']}, format {a['format']}, "
           f"created {a['created']}, complete = {bool(a['complete'])}, status = {res.status}")
@@ -265,7 +305,12 @@ def cmd_info(args) -> int:
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
         if s.get("stiff_rerun"):
             print(f"  {s['stiff_rerun']}")
+    _print_provenance(a)
+    if text:
+        print(f"  scene file: {escaped(file)} ({len(text.splitlines())} lines, comments "
+              f"included, stored in /scene/source: `transient info --source` prints them)")
     values = {k: v for k, (v, _) in res.analysis.items()}
+    _print_stops(values)
     _print_response(values)
     # (the pairs' names are in the resolved scene, read only when there are pairs)
     _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())
@@ -281,6 +326,22 @@ def cmd_info(args) -> int:
         print(f"  analyses asked for by the scene ([analysis]; {len(arrays)} arrays): "
               + ", ".join(arrays))
     return EXIT_OK
+
+
+#: The versions a result records (``results.provenance``), in the order ``info`` prints them.
+_VERSIONS = ("python", "numpy", "scipy", "numba", "h5py", "hdf5", "dask", "distributed",
+             "matplotlib", "pandas")
+
+
+def _print_provenance(attrs) -> None:
+    """How the result was made: the command, the CPU, the git commit, the versions (those the
+    file records: older files record fewer)."""
+    commit = f" at git {attrs['git_commit']}" if attrs.get("git_commit") else ""
+    print(f"  made by `{escaped(str(attrs.get('command', '')))}` on {attrs.get('cpu', '?')}"
+          f"{commit}")
+    versions = [f"{name} {attrs[name]}" for name in _VERSIONS if name in attrs]
+    if versions:
+        print(f"  versions: {', '.join(versions)}")
 
 
 def cmd_warmup(args) -> int:

@@ -87,6 +87,9 @@ def cmd_sweep(args) -> int:
         print(f"wrote {out.path} and {out.csv}: {_counts(out)}")
         for r in out.failed:
             print(f"  run {r['run']} failed: {r['message']}")
+        for r in out.rows:
+            if r["note"] and r not in out.failed:
+                print(f"  run {r['run']}: NaN: {r['note']}")
     if out.failed:
         print(f"transient: {len(out.failed)} of {len(sweep.runs)} runs failed (recorded in "
               f"{out.path}; --retry-failed runs them again)", file=sys.stderr)
@@ -116,7 +119,7 @@ def cmd_sweep_plot(args) -> int:
                          file=str(args.result)) from None
     quantities = args.quantity or tab.collect
     for q in quantities:
-        if q not in tab.columns or q in ("run", "status", "message"):
+        if q not in tab.columns or q in ("run", "status", "note", "message"):
             raise SceneError("--quantity", f"{show_value(q)} is not in the summary; allowed: "
                                            f"{', '.join(tab.collect)}", file=str(args.result))
     out = output_folder(args.output, tab.path.parent)

@@ -17,7 +17,7 @@ from .forcing import command, inertia, speed
 from .layout import OMEGA, PHI, cyl_index, latch_index
 from .stepper_io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, C_T_END,
                          EV_INJECTION, F_PASSED_BP, F_REDO_LEVEL, I_ANGLE_MODE, I_NREDO,
-                         _emit_event, _retake)
+                         MAX_OUTPUT_INTERVALS, _emit_event, _retake)
 
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
@@ -82,10 +82,10 @@ def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
     down = next_breakpoint(bp, m.period, here, False)
     if angle_mode:
         x_end = min(up, cfg[C_PHI_END])
-        h_max = min(cfg[C_MAX_STEP_PHI], 256.0 * cfg[C_DPHI_OUT])
+        h_max = min(cfg[C_MAX_STEP_PHI], MAX_OUTPUT_INTERVALS * cfg[C_DPHI_OUT])
     else:
         x_end = cfg[C_T_END]
-        h_max = min(cfg[C_MAX_STEP_T], 256.0 * cfg[C_DT_OUT])
+        h_max = min(cfg[C_MAX_STEP_T], MAX_OUTPUT_INTERVALS * cfg[C_DT_OUT])
     tol_end = 1e-13 * max(1.0, abs(x))
     corner = _load_corner(m, ix, sw)
     if tol_end < corner - x and corner < x_end:

@@ -146,6 +146,11 @@ def chain_solve(J, dJ, M, eta_s, w, S_out):
         s = M[k] - dJ[k] * half_w2 - J[k] * a + prev
         S_out[k] = s
         prev = eta_s[k] * s
+    if n > 0 and J[n] == 0.0 and dJ[n] == 0.0:
+        # A last sub-chain without inertia (the cylinders, loaded by the gas alone) is in
+        # balance with the pair before it: that pair carries its moment exactly, zero where the
+        # gas force is, rather than the rounding left of the recursion's long sum.
+        S_out[n - 1] = -M[n] / eta_s[n - 1]
     return a
 
 

@@ -107,10 +107,13 @@ def gas_pair(m, k, phi, sel, wk):
 
 @kernel(inline=True)
 def applied_value(m, extras, k, phi, sel, f, wk):
-    """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot).
+    """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot), so
+    that the fuel scales the combustion, never the compression.
 
-    Without a motored table the motored curve is the constant ``gas_offset`` (p0), and at f = 1
-    the value is the table's to the last bit.
+    Without a paired motored table either the scene burns full-load fuel throughout (f = 1,
+    ``transient.assemble.burns_part_load``) or the model is a force pulse whose motored force is
+    ``gas_offset`` = 0; the value is then gas_offset + f·(p − gas_offset), at f = 1 the table's
+    to the last bit.
     """
     if m.has_motored:
         p, p_mot = gas_pair(m, k, phi, sel, wk)
@@ -192,9 +195,9 @@ def governor_branch(m, w, rising):
 def fuel(m, w, branch):
     """Fuel command f of the static droop governor (Antonyuk §4): 1 below ω_a, falling linearly
     to 0 at ω_1c, 0 above; 1 without a governor. The cylinder pressure is p_mot + f·(p_full −
-    p_mot) (:func:`applied_value`), i.e. f scales the gas force (p − p0)·F_p when the motored curve
-    is p0. The branch is fixed for a whole step (a state event stops on each corner), so that the
-    right-hand side is smooth inside every step."""
+    p_mot) (:func:`applied_value`), i.e. f scales the combustion's part of the gas force (all of
+    a force pulse's, as the paper's P₀). The branch is fixed for a whole step (a state event
+    stops on each corner), so that the right-hand side is smooth inside every step."""
     if not m.gov_on or branch == 0:
         return 1.0
     if branch == 2:
@@ -378,7 +381,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                 if extras is not None and m.reaction:  # each piston's force, for the joints
                     wk[WK_RX + rx.R_P, k] = (m.gas_scale[k] * (p_k - m.gas_offset)
                                              * (m.var_par[k, PRESSURE] if m.var_on else 1.0))
-        else:  # the motored curve is p0: f·Σ(p − p0)F_p u, one multiplication
+        else:  # f = 1, or a force pulse (motored force 0): f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
                 p_k = gas_value(m, extras, k, phi, sel, wk)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]

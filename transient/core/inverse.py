@@ -118,7 +118,7 @@ def inverse_dynamics(m, extras, t, phi, omega, eps, rows, M_drive, n_consistent)
             M_drive[i] = inverse_drive(m, eps[i], w, sigma, M_load, wk)
             n_consistent[i] = 1
         else:
-            split_subchains(m, J, dJ, M_gas, M_load, wk)
+            split_subchains(m, phi[i], J, dJ, M_gas, M_load, wk)
             M_drive[i], n_consistent[i] = inverse_chain(m, eps[i], w, sigma, wk)
         pair_rows(m, w, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, N_OUT_FIXED + m.ncyl:])
         if m.reaction:

@@ -54,6 +54,13 @@ N_SWITCHES = 8
 #: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
 CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
 
+#: How the reduced inertia of a link of the serial chain follows φ (a mechanism's ``link_laws``;
+#: ``Model.link_own`` holds the first two where a pair cuts such a link from the rest):
+#: LINK_FIXED a constant (``Model.link_J``), LINK_PISTONS the pistons' m·Σ_k u_k² (m
+#: ``Model.link_mass``), LINK_SWASH the swash plate's link 9 with cross 13
+#: (``swash_plate.link_terms``), LINK_REST what J(φ) holds beyond every other link (the rods).
+LINK_FIXED, LINK_PISTONS, LINK_SWASH, LINK_REST = 0, 1, 2, 3
+
 #: Abscissae of a tabulated load (``Model.lt_kind``; :func:`.forcing.table_load`): none, the
 #: speed ω, the shaft angle φ in its cycle, the time t.
 LT_NONE, LT_SPEED, LT_ANGLE, LT_TIME = 0, 1, 2, 3
@@ -171,6 +178,10 @@ Model = namedtuple(
         "policy",  # int: POWER_FLOW or PAPER
         "link_sub",  # int64[n_links]: sub-chain of each link (shaft first, gas-carrying link last)
         "link_J",  # float64[n_links]: constant reduced inertia of the middle links [kg m²]
+        "link_rest",  # int: the link that holds J(φ) less every other link's inertia
+        "link_own",  # int64[n_links]: LINK_PISTONS or LINK_SWASH where a pair cuts the link
+        #   from link_rest's sub-chain (its inertia then computed on its own), else LINK_FIXED
+        "link_mass",  # float64[n_links]: m of a LINK_PISTONS link, J = m·Σ_k u_k² [kg]
         # per-cylinder variation (transient.core.variation; the arrays' types are the same
         # without it, so that one compile serves every scene; packed in two arrays, as a
         # kernel that is not inlined copies every field of the Model at each call)

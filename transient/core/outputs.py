@@ -36,7 +36,7 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     row[0] = y[T]
     row[1] = y[PHI]
     row[2] = w
-    row[3] = acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
+    row[3] = acceleration(m, extras, y[PHI], J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     row[4] = J
     row[5] = dJ
     row[6] = M_gas

@@ -18,20 +18,25 @@ from . import eta_table as et
 from . import joint_friction as jf
 from . import reactions as rx
 from . import stuck as st
+from .swash_plate import link_terms as swash_link_terms
 from .forcing import command, cylinder_rates, governor_rates, moments
-from .layout import (KINETIC, OMEGA, PHI, POWER_FLOW, SW_DIRECTION, SW_MODES, T, W_GAS, W_LOAD,
-                     W_LOSS0, W_STARTER, WK_DJ, WK_ETA, WK_G, WK_G_MIN, WK_J, WK_M, WK_S,
-                     WK_SCRATCH, WK_SPEED)
+from .layout import (KINETIC, LINK_FIXED, LINK_PISTONS, OMEGA, PHI, POWER_FLOW, SW_DIRECTION,
+                     SW_MODES, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_DJ, WK_DU, WK_ETA, WK_G,
+                     WK_G_MIN, WK_J, WK_M, WK_S, WK_SCRATCH, WK_SPEED, WK_U)
 
 
 @kernel(inline=True)
-def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
+def split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk):
     """J_k, J′_k and M_k of every sub-chain into ``wk`` (docs/theory.md, The serial chain;
     :mod:`transient.core.chain`).
 
-    Links in order: the shaft (J0 with flywheel and load; load and starter act on it), middle links
-    of constant reduced inertia ``link_J`` (the crank), and the last link with the rest of the
-    mechanism's inertia and the gas forces. Links between ideal pairs share a sub-chain.
+    Links in order (the mechanism's ``links``): the shaft (J0 with flywheel and load; load and
+    starter act on it), links of constant reduced inertia ``link_J`` (the crank), the link
+    ``link_rest`` with what J(φ) holds beyond the others (the rods), and last the cylinders,
+    whose gas forces do their work on the pistons through the pistons' pair with them. A link
+    whose inertia varies with φ (the pistons, the swash plate's link 9) has it computed on its
+    own only where a pair cuts it from ``link_rest`` (``link_own``); elsewhere it is in the rest.
+    Links between ideal pairs share a sub-chain.
     """
     for k in range(m.n_pairs + 1):
         wk[WK_J, k] = 0.0
@@ -39,14 +44,37 @@ def split_subchains(m, J, dJ, M_gas, M_shaft, wk):
         wk[WK_M, k] = 0.0
     last = m.link_sub.shape[0] - 1
     J_rest = J
-    for i in range(last):
+    dJ_rest = dJ
+    for i in range(last + 1):
         c = m.J0 if i == 0 else m.link_J[i]
         wk[WK_J, m.link_sub[i]] += c
         J_rest -= c
+        if m.link_own[i] != LINK_FIXED:
+            J_i, dJ_i = own_inertia(m.link_own[i], m.link_mass[i], m.mech, phi,
+                                    wk[WK_U, :m.ncyl], wk[WK_DU, :m.ncyl])
+            wk[WK_J, m.link_sub[i]] += J_i
+            wk[WK_DJ, m.link_sub[i]] += dJ_i
+            J_rest -= J_i
+            dJ_rest -= dJ_i
     wk[WK_M, m.link_sub[0]] += M_shaft
-    wk[WK_J, m.link_sub[last]] += J_rest
-    wk[WK_DJ, m.link_sub[last]] += dJ
+    wk[WK_J, m.link_sub[m.link_rest]] += J_rest
+    wk[WK_DJ, m.link_sub[m.link_rest]] += dJ_rest
     wk[WK_M, m.link_sub[last]] += M_gas
+
+
+@kernel
+def own_inertia(law, mass, mech, phi, u, du):
+    """J and dJ/dφ of a link by its law (``layout.LINK_*``): the pistons' m·Σ u_k² from the
+    transfer functions u, u′ (``moments`` with dJ leaves them), or the swash plate's links 9 and
+    crosses 13 from its parameters ``mech``."""
+    if law == LINK_PISTONS:
+        su2 = 0.0
+        suu = 0.0
+        for k in range(u.shape[0]):
+            su2 += u[k] * u[k]
+            suu += u[k] * du[k]
+        return mass * su2, 2.0 * mass * suu
+    return swash_link_terms(mech, phi)
 
 
 @kernel(inline=True)
@@ -57,29 +85,29 @@ def pair_etas(m, modes, eta_out):
 
 
 @kernel(inline=True)
-def acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
+def acceleration(m, extras, phi, J, dJ, w, M_gas, M_load, M_starter, sw, wk):
     """φ̈ from (18) without non-ideal pairs, else from the serial chain (:func:`chain_acceleration`)
     or with the joints' reaction friction (:mod:`.reactions`)."""
     if extras is None or m.n_pairs == 0:
         return (M_gas + M_load + M_starter - 0.5 * dJ * w * w) / J
-    return chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+    return chain_acceleration(m, phi, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
 
 
 @kernel(inline=True)
-def chain_acceleration(m, J, dJ, w, M_gas, M_shaft, sw, wk):
+def chain_acceleration(m, phi, J, dJ, w, M_gas, M_shaft, sw, wk):
     """φ̈ of the serial chain with the pair modes held in ``sw``; leaves the sub-chains' J, J′, M
     and the pairs' η*, S in the rows of ``wk``. With reaction friction the pairs are joints of
     one rigid chain: φ̈ and their η*, S and losses come from :mod:`.reactions`, in direction σ.
     Stuck at rest (``stuck``): φ̈ = 0, and the holding margin in ``wk[WK_G]``."""
     if sw[SW_DIRECTION] == st.STUCK:
         if not m.reaction:
-            split_subchains(m, J, dJ, M_gas, M_shaft, wk)
+            split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk)
         return st.hold(m, J, M_gas, M_shaft, wk)
     if m.reaction:
         return rx.acceleration(m, J, dJ, w, M_gas, M_shaft, float(sw[SW_DIRECTION]),
                                sw[SW_MODES], wk)
     n = m.n_pairs
-    split_subchains(m, J, dJ, M_gas, M_shaft, wk)
+    split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk)
     if m.eta_table:  # η* depends on S: solved with the modes held (``eta_table``)
         return et.solve_held(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1], w,
                              sw[SW_MODES], m.et_speed, m.et_torque, m.et_size, m.et_eta,
@@ -113,7 +141,7 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     if extras is None or m.n_pairs == 0:  # equation (18); no chain to solve
         a = (M - 0.5 * dJ * w * w) / J  # read in time mode only (in crank angle dJ may be NaN)
     else:
-        a = chain_acceleration(m, J, dJ, w, M_gas, M_load + M_starter, sw, wk)
+        a = chain_acceleration(m, y[PHI], J, dJ, w, M_gas, M_load + M_starter, sw, wk)
         mode_margins(m, sw, wk)  # watched at every stage: a mode switch inside a step shows here
         if m.reaction and angle_mode and rx.tracks_sides(m):  # a side force changing side
             jf.track_sides(m.ncyl, y[PHI], wk)  # in a step shows here
@@ -175,7 +203,7 @@ def margins_inline(m, extras, angle_mode, y, sel, sw, wk):
     stepper's root finder, whose iterations evaluate them most: there a call would copy the Model
     at every iteration."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
-    acceleration(m, extras, J, dJ, w, M_gas, M_load, M_starter, sw, wk)
+    acceleration(m, extras, y[PHI], J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     mode_margins(m, sw, wk)
 
 
@@ -208,7 +236,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
         sw[SW_MODES] = rx.mode_mask(m, sigma, wk)
         return status
-    split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
+    split_subchains(m, y[PHI], J, dJ, M_gas, M_load + M_starter, wk)
     if m.eta_table:
         a, status = _table_modes(m, w, wk)
     else:
@@ -232,7 +260,7 @@ def release(m, extras, y, sel, sw, wk):
     direction whose margin crossed, the modes chosen afresh for it; time domain, ω = 0."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, False, y, sel, sw, wk, True)
     if not m.reaction:
-        split_subchains(m, J, dJ, M_gas, M_load + M_starter, wk)
+        split_subchains(m, y[PHI], J, dJ, M_gas, M_load + M_starter, wk)
     sigma = st.release_direction(m, J, M_gas, M_load + M_starter, wk)
     sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
     sw[SW_MODES] = (rx.mode_mask(m, sigma, wk) if m.reaction

@@ -49,7 +49,7 @@ from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .chain import AMBIGUOUS, NONE_CONSISTENT
 from .chain import LOCKED as LOCKED_STATUS
 from .events import (DEMAND_COMP, MAX_UNSEEN, N_MARGIN_SAMPLES, PAIR_COMP, _dense_once, _event_g,
-                     _locate_events, _sleeve_stops)
+                     _locate_events, _root, _sleeve_stops)
 from . import governor as gv
 from .forcing import (generator_branch, governor_branch, inertia, load_segment, moments, speed,
                       speed_knot_segment, start_branch)
@@ -60,7 +60,8 @@ from . import joint_friction as jf
 from . import reactions as rx
 from . import stuck as st
 from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
-from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL, C_T_END,
+from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_DPHI_OUT, C_FIXED_STEP, C_DT_OUT, C_PHI_END,
+                         C_RTOL, C_T_END,
                          C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
                          EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL,
                          EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_STUCK, EV_TO_ANGLE,
@@ -72,8 +73,8 @@ from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_FIXED_STEP, C_DT_OUT, C_PHI_EN
                          I_NSTEPS,
                          I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED,
                          I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
-                         _emit_row, _emit_samples, _finish, _locked, _out_spacing,
-                         _reset_output_grid, _retake)
+                         MAX_OUTPUT_INTERVALS, _emit_new_row, _emit_row, _emit_samples, _finish,
+                         _locked, _reset_output_grid, _retake)
 
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
@@ -138,7 +139,8 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
     """
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
-    margin = 300  # rows kept free: a step never spans more than 256 output intervals
+    # rows kept free: a step spans at most 256 intervals of its grid (in time, of each grid)
+    margin = 600
     g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics,
     g1 = g0 + gv.n_states(m.gov_dyn)
     c0 = cyl_index(m)  # and so are the cylinder pressures y[c0:]
@@ -244,6 +246,12 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
             return STIFF
+        if not angle_mode and abs(y_new[PHI] - y[PHI]) > MAX_OUTPUT_INTERVALS * cfg[C_DPHI_OUT]:
+            # (a step in time writes a sample at each crossing of the angle grid: no more of
+            # them than a step in crank angle writes)
+            _retake(fst, ist, 0.5 * h)
+            steps_here += 1
+            continue
         retake, dense_ready = _aim_at_breakpoint(tab, m, extras, angle_mode, y, y_new, h, sel, sw,
                                                  K, F, tmp, wk, fst, ist, up, down, min_step)
         if retake:
@@ -437,13 +445,77 @@ def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
 @kernel(inline=True)
 def _emit_step_samples(tab, m, extras, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F,
                        tmp, wk, outbuf, ist, fst, dense_ready):
-    """The output grid's samples inside the step, up to ``x_stop`` (its end, or its event), from
-    the dense output."""
-    if fst[F_NEXT_OUT] <= x_stop:
-        _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk,
-                    ist)
-        _emit_samples(m, extras, F, y, x, h, x_stop, ix, _out_spacing(cfg, angle_mode), sel, sw,
-                      outbuf, ist, fst, tmp, wk)
+    """The output samples inside the step, up to ``x_stop`` (its end, or its event), from the
+    dense output: in crank angle the angle grid's; in time the time grid's and the angle grid's
+    crossings (:func:`_emit_time_samples`)."""
+    if angle_mode:
+        if fst[F_NEXT_OUT] <= x_stop:
+            _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp,
+                        wk, ist)
+            _emit_samples(m, extras, F, y, x, h, x_stop, ix, cfg[C_DPHI_OUT], sel, sw, outbuf,
+                          ist, fst, tmp, wk)
+        return
+    whole = x_stop == x + h
+    if whole and fst[F_NEXT_OUT] > x_stop and not _crosses_level(
+            fst[F_LAST_PHI], y[PHI], y_new[PHI], cfg[C_DPHI_OUT]):
+        return  # (most steps in time: nothing to write, no dense output needed)
+    _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
+    if whole:
+        phi_stop = y_new[PHI]
+    else:
+        _dense_eval(F, y, (x_stop - x) / h, tmp)
+        phi_stop = tmp[PHI]
+    _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, sel, sw, outbuf, ist, fst, tmp,
+                       wk)
+
+
+@kernel(inline=True)
+def _next_level(last, d, dphi):
+    """The first multiple of the angle spacing ``dphi`` beyond the angle ``last`` in the
+    direction ``d`` (±1), at least a millionth of the spacing beyond it (``last`` may be a
+    multiple computed another way, an ulp off)."""
+    k = np.floor(last / dphi) if d > 0.0 else np.ceil(last / dphi)
+    level = (k + d) * dphi
+    if d * (level - last) <= 1e-6 * dphi:
+        level = (k + 2.0 * d) * dphi
+    return level
+
+
+@kernel(inline=True)
+def _crosses_level(last, a, b, dphi):
+    """Whether the shaft, turning from ``a`` to ``b``, crosses the next multiple of ``dphi``
+    beyond the last sample's angle ``last``."""
+    d = 1.0 if b >= a else -1.0
+    return d * (b - _next_level(last, d, dphi)) >= 0.0
+
+
+@kernel
+def _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, sel, sw, outbuf, ist, fst, tmp,
+                       wk):
+    """The time domain's samples inside the last step (from time x, size h) up to ``x_stop``
+    (where the shaft is at ``phi_stop``), in time order: the time grid's (spacing
+    ``cfg[C_DT_OUT]``), and one wherever the shaft angle crosses a multiple of the angle spacing
+    ``cfg[C_DPHI_OUT]``, either way. So a shaft that turns fast in time (backwards, rocking,
+    ``domain = "time"``) is sampled at least as densely in angle as one turning forwards in
+    crank angle. Inside a step φ is monotone: a reversal is an event, which ends a step."""
+    dt, dphi = cfg[C_DT_OUT], cfg[C_DPHI_OUT]
+    theta_stop = (x_stop - x) / h
+    d = 1.0 if phi_stop >= y[PHI] else -1.0
+    level = _next_level(fst[F_LAST_PHI], d, dphi)
+    while d * (phi_stop - level) >= 0.0:
+        g0 = y[PHI] - level
+        if d * g0 < 0.0:  # (a level on the step's start by rounding was passed with it)
+            theta = _root(m, extras, False, F, y, PHI, level, sel, sw, tmp, wk, 0.0, theta_stop,
+                          g0, phi_stop - level)[0]
+            t = x + theta * h
+            _emit_samples(m, extras, F, y, x, h, t, T, dt, sel, sw, outbuf, ist, fst, tmp, wk)
+            if t > fst[F_LAST_T]:  # (else the time grid's sample is at this instant)
+                _dense_eval(F, y, theta, tmp)
+                tmp[T] = t
+                tmp[PHI] = level
+                _emit_row(m, extras, tmp, sel, sw, outbuf, ist, fst, wk)
+        level = _next_level(level, d, dphi)
+    _emit_samples(m, extras, F, y, x, h, x_stop, T, dt, sel, sw, outbuf, ist, fst, tmp, wk)
 
 
 @kernel(inline=True)
@@ -526,11 +598,13 @@ def _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code
     _emit_event(m, evbuf, ist, ev_code, y, wk)
     if ev_code == EV_END:
         return _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk)
-    if ev_code == EV_REVERSAL and not np.isfinite(cfg[C_T_END]):
-        # A run that ends only by revolutions would never end once the shaft stops: report
-        # the stall (with what was computed) instead of integrating on.
-        _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
-        return STALLED
+    if ev_code == EV_REVERSAL:
+        # The turning point (ω = 0) as a sample: the grids' samples rarely fall on it.
+        _emit_new_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
+        if not np.isfinite(cfg[C_T_END]):
+            # A run that ends only by revolutions would never end once the shaft stops: report
+            # the stall (with what was computed) instead of integrating on.
+            return STALLED
     if extras is not None and ev_code == EV_REVERSAL and m.n_pairs > 0:
         # At rest the pairs may hold the applied moments; else the modes start afresh.
         if (_start_modes(m, extras, y, sel, ist, wk) == LOCKED_STATUS
@@ -543,7 +617,7 @@ def _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code
     fst[F_LAST_SWITCH] = x_stop
     if ist[I_NCHATTER] >= CHATTER_COUNT:
         ist[I_CHATTER_CODE] = ev_code
-        _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
+        _emit_new_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
         return CHATTERING
     ist[I_AT_EVENT] = ev_code + 1
     return RUNNING

@@ -47,6 +47,10 @@ I_LOAD_SEG, I_GEN_LOW, I_SLEEVE, I_LOAD_TABLE = SW_LOAD, SW_GENERATOR, SW_SLEEVE
 I_REJECTED, I_NBAD, I_NUNSEEN = range(N_SWITCHES + 17, N_SWITCHES + 20)
 N_IST = N_SWITCHES + 20
 
+#: Most intervals of an output grid one step may span (its samples fit the rows the stepper keeps
+#: free in the output buffer).
+MAX_OUTPUT_INTERVALS = 256.0
+
 # advance() return codes
 RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING, STIFF = range(8)
 # event codes written to the event buffer as (code, t, phi, omega)
@@ -107,6 +111,14 @@ def _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk):
     """One output row at state ``y`` (an event's): a call into ``outputs.output_row``."""
     output_row(m, extras, ist[I_ANGLE_MODE] == 1, y, sel, sw, wk, outbuf[ist[I_NOUT]])
     _count_row(y, ist, fst)
+
+
+@kernel
+def _emit_new_row(m, extras, y, sel, sw, outbuf, ist, fst, wk):
+    """:func:`_emit_row` unless the last row is at the time of ``y`` already (a grid's sample
+    that fell on an event): the trajectory's time never repeats."""
+    if y[T] > fst[F_LAST_T]:
+        _emit_row(m, extras, y, sel, sw, outbuf, ist, fst, wk)
 
 
 @kernel(inline=True)

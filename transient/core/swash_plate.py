@@ -169,6 +169,27 @@ def rod_motion(mp, k, c_phi, s_phi, c_theta, s_theta, w, dw):
     return b, b1, b2, x1, x2, e, e1, e2
 
 
+@kernel(inline=True)
+def link_inertia(mp, d1, d2, u13, du13):
+    """J and dJ/dφ of link 9 and cross 13 of one half from :func:`hooke`'s θ′, θ″, u₁₃, u₁₃′:
+    link 9 (ω·n)² J_p + (φ̇ sin α)² J_d, the reference's form of (15)–(17), cross 13 about its
+    hinge a."""
+    sa = mp[SIN_A]
+    wn = mp[COS_A] + d1
+    J = mp[J_POLAR] * wn * wn + mp[J_DIAM] * sa * sa + mp[I_CROSS] * u13 * u13
+    dJ = 2.0 * (mp[J_POLAR] * wn * d2 + mp[I_CROSS] * u13 * du13)
+    return J, dJ
+
+
+@kernel
+def link_terms(mp, phi):
+    """J and dJ/dφ of the links 9 and crosses 13 of every half: the chain's link ``link``, whose
+    inertia a pair on either side of it separates from the rods' (``rhs.split_subchains``)."""
+    _, d1, d2, u13, du13 = hooke(mp, phi)
+    J, dJ = link_inertia(mp, d1, d2, u13, du13)
+    return mp[HALVES] * J, mp[HALVES] * dJ
+
+
 @kernel
 def swash_terms(mp, phi, u, du):
     """Reduced inertia of the moving parts except shaft and plates, eqs. (19), (21).
@@ -194,13 +215,9 @@ def swash_terms(mp, phi, u, du):
     J, dJ : float
         J(φ) [kg m²] and dJ/dφ [kg m²/rad].
     """
-    sa = mp[SIN_A]
     cg = mp[ROD_CG]
     c_phi, s_phi, c_theta, s_theta, n, w, dw, d1, d2, u13, du13 = link_motion(mp, phi)
-    # Link 9: (ω·n)² J_p + (φ̇ sin α)² J_d, the reference's form of (15)–(17); cross 13 about a.
-    wn = mp[COS_A] + d1
-    J = mp[J_POLAR] * wn * wn + mp[J_DIAM] * sa * sa + mp[I_CROSS] * u13 * u13
-    dJ = 2.0 * (mp[J_POLAR] * wn * d2 + mp[I_CROSS] * u13 * du13)
+    J, dJ = link_inertia(mp, d1, d2, u13, du13)
     halves = mp[HALVES]
     for k in range(int(mp[N_CYL])):
         _, _, _, x1, x2, _, e1, e2 = rod_motion(mp, k, c_phi, s_phi, c_theta, s_theta, w, dw)

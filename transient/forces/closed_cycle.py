@@ -567,11 +567,15 @@ def integrate_closed(st: CycleSetup, fuel_mass: float, volume: VolumeFunction,
         burning = q_total > 0.0 and lo >= st.start and hi <= end
         power = st.m + 1.0 if burning and st.m < 0.0 else None
         u_lo, u_hi = (lo, hi) if power is None else (0.0, 1.0)
-        sol = solve_ivp(segment_rhs(lo, hi, burning, power), (u_lo, u_hi), y0, method="DOP853",
-                        rtol=st.rtol, atol=atol, dense_output=True)
-        if sol.status != 0:
-            raise RuntimeError(f"closed-cycle integration failed from {deg_text(lo)} to "
-                               f"{deg_text(hi)}: {sol.message}")
+        with np.errstate(all="ignore"):  # (a failure is said below, in one line)
+            sol = solve_ivp(segment_rhs(lo, hi, burning, power), (u_lo, u_hi), y0,
+                            method="DOP853", rtol=st.rtol, atol=atol, dense_output=True)
+        if sol.status != 0 or not np.all(np.isfinite(sol.y[:, -1])):
+            # Physical inputs give a smooth solution: this is a magnitude that none has.
+            raise SceneError("gas.wiebe", f"the cycle's pressure cannot be integrated from "
+                                          f"{deg_text(lo)} to {deg_text(hi)} ({sol.message}): "
+                                          f"its inputs give no physical gas; check fuel_mass, "
+                                          f"lhv, m, gamma, gamma_slope and p_a, and their units")
         segments.append(Segment(lo=float(lo), hi=float(hi), power=power, sol=sol.sol, size=size))
         y0 = sol.y[:, -1].copy()
         y0[0] = max(y0[0], 0.0)

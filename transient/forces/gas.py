@@ -635,6 +635,10 @@ class MixedCycle(IndicatedCycle):
         2 or 4.
     interpolation_error : float
         Relative tabulation error estimate returned by :func:`table_from_function`.
+    motored : PressureTable
+        The motored cycle (no fuel) on the same corners: the closed part on the
+        compression polytrope both ways, p_a·(V_a/V)^n1, and the same gas exchange
+        (:func:`mixed_cycle`, *Part load*).
     """
 
     p_c: float
@@ -646,6 +650,7 @@ class MixedCycle(IndicatedCycle):
     v_b: float
     strokes: int
     interpolation_error: float
+    motored: PressureTable
 
     @property
     def v_h(self) -> float:
@@ -690,6 +695,23 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
     expansion ends at 2π + b (4-stroke) or b, so that V_a and V_c are the cylinder's largest and
     least volume; the table keeps its angle 0 and the pieces wrap across it.
 
+    **Part load and misfire.** The cycle's heat release follows from its pressure by the first
+    law of one ideal-gas zone, V dp = (k − 1) δQ − k p dV, with the adiabatic exponent k. The
+    compression is the cycle's one process without heat release, so k = n₁ (the model holds no
+    other). The full-load cycle then releases Q_v = V_c (p_z − p_c)/(n₁ − 1) at the firing TDC,
+    δQ = n₁/(n₁ − 1)·p_z dV on the isobar and δQ = (n₁ − n₂)/(n₁ − 1)·p dV on the expansion
+    (the afterburning that an n₂ below n₁ stands for). The first law is linear in (p, Q) from
+    the common start p_a at V_a, so a cycle that burns f times the heat at every angle (the
+    combustion's timing fixed, its heat scaled, as for the Wiebe model) has exactly
+    p_f = p_mot + f·(p_full − p_mot), where p_mot is the cycle without heat: the compression
+    polytrope both ways, p_a·(V_a/V)^n₁ over the whole closed part (its closed loop encloses no
+    work; the pumping loop is left). Its peak is p_z(f) = p_c + f·(p_z − p_c), at the firing
+    TDC; the heat addition still ends at V = ρ·V_c, but the pressure falls along it from
+    p_z(f) (the isobar is one at f = 1 only). Keeping the isobar at part load, with ρ falling
+    too, would make the pressure non-linear in f, and the governor's continuous command would
+    need a cycle per fuel level. (Expanding the motored cycle on n₂ instead would leave it above
+    its compression and give work from no fuel whenever n₂ < n₁.) ``motored`` is that p_mot.
+
     Parameters
     ----------
     volume : callable
@@ -725,7 +747,8 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
         ``W = p_in(V_a - V_c) + (p_a V_a - p_c V_c)/(n1 - 1) + p_z(V_z - V_c)
         + (p_z V_z - p_b V_b)/(n2 - 1) + p_ex(V_c - V_b)`` (polytrope work
         ``(p1 V1 - p2 V2)/(n - 1)``; the intake and exhaust terms are the pumping loop, absent
-        for a 2-stroke), p_c, p_b and the isobar end angle.
+        for a 2-stroke), p_c, p_b, the isobar end angle and the motored cycle on the same
+        corners.
 
     Raises
     ------
@@ -766,11 +789,14 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
                          f"{deg_text(x_tdc)}) give V_a/V_c = {ratio:.10g}, not the "
                          f"compression_ratio {compression_ratio:.10g}; the clearance volume "
                          f"must be the swept volume/(ε − 1)")
-    p_c = p_a * ratio ** n1
+    try:
+        p_c = p_a * ratio ** n1
+    except OverflowError:  # (an absurd ε or n1: a p_c beyond a double, which p_z cannot reach)
+        p_c = math.inf
     if p_z < p_c:
         raise SceneError("gas.p_z", f"p_z = {p_z / 1e6:.6g} MPa is below the compression end "
-                                    f"p_c = p_a·ε^n1 = {p_c / 1e6:.6g} MPa; the mixed cycle needs "
-                                    "p_z ≥ p_c")
+                                    f"p_c = p_a·ε^n1 = {p_c / 1e6:.6g} MPa (ε = {ratio:.6g}, n1 = "
+                                    f"{n1:g}); the mixed cycle needs p_z ≥ p_c")
     v_z = rho * v_c
     if not (np.isfinite(rho) and 1.0 <= rho and v_z < v_b):
         raise SceneError("gas.rho", f"ρ = {rho!r}; it must satisfy 1 ≤ ρ < V_b/V_c = "
@@ -797,21 +823,27 @@ def mixed_cycle(volume: VolumeFunction, *, compression_ratio: float,
     work = ((p_a * v_a - p_c * v_c) / (n1 - 1.0) + p_z * (v_z - v_c)
             + (p_z * v_z - p_b * v_b) / (n2 - 1.0))
     # Each piece from the angle where it starts; the exhaust ends at the period's end (4π ≡ 0).
-    starts: list[tuple[float, PieceFunction]] = [(x_start, compression), (x_tdc, p_z),
+    # (the motored cycle's closed part is the compression polytrope throughout, on the same
+    # pieces so that both tables share their corners)
+    closed: list[tuple[float, PieceFunction]] = [(x_start, compression), (x_tdc, p_z),
                                                  (angle_z, expansion)]
     if not has_isobar:
-        starts.pop(1)
+        closed.pop(1)
+    exchange: list[tuple[float, PieceFunction]] = []
     if strokes == 4:
-        starts += [(0.0, float(p_intake)), (x_bdc, float(p_exhaust))]
+        exchange = [(0.0, float(p_intake)), (x_bdc, float(p_exhaust))]
         # Pumping loop, from the volumes at the same corners the table uses.
         v_0 = volume_at(volume, 0.0)
         v_end = volume_at(volume, period)
         work += p_intake * (v_a - v_0) + p_exhaust * (v_end - v_b)
-    funcs, corners = wrapped_pieces(starts, period)
+    funcs, corners = wrapped_pieces(closed + exchange, period)
     table, err = table_from_function(funcs, period, corners, step)
+    funcs, _ = wrapped_pieces([(x, compression) for x, _ in closed] + exchange, period)
+    motored, _ = table_from_function(funcs, period, corners, step)
     return MixedCycle(knots=table.knots, coef=table.coef, piece_knot=table.piece_knot,
                       period=period, work=work, p_c=p_c, p_b=p_b, angle_z=angle_z, v_c=v_c,
-                      v_a=v_a, v_z=v_z, v_b=v_b, strokes=strokes, interpolation_error=err)
+                      v_a=v_a, v_z=v_z, v_b=v_b, strokes=strokes, interpolation_error=err,
+                      motored=motored)
 
 
 def wrapped_pieces(starts: list[tuple[float, PieceFunction]], period: float

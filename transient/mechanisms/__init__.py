@@ -54,7 +54,13 @@ class Mechanism(Protocol):
     kind: ClassVar[int]
     #: The links of its serial chain, shaft first: a friction pair joins two neighbours
     #: (the scene's ``[friction]``, the chain of ``transient.assemble`` and the reference path).
+    #: The first carries the shaft's inertia and the load, the last the gas forces (the
+    #: cylinders: their gas does its work on the pistons through the pair between them).
     links: ClassVar[tuple[str, ...]]
+    #: How each link's reduced inertia follows φ (``transient.core.layout.LINK_*``): constant
+    #: (:meth:`link_inertias`), the pistons' (:attr:`piston_link_mass`), the swash plate's
+    #: link 9, or the rest of J(φ) (exactly one link).
+    link_laws: ClassVar[tuple[int, ...]]
     #: Whether a scene may give it wall heat transfer (``[gas.woschni]``): the cylinder ODE of
     #: ``transient.core.cylinder`` is built for the crank-slider's volume.
     wall_heat_transfer: ClassVar[bool]
@@ -113,16 +119,21 @@ class Mechanism(Protocol):
         """The parameter array of its compiled kernel."""
 
     def link_inertias(self) -> tuple[float, ...]:
-        """Constant reduced inertia of each link besides the shaft's [kg m²]; the last link
-        holds the rest of J(φ)."""
+        """Constant reduced inertia of each link besides the shaft's [kg m²] (0 where it
+        varies with φ, ``link_laws``)."""
+
+    @property
+    def piston_link_mass(self) -> float:
+        """m of the pistons' link, whose reduced inertia is m·Σ_k u_k² [kg]."""
 
     def kinematics_table(self, phi: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
         """Columns over the shaft angles ``phi`` [rad]: ``phi_deg``, ``J`` [kg m²], ``dJ_dphi``
         [kg m²/rad] and per cylinder k ``u_k`` [m/rad], ``du_k`` [m/rad²] and positions (the
         scene's check J(φ) > 0, ``transient kinematics``)."""
 
-    def reference_terms(self) -> Callable[[float], tuple[float, float, NDArray[np.float64]]]:
-        """φ ↦ (J, dJ/dφ, u_k) outside the compiled code, for the reference path
+    def reference_terms(self) -> Callable[[float], tuple[float, float, NDArray[np.float64],
+                                                         NDArray[np.float64]]]:
+        """φ ↦ (J, dJ/dφ, u_k, u′_k) outside the compiled code, for the reference path
         (:mod:`transient.mechanisms.twins`)."""
 
     def toml_lines(self) -> list[str]:

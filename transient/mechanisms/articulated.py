@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import articulated as core
-from ..core.layout import ARTICULATED
+from ..core.layout import ARTICULATED, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -129,9 +129,13 @@ class Articulated:
     wall_heat_transfer = False
     #: The slave pistons do not follow the crank-slider's law, from which the analyses derive W_k.
     slider_law = False
-    #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, then the
-    #: rods with the pistons and gas forces.
-    links = ("shaft", "crank", "rod")
+    #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, the rods
+    #: (each row's master rod with its slave rods: the link pins join them inside the link, the
+    #: master piston hanging on the master rod beside the slaves, not beyond them), the pistons
+    #: and the cylinders, whose gas does its work on the pistons.
+    links = ("shaft", "crank", "rod", "piston", "cylinder")
+    #: How each link's reduced inertia follows φ (``core.layout.LINK_*``), as the crank-slider's.
+    link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions
     #: (:mod:`transient.core.articulated_friction`).
     reaction_links = ("shaft", "crank", "master rod", "slave rod", "piston", "cylinder")
@@ -183,7 +187,12 @@ class Articulated:
 
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia per link besides the shaft's [kg m²]: the crank throws'."""
-        return (0.0, self.rows * self.crank_mass * self.crank_radius**2, 0.0)
+        return (0.0, self.rows * self.crank_mass * self.crank_radius**2, 0.0, 0.0, 0.0)
+
+    @property
+    def piston_link_mass(self) -> float:
+        """m of the pistons' reduced inertia m·Σ_k u_k² [kg]: every piston's group mass."""
+        return self.piston_mass
 
     def master(self) -> CrankSlider:
         """The master cylinder alone, a centred crank-slider (its kernel header and its volume)."""
@@ -400,7 +409,7 @@ class Articulated:
         return self.master().dead_centre_angles()
 
     def reference_terms(self) -> Callable[[float], tuple]:
-        """φ ↦ (J, dJ/dφ, u_k) for the reference path: the kernel's pure-Python code
+        """φ ↦ (J, dJ/dφ, u_k, u′_k) for the reference path: the kernel's pure-Python code
         (:class:`~.twins.KernelTwin`), there being no numpy twin of it."""
         return KernelTwin(self, core.articulated_terms).terms
 

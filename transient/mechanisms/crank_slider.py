@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core import crank_slider as core
-from ..core.layout import CRANK_SLIDER
+from ..core.layout import CRANK_SLIDER, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..tomlout import toml_value
 from .throws import ANGLE_TOL, SHARED, SINGLE, equal_angles, read_crank, wrap_angle
@@ -111,8 +111,13 @@ class CrankSlider:
     #: Its pistons follow the slider law the analyses derive piston accelerations W_k from.
     slider_law = True
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
-    #: flywheel and load, the crank, and the rods with pistons and gas forces.
-    links = ("shaft", "crank", "rod")
+    #: flywheel and load, the crank throws, the rods, the pistons, and the cylinders, whose gas
+    #: does its work on the pistons (so [shaft, crank] are the main bearings, [crank, rod] the
+    #: crankpins, [rod, piston] the piston pins, [piston, cylinder] the pistons in their bores).
+    links = ("shaft", "crank", "rod", "piston", "cylinder")
+    #: How each link's reduced inertia follows φ (``core.layout.LINK_*``): the crank's is
+    #: constant, the rods' what J(φ) holds beyond the others, the pistons' m_p·Σ u_k².
+    link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions (:mod:`transient.core.joint_friction`):
     #: the piston is a link of its own and the cylinder (the frame) the last, so the pairs are
     #: the main bearings, the crankpins, the piston pins and the pistons in their cylinders.
@@ -180,8 +185,14 @@ class CrankSlider:
 
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia of each link besides the shaft's [kg m²]: the crank throws'
-        n_throws·m_crank·r²; the last link (rods, pistons) has the rest of J(φ), which varies."""
-        return (0.0, self.n_throws * self.crank_mass * self.crank_radius ** 2, 0.0)
+        n_throws·m_crank·r²; the rods' and the pistons' vary with φ (``link_laws``)."""
+        return (0.0, self.n_throws * self.crank_mass * self.crank_radius ** 2, 0.0, 0.0, 0.0)
+
+    @property
+    def piston_link_mass(self) -> float:
+        """m of the pistons' reduced inertia m·Σ_k u_k² [kg]: the piston group (the two-mass
+        rod's share at the pin is the rod's)."""
+        return self.piston_mass
 
     @property
     def piston_area(self) -> float:
@@ -429,7 +440,7 @@ class CrankSlider:
         return volume
 
     def reference_terms(self) -> Callable[[float], tuple]:
-        """φ ↦ (J, dJ/dφ, u_k) for the reference path: the numpy twin written from the Gots
+        """φ ↦ (J, dJ/dφ, u_k, u′_k) for the reference path: the numpy twin written from the Gots
         relations (:class:`~.twins.CrankSliderNumpy`), independent of the kernel."""
         return CrankSliderNumpy(self).terms
 

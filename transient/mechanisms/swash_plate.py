@@ -50,7 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core import swash_plate as core
-from ..core.layout import SWASH_PLATE
+from ..core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH, SWASH_PLATE
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -141,8 +141,15 @@ class SwashPlate:
     #: Cycle length in shaft angle [rad].
     cycle = 2.0 * pi
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with the
-    #: plates, and link 9 with cross 13, rods, pistons and gas forces (beyond plate bearing 11).
-    links = ("shaft", "link")
+    #: plates, link 9 with cross 13 (beyond plate bearing 11; the Hooke joint's cross only turns
+    #: with it), the rods, the pistons, and the cylinders, whose gas does its work on the pistons.
+    #: So [shaft, link] is plate bearing 11, [link, rod] the ball joints B_k, [rod, piston] the
+    #: ball joints D_k and [piston, cylinder] the pistons in their bores.
+    links = ("shaft", "link", "rod", "piston", "cylinder")
+    #: How each link's reduced inertia follows φ (``core.layout.LINK_*``): link 9's and the
+    #: crosses' by (15)–(17), the rods' what J(φ) holds beyond the others, the pistons'
+    #: m_p·Σ_k u_k²/halves.
+    link_laws = (LINK_FIXED, LINK_SWASH, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions (:mod:`transient.core.swash_friction`),
     #: the shaft side first: the shaft with flywheel and load, the plate on it, link 9, the rods,
     #: the pistons and the cylinders (the frame). So [shaft, plate] is the main bearing (the
@@ -157,7 +164,13 @@ class SwashPlate:
 
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia of each link besides the shaft's: none here [kg m²]."""
-        return (0.0, 0.0)
+        return (0.0, 0.0, 0.0, 0.0, 0.0)
+
+    @property
+    def piston_link_mass(self) -> float:
+        """m of the pistons' reduced inertia m·Σ_k u_k² [kg]: u_k sums the ``halves`` pistons
+        of cylinder k, which move alike, so m_p·halves·(u_k/halves)² = (m_p/halves)·u_k²."""
+        return self.piston_mass / self.halves
 
     def max_rod_tilt(self) -> float:
         """The largest angle [rad] of a rod to its cylinder axis over a turn (sampled,
@@ -432,7 +445,7 @@ class SwashPlate:
 
 
     def reference_terms(self) -> Callable[[float], tuple]:
-        """φ ↦ (J, dJ/dφ, u_k) for the reference path: the kernel's pure-Python code
+        """φ ↦ (J, dJ/dφ, u_k, u′_k) for the reference path: the kernel's pure-Python code
         (:class:`~.twins.KernelTwin`), there being no numpy twin of it."""
         return KernelTwin(self, core.swash_terms).terms
 

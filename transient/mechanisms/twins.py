@@ -1,6 +1,6 @@
 """Plain-Python twins of the mechanisms' compiled kernels, for the reference path
 (:mod:`transient.reference`), which must not share the compiled code it checks: each gives
-J(φ), dJ/dφ and the piston transfer functions u_k(φ) at one shaft angle.
+J(φ), dJ/dφ and the piston transfer functions u_k(φ) and their derivatives at one shaft angle.
 """
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ class CrankSliderNumpy:
         self.phases = np.asarray(mech.firing_angles)
 
     def terms(self, phi: float):
-        """(J, dJ, u[k]) at shaft angle φ, all cylinders."""
+        """(J, dJ, u[k], u′[k]) at shaft angle φ, all cylinders."""
         a = phi - self.phases
         r, l = self.r, self.l
         beta = np.arcsin((r * np.sin(a) - self.e) / l)
@@ -42,7 +42,7 @@ class CrankSliderNumpy:
                    + self.I_rod * db**2)
         dJ = 2 * np.sum(self.m_slide * u * du + self.m_rod * np.sum(g1 * g2, axis=0)
                         + self.I_rod * db * ddb)
-        return J, dJ, u
+        return J, dJ, u, du
 
 
 class KernelTwin:
@@ -56,6 +56,6 @@ class KernelTwin:
         self.du = np.empty(mech.n_cylinders)
 
     def terms(self, phi):
-        """(J, dJ, u[k]) at shaft angle φ, all cylinders."""
+        """(J, dJ, u[k], u′[k]) at shaft angle φ, all cylinders."""
         J, dJ = self.fn(self.mp, phi, self.u, self.du)
-        return J, dJ, self.u.copy()
+        return J, dJ, self.u.copy(), self.du.copy()

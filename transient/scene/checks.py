@@ -11,15 +11,20 @@ import numpy as np
 
 from ..errors import SceneError, show_value
 from .reader import Section
-from .records import COMPILED_METHODS, Scene
+from .records import COMPILED_METHODS, RUNAWAY_SPEED, Scene
 
 
-def check_consistency(scene: Scene) -> None:
-    """Checks across sections, done before any integration."""
+def check_consistency(scene: Scene) -> tuple[float, float]:
+    """Checks across sections, done before any integration. Returns what the kinematics give
+    over the cycle for :func:`check_magnitudes`: the least reduced inertia J_min [kg m²] and the
+    lever of the pistons' forces Σ_k max|u_k| [m/rad] (u_k = dx_k/dφ)."""
     # (18) divides by J(φ): it must stay positive over the whole cycle, dead centres included.
     phi = np.linspace(0.0, scene.mechanism.cycle, 721)
     with np.errstate(over="ignore", invalid="ignore"):
-        J = scene.mechanism.kinematics_table(phi)["J"] + scene.inertia.total
+        kinematics = scene.mechanism.kinematics_table(phi)
+        J = kinematics["J"] + scene.inertia.total
+        lever = sum(float(np.max(np.abs(kinematics[f"u_{k + 1}"])))
+                    for k in range(scene.mechanism.n_cylinders))
     if not np.all(np.isfinite(J)):
         raise SceneError("mechanism", "the reduced inertia J(φ) overflows (is not finite); "
                                       "check the masses and lengths and their units")
@@ -71,10 +76,97 @@ def check_consistency(scene: Scene) -> None:
         raise SceneError("governor.model", f"a compressor has no fuel for a governor to set; use "
                                            f"model = \"none\", not {scene.governor.model!r} (a "
                                            f"speed is held by the motor or a prescribed speed)")
+    check_part_load(scene)
     if scene.run.mode == "dynamic" and scene.initial.omega == 0.0 and scene.starter.torque == 0.0:
         if scene.gas.model == "none":
             raise SceneError("initial.omega", "a machine at rest with no starter and no gas force "
                                               "never moves; give omega or a starter")
+    return float(J.min()), lever
+
+
+def check_magnitudes(scene: Scene, least_inertia: float, lever: float, gas_table) -> None:
+    """Refuse the magnitudes no machine has, which pass every other check and fail at the first
+    step: a speed beyond :data:`~.records.RUNAWAY_SPEED` (the run would have run away at its
+    start), and in a dynamic run a torque that would take the machine from rest past that speed
+    within one revolution — the work M·2π would exceed ½ J_min ω_r², so M > J_min ω_r²/(4π),
+    J_min the least reduced inertia. The torques: the load's terms at the initial speed (at the
+    schedule's largest scale), the starter's, and the gas force's largest (p − p0)·F_p, or
+    force, on the pistons' lever Σ_k max|u_k| (``gas_table``: the full-load table, or None)."""
+    speeds = {"initial.omega": abs(scene.initial.omega)}
+    if scene.run.mode == "prescribed-speed":
+        speeds["run.speed_table" if scene.run.time else "run.speed"] = max(
+            map(abs, scene.run.speed_table or (scene.run.speed,)))
+    for key, w in speeds.items():
+        if w > RUNAWAY_SPEED:
+            raise SceneError(key, f"{w:.3g} rad/s is beyond {RUNAWAY_SPEED:g} rad/s "
+                                  f"({RUNAWAY_SPEED * 30 / math.pi:.3g} rpm), faster than any "
+                                  f"piston machine turns (a run reaching it ends as a runaway); "
+                                  f"give a speed up to that")
+    if scene.run.mode != "dynamic":
+        return
+    most = least_inertia * RUNAWAY_SPEED ** 2 / (4.0 * math.pi)
+    for key, (torque, what) in _torques(scene, lever, gas_table).items():
+        if torque > most:
+            raise SceneError(key, f"gives a torque of {torque:.3g} N m{what}, which would take "
+                                  f"the machine (least reduced inertia {least_inertia:.3g} kg m²) "
+                                  f"from rest past {RUNAWAY_SPEED:g} rad/s, faster than any "
+                                  f"piston machine turns, within one revolution; allowed up to "
+                                  f"J_min·ω²/(4π) = {most:.3g} N m")
+
+
+def _torques(scene: Scene, lever: float, gas_table) -> dict[str, tuple[float, str]]:
+    """The largest torque each source in the scene applies [N m], and how it arises, by the key
+    that sets it."""
+    load, w0 = scene.load, abs(scene.initial.omega)
+    scale = max(map(abs, load.schedule_scale), default=1.0)
+    at_start = " at the initial speed"
+    out = {"starter.torque": (scene.starter.torque, ""),
+           "load.torque": (scale * abs(load.torque), ""),
+           "load.linear": (scale * load.linear * w0, at_start),
+           "load.fan": (scale * load.fan * w0 * w0, at_start)}
+    if load.generator_power > 0.0:
+        out["load.generator_power"] = (scale * load.generator_power / max(
+            w0, load.generator_min_speed), at_start)
+    if load.table is not None:
+        out["load.table.torque"] = (scale * max(map(abs, load.table.torque)), "")
+    if gas_table is not None:
+        from ..assemble import gas_is_force
+
+        is_force = gas_is_force(scene)
+        offset = 0.0 if is_force else scene.gas.p0
+        p = np.asarray(gas_table.coef)[:, 0]
+        force = float(np.max(np.abs(p - offset)))
+        what = f" (a force up to {force:.3g} N per piston"
+        if not is_force:
+            what = (f" (the pressure difference p − p0 up to {force:.3g} Pa on pistons of "
+                    f"{scene.mechanism.piston_area:.3g} m²")
+            force *= scene.mechanism.piston_area
+        # (the key of the largest pressure: the crankcase's, a gas exchange's, the model's peak)
+        exchange = max((scene.gas.p_intake, "gas.p_intake"), (scene.gas.p_exhaust, "gas.p_exhaust"))
+        key = {"trapezoid": "gas.amplitude", "table": "gas.force" if is_force else "gas.p",
+               "wiebe": "gas.wiebe.fuel_mass", "mixed-cycle": "gas.p_z",
+               "compressor": "gas.p_discharge"}[scene.gas.model]
+        if scene.gas.model in ("mixed-cycle", "wiebe") and exchange[0] >= float(np.max(p)):
+            key = exchange[1]
+        out["gas.p0" if offset > float(np.max(p)) else key] = (
+            force * lever, f"{what}, on their lever Σ max|dx/dφ| = {lever:.3g} m)")
+    return out
+
+
+def check_part_load(scene: Scene) -> None:
+    """What would burn less than full-load fuel (a ``[[gas.cylinders]]`` entry that changes the
+    combustion, a governor) needs a gas model that can: a motored curve to scale the combustion
+    above (:func:`transient.assemble.part_load_refusal`)."""
+    from ..assemble import part_load_refusal
+
+    why = part_load_refusal(scene)
+    if why is None:
+        return
+    for i, c in enumerate(scene.gas.cylinders):
+        if c.combustion_keys:
+            raise SceneError(f"gas.cylinders[{i}].{c.combustion_keys[0]}", why)
+    if scene.governor.model != "none":
+        raise SceneError("governor.model", f"the governor's fuel command: {why}")
 
 
 def check_woschni(scene: Scene) -> None:
@@ -99,19 +191,21 @@ def check_woschni(scene: Scene) -> None:
                                               "exact kinematics; use kinematics = \"exact\"")
 
 
-def check_gas_table(scene: Scene, section: Section) -> None:
-    """Build (and so validate) the pressure table; report under the key the user wrote."""
+def check_gas_table(scene: Scene, section: Section):
+    """Build (and so validate) the pressure table; report under the key the user wrote.
+    Returns the table (None without gas forces)."""
     from ..assemble import gas_table
 
     try:
-        gas_table(scene)
+        table = gas_table(scene)
     except SceneError as exc:
         if "file" in section.written and exc.key in ("gas.phi_deg", "gas.p", "gas.phi",
-                                                     "gas.force"):
+                                                     "gas.force", "gas.motored_p"):
             exc.key = "gas.file"
         raise section.rename(exc) from None
     if scene.gas.woschni is not None:
         check_offsets_in_closed_part(scene)
+    return table
 
 
 def check_offsets_in_closed_part(scene: Scene) -> None:

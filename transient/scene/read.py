@@ -17,15 +17,15 @@ from ..mechanisms import MECHANISMS, reaction_joints
 from ..mechanisms.articulated import slave_reach
 from ..units import ALL_SUFFIXES
 from .budget import check_work
-from .checks import check_analysis, check_consistency, check_gas_table
+from .checks import check_analysis, check_consistency, check_gas_table, check_magnitudes
 from .files import parse_toml, read_text, table_number, table_rows
 from .eta_map import check_map, grid_from_points
 from .reader import MISSING, Section, finite_number, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
-                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_SAMPLES_PER_REV, METHODS,
-                      MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction, Gas,
-                      Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
+                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_GAMMA, MAX_SAMPLES_PER_REV,
+                      METHODS, MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction,
+                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
                       Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
@@ -81,7 +81,17 @@ def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
     path = Path(source)
     if text is None:
         text = read_text(path, "scene")
-    return scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
+    scene = scene_from_dict(parse_toml(text, str(path)), file=str(path), base_dir=path.parent)
+    return replace(scene, source_file=str(path), source_text=text)
+
+
+class SweepNotScene(SceneError):
+    """A sweep file (a ``[sweep]`` table and no ``[mechanism]``: :mod:`transient.sweeps.spec`)
+    given where a scene is read; ``transient check`` checks it as a sweep instead."""
+
+    def __init__(self, file: str) -> None:
+        super().__init__("[sweep]", "this is a sweep file, not a scene: run it with `transient "
+                                    "sweep`, check it with `transient check`", file=file)
 
 
 def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
@@ -160,10 +170,12 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
     0.088
     """
     base_dir = base_dir or Path.cwd()
+    if isinstance(data.get("sweep"), dict) and "mechanism" not in data:
+        raise SweepNotScene(file)
     try:
         root = Section(data, "")
         head = root.sub("scene")
-        name = head.string("name", Path(file).stem if file else "scene")
+        name = _label(head, Path(file).stem if file else "scene")
         if not name.strip():
             raise SceneError(head.key(head.written.get("name", "name")),
                              "must not be empty; it names the result (leave it out to use the "
@@ -226,15 +238,21 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sections["output"] = Output(spr, dt)
         so.finish()
         sf = root.sub("friction")
-        sections["friction"] = _read_friction(sf, mech, base_dir)
+        sections["friction"] = _read_friction(sf, mech, base_dir, sections["gas"].model)
         sf.finish()
         sa = root.sub("analysis")
         sections["analysis"] = _read_analysis(sa)
         sa.finish()
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
-        check_consistency(scene)
-        check_gas_table(scene, sg)
+        least_inertia, lever = check_consistency(scene)
+        table = check_gas_table(scene, sg)
+        try:
+            check_magnitudes(scene, least_inertia, lever, table)
+        except SceneError as exc:  # (reported under the key as written: omega_rpm, p_z_MPa, …)
+            for section in (s0, sg, sl, ss, sr):
+                section.rename(exc)
+            raise
         check_analysis(scene)
         try:
             check_work(scene)
@@ -247,6 +265,20 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         exc.file = exc.file or file
         exc.args = (exc.line(),)
         raise
+
+
+def _label(s: Section, default: str) -> str:
+    """The ``name`` of a table (the scene's, a pair's): it labels terminal lines, figures and
+    result files, so a character a terminal would act on (an escape sequence, a newline) is
+    refused, not printed."""
+    name = s.string("name", default)
+    bad = next((c for c in name if not c.isprintable()), None)
+    if bad is not None:
+        raise SceneError(s.key(s.written.get("name", "name")),
+                         f"holds the control character {show_value(bad)} (character "
+                         f"{name.index(bad) + 1}); a name labels terminal lines, figures and "
+                         f"results: give printable text")
+    return name
 
 
 def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: int) -> Gas:
@@ -334,21 +366,40 @@ def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
                    p_discharge=s.number("p_discharge", "pressure", gt=0.0), n=n,
                    n_reexpansion=s.number("n_reexpansion", default=n, gt=1.0),
                    clearance_ratio=s.number("clearance_ratio", gt=0.0))
+    p_in, p_ex = _gas_exchange(s, strokes, gt=0.0)
     return Gas(
         model="mixed-cycle", p0=p0,
         compression_ratio=s.number("compression_ratio", gt=1.0),
         p_a=s.number("p_a", "pressure", gt=0.0), n1=s.number("n1", gt=1.0),
         p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
-        n2=s.number("n2", gt=1.0), p_intake=s.number("p_intake", "pressure", gt=0.0),
-        p_exhaust=s.number("p_exhaust", "pressure", gt=0.0))
+        n2=s.number("n2", gt=1.0), p_intake=p_in, p_exhaust=p_ex)
+
+
+def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, float]:
+    """``p_intake`` and ``p_exhaust`` [Pa], the constant pressures of a 4-stroke's intake and
+    exhaust strokes (required, within ``bounds``, :meth:`Section.number`'s). A 2-stroke has no
+    such strokes: the cycle models scavenge it to p_a at bottom dead centre, so the keys would
+    mean nothing and are refused (0 in the record)."""
+    if strokes == 4:
+        return (s.number("p_intake", "pressure", **bounds),
+                s.number("p_exhaust", "pressure", **bounds))
+    for name in ("p_intake", "p_exhaust"):
+        if s.has(name, "pressure"):
+            s.number(name, "pressure")  # (taken off the table: its key as written)
+            raise SceneError(s.key(s.written[name]), "a two-stroke cycle (mechanism.strokes = "
+                                                     "2) has no intake or exhaust stroke: it is "
+                                                     "scavenged to p_a at bottom dead centre; "
+                                                     "leave p_intake and p_exhaust out (they "
+                                                     "are for strokes = 4)")
+    return 0.0, 0.0
 
 
 def _read_gas_table(s: Section, base_dir: Path) -> Gas:
-    """``model = "table"``: absolute pressures ``p`` (with the crankcase's ``p0``) or forces on
-    each piston ``force`` (applied as they are: no ``p0``) at the local angles ``phi``, inline or
-    from a CSV ``file``."""
+    """``model = "table"``: absolute pressures ``p`` (with the crankcase's ``p0`` and optionally
+    the motored ``motored_p``) or forces on each piston ``force`` (applied as they are: no
+    ``p0``) at the local angles ``phi``, inline or from a CSV ``file``."""
     if s.has("file"):
-        phi, column, values = _read_diagram_csv(s, base_dir)
+        phi, column, values, motored = _read_diagram_csv(s, base_dir)
         force = column in FORCE_COLUMNS
     else:
         phi = s.numbers("phi", "angle")
@@ -364,11 +415,17 @@ def _read_gas_table(s: Section, base_dir: Path) -> Gas:
                                          "'p_MPa') or the forces on the piston 'force' (or "
                                          "'force_kN'), one per angle")
         values = values or s.numbers("p", "pressure")
+        motored = s.numbers("motored_p", "pressure", ())
+    if force and motored:
+        key = "file" if "file" in s.written else s.written.get("motored_p", "motored_p")
+        raise SceneError(s.key(key), "gives motored pressures with forces on the piston; the "
+                                     "motored curve goes with the pressures 'p' it lies under")
     p0 = 0.0 if force else s.number("p0", "pressure", 1.0e5, ge=0.0)
     corners = s.numbers("corners", "angle", ())
     interp = s.string("interpolation", "pchip", choices=("pchip", "spline", "linear"))
     return Gas(model="table", p0=p0, phi=phi, p=() if force else values,
-               force=values if force else (), corners=corners, interpolation=interp)
+               force=values if force else (), motored_p=motored, corners=corners,
+               interpolation=interp)
 
 
 def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
@@ -381,17 +438,14 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
     d = Wiebe()
     ratio = s.number("compression_ratio", gt=1.0)
     p_a = s.number("p_a", "pressure", gt=0.0)
-    # A 2-stroke is scavenged to p_a: it has no intake or exhaust stroke.
-    need = MISSING if strokes == 4 else 0.0
-    p_in = s.number("p_intake", "pressure", need, ge=0.0)
-    p_ex = s.number("p_exhaust", "pressure", need, ge=0.0)
+    p_in, p_ex = _gas_exchange(s, strokes, ge=0.0)
     w = s.sub("wiebe", required=True)
     wiebe = Wiebe(
         start=w.number("start", "angle"), duration=w.number("duration", "angle", gt=0.0),
         fuel_mass=w.number("fuel_mass", ge=0.0), a=w.number("a", default=d.a, gt=0.0),
         m=w.number("m", default=d.m, gt=-1.0), lhv=w.number("lhv", default=d.lhv, gt=0.0),
         efficiency=w.number("efficiency", default=d.efficiency, gt=0.0, le=1.0),
-        gamma=w.number("gamma", default=d.gamma, gt=1.0),
+        gamma=w.number("gamma", default=d.gamma, gt=1.0, le=MAX_GAMMA),
         gamma_slope=w.number("gamma_slope", default=d.gamma_slope),
         gamma_t_ref=w.number("gamma_t_ref", default=d.gamma_t_ref, gt=0.0),
         t_a=w.number("t_a", default=d.t_a, gt=0.0),
@@ -420,16 +474,21 @@ FORCE_COLUMNS = {"force": 1.0, "force_N": 1.0, "force_kN": 1e3}
 
 def _read_diagram_csv(s: Section, base_dir: Path):
     """Indicator diagram (or force diagram) from a CSV with an angle column and a pressure or a
-    force column (units in names): the angles, the name of that column and its values."""
-    (_, phi), (column, values) = _read_csv(s, base_dir, {
-        "angle": ANGLE_COLUMNS, "pressure or force": {**PRESSURE_COLUMNS, **FORCE_COLUMNS}})
-    return phi, column, values
+    force column (units in names): the angles, the name of that column and its values, and the
+    values of a motored pressure column (``motored_p_bar`` …) if it has one, else ()."""
+    motored_columns = {f"motored_{c}": f for c, f in PRESSURE_COLUMNS.items()}
+    (_, phi), (column, values), (_, motored) = _read_csv(s, base_dir, {
+        "angle": ANGLE_COLUMNS, "pressure or force": {**PRESSURE_COLUMNS, **FORCE_COLUMNS},
+        "motored pressure": motored_columns}, optional=("motored pressure",))
+    return phi, column, values, motored
 
 
-def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
+def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]],
+              optional: tuple[str, ...] = ()):
     """The CSV file named by the key ``file`` of ``s`` (relative to the scene): for each group
     of column names (what it is → {column name: factor to SI}) the first column of the header
-    in it, as ``(name, values in SI)``. Every error names the file under the key ``file``."""
+    in it, as ``(name, values in SI)``; a group in ``optional`` that the header lacks gives
+    ``(None, ())``. Every error names the file under the key ``file``."""
     name = s.string("file")
     try:
         path = (base_dir / name).resolve()
@@ -444,12 +503,13 @@ def _read_csv(s: Section, base_dir: Path, groups: dict[str, dict[str, float]]):
         header = [h.strip() for h in rows[0][1]] if rows else []
         found = {what: next((c for c in header if c in columns), None)
                  for what, columns in groups.items()}
-        if None in found.values():
+        if any(c is None and what not in optional for what, c in found.items()):
             needs = " and ".join(f"{'an' if what[0] in 'aeiou' else 'a'} {what} column "
-                                 f"({', '.join(columns)})" for what, columns in groups.items())
+                                 f"({', '.join(columns)})" for what, columns in groups.items()
+                                 if what not in optional)
             raise SceneError("(line)", f"needs {needs}; header is {show_value(header)}")
         out = [(c, _table_column(rows[1:], header.index(c), c, groups[what][c]))
-               for what, c in found.items()]
+               if c is not None else (None, ()) for what, c in found.items()]
     except SceneError as exc:  # (placed here: the message names the table, the key the scene's)
         raise SceneError(s.key("file"), f"{path.name}: {exc.message}") from None
     return out
@@ -467,9 +527,11 @@ def _table_column(rows, index: int, column: str, factor: float) -> tuple[float, 
     return tuple(out)
 
 
-def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
+def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction:
     """The [friction] table: a policy and an array of [[friction.pairs]] between neighbouring
-    links of the mechanism (shaft side first), each with its friction model."""
+    links of the mechanism (shaft side first), each with its friction model; a constant-η or
+    mapped pair into the cylinders (the last link, ``gas_model`` its gas) needs gas forces to
+    pass on."""
     policy = s.string("policy", "power-flow", choices=POLICIES)
     s.known.append("pairs")
     raw = s.data.pop("pairs", [])
@@ -487,13 +549,18 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
                                                   f"for {mech.name!r}; use model = "
                                                   f"\"constant-eta\" here")
         hint = ""
-        if model != "reaction" and getattr(mech, "reaction_links", ()):
+        if model != "reaction" and getattr(mech, "reaction_links", links) != links:
             hint = (f" (pairs with model = \"reaction\" join "
                     f"{' – '.join(mech.reaction_links)})")
         if model == "reaction" and hasattr(mech, "reaction_joints"):
             between = _joint(ps, mech)
         else:
             between = _between(ps, links, hint)
+        if model != "reaction" and between[1] == links[-1] and gas_model == "none":
+            raise SceneError(ps.key("between"), f"{list(between)} passes on the gas forces' "
+                                                f"work, and this scene has none (gas.model = "
+                                                f"\"none\"); give a gas model, or join other "
+                                                f"links of {' – '.join(links)}")
         ideal = getattr(mech, "ideal_reaction_joints", {}) if model == "reaction" else {}
         if between[0] in ideal:
             allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in zip(links, links[1:])
@@ -506,7 +573,7 @@ def _read_friction(s: Section, mech, base_dir: Path) -> Friction:
             raise SceneError(ps.key("between"), f"the same pair as "
                                                 f"{s.key('pairs')}[{seen[tuple(between)]}]")
         seen[tuple(between)] = i
-        name = ps.string("name", f"{between[0]}-{between[1]}")
+        name = _label(ps, f"{between[0]}-{between[1]}")
         if model == "reaction":
             pair = _reaction_pair(ps, between, name, slider=between[1] == links[-1])
         elif model == "table":

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from ..errors import SceneError, show_value
 from ..units import ALL_SUFFIXES, SUFFIXES
 
@@ -158,10 +160,10 @@ class Section:
             if default is MISSING:
                 raise SceneError(self.key(name), f"is missing; {self._unit_hint(name, kind)} list")
             return default
-        if not isinstance(value, list) or not all(finite_number(v) for v in value):
+        if not isinstance(value, list) or not finite_numbers(value):
             raise SceneError(self.key(written), f"must be a list of finite numbers, got "
                                                 f"{show_value(value)}")
-        return tuple(float(v) * factor for v in value)
+        return tuple((np.asarray(value, dtype=float) * factor).tolist())
 
     def integers(self, name: str, default: Any = MISSING) -> tuple:
         value, _, written = self._take(name, None)
@@ -230,6 +232,18 @@ def finite_number(v: Any) -> bool:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         return False
     return abs(v) <= MAX_EXACT_INT if isinstance(v, int) else math.isfinite(v)
+
+
+def finite_numbers(values: list) -> bool:
+    """Whether every item of ``values`` is a :func:`finite_number`; a long table inline is
+    checked in one pass of numpy, not number by number."""
+    if not all(issubclass(k, (int, float)) and not issubclass(k, bool)
+               for k in set(map(type, values))):
+        return False
+    try:
+        return bool(np.all(np.isfinite(np.asarray(values, dtype=float))))
+    except OverflowError:  # (an integer beyond a float's range)
+        return False
 
 
 def _looks_like_unit(suffix: str) -> bool:

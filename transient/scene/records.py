@@ -34,7 +34,8 @@ class Wiebe:
     burned per cycle and cylinder at full load (governor fuel 1); 0 runs the engine motored.
     ``a``, ``m`` [1]: Wiebe efficiency parameter and shape exponent. ``lhv`` [J/kg]: lower heating
     value; ``efficiency`` [1]: combustion efficiency η_c, the share of m_f·LHV released.
-    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K].
+    ``gamma`` [1]: heat capacity ratio, at ``gamma_t_ref`` [K] with ``gamma_slope`` dγ/dT [1/K];
+    at most 5/3, a monatomic ideal gas's.
     ``t_a`` [K]: gas temperature at intake closing. ``intake_closing``, ``exhaust_opening`` [rad]:
     ends of the closed part (None: the BDCs around the firing TDC). ``step`` [rad] and
     ``tolerance`` [1]: largest knot spacing and target relative error of the tables.
@@ -89,28 +90,31 @@ class Cylinder:
     ``cylinder`` [1]: its number, 1 to the mechanism's cylinder count. ``fuel`` [1]: its fuel
     factor φ_k, multiplying the governor's command, so that its pressure is
     p_mot + φ_k·f·(p_full − p_mot) (:class:`Gas`; for ``"wiebe"`` with ``[gas.woschni]`` the
-    heat released); ``cut_out``: no fuel in any cycle (φ_k = 0, the motored curve). ``pressure``
+    heat released); ``cut_out``: no fuel in any cycle (φ_k = 0, the motored curve: the
+    model's compression and expansion without heat release; for ``"trapezoid"`` no force).
+    A pressure table needs its ``motored_p`` curve for these and the misfires below. ``pressure``
     [1]: its pressure factor β_k, multiplying its pressure above p0 where it acts on the piston,
     p0 + β_k·(p − p0) (a leaking cylinder, or an indicator's calibration): the gas force, the
     ``p_<k>`` column and the work all see it. Both in [0, 2].
 
     ``combustion_offset`` δ_k [rad] (``combustion_offset_deg``), within ±30°: its combustion
     happens δ_k later (earlier if negative),
-    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x. For
-    ``"table"``, ``"mixed-cycle"`` and ``"trapezoid"``, whose motored curve is p0, that moves the whole curve (the table holds no other account of the
-    combustion); for ``"wiebe"`` the combustion's part only, the motored compression staying
-    with the piston; with ``[gas.woschni]`` the heat release and Woschni's combustion term of
-    the closed part, which must then still lie inside it.
+    p = p_mot(x) + φ_k·f·(p_full(x − δ_k) − p_mot(x − δ_k)) at its local angle x: the
+    combustion's part only, the motored compression staying with the piston (for
+    ``"trapezoid"``, whose motored force is 0, the whole pulse); with ``[gas.woschni]`` the heat
+    release and Woschni's combustion term of the closed part, which must then still lie inside
+    it.
 
     **Misfire.** In a misfiring cycle the cylinder burns nothing (its fuel is 0 for that whole
-    cycle). A cylinder's cycles begin at its local angle 0 (the gas-exchange TDC of a 4-stroke)
-    or π (the BDC of a 2-stroke, so that no combustion straddles two cycles); cycle 1 is the
-    one in progress at the initial angle. ``misfire_cycles``: the cycles that misfire (each
-    ≥ 1); ``misfire_every`` n [1]: cycles n, 2n, 3n, … misfire (0: none); ``misfire_rate`` [1]
-    in [0, 1]: each cycle misfires with this probability, drawn from ``misfire_seed`` (a
-    counter-based generator, :func:`transient.core.variation.misfire_draw`, the same draws for the
-    same seed, cylinder and cycle in every run and on every machine). A cycle misfires if any
-    of the three says so.
+    cycle): it follows the motored curve, compressing and expanding. A cylinder's cycles begin
+    at its local angle 0 (the gas-exchange TDC of a 4-stroke) or π (the BDC of a 2-stroke, so
+    that no combustion straddles two cycles); cycle 1 is the one in progress at the initial
+    angle. ``misfire_cycles``: the cycles that misfire (each ≥ 1); ``misfire_every`` n [1]:
+    cycles n, 2n, 3n, … misfire (0: none); ``misfire_rate`` [1] in [0, 1]: each cycle misfires
+    with this probability, drawn from ``misfire_seed`` (a counter-based generator,
+    :func:`transient.core.variation.misfire_draw`, the same draws for the same seed, cylinder
+    and cycle in every run and on every machine). A cycle misfires if any of the three says
+    so.
     """
 
     cylinder: int
@@ -123,6 +127,17 @@ class Cylinder:
     misfire_seed: int = 0
     combustion_offset: float = 0.0
 
+    @property
+    def combustion_keys(self) -> tuple[str, ...]:
+        """The keys of this entry that change its combustion (the fuel it burns, or when), which
+        act on the pressure above the motored curve; empty if it only scales the pressure."""
+        keys = (("cut_out", self.cut_out), ("fuel", self.fuel != 1.0 and not self.cut_out),
+                ("misfire_cycles", bool(self.misfire_cycles)),
+                ("misfire_every", self.misfire_every > 0),
+                ("misfire_rate", self.misfire_rate > 0.0),
+                ("combustion_offset", self.combustion_offset != 0.0))
+        return tuple(k for k, on in keys if on)
+
 
 @dataclass(frozen=True)
 class Gas:
@@ -132,10 +147,13 @@ class Gas:
     local angles ``phi`` [rad] over one cycle, local angle 0 = gas-exchange TDC for a 4-stroke,
     firing TDC for a 2-stroke; ``corners`` [rad] where the curve may jump or kink, also between
     samples; ``interpolation`` ``"pchip"``, ``"spline"`` or ``"linear"``; every angle of the
-    table and every corner is a breakpoint), ``"mixed-cycle"`` (Gots App. 2,
+    table and every corner is a breakpoint; ``motored_p``: the motored pressures [Pa] at the same
+    angles, optional), ``"mixed-cycle"`` (Gots App. 2,
     Trinkler–Sabathé: ``compression_ratio`` [1], ``p_a`` [Pa] at the start of compression,
     polytropic exponents ``n1`` and ``n2`` [1], peak pressure ``p_z`` [Pa], pre-expansion ratio
-    ``rho`` [1], ``p_intake`` and ``p_exhaust`` [Pa]), ``"trapezoid"`` (the swash-plate paper's
+    ``rho`` [1] and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]; a 2-stroke, scavenged
+    to ``p_a`` at bottom dead centre, has no gas-exchange strokes and refuses them),
+    ``"trapezoid"`` (the swash-plate paper's
     force pulse per piston, §4: ``amplitude`` [N], ``ramp`` and ``duration`` [rad]) or
     ``"wiebe"`` (single-zone Wiebe combustion, :class:`Wiebe`; with ``compression_ratio``, ``p_a``
     [Pa] at intake closing and, for a 4-stroke, ``p_intake`` and ``p_exhaust`` [Pa]) or
@@ -149,9 +167,16 @@ class Gas:
     piston area, no p0), as the trapezoid's.
 
     **Fuel command.** The governor's fuel f ∈ [0, 1] (1 without a governor) sets the cylinder
-    pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot). For
-    ``"table"`` and ``"mixed-cycle"`` the motored curve is the constant p0, so the gas force is
-    f·(p − p0)·F_p (for ``"trapezoid"``, f times the force). For ``"wiebe"`` it is the cycle with
+    pressure between a motored curve and the full-load curve, p = p_mot + f·(p_full − p_mot):
+    the fuel scales the combustion, never the compression. For ``"mixed-cycle"`` p_mot is the
+    cycle without heat release, the compression polytrope n1 both ways, and p_mot + f·(p_full −
+    p_mot) is exactly the cycle that burns f times the heat at every angle
+    (:func:`transient.forces.gas.mixed_cycle`, *Part load*). For ``"table"`` it is ``motored_p``,
+    the user's motored curve: a table holds no account of which part of it is compression, so
+    without ``motored_p`` a fuel below 1 (a governor, a fuel factor, a misfire or cut-out, a
+    combustion offset) is refused. ``"trapezoid"`` is a force pulse without thermodynamics
+    whose amplitude the governor sets (Antonyuk §4): f times the force, no force at f = 0.
+    For ``"wiebe"`` p_mot is the cycle with
     no fuel and p_full the cycle with ``fuel_mass``: with a constant γ the single-zone pressure is
     linear in the fuel mass, so this is exactly the cycle burning f·fuel_mass. With
     ``gamma_slope`` ≠ 0 (γ(T)) it is not, and the pressure at part load is only approximately
@@ -177,6 +202,7 @@ class Gas:
     p0: float = 1.0e5
     phi: tuple[float, ...] = ()
     p: tuple[float, ...] = ()
+    motored_p: tuple[float, ...] = ()
     corners: tuple[float, ...] = ()
     interpolation: str = "pchip"
     compression_ratio: float = 0.0
@@ -363,11 +389,13 @@ class Run:
     """What to run: ``dynamic`` (integrate (18)) or ``prescribed-speed`` (inverse dynamics).
 
     The run ends at ``t_end`` [s] or after ``revolutions`` of the shaft, whichever comes first
-    (``inf`` = not set). For prescribed speed: ``speed`` [rad/s] constant, or a table ``time`` [s],
-    ``speed_table`` [rad/s] interpolated by ``interpolation``: ``"linear"`` (the default: a table
-    with corners, a ramp to a plateau, is followed exactly, with ε jumping at each point) or
-    ``"pchip"`` (monotone cubic, C¹: it never overshoots the table's speeds);
-    :mod:`transient.forces.load_table`.
+    (``inf`` = not set); it did what they ask if the shaft turned the revolutions, or with
+    ``t_end`` alone runs forwards at the end (status ``finished``; ``t_end`` first is
+    ``out-of-time``: :data:`transient.outcome.STATUSES`). For prescribed speed: ``speed``
+    [rad/s] constant, or a table ``time`` [s], ``speed_table`` [rad/s] interpolated by
+    ``interpolation``: ``"linear"`` (the default: a table with corners, a ramp to a plateau, is
+    followed exactly, with ε jumping at each point) or ``"pchip"`` (monotone cubic, C¹: it never
+    overshoots the table's speeds); :mod:`transient.forces.load_table`.
 
     Budgets (:mod:`.budget`), so that a mistyped end or limit is refused before any work instead
     of filling the disk or running for ever: ``max_output_bytes`` [bytes], the trajectory a run
@@ -415,11 +443,27 @@ class Solver:
 
 @dataclass(frozen=True)
 class Output:
-    """Output sampling: ``samples_per_rev`` in crank angle; in time mode every ``dt`` [s]."""
+    """Output sampling. In crank angle (forwards, above the switch speed) a sample every
+    360°/``samples_per_rev``. In time (below the switch speed, whenever the shaft turns
+    backwards, ``solver.domain = "time"``) a sample every ``dt`` [s] (0: the angle spacing at
+    1.5 × the switch speed), and besides wherever the shaft angle crosses a multiple of
+    360°/``samples_per_rev``, either way, and at every speed reversal (the turning point, ω = 0):
+    so a rocking or reversing shaft is sampled as densely in angle as one turning forwards, and
+    ``dt`` bounds the time between the samples of a slow one. (The reference path, scipy-*,
+    writes its own steps.)"""
 
     samples_per_rev: int = 72
     dt: float = 0.0  # 0: Δφ / switch_speed
 
+
+#: A speed no piston machine reaches [rad/s] (about 955 000 rpm): beyond it a run ran away
+#: (status ``runaway``), and a scene that would start there, or whose torques would drive its
+#: least inertia there within a revolution, is refused (``checks.check_magnitudes``).
+RUNAWAY_SPEED = 1e5
+
+#: The largest ratio of specific heats of an ideal gas, a monatomic one's (γ = 1 + 2/f, f ≥ 3
+#: degrees of freedom): the Wiebe cycle's ``gamma`` is at most this.
+MAX_GAMMA = 5.0 / 3.0
 
 #: Output samples per revolution at most (0.00036° apart).
 MAX_SAMPLES_PER_REV = 1_000_000
@@ -445,7 +489,11 @@ class Pair:
     """A non-ideal kinematic pair between two neighbouring links (Antonyuk (22)–(25)).
 
     ``between``: the link on the shaft side first (a), then the far one (b), names from the
-    mechanism's ``links``; for the reaction model two links of one of its reaction joints
+    mechanism's ``links`` (crank-slider and articulated ``shaft`` – ``crank`` – ``rod`` –
+    ``piston`` – ``cylinder``, swash plate ``shaft`` – ``link`` – ``rod`` – ``piston`` –
+    ``cylinder``; any number of pairs, each couple of neighbours once, gaps allowed; a pair into
+    the ``cylinder`` passes on the gas forces' work, so it needs a gas model); for the reaction
+    model two links of one of its reaction joints
     (``transient.mechanisms.reaction_joints``): crank-slider ``shaft`` – ``crank`` – ``rod`` –
     ``piston`` – ``cylinder``, swash plate ``shaft`` – ``plate`` – ``link`` – ``rod`` – ``piston``
     – ``cylinder`` (its ball joints, ``["link", "rod"]`` and ``["rod", "piston"]``, stay ideal),
@@ -546,6 +594,11 @@ class Scene:
     table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
     ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`.
 
+    ``source_file`` and ``source_text``: the file the scene was read from and its text as read,
+    comments included (where each number comes from), which a result stores beside the resolved
+    scene; empty for a scene built in code. Not part of what the scene is: two scenes that differ
+    only there are equal.
+
     A scene is frozen: :meth:`~transient.Scene.replace` makes a changed copy, validated as a
     file is; :meth:`~transient.Scene.to_toml` writes it back as TOML that
     :func:`transient.load_scene` reads to an equal scene.
@@ -586,6 +639,8 @@ class Scene:
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
     analysis: Analysis = field(default_factory=Analysis)
+    source_file: str = field(default="", compare=False, repr=False)
+    source_text: str = field(default="", compare=False, repr=False)
 
     def geometry(self) -> dict[str, tuple[float, str]]:
         """What the mechanism's geometry implies, without a run, name → (value, unit) in SI

@@ -18,7 +18,7 @@ def to_toml(scene: Scene) -> str:
              "[scene]", f"name = {toml_value(scene.name)}", f"description = {toml_value(scene.description)}"]
     lines += [""] + scene.mechanism.toml_lines()
     lines += _section("inertia", scene.inertia)
-    lines += _gas_section(scene.gas)
+    lines += _gas_section(scene.gas, scene.mechanism.strokes)
     lines += _load_section(scene.load)
     lines += _section("starter", scene.starter)
     lines += ["", "[governor]"] + [f"{k} = {toml_value(getattr(scene.governor, k))}"
@@ -60,7 +60,7 @@ def to_toml(scene: Scene) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _gas_section(gas: Gas) -> list[str]:
+def _gas_section(gas: Gas, strokes: int) -> list[str]:
     keep = {"none": ("model", "p0"), "table": ("model", "p0", "phi", "p", "corners", "interpolation"),
             "trapezoid": ("model", "amplitude", "ramp", "duration"),
             "wiebe": ("model", "p0", "compression_ratio", "p_a", "p_intake", "p_exhaust"),
@@ -68,8 +68,12 @@ def _gas_section(gas: Gas) -> list[str]:
                            "clearance_ratio")}
     names = keep.get(gas.model, ("model", "p0", "compression_ratio", "p_a", "n1", "p_z", "rho",
                                  "n2", "p_intake", "p_exhaust"))
+    if strokes != 4:  # (a 2-stroke has no gas-exchange strokes: the reader refuses the keys)
+        names = tuple(n for n in names if n not in ("p_intake", "p_exhaust"))
     if gas.force:  # a force table: no pressure, no p0
         names = ("model", "phi", "force", "corners", "interpolation")
+    if gas.motored_p:
+        names = (*names, "motored_p")
     if gas.injection is not None:
         names = (*names, "injection")
     lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]

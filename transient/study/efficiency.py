@@ -3,7 +3,11 @@
 Each point is a prescribed constant speed (a dynamometer holding ω, the textbook setting and the
 limit of a large flywheel), one engine cycle of inverse dynamics through the serial chain: the
 motion is periodic, so one cycle is the steady state. The load is the gas-force fraction
-``fuel`` (1 full load), as the swash-plate paper's governor sets it. η_mech is the work ratio of
+``fuel`` (1 full load), as the swash-plate paper's governor sets it; the study holds it, as it
+holds the speed, so the scene's governor is left out (it would set the fuel from the speed: a
+droop governor cuts it to 0 above its cut-off speed, a PI governor's rack has no state to act
+from at a prescribed speed). A value that is NaN in a row (η_mech where no work comes in) has
+its reason in the row's ``note``. η_mech is the work ratio of
 :mod:`transient.analysis.efficiency`, and each pair's loss and circulated energy say why it falls
 with speed: the inertia torques ½J′(φ)ω² grow as ω², and the power they send back and forth
 through the pairs is lost on too. Each row carries the friction budget of its point (imep, bmep,
@@ -12,29 +16,34 @@ each pair's FMEP and the total); :func:`plot_budget` draws it against speed, :fu
 """
 from __future__ import annotations
 
+import csv
 import dataclasses
 import math
 
 from ..analysis.efficiency import mechanical_efficiency
+from ..analysis.summary import nan_reason
 from ..plots import friction_budget, sweep_heatmap
-from ..scene import Friction, Initial, Output, Run
+from ..scene import Friction, Governor, Initial, Output, Run
 from ..run import prescribed
 
 #: Columns of a study row besides the per-pair ones.
 STUDY_COLUMNS = ("policy", "fuel", "rpm", "eta_mech_work", "eta_mech_printed",
                  "eta_mech_printed_excluded", "W_in_per_cycle", "W_out_per_cycle",
-                 "energy_balance_residual", "inconsistent_samples")
+                 "energy_balance_residual", "inconsistent_samples", "note")
+#: The values of a row whose NaN the row's note explains.
+NAN_SAID = ("eta_mech_work", "eta_mech_printed")
 
 
 def point_scene(scene, omega: float, policy: str, samples_per_rev: int):
-    """The scene as one cycle at the constant speed ``omega`` [rad/s] under ``policy``."""
+    """The scene as one cycle at the constant speed ``omega`` [rad/s] under ``policy``, without
+    its governor (the study holds the fuel)."""
     cycle = scene.mechanism.cycle
     return dataclasses.replace(
         scene,
         run=Run(mode="prescribed-speed", speed=omega, revolutions=cycle / (2 * math.pi)),
         initial=Initial(phi=0.0, omega=omega),
         output=Output(samples_per_rev=samples_per_rev),
-        friction=Friction(policy, scene.friction.pairs))
+        friction=Friction(policy, scene.friction.pairs), governor=Governor())
 
 
 def efficiency_study(scene, rpm, fuels=(1.0,), policies=None, samples_per_rev: int = 1440,
@@ -50,6 +59,8 @@ def efficiency_study(scene, rpm, fuels=(1.0,), policies=None, samples_per_rev: i
         row = {"policy": policy, "fuel": fuel, "rpm": n,
                "inconsistent_samples": data.solver["inconsistent_samples"]}
         row.update({k: v for k, (v, _) in eff.items()})
+        reasons = ((k, nan_reason(k, row)) for k in NAN_SAID)
+        row["note"] = "; ".join(f"{k}: {why}" for k, why in reasons if why)
         rows.append(row)
         if progress:
             progress((i + 1) / len(points))
@@ -62,11 +73,11 @@ def write_csv(rows: list[dict], fh) -> None:
     extra = sorted({k for r in rows for k in r} - set(STUDY_COLUMNS) - {"steady_phi_start",
                                                                         "steady_cycles"})
     cols = list(STUDY_COLUMNS) + extra
-    lines = [",".join(cols)]
+    out = csv.writer(fh, lineterminator="\n")  # (quotes a note holding a comma)
+    out.writerow(cols)
     for r in rows:
-        lines.append(",".join(str(r.get(c, "")) if isinstance(r.get(c), str)
-                              else f"{r.get(c, math.nan):.10g}" for c in cols))
-    fh.write("\n".join(lines) + "\n")
+        out.writerow([r.get(c, "") if isinstance(r.get(c), str)
+                      else f"{r.get(c, math.nan):.10g}" for c in cols])
 
 
 def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:

@@ -42,6 +42,7 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq
 
 from ..analysis.irregularity import cycle_boundaries, cycle_means
+from ..outcome import FINISHED
 
 #: Samples per revolution of the constant-speed (inverse-dynamics) analysis: the excess work is a
 #: trapezoidal integral over them (0.05°; the gas torque has corners at valve events and firing).
@@ -170,8 +171,9 @@ def _steady_run(scene, flywheel: float, speed: float, phi, E, J_scene, revolutio
                 output=replace(scene.output, samples_per_rev=max(scene.output.samples_per_rev,
                                                                  DYNAMIC_SAMPLES)))
     data = integrate(s)
-    if not data.complete:
-        raise RuntimeError(f"the run with flywheel {flywheel:g} kg m² failed: {data.message}")
+    if data.status != FINISHED:
+        raise RuntimeError(f"the run with flywheel {flywheel:g} kg m² ended {data.status}: "
+                           f"{data.message}")
     tr = data.trajectory
     t, ph, om = tr["t"], tr["phi"], tr["omega"]
     tb, _ = cycle_boundaries(t, ph, cycle, phi0)

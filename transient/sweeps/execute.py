@@ -56,7 +56,7 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
         out["trajectory"] = keep
         out["complete"] = data.complete
         if data.complete:
-            out["summary"] = summarize(scene, data.trajectory, data.events)
+            out["summary"] = {**summarize(scene, data.trajectory, data.events), **data.summary}
         out["status"] = data.status
         out["message"] = data.message
     except Exception as exc:  # noqa: BLE001 (this run failed: say so, the sweep goes on)
@@ -128,6 +128,8 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
     total)`` is called after each run is written (the progress bar). On KeyboardInterrupt the
     file keeps the finished runs (``complete = false``) and the interrupt goes on.
     """
+    if scheduler is None:
+        check_main_guarded()  # (before the sweep file is touched)
     out_dir = Path(out_dir)
     stem = sweep.path.stem
     store = SweepStore(out_dir / f"{stem}.h5", sweep, force, retry_failed)
@@ -188,6 +190,69 @@ def _lost(exc: BaseException) -> dict[str, Any]:
             "message": f"{type(exc).__name__} (on the cluster): {exc}",
             "trajectory": {}, "events": {}, "solver": {}, "summary": {}, "units": {},
             "worker": "?", "wall_s": math.nan}
+
+
+class UnguardedMain(RuntimeError):
+    """A sweep on a local cluster started from a script's top level, outside
+    ``if __name__ == "__main__":`` (:func:`check_main_guarded`)."""
+
+
+def check_main_guarded() -> None:
+    """Refuse, in one line, to start a local cluster from the top-level code of the main script
+    outside ``if __name__ == "__main__":``.
+
+    The cluster's workers are processes that multiprocessing starts by "spawn" (Dask's default),
+    and spawn runs the main module again in each of them, as ``multiprocessing.spawn``
+    prepares it: by its name where it was run as ``python -m pkg.mod`` (not a package's
+    ``__main__``), else by its file. There the call would start a cluster again while the worker
+    is still starting, and Dask fails with a traceback from deep inside its nanny. The call is
+    guarded when the main module's top-level statement that is running it (the frame of the
+    module on the stack) is that ``if``; a main module with no source to read (an interactive
+    session) is not run again."""
+    import ast
+    import linecache
+
+    import dask
+
+    main = sys.modules.get("__main__")
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    rerun = (not (name == "__main__" or name.endswith(".__main__")) if name is not None
+             else getattr(main, "__file__", None) is not None)
+    if main is None or not rerun or dask.config.get(
+            "distributed.worker.multiprocessing-method", "spawn") == "fork":
+        return
+    frame = sys._getframe()
+    while frame is not None and not (frame.f_globals is vars(main)
+                                     and frame.f_code.co_name == "<module>"):
+        frame = frame.f_back
+    if frame is None:
+        return  # (called after the main module ran: it does not run its calls again)
+    file, line = frame.f_code.co_filename, frame.f_lineno
+    try:
+        tree = ast.parse("".join(linecache.getlines(file)) or "\n")
+    except SyntaxError:
+        return
+    top = next((node for node in tree.body
+                if node.lineno <= line <= (node.end_lineno or node.lineno)), None)
+    if top is None or _is_main_guard(top):
+        return
+    raise UnguardedMain(f"a sweep on a local Dask cluster starts its workers by running the main "
+                        f"script again, so the script must start it under `if __name__ == "
+                        f"\"__main__\":` ({file}, line {line}); or give scheduler=\"serial\" "
+                        f"or a client")
+
+
+def _is_main_guard(node) -> bool:
+    """Whether ``node`` is ``if __name__ == "__main__":`` (either way round)."""
+    import ast
+
+    test = getattr(node, "test", None)
+    if not (isinstance(node, ast.If) and isinstance(test, ast.Compare) and len(test.ops) == 1
+            and isinstance(test.ops[0], ast.Eq)):
+        return False
+    sides = [test.left, test.comparators[0]]
+    return (any(isinstance(x, ast.Name) and x.id == "__name__" for x in sides)
+            and any(isinstance(x, ast.Constant) and x.value == "__main__" for x in sides))
 
 
 @contextlib.contextmanager

@@ -162,6 +162,9 @@ def load_sweep(source: str | Path) -> Sweep:
     root = _Table(data, "", file)
     head = _Table(root.get("sweep", (dict,), None, "a table") or {}, "sweep", file)
     name = head.get("name", (str,), path.stem, "a string")
+    if not name.isprintable():  # (it labels the progress bar and the sweep's files, as a scene's)
+        raise head.error("name", f"holds a control character ({show_value(name)}); give "
+                                 f"printable text")
     base_path = head.get("base", (str,), None, "a scene file path (string)")
     inline = root.get("base", (dict,), None, "a table holding the whole base scene")
     if (base_path is None) == (inline is None):

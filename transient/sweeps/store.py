@@ -22,6 +22,7 @@ import h5py
 import numpy as np
 
 from .. import results
+from ..analysis.summary import nan_reason
 from ..errors import SceneError
 from ..outcome import FINISHED
 from ..units import ALL_SUFFIXES
@@ -261,9 +262,10 @@ class SweepStore:
                 units[q] = units[q] or unit
             row["wall_s"] = float(g.attrs["wall_s"])
             row["compile_s"] = float(g["solver"].attrs.get("compile_s", math.nan))
+            row["note"] = _why_nan(row, self.sweep.collect, g["analysis"])
             row["message"] = str(g.attrs["message"])
             rows.append(row)
-        units.update(wall_s="s", compile_s="s", message="")
+        units.update(wall_s="s", compile_s="s", note="", message="")
         return rows, units
 
     def write_summary(self, csv_path: Path) -> list[dict[str, Any]]:
@@ -309,6 +311,20 @@ def _quantity(analysis, name: str) -> tuple[float, str]:
     if entry not in analysis:
         return math.nan, unit or ""
     return float(analysis[entry][()]) * factor, unit or str(analysis[entry].attrs.get("unit", ""))
+
+
+def _why_nan(row: dict[str, Any], collect, analysis) -> str:
+    """Why each collected quantity of ``row`` that is NaN is so (a run's ``analysis`` group
+    holds its summary), "; "-separated; "" if none is."""
+    nan = [q for q in collect if isinstance(row[q], float) and math.isnan(row[q])]
+    if not nan:
+        return ""
+    if not finished(row["status"]):
+        return f"not collected: the run ended {row['status']} (its message says how)"
+    values = {k: float(ds[()]) for k, ds in analysis.items()
+              if ds.ndim == 0 and ds.dtype.kind in "fiub"}
+    return "; ".join(f"{q}: {nan_reason(QUANTITIES[q][0] if q in QUANTITIES else q, values)}"
+                     for q in nan)
 
 
 def _column_dtype(name: str, rows: list[dict]) -> Any:

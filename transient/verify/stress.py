@@ -130,7 +130,7 @@ class Outcome:
 
     ok: bool = True  # every check held so far (the outcome is decided by run_case)
     outcome: str = ""  # "pass", "FAIL", "known failure"
-    status: str = ""  # complete, stalled, locked, chattering, interrupted, failed, timeout, error
+    status: str = ""  # complete, a result's status (stalled, locked, …), timeout, error
     error: float = math.nan  # the invariant's error (the balance residual unless said otherwise)
     tolerance: float = math.nan
     steps: int = 0
@@ -174,15 +174,12 @@ class Run:
     events: dict  # name -> (n, 2) of (t, φ)
     solver: dict
     wall_s: float
+    result_status: str  # the result's (transient.outcome.STATUSES)
 
     @property
     def status(self) -> str:
-        if self.complete:
-            return "complete"
-        for word in ("stalled", "locked", "chattering", "interrupted"):
-            if self.message.startswith(word):
-                return word
-        return "failed" if self.message.startswith("integration failed") else "error"
+        """The result's status, ``complete`` for a run that did what its scene asks."""
+        return "complete" if self.result_status == "finished" else self.result_status
 
     def count(self, event: str) -> int:
         return int(self.events.get(event, np.zeros((0, 2))).shape[0])
@@ -211,7 +208,7 @@ def run_scene(d: dict, name: str, ctx: Context) -> Run:
     res = open_result(path)
     events = {k: np.column_stack([v["t"], v["phi"]]) for k, v in res.events.items()}
     return Run(scene, res.complete, str(res.attrs.get("message", "")), res.trajectory, events,
-               res.solver, wall)
+               res.solver, wall, res.status)
 
 
 def _diagnosis_names_where(run: Run) -> bool:
@@ -526,7 +523,7 @@ def efficiency_sweep(quick: bool, ctx: Context) -> Outcome:
     for eta in etas:
         r = run_scene(friction(eta=(eta, eta))(quick), f"eta-{eta:g}", ctx)
         n = len(o.notes)
-        check_run(r, o, "complete|stalled")  # low η may lose more than the gas gives
+        check_run(r, o, "complete|stalled|not-started")  # low η may lose more than gas gives
         o.notes[n:] = [f"η = {eta:g}: {s}" for s in o.notes[n:]]
         finals[eta] = (r.trajectory["t"][-1], r.trajectory["omega"][-1])
     d = friction()(quick)
@@ -805,6 +802,185 @@ def kill_and_resume(quick: bool, ctx: Context) -> Outcome:
     return o
 
 
+# --- the cases a user tries -------------------------------------------------------------------
+# Each must end without a traceback and with the status that says what happened; a run that did
+# not do what its scene asked never ends ``finished``.
+
+
+def inline_six(quick: bool) -> dict:
+    """The Gots cylinder as an in-line six (firing order 1-5-3-6-2-4, 120° apart), its fan load
+    doubled for twice the cylinders, spinning up from 1000 rpm."""
+    d = spinup(10 if quick else 200)
+    put(d, "mechanism", cylinders=6, firing_order=[1, 5, 3, 6, 2, 4])
+    del d["mechanism"]["firing_deg"]  # (the order spreads them evenly)
+    return put(d, "load", fan=2 * 9.692e-4)
+
+
+def v8(quick: bool) -> dict:
+    """The cross-plane V8 (cases/v8_cross_plane.toml: two cylinders on each of four throws, side
+    by side, crank_mass per throw), spinning up from 1500 rpm."""
+    return put(base("v8_cross_plane"), "run", revolutions=10 if quick else 200)
+
+
+def _v8_journals(run: Run, o: Outcome) -> bool:
+    """The loads analysis gives the V8 its five main journals (four throws), finite and loaded."""
+    from ..analysis.requested import stored_loads
+
+    cuts = run.events.get("breakpoint", np.zeros((0, 2)))[:, 1]
+    x = np.asarray(stored_loads(run.scene, run.trajectory, cuts)["loads_main_x"][0])
+    ok = x.shape[0] == 5 and bool(np.all(np.isfinite(x))) and float(np.max(np.abs(x))) > 0.0
+    if not ok:
+        o.notes.append(f"main journals: {x.shape[0]} of 5, finite {np.all(np.isfinite(x))}")
+    return ok
+
+
+def two_stroke(quick: bool) -> dict:
+    """The Gots engine as a two-stroke (firing 120° apart over a 360° cycle), scavenged to p_a
+    at bottom dead centre: no gas-exchange pressures (a scene that gives them is refused)."""
+    d = spinup(10 if quick else 200)
+    put(d, "mechanism", strokes=2, firing_deg=[0, 120, 240])
+    for key in ("p_intake_MPa", "p_exhaust_MPa"):
+        del d["gas"][key]
+    return d
+
+
+def _refuses_exchange_pressures(run: Run, o: Outcome) -> bool:
+    """The same two-stroke with p_intake given is refused, naming the key."""
+    from ..errors import SceneError
+
+    d = two_stroke(True)
+    put(d, "gas", p_intake_MPa=0.165)
+    try:
+        scene_of(d, "two-stroke-p-intake")
+    except SceneError as exc:
+        return exc.key == "gas.p_intake_MPa"
+    o.notes.append("a two-stroke scene with p_intake was accepted")
+    return False
+
+
+def weak_starter(t_end: float):
+    """A 5 N m starter from rest on the reaction-friction diesel, 30 revolutions asked by
+    ``t_end``: far too weak to push a cylinder through compression, it rocks the crank in the
+    first one (by 0.5 s it turns backwards at the end; by 2 s the pairs hold it at rest)."""
+    def build(quick: bool) -> dict:
+        d = put(base("gots_diesel_reaction_friction"), "run", revolutions=30, t_end=t_end)
+        put(d, "starter", torque=5.0, noload_speed_rpm=600.0, cutout_speed_rpm=400.0)
+        return put(d, "initial", phi=0.0, omega=0.0)
+    return build
+
+
+def light_flywheel(t_end: float):
+    """The spin-up scene without its flywheel (a 0.001 kg m² shaft), asked for 30 revolutions:
+    the compression stops the crank within the first turn and it rocks until ``t_end``."""
+    def build(quick: bool) -> dict:
+        d = spinup(30, t_end=t_end)
+        return put(d, "inertia", flywheel=0.0, shaft=0.001)
+    return build
+
+
+def _did_not_start(run: Run, o: Outcome) -> bool:
+    """A run whose shaft never completed what its scene asked: it must not end ``finished``,
+    and its message must say that it did not start, whichever way the shaft turns at the end;
+    each reversal is a sample at rest (the time-domain output rule)."""
+    rev = run.events.get("speed_reversal", np.zeros((0, 2)))
+    tr = run.trajectory
+    at_rest = all(np.any((tr["t"] == t) & (tr["omega"] == 0.0)) for t, _ in rev)
+    o.notes.append(f"status {run.result_status}, {len(rev)} reversal(s); {run.message[:160]}")
+    ok = run.result_status != "finished" and "did not start" in run.message and at_rest
+    if not ok:
+        o.notes.append("expected a status other than finished, saying it did not start"
+                       + ("" if at_rest else "; a reversal is not a sample at rest"))
+    return ok
+
+
+def failed_starts(builds: dict[str, Callable[[bool], dict]]):
+    """A case's ``run`` for scenes whose shaft never completes what they ask: the verdict is
+    ``_did_not_start``'s, whatever status the run ends with (the common checks still hold:
+    finite values, the balance, a diagnosis naming time and angle)."""
+    def run(quick: bool, ctx: Context) -> Outcome:
+        o = Outcome()
+        for label, build in builds.items():
+            r = run_scene(build(quick), label, ctx)
+            n = len(o.notes)
+            check_run(r, o, r.status, _did_not_start)
+            o.notes[n:] = [f"{label}: {x}" for x in o.notes[n:]]
+        return o
+    return run
+
+
+#: The revolutions of the load steps of :func:`load_steps_at_revolutions` (quick, full).
+STEP_REVOLUTIONS = {True: (20.0, 50.0, 80.0), False: (60.0, 200.0, 300.0)}
+
+
+def load_steps_at_revolutions(quick: bool) -> dict:
+    """The Gots generator set taking its full load at one revolution count and shedding half
+    of it at another, the run ending by revolutions."""
+    on, off, end = STEP_REVOLUTIONS[quick]
+    d = base("gots_diesel_load_steps")
+    del d["load"]["schedule_time"]
+    put(d, "load", schedule_revolutions=[on, on, off, off], schedule_scale=[0.0, 1.0, 1.0, 0.5])
+    d["run"] = {"revolutions": end}
+    return d
+
+
+def _steps_at_their_revolutions(run: Run, o: Outcome) -> bool:
+    """One event per step, each at φ₀ + 2π·(its revolution count) to rounding."""
+    quick = run.scene.run.revolutions == STEP_REVOLUTIONS[True][2]
+    on, off, _ = STEP_REVOLUTIONS[quick]
+    phi0 = run.scene.initial.phi
+    got = run.events.get("load_schedule", np.zeros((0, 2)))[:, 1]
+    want = phi0 + 2.0 * math.pi * np.array([on, off])
+    ok = got.size == 2 and bool(np.all(np.abs(got - want) <= 1e-9 * want))
+    o.notes.append(f"load steps at φ = {', '.join(f'{g:.12g}' for g in got)} rad (want "
+                   f"{', '.join(f'{w:.12g}' for w in want)})")
+    return ok and run.result_status == "finished"
+
+
+SWEEP_SCRIPT = """\
+import transient
+
+def main():
+    base = transient.load_scene({scene!r}).replace(run={{"revolutions": 2}})
+    done = transient.sweep(base, {{"load.torque": [0.0, 5.0]}}, output={out!r}, workers=2)
+    print(*done.table.columns["status"])
+
+{call}
+"""
+
+
+def sweep_from_script(quick: bool, ctx: Context) -> Outcome:
+    """The guide's sweep from code as a script on a local cluster: under the ``__main__`` guard
+    it runs (both runs finished); without it, it fails in one line saying to add the guard,
+    before Dask starts a worker (no traceback from inside Dask)."""
+    import subprocess
+    import sys
+
+    o = Outcome(status="complete", error=0.0, tolerance=0.0)
+    for guarded in (True, False):
+        folder = ctx.out / f"sweep-script-{'guarded' if guarded else 'plain'}"
+        folder.mkdir(parents=True, exist_ok=True)
+        script = folder / "study.py"
+        script.write_text(SWEEP_SCRIPT.format(
+            scene=str(CASES_DIR / "coasting_single.toml"), out=str(folder),
+            call='if __name__ == "__main__":\n    main()' if guarded else "main()"),
+            encoding="utf-8")
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                              timeout=max(10.0, ctx.deadline - time.monotonic()))
+        o.wall_s += time.perf_counter() - t0
+        last = (proc.stderr.strip().splitlines() or [""])[-1]
+        if guarded:
+            ok = proc.returncode == 0 and proc.stdout.split() == ["finished", "finished"]
+            o.notes.append(f"guarded: exit {proc.returncode}, statuses {proc.stdout.split()}")
+        else:
+            ok = (proc.returncode == 1 and "UnguardedMain" in last
+                  and 'if __name__ == "__main__":' in last and "distributed" not in proc.stderr)
+            o.notes.append(f"unguarded: exit {proc.returncode}: {last[:200]}")
+        o.steps += 1
+        o.ok = o.ok and ok
+    return o
+
+
 def catalogue() -> list[Case]:
     """Every case, in report order."""
     return [
@@ -812,14 +988,14 @@ def catalogue() -> list[Case]:
              single(from_rest, extra=_from_rest_extra, name="start-from-rest")),
         Case("stall-overload", f"load torque {OVERLOAD:g} N m, about 3× what the engine carries; "
                                f"the run ends by revolutions",
-             single(overload, "stalled", _stall_extra, "stall-overload")),
+             single(overload, "not-started", _stall_extra, "stall-overload")),
         Case("reversal-by-load", "the same overload with an end time: the load drives the shaft "
                                  "backwards through the gas cycle",
-             single(lambda q: overload(q, t_end=0.4), "complete", _reversal_extra,
+             single(lambda q: overload(q, t_end=0.4), "reversed", _reversal_extra,
                     "reversal-by-load")),
         Case("through-zero-rocking", "weak starter against compression: ω through zero many "
                                      "times",
-             single(rocking, extra=_rocking_extra, name="through-zero-rocking")),
+             single(rocking, "not-started", _rocking_extra, "through-zero-rocking")),
         Case("lambda-0.9", "λ = r/l = 0.9 (crank angle and time domain); λ = 0.75",
              several({"lambda-0.9": long_rod_ratio(0.9), "lambda-0.9-time":
                       long_rod_ratio(0.9, "time"), "lambda-0.75": long_rod_ratio(0.75)})),
@@ -865,7 +1041,7 @@ def catalogue() -> list[Case]:
                           eta=(0.05, 0.05), starter={"torque": 500.0, "noload_speed_rpm": 600.0,
                                                      "cutout_speed_rpm": 400.0},
                           initial={"omega": 0.0}, run={"t_end": 2.0})},
-                     "complete|stalled|locked")),
+                     "complete|stalled|not-started|locked")),
         Case("efficiency-0.3-to-1", "η from 0.3 to 1 on both pairs; η = 1 equals no pairs",
              efficiency_sweep),
         Case("tolerance-ladder", "rtol 1e-3 … 1e-12 (quick: … 1e-9): the largest error of t and "
@@ -878,7 +1054,7 @@ def catalogue() -> list[Case]:
         Case("backward-revolutions-only", "starter weaker than a constant load, from rest, the "
                                           "run ending by revolutions only: the shaft turns "
                                           "backwards and can never reach them",
-             single(backward_from_rest, "stalled|locked", name="backward-revolutions-only"),
+             single(backward_from_rest, "not-started|locked", name="backward-revolutions-only"),
              time_limit=10.0),
         Case("runaway", "inputs that would run without bound (t_end, revolutions 1e30, …) "
                         "refused naming their key; a run over its output budget stopped, kept",
@@ -886,6 +1062,33 @@ def catalogue() -> list[Case]:
         Case("kill-and-resume", "runs killed (SIGKILL) at random instants, then --resume: "
                                 "a prefix of the run kept, the resumed run bit-identical",
              kill_and_resume, time_limit=120.0, full_time_limit=600.0),
+        Case("in-line-six", "the Gots cylinder as an in-line six (1-5-3-6-2-4), spinning up",
+             single(inline_six, name="in-line-six")),
+        Case("v8", "the cross-plane V8, two cylinders on each of four throws, spinning up; "
+                   "its five main journals loaded",
+             single(v8, extra=_v8_journals, name="v8")),
+        Case("two-stroke", "the Gots engine as a two-stroke; the same scene with p_intake is "
+                           "refused, naming the key",
+             single(two_stroke, extra=_refuses_exchange_pressures, name="two-stroke")),
+        Case("weak-starter-from-rest", "a 5 N m starter from rest on the reaction-friction "
+                                       "diesel, t_end 0.5 s and 2 s: it rocks the crank (then "
+                                       "is held at rest) and must say it did not start",
+             failed_starts({"weak-starter-0.5s": weak_starter(0.5),
+                            "weak-starter-2s": weak_starter(2.0)})),
+        Case("light-flywheel", "no flywheel, a 0.001 kg m² shaft, 30 revolutions asked by "
+                               "t_end 0.5 s and 2 s: the crank rocks in compression and the "
+                               "run must say it did not start, whichever way it turns at the "
+                               "end",
+             failed_starts({"light-flywheel-0.5s": light_flywheel(0.5),
+                            "light-flywheel-2s": light_flywheel(2.0)})),
+        Case("load-steps-at-revolutions", "full load taken at one revolution count and half "
+                                          "shed at another under a droop governor; the steps "
+                                          "land there",
+             single(load_steps_at_revolutions, extra=_steps_at_their_revolutions,
+                    name="load-steps-at-revolutions")),
+        Case("sweep-from-script", "the guide's sweep from code run as a script on a local "
+                                  "cluster, with and without the __main__ guard",
+             sweep_from_script, time_limit=180.0),
         Case("million-revolutions-coasting", "10⁶ revolutions coasting: energy drift, phase "
                                              "drift, memory", million_revolutions(False),
              quick=False, time_limit=900.0),
