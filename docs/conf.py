@@ -97,10 +97,6 @@ numpydoc_xref_aliases = {
     "SceneError": "transient.SceneError",
     "SimulationError": "transient.SimulationError",
     "Client": "distributed.Client",
-    "Axes": "matplotlib.axes.Axes",
-    "Figure": "matplotlib.figure.Figure",
-    "h5py.File": "h5py.File",
-    "h5py.Group": "h5py.Group",
 }
 
 sphinx_gallery_conf = {
@@ -113,6 +109,9 @@ sphinx_gallery_conf = {
     "matplotlib_animations": False,
     "image_scrapers": ("matplotlib",),
     "within_subsection_order": "FileNameSortKey",
+    # The API pages of the public names list the examples that use them (``minigallery``).
+    "doc_module": ("transient",),
+    "backreferences_dir": "generated/backreferences",
 }
 
 # Results, scenes and benchmark records are read from the repository, never from elsewhere.
