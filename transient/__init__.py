@@ -34,22 +34,29 @@ Public API: :func:`load_scene` and :class:`Scene` (``Scene.from_dict``, ``scene.
 the errors :class:`SceneError` (invalid input) and :class:`SimulationError` (a run that
 failed).
 """
-from . import errors  # noqa: E402
-from .errors import SceneError, SimulationError  # noqa: E402
-from .results import Result, open_result  # noqa: E402
-from .run import simulate  # noqa: E402
-from .scene import Scene, load_scene  # noqa: E402
+from . import errors
+from .errors import SceneError, SimulationError
 from .version import __version__
 
 __all__ = ["load_scene", "Scene", "simulate", "Result", "open_result", "sweep", "SceneError",
            "SimulationError", "errors", "__version__"]
 
+#: The public names imported when first used (PEP 562), each from its module: importing a part
+#: of the package (``transient.core.integrator`` alone, say) does not import the rest, and a
+#: tool that needs only the scene reader does not start the stepper's modules.
+_LAZY = {"load_scene": "scene", "Scene": "scene", "simulate": "run", "Result": "results",
+         "open_result": "results", "sweep": "sweeps.api"}
+
 
 def __getattr__(name: str):
-    """``transient.sweep``, imported when first used: the sweep machinery is not part of a
-    single run's start."""
-    if name == "sweep":
-        from .sweeps.api import sweep
+    if name in _LAZY:
+        from importlib import import_module
 
-        return sweep
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'transient' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -11,16 +11,16 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from .core import cylinder as cyl
-from .core import governor as gv
-from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
-from .core import variation as var
-from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER, PHI,
-                          POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                          RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T, extras_of,
-                          work_array)
-from .core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
+from .core.model import cylinder as cyl
+from .core.model import governor as gv
+from .core.model.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core.model import variation as var
+from .core.model.variation import cycle_fuel
+from .core.model.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER,
+                                PHI, POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS,
+                                RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T,
+                                extras_of, work_array)
+from .core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
 from .errors import SceneError
 from .forces.compressor import compressor_cycle
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
@@ -273,7 +273,7 @@ def _piston_moves(mech, k: int, angle: float) -> bool:
 
 def paired_table(full: PressureTable, motored: PressureTable
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
-    """Both curves on common knots, as the model holds them (``transient.core.tables``, paired):
+    """Both curves on common knots, as the model holds them (``transient.core.model.tables``, paired):
     ``(knots, coef, piece_knot)`` with ``coef`` float64[n, 8], the full-load cubic in columns
     0–3 and the motored one in 4–7, so that the right-hand side finds the interval once.
 
@@ -337,7 +337,7 @@ def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]
 
 
 def load_table_fields(scene) -> dict:
-    """The tabulated load's part of the Model (``transient.core.forcing.table_load``): its
+    """The tabulated load's part of the Model (``transient.core.model.forcing.table_load``): its
     abscissa, knots and cubics; one zero interval without a table (the kernels never read it)."""
     curve = load_table_curve(scene)
     if curve is None:
@@ -424,14 +424,14 @@ def build_model(scene, part_load: bool = False
 
 def cycle_begin(mech) -> float:
     """Local angle where a cylinder's cycle begins, for its fuel factor and misfires
-    (:mod:`transient.core.variation`): 0, the gas-exchange TDC of a 4-stroke, whose cycle then
+    (:mod:`transient.core.model.variation`): 0, the gas-exchange TDC of a 4-stroke, whose cycle then
     holds one intake, compression, combustion and exhaust; π, the BDC of a 2-stroke, whose
     local 0 is its firing TDC, so that no combustion straddles two cycles."""
     return 0.0 if mech.strokes == 4 else math.pi
 
 
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
-    """The per-cylinder variation's part of the Model (:mod:`transient.core.variation`) from the
+    """The per-cylinder variation's part of the Model (:mod:`transient.core.model.variation`) from the
     ``[[gas.cylinders]]`` entries; factors of 1 and no misfires for cylinders without one, and
     ``var_on`` False without any, so that such a scene runs the kernels' plain path."""
     mech, entries = scene.mechanism, scene.gas.cylinders
@@ -470,7 +470,7 @@ def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model,
 
 def cylinder_fields(scene) -> dict:
     """The cylinder-pressure states' part of the Model: with ``[gas.woschni]`` the closed part's
-    parameters of :mod:`transient.core.cylinder` (from the full-load Wiebe cycle, whose closed
+    parameters of :mod:`transient.core.model.cylinder` (from the full-load Wiebe cycle, whose closed
     part it integrates again, now with wall heat)."""
     gas = scene.gas
     par = np.zeros(cyl.N_PAR)
@@ -507,7 +507,7 @@ def _on_closed_part_corner(bp: NDArray[np.float64], phases: NDArray[np.float64],
 
 
 def governor_kind(governor) -> int:
-    """The dynamic governor (``transient.core.governor``) of a scene's governor: none for the
+    """The dynamic governor (``transient.core.model.governor``) of a scene's governor: none for the
     static droop; PID only with a derivative gain (else the filter state would be integrated for
     nothing)."""
     if governor.model == "pi":
@@ -516,7 +516,7 @@ def governor_kind(governor) -> int:
 
 
 def governor_fields(scene) -> dict:
-    """The dynamic governor's and the fuel latching's part of the Model (``transient.core.governor``
+    """The dynamic governor's and the fuel latching's part of the Model (``transient.core.model.governor``
     for the parameters' meaning)."""
     g = scene.governor
     latch = dict(latch=scene.gas.injection is not None,
@@ -624,7 +624,7 @@ def chain_fields(scene) -> dict:
 
 
 def link_fields(mech, link_sub: list[int]) -> dict:
-    """The links' part of the Model (``transient.core.rhs.split_subchains``): the sub-chain of
+    """The links' part of the Model (``transient.core.model.rhs.split_subchains``): the sub-chain of
     each, their constant inertias, the link with the rest of J(φ), and the law of each link
     whose φ-dependent inertia a pair cuts from the rest's sub-chain (elsewhere it stays in the
     rest: a chain cut only where the links' inertias are constant adds nothing to compute)."""
@@ -639,7 +639,7 @@ def link_fields(mech, link_sub: list[int]) -> dict:
 
 
 def eta_table_fields(pairs) -> dict:
-    """The Model's efficiency maps (:mod:`transient.core.eta_table`), padded to one shape: each
+    """The Model's efficiency maps (:mod:`transient.core.model.eta_table`), padded to one shape: each
     pair's speed and moment axes and its two maps; a constant-η pair among mapped ones becomes a
     one-point map of its two efficiencies (held everywhere: the same η). Without mapped pairs,
     one row of zeros of the same types."""
@@ -656,7 +656,7 @@ def eta_table_fields(pairs) -> dict:
 
 
 def pack_maps(maps) -> tuple:
-    """The arrays (speed, torque, size, eta, η_min) of :mod:`transient.core.eta_table` from one
+    """The arrays (speed, torque, size, eta, η_min) of :mod:`transient.core.model.eta_table` from one
     (speed axis, moment axis, η_fwd grid, η_bwd grid) per pair, padded to one shape."""
     n = len(maps)
     nw = max(len(m[0]) for m in maps)
@@ -678,7 +678,7 @@ def reaction_friction(scene) -> bool:
 
 
 def reaction_fields(scene) -> dict:
-    """The chain's part of the Model with reaction friction (:mod:`transient.core.reactions`):
+    """The chain's part of the Model with reaction friction (:mod:`transient.core.model.reactions`):
     no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
     the mechanism's ``reaction_joints`` (:func:`transient.mechanisms.reaction_joints`) has its
     pair's coefficients and reports as that pair; a constant-η pair among them (at the shaft's
@@ -714,7 +714,7 @@ def reaction_breakpoints(scene) -> NDArray[np.float64]:
     ``joint_reversals`` (the swash plate's: its pistons' dead centres); the local angles of a row
     where any joint of the articulated mechanism reverses (``Articulated.reaction_reversals``),
     repeated at each row's phase; else the crank-slider's, each piston's dead centres (its speed)
-    and its local 90° and 270° (the rod's rate β̇ ∝ cos α, ``transient.core.joint_friction``)."""
+    and its local 90° and 270° (the rod's rate β̇ ∝ cos α, ``transient.core.model.joint_friction``)."""
     mech = scene.mechanism
     own = getattr(mech, "joint_reversals", None)
     if own is not None:

@@ -9,8 +9,8 @@ from __future__ import annotations
 import re
 
 from .assemble import gas_is_force, governor_kind, reaction_friction
-from .core import governor as gv
-from .core.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
+from .core.model import governor as gv
+from .core.model.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
 
 
 def output_columns(scene) -> dict[str, str]:

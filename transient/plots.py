@@ -138,7 +138,7 @@ def _cycle_fuel(scene):
     if not scene.gas.cylinders:
         return lambda cylinder, phi: ""
     from .assemble import build_model
-    from .core.variation import FUEL, cycle_fuel
+    from .core.model.variation import FUEL, cycle_fuel
 
     model = build_model(scene)[0]
 

@@ -30,31 +30,34 @@ import sys
 
 from numba import config, typeof, types
 
-from .core import breakpoints, events, jit, layout, rhs, rk, stepper
-from .core import stepper_io as sio
+from .core import jit
+from .core.integrator import rk
+from .core.model import layout, rhs
+from .core.stepper import breakpoints, events, loop
+from .core.stepper import io as sio
 
 #: The stepper's callees, each compiled apart with its own callees (:func:`.core.jit.kernel`), in
 #: the reverse of the order in which the stepper's compile first calls for them (recorded with
 #: numba's "numba:compile" events), so that the helper and the stepper's compile meet in the
 #: middle.
 CALLEES = (
-    stepper._switch_at_event,
-    stepper._record_event,
-    stepper._move_to_event,
-    stepper._take_step,
-    stepper._emit_step_samples,
+    loop._switch_at_event,
+    loop._record_event,
+    loop._move_to_event,
+    loop._take_step,
+    loop._emit_step_samples,
     events._locate_events,
     breakpoints._aim_at_breakpoint,
-    stepper._stiff,
-    stepper._accepted_size,
-    stepper._judge_attempt,
+    loop._stiff,
+    loop._accepted_size,
+    loop._judge_attempt,
     rk._step,
     sio._finish,
     breakpoints._segment_end,
-    stepper._settle_at_restart,
+    loop._settle_at_restart,
     rhs.derivative,
     sio._emit_row,
-    stepper._start_run,
+    loop._start_run,
 )
 
 
@@ -95,7 +98,7 @@ def compile_callees(model, tab, callees=CALLEES) -> None:
 
 
 #: The stepper, whose compile the helper joins (taken at import: tests wrap ``stepper.advance``).
-STEPPER = stepper.advance
+STEPPER = loop.advance
 
 
 def stepper_is_cached(model, tab) -> bool:

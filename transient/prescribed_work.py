@@ -23,9 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .core import layout
-from .core.inverse import inverse_dynamics
-from .core.layout import n_outputs
+from .core.model import layout
+from .core.model.inverse import inverse_dynamics
+from .core.model.layout import n_outputs
 from .forces.load_table import interpolant
 from .quadrature import integrals
 

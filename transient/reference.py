@@ -29,21 +29,21 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from .assemble import build_model, gas_tables, initial_governor, load_table_curve
-from .core.breakpoints import next_breakpoint
-from .core import governor as gv
-from .core.forcing import generator_branch, load_segment
-from .core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
-                           RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
-from .core.layout import LINK_PISTONS, LINK_REST, LINK_SWASH
-from .core.swash_plate import link_terms as swash_link_terms
-from .core.variation import PRESSURE, SHIFT, cycle_fuel
+from .core.stepper.breakpoints import next_breakpoint
+from .core.model import governor as gv
+from .core.model.forcing import generator_branch, load_segment
+from .core.model.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU,
+                                RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, T)
+from .core.model.layout import LINK_PISTONS, LINK_REST, LINK_SWASH
+from .core.model.swash_plate import link_terms as swash_link_terms
+from .core.model.variation import PRESSURE, SHIFT, cycle_fuel
 from .errors import SimulationError
 from .mechanisms import reaction_joints
 from .mechanisms.articulated import positions
 
 
 class ChainNumpy:
-    """The serial chain with power-flow modes, solved as the proof in ``transient.core.chain``
+    """The serial chain with power-flow modes, solved as the proof in ``transient.core.model.chain``
     suggests rather than as the kernel does: the residual of the last sub-chain, F(a), strictly
     decreases in the acceleration a, so its one root is bracketed and found by Brent's method,
     the mode of each pair following from the sign of the power it transmits."""
@@ -310,7 +310,7 @@ class CylindersNumpy:
     """The cylinder pressures of the closed part with wall heat transfer (``[gas.woschni]``),
     from the scalar functions of :mod:`transient.forces.woschni` and
     :mod:`transient.forces.closed_cycle` (not from the kernels of
-    ``transient.core.cylinder``): the state is ``y[c:]`` of the reference state, in time,
+    ``transient.core.model.cylinder``): the state is ``y[c:]`` of the reference state, in time,
     dp/dt = (γ − 1)/V·(ω dQ_b/dx − Q̇_w) − γ p/V·dV/dt, dV/dt = F_p·u_k·ω. The combustion and
     Woschni's combustion term are switched by the segment between breakpoints, as in
     :func:`transient.forces.closed_cycle.integrate_closed`."""
@@ -378,7 +378,7 @@ class CylindersNumpy:
 
 
 class GovernorNumpy:
-    """The dynamic governors of ``transient.core.governor``, written out again from the equations
+    """The dynamic governors of ``transient.core.model.governor``, written out again from the equations
     in its docstring (not from its kernels): the state is ``y[g:]`` of the reference state."""
 
     def __init__(self, scene, g: int) -> None:
@@ -1117,7 +1117,7 @@ def _at_acceleration(both: JointForces, eps: float) -> JointForces:
 class ArticulatedForces:
     """The joint forces of an articulated mechanism at one state, from
     :func:`articulated_joint_forces`; vectors ``(2, …)`` in each row's frame
-    (:mod:`transient.core.articulated`: x along the row's master cylinder, y a quarter-turn on
+    (:mod:`transient.core.model.articulated`: x along the row's master cylinder, y a quarter-turn on
     in the direction of rotation), cylinders numbered as the mechanism numbers them.
 
     Attributes
@@ -1132,7 +1132,7 @@ class ArticulatedForces:
         rotation [N m].
     S, L : (6,) per joint (main bearings, crankpins, link pins, master pins, slave pins,
         pistons) summed over the rows: the moment the shaft side puts into the joint and the
-        loss moment [N m] (powers over ω, as ``transient.core.articulated_friction`` defines
+        loss moment [N m] (powers over ω, as ``transient.core.model.articulated_friction`` defines
         them).
     L_cyl : (6, n_cyl) the loss moments per joint and cylinder, a row's main bearing and
         crankpin counted as its master cylinder's; they sum to L.
@@ -1171,7 +1171,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
                              J0: float = 0.0, M_shaft: float = 0.0, turns: int = 400,
                              sel: float | None = None) -> ArticulatedForces:
     """Joint forces of an articulated mechanism (radial or V) at one state by Newton–Euler, with
-    friction on its joints: the independent check of ``transient.core.articulated_friction``.
+    friction on its joints: the independent check of ``transient.core.model.articulated_friction``.
 
     Each row is 3 + 2 + 5 z′ bodies' equations — the throw (mass m_k at the crankpin: Newton and
     Euler about O, with the shaft's moment on it unknown), the master rod (rigid: mass at its
@@ -1187,7 +1187,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
 
     The friction (``coefficients`` = the (6, 5) rows of ``Model.rx_par``: per joint μ, radius,
     viscous, ring force, ring pressure share) acts as the module docstring of
-    ``transient.core.articulated_friction`` states it, on the forces of the previous solve: a plain
+    ``transient.core.model.articulated_friction`` states it, on the forces of the previous solve: a plain
     fixed point, repeated until nothing changes by more than 1e-15 of the largest force (each
     turn contracts by about μ, so a few dozen turns). The directions are the relative rates' signs
     at ``sel`` (default φ) times σ (default sign ω).
@@ -1444,7 +1444,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
 class SwashReactions:
     """The motion and the joint reactions of a swash-plate engine at one state, from
     :func:`swash_plate_reactions` (half 1; vectors in the fixed frame of
-    :mod:`transient.core.swash_plate`) [rad/s², N, N·m].
+    :mod:`transient.core.model.swash_plate`) [rad/s², N, N·m].
 
     Attributes
     ----------
@@ -1495,9 +1495,9 @@ def swash_plate_motion(mech, phi, omega, epsilon):
     ω₉ = ω(x̂ + θ′n) and α₉ (Antonyuk (8), differentiated once more), each joint's B = Q₉ B₀ and
     its acceleration α₉ × B + ω₉ × (ω₉ × B), D on its cylinder axis at distance ℓ from B (10),
     ẋ_D, ẍ_D from |B − D|² = ℓ² differentiated twice, the rods' e, ė, ë and the cross's hinge
-    c = Q₉ c₀ with ψ̈ = α₉·a. Only θ(φ), θ′, θ″ come from :func:`transient.core.swash_plate.hooke`;
+    c = Q₉ c₀ with ψ̈ = α₉·a. Only θ(φ), θ′, θ″ come from :func:`transient.core.model.swash_plate.hooke`;
     the Hooke constraint a·c = 0 is returned to be checked. A dict of arrays."""
-    from .core import swash_plate as core
+    from .core.model import swash_plate as core
     from .mechanisms.swash_plate import HINGES
 
     mp = mech.pack()
@@ -1540,7 +1540,7 @@ def swash_plate_motion(mech, phi, omega, epsilon):
 def swash_plate_reactions(mech, phi, omega, epsilon, gas_force, M_main=0.0, M_plate=0.0,
                           f=None, J0=None, M_shaft=None, motion=None) -> SwashReactions:
     """The joint reactions of the swash plate by Newton–Euler, every body's equations one linear
-    system: the independent check of :mod:`transient.core.swash_friction` and, without friction,
+    system: the independent check of :mod:`transient.core.model.swash_friction` and, without friction,
     of the reduced model (18).
 
     Bodies (half 1; the mirror half of ``halves = 2`` is its mirror image, so it doubles the

@@ -16,14 +16,14 @@ from typing import Callable
 import numpy as np
 
 from .assemble import build_model, initial_governor, part_load_refusal
-from .core import forcing, layout, stepper
-from .core import stepper_io as sio
-from .core.inverse import inverse_dynamics
-from .core.layout import n_outputs, n_state
-from .core.tableaus import TABLEAUS
+from .core.model import forcing, layout
+from .core import stepper
+from .core.stepper import io as sio
+from .core.model.inverse import inverse_dynamics
+from .core.model.layout import n_outputs, n_state
+from .core.integrator.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
-from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge,
-                      status_of)
+from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of)
 from .outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .prescribed_work import Motion, work_columns

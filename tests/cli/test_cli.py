@@ -23,7 +23,7 @@ import pytest
 
 import transient
 import transient.core.stepper as stepper
-import transient.core.stepper_io as sio
+import transient.core.stepper.io as sio
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import to_toml
 

@@ -2,7 +2,7 @@
 mechanism and mode then load without compiling anything; a second warm-up finds all cached.
 
 Before it, on the same empty cache, a run of a plain scene compiles none of the kernels that only
-the features it does not use need (the kernels' plain variant, ``transient.core.layout.extras_of``),
+the features it does not use need (the kernels' plain variant, ``transient.core.model.layout.extras_of``),
 and the warm-up, whose built-in scenes use them, does: the cache's files say which kernels were
 compiled, by this process or by its compile helper (``transient.precompile``)."""
 from __future__ import annotations
@@ -80,7 +80,7 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
     # (the stepper's callees, such as rhs.derivative, may be the compile helper's, which this
     # process then loads: the cache below has them)
     assert {"transient.core.stepper.advance",
-            "transient.core.inverse.inverse_dynamics"} <= set(compiled)
+            "transient.core.model.inverse.inverse_dynamics"} <= set(compiled)
     assert lines[-1] == f"{len(compiled)} kernel(s) compiled"
     full = cached_kernels(tmp_path / "cache")
     for feature, kernels in FEATURE_KERNELS.items():

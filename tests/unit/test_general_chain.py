@@ -1,6 +1,6 @@
 """The general serial chain from a scene: constant-η pairs between any neighbouring links of a
 mechanism (crank-slider ``shaft`` – ``crank`` – ``rod`` – ``piston`` – ``cylinder``), each
-passing on the power it really transmits (``transient.core.rhs.split_subchains``).
+passing on the power it really transmits (``transient.core.model.rhs.split_subchains``).
 
 Independent checks:
 
@@ -30,8 +30,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from transient.assemble import build_model
-from transient.core import forcing, inverse, layout, rhs
-from transient.core.chain import UNIQUE
+from transient.core.model import forcing, inverse, layout, rhs
+from transient.core.model.chain import UNIQUE
 from transient.errors import SceneError
 from transient.run import integrate
 from transient.scene import Friction, Pair, load_scene

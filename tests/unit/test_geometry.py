@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 
 from transient.assemble import cycle_figures
 from transient.cli import main
-from transient.core import crank_slider as cs_core
+from transient.core.model import crank_slider as cs_core
 from transient.mechanisms import articulated as art
 from transient.mechanisms import swash_plate as sp
 from transient.mechanisms.crank_slider import CrankSlider

@@ -1,4 +1,4 @@
-"""The serial chain inside the compiled model (``transient.core.rhs``): how a mechanism's links
+"""The serial chain inside the compiled model (``transient.core.model.rhs``): how a mechanism's links
 become sub-chains, the right-hand side with held pair modes, the forward/inverse consistency of the
 chain, and the choice of modes at a state."""
 from __future__ import annotations
@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core import forcing
-from transient.core import inverse
-from transient.core import layout
-from transient.core import rhs
-from transient.core.chain import LOCKED, UNIQUE
+from transient.core.model import forcing
+from transient.core.model import inverse
+from transient.core.model import layout
+from transient.core.model import rhs
+from transient.core.model.chain import LOCKED, UNIQUE
 from transient.scene import Friction, Pair, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"

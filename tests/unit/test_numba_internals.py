@@ -19,8 +19,7 @@ from pathlib import Path
 
 import llvmlite.binding as ll
 import numba
-from numba.core import (caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes,
-                        types)
+from numba.core import (caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes, types)
 from numba.core.base import BaseContext
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
@@ -97,7 +96,7 @@ with warnings.catch_warnings(record=True) as caught:
 from numba.core.caching import FunctionCache
 from transient import precompile
 from transient.assemble import build_model
-from transient.core.tableaus import TABLEAUS
+from transient.core.integrator.tableaus import TABLEAUS
 from transient.scene import load_scene
 
 assert not jit.REPLACEMENTS_ON
@@ -481,7 +480,7 @@ def test_linked_only_libraries_rely_on_how_numba_lowers_links_and_caches():
 
 
 def rhs_derivative():
-    from transient.core.rhs import derivative
+    from transient.core.model.rhs import derivative
 
     return derivative.py_func
 

@@ -259,7 +259,7 @@ def test_paired_table_on_different_knots():
     """Two curves with different knots and corners go onto the union of both, each re-expanded
     exactly; the compiled pair look-up agrees with each table's numpy evaluation."""
     from transient.assemble import paired_table
-    from transient.core.tables import find_piece, table_eval, table_eval_pair
+    from transient.core.model.tables import find_piece, table_eval, table_eval_pair
     from transient.forces.gas import table_from_points
 
     period = 4 * math.pi

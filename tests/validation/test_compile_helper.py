@@ -1,15 +1,15 @@
 """The compile helper (:mod:`transient.precompile`) compiles each of the stepper's callees with the
 argument types the stepper calls it with: after the helper's compile and the stepper's (in either
 order, on a cold or a warm cache), each callee's numba cache holds the helper's signature and no
-other but the one of the kernels' other variant (:func:`transient.core.layout.extras_of`). A wrong
+other but the one of the kernels' other variant (:func:`transient.core.model.layout.extras_of`). A wrong
 type would leave one more (the stepper's own), and the helper's work wasted."""
 from __future__ import annotations
 
 from dataclasses import replace
 
 from transient.assemble import build_model
-from transient.core.layout import extras_of
-from transient.core.tableaus import TABLEAUS
+from transient.core.model.layout import extras_of
+from transient.core.integrator.tableaus import TABLEAUS
 from transient.precompile import CALLEES, compile_callees, signature
 from transient.scene import load_scene
 from transient.run import integrate

@@ -1,4 +1,4 @@
-"""Runs with friction on the joints' reactions (:mod:`transient.core.joint_friction`), checked
+"""Runs with friction on the joints' reactions (:mod:`transient.core.model.joint_friction`), checked
 against what holds independently of the friction model:
 
 * **Work–energy balance** in a spin-up of ``cases/gots_diesel_reaction_friction.toml`` with

@@ -1,5 +1,5 @@
 """Wall heat transfer in the ODE (``[gas.woschni]``): the cylinder pressures of the closed
-part are states of the compiled stepper (``transient.core.cylinder``).
+part are states of the compiled stepper (``transient.core.model.cylinder``).
 
 Independent checks:
 * with h = 0 (c1 = c2 = 0) the states integrate the Wiebe cycle again, so a run must reproduce the

@@ -26,7 +26,7 @@ IMEP_k = W_i,k/V_d,k over the cylinder's own cycle, V_d,k its exact swept volume
 engine's IMEP is ΣW_i,k/ΣV_d,k with every W_i,k over the engine's cycle.
 
 **Brake and friction.** From the work integrals the stepper integrates with the motion
-(``W_load``, ``W_loss_<k>``, ``W_gas``: :mod:`transient.core.layout`), read at the cycle ends:
+(``W_load``, ``W_loss_<k>``, ``W_gas``: :mod:`transient.core.model.layout`), read at the cycle ends:
 BMEP = −ΔW_load/ΣV_d (the work the load takes), FMEP = ΣΔW_loss,k/ΣV_d (the pairs' losses), and
 the indicated work of the gas torque ΔW_gas = Σ∮(p_k − p0) dV_k = ΣW_i,k (∮dV = 0). Over a cycle
 the work–energy law gives

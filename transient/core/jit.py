@@ -12,7 +12,7 @@ made into machine code on its own (:func:`_linked_only`); ``kernel(inline=True)`
 LLVM inlines it at its call sites (:func:`_inlined_by_llvm`). What Python calls to run
 (the stepper) is ``compiled``. ``kernel`` is ``compiled`` without numba's reference counting
 (``_nrt=False``), because with it every call that passes arrays — the
-:data:`transient.core.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
+:data:`transient.core.model.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
 an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
 caller allocated); the few that allocate (work arrays) are ``compiled``.
 
@@ -69,7 +69,7 @@ COMPILE_LOCK = "{}.compile.lock"
 
 class _SharedLocator(UserProvidedCacheLocator):
     """numba's locator of a function's cache files in ``numba.config.CACHE_DIR``, with their
-    folder named by the function's module (``transient.core.rhs``) where numba names it by a hash
+    folder named by the function's module (``transient.core.model.rhs``) where numba names it by a hash
     of the source file's absolute path: copies of the same sources at other paths (the nodes of a
     cluster, a clone and its worktrees, a fresh virtual environment) share one cache. numba's
     index keys each entry by a hash of the source's contents and by the CPU (its codegen's magic

@@ -234,7 +234,7 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     from CyRK import nbsolve2_ivp
 
     from ..assemble import build_model
-    from ..core import layout
+    from ..core.model import layout
     from .cyrk_rhs import make_rhs
 
     model, _, _ = build_model(base)

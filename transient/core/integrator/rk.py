@@ -5,18 +5,18 @@ step-size factors, Hairer's stiffness estimate and the dense output (Hairer, Nø
 One set of functions for every pair in :mod:`.tableaus` (DOP853, DOPRI5), passed as data. They
 know the state vector's layout only as far as the error control needs it (which components are
 controlled and how the accumulating ones are scaled), and nothing of events or of the stepper's
-bookkeeping, which :mod:`.stepper` keeps. The step, the error norm and the stiffness estimate
+bookkeeping, which :mod:`~transient.core.stepper` keeps. The step, the error norm and the stiffness estimate
 run once per step attempt and are inlined into it by LLVM: as calls they would copy the Model's
-flattened fields onto the stack (:func:`.jit.kernel`).
+flattened fields onto the stack (:func:`transient.core.jit.kernel`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
-from .layout import N_DYNAMIC, PHI, T
-from .rhs import derivative
+from ..model.layout import N_DYNAMIC, PHI, T
+from ..model.rhs import derivative
 
 # Step-size control as in SciPy's DOP853 and RK45 (error exponent −1/(q + 1), tab.exponent).
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0

@@ -1,6 +1,6 @@
 """Explicit Runge–Kutta pairs for the compiled stepper, as data (docs/theory.md, Steppers).
 
-A :class:`Tableau` holds what :mod:`transient.core.rk` needs of an embedded pair with
+A :class:`Tableau` holds what :mod:`transient.core.integrator.rk` needs of an embedded pair with
 dense output, so that one compiled loop serves every method:
 
 * ``A`` (n_ext × n_ext): the stage coefficients, the main stages ``0 … n_stages − 1``, the FSAL

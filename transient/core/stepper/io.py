@@ -1,4 +1,4 @@
-"""What the stepper (:func:`.stepper.advance`) and its Python caller exchange: the settings
+"""What the stepper (:func:`~transient.core.stepper.advance`) and its Python caller exchange: the settings
 ``cfg``, the stepper's state kept between chunks (``fst``, ``ist``), the return codes, the event
 codes and their names, and the writing of output rows and events into the caller's buffers.
 
@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
-from .forcing import inertia, speed
-from .layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
-                     SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T, n_state)
-from .outputs import output_row, output_row_inline
-from .rk import _dense_eval
+from ..model.forcing import inertia, speed
+from ..model.layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
+                            SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T, n_state)
+from ..model.outputs import output_row, output_row_inline
+from ..integrator.rk import _dense_eval
 
 # cfg[...] — settings (float64 array, filled by transient.simulate)
 C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range(8)

@@ -1,31 +1,31 @@
 """State events on a step: the event functions, their crossings located on the dense output
 (Illinois root finding, sampling for crossings that come and go inside a step), which events are
-watched in the current switches (:func:`~transient.core.events._event_spec`), and the search for a
-step's earliest event (:func:`~transient.core.events._locate_events`).
+watched in the current switches (:func:`~transient.core.stepper.events._event_spec`), and the search for a
+step's earliest event (:func:`~transient.core.stepper.events._locate_events`).
 
 The events are the switches between time and crank angle, starter cut-out, the governor
 characteristic's corners, the PI governor's limits, the flyweight governor's stops, the corners of
 the load schedule and the generator's minimum speed, speed reversals, the end of the run and the
 pairs' mode switches (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6). Locating them is kept
-apart from acting on them (:mod:`.stepper`), because location only reads the step and its dense
+apart from acting on them (:mod:`~transient.core.stepper`), because location only reads the step and its dense
 output, while acting changes the state and the switches.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
-from .chain import MAX_PAIRS
-from . import governor as gv
-from .forcing import demand, inertia, is_pi, speed
-from .layout import (LT_SPEED, OMEGA, PHI, SW_LOAD, SW_LOAD_TABLE, SW_SLEEVE, SW_STARTER, T,
-                     WK_DEMAND, WK_G, WK_G_MIN, gov_index)
-from .rhs import margins_at, margins_inline
-from .rk import _dense, _dense_eval, _dense_state
-from .stepper_io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR,
-                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE,
-                         EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
+from ..model.chain import MAX_PAIRS
+from ..model import governor as gv
+from ..model.forcing import demand, inertia, is_pi, speed
+from ..model.layout import (LT_SPEED, OMEGA, PHI, SW_LOAD, SW_LOAD_TABLE, SW_SLEEVE, SW_STARTER, T,
+                            WK_DEMAND, WK_G, WK_G_MIN, gov_index)
+from ..model.rhs import margins_at, margins_inline
+from ..integrator.rk import _dense, _dense_eval, _dense_state
+from .io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR, EV_LOAD,
+                 EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
+                 EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
 
 # Event "components" at and above PAIR_COMP are the mode margins of the pairs (rhs.mode_margins);
 # DEMAND_COMP is the PI governor's demand u (forcing.demand).

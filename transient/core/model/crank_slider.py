@@ -14,7 +14,7 @@ from math import asin, cos, sin, sqrt
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 #: Layout of the parameter array ``mp`` of :func:`crank_slider_terms` (filled by
 #: ``transient.mechanisms.crank_slider.CrankSlider.pack``).

@@ -2,10 +2,10 @@
 functions, the cylinders' gas values (tables, or pressure states with wall heat transfer), the
 governors' fuel command and branches, the load with its schedule and generator, the starter, and
 their sum into the reduced moments
-(:func:`~transient.core.forcing.moments`).
+(:func:`~transient.core.model.forcing.moments`).
 
 These are the physics the right-hand side (:mod:`.rhs`), the output rows
-(:mod:`transient.core.outputs`) and
+(:mod:`transient.core.model.outputs`) and
 the inverse dynamics (:mod:`.inverse`) share; the discrete branches (governor, load segment,
 generator) are chosen here too, because each is the same formula the term evaluates, held fixed
 over a step so that the right-hand side is smooth inside it.
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 from . import cylinder as cyl
 from . import governor as gv

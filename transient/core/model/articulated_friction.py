@@ -3,7 +3,7 @@ exactly with the motion, as :mod:`.joint_friction` does for the crank-slider.
 
 The friction laws are that module's: a journal or pin loses μ·r·|R| + c·q, opposing its relative
 angular speed q; a piston in its cylinder μ·|N| + F_ring + c_p·P⁺ + c·v, opposing its speed v.
-The joints of a row (:mod:`transient.core.articulated`; ``transient.mechanisms.articulated`` names
+The joints of a row (:mod:`transient.core.model.articulated`; ``transient.mechanisms.articulated`` names
 them for
 the scene): the main bearing (frame – throw), the master crankpin (throw – master rod), the link
 pins (master rod – slave rod i; with central articulation, r_i = 0, the slave rod sits on the
@@ -12,7 +12,7 @@ piston pins (rod – piston) and the pistons in their cylinders.
 
 The reactions by Newton–Euler
 -----------------------------
-In the row frame of :mod:`transient.core.articulated` (x along the master cylinder, rotation
+In the row frame of :mod:`transient.core.model.articulated` (x along the master cylinder, rotation
 positive, so every
 moment below is about z in the direction of rotation; a × b = a_x b_y − a_y b_x). Every point p
 of the row moves as p(α), α = φ − φ_j, so its acceleration is p″ω² + p′ε, affine in ε = φ̈:
@@ -81,14 +81,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
-from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0, SLAVE_CG,
-                          SLAVE_I, SLAVE_L, SLAVE_PISTON, SLAVE_ROD, SLAVE_STRIDE, master_rod,
-                          row0, slave)
+from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0, SLAVE_CG, SLAVE_I,
+                          SLAVE_L, SLAVE_PISTON, SLAVE_ROD, SLAVE_STRIDE, master_rod, row0, slave)
 from .crank_slider import I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, R, ROD_CG
-from .joint_friction import (MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope, clear_pairs,
-                             newton_step, pair_efficiencies)
+from .joint_friction import (MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope, clear_pairs, newton_step,
+                             pair_efficiencies)
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_AX,
                      WK_CYL_LOSS, WK_RX, WK_S)
 

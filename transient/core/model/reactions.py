@@ -25,7 +25,7 @@ unchanged, and as exact as that is. Under the power-flow policy (the scene check
 other here) η* = η_fwd where S σ ≥ 0 and 1/η_bwd where S σ < 0. The residual
 J₀ ε − M_shaft − T(ε)/η* increases strictly in ε for either η* (T falls with ε: the throws' and
 the rods' inertia), and the two modes' residuals agree where T = 0, so exactly one mode is
-consistent (the proof of ``transient.core.chain`` for one pair). Where no mode is held (a start,
+consistent (the proof of ``transient.core.model.chain`` for one pair). Where no mode is held (a start,
 a reversal, at rest: :data:`AUTO`) the forward solve is taken if its S σ ≥ 0, else the backward
 one. While moving, the mode is held over each step as every chain pair's is, with the margin
 S σ (forward) or −S σ (backward) watched at every stage (``rhs.mode_margins``), so that the
@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 from .chain import LOCKED, UNIQUE
 from . import articulated_friction as af
@@ -206,7 +206,7 @@ def loss_moment(wk, k):
 @kernel(inline=True)
 def choose_direction(m, J, dJ, w, M_gas, M_shaft, wk):
     """``(σ, φ̈, status)`` at a start or a reversal: σ = sign ω while moving; at rest the
-    incipient motion decides, as for the chain (``transient.core.chain``): with the friction
+    incipient motion decides, as for the chain (``transient.core.model.chain``): with the friction
     opposing σ = +1, φ̈ > 0 starts forward; else with it opposing σ = −1, φ̈ < 0 starts backward;
     else the joints' friction holds the applied moments (LOCKED, φ̈ = 0)."""
     if w != 0.0:

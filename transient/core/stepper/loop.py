@@ -2,7 +2,7 @@
 between breakpoints, with state events located on the dense output (docs/theory.md, Steppers;
 Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
 
-One loop for every pair in :mod:`.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
+One loop for every pair in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
 fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).
 While ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint,
 so the right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal)
@@ -22,9 +22,9 @@ samples inside the step (:func:`_emit_step_samples`), and either the step taken 
 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks
-(:mod:`.stepper_io`).
+(:mod:`~transient.core.stepper.io`).
 
-Every function here is a compile unit of its own (:func:`.jit.kernel`). The pieces of the loop,
+Every function here is a compile unit of its own (:func:`transient.core.jit.kernel`). The pieces of the loop,
 and the helpers called once per step or per root-finding iteration that take the Model, are
 inlined by LLVM (``kernel(inline=True)``) at each call site: a call that is not inlined copies
 the Model's ~150 flattened words onto the stack. Calls that run rarely, or whose callee is too
@@ -34,7 +34,7 @@ into the root finder, whose iterations evaluate them most (``rhs.margins_inline`
 row into the writing of the grid's samples (``outputs.output_row_inline``).
 
 The kernels on a path from :func:`advance` to a feature that only some scenes use take the
-argument ``extras`` (:func:`.layout.extras_of`) and test it where the feature's code begins, so
+argument ``extras`` (:func:`~transient.core.model.layout.extras_of`) and test it where the feature's code begins, so
 that a plain scene's compile leaves that code out. The time-domain phase is in both variants: a
 scene of either may need it at any point of a run (a start from rest, a load that slows the shaft
 below the switch speed, a reversal).
@@ -43,38 +43,35 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import compiled, kernel
+from ..jit import compiled, kernel
 
 from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
-from .chain import AMBIGUOUS, NONE_CONSISTENT
-from .chain import LOCKED as LOCKED_STATUS
+from ..model.chain import AMBIGUOUS, NONE_CONSISTENT
+from ..model.chain import LOCKED as LOCKED_STATUS
 from .events import (DEMAND_COMP, MAX_UNSEEN, N_MARGIN_SAMPLES, PAIR_COMP, _dense_once, _event_g,
                      _locate_events, _root, _sleeve_stops)
-from . import governor as gv
-from .forcing import (generator_branch, governor_branch, inertia, load_segment, moments, speed,
-                      speed_knot_segment, start_branch)
-from .layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND, WK_G,
-                     WK_G_MIN, WK_SPEED, cyl_index, gov_index, n_state, work_array)
-from .rhs import choose_modes, derivative, margins_at, release
-from . import joint_friction as jf
-from . import reactions as rx
-from . import stuck as st
-from .rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
-from .stepper_io import (C_ATOL, C_CHUNK_STEPS, C_DPHI_OUT, C_FIXED_STEP, C_DT_OUT, C_PHI_END,
-                         C_RTOL, C_T_END,
-                         C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
-                         EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL,
-                         EV_SLEEVE_FREE, EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_STUCK, EV_TO_ANGLE,
-                         EV_TO_TIME, F_ERR_OLD, F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T,
-                         F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL, F_SEL, FAIL_NONFINITE, FAIL_STEP,
-                         I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE, I_DIRECTION, I_F_VALID,
-                         I_FLIPPED, I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG, I_LOAD_TABLE, I_MODES,
-                         I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT, I_NREDO, I_NREJECT,
-                         I_NSTEPS,
-                         I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE, I_STARTED,
-                         I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
-                         MAX_OUTPUT_INTERVALS, _emit_new_row, _emit_row, _emit_samples, _finish,
-                         _locked, _reset_output_grid, _retake)
+from ..model import governor as gv
+from ..model.forcing import (generator_branch, governor_branch, inertia, load_segment, moments,
+                             speed, speed_knot_segment, start_branch)
+from ..model.layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND,
+                            WK_G, WK_G_MIN, WK_SPEED, cyl_index, gov_index, n_state, work_array)
+from ..model.rhs import choose_modes, derivative, margins_at, release
+from ..model import joint_friction as jf
+from ..model import reactions as rx
+from ..model import stuck as st
+from ..integrator.rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
+from .io import (C_ATOL, C_CHUNK_STEPS, C_DPHI_OUT, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
+                 C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
+                 EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL, EV_SLEEVE_FREE,
+                 EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_STUCK, EV_TO_ANGLE, EV_TO_TIME, F_ERR_OLD,
+                 F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T, F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL,
+                 F_SEL, FAIL_NONFINITE, FAIL_STEP, I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE,
+                 I_DIRECTION, I_F_VALID, I_FLIPPED, I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG,
+                 I_LOAD_TABLE, I_MODES, I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT,
+                 I_NREDO, I_NREJECT, I_NSTEPS, I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE,
+                 I_STARTED, I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
+                 MAX_OUTPUT_INTERVALS, _emit_new_row, _emit_row, _emit_samples, _finish, _locked,
+                 _reset_output_grid, _retake)
 
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
@@ -108,12 +105,12 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
     ----------
     m : Model
     extras : None or True
-        The kernels' variant for ``m`` (:func:`.layout.extras_of`): None compiles none of the
+        The kernels' variant for ``m`` (:func:`~transient.core.model.layout.extras_of`): None compiles none of the
         features a plain scene does not use.
     tab : tableaus.Tableau
         The Runge–Kutta pair (DOP853, DOPRI5).
     cfg : float64[N_CFG]
-        Settings, indices ``C_*`` (:mod:`.stepper_io`, as the other layouts and codes).
+        Settings, indices ``C_*`` (:mod:`~transient.core.stepper.io`, as the other layouts and codes).
     bp : float64[:]
         Sorted breakpoints in [0, m.period).
     y : float64[layout.n_state(m)]

@@ -4,7 +4,7 @@ drive exceeds what the friction can hold in one direction (as the Modelica Stand
 the efficiency of gearboxes and of planetary gearboxes", 2nd International Modelica Conference,
 2002, pp. 257–266: a gear's stuck and rolling modes).
 
-At ω = 0 the friction's direction is that of the incipient motion (``transient.core.chain``, *At
+At ω = 0 the friction's direction is that of the incipient motion (``transient.core.model.chain``, *At
 rest*): with the friction opposing σ = +1 the chain's acceleration is a₊, opposing σ = −1 it is
 a₋. If a₊ > 0 the machine starts forward, if a₋ < 0 backward; if a₊ ≤ 0 ≤ a₋ the pairs hold the
 applied moments. While they hold, the machine is *stuck*: φ is fixed, ω = φ̈ = 0, time goes on,
@@ -39,14 +39,13 @@ the moments (:func:`can_change`); elsewhere nothing could release it and the run
 """
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 
 from .chain import _best_candidate
 from . import eta_table as et
 from . import governor as gv
 from . import reactions as rx
-from .layout import (LT_TIME, SW_LOAD, T, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S,
-                     WK_SCRATCH)
+from .layout import (LT_TIME, SW_LOAD, T, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S, WK_SCRATCH)
 
 #: ``sw[SW_DIRECTION]`` while the machine is stuck (±1 while it moves).
 STUCK = 0

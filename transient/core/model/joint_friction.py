@@ -12,11 +12,11 @@ opposes, so the power lost, Σ (μ r |R| + c|q|)|q| + (μ|N| + F_ring + c_p P⁺
 
 The reactions by Newton–Euler
 -----------------------------
-Per cylinder, in its own frame (:mod:`transient.core.crank_slider`;
+Per cylinder, in its own frame (:mod:`transient.core.model.crank_slider`;
 ``transient.reference.crank_slider_joint_forces`` solves the same bodies as eight linear
 equations and is the independent check): the piston
 (mass m_p at the pin B), the rod (point masses at B and A and a rigid part at G with inertia I
-about G — the packed masses of :mod:`transient.core.crank_slider`), the throw (m_k at the crankpin
+about G — the packed masses of :mod:`transient.core.model.crank_slider`), the throw (m_k at the crankpin
 A). With F_B the rod's force on the piston, F_A the throw's on the rod, P_y = m_p a_By + P + F_s the
 piston's axial balance (F_s the slider's friction, toward the crank), D the rod's mass times
 acceleration and H its rate of angular momentum about B::
@@ -86,13 +86,12 @@ from math import cos, sin, sqrt
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 from .crank_slider import (E, I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, N_CYL, R,
                            ROD_CG, SIN0, rod_and_piston, rod_and_piston_second)
 from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
-                     RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS, WK_ETA, WK_RX,
-                     WK_S)
+                     RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS, WK_ETA, WK_RX, WK_S)
 
 #: Offsets of the rows from ``layout.WK_RX``: geometry at the state (l cos β, l sin β, the
 #: crankpin's position r sin α, r cos α, β′, s′), then per acceleration its part at ε = 0 and its

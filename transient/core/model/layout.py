@@ -1,4 +1,4 @@
-"""The layout of the compiled reduced model: the :data:`~transient.core.layout.Model` tuple, the
+"""The layout of the compiled reduced model: the :data:`~transient.core.model.layout.Model` tuple, the
 state vector, the
 switches, the output columns and the work array, with the index helpers that place the optional
 states (governor, latched fuels, cylinder pressures) after the fixed ones.
@@ -18,7 +18,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from .jit import compiled, kernel
+from ..jit import compiled, kernel
 
 from . import governor as gv
 
@@ -65,7 +65,7 @@ LINK_FIXED, LINK_PISTONS, LINK_SWASH, LINK_REST = 0, 1, 2, 3
 #: speed ω, the shaft angle φ in its cycle, the time t.
 LT_NONE, LT_SPEED, LT_ANGLE, LT_TIME = 0, 1, 2, 3
 
-#: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.chain``).
+#: Mode-selection policies of the non-ideal pairs (``Model.policy``; ``transient.core.model.chain``).
 POWER_FLOW, PAPER = 0, 1
 
 #: Columns written for every output sample; then one gas column per cylinder, then
@@ -135,7 +135,7 @@ Model = namedtuple(
     [
         "kind",  # int: CRANK_SLIDER, SWASH_PLATE, ARTICULATED or TABULATED
         "mech",  # float64[:]: the mechanism's packed parameters
-        "kin_coef",  # float64[1 + ncyl, n, 6]: the TABULATED kind's splines (transient.core.tabulated)
+        "kin_coef",  # float64[1 + ncyl, n, 6]: the TABULATED kind's splines (transient.core.model.tabulated)
         "ncyl",  # int: number of cylinders (gas force points)
         "J0",  # float: constant inertia of shaft, flywheel and load [kg m²]
         "has_gas",  # bool
@@ -143,7 +143,7 @@ Model = namedtuple(
         "gas_scale",  # float64[ncyl]: force per unit table value (piston area [m²], or 1 for forces)
         "gas_offset",  # float: table value of zero force (crankcase pressure p0 [Pa], or 0)
         "period",  # float: cycle length in local angle [rad] (4π four-stroke, 2π two-stroke)
-        "knots",  # float64[:], piecewise-cubic table (transient.core.tables)
+        "knots",  # float64[:], piecewise-cubic table (transient.core.model.tables)
         "coef",  # float64[:, 4], or [:, 8] with has_motored (full-load, then motored cubic)
         "piece_knot",  # int64[:]
         "has_motored",  # bool: coef pairs a motored curve; else it is the constant gas_offset
@@ -166,12 +166,12 @@ Model = namedtuple(
         "gov_on",  # bool: a static droop governor scales the gas forces
         "gov_full",  # float: ω_a, full fuel at and below it [rad/s]
         "gov_zero",  # float: ω_1c, no fuel at and above it [rad/s]
-        "gov_dyn",  # int: governor with states (transient.core.governor: NONE, PI, PID, FLYWEIGHT)
+        "gov_dyn",  # int: governor with states (transient.core.model.governor: NONE, PI, PID, FLYWEIGHT)
         "gov_par",  # float64[:]: its parameters (governor.P_* or governor.F_*)
         "latch",  # bool: each cylinder's fuel is latched at its start of injection
         "inj_angle",  # float: local angle of the start of injection [rad] (with latch)
         "woschni",  # bool: the closed part's pressures are states (wall heat transfer, .cylinder)
-        "cyl_par",  # float64[cylinder.N_PAR]: their parameters (transient.core.cylinder)
+        "cyl_par",  # float64[cylinder.N_PAR]: their parameters (transient.core.model.cylinder)
         "n_pairs",  # int: number of non-ideal pairs (0: ideal constraints, equation (18))
         "eta_fwd",  # float64[n_pairs]: efficiency of pair k when its shaft side drives
         "eta_bwd",  # float64[n_pairs]: efficiency of pair k when its far side drives
@@ -182,19 +182,19 @@ Model = namedtuple(
         "link_own",  # int64[n_links]: LINK_PISTONS or LINK_SWASH where a pair cuts the link
         #   from link_rest's sub-chain (its inertia then computed on its own), else LINK_FIXED
         "link_mass",  # float64[n_links]: m of a LINK_PISTONS link, J = m·Σ_k u_k² [kg]
-        # per-cylinder variation (transient.core.variation; the arrays' types are the same
+        # per-cylinder variation (transient.core.model.variation; the arrays' types are the same
         # without it, so that one compile serves every scene; packed in two arrays, as a
         # kernel that is not inlined copies every field of the Model at each call)
         "var_on",  # bool: some cylinder has a [[gas.cylinders]] entry
         "var_shifted",  # bool: some cylinder has a combustion offset
         "var_par",  # float64[ncyl, variation.N_VAR_PAR]: factors, cycle start, rate, offset
         "var_int",  # int64[ncyl, 2 + cycles listed]: misfire period, seed, misfiring cycles
-        # reaction friction in the mechanism's joints (transient.core.reactions); the
+        # reaction friction in the mechanism's joints (transient.core.model.reactions); the
         # pairs are then the joints that have friction, and no sub-chain is cut
         "reaction",  # bool: the pairs' losses follow from the joint reactions
         "rx_par",  # float64[N_JOINTS, N_RX_PAR]: each joint's coefficients (zeros: ideal)
         "rx_pair",  # int64[N_JOINTS]: the pair each joint reports as, −1 for an ideal joint
-        # efficiencies mapped over speed and transmitted moment (transient.core.eta_table); the
+        # efficiencies mapped over speed and transmitted moment (transient.core.model.eta_table); the
         # arrays keep their types without maps (one row of zeros), so one compile serves all
         "eta_table",  # bool: the pairs' η come from the maps below (eta_fwd, eta_bwd unused)
         "et_speed",  # float64[n_pairs, nw_max]: pair k's speed axis |ω|, increasing [rad/s]

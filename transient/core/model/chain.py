@@ -93,7 +93,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import compiled, kernel
+from ..jit import compiled, kernel
 
 #: Largest number of pairs :func:`modes_power_flow` enumerates (2ⁿ candidates).
 MAX_PAIRS = 6

@@ -2,14 +2,14 @@
 and the pairs' moments, solved through the serial chain from its far end.
 
 A run with prescribed speed calls this instead of the stepper; it shares the applied terms
-(:mod:`.forcing`) and the output rows (:mod:`transient.core.outputs`) with the dynamic run, so that
+(:mod:`.forcing`) and the output rows (:mod:`transient.core.model.outputs`) with the dynamic run, so that
 both report the same columns.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .jit import compiled, kernel
+from ..jit import compiled, kernel
 
 from .forcing import (fuel, generator_branch, governor_branch, load_segment, moments,
                       speed_knot_segment)
@@ -28,7 +28,7 @@ def inverse_chain(m, a, w, sigma, wk):
     """Drive torque on the shaft and pair moments for a prescribed motion (φ̈ = a, φ̇ = w).
 
     With a known, the sub-chain equations J_k a = R_k + η*_{k−1} S_{k−1} − S_k
-    (``transient.core.chain``) are solved from the far end: η*_{n−1} S_{n−1} = J_n a − R_n, …,
+    (``transient.core.model.chain``) are solved from the far end: η*_{n−1} S_{n−1} = J_n a − R_n, …,
     and the drive M_drive = J_0 a − R_0 + S_0. Every mode vector is tried (bit k: pair k backward)
     and the first consistent one kept: for ``power-flow`` S_k σ must have the mode's sign (always
     exactly one vector, because η* > 0 keeps the sign of η* S_k), for ``paper`` the criterion (25)

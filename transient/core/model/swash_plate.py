@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from math import atan2, cos, sin, sqrt
 
-from .jit import kernel
+from ..jit import kernel
 
 #: Layout of the parameter array ``mp``, filled by
 #: ``transient.mechanisms.swash_plate.SwashPlate.pack``:

@@ -8,7 +8,7 @@ stepper's grid samples and as a call for the rows written at events.
 """
 from __future__ import annotations
 
-from .jit import kernel
+from ..jit import kernel
 
 from .reactions import loss_moment
 from .forcing import command, cylinder_value, moments
@@ -28,7 +28,7 @@ def output_row(m, extras, angle_mode, y, sel, sw, wk, row):
 @kernel(inline=True)
 def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
-    (p_mot + f·(p_full − p_mot), see :func:`~transient.core.forcing.applied_value`, with a
+    (p_mot + f·(p_full − p_mot), see :func:`~transient.core.model.forcing.applied_value`, with a
     cylinder's fuel and pressure factors), ``PAIR_OUTPUTS`` of each pair, the
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
     samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample."""

@@ -5,7 +5,7 @@ A cylinder's cycles begin at its own angle ``Model.var_par[k, START]`` (cycle 1 
 progress at the initial angle) and repeat every ``Model.period``; the factor is constant over a
 cycle and changes only on a cycle's first angle, which is a breakpoint, so that the right-hand
 side stays smooth inside every step. The factor of a step is taken at its ``sel``, as the gas
-table's piece is (:func:`transient.core.forcing.select_pieces`).
+table's piece is (:func:`transient.core.model.forcing.select_pieces`).
 
 Random misfires come from a counter-based generator: the draw of cylinder k in cycle n is a
 hash of (seed, k, n), the SplitMix64 finaliser (Steele, Lea & Flood 2014, "Fast splittable
@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 #: Columns of ``Model.var_par`` (filled by ``transient.assemble.variation_fields``), per
 #: cylinder: fuel factor φ_k (0: cut out) [1], pressure factor β_k on p − p0 [1], the shaft

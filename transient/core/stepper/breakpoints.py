@@ -9,15 +9,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
-from . import cylinder as cyl
+from ..model import cylinder as cyl
 from .events import _crossing, _dense_once, _load_corner
-from .forcing import command, inertia, speed
-from .layout import OMEGA, PHI, cyl_index, latch_index
-from .stepper_io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, C_T_END,
-                         EV_INJECTION, F_PASSED_BP, F_REDO_LEVEL, I_ANGLE_MODE, I_NREDO,
-                         MAX_OUTPUT_INTERVALS, _emit_event, _retake)
+from ..model.forcing import command, inertia, speed
+from ..model.layout import OMEGA, PHI, cyl_index, latch_index
+from .io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, C_T_END,
+                 EV_INJECTION, F_PASSED_BP, F_REDO_LEVEL, I_ANGLE_MODE, I_NREDO,
+                 MAX_OUTPUT_INTERVALS, _emit_event, _retake)
 
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
@@ -172,7 +172,7 @@ def _inject(m, extras, y, sw, evbuf, ist, wk):
 @kernel
 def _close_intake(m, y):
     """At a breakpoint: each cylinder whose intake closes here starts its closed part at p_a
-    (``m.woschni``, :mod:`.cylinder`). Returns whether any did (the derivative at y changes)."""
+    (``m.woschni``, :mod:`~transient.core.model.cylinder`). Returns whether any did (the derivative at y changes)."""
     if not m.woschni:
         return False
     c = cyl_index(m)

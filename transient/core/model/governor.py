@@ -1,7 +1,7 @@
 """Dynamic speed governors, whose states are integrated with the engine.
 
 The static droop characteristic of the swash-plate paper (§4) has no state and lives in
-``transient.core.forcing`` (``fuel``). The two governors here move the fuel rack through states of
+``transient.core.model.forcing`` (``fuel``). The two governors here move the fuel rack through states of
 their own, appended to the state vector after the pairs' work integrals (``layout.gov_index``):
 
 **PI(D), isochronous.** Relative speed error e = (ω_ref − ω)/ω_ref. Controller output
@@ -45,7 +45,7 @@ from __future__ import annotations
 
 from math import sqrt
 
-from .jit import kernel
+from ..jit import kernel
 
 #: ``Model.gov_dyn``: the governor whose states are integrated (PID: PI with the derivative term
 #: and its filter state; a PI governor has no filter state to integrate).

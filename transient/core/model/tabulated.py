@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from .jit import kernel
+from ..jit import kernel
 
 TWO_PI = 2.0 * math.pi
 

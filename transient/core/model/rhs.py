@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from . import governor as gv
@@ -28,7 +28,7 @@ from .layout import (KINETIC, LINK_FIXED, LINK_PISTONS, OMEGA, PHI, POWER_FLOW, 
 @kernel(inline=True)
 def split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk):
     """J_k, J′_k and M_k of every sub-chain into ``wk`` (docs/theory.md, The serial chain;
-    :mod:`transient.core.chain`).
+    :mod:`transient.core.model.chain`).
 
     Links in order (the mechanism's ``links``): the shaft (J0 with flywheel and load; load and
     starter act on it), links of constant reduced inertia ``link_J`` (the crank), the link
@@ -125,7 +125,7 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     scalar arguments) would cost about as much as the right-hand side itself.
 
     In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
-    (``transient.core.chain``), so that the energy lost is exactly what the pairs account for.
+    (``transient.core.model.chain``), so that the energy lost is exactly what the pairs account for.
     ``extras``: the kernels' variant for ``m`` (:func:`.layout.extras_of`), as for every kernel
     that reaches a feature only some scenes use.
     """
@@ -174,7 +174,7 @@ def mode_margins(m, sw, wk):
 
     ``power-flow``: the power the pair transmits must have the mode's sign, S_k σ ≥ 0 forward,
     S_k σ < 0 backward. ``paper``: criterion (25) on the moments of everything on the shaft side,
-    (Σ_{j≤k} M_j) σ ≥ 0 forward (``transient.core.chain.modes_paper``).
+    (Σ_{j≤k} M_j) σ ≥ 0 forward (``transient.core.model.chain.modes_paper``).
     """
     sigma = sw[SW_DIRECTION]
     if sigma == st.STUCK:  # the holding margin, left by chain_acceleration

@@ -20,17 +20,17 @@ e′ = −β′ n, so (a e + q n)′ = β′(v_y, −v_x) for v = a e + q n; c�
 the crankpin) is r_i = 0: A_i = A, nothing else changes.
 
 The master cylinder is exactly a centred crank-slider: its piston, rod and crank throw use
-:func:`transient.core.crank_slider.cylinder_terms` on the same header of ``mp``.
+:func:`transient.core.model.crank_slider.cylinder_terms` on the same header of ``mp``.
 """
 from __future__ import annotations
 
 from math import cos, sin, sqrt
 
 from .crank_slider import L, R, cylinder_terms, slider
-from .jit import kernel
+from ..jit import kernel
 
 #: Layout of ``mp`` (filled by ``transient.mechanisms.articulated.Articulated.pack``). Slots 0–9
-#: are the crank-slider header of the master cylinder (``transient.core.crank_slider``: R, L,
+#: are the crank-slider header of the master cylinder (``transient.core.model.crank_slider``: R, L,
 #: E = 0, masses of the master piston, the master rod and the crank throw); then N_ROWS, N_SLAVES
 #: (slaves per row), and SLAVE_STRIDE entries per slave i from SLAVE0 + SLAVE_STRIDE·i: LINK_A a_i,
 #: LINK_Q q_i [m]; COS_D, SIN_D of δ_i; SLAVE_L l_i [m]; SLAVE_PISTON [kg]; SLAVE_ROD mass [kg];

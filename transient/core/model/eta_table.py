@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import kernel
+from ..jit import kernel
 
 from .chain import chain_solve
 
