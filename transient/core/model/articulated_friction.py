@@ -73,7 +73,7 @@ L the loss moment (−M q over ω for a journal, −F_s X′ for a slider) and �
 :func:`.joint_friction._pair_terms`.
 
 Shapes: ``jp`` = ``Model.rx_par`` float64[N_JOINTS, N_RX_PAR] (rows ``J_*`` below); the rows
-``WK_AX + A_*`` of ``wk`` hold one value per cylinder (the master's column k₀ = j(1 + z′) also
+``WK_RX + A_*`` of ``wk`` hold one value per cylinder (the master's column k₀ = j(1 + z′) also
 the row's crankpin and throw), the gas force row ``WK_RX + joint_friction.R_P`` and per pair the
 loss ``WK_RX + joint_friction.R_LOSS`` as the crank-slider's.
 """
@@ -81,14 +81,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..declare import Layout
 from ..jit import kernel
 
 from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0, SLAVE_CG, SLAVE_I,
                           SLAVE_L, SLAVE_PISTON, SLAVE_ROD, SLAVE_STRIDE, master_rod, row0, slave)
 from .crank_slider import I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, R, ROD_CG
-from .joint_friction import (MAX_ITER, R_LOSS, R_P, TOL, _norm, _slope, clear_pairs, newton_step,
+from .joint_friction import (MAX_ITER, R_LOSS, R_P, SHARED, TOL, _norm, _slope, clear_pairs, newton_step,
                              pair_efficiencies)
-from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_AX,
+from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
                      WK_CYL_LOSS, WK_RX, WK_S)
 
 #: The joints (rows of ``Model.rx_par``): main bearing, master crankpin, link pins, master piston
@@ -96,7 +97,8 @@ from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCO
 J_MAIN, J_CRANKPIN, J_LINK, J_MASTER_PIN, J_SLAVE_PIN, J_SLIDER = range(6)
 N_JOINTS = 6
 
-#: Offsets of the rows from ``layout.WK_AX``, per cylinder k: the rod from the piston pin to its
+#: The articulated mechanism's own rows, after the rows every solver shares
+#: (``joint_friction.SHARED``; offsets from ``layout.WK_RX``), per cylinder k: the rod from the piston pin to its
 #: other end (A − B, A_i − B_i), the piston's rate X′, the rod's rate θ′, per acceleration its
 #: part at ε = 0 and its slope in ε (the piston along its axis, D_x, D_y, H), the signs at ``sel``
 #: per unit σ of the slider's, the piston pin's and the big end's (crankpin or link pin) relative
@@ -104,9 +106,14 @@ N_JOINTS = 6
 #: velocity A_i′, and the force F_Ai with its derivatives in N_i and ε and the link friction's
 #: slopes; per row (the master's column) the crankpin A, its acceleration's parts and the forces
 #: F_A, F_O; the ``sel`` of the signs ([0]).
+ROWS = Layout("articulated reaction rows",
+              "lx", "ly", "dx", "dt", "ab0", "ab1", "dx0", "dx1", "dy0", "dy1", "h0", "h1", "ss",
+              "sp", "sj", "n", "rs", "qs", "ox", "oy", "px", "py", "fx", "fy", "vx", "vy", "wx",
+              "wy", "ln", "le", "ax", "ay", "aax0", "aax1", "aay0", "aay1", "fox", "foy", "sel",
+              start=SHARED.end)
 (A_LX, A_LY, A_DX, A_DT, A_AB0, A_AB1, A_DX0, A_DX1, A_DY0, A_DY1, A_H0, A_H1, A_SS, A_SP, A_SJ,
  A_N, A_RS, A_QS, A_OX, A_OY, A_PX, A_PY, A_FX, A_FY, A_VX, A_VY, A_WX, A_WY, A_LN, A_LE, A_AX,
- A_AY, A_AAX0, A_AAX1, A_AAY0, A_AAY1, A_FOX, A_FOY, A_SEL) = range(39)
+ A_AY, A_AAX0, A_AAX1, A_AAY0, A_AAY1, A_FOX, A_FOY, A_SEL) = ROWS
 
 
 @kernel(inline=True)
@@ -124,7 +131,7 @@ def prepare(mp, phi, w, sel, wk):
     """The rows of the state (φ, ω) for :func:`solve`: per cylinder its rod's geometry and the
     parts of the accelerations, per row the crankpin's; the joints' directions at ``sel`` when
     ``sel`` has changed (:func:`_directions`)."""
-    c = WK_AX
+    c = WK_RX
     r, l = mp[R], mp[L]
     ns = int(mp[N_SLAVES])
     j0 = row0(mp)
@@ -196,7 +203,7 @@ def prepare(mp, phi, w, sel, wk):
 def _directions(mp, sel, wk):
     """The signs at the angle ``sel`` of each cylinder's slider rate X′, its piston pin's and its
     big end's (crankpin or link pin) relative rate, per unit σ."""
-    c = WK_AX
+    c = WK_RX
     r, l = mp[R], mp[L]
     ns = int(mp[N_SLAVES])
     j0 = row0(mp)
@@ -221,7 +228,7 @@ def _row(mp, jp, pair_of, wk, j, eps, w, sigma, mu_on, out):
     to its pair's. Without ``mu_on`` the terms in |·| are left out (the start). Returns
     ``(T, Σ ∂T/∂N_k r_k, ∂T/∂ε − Σ ∂T/∂N_k q_k, converged)``, converged when every |r_k| is
     within TOL of its forces' scale."""
-    c = WK_AX
+    c = WK_RX
     ns = int(mp[N_SLAVES])
     k0 = j * (1 + ns)
     on = 1.0 if mu_on else 0.0
@@ -376,10 +383,10 @@ def _start(mp, jp, pair_of, wk, eps, w, sigma):
     ns = int(mp[N_SLAVES])
     for j in range(int(mp[N_ROWS])):
         for k in range(j * (1 + ns), (j + 1) * (1 + ns)):
-            wk[WK_AX + A_N, k] = 0.0
+            wk[WK_RX + A_N, k] = 0.0
         _row(mp, jp, pair_of, wk, j, eps, w, sigma, False, False)
         for k in range(j * (1 + ns), (j + 1) * (1 + ns)):
-            wk[WK_AX + A_N, k] = -wk[WK_AX + A_RS, k]
+            wk[WK_RX + A_N, k] = -wk[WK_RX + A_RS, k]
 
 
 @kernel
@@ -404,7 +411,7 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
             small = small and conv
         if not np.isfinite(H):
             return np.nan
-        eps -= newton_step(wk, WK_AX + A_N, WK_AX + A_RS, WK_AX + A_QS, n, H, den)
+        eps -= newton_step(wk, WK_RX + A_N, WK_RX + A_RS, WK_RX + A_QS, n, H, den)
         if small and abs(H) <= TOL * scale:
             _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs)
             return eps
@@ -437,7 +444,7 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
         for _ in range(MAX_ITER):
             conv = _row(mp, jp, pair_of, wk, j, eps, w, sigma, True, False)[3]
             for k in range(j * (1 + ns), (j + 1) * (1 + ns)):
-                wk[WK_AX + A_N, k] -= wk[WK_AX + A_RS, k]
+                wk[WK_RX + A_N, k] -= wk[WK_RX + A_RS, k]
             if conv:
                 done = True
                 break

@@ -86,6 +86,7 @@ from math import cos, sin, sqrt
 
 import numpy as np
 
+from ..declare import Layout
 from ..jit import kernel
 
 from .crank_slider import (E, I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, N_CYL, R,
@@ -93,19 +94,28 @@ from .crank_slider import (E, I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_
 from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
                      RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS, WK_ETA, WK_RX, WK_S)
 
-#: Offsets of the rows from ``layout.WK_RX``: geometry at the state (l cos β, l sin β, the
-#: crankpin's position r sin α, r cos α, β′, s′), then per acceleration its part at ε = 0 and its
-#: slope in ε (a_By, a_Ax, a_Ay, D_x, D_y, H), the gas force P, the signs of the crankpin's, the
-#: piston pin's and the piston's relative speed at ``sel`` per unit σ, the ``sel`` they are for
-#: ([0]), N's iterate, per pair the loss moment, per cylinder the parts g/g′ and (∂g/∂ε)/g′ of
-#: its Newton correction, and 1/(l cos β) (the solve multiplies by it, a division here).
+#: The rows from ``layout.WK_RX`` that every reaction solver shares, so that its callers fill
+#: and read them alike: each piston's gas force P (filled by :func:`.forcing.moments`), the step's
+#: angle ``sel`` that the joints' directions are for ([0]; a solver may keep its own) and, per
+#: pair, the moment its losses reduce to.
+SHARED = Layout("reaction rows, shared", "P", "sel", "loss")
+R_P, R_SEL, R_LOSS = SHARED
+#: The crank-slider's own rows, after the shared ones (offsets from ``layout.WK_RX``): geometry at
+#: the state (l cos β, l sin β, the crankpin's position r sin α, r cos α, β′, s′), then per
+#: acceleration its part at ε = 0 and its slope in ε (a_By, a_Ax, a_Ay, D_x, D_y, H), the signs
+#: of the crankpin's, the piston pin's and the piston's relative speed at ``sel`` per unit σ, N's
+#: iterate, per cylinder the parts g/g′ and (∂g/∂ε)/g′ of its Newton correction, and 1/(l cos β)
+#: (the solve multiplies by it, a division here); then the side forces seen by a step attempt's
+#: stages (:func:`track_sides`): the largest abscissa with N ≥ 0 and N there, the least with
+#: N < 0 and N there, the largest with N < 0, the least with N ≥ 0 (and N at each).
+ROWS = Layout("crank-slider reaction rows",
+              "lcb", "lsb", "ax", "ay", "db", "ds", "aby0", "aby1", "aax0", "aax1", "aay0",
+              "aay1", "dx0", "dx1", "dy0", "dy1", "h0", "h1", "sa", "sb", "ss", "n", "step",
+              "couple", "ilcb", "xp_hi", "np_hi", "xn_lo", "nn_lo", "xn_hi", "nn_hi", "xp_lo",
+              "np_lo", start=SHARED.end)
 (R_LCB, R_LSB, R_AX, R_AY, R_DB, R_DS, R_ABY0, R_ABY1, R_AAX0, R_AAX1, R_AAY0, R_AAY1, R_DX0,
- R_DX1, R_DY0, R_DY1, R_H0, R_H1, R_P, R_SA, R_SB, R_SS, R_SEL, R_N, R_LOSS, R_STEP,
- R_COUPLE, R_ILCB) = range(28)
-#: Rows of the side forces seen by a step attempt's stages (:func:`track_sides`): the largest
-#: abscissa with N ≥ 0 and N there, the least with N < 0 and N there, the largest with N < 0, the
-#: least with N ≥ 0 (and N at each).
-(R_XP_HI, R_NP_HI, R_XN_LO, R_NN_LO, R_XN_HI, R_NN_HI, R_XP_LO, R_NP_LO) = range(28, 36)
+ R_DX1, R_DY0, R_DY1, R_H0, R_H1, R_SA, R_SB, R_SS, R_N, R_STEP, R_COUPLE, R_ILCB,
+ R_XP_HI, R_NP_HI, R_XN_LO, R_NN_LO, R_XN_HI, R_NN_HI, R_XP_LO, R_NP_LO) = ROWS
 
 #: Newton's method has converged when its corrections are below TOL of their scales; the
 #: correction is then applied and, convergence being quadratic with a constant of the order of

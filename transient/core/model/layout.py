@@ -18,38 +18,102 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED, Block, Layout, Sized
 from ..jit import compiled, kernel
 
 from . import governor as gv
 
-#: Names of the state components, in order (the third is K = ½Jω² in crank-angle mode). The first
-#: three are the dynamics; then work integrals (quadratures that do not feed back): the work
-#: of the gas forces, of the load and of the starter [J], then the energy lost in each non-ideal
-#: pair k (``W_loss_<k+1>``). Integrated with the motion, the work–energy balance
-#: ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load + W_starter − Σ W_loss,k holds to the solver's accuracy.
-#: After them the dynamic governor's states (:mod:`.governor`, from :func:`gov_index`), then, with
-#: fuel latching, the fuel each cylinder took at its last injection (:func:`latch_index`; held
-#: constant between injections: their derivative is zero and the stepper sets them), then, with
-#: wall heat transfer, each cylinder's pressure in its closed part (:func:`cyl_index`,
-#: :mod:`.cylinder`; the ``p_<k>`` columns show it there).
-STATE = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
-PHI, T, OMEGA, W_GAS, W_LOAD, W_STARTER = range(6)
+#: The state vector's blocks, in order (a :class:`~transient.core.declare.Layout`). The first
+#: three are the dynamics, φ, t and the third, ω in time or K = ½Jω² in crank angle; then work
+#: integrals, quadratures that do not feed back: the work of the gas forces, of the load and of
+#: the starter [J], then the energy lost in each non-ideal pair k (``W_loss_<k+1>``).
+#: Integrated with the motion, the work–energy balance ½J(φ)ω² − ½J(φ₀)ω₀² = W_gas + W_load +
+#: W_starter − Σ W_loss,k holds to the solver's accuracy. After them the dynamic governor's
+#: states (:mod:`.governor`), then, with fuel latching, the fuel each cylinder took at its last
+#: injection (held constant between injections: their derivative is zero and the stepper sets
+#: them), then, with wall heat transfer, each cylinder's pressure in its closed part
+#: (:mod:`.cylinder`; the ``p_<k>`` columns show it there).
+#:
+#: A block whose length depends on the scene is :class:`~transient.core.declare.Sized`: its
+#: offset is computed at assembly into ``Model.state_at`` (:func:`layout_fields`), which the
+#: kernels read (:func:`gov_index`, :func:`latch_index`, :func:`cyl_index`, :func:`n_state`)
+#: instead of counting it. A new block of states (per cylinder, per shaft station) is one more
+#: entry here, its size rule and its error control (:data:`CONTROL`), and an index function.
+STATE = Layout(
+    "state",
+    Block("phi", 1, "shaft angle φ [rad]"),
+    Block("t", 1, "time t [s]"),
+    Block("omega", 1, "shaft speed ω [rad/s] in time; kinetic energy K = ½Jω² [J] in crank angle"),
+    Block("work", 3, "work of the gas forces, of the load, of the starter [J]"),
+    Block("loss", Sized(lambda m: m.n_pairs, "one per non-ideal pair"),
+          "energy lost in each non-ideal pair [J]"),
+    Block("governor", Sized(lambda m: gv.n_states(m.gov_dyn), "the governor's states"),
+          "the dynamic governor's states (governor.STATE_NAMES)"),
+    Block("latched", Sized(lambda m: m.ncyl if m.latch else 0, "one per cylinder with latching"),
+          "the fuel each cylinder latched at its last injection [1]"),
+    Block("pressure", Sized(lambda m: m.ncyl if m.woschni else 0,
+                            "one per cylinder with wall heat"),
+          "each cylinder's pressure in its closed part [Pa]"),
+)
+#: The blocks' numbers (places in :data:`STATE`, the indices of ``Model.state_at``).
+B_PHI, B_T, B_OMEGA, B_WORK, B_LOSS, B_GOVERNOR, B_LATCHED, B_PRESSURE = range(len(STATE))
+N_STATE_BLOCKS = len(STATE)
+#: The components at offsets known at import (every block before them has a fixed size).
+PHI, T, OMEGA = STATE.fixed_offset("phi"), STATE.fixed_offset("t"), STATE.fixed_offset("omega")
 KINETIC = OMEGA
-N_DYNAMIC = 3
-N_STATE_BASE = len(STATE)
+W_GAS, W_LOAD, W_STARTER = range(STATE.fixed_offset("work"), STATE.fixed_offset("loss"))
+N_DYNAMIC = STATE.fixed_offset("work")
+N_STATE_BASE = STATE.fixed_offset("loss")
 W_LOSS0 = N_STATE_BASE  # y[W_LOSS0 + k]: energy lost in pair k
+#: Names of the components of fixed offset, in order (the third is K = ½Jω² in crank angle).
+STATE_NAMES = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
+#: How the step's error control treats each block (:data:`transient.core.declare.BY_SIZE` …):
+#: φ and t accumulate, so an error in them is scaled by their increment over the step; the work
+#: integrals, the losses and the latched fuels are not controlled (they do not feed back, or are
+#: held constant between injections).
+CONTROL = {"phi": BY_INCREMENT, "t": BY_INCREMENT, "omega": BY_SIZE, "work": NOT_CONTROLLED,
+           "loss": NOT_CONTROLLED, "governor": BY_SIZE, "latched": NOT_CONTROLLED,
+           "pressure": BY_SIZE}
 
-#: Discrete switches held constant over a step (an int array ``sw``): starter engaged (0/1), the
-#: governor's branch (see :func:`.forcing.governor_branch`), the modes of the non-ideal pairs
-#: (bit k set: pair k backward, its far side drives), the direction of motion σ = ±1 that the
-#: pair modes refer to (sign of ω; changed only at a speed reversal, where the modes are chosen
-#: afresh), the segment of the load schedule (:func:`.forcing.load_segment`) and the generator's
-#: low-speed branch (:func:`.forcing.generator_branch`), the flyweight governor's sleeve,
-#: moving or on a stop (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``), and the interval of
-#: a tabulated load against speed (:func:`.forcing.speed_knot_segment`).
+
+def layout_fields(fields: dict) -> dict:
+    """The Model's fields that lay out its state and its output row, from its other ``fields``
+    (by name): ``state_at``, the offset of each block of :data:`STATE` and then the state's
+    length; ``state_control``, the error control of each component (:data:`CONTROL`);
+    ``out_at``, the offsets of :data:`OUTPUT`'s blocks and then the row's length."""
+    view = _Fields(fields)
+    at = STATE.offsets_for(view)
+    if at[B_LOSS] != W_LOSS0 or OUTPUT.offsets_for(view)[O_GAS] != N_OUT_FIXED:
+        # (the kernels index what comes before these by constants)
+        raise AssertionError("the layouts' fixed blocks moved: STATE's loss block starts at "
+                             f"{at[B_LOSS]}, not {W_LOSS0}")
+    control = np.concatenate([np.full(n, CONTROL[b.name], dtype=np.int64)
+                              for b, n in zip(STATE.blocks, STATE.sizes_for(view))])
+    return dict(state_at=np.array(at, dtype=np.int64), state_control=control,
+                out_at=np.array(OUTPUT.offsets_for(view), dtype=np.int64))
+
+
+class _Fields:
+    """A Model's fields by attribute, before the Model is made (for the size rules)."""
+
+    def __init__(self, fields: dict):
+        self.__dict__.update(fields)
+
+
+#: Discrete switches held constant over a step (an int array ``sw``, the first block of the
+#: stepper's integer state, ``stepper.io.INTS``): starter engaged (0/1), the governor's branch
+#: (see :func:`.forcing.governor_branch`), the modes of the non-ideal pairs (bit k set: pair k
+#: backward, its far side drives), the direction of motion σ = ±1 that the pair modes refer to
+#: (sign of ω; changed only at a speed reversal, where the modes are chosen afresh), the segment
+#: of the load schedule (:func:`.forcing.load_segment`) and the generator's low-speed branch
+#: (:func:`.forcing.generator_branch`), the flyweight governor's sleeve, moving or on a stop
+#: (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``), and the interval of a tabulated load
+#: against speed (:func:`.forcing.speed_knot_segment`).
+SWITCHES = Layout("switches", "starter", "governor", "modes", "direction", "load", "generator",
+                  "sleeve", "load_table")
 (SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE,
- SW_LOAD_TABLE) = range(8)
-N_SWITCHES = 8
+ SW_LOAD_TABLE) = SWITCHES
+N_SWITCHES = SWITCHES.size
 
 #: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
 CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
@@ -82,31 +146,58 @@ COL_M_GAS, COL_M_LOAD = OUTPUTS.index("M_gas"), OUTPUTS.index("M_load")
 #: η*_k S_k), η*_k in use, the power lost (1 − η*_k) S_k ω and the energy lost so far.
 PAIR_OUTPUTS = ("S", "eta", "P_loss", "W_loss")
 PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
+#: The output row's blocks (``transient.outputs.output_columns`` names the columns in this
+#: order); the offsets of the sized ones in ``Model.out_at``, computed at assembly
+#: (:func:`layout_fields`) as the state's.
+OUTPUT = Layout(
+    "output row",
+    Block("fixed", len(OUTPUTS), "the columns OUTPUTS"),
+    Block("gas", Sized(lambda m: m.ncyl, "one per cylinder"),
+          "the pressure (force) applied in each cylinder"),
+    Block("pairs", Sized(lambda m: len(PAIR_OUTPUTS) * m.n_pairs, "PAIR_OUTPUTS per pair"),
+          "each non-ideal pair's PAIR_OUTPUTS"),
+    Block("governor", Sized(lambda m: gv.n_states(m.gov_dyn), "the governor's states"),
+          "the dynamic governor's states"),
+    Block("latched", Sized(lambda m: m.ncyl if m.latch else 0, "one per cylinder with latching"),
+          "the fuel each cylinder latched"),
+    Block("cyl_loss", Sized(lambda m: m.n_pairs * m.ncyl if m.reaction else 0,
+                            "one per reaction pair and cylinder"),
+          "the power each reaction pair loses in each cylinder (pair 1 in cylinders 1 … n, …)"),
+)
+O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS = range(len(OUTPUT))
+N_OUTPUT_BLOCKS = len(OUTPUT)
 
-#: Rows of the work array ``wk`` (see :func:`work_array`): transfer functions u, u′ per cylinder;
-#: per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the mode margins g_k, their least value
-#: over the right-hand sides evaluated since the stepper reset it, and η*, S of a trial mode
-#: vector; the least and largest speed ω over those right-hand sides ([0], [1] of WK_SPEED), and
-#: of the PI governor's demand u (WK_DEMAND); per cylinder the angle ``sel`` in its own cycle
-#: and the gas table's piece there (WK_LOCAL, WK_PIECE), for the ``sel`` in WK_SEL[0]
-#: (:func:`.forcing.select_pieces`), with per-cylinder variation its fuel factor in that cycle
-#: (WK_FUEL, :func:`.variation.cycle_fuel`) and, with combustion offsets, its angle and piece
-#: on the curve shifted by its offset (WK_LOCAL_SHIFT, WK_PIECE_SHIFT).
+#: Rows of the work array ``wk`` (see :func:`work_array`), one column per cylinder, pair or link:
+#: transfer functions u, u′ per cylinder; per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the
+#: mode margins g_k, their least value over the right-hand sides evaluated since the stepper
+#: reset it, and η*, S of a trial mode vector; the least and largest speed ω over those
+#: right-hand sides ([0], [1] of WK_SPEED), and of the PI governor's demand u (WK_DEMAND); per
+#: cylinder the angle ``sel`` in its own cycle and the gas table's piece there (WK_LOCAL,
+#: WK_PIECE), for the ``sel`` in WK_SEL[0] (:func:`.forcing.select_pieces`), with per-cylinder
+#: variation its fuel factor in that cycle (WK_FUEL, :func:`.variation.cycle_fuel`) and, with
+#: combustion offsets, its angle and piece on the curve shifted by its offset (WK_LOCAL_SHIFT,
+#: WK_PIECE_SHIFT); scratch rows for ``chain.modes_power_flow_into``; with reaction friction,
+#: row WK_CYL_LOSS + p holds pair p's loss moment in each cylinder (the split of the pair's loss
+#: that the output rows report per cylinder; one row per joint, the most pairs there can be).
+#:
+#: From WK_RX on, the rows of the mechanism's reaction solver (``Model.reaction``,
+#: :mod:`.reactions`): the rows every solver shares (``reactions.SHARED``: each piston's gas
+#: force, the angle its joints' directions are for, the pairs' loss moments), then each solver's
+#: own, which it declares (``joint_friction.ROWS``, ``swash_friction.ROWS``,
+#: ``articulated_friction.ROWS``), laid over one another: a scene has one mechanism. A scene's
+#: array has its own solver's rows (``Model.wk_rows``, ``reactions.work_rows``).
+WORK = Layout(
+    "work array rows",
+    "u", "du", "J", "dJ", "M", "eta", "S", "g", "g_min", "eta_try", "S_try", "speed", "demand",
+    "local", "piece", "sel", "fuel", "local_shift", "piece_shift",
+    ("scratch", 4, "scratch of chain.modes_power_flow_into"),
+    ("cyl_loss", 6, "each reaction pair's loss moment in each cylinder"),
+)
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
- WK_SCRATCH) = range(20)
-#: With reaction friction (``Model.reaction``, :mod:`.reactions`) the rows from WK_RX on
-#: hold, per cylinder, the mechanism's geometry and accelerations at the state, the gas force,
-#: the joints' directions of sliding at the step's angle ``sel`` and the solve's iterates
-#: (``joint_friction.R_*``, ``swash_friction.S_*`` are the offsets), and per pair the moment its
-#: losses reduce to: as many rows as the mechanism that needs most (the swash plate's).
-WK_RX = WK_SCRATCH + 4  # four rows of scratch for chain.modes_power_flow_into before it
-N_WK_RX = 36
-#: The articulated mechanism's rows (:mod:`.articulated_friction`, ``A_*`` are the offsets): per
-#: cylinder its rods' geometry and accelerations, the directions and the solve's iterates; it
-#: shares the gas force's and the pairs' loss rows of WK_RX.
-WK_AX = WK_RX + N_WK_RX
-N_WK_AX = 39
+ WK_SCRATCH, WK_CYL_LOSS) = WORK
+N_SCRATCH = WORK.size_of("scratch")
+WK_RX = WORK.end
 
 #: The joints of the crank-slider that reaction friction acts in (rows of ``Model.rx_par``): the
 #: main bearing (frame – throw), the crankpin (throw – rod), the piston pin (rod – piston) and the
@@ -115,11 +206,7 @@ JOINT_MAIN, JOINT_CRANKPIN, JOINT_PIN, JOINT_SLIDER = range(4)
 #: Rows of ``Model.rx_par`` and ``Model.rx_pair``: the most joints of a mechanism's reaction
 #: friction (the articulated mechanism's six, ``articulated_friction.J_*``), so that the arrays
 #: have one shape and one compile serves every scene.
-N_JOINTS = 6
-#: With reaction friction, row WK_CYL_LOSS + p holds pair p's loss moment in each cylinder (one
-#: column per cylinder): the split of the pair's loss that the output rows report per cylinder.
-WK_CYL_LOSS = WK_AX + N_WK_AX
-N_WK = WK_CYL_LOSS + N_JOINTS
+N_JOINTS = WORK.size_of("cyl_loss")
 #: Columns of ``Model.rx_par``: the friction coefficient μ [1], the journal's radius r [m], the
 #: viscous coefficient (journal: N m s/rad on the relative angular speed; slider: N s/m on the
 #: piston speed), the rings' tension friction force [N] and the share of the gas force that
@@ -202,6 +289,12 @@ Model = namedtuple(
         "et_size",  # int64[n_pairs, 2]: the lengths of pair k's two axes
         "et_eta",  # float64[n_pairs, 2, nw_max, ns_max]: η_fwd, η_bwd on pair k's grid [1]
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
+        # the layouts of the arrays whose blocks' lengths depend on the scene (computed at
+        # assembly from the declarations: layout_fields, reactions.work_rows)
+        "state_at",  # int64[len(STATE) + 1]: the offset of each block of the state, then its size
+        "state_control",  # int64[n_state]: each component's error control (CONTROL)
+        "out_at",  # int64[len(OUTPUT) + 1]: the offset of each block of the output row, its size
+        "wk_rows",  # int: rows of the work array: WORK, then the scene's reaction solver's
     ],
 )
 
@@ -226,45 +319,45 @@ def extras_of(m):
 @kernel(inline=True)
 def gov_index(m):
     """Index of the dynamic governor's first state."""
-    return N_STATE_BASE + m.n_pairs
+    return m.state_at[B_GOVERNOR]
 
 
 @kernel(inline=True)
 def latch_index(m):
     """Index of cylinder 0's latched fuel (with ``m.latch``)."""
-    return N_STATE_BASE + m.n_pairs + gv.n_states(m.gov_dyn)
+    return m.state_at[B_LATCHED]
 
 
 @kernel(inline=True)
 def cyl_index(m):
     """Index of cylinder 0's pressure state (with ``m.woschni``), after the latched fuels."""
-    return latch_index(m) + (m.ncyl if m.latch else 0)
+    return m.state_at[B_PRESSURE]
 
 
 @kernel
 def n_state(m):
     """Length of the state vector of model ``m``."""
-    return cyl_index(m) + (m.ncyl if m.woschni else 0)
+    return m.state_at[N_STATE_BLOCKS]
 
 
 @kernel
 def n_outputs(m):
     """Columns of an output row of model ``m``."""
-    return cylinder_loss_col(m) + (m.n_pairs * m.ncyl if m.reaction else 0)
+    return m.out_at[N_OUTPUT_BLOCKS]
 
 
 @kernel(inline=True)
 def cylinder_loss_col(m):
     """Column of an output row where the reaction pairs' losses per cylinder start (the last
     columns: pair 1 in cylinders 1 … n, then pair 2, …)."""
-    return (N_OUT_FIXED + m.ncyl + len(PAIR_OUTPUTS) * m.n_pairs + gv.n_states(m.gov_dyn)
-            + (m.ncyl if m.latch else 0))
+    return m.out_at[O_CYL_LOSS]
 
 
 @compiled
 def work_array(m):
-    """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
-    wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
+    """Scratch space of the right-hand side (rows ``WK_*``, ``Model.wk_rows`` of them),
+    allocated once per run."""
+    wk = np.empty((m.wk_rows, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
     wk[WK_SEL, 0] = np.nan  # no pieces selected yet
     wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
     return wk

@@ -22,7 +22,7 @@ from .swash_plate import link_terms as swash_link_terms
 from .forcing import command, cylinder_rates, governor_rates, moments
 from .layout import (KINETIC, LINK_FIXED, LINK_PISTONS, OMEGA, PHI, POWER_FLOW, SW_DIRECTION,
                      SW_MODES, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_DJ, WK_DU, WK_ETA, WK_G,
-                     WK_G_MIN, WK_J, WK_M, WK_S, WK_SCRATCH, WK_SPEED, WK_U)
+                     WK_G_MIN, WK_J, WK_M, WK_S, WK_SCRATCH, WK_SPEED, WK_U, N_SCRATCH)
 
 
 @kernel(inline=True)
@@ -243,7 +243,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
                                              wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,
                                              wk[WK_ETA, :n], wk[WK_S, :n],
-                                             wk[WK_SCRATCH: WK_SCRATCH + 4, :n])
+                                             wk[WK_SCRATCH: WK_SCRATCH + N_SCRATCH, :n])
     if status == LOCKED:
         return status
     if w != 0.0:

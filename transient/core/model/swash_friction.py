@@ -104,9 +104,10 @@ from math import cos, sin, sqrt
 
 import numpy as np
 
+from ..declare import Layout
 from ..jit import kernel
 
-from .joint_friction import (MAX_ITER, R_LOSS, R_P, R_SEL, TOL, _norm, _slope, clear_pairs,
+from .joint_friction import (MAX_ITER, R_LOSS, R_P, R_SEL, SHARED, TOL, _norm, _slope, clear_pairs,
                              newton_step, pair_efficiencies)
 from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS,
                      WK_RX, WK_S)
@@ -118,22 +119,21 @@ from .swash_plate import (COS_A, HALVES, HINGE_PHASE, I_CROSS, I_ROD, J_DIAM, J_
 #: (link 9 – rod) and D_k (rod – piston), ideal here, and the pistons in their cylinders.
 J_MAIN, J_PLATE, J_BALL_B, J_BALL_D, J_SLIDER = range(5)
 
-#: Offsets of the rows from ``layout.WK_RX``, per cylinder: the rod's axial force t at f = 0 (the
-#: part at ε = 0, its slope in ε; the gas force is added when solving), the side force N at
-#: f = 0 (y, z; part and slope), e⊥/e_x (∂N/∂f), K = m a_G − Q (x, y, z; part and slope), e, the
-#: shaft-torque terms −(ξ × B)·K (part, slope) and ρ = (ξ × B)·e, x_D′, the piston's direction
-#: of sliding at ``sel`` per unit σ, f's iterate and the two parts of its Newton correction.
-#: R_P (gas force), R_SEL and R_LOSS are :mod:`.joint_friction`'s rows, so that the caller fills
-#: and reads them alike. Then one value each (column 0): link 9's and the cross's part of T
-#: (part, slope), κ and θ′.
+#: The swash plate's own rows, after the rows every solver shares (``joint_friction.SHARED``:
+#: the gas force R_P, the angle R_SEL, the losses R_LOSS), offsets from ``layout.WK_RX``; per
+#: cylinder: the rod's axial force t at f = 0 (the part at ε = 0, its slope in ε; the gas force
+#: is added when solving), the side force N at f = 0 (y, z; part and slope), e⊥/e_x (∂N/∂f),
+#: K = m a_G − Q (x, y, z; part and slope), e, the shaft-torque terms −(ξ × B)·K (part, slope)
+#: and ρ = (ξ × B)·e, x_D′, the piston's direction of sliding at ``sel`` per unit σ, f's iterate
+#: and the two parts of its Newton correction. Then one value each (column 0): link 9's and the
+#: cross's part of T (part, slope), κ and θ′.
+ROWS = Layout("swash-plate reaction rows",
+              "t0", "t1", "ny0", "ny1", "nz0", "nz1", "ry", "rz", "kx0", "kx1", "ky0", "ky1",
+              "kz0", "kz1", "ex", "ey", "ez", "tau0", "tau1", "rho", "x1", "ss", "f", "step",
+              "couple", "gx0", "gx1", "gkappa", "gdth", start=SHARED.end)
 (S_T0, S_T1, S_NY0, S_NY1, S_NZ0, S_NZ1, S_RY, S_RZ, S_KX0, S_KX1, S_KY0, S_KY1, S_KZ0, S_KZ1,
- S_EX, S_EY, S_EZ, S_TAU0) = range(18)
-S_TAU1, S_RHO, S_X1 = 19, 20, 21
-S_SS = 23
-S_F, S_STEP, S_COUPLE = 25, 26, 27
-S_GX0, S_GX1, S_GKAPPA, S_GDTH = 28, 29, 30, 31
-#: Rows from ``layout.WK_RX`` this module uses.
-N_ROWS = 32
+ S_EX, S_EY, S_EZ, S_TAU0, S_TAU1, S_RHO, S_X1, S_SS, S_F, S_STEP, S_COUPLE, S_GX0, S_GX1,
+ S_GKAPPA, S_GDTH) = ROWS
 
 
 @kernel(inline=True)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..declare import Layout
 from ..jit import kernel
 
 from ..model.chain import MAX_PAIRS
@@ -193,8 +194,28 @@ def _fall_after_rise(m, extras, angle_mode, F, y, x, h, k, theta_end, sel, sw, t
     return 0.0, N_FINE_SAMPLES
 
 
-FIRST_PAIR_EVENT = 16
-N_EVENT_KINDS = FIRST_PAIR_EVENT + MAX_PAIRS
+#: The state events watched on every step (:func:`_event_spec`), each with its slots (the event
+#: functions it may need at once: a corner above and one below, both stops of the sleeve, one
+#: per pair), in the order that breaks a tie between two events at one instant (the first slot
+#: wins). The events themselves, with their names and codes, are ``io.EVENTS``.
+WATCHED = Layout(
+    "watched events",
+    ("starter_cutout", 1, "the speed rising to the starter's cut-out"),
+    ("to_time", 1, "in crank angle, the speed falling to the switch speed"),
+    ("to_angle", 1, "in time, the speed rising to 1.5 × the switch speed"),
+    ("reversal", 1, "in time, ω = 0"),
+    ("end", 1, "the run's end by the variable that is not independent"),
+    ("governor", 2, "the droop characteristic's corners, or the PI demand's limits"),
+    ("load_schedule", 2, "the schedule's corner ahead; in φ, the one behind"),
+    ("generator", 1, "the generator's minimum speed"),
+    ("sleeve", 4, "the sleeve reaching its low, its high stop; leaving the low, the high"),
+    ("load_knot", 2, "a speed map's knot above ω, and the one below"),
+    ("pair_mode", MAX_PAIRS, "each pair's mode margin falling to zero"),
+)
+(W_STARTER_CUTOUT, W_TO_TIME, W_TO_ANGLE, W_REVERSAL, W_END, W_GOVERNOR, W_LOAD_SCHEDULE,
+ W_GENERATOR, W_SLEEVE, W_LOAD_KNOT, W_PAIR_MODE) = WATCHED
+FIRST_PAIR_EVENT = W_PAIR_MODE
+N_EVENT_KINDS = WATCHED.size
 
 
 @kernel(inline=True)
@@ -217,55 +238,57 @@ def _event_spec(m, extras, cfg, e, angle_mode, sw):
     above and, for corners in φ (the shaft may turn back in time mode), the one below. On the
     independent variable the segment also ends on the corner (``breakpoints._segment_end``), so
     the event is found at the step's end exactly, as a breakpoint is in crank angle."""
-    if e == 0 and sw[SW_STARTER] == 1:
+    if e == W_STARTER_CUTOUT and sw[SW_STARTER] == 1:
         return EV_STARTER_CUTOUT, OMEGA, m.starter_cutout, 1
-    if e == 1 and angle_mode:
+    if e == W_TO_TIME and angle_mode:
         return EV_TO_TIME, OMEGA, cfg[C_W_LO], -1
-    if e == 2 and not angle_mode:
+    if e == W_TO_ANGLE and not angle_mode:
         return EV_TO_ANGLE, OMEGA, cfg[C_W_HI], 1
-    if e == 3 and not angle_mode:
+    if e == W_REVERSAL and not angle_mode:
         return EV_REVERSAL, OMEGA, 0.0, 0
-    if e == 4:  # the end of the run by the variable that is not independent
+    if e == W_END:  # the end of the run by the variable that is not independent
         if angle_mode:
             return EV_END, T, cfg[C_T_END], 1
         return EV_END, PHI, cfg[C_PHI_END], 1
-    if 5 <= e < 7 and m.gov_on:  # the droop characteristic's corners at ω_a and ω₁c
-        return EV_GOVERNOR, OMEGA, m.gov_full if e == 5 else m.gov_zero, 0
-    if extras is not None and 5 <= e < 7 and is_pi(m):  # the PI demand reaching a limit
-        return EV_GOVERNOR, DEMAND_COMP, m.gov_par[gv.P_FMAX if e == 5 else gv.P_FMIN], 0
-    if e == 7 and sw[SW_LOAD] < m.load_x.shape[0]:  # the schedule's corner ahead
+    if W_GOVERNOR <= e < W_GOVERNOR + 2 and m.gov_on:  # the droop characteristic's corners
+        return EV_GOVERNOR, OMEGA, m.gov_full if e == W_GOVERNOR else m.gov_zero, 0
+    if extras is not None and W_GOVERNOR <= e < W_GOVERNOR + 2 and is_pi(m):  # PI demand limits
+        return EV_GOVERNOR, DEMAND_COMP, m.gov_par[gv.P_FMAX if e == W_GOVERNOR else gv.P_FMIN], 0
+    if e == W_LOAD_SCHEDULE and sw[SW_LOAD] < m.load_x.shape[0]:  # the schedule's corner ahead
         return EV_LOAD, m.load_comp, m.load_x[sw[SW_LOAD]], 1
-    if e == 8 and m.load_comp == PHI and sw[SW_LOAD] > 0:  # behind, reached turning back
-        return EV_LOAD, PHI, m.load_x[sw[SW_LOAD] - 1], -1
-    if e == 9 and m.gen_power != 0.0:  # the generator's minimum speed
+    if e == W_LOAD_SCHEDULE + 1 and m.load_comp == PHI and sw[SW_LOAD] > 0:  # behind, reached
+        return EV_LOAD, PHI, m.load_x[sw[SW_LOAD] - 1], -1  # turning back
+    if e == W_GENERATOR and m.gen_power != 0.0:  # the generator's minimum speed
         return EV_GENERATOR, OMEGA, m.gen_min, 0
-    if extras is not None and 10 <= e < 14 and m.gov_dyn == gv.FLYWEIGHT:
-        return _sleeve_event(m, e, sw)
-    if (extras is not None and e == 14 and m.lt_kind == LT_SPEED
+    if extras is not None and W_SLEEVE <= e < W_SLEEVE + 4 and m.gov_dyn == gv.FLYWEIGHT:
+        return _sleeve_event(m, e - W_SLEEVE, sw)
+    if (extras is not None and e == W_LOAD_KNOT and m.lt_kind == LT_SPEED
             and sw[SW_LOAD_TABLE] < m.lt_x.shape[0]):
         return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE]], 1  # a speed map's knot above ω
-    if extras is not None and e == 15 and m.lt_kind == LT_SPEED and sw[SW_LOAD_TABLE] > 0:
+    if (extras is not None and e == W_LOAD_KNOT + 1 and m.lt_kind == LT_SPEED
+            and sw[SW_LOAD_TABLE] > 0):
         return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE] - 1], -1  # and the one below
-    if extras is not None and e >= FIRST_PAIR_EVENT and e - FIRST_PAIR_EVENT < m.n_pairs:
-        # the mode margin of pair e − FIRST_PAIR_EVENT falls to zero
-        return EV_PAIR_MODE, PAIR_COMP + e - FIRST_PAIR_EVENT, 0.0, -1
+    if extras is not None and e >= W_PAIR_MODE and e - W_PAIR_MODE < m.n_pairs:
+        # the mode margin of pair e − W_PAIR_MODE falls to zero
+        return EV_PAIR_MODE, PAIR_COMP + e - W_PAIR_MODE, 0.0, -1
     return -1, OMEGA, 0.0, 0
 
 
 @kernel(inline=True)
-def _sleeve_event(m, e, sw):
-    """The flyweight governor's events (``_event_spec``, e = 10 … 13): a moving sleeve reaching
-    its low or high stop; on a stop, the speed at which the net force turns away from it."""
+def _sleeve_event(m, s, sw):
+    """The flyweight governor's events (``_event_spec``, slot ``s`` of the sleeve's four): a
+    moving sleeve reaching its low or high stop; on a stop, the speed at which the net force
+    turns away from it."""
     par = m.gov_par
     z = gov_index(m) + gv.FW_LIFT
     sleeve = sw[SW_SLEEVE]
-    if e == 10 and sleeve == gv.FREE:
+    if s == 0 and sleeve == gv.FREE:
         return EV_SLEEVE_STOP, z, 0.0, -1
-    if e == 11 and sleeve == gv.FREE:
+    if s == 1 and sleeve == gv.FREE:
         return EV_SLEEVE_STOP, z, par[gv.F_TRAVEL], 1
-    if e == 12 and sleeve == gv.ON_LOW_STOP:
+    if s == 2 and sleeve == gv.ON_LOW_STOP:
         return EV_SLEEVE_FREE, OMEGA, par[gv.F_W_LIFT], 1
-    if e == 13 and sleeve == gv.ON_HIGH_STOP:
+    if s == 3 and sleeve == gv.ON_HIGH_STOP:
         return EV_SLEEVE_FREE, OMEGA, par[gv.F_W_TOP], -1
     return -1, OMEGA, 0.0, 0
 

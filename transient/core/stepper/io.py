@@ -15,58 +15,110 @@ import numpy as np
 from ..jit import kernel
 
 from ..model.forcing import inertia, speed
+from ..declare import Block, Layout, Sized
 from ..model.layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
-                            SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T, n_state)
+                            SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T)
 from ..model.outputs import output_row, output_row_inline
 from ..integrator.rk import _dense_eval
 
-# cfg[...] — settings (float64 array, filled by transient.simulate)
-C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT = range(8)
-C_MAX_STEP_PHI, C_MAX_STEP_T, C_CHUNK_STEPS, C_FIXED_STEP = range(8, 12)
-N_CFG = 12
-# fst[...] — float stepper state kept between chunks
-F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH = range(8)
-F_ERR_OLD = 8  # the last accepted step's error norm (≥ 1e-4), for the PI step-size control
-N_FST = 9
-# fst[F_DERIV:F_DERIV + n]: the derivative at y that the last step carried over (FSAL), then the
-# pairs' margins there; kept where a chunk ends with them valid (ist[I_F_VALID]). Recomputed at a
-# chunk's start instead (with the table piece ahead of the shaft, not the step's), they would make
-# the run depend in its last bits on where the output buffer fills, i.e. on the samples per turn.
-F_DERIV = N_FST
-# ist[...] — integer stepper state kept between chunks
-# ist[:N_SWITCHES] are the model's switches (starter, governor branch, pair modes, direction,
-# load-schedule segment, generator branch, sleeve on a stop, speed map's interval), passed on as
-# ``sw``.
-I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION = SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION
-I_LOAD_SEG, I_GEN_LOW, I_SLEEVE, I_LOAD_TABLE = SW_LOAD, SW_GENERATOR, SW_SLEEVE, SW_LOAD_TABLE
-(I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
+#: ``cfg``, the run's settings (float64, filled by ``transient.run``): the tolerances, the ends of
+#: the run in time and in angle, the switch speeds from crank angle to time and back, the output
+#: spacings in angle and in time, the largest steps in angle and in time, the steps a chunk may
+#: take, and the fixed step in angle (0: adaptive).
+SETTINGS = Layout("settings", "rtol", "atol", "t_end", "phi_end", "w_lo", "w_hi", "dphi_out",
+                  "dt_out", "max_step_phi", "max_step_t", "chunk_steps", "fixed_step")
+(C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI,
+ C_MAX_STEP_T, C_CHUNK_STEPS, C_FIXED_STEP) = SETTINGS
+N_CFG = SETTINGS.size
+#: ``fst``, the float state the stepper keeps between chunks: the next step's size, the angle
+#: ``sel`` of the last step (it picks the table pieces), the next output sample on the grid, the
+#: time and angle of the last row written, the breakpoint a step in time last landed on, the
+#: level a retaken step aims at, where the last state event was (for chattering), the last
+#: accepted step's error norm (≥ 1e-4, for the PI step-size control); then the derivative at y
+#: that the last step carried over (FSAL), then the pairs' margins there (``F_DERIV``, kept where
+#: a chunk ends with them valid, ``ist[I_F_VALID]``: recomputed at a chunk's start instead, with
+#: the table piece ahead of the shaft, not the step's, they would make the run depend in its last
+#: bits on where the output buffer fills, i.e. on the samples per turn).
+FLOATS = Layout(
+    "stepper floats", "h", "sel", "next_out", "last_t", "last_phi", "passed_bp", "redo_level",
+    "last_switch", "err_old",
+    Block("deriv", Sized(lambda m: int(m.state_at[-1]), "the state's length"),
+          "the carried derivative"),
+    Block("margins", Sized(lambda m: max(m.n_pairs, 1), "one per pair, at least one"),
+          "the pairs' margins at y"),
+)
+(F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH,
+ F_ERR_OLD) = (FLOATS.fixed_offset(n) for n in FLOATS.names[:9])
+F_DERIV = FLOATS.fixed_offset("deriv")
+N_FST = F_DERIV
+#: ``ist``, the integer state the stepper keeps between chunks: first the model's switches
+#: (``layout.SWITCHES``, passed on as ``sw = ist[:N_SWITCHES]``), then whether the independent
+#: variable is the crank angle; the counters of right-hand sides, steps, rejections, output rows
+#: and events written; whether the run has started and whether ``fst[F_DERIV:]`` is valid; the
+#: retakes aimed at a breakpoint, the state events in a row without progress (chattering), the
+#: pair-mode switches, the rounding ties of a mode choice, the pair an event has just flipped
+#: (+1), the event that chattered, the event just acted on (+1), the stiffness test's counts;
+#: whether the last attempt was rejected by the error test, the consecutive non-finite attempts
+#: and the consecutive attempts retaken for a crossing that no sample found.
+INTS = Layout(
+    "stepper ints", Block("switches", N_SWITCHES, "the model's switches (layout.SWITCHES)"),
+    "angle_mode", "nfev", "nsteps", "nreject", "nout", "nev", "started", "f_valid", "nredo",
+    "nchatter", "nswitch", "nties", "flipped", "chatter_code", "at_event", "stiff", "nonstiff",
+    "rejected", "nbad", "nunseen",
+)
+(I_SWITCHES, I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
  I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT, I_STIFF,
- I_NONSTIFF) = range(N_SWITCHES, N_SWITCHES + 17)
-# the last attempt was rejected by the error test; consecutive non-finite attempts; consecutive
-# attempts retaken for a crossing that no sample found
-I_REJECTED, I_NBAD, I_NUNSEEN = range(N_SWITCHES + 17, N_SWITCHES + 20)
-N_IST = N_SWITCHES + 20
+ I_NONSTIFF, I_REJECTED, I_NBAD, I_NUNSEEN) = INTS
+N_IST = INTS.size
+#: The switches in ``ist``, by their names in the stepper.
+(I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION, I_LOAD_SEG, I_GEN_LOW, I_SLEEVE,
+ I_LOAD_TABLE) = (I_SWITCHES + sw for sw in (SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION,
+                                             SW_LOAD, SW_GENERATOR, SW_SLEEVE, SW_LOAD_TABLE))
+if I_SWITCHES != 0:  # (the stepper passes ist[:N_SWITCHES] on as the switches)
+    raise AssertionError("the switches must lead the stepper's integer state")
 
 #: Most intervals of an output grid one step may span (its samples fit the rows the stepper keeps
 #: free in the output buffer).
 MAX_OUTPUT_INTERVALS = 256.0
 
-# advance() return codes
-RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING, STIFF = range(8)
-# event codes written to the event buffer as (code, t, phi, omega)
+#: What :func:`~transient.core.stepper.loop.advance` returns: the chunk ended with the run going
+#: on, the run finished, or how it failed or stopped.
+(RUNNING, FINISHED, FAIL_NONFINITE, FAIL_STEP, STALLED, LOCKED, CHATTERING,
+ STIFF) = range(8)
+
+#: Every event a run records, in one table: its name (the result file's, ``transient.run``) and
+#: what it is. An event's code, written to the event buffer as (code, t, φ, ω) and kept in a
+#: checkpoint's integer state (``I_AT_EVENT``, ``I_CHATTER_CODE``), is its place here: a new
+#: event goes at the end. Which of them are state events watched on every step, and in what
+#: order a tie between two at one instant is broken, is :data:`.events.WATCHED`.
+EVENTS = (
+    ("breakpoint", "the shaft on a breakpoint of the tables (a step ends there)"),
+    ("to_time_domain", "the speed fell below the switch speed: time is the variable"),
+    ("to_angle_domain", "the speed rose past 1.5 × the switch speed: crank angle is the variable"),
+    ("starter_cutout", "the starter disengaged at its cut-out speed"),
+    ("speed_reversal", "ω = 0 in time: the shaft turns back or stops"),
+    ("end", "the run's end in time or in angle"),
+    ("governor_corner", "a corner of the droop characteristic, or the PI demand at a limit"),
+    ("pair_mode", "a non-ideal pair's mode switched (its margin fell to zero)"),
+    ("locked", "at rest, held by the pairs' friction for good"),
+    ("load_schedule", "a corner of the load schedule"),
+    ("generator_min_speed", "the generator's minimum speed"),
+    ("sleeve_stop", "the flyweight governor's sleeve reached a stop"),
+    ("sleeve_free", "the sleeve left its stop"),
+    ("injection", "a cylinder latched its fuel at its start of injection"),
+    ("load_table_speed", "a knot of a load tabulated against speed"),
+    ("stuck", "at rest, held by the pairs' friction until the drive exceeds it"),
+    ("released", "the drive exceeded the friction holding it: moving again"),
+)
+EVENT_NAMES = tuple(name for name, _ in EVENTS)
 (EV_BREAKPOINT, EV_TO_TIME, EV_TO_ANGLE, EV_STARTER_CUTOUT, EV_REVERSAL, EV_END, EV_GOVERNOR,
  EV_PAIR_MODE, EV_LOCKED, EV_LOAD, EV_GENERATOR, EV_SLEEVE_STOP, EV_SLEEVE_FREE,
- EV_INJECTION, EV_LOAD_KNOT, EV_STUCK, EV_RELEASED) = range(17)
-EVENT_NAMES = ("breakpoint", "to_time_domain", "to_angle_domain", "starter_cutout",
-               "speed_reversal", "end", "governor_corner", "pair_mode", "locked", "load_schedule",
-               "generator_min_speed", "sleeve_stop", "sleeve_free", "injection", "load_table_speed",
-               "stuck", "released")
+ EV_INJECTION, EV_LOAD_KNOT, EV_STUCK, EV_RELEASED) = range(len(EVENTS))
 
 
-@kernel
-def fst_size(m):
-    """Length of the float stepper state ``fst``: N_FST, then the carried derivative and margins."""
-    return N_FST + n_state(m) + max(m.n_pairs, 1)
+def fst_size(m) -> int:
+    """Length of the float stepper state ``fst`` of model ``m`` (:data:`FLOATS`)."""
+    return FLOATS.offsets_for(m)[-1]
 
 
 @kernel(inline=True)
