@@ -49,9 +49,9 @@ CALLEES = (
     events._locate_events,
     breakpoints._aim_at_breakpoint,
     loop._stiff,
-    loop._accepted_size,
+    rk.accepted_size,
     loop._judge_attempt,
-    rk._step,
+    rk.step,
     sio._finish,
     breakpoints._segment_end,
     loop._settle_at_restart,
@@ -66,20 +66,25 @@ def _types_by_parameter(model, tab) -> dict:
     scalar = {types.boolean: ("angle_mode", "upward", "rising", "fixed", "on_corner",
                               "at_segment_end", "after_rejection", "dip", "dense_ready",
                               "redo_hit_breakpoint", "ends_on_breakpoint", "on_breakpoint",
-                              "ev_rising", "keep"),
+                              "ev_rising", "keep", "cut"),
               types.float64: ("h", "sel", "x", "level", "theta", "theta_end", "x_stop", "d_out",
                               "ga", "gb", "a", "b", "phi", "period", "w", "x_end", "h_max",
                               "tol_end", "rtol", "atol", "corner", "err", "h_planned", "up",
                               "down", "min_step", "w_lo", "w_hi", "ev_theta", "ev_level",
-                              "h_next"),
+                              "h_next", "err_old"),
               types.int64: ("comp", "k", "direction", "code", "ix", "n_samples", "g0", "g1", "c0",
                             "ev_code", "ev_comp", "n_pairs")}
     array = {types.float64[::1]: ("y", "y_new", "tmp", "out", "row", "cfg", "fst", "bp", "f",
                                   "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
-             types.int64[::1]: ("ist", "sw")}
+             types.int64[::1]: ("ist", "sw", "control")}
     # (``extras`` is None or True: the plain or the full variant, :func:`.core.layout.extras_of`)
-    by_name = {"m": typeof(model), "tab": typeof(tab), "extras": typeof(layout.extras_of(model))}
+    extras = typeof(layout.extras_of(model))
+    by_name = {"m": typeof(model), "tab": typeof(tab), "extras": extras,
+               # the model's derivative in the integrator's form, and its context
+               "rhs": typeof(rhs.model_rhs),
+               "ctx": types.Tuple((typeof(model), extras, types.boolean, types.float64,
+                                   types.int64[::1], types.float64[:, ::1]))}
     for numba_type, names in (scalar | array).items():
         by_name.update(dict.fromkeys(names, numba_type))
     return by_name

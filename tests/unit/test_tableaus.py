@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import DOP853, RK45
 
-from transient.core.integrator.rk import _dense_eval
+from transient.core.integrator.rk import dense_eval
 from transient.core.integrator.tableaus import TABLEAUS
 
 SCIPY = {"dopri5": RK45, "dop853": DOP853}
@@ -59,7 +59,7 @@ def test_step_and_dense_output_match_scipy(name):
     sol = solver.dense_output()
     out = np.empty(2)
     for theta in (0.0, 0.13, 0.5, 0.77, 1.0):
-        _dense_eval(F, y0, theta, out)
+        dense_eval(F, y0, theta, out)
         np.testing.assert_allclose(out, sol(theta * h), rtol=1e-13, atol=1e-15,
                                    err_msg=f"{name} at θ = {theta}")
 
@@ -79,7 +79,7 @@ def test_dense_output_order(name):
         ref = solve_ivp(pendulum, (0.0, 0.5 * h), y0, method="DOP853", rtol=1e-13,
                         atol=1e-15).y[:, -1]
         out = np.empty(2)
-        _dense_eval(F, y0, 0.5, out)
+        dense_eval(F, y0, 0.5, out)
         errs.append(np.max(np.abs(out - ref)))
     order = np.log2(errs[0] / errs[1])
     print(f"{name}: midpoint errors {errs}, order {order:.2f}")

@@ -36,7 +36,7 @@ def test_the_stepper_calls_no_kernel_marked_inline():
     assert len(inlined) > 50  # (the right-hand side, the step, the loop's pieces, …)
     assert [n for n in names if n.startswith(inlined)] == []
     # a kernel left a call (the dense output: run when output or an event needs it) is seen
-    assert any(n.startswith(jit._symbol_prefix(rk._dense.py_func)) for n in names)
+    assert any(n.startswith(jit._symbol_prefix(rk.dense.py_func)) for n in names)
 
 
 def test_a_plain_scene_runs_the_same_in_either_variant(monkeypatch):

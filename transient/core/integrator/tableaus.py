@@ -17,7 +17,7 @@ dense output, so that one compiled loop serves every method:
   §IV.2). ``dop853.f`` tests 6.1 and ``dopri5.f`` 3.25, the edges of the stability regions on
   the negative real axis; but the error estimators already hold the step below them: on a PI
   governor with a 2 µs actuator lag (λ ≈ −1/(τ_A ω) ≈ −1190 /rad) DOP853 settles at hλ = 5.17
-  (measured with ``_stiffness``, which then equals h/(τ_A ω) to 4 digits), and 6.1 never fires.
+  (measured with ``rk.stiffness``, which then equals h/(τ_A ω) to 4 digits), and 6.1 never fires.
   Hence 4.0 and, in the same ratio, 2.5 for DOPRI5 (on the same scene at rtol 1e-8 DOPRI5's
   step was still limited by accuracy, at hλ = 0.875). No scene in ``cases/`` trips the test
   with either pair (scanned with every case at its own tolerance).

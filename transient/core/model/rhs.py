@@ -168,6 +168,40 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
 
 
 @kernel(inline=True)
+def model_rhs(ctx, y, out):
+    """:func:`derivative` in the integrator's form (``rhs(ctx, y, out)``,
+    :mod:`transient.core.integrator.rk`), with ``ctx`` = (m, extras, angle_mode, sel, sw, wk).
+    It hands each on as an argument: ``extras`` must reach the kernels as one for their branches
+    on it to be pruned (:func:`.layout.extras_of`)."""
+    derivative(ctx[0], ctx[1], ctx[2], y, ctx[3], ctx[4], ctx[5], out)
+
+
+@kernel(inline=True)
+def watches_kinks(m, extras, angle_mode):
+    """Whether the derivative records, over a step attempt's stages, where it has a kink that a
+    step should end on rather than straddle (:func:`kink_in_attempt`): the crank-slider's side
+    forces changing side under reaction friction (the kink of μ|N|, ``joint_friction``), in
+    crank angle. The stepper's hook into the model for retaking a rejected step at a kink."""
+    return extras is not None and m.reaction and rx.tracks_sides(m) and angle_mode
+
+
+@kernel(inline=True)
+def reset_kinks(m, extras, wk):
+    """Before a step attempt where :func:`watches_kinks`: no stage has seen a kink yet."""
+    if extras is not None:
+        jf.reset_sides(m.ncyl, wk)
+
+
+@kernel(inline=True)
+def kink_in_attempt(m, extras, wk):
+    """The earliest abscissa where the last attempt's stages show a kink (where
+    :func:`watches_kinks`), or ∞."""
+    if extras is not None:
+        return jf.side_change(m.ncyl, wk)
+    return np.inf
+
+
+@kernel(inline=True)
 def mode_margins(m, sw, wk):
     """How far each pair's held mode is from switching, into ``wk[WK_G]`` (after
     :func:`acceleration`); a mode switch is due where a margin falls to zero.

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..jit import kernel
 
+from ..integrator.breakpoints import count_below, next_breakpoint
 from ..model import cylinder as cyl
 from .events import _crossing, _dense_once, _load_corner
 from ..model.forcing import command, inertia, speed
@@ -22,45 +23,6 @@ from .io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, 
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
 BP_LANDING = 1e-7
-
-
-@kernel
-def next_breakpoint(bp, period, phi, upward):
-    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle; by
-    bisection, as a table from points makes every knot of every cylinder a breakpoint."""
-    tol = 1e-13 * max(1.0, abs(phi))
-    k = np.floor(phi / period)
-    n = bp.shape[0]
-    if upward:
-        for c in range(2):
-            base = (k + c) * period
-            j = _count_below(bp, base, phi + tol, True)
-            if j < n:
-                return base + bp[j]
-        return np.inf
-    for c in range(2):
-        base = (k - c) * period
-        j = _count_below(bp, base, phi - tol, False) - 1
-        if j >= 0:
-            return base + bp[j]
-    return -np.inf
-
-
-@kernel(inline=True)
-def _count_below(bp, base, level, inclusive):
-    """How many of the angles ``base + bp[j]`` lie below ``level`` (or on it, ``inclusive``).
-    They are a leading run of j: bp is sorted and rounded addition is monotone, so bisection
-    finds what a scan from j = 0 would."""
-    lo = 0
-    hi = bp.shape[0]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        v = base + bp[mid]
-        if v < level or (inclusive and v == level):
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
 
 
 @kernel(inline=True)
@@ -141,7 +103,7 @@ def _jumps_at(m, bp, phi):
     reach = 2.0 * BP_LANDING  # (wider than _on_angle's test, which decides)
     for shift in (-m.period, 0.0, m.period):
         c = y + shift
-        j = _count_below(bp, 0.0, c - reach, False)
+        j = count_below(bp, 0.0, c - reach, False)
         while j < bp.shape[0] and bp[j] <= c + reach:
             if m.bp_jump[j] and _on_angle(phi, bp[j], m.period):
                 return True

@@ -22,8 +22,9 @@ from ..model import governor as gv
 from ..model.forcing import demand, inertia, is_pi, speed
 from ..model.layout import (LT_SPEED, OMEGA, PHI, SW_LOAD, SW_LOAD_TABLE, SW_SLEEVE, SW_STARTER, T,
                             WK_DEMAND, WK_G, WK_G_MIN, gov_index)
-from ..model.rhs import margins_at, margins_inline
-from ..integrator.rk import _dense, _dense_eval, _dense_state
+from ..integrator.rk import dense, dense_state
+from ..integrator.roots import crosses, crossing_inside, fall_after_rise, root
+from ..model.rhs import margins_at, margins_inline, model_rhs
 from .io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR, EV_LOAD,
                  EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
                  EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
@@ -53,6 +54,37 @@ def _event_g(m, extras, angle_mode, yv, comp, level, sel, sw, wk):
     return yv[comp] - level
 
 
+@kernel(inline=True)
+def event_value(ctx, yv):
+    """:func:`_event_g` in the integrator's form (:mod:`transient.core.integrator.roots`):
+    ``ctx`` = (m, extras, angle_mode, comp, level, sel, sw, wk)."""
+    return _event_g(ctx[0], ctx[1], ctx[2], yv, ctx[3], ctx[4], ctx[5], ctx[6], ctx[7])
+
+
+@kernel(inline=True)
+def _iterated_g(m, extras, angle_mode, yv, comp, level, sel, sw, wk):
+    """:func:`_event_g` with a pair's margins inlined: the root finder's iterations evaluate
+    them most, and there a call would copy the Model at every iteration."""
+    if extras is not None and comp >= PAIR_COMP:
+        margins_inline(m, extras, angle_mode, yv, sel, sw, wk)
+        return wk[WK_G, comp - PAIR_COMP]
+    return _event_g(m, extras, angle_mode, yv, comp, level, sel, sw, wk)
+
+
+@kernel(inline=True)
+def iterated_value(ctx, yv):
+    """:func:`_iterated_g` in the integrator's form (``ctx`` as :func:`event_value`'s)."""
+    return _iterated_g(ctx[0], ctx[1], ctx[2], yv, ctx[3], ctx[4], ctx[5], ctx[6], ctx[7])
+
+
+@kernel(inline=True)
+def _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
+    """The root of event ``comp`` at ``level`` in the bracket θ ∈ [a, b] (values ga, gb) on the
+    dense output (:func:`transient.core.integrator.roots.root`). Returns (θ, evaluations)."""
+    return root(iterated_value, (m, extras, angle_mode, comp, level, sel, sw, wk), F, y, tmp, a,
+                b, ga, gb)
+
+
 @kernel
 def _crossing(m, extras, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk):
     """θ ∈ (0, 1] where the event function crosses zero on the dense output.
@@ -64,45 +96,6 @@ def _crossing(m, extras, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
     ga = _event_g(m, extras, angle_mode, y, comp, level, sel, sw, wk)
     gb = _event_g(m, extras, angle_mode, y_new, comp, level, sel, sw, wk)
     return _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk, 0.0, 1.0, ga, gb)[0]
-
-
-@kernel
-def _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
-    """Root of the event function in the bracket θ ∈ [a, b] (values ga, gb) on the dense output
-    (Illinois method); b if the bracket holds no sign change. Returns (θ, evaluations).
-
-    The θ returned is on the far side of the crossing (g there has gb's sign, or is 0): the
-    state at the event has crossed. Two pairs whose margins fall through zero at the same angle
-    (a massless link between them) then both see their crossing there, and a switch is never
-    undone because rounding left the event a hair before its own root."""
-    if gb == 0.0 or (ga > 0.0) == (gb > 0.0):
-        return b, 0
-    side = 0
-    for i in range(100):
-        if b - a < 1e-12:
-            return b, i
-        c = b - gb * (b - a) / (gb - ga)
-        if not (a < c < b):
-            c = 0.5 * (a + b)
-        _dense_eval(F, y, c, tmp)
-        if extras is not None and comp >= PAIR_COMP:  # most iterations: the margins inlined
-            margins_inline(m, extras, angle_mode, tmp, sel, sw, wk)
-            gc = wk[WK_G, comp - PAIR_COMP]
-        else:
-            gc = _event_g(m, extras, angle_mode, tmp, comp, level, sel, sw, wk)
-        if gc == 0.0:
-            return c, i + 1
-        if (gc > 0.0) == (gb > 0.0):
-            b, gb = c, gc
-            if side == -1:
-                ga *= 0.5
-            side = -1
-        else:
-            a, ga = c, gc
-            if side == 1:
-                gb *= 0.5
-            side = 1
-    return b, 100
 
 
 #: A pair's mode margin can fall through zero and come back within one step, unseen at the
@@ -118,7 +111,7 @@ def _sample_margins(m, extras, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
     holds the step's start and row N its end already)."""
     ix = PHI if angle_mode else T
     for j in range(1, N_MARGIN_SAMPLES):
-        _dense_state(F, y, x, h, j / N_MARGIN_SAMPLES, ix, tmp)
+        dense_state(F, y, x, h, j / N_MARGIN_SAMPLES, ix, tmp)
         margins_at(m, extras, angle_mode, tmp, sel, sw, wk)
         for k in range(m.n_pairs):
             gs[j, k] = wk[WK_G, k]
@@ -130,25 +123,16 @@ def _sample_margins(m, extras, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
 N_FINE_SAMPLES, MAX_UNSEEN = 64, 3
 
 
-@kernel
+@kernel(inline=True)
 def _crossing_inside(m, extras, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp,
                      wk, n_samples):
     """θ where the speed, the PI demand or a pair's margin (``comp``) first crosses ``level``
     (in ``direction``) inside a step whose ends are on the same side of it, sampled at
     θ = j/n_samples on the dense output; 2 if the samples see no crossing (it was only in a
     stage, or between samples). Returns (θ, evaluations)."""
-    ix = PHI if angle_mode else T
-    g_prev = ga
-    for j in range(1, n_samples + 1):
-        theta = j / n_samples
-        _dense_state(F, y, x, h, theta, ix, tmp)
-        g = _event_g(m, extras, angle_mode, tmp, comp, level, sel, sw, wk)
-        if _crosses(g_prev, g, direction):
-            root, evals = _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk,
-                                (j - 1) / n_samples, theta, g_prev, g)
-            return root, j + evals
-        g_prev = g
-    return 2.0, n_samples
+    return crossing_inside(event_value, iterated_value,
+                           (m, extras, angle_mode, comp, level, sel, sw, wk), F, y, x, h,
+                           PHI if angle_mode else T, direction, ga, tmp, n_samples)
 
 
 @kernel(inline=True)
@@ -159,39 +143,18 @@ def _pair_crossing(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     A margin that starts at 0 (an event has just switched this pair's mode) and is below it a
     sample on either fell at once — the power only touched zero there and turns back, and the
     switch is undone at the step's start (θ = 0) — or first rose for less than a sample's span
-    (the power reversed for a few degrees): :func:`_fall_after_rise` tells which.
+    (the power reversed for a few degrees): ``fall_after_rise`` tells which.
     """
     if gs[0, k] == 0.0 and gs[1, k] < 0.0:
-        return _fall_after_rise(m, extras, angle_mode, F, y, x, h, k, 1.0 / N_MARGIN_SAMPLES, sel,
-                                sw, tmp, wk)
+        return fall_after_rise(event_value, iterated_value,
+                               (m, extras, angle_mode, PAIR_COMP + k, 0.0, sel, sw, wk), F, y, x,
+                               h, PHI if angle_mode else T, 1.0 / N_MARGIN_SAMPLES,
+                               N_FINE_SAMPLES, tmp)
     for j in range(N_MARGIN_SAMPLES):
-        if _crosses(gs[j, k], gs[j + 1, k], -1):
+        if crosses(gs[j, k], gs[j + 1, k], -1):
             return _root(m, extras, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
                          j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
     return 2.0, 0
-
-
-@kernel
-def _fall_after_rise(m, extras, angle_mode, F, y, x, h, k, theta_end, sel, sw, tmp, wk):
-    """For a margin that starts at 0 and is below it at ``theta_end``: θ where it falls to zero
-    after rising above it (sampled at N_FINE_SAMPLES points up to ``theta_end``), or 0 if no
-    sample rises above zero (it fell at once). Returns (θ, evaluations)."""
-    ix = PHI if angle_mode else T
-    rose = False
-    g_prev = 0.0
-    th_prev = 0.0
-    for j in range(1, N_FINE_SAMPLES + 1):
-        theta = theta_end * j / N_FINE_SAMPLES
-        _dense_state(F, y, x, h, theta, ix, tmp)
-        g = _event_g(m, extras, angle_mode, tmp, PAIR_COMP + k, 0.0, sel, sw, wk)
-        if rose and g <= 0.0:
-            root, evals = _root(m, extras, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
-                                th_prev, theta, g_prev, g)
-            return root, j + evals
-        rose = rose or g > 0.0
-        g_prev = g
-        th_prev = theta
-    return 0.0, N_FINE_SAMPLES
 
 
 #: The state events watched on every step (:func:`_event_spec`), each with its slots (the event
@@ -309,23 +272,11 @@ def _sleeve_stops(m, y, level, w):
 
 
 @kernel(inline=True)
-def _crosses(g0, g1, direction):
-    """Whether g goes from g0 to g1 through zero in the given direction (reaching it counts)."""
-    rising = g0 < 0.0 <= g1
-    falling = g1 <= 0.0 < g0
-    if direction > 0:
-        return rising
-    if direction < 0:
-        return falling
-    return rising or falling
-
-
-@kernel(inline=True)
 def _dense_once(ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist):
     """The last step's dense output into F, unless ``ready`` (it costs the pair's extra stages,
     so a step computes it only when an event or an output sample needs it); returns True."""
     if not ready:
-        _dense(tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk)
+        dense(tab, model_rhs, (m, extras, angle_mode, sel, sw, wk), y, y_new, h, K, F, tmp)
         ist[I_NFEV] += tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
     return True
 
@@ -411,7 +362,7 @@ def _level_event(tab, m, extras, angle_mode, x, h, y, y_new, K, F, code, comp, l
         gb = (w1 if comp == OMEGA else y_new[comp]) - level
     if code == ist[I_AT_EVENT] - 1 and abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
         ga = 0.0
-    ends = _crosses(ga, gb, direction)
+    ends = crosses(ga, gb, direction)
     # The speed (the PI demand) can pass a level and come back within one step (its
     # fluctuation within a cycle about a governor corner): the stages' range shows it.
     inside = not ends and ((comp == OMEGA and w_lo < level < w_hi) or (

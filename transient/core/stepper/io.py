@@ -19,7 +19,7 @@ from ..declare import Block, Layout, Sized
 from ..model.layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
                             SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T)
 from ..model.outputs import output_row, output_row_inline
-from ..integrator.rk import _dense_eval
+from ..integrator.rk import dense_eval
 
 #: ``cfg``, the run's settings (float64, filled by ``transient.run``): the tolerances, the ends of
 #: the run in time and in angle, the switch speeds from crank angle to time and back, the output
@@ -190,7 +190,7 @@ def _emit_samples(m, extras, F, y, x, h, x_stop, ix, d_out, sel, sw, outbuf, ist
     copy it), and a call per sample through ``_emit_row`` copies it twice."""
     angle_mode = ist[I_ANGLE_MODE] == 1
     while fst[F_NEXT_OUT] <= x_stop:
-        _dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
+        dense_eval(F, y, (fst[F_NEXT_OUT] - x) / h, tmp)
         tmp[ix] = fst[F_NEXT_OUT]
         output_row_inline(m, extras, angle_mode, tmp, sel, sw, wk, outbuf[ist[I_NOUT]])
         _count_row(tmp, ist, fst)

@@ -54,12 +54,11 @@ from ..model import governor as gv
 from ..model.forcing import (generator_branch, governor_branch, inertia, load_segment, moments,
                              speed, speed_knot_segment, start_branch)
 from ..model.layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND,
-                            WK_G, WK_G_MIN, WK_SPEED, cyl_index, gov_index, n_state, work_array)
-from ..model.rhs import choose_modes, derivative, margins_at, release
-from ..model import joint_friction as jf
-from ..model import reactions as rx
+                            WK_G, WK_G_MIN, WK_SPEED, gov_index, n_state, work_array)
+from ..model.rhs import (choose_modes, derivative, kink_in_attempt, margins_at, model_rhs,
+                         release, reset_kinks, watches_kinks)
 from ..model import stuck as st
-from ..integrator.rk import _dense_eval, _error_norm, _grow, _shrink, _step, _stiffness
+from ..integrator.rk import accepted_size, dense_eval, error_norm, shrink, step, stiffness
 from .io import (C_ATOL, C_CHUNK_STEPS, C_DPHI_OUT, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
                  C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
                  EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL, EV_SLEEVE_FREE,
@@ -138,9 +137,6 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
     atol = cfg[C_ATOL]
     # rows kept free: a step spans at most 256 intervals of its grid (in time, of each grid)
     margin = 600
-    g0 = gov_index(m)  # the governor's states y[g0:g1] are error-controlled with the dynamics,
-    g1 = g0 + gv.n_states(m.gov_dyn)
-    c0 = cyl_index(m)  # and so are the cylinder pressures y[c0:]
 
     if ist[I_STARTED] == 0:
         status = _start_run(m, extras, cfg, y, fst, ist, outbuf, evbuf, wk)
@@ -192,24 +188,23 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             sel = y[PHI] + 0.5 * h * y[OMEGA]
 
         # The step attempt, its acceptance and the next step size.
-        kinked = (extras is not None and m.reaction and rx.tracks_sides(m) and angle_mode
-                  and not fixed)
+        retakes_at_kinks = watches_kinks(m, extras, angle_mode) and not fixed
         on_corner = at_segment_end and x_end == corner
         cut = at_segment_end
         for attempt in range(2):
-            if kinked:
-                jf.reset_sides(m.ncyl, wk)
+            if retakes_at_kinks:
+                reset_kinks(m, extras, wk)
             _start_attempt(f, K, wk)
-            _step(tab, m, extras, angle_mode, x, y, f, h, sel, sw, K, y_new, tmp, wk)
+            step(tab, model_rhs, (m, extras, angle_mode, sel, sw, wk), ix, x, y, f, h, K, y_new, tmp)
             finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
-                                                          rtol, atol, g0, g1, c0, on_corner,
-                                                          corner)
-            if attempt > 0 or not (kinked and finite and err > 1.0):
+                                                          rtol, atol, on_corner, corner)
+            if attempt > 0 or not (retakes_at_kinks and finite and err > 1.0):
                 break
-            # A side force changing side inside the step (a kink of the pistons' μ|N|): the
-            # step is retaken at once to end where the stages put it, so that the kink lies
-            # between two steps instead of inside a run of rejected ones (``joint_friction``).
-            x_kink = jf.side_change(m.ncyl, wk)
+            # A kink of the derivative inside the step (the model's hook: a side force changing
+            # side, the kink of the pistons' μ|N|): the step is retaken at once to end where the
+            # stages put it, so that the kink lies between two steps instead of inside a run of
+            # rejected ones.
+            x_kink = kink_in_attempt(m, extras, wk)
             if not x + MIN_KINK_FRACTION * h < x_kink < x + h:
                 break
             ist[I_NREJECT] += 1
@@ -231,14 +226,15 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
         if fixed:
             err = 0.0  # every step is accepted; the step size alone sets the accuracy
         if err > 1.0:
-            _retake(fst, ist, h * _shrink(tab, err))
+            _retake(fst, ist, h * shrink(tab, err))
             ist[I_NREDO] = 0  # a shorter step no longer ends on the breakpoint it aimed at
             steps_here += 1
             rejected = True
             continue
-        h_next = _accepted_size(tab, err, h, h_planned, cut, rejected, fst)
+        h_next, fst[F_ERR_OLD] = accepted_size(tab, err, fst[F_ERR_OLD], h, h_planned, cut,
+                                               rejected)
         rejected = False
-        if not fixed and _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
+        if not fixed and _stiff(tab, K, h, y, ix, m.state_control, rtol, atol, ist):
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
@@ -384,8 +380,7 @@ def _start_attempt(f, K, wk):
 
 
 @kernel(inline=True)
-def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, c0, on_corner,
-                   corner):
+def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, on_corner, corner):
     """After the step attempt of size h from y (stages in K, new state in y_new): ``(finite, err,
     dip, w_lo, w_hi)``, with the pairs' margins at y_new into ``gs[N_MARGIN_SAMPLES]``.
 
@@ -406,7 +401,7 @@ def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, 
         g_min = wk[WK_G_MIN, k]
         dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
     ist[I_NFEV] += tab.n_stages
-    err = _error_norm(tab, K, h, y, y_new, rtol, atol, ix, g0, g1, c0)
+    err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, m.state_control)
     finite = np.isfinite(err)
     for i in range(n):
         finite = finite and np.isfinite(y_new[i])
@@ -414,22 +409,9 @@ def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, g0, g1, 
 
 
 @kernel(inline=True)
-def _accepted_size(tab, err, h, h_planned, at_segment_end, after_rejection, fst):
-    """The next step's size after a step of size h accepted with error norm ``err``; keeps the
-    error for the next step's PI control."""
-    factor = _grow(tab, err, fst[F_ERR_OLD], after_rejection)
-    fst[F_ERR_OLD] = max(err, 1e-4)
-    h_next = h * factor
-    if at_segment_end and not after_rejection:
-        # a step cut short to end on a breakpoint says nothing against the step planned
-        h_next = max(h_next, min(h_planned, h_planned * factor))
-    return h_next
-
-
-@kernel(inline=True)
-def _stiff(tab, K, h, y, ix, g0, g1, c0, rtol, atol, ist):
+def _stiff(tab, K, h, y, ix, control, rtol, atol, ist):
     """Count an accepted step in Hairer's stiffness test (``STIFF_COUNT``); True when stiff."""
-    if _stiffness(tab, K, h, y, ix, g0, g1, c0, rtol, atol) > tab.stiff_bound:
+    if stiffness(tab, K, h, y, ix, control, rtol, atol) > tab.stiff_bound:
         ist[I_NONSTIFF] = 0
         ist[I_STIFF] += 1
         return ist[I_STIFF] >= STIFF_COUNT
@@ -460,7 +442,7 @@ def _emit_step_samples(tab, m, extras, cfg, angle_mode, ix, x, h, x_stop, y, y_n
     if whole:
         phi_stop = y_new[PHI]
     else:
-        _dense_eval(F, y, (x_stop - x) / h, tmp)
+        dense_eval(F, y, (x_stop - x) / h, tmp)
         phi_stop = tmp[PHI]
     _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, sel, sw, outbuf, ist, fst, tmp,
                        wk)
@@ -507,7 +489,7 @@ def _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, sel, sw, ou
             t = x + theta * h
             _emit_samples(m, extras, F, y, x, h, t, T, dt, sel, sw, outbuf, ist, fst, tmp, wk)
             if t > fst[F_LAST_T]:  # (else the time grid's sample is at this instant)
-                _dense_eval(F, y, theta, tmp)
+                dense_eval(F, y, theta, tmp)
                 tmp[T] = t
                 tmp[PHI] = level
                 _emit_row(m, extras, tmp, sel, sw, outbuf, ist, fst, wk)
@@ -558,7 +540,7 @@ def _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_leve
     power changes sign at a pressure corner, a load corner there) is on it, and the state goes
     exactly there, so that both are recorded (else the next step would take the breakpoint as
     passed, unseen)."""
-    _dense_eval(F, y, ev_theta, y_evt)
+    dense_eval(F, y, ev_theta, y_evt)
     on_breakpoint = angle_mode and ends_on_breakpoint and x_end - x_stop <= tol_end
     if on_breakpoint:
         x_stop = x_end
