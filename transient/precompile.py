@@ -28,6 +28,7 @@ import pickle
 import subprocess
 import sys
 
+import numpy as np
 from numba import config, typeof, types
 
 from .core import jit
@@ -84,10 +85,26 @@ def _types_by_parameter(model, tab) -> dict:
                # the model's derivative in the integrator's form, and its context
                "rhs": typeof(rhs.model_rhs),
                "ctx": types.Tuple((typeof(model), extras, types.boolean, types.float64,
-                                   types.int64[::1], types.float64[:, ::1]))}
+                                   types.int64[::1], types.float64[:, ::1])),
+               # the loop's records (stepper.io)
+               "io": typeof(sio.Chunk(*_vectors(3), np.zeros(1, np.int64), *_matrices(2))),
+               "work": typeof(sio.Work(*_matrices(2), *_vectors(4), *_matrices(2))),
+               "at": typeof(sio.At(True, 0, 0.0, 0.0, 0.0, np.zeros(1, np.int64))),
+               "seg": typeof(sio.Segment(*(6 * [0.0]))),
+               "seen": types.Tuple((types.boolean, types.float64, types.float64)),
+               "crossing": types.Tuple((types.float64, types.int64, types.float64)),
+               "event": types.Tuple((types.int64, types.int64, types.float64, types.boolean))}
     for numba_type, names in (scalar | array).items():
         by_name.update(dict.fromkeys(names, numba_type))
     return by_name
+
+
+def _vectors(n: int) -> list:
+    return [np.zeros(1) for _ in range(n)]
+
+
+def _matrices(n: int) -> list:
+    return [np.zeros((1, 1)) for _ in range(n)]
 
 
 def signature(fn, model, tab) -> tuple:

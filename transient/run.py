@@ -95,7 +95,7 @@ def _compile(model, tab, cfg, bp) -> float:
         stepper.advance(model, layout.extras_of(model), tab, warm, bp, y,
                         np.zeros(sio.fst_size(model)), np.zeros(sio.N_IST, dtype=np.int64),
                         np.empty((1024, n_outputs(model))), np.empty((64, 4)),
-                        *stepper.buffers(model, tab, y.shape[0]))
+                        stepper.buffers(model, tab, y.shape[0]))
     finally:
         stop_helper(helper)
     return time.perf_counter() - t0
@@ -157,7 +157,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     try:
         while status == sio.RUNNING:
             status = stepper.advance(model, extras, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf,
-                                     *stepper.buffers(model, tab, y.shape[0]))
+                                     stepper.buffers(model, tab, y.shape[0]))
             switching = status == sio.FINISHED and y[layout.T] == switch_at
             block = {name: outbuf[: ist[sio.I_NOUT], j].copy() for j, name in enumerate(names)}
             ev = _events_by_name(evbuf[: ist[sio.I_NEV]], switching)

@@ -18,7 +18,7 @@ from ..model.forcing import command, inertia, speed
 from ..model.layout import OMEGA, PHI, cyl_index, latch_index
 from .io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, C_T_END,
                  EV_INJECTION, F_PASSED_BP, F_REDO_LEVEL, I_ANGLE_MODE, I_NREDO,
-                 MAX_OUTPUT_INTERVALS, _emit_event, _retake)
+                 MAX_OUTPUT_INTERVALS, Segment, _emit_event, _retake)
 
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).
@@ -27,8 +27,8 @@ BP_LANDING = 1e-7
 
 @kernel(inline=True)
 def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
-    """Where the segment of the next step ends, and what bounds that step: ``(x_end, up, down,
-    h_max, tol_end, corner)``.
+    """Where the segment of the next step ends, and what bounds that step: a ``Segment`` of
+    ``(x_end, up, down, h_max, tol_end, corner)``.
 
     ``x_end``: the next breakpoint (in crank angle), the end of the run, or a load-schedule corner
     on the independent variable before them (the step lands on it and its event is found there,
@@ -52,21 +52,22 @@ def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
     corner = _load_corner(m, ix, sw)
     if tol_end < corner - x and corner < x_end:
         x_end = corner
-    return x_end, up, down, h_max, tol_end, corner
+    return Segment(x_end, up, down, h_max, tol_end, corner)
 
 
 @kernel(inline=True)
-def _aim_at_breakpoint(tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, fst, ist,
-                       up, down, min_step):
+def _aim_at_breakpoint(tab, m, extras, at, y, work, fst, ist, seg, min_step):
     """In time, a step must not cross a breakpoint: one that does is retaken so that it ends
     there, at most four times in a row. Returns ``(retake, dense_ready)``: whether the step is
     to be computed again (``fst[F_H]`` set), and whether its dense output is in F."""
-    if angle_mode:
+    if at.angle_mode:
         return False, False
-    if y_new[PHI] > up or y_new[PHI] < down:
-        _dense_once(False, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
-        level = up if y_new[PHI] > up else down
-        theta = _crossing(m, extras, angle_mode, F, y, y_new, PHI, level, sel, sw, tmp, wk)
+    y_new, h = work.y_new, at.h
+    if y_new[PHI] > seg.up or y_new[PHI] < seg.down:
+        _dense_once(False, tab, m, extras, at, y, work, ist)
+        level = seg.up if y_new[PHI] > seg.up else seg.down
+        theta = _crossing(m, extras, at.angle_mode, work.F, y, y_new, PHI, level, at.sel, at.sw,
+                          work.tmp, work.wk)
         fst[F_REDO_LEVEL] = level
         if theta * h > min_step and ist[I_NREDO] < 4:
             _retake(fst, ist, theta * h)

@@ -106,15 +106,14 @@ N_MARGIN_SAMPLES = 4
 
 
 @kernel(inline=True)
-def _sample_margins(m, extras, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs):
+def _sample_margins(m, extras, at, y, work):
     """Mode margins of all pairs at θ = j/N_MARGIN_SAMPLES, j = 1 … N − 1 (rows of ``gs``; row 0
     holds the step's start and row N its end already)."""
-    ix = PHI if angle_mode else T
     for j in range(1, N_MARGIN_SAMPLES):
-        dense_state(F, y, x, h, j / N_MARGIN_SAMPLES, ix, tmp)
-        margins_at(m, extras, angle_mode, tmp, sel, sw, wk)
+        dense_state(work.F, y, at.x, at.h, j / N_MARGIN_SAMPLES, at.ix, work.tmp)
+        margins_at(m, extras, at.angle_mode, work.tmp, at.sel, at.sw, work.wk)
         for k in range(m.n_pairs):
-            gs[j, k] = wk[WK_G, k]
+            work.gs[j, k] = work.wk[WK_G, k]
 
 
 #: Samples of the fine search for a crossing that a step's stages show and its coarse samples
@@ -124,19 +123,19 @@ N_FINE_SAMPLES, MAX_UNSEEN = 64, 3
 
 
 @kernel(inline=True)
-def _crossing_inside(m, extras, angle_mode, F, y, x, h, comp, level, direction, ga, sel, sw, tmp,
-                     wk, n_samples):
+def _crossing_inside(m, extras, at, y, work, comp, level, direction, ga, n_samples):
     """θ where the speed, the PI demand or a pair's margin (``comp``) first crosses ``level``
     (in ``direction``) inside a step whose ends are on the same side of it, sampled at
     θ = j/n_samples on the dense output; 2 if the samples see no crossing (it was only in a
-    stage, or between samples). Returns (θ, evaluations)."""
+    stage, or between samples). ``ga``: the event function at the step's start. Returns (θ,
+    evaluations)."""
     return crossing_inside(event_value, iterated_value,
-                           (m, extras, angle_mode, comp, level, sel, sw, wk), F, y, x, h,
-                           PHI if angle_mode else T, direction, ga, tmp, n_samples)
+                           (m, extras, at.angle_mode, comp, level, at.sel, at.sw, work.wk), work.F,
+                           y, at.x, at.h, at.ix, direction, ga, work.tmp, n_samples)
 
 
 @kernel(inline=True)
-def _pair_crossing(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
+def _pair_crossing(m, extras, at, y, work, k):
     """θ where pair k's margin first falls to zero within the step, or 2 if it does not; and the
     margin evaluations (right-hand sides) the root finding took.
 
@@ -145,15 +144,17 @@ def _pair_crossing(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs):
     switch is undone at the step's start (θ = 0) — or first rose for less than a sample's span
     (the power reversed for a few degrees): ``fall_after_rise`` tells which.
     """
+    gs = work.gs
     if gs[0, k] == 0.0 and gs[1, k] < 0.0:
         return fall_after_rise(event_value, iterated_value,
-                               (m, extras, angle_mode, PAIR_COMP + k, 0.0, sel, sw, wk), F, y, x,
-                               h, PHI if angle_mode else T, 1.0 / N_MARGIN_SAMPLES,
-                               N_FINE_SAMPLES, tmp)
+                               (m, extras, at.angle_mode, PAIR_COMP + k, 0.0, at.sel, at.sw,
+                                work.wk), work.F, y, at.x, at.h, at.ix, 1.0 / N_MARGIN_SAMPLES,
+                               N_FINE_SAMPLES, work.tmp)
     for j in range(N_MARGIN_SAMPLES):
         if crosses(gs[j, k], gs[j + 1, k], -1):
-            return _root(m, extras, angle_mode, F, y, PAIR_COMP + k, 0.0, sel, sw, tmp, wk,
-                         j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES, gs[j, k], gs[j + 1, k])
+            return _root(m, extras, at.angle_mode, work.F, y, PAIR_COMP + k, 0.0, at.sel, at.sw,
+                         work.tmp, work.wk, j / N_MARGIN_SAMPLES, (j + 1) / N_MARGIN_SAMPLES,
+                         gs[j, k], gs[j + 1, k])
     return 2.0, 0
 
 
@@ -272,26 +273,28 @@ def _sleeve_stops(m, y, level, w):
 
 
 @kernel(inline=True)
-def _dense_once(ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist):
+def _dense_once(ready, tab, m, extras, at, y, work, ist):
     """The last step's dense output into F, unless ``ready`` (it costs the pair's extra stages,
     so a step computes it only when an event or an output sample needs it); returns True."""
     if not ready:
-        dense(tab, model_rhs, (m, extras, angle_mode, sel, sw, wk), y, y_new, h, K, F, tmp)
+        dense(tab, model_rhs, (m, extras, at.angle_mode, at.sel, at.sw, work.wk), y, work.y_new,
+              at.h, work.K, work.F, work.tmp)
         ist[I_NFEV] += tab.n_ext - tab.n_stages - 1  # the dense output's extra stages
     return True
 
 
 @kernel(inline=True)
-def _locate_events(tab, m, extras, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs,
-                   ist, dip, dense_ready, w_lo, w_hi):
-    """The earliest state event in the last step (from x, size h; accepted, not yet taken):
+def _locate_events(tab, m, extras, cfg, at, y, work, ist, seen, dense_ready):
+    """The earliest state event in the last step (``at``; accepted, not yet taken):
     ``(code, θ, component, level, rising, unseen, dense_ready)``, code −1 if there is none.
 
     ``rising``: the event function crosses from below. ``unseen``: a pair's margin dipped below
     zero in the step's stages only, which no sample found (the caller retakes the step shorter).
-    ``dip``: the stages saw some pair's margin reach zero; ``w_lo``, ``w_hi``: the speed's range
-    over the stages; ``gs[0]`` and ``gs[N_MARGIN_SAMPLES]`` hold the margins at the step's ends.
+    ``seen``: what the step's stages saw, (``dip``, ``w_lo``, ``w_hi``): whether some pair's
+    margin reached zero, the speed's range; ``gs[0]`` and ``gs[N_MARGIN_SAMPLES]`` hold the
+    margins at the step's ends.
     """
+    dip, w_lo, w_hi = seen
     ev_code = -1
     ev_theta = 2.0
     unseen = False
@@ -299,33 +302,31 @@ def _locate_events(tab, m, extras, cfg, angle_mode, x, h, y, y_new, f, K, F, sel
     ev_level = 0.0
     ev_rising = True
     # ω at both ends: in crank angle the derivative holds dt/dφ = 1/ω.
-    w0 = 1.0 / f[T] if angle_mode else y[OMEGA]
-    w1 = 1.0 / K[tab.n_stages, T] if angle_mode else y_new[OMEGA]
+    w0 = 1.0 / work.f[T] if at.angle_mode else y[OMEGA]
+    w1 = 1.0 / work.K[tab.n_stages, T] if at.angle_mode else work.y_new[OMEGA]
     if extras is not None and dip:
-        dense_ready = _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K,
-                                  F, tmp, wk, ist)
-        _sample_margins(m, extras, angle_mode, F, y, x, h, sel, sw, tmp, wk, gs)
+        dense_ready = _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
+        _sample_margins(m, extras, at, y, work)
         ist[I_NFEV] += N_MARGIN_SAMPLES - 1
     # (the plain variant watches no pair: its events end before the pairs')
     n_kinds = FIRST_PAIR_EVENT
     if extras is not None:
         n_kinds = N_EVENT_KINDS
     for e in range(n_kinds):
-        code, comp, level, direction = _event_spec(m, extras, cfg, e, angle_mode, sw)
+        code, comp, level, direction = _event_spec(m, extras, cfg, e, at.angle_mode, at.sw)
         if code < 0:
             continue
         if extras is not None and comp >= PAIR_COMP:
             if not dip:
                 continue
-            theta, only_stages = _pair_event(m, extras, angle_mode, F, y, x, h, comp - PAIR_COMP,
-                                             sel, sw, tmp, wk, gs, ist)
+            theta, only_stages = _pair_event(m, extras, at, y, work, comp - PAIR_COMP, ist)
             unseen = unseen or only_stages
             if theta < ev_theta:
                 ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
             continue
-        theta, rising, dense_ready = _level_event(tab, m, extras, angle_mode, x, h, y, y_new, K, F,
-                                                  code, comp, level, direction, w0, w1, w_lo, w_hi,
-                                                  sel, sw, tmp, wk, ist, dense_ready)
+        theta, rising, dense_ready = _level_event(tab, m, extras, at, y, work,
+                                                  (code, comp, level, direction),
+                                                  (w0, w1, w_lo, w_hi), ist, dense_ready)
         if theta < ev_theta:
             ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
             ev_rising = rising
@@ -333,33 +334,37 @@ def _locate_events(tab, m, extras, cfg, angle_mode, x, h, y, y_new, f, K, F, sel
 
 
 @kernel(inline=True)
-def _pair_event(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs, ist):
+def _pair_event(m, extras, at, y, work, k, ist):
     """θ where pair k's margin first falls to zero in the step (2 if it does not), and whether
     only the stages saw it fall below zero (the samples, coarse and fine, did not)."""
-    theta, evals = _pair_crossing(m, extras, angle_mode, F, y, x, h, k, sel, sw, tmp, wk, gs)
+    theta, evals = _pair_crossing(m, extras, at, y, work, k)
     ist[I_NFEV] += evals
     only_stages = False
-    if theta > 1.0 and wk[WK_G_MIN, k] < 0.0 <= gs[0, k]:
+    if theta > 1.0 and work.wk[WK_G_MIN, k] < 0.0 <= work.gs[0, k]:
         # the stages saw the margin fall below zero, the samples did not
-        theta, evals = _crossing_inside(m, extras, angle_mode, F, y, x, h, PAIR_COMP + k, 0.0, -1,
-                                        gs[0, k], sel, sw, tmp, wk, N_FINE_SAMPLES)
+        theta, evals = _crossing_inside(m, extras, at, y, work, PAIR_COMP + k, 0.0, -1,
+                                        work.gs[0, k], N_FINE_SAMPLES)
         ist[I_NFEV] += evals
         only_stages = theta > 1.0
     return theta, only_stages
 
 
 @kernel(inline=True)
-def _level_event(tab, m, extras, angle_mode, x, h, y, y_new, K, F, code, comp, level, direction, w0,
-                 w1, w_lo, w_hi, sel, sw, tmp, wk, ist, dense_ready):
+def _level_event(tab, m, extras, at, y, work, spec, speeds, ist, dense_ready):
     """θ where the speed, the PI demand or the state ``comp`` first crosses ``level`` (in
     ``direction``) in the step, 2 if it does not; whether it crosses from below; ``dense_ready``.
-    ``w0``, ``w1``: the speed at the step's ends."""
+    ``spec``: the event, (code, comp, level, direction) as :func:`_event_spec` gives it;
+    ``speeds``: the speed at the step's ends and its range over the stages, (w0, w1, w_lo,
+    w_hi)."""
+    code, comp, level, direction = spec
+    w0, w1, w_lo, w_hi = speeds
+    wk = work.wk
     if extras is not None and comp == DEMAND_COMP:
-        ga = _event_g(m, extras, angle_mode, y, comp, level, sel, sw, wk)
-        gb = _event_g(m, extras, angle_mode, y_new, comp, level, sel, sw, wk)
+        ga = _event_g(m, extras, at.angle_mode, y, comp, level, at.sel, at.sw, wk)
+        gb = _event_g(m, extras, at.angle_mode, work.y_new, comp, level, at.sel, at.sw, wk)
     else:
         ga = (w0 if comp == OMEGA else y[comp]) - level
-        gb = (w1 if comp == OMEGA else y_new[comp]) - level
+        gb = (w1 if comp == OMEGA else work.y_new[comp]) - level
     if code == ist[I_AT_EVENT] - 1 and abs(ga) <= ON_LEVEL * max(1.0, abs(level)):
         ga = 0.0
     ends = crosses(ga, gb, direction)
@@ -371,14 +376,14 @@ def _level_event(tab, m, extras, angle_mode, x, h, y, y_new, K, F, code, comp, l
     theta = 2.0
     rising = True
     if ends or inside:
-        dense_ready = _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K,
-                                  F, tmp, wk, ist)
+        dense_ready = _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
         if ends:
-            theta = _crossing(m, extras, angle_mode, F, y, y_new, comp, level, sel, sw, tmp, wk)
+            theta = _crossing(m, extras, at.angle_mode, work.F, y, work.y_new, comp, level, at.sel,
+                              at.sw, work.tmp, wk)
         else:
             for n_samples in (N_MARGIN_SAMPLES, N_FINE_SAMPLES):  # coarse, then fine
-                theta, evals = _crossing_inside(m, extras, angle_mode, F, y, x, h, comp, level,
-                                                direction, ga, sel, sw, tmp, wk, n_samples)
+                theta, evals = _crossing_inside(m, extras, at, y, work, comp, level, direction, ga,
+                                                n_samples)
                 ist[I_NFEV] += evals
                 if theta <= 1.0:
                     break

@@ -10,6 +10,8 @@ fills ``cfg`` and reads the counters.
 """
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 
 from ..jit import kernel
@@ -76,6 +78,22 @@ N_IST = INTS.size
                                              SW_LOAD, SW_GENERATOR, SW_SLEEVE, SW_LOAD_TABLE))
 if I_SWITCHES != 0:  # (the stepper passes ist[:N_SWITCHES] on as the switches)
     raise AssertionError("the switches must lead the stepper's integer state")
+
+#: The loop's arguments, bundled by what they are (numba passes a tuple to an inlined helper
+#: for free, and flattened, as its fields, to one that is called). ``Chunk``: what
+#: :func:`~transient.core.stepper.loop.advance` exchanges with its caller, the settings, the
+#: breakpoints, the float and integer state kept between chunks, the output and event buffers.
+#: ``Work``: the work arrays of one call (:func:`~transient.core.stepper.loop.buffers`), the
+#: stages, the dense output's coefficients, the derivative at the state, the new state, the
+#: state at an event, a scratch state, the right-hand side's work array and the pairs' margins
+#: over a step. ``At``: the step attempt at hand, whether crank angle is the independent
+#: variable and its index in the state, the step's start and size, the angle ``sel`` that picks
+#: the tables' pieces for it, the switches. ``Segment``: where the segment ends and what bounds
+#: the step (:func:`~transient.core.stepper.breakpoints._segment_end`).
+Chunk = namedtuple("Chunk", ["cfg", "bp", "fst", "ist", "outbuf", "evbuf"])
+Work = namedtuple("Work", ["K", "F", "f", "y_new", "y_evt", "tmp", "wk", "gs"])
+At = namedtuple("At", ["angle_mode", "ix", "x", "h", "sel", "sw"])
+Segment = namedtuple("Segment", ["x_end", "up", "down", "h_max", "tol_end", "corner"])
 
 #: Most intervals of an output grid one step may span (its samples fit the rows the stepper keeps
 #: free in the output buffer).

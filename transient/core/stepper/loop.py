@@ -69,8 +69,8 @@ from .io import (C_ATOL, C_CHUNK_STEPS, C_DPHI_OUT, C_FIXED_STEP, C_DT_OUT, C_PH
                  I_LOAD_TABLE, I_MODES, I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT,
                  I_NREDO, I_NREJECT, I_NSTEPS, I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE,
                  I_STARTED, I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
-                 MAX_OUTPUT_INTERVALS, _emit_new_row, _emit_row, _emit_samples, _finish, _locked,
-                 _reset_output_grid, _retake)
+                 MAX_OUTPUT_INTERVALS, At, Chunk, Work, _emit_new_row, _emit_row, _emit_samples,
+                 _finish, _locked, _reset_output_grid, _retake)
 
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
@@ -84,32 +84,32 @@ CHATTER_GAP, CHATTER_COUNT = 1e-9, 50
 MIN_KINK_FRACTION = 0.05
 
 
-def buffers(m, tab, n: int) -> tuple:
-    """The work arrays of one call of :func:`advance`, after its first ten arguments: the
+def buffers(m, tab, n: int) -> Work:
+    """The work arrays of one call of :func:`advance`, its last argument (a ``Work``): the
     stages ``K``, the dense output ``F``, the derivative ``f``, three states, the right-hand
     side's scratch ``wk`` and the pairs' margins over a step ``gs``. Allocated by the caller,
     so that the stepper is one compile unit of its own, without reference counting. ``n``: the
     length of the state."""
-    return (np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
-            np.empty(n), np.empty(n), np.empty(n), work_array(m),
-            np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))))
+    return Work(np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
+                np.empty(n), np.empty(n), np.empty(n), work_array(m),
+                np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))))
 
 
 @compiled(nogil=True, _nrt=False)  # (nogil: the previous block is written meanwhile, simulate)
-def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new, y_evt, tmp, wk,
-            gs):
+def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
     """Integrate until the run ends, a buffer fills or the chunk's step budget is used.
 
     Parameters
     ----------
     m : Model
     extras : None or True
-        The kernels' variant for ``m`` (:func:`~transient.core.model.layout.extras_of`): None compiles none of the
-        features a plain scene does not use.
+        The kernels' variant for ``m`` (:func:`~transient.core.model.layout.extras_of`): None
+        compiles none of the features a plain scene does not use.
     tab : tableaus.Tableau
         The Runge–Kutta pair (DOP853, DOPRI5).
     cfg : float64[N_CFG]
-        Settings, indices ``C_*`` (:mod:`~transient.core.stepper.io`, as the other layouts and codes).
+        Settings, indices ``C_*`` (:mod:`~transient.core.stepper.io`, as the other layouts and
+        codes).
     bp : float64[:]
         Sorted breakpoints in [0, m.period).
     y : float64[layout.n_state(m)]
@@ -121,7 +121,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
         Output samples; ``ist[I_NOUT]`` rows are filled (the caller resets it after draining).
     evbuf : float64[nev, 4]
         Events (code, t, φ, ω); ``ist[I_NEV]`` rows filled.
-    K, F, f, y_new, y_evt, tmp, wk, gs
+    work : io.Work
         Work arrays, fresh for each call (:func:`buffers`).
 
     Returns
@@ -133,13 +133,15 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
         CHATTERING (pair modes switching without progress) or STIFF (Hairer's stiffness test
         fired).
     """
+    io = Chunk(cfg, bp, fst, ist, outbuf, evbuf)
+    K, F, f, y_new, tmp, wk, gs = work.K, work.F, work.f, work.y_new, work.tmp, work.wk, work.gs
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     # rows kept free: a step spans at most 256 intervals of its grid (in time, of each grid)
     margin = 600
 
     if ist[I_STARTED] == 0:
-        status = _start_run(m, extras, cfg, y, fst, ist, outbuf, evbuf, wk)
+        status = _start_run(m, extras, io, y, wk)
         if status != RUNNING:
             return status
     # As the last chunk left them: its derivative and margins (F_DERIV), if valid, and the
@@ -173,12 +175,12 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             _restarted(cfg, angle_mode, fst, ist)
 
         # The segment and the step size.
-        x_end, up, down, h_max, tol_end, corner = _segment_end(m, cfg, bp, angle_mode, ix, x, y,
-                                                               sw, fst)
-        if x_end - x <= tol_end:
+        seg = _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst)
+        if seg.x_end - x <= seg.tol_end:
             return _finish(m, extras, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
         fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
-        h, h_planned, at_segment_end = _step_size(cfg, fst, fixed, x, x_end, h_max, tol_end)
+        h, h_planned, at_segment_end = _step_size(cfg, fst, fixed, x, seg.x_end, seg.h_max,
+                                                  seg.tol_end)
         min_step = 10.0 * (np.nextafter(abs(x), np.inf) - abs(x))
         if h < min_step:
             return FAIL_STEP
@@ -189,15 +191,15 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
 
         # The step attempt, its acceptance and the next step size.
         retakes_at_kinks = watches_kinks(m, extras, angle_mode) and not fixed
-        on_corner = at_segment_end and x_end == corner
+        on_corner = at_segment_end and seg.x_end == seg.corner
         cut = at_segment_end
         for attempt in range(2):
             if retakes_at_kinks:
                 reset_kinks(m, extras, wk)
             _start_attempt(f, K, wk)
             step(tab, model_rhs, (m, extras, angle_mode, sel, sw, wk), ix, x, y, f, h, K, y_new, tmp)
-            finite, err, dip, w_lo, w_hi = _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist,
-                                                          rtol, atol, on_corner, corner)
+            finite, err, seen = _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner,
+                                               seg.corner)
             if attempt > 0 or not (retakes_at_kinks and finite and err > 1.0):
                 break
             # A kink of the derivative inside the step (the model's hook: a side force changing
@@ -245,8 +247,9 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             _retake(fst, ist, 0.5 * h)
             steps_here += 1
             continue
-        retake, dense_ready = _aim_at_breakpoint(tab, m, extras, angle_mode, y, y_new, h, sel, sw,
-                                                 K, F, tmp, wk, fst, ist, up, down, min_step)
+        at = At(angle_mode, ix, x, h, sel, sw)
+        retake, dense_ready = _aim_at_breakpoint(tab, m, extras, at, y, work, fst, ist, seg,
+                                                 min_step)
         if retake:
             steps_here += 1
             continue
@@ -255,8 +258,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
 
         # State events on this step: the earliest one truncates it.
         ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready = _locate_events(
-            tab, m, extras, cfg, angle_mode, x, h, y, y_new, f, K, F, sel, sw, tmp, wk, gs, ist,
-            dip, dense_ready, w_lo, w_hi)
+            tab, m, extras, cfg, at, y, work, ist, seen, dense_ready)
         if unseen and ev_code < 0 and n_unseen < MAX_UNSEEN:
             _retake(fst, ist, 0.5 * h)  # computed again, shorter
             n_unseen += 1
@@ -264,16 +266,14 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
             continue
         n_unseen = 0
         x_stop = x + h if ev_code < 0 else x + ev_theta * h
-        _emit_step_samples(tab, m, extras, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K,
-                           F, tmp, wk, outbuf, ist, fst, dense_ready)
+        _emit_step_samples(tab, m, extras, io, at, x_stop, y, work, dense_ready)
         ist[I_NSTEPS] += 1
         steps_here += 1
         fst[F_H] = h_next
         fst[F_SEL] = sel
         if ev_code < 0:
-            status = _take_step(tab, m, extras, cfg, bp, angle_mode, at_segment_end, x_end, up,
-                                redo_hit_breakpoint, y, y_new, f, K, gs, sel, sw, outbuf, evbuf,
-                                ist, fst, wk)
+            status = _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint, y,
+                                work)
             if status != RUNNING:
                 return status
             continue
@@ -281,22 +281,22 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, K, F, f, y_new,
         # Truncate the step at the event, act on it and restart from there.
         if extras is not None and ev_code == EV_PAIR_MODE and ist[I_DIRECTION] == st.STUCK:
             ev_code = EV_RELEASED  # (the holding margin, in pair 0's slot, fell to zero)
-        x_stop, on_breakpoint = _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp,
-                                               ev_level, at_segment_end and x_end == up, x_end,
-                                               tol_end, F, y, y_evt, sel, sw, wk, ist)
-        status = _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y,
-                               sel, sw, outbuf, evbuf, ist, fst, wk)
+        x_stop, on_breakpoint = _move_to_event(m, extras, at, seg, at_segment_end, x_stop,
+                                               (ev_theta, ev_comp, ev_level), y, work, ist)
+        status = _record_event(m, extras, io, angle_mode, on_breakpoint, x_stop, ev_code, y, sel,
+                               sw, wk)
         if status != RUNNING:
             return status
-        _switch_at_event(m, extras, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next,
-                         y, ist, fst, wk)
+        _switch_at_event(m, extras, io, angle_mode, (ev_code, ev_comp, ev_level, ev_rising),
+                         h_next, y, wk)
 
 
 @kernel(inline=True)
-def _start_run(m, extras, cfg, y, fst, ist, outbuf, evbuf, wk):
+def _start_run(m, extras, io, y, wk):
     """The first chunk's start: the switches chosen at the initial state, the independent
     variable, the output grid and the first row. Returns RUNNING, or LOCKED where the pairs'
     friction holds the machine at rest."""
+    cfg, fst, ist, outbuf, evbuf = io.cfg, io.fst, io.ist, io.outbuf, io.evbuf
     ist[I_STARTED] = 1
     fst[F_ERR_OLD] = 1e-4
     ist[I_GOV_BRANCH] = start_branch(m, extras, y[OMEGA], y)
@@ -380,15 +380,17 @@ def _start_attempt(f, K, wk):
 
 
 @kernel(inline=True)
-def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, on_corner, corner):
+def _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner, corner):
     """After the step attempt of size h from y (stages in K, new state in y_new): ``(finite, err,
-    dip, w_lo, w_hi)``, with the pairs' margins at y_new into ``gs[N_MARGIN_SAMPLES]``.
+    seen)``, with the pairs' margins at y_new into ``gs[N_MARGIN_SAMPLES]``.
 
-    ``err``: the error norm; ``finite``: it and y_new are finite; ``dip``: some pair's margin
-    reached zero in a stage (:func:`.events._locate_events` then samples them); ``w_lo``,
-    ``w_hi``: the speed's range over the stages, read before any dense output adds its own stages
-    to it. ``on_corner``: the step ends on a load-schedule corner.
+    ``err``: the error norm; ``finite``: it and y_new are finite; ``seen``: what the stages saw,
+    (``dip``, ``w_lo``, ``w_hi``): whether some pair's margin reached zero in a stage
+    (:func:`.events._locate_events` then samples them), and the speed's range over the stages,
+    read before any dense output adds its own stages to it. ``on_corner``: the step ends on a
+    load-schedule corner.
     """
+    K, y_new, wk, gs = work.K, work.y_new, work.wk, work.gs
     n = y.shape[0]
     if on_corner:
         y_new[ix] = corner  # x + (corner − x) can miss it by an ulp: the event needs g = 0
@@ -405,7 +407,7 @@ def _judge_attempt(tab, m, ix, h, y, K, y_new, wk, gs, ist, rtol, atol, on_corne
     finite = np.isfinite(err)
     for i in range(n):
         finite = finite and np.isfinite(y_new[i])
-    return finite, err, dip, w_lo, w_hi
+    return finite, err, (dip, w_lo, w_hi)
 
 
 @kernel(inline=True)
@@ -422,30 +424,31 @@ def _stiff(tab, K, h, y, ix, control, rtol, atol, ist):
 
 
 @kernel(inline=True)
-def _emit_step_samples(tab, m, extras, cfg, angle_mode, ix, x, h, x_stop, y, y_new, sel, sw, K, F,
-                       tmp, wk, outbuf, ist, fst, dense_ready):
+def _emit_step_samples(tab, m, extras, io, at, x_stop, y, work, dense_ready):
     """The output samples inside the step, up to ``x_stop`` (its end, or its event), from the
     dense output: in crank angle the angle grid's; in time the time grid's and the angle grid's
     crossings (:func:`_emit_time_samples`)."""
-    if angle_mode:
+    cfg, fst, ist, outbuf = io.cfg, io.fst, io.ist, io.outbuf
+    F, tmp, wk = work.F, work.tmp, work.wk
+    x, h = at.x, at.h
+    if at.angle_mode:
         if fst[F_NEXT_OUT] <= x_stop:
-            _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp,
-                        wk, ist)
-            _emit_samples(m, extras, F, y, x, h, x_stop, ix, cfg[C_DPHI_OUT], sel, sw, outbuf,
-                          ist, fst, tmp, wk)
+            _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
+            _emit_samples(m, extras, F, y, x, h, x_stop, at.ix, cfg[C_DPHI_OUT], at.sel, at.sw,
+                          outbuf, ist, fst, tmp, wk)
         return
     whole = x_stop == x + h
     if whole and fst[F_NEXT_OUT] > x_stop and not _crosses_level(
-            fst[F_LAST_PHI], y[PHI], y_new[PHI], cfg[C_DPHI_OUT]):
+            fst[F_LAST_PHI], y[PHI], work.y_new[PHI], cfg[C_DPHI_OUT]):
         return  # (most steps in time: nothing to write, no dense output needed)
-    _dense_once(dense_ready, tab, m, extras, angle_mode, y, y_new, h, sel, sw, K, F, tmp, wk, ist)
+    _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
     if whole:
-        phi_stop = y_new[PHI]
+        phi_stop = work.y_new[PHI]
     else:
         dense_eval(F, y, (x_stop - x) / h, tmp)
         phi_stop = tmp[PHI]
-    _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, sel, sw, outbuf, ist, fst, tmp,
-                       wk)
+    _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, at.sel, at.sw, outbuf, ist,
+                       fst, tmp, wk)
 
 
 @kernel(inline=True)
@@ -498,11 +501,13 @@ def _emit_time_samples(m, extras, F, y, x, h, x_stop, phi_stop, cfg, sel, sw, ou
 
 
 @kernel(inline=True)
-def _take_step(tab, m, extras, cfg, bp, angle_mode, at_segment_end, x_end, up, redo_hit_breakpoint,
-               y, y_new, f, K, gs, sel, sw, outbuf, evbuf, ist, fst, wk):
+def _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint, y, work):
     """The accepted step, without an event in it, becomes the state (with its derivative and
     margins carried over); a breakpoint it ends on acts. Returns RUNNING, or FINISHED where the
     run ends with it."""
+    cfg, bp, fst, ist, outbuf, evbuf = io
+    y_new, f, K, gs, wk = work.y_new, work.f, work.K, work.gs, work.wk
+    angle_mode, sel, sw = at.angle_mode, at.sel, at.sw
     n = y.shape[0]
     ist[I_AT_EVENT] = 0
     for i in range(n):
@@ -515,7 +520,7 @@ def _take_step(tab, m, extras, cfg, bp, angle_mode, at_segment_end, x_end, up, r
             # rounding on its far side) would never be seen falling: the next step settles the
             # modes first (_settle_modes).
             ist[I_F_VALID] = 0
-    if angle_mode and at_segment_end and x_end == up:
+    if angle_mode and at_segment_end and seg.x_end == seg.up:
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
         if _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
             ist[I_F_VALID] = 0
@@ -524,27 +529,29 @@ def _take_step(tab, m, extras, cfg, bp, angle_mode, at_segment_end, x_end, up, r
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
         if _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
             ist[I_F_VALID] = 0
-    if angle_mode and at_segment_end and x_end == cfg[C_PHI_END]:
+    if angle_mode and at_segment_end and seg.x_end == cfg[C_PHI_END]:
         return _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk)
-    if not angle_mode and at_segment_end and x_end == cfg[C_T_END]:
+    if not angle_mode and at_segment_end and seg.x_end == cfg[C_T_END]:
         return _finish(m, extras, y, sel, sw, outbuf, evbuf, ist, fst, wk)
     return RUNNING
 
 
 @kernel(inline=True)
-def _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_level,
-                   ends_on_breakpoint, x_end, tol_end, F, y, y_evt, sel, sw, wk, ist):
-    """The state at the event (at θ = ``ev_theta`` of the step, independent variable
-    ``x_stop``), put exactly on the event's level, becomes the state. Returns ``(x_stop,
-    on_breakpoint)``: an event within rounding of the breakpoint the step ends on (a pair whose
+def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work, ist):
+    """The state at the event (``crossing``: its θ in the step, its component and level; the
+    independent variable ``x_stop``), put exactly on the event's level, becomes the state.
+    Returns ``(x_stop, on_breakpoint)``: an event within rounding of the breakpoint the step ends on (a pair whose
     power changes sign at a pressure corner, a load corner there) is on it, and the state goes
     exactly there, so that both are recorded (else the next step would take the breakpoint as
     passed, unseen)."""
-    dense_eval(F, y, ev_theta, y_evt)
-    on_breakpoint = angle_mode and ends_on_breakpoint and x_end - x_stop <= tol_end
+    ev_theta, ev_comp, ev_level = crossing
+    angle_mode, sel, sw, wk, y_evt = at.angle_mode, at.sel, at.sw, work.wk, work.y_evt
+    dense_eval(work.F, y, ev_theta, y_evt)
+    ends_on_breakpoint = at_segment_end and seg.x_end == seg.up
+    on_breakpoint = angle_mode and ends_on_breakpoint and seg.x_end - x_stop <= seg.tol_end
     if on_breakpoint:
-        x_stop = x_end
-    y_evt[ix] = x_stop
+        x_stop = seg.x_end
+    y_evt[at.ix] = x_stop
     if ev_comp >= PAIR_COMP:
         pass  # the margin is zero here to the root finder's accuracy; nothing to put on a level
     elif extras is not None and ev_comp == DEMAND_COMP:
@@ -566,11 +573,11 @@ def _move_to_event(m, extras, angle_mode, ix, x_stop, ev_theta, ev_comp, ev_leve
 
 
 @kernel(inline=True)
-def _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw,
-                  outbuf, evbuf, ist, fst, wk):
+def _record_event(m, extras, io, angle_mode, on_breakpoint, x_stop, ev_code, y, sel, sw, wk):
     """The event (and a breakpoint it sits on) into the event buffer, and the ends of a run it
     may bring: the end, a stall, the pairs locking at rest, chattering. Returns RUNNING, or the
     code the run ends with."""
+    cfg, bp, fst, ist, outbuf, evbuf = io
     if on_breakpoint:
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
         _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk)
@@ -603,12 +610,13 @@ def _record_event(m, extras, cfg, bp, angle_mode, on_breakpoint, x_stop, ev_code
 
 
 @kernel(inline=True)
-def _switch_at_event(m, extras, cfg, angle_mode, ev_code, ev_comp, ev_level, ev_rising, h_next, y,
-                     ist, fst, wk):
+def _switch_at_event(m, extras, io, angle_mode, event, h_next, y, wk):
     """What the event switches: a pair's mode, the starter, the governor's branch, the load
     schedule's segment, the generator's branch, the speed map's interval, the sleeve on or off a
     stop, or the independent variable (with the next step's size converted by ω = level and the
-    output grid of the new variable)."""
+    output grid of the new variable). ``event``: (code, component, level, rising)."""
+    ev_code, ev_comp, ev_level, ev_rising = event
+    cfg, fst, ist = io.cfg, io.fst, io.ist
     if ev_code == EV_PAIR_MODE:
         ist[I_MODES] ^= 1 << (ev_comp - PAIR_COMP)
         ist[I_NSWITCH] += 1
