@@ -19,9 +19,9 @@ from .core.model.variation import cycle_fuel
 from .core.model.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER,
                                 PHI, POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS,
                                 RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T,
-                                extras_of, layout_fields, work_array)
+                                extras_of)
 from .core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
-from .core.model.reactions import work_rows
+from .core.model.work import work_array
 from .errors import SceneError
 from .forces.compressor import compressor_cycle
 from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
@@ -393,7 +393,7 @@ def build_model(scene, part_load: bool = False
         bp = union_of_angles(bp, curve.corners, period)
     if reaction_friction(scene):
         bp = union_of_angles(bp, reaction_breakpoints(scene), period)
-    fields = dict(
+    model = Model(
         kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
         J0=float(scene.inertia.total),
@@ -411,8 +411,6 @@ def build_model(scene, part_load: bool = False
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
         **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation)
-    model = Model(**fields, **layout_fields(fields),
-                  wk_rows=work_rows(fields["kind"], fields["reaction"]))
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
         if moved.size:  # the combustion's start and end, δ_k later

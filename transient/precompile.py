@@ -88,7 +88,8 @@ def _types_by_parameter(model, tab) -> dict:
                                    types.int64[::1], types.float64[:, ::1])),
                # the loop's records (stepper.io)
                "io": typeof(sio.Chunk(*_vectors(3), np.zeros(1, np.int64), *_matrices(2))),
-               "work": typeof(sio.Work(*_matrices(2), *_vectors(4), *_matrices(2))),
+               "work": typeof(sio.Work(*_matrices(2), *_vectors(4), *_matrices(2),
+                                       np.zeros(1, np.int64))),
                "at": typeof(sio.At(True, 0, 0.0, 0.0, 0.0, np.zeros(1, np.int64))),
                "seg": typeof(sio.Segment(*(6 * [0.0]))),
                "seen": types.Tuple((types.boolean, types.float64, types.float64)),

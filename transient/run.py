@@ -16,7 +16,7 @@ from typing import Callable
 import numpy as np
 
 from .assemble import build_model, initial_governor, part_load_refusal
-from .core.model import forcing, layout
+from .core.model import forcing, layout, work
 from .core import stepper
 from .core.stepper import io as sio
 from .core.model.inverse import inverse_dynamics
@@ -249,7 +249,7 @@ def switch_inertia(model, extra: float, y, ist):
     (the governor's branch, the generator's, the speed map's interval); returns the model with
     the extra inertia on the shaft (``J0``)."""
     angle_mode = ist[sio.I_ANGLE_MODE] == 1
-    J = forcing.inertia(model, y[layout.PHI], layout.work_array(model))
+    J = forcing.inertia(model, y[layout.PHI], work.work_array(model))
     w = forcing.speed(J, angle_mode, y)
     w_new = J * w / (J + extra)
     y[layout.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new

@@ -28,7 +28,7 @@ from scipy.integrate import quad
 from transient.analysis.summary import summarize
 from transient.assemble import build_model, gas_table
 from transient.core.model.forcing import inertia
-from transient.core.model.layout import work_array
+from transient.core.model.work import work_array
 from transient.run import integrate
 from transient.scene import load_scene
 from transient.scene.read import scene_from_dict

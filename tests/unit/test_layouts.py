@@ -1,6 +1,6 @@
 """The declared layouts of the compiled arrays (:mod:`transient.core.declare`): offsets derived
-from the declarations, the per-scene offsets computed at assembly, and each checked against
-something counted another way: the state's and the output row's lengths against the trajectory's
+from the declarations, the compiled index kernels against the declaration's offsets on every case,
+and each checked against something counted another way: the state's and the output row's lengths against the trajectory's
 columns that ``transient.outputs`` names from the scene, the reaction solvers' rows against the
 rows they share, the event tables against each other."""
 from __future__ import annotations
@@ -16,8 +16,8 @@ from transient.core.model import articulated_friction as af
 from transient.core.model import governor as gv
 from transient.core.model import joint_friction as jf
 from transient.core.model import layout
-from transient.core.model import reactions as rx
 from transient.core.model import swash_friction as sf
+from transient.core.model.work import N_WK, work_array
 from transient.core.stepper import events
 from transient.core.stepper import io as sio
 from transient.outputs import output_columns
@@ -59,31 +59,34 @@ def test_bad_declarations_are_refused():
 
 @pytest.mark.parametrize("case", CASES, ids=[c.stem for c in CASES])
 def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
+    """The compiled index kernels (the chain the kernels index by) and the declaration's offsets
+    (what the Python side lays out) agree, and both with what the scene counts otherwise."""
     scene = load_scene(case)
     model, _, _ = build_model(scene)
-    n = model.state_at[-1]
-    # the state: every block where the declaration puts it, its length counted from the scene
-    expected = (6 + len(scene.friction.pairs) + gv.n_states(model.gov_dyn)
+    at = layout.STATE.offsets_for(model)
+    assert [layout.gov_index(model), layout.latch_index(model), layout.cyl_index(model),
+            layout.n_state(model)] == at[layout.B_GOVERNOR:]
+    # the state: its length counted from the scene
+    expected = (6 + len(scene.friction.pairs) + len(gv.STATE_NAMES[model.gov_dyn])
                 + scene.mechanism.n_cylinders * (int(model.latch) + int(model.woschni)))
-    assert n == expected == model.state_control.size
-    assert np.all(np.diff(model.state_at) >= 0)
-    assert list(model.state_control[:3]) == [BY_INCREMENT, BY_INCREMENT, BY_SIZE]
-    assert np.all(model.state_control[3:layout.W_LOSS0 + model.n_pairs] == NOT_CONTROLLED)
-    governor = slice(model.state_at[layout.B_GOVERNOR], model.state_at[layout.B_GOVERNOR + 1])
-    assert np.all(model.state_control[governor] == BY_SIZE)
+    control = layout.state_control(model)
+    assert at[-1] == expected == control.size and np.all(np.diff(at) >= 0)
+    assert list(control[:3]) == [BY_INCREMENT, BY_INCREMENT, BY_SIZE]
+    assert np.all(control[3:layout.W_LOSS0 + model.n_pairs] == NOT_CONTROLLED)
+    assert np.all(control[at[layout.B_GOVERNOR]:at[layout.B_GOVERNOR + 1]] == BY_SIZE)
+    assert np.all(control[at[layout.B_PRESSURE]:] == BY_SIZE)
     # the output row: as long as the trajectory's columns that the scene names
-    columns = output_columns(scene)
+    out = layout.OUTPUT.offsets_for(model)
+    assert [layout.pair_col(model), layout.governor_col(model), layout.cylinder_loss_col(model),
+            layout.n_outputs(model)] == [out[layout.O_PAIRS], out[layout.O_GOVERNOR],
+                                         out[layout.O_CYL_LOSS], out[-1]]
     if scene.run.mode != "prescribed-speed":
-        assert model.out_at[-1] == len(columns)
-        names = list(columns)
-        assert names[model.out_at[layout.O_GAS]] == "p_1"
+        names = list(output_columns(scene))
+        assert out[-1] == len(names) and names[out[layout.O_GAS]] == "p_1"
         if model.n_pairs:
-            assert names[model.out_at[layout.O_PAIRS]] == "S_1"
-    # the work array: the declared rows, then the scene's reaction solver's own
-    wk = layout.work_array(model)
-    assert wk.shape[0] == model.wk_rows
-    assert model.wk_rows == layout.WK_RX + (rx.SOLVER_ROWS[model.kind] if model.reaction else 0)
-    assert sio.fst_size(model) == sio.N_FST + n + max(model.n_pairs, 1)
+            assert names[out[layout.O_PAIRS]] == "S_1"
+    assert work_array(model).shape[0] == N_WK
+    assert sio.fst_size(model) == sio.N_FST + at[-1] + max(model.n_pairs, 1)
 
 
 @pytest.mark.parametrize("solver", [jf, sf, af], ids=["crank-slider", "swash plate", "articulated"])
@@ -91,7 +94,7 @@ def test_each_reaction_solver_lays_its_rows_after_the_shared_ones(solver):
     shared = set(jf.SHARED)
     own = set(solver.ROWS)
     assert not shared & own and min(own) == jf.SHARED.end
-    assert rx.N_WK >= layout.WK_RX + solver.ROWS.end
+    assert N_WK >= layout.WK_RX + solver.ROWS.end
     # every row constant of the module is one of its declared rows or a shared one
     prefix = {jf: "R_", sf: "S_", af: "A_"}[solver]
     constants = {getattr(solver, k) for k in dir(solver) if k.startswith(prefix) and k.isupper()

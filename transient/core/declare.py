@@ -13,10 +13,11 @@ here as a :class:`Layout`, and the integer constants the kernels index with are 
 
 An unpacking that names more or fewer blocks than the layout holds fails at import. A block's
 size is a number of entries known at import; a block whose length depends on the scene (per
-cylinder, per pair, per shaft station) is declared with a :class:`Sized` rule instead, and its
-offset is computed once per scene at assembly (:meth:`Layout.offsets_for`) and handed to the
-kernels as an array of offsets, never recomputed by them. The blocks before the first sized one
-keep offsets known at import (:meth:`Layout.fixed_offset`).
+cylinder, per pair, per shaft station) is declared with a :class:`Sized` rule instead, a kernel
+of the Model: the compiled code chains the rules in the declared order (an offset is the one
+before it plus that block's size), and the Python side runs the same rules
+(:meth:`Layout.offsets_for`). The blocks before the first sized one keep offsets known at import
+(:meth:`Layout.fixed_offset`).
 
 Pure Python; nothing here is compiled.
 """
@@ -29,7 +30,8 @@ from typing import Callable, Iterator
 @dataclass(frozen=True)
 class Sized:
     """The length of a block that depends on the scene: ``rule`` of the object the layout is
-    laid out for (the compiled Model), ``what`` says it in words (for the developer's tables)."""
+    laid out for (the compiled Model; a kernel, whose compiled code indexes the array), ``what``
+    says it in words (for the developer's tables)."""
 
     rule: Callable[[object], int]
     what: str
@@ -115,10 +117,12 @@ class Layout:
     size = end
 
     def sizes_for(self, obj) -> list[int]:
-        """Each block's size for ``obj`` (the Model its sized blocks' rules read)."""
+        """Each block's size for ``obj`` (the Model its sized blocks' rules read; a rule that is
+        a kernel runs as Python, its ``py_func``, the same code the compiled kernels run)."""
         sizes = []
         for b in self.blocks:
-            n = b.size.rule(obj) if isinstance(b.size, Sized) else b.size
+            n = (getattr(b.size.rule, "py_func", b.size.rule)(obj) if isinstance(b.size, Sized)
+                 else b.size)
             if int(n) != n or n < 0:
                 raise ValueError(f"layout {self.name}: block {b.name} would have size {n!r}")
             sizes.append(int(n))
@@ -156,7 +160,7 @@ def _block(b) -> Block:
     return Block(*b)
 
 
-#: How a step's error control treats a state component (``Model.state_control``, the argument
+#: How a step's error control treats a state component (``layout.state_control``, the argument
 #: ``control`` of :func:`transient.core.integrator.rk.error_norm`): the model declares it per
 #: block of its state, the integrator reads it; neither imports the other.
 #: NOT_CONTROLLED: no error test (a quadrature that does not feed back, a held value);

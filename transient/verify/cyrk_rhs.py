@@ -13,7 +13,8 @@ import numpy as np
 
 from ..core.model.forcing import governor_branch
 from ..core.model.layout import (N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, extras_of,
-                                 n_state, work_array)
+                                 n_state)
+from ..core.model.work import work_array
 from ..core.model.rhs import choose_modes, derivative
 
 # CyRK's callback signature: dy (double*), t, y (double*), args (double*).

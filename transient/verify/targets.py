@@ -43,7 +43,7 @@ from ..core import CACHE_DIR_VARIABLE
 from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS, SAMPLES_PER_REV,
                     TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight, on_plateau,
                     order_slope, read_record)
-from ..core.model import layout
+from ..core.model import layout, work
 from ..core.jit import kernel
 from ..core.model.rhs import derivative
 from ..results import open_result
@@ -128,7 +128,7 @@ def rhs_arguments(scene, n_states=2000):
     states[:, layout.PHI], states[:, layout.T] = phi, np.interp(phi, tr["phi"], tr["t"])
     states[:, layout.KINETIC] = np.interp(phi, tr["phi"], 0.5 * tr["J"] * tr["omega"] ** 2)
     n = layout.n_state(model)
-    return model, states, np.empty(n), np.zeros(n), _switches(), layout.work_array(model)
+    return model, states, np.empty(n), np.zeros(n), _switches(), work.work_array(model)
 
 
 def _switches():
@@ -292,7 +292,7 @@ def hand_against_transient(base, rows, **flags) -> tuple[np.ndarray, np.ndarray]
     theirs = np.zeros(6)
     hand, transient = [], []
     for i in rows:
-        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), layout.work_array(m), False,
+        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), work.work_array(m), False,
                  layout.extras_of(m))
         rhs(p, states[i], out, rec)
         hand.append((out[layout.T], out[layout.KINETIC]))
@@ -321,7 +321,7 @@ def bare_kernel(rounds=7) -> dict:
     for kin in ("exact", "tabulated"):
         m, _, _ = build_model(dc.replace(base, solver=dc.replace(base.solver, kinematics=kin)))
         costs[kin] = per_call(rhs_loop, m, states, np.empty(6), np.zeros(6), _switches(),
-                              layout.work_array(m), False, layout.extras_of(m), rounds=rounds)
+                              work.work_array(m), False, layout.extras_of(m), rounds=rounds)
     return {"hand_written_s": hand, "exact_s": costs["exact"], "tabulated_s": costs["tabulated"]}
 
 

@@ -70,14 +70,14 @@ STATE_NAMES = ((), ("gov_integral", "gov_rack"), ("sleeve_lift", "sleeve_speed")
 STATE_UNITS = ((), ("1", "1"), ("m", "m/s"), ("1", "1", "rad/s"))
 
 
+#: Number of states of each governor (by ``Model.gov_dyn``).
+N_STATES = tuple(len(names) for names in STATE_NAMES)
+
+
 @kernel(inline=True)
 def n_states(kind):
     """Number of states of governor ``kind``."""
-    if kind == PID:
-        return 3
-    if kind == PI or kind == FLYWEIGHT:
-        return 2
-    return 0
+    return N_STATES[kind]
 
 
 #: Branches of the PI(D) demand's clipping (held for a step, like the droop characteristic's,

@@ -13,10 +13,11 @@ from ..jit import compiled, kernel
 
 from .forcing import (fuel, generator_branch, governor_branch, load_segment, moments,
                       speed_knot_segment)
-from .layout import (COL_EPS, N_SWITCHES, O_PAIRS, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
+from .layout import (COL_EPS, N_SWITCHES, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
                      SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY,
                      WK_J, WK_M, WK_S, WK_S_TRY, cylinder_loss_col, latch_index, n_state,
-                     work_array)
+                     pair_col)
+from .work import work_array
 from .eta_table import invert
 from .reactions import inverse_drive
 from .outputs import cylinder_loss_rows, output_row, pair_rows
@@ -120,6 +121,6 @@ def inverse_dynamics(m, extras, t, phi, omega, eps, rows, M_drive, n_consistent)
         else:
             split_subchains(m, phi[i], J, dJ, M_gas, M_load, wk)
             M_drive[i], n_consistent[i] = inverse_chain(m, eps[i], w, sigma, wk)
-        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, m.out_at[O_PAIRS]:])
+        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, pair_col(m):])
         if m.reaction:
             cylinder_loss_rows(m, w, wk, rows[i, cylinder_loss_col(m):])

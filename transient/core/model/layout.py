@@ -19,9 +19,33 @@ from collections import namedtuple
 import numpy as np
 
 from ..declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED, Block, Layout, Sized
-from ..jit import compiled, kernel
+from ..jit import kernel
 
 from . import governor as gv
+
+@kernel(inline=True)
+def n_losses(m):
+    """The state's energies lost: one per non-ideal pair."""
+    return m.n_pairs
+
+
+@kernel(inline=True)
+def n_governor_states(m):
+    """The dynamic governor's states (:data:`.governor.N_STATES`)."""
+    return gv.N_STATES[m.gov_dyn]
+
+
+@kernel(inline=True)
+def n_latched(m):
+    """The latched fuels: one per cylinder with fuel latching."""
+    return m.ncyl if m.latch else 0
+
+
+@kernel(inline=True)
+def n_pressures(m):
+    """The pressures of the cylinders' closed parts: one per cylinder with wall heat."""
+    return m.ncyl if m.woschni else 0
+
 
 #: The state vector's blocks, in order (a :class:`~transient.core.declare.Layout`). The first
 #: three are the dynamics, φ, t and the third, ω in time or K = ½Jω² in crank angle; then work
@@ -34,30 +58,34 @@ from . import governor as gv
 #: them), then, with wall heat transfer, each cylinder's pressure in its closed part
 #: (:mod:`.cylinder`; the ``p_<k>`` columns show it there).
 #:
-#: A block whose length depends on the scene is :class:`~transient.core.declare.Sized`: its
-#: offset is computed at assembly into ``Model.state_at`` (:func:`layout_fields`), which the
-#: kernels read (:func:`gov_index`, :func:`latch_index`, :func:`cyl_index`, :func:`n_state`)
-#: instead of counting it. A new block of states (per cylinder, per shaft station) is one more
-#: entry here, its size rule and its error control (:data:`CONTROL`), and an index function.
+#: A block whose length depends on the scene is :class:`~transient.core.declare.Sized` by a
+#: kernel of the Model (:func:`n_losses` …). The kernels index the state through
+#: :func:`gov_index`, :func:`latch_index`, :func:`cyl_index` and :func:`n_state`: each the
+#: offset of the block before it plus that block's size kernel, in the declared order. The
+#: Python side lays the state out with the same kernels' code
+#: (:meth:`~transient.core.declare.Layout.offsets_for`), and ``tests/unit/test_layouts.py``
+#: checks the two on every case. The offsets are computed, never stored in the Model: a field
+#: more there would be copied at every call that passes the Model (a tenth of a bare scene's
+#: run time for four fields). A new block of states (per cylinder, per shaft station) is one
+#: more entry here with its size kernel and its error control (:data:`CONTROL`), and one more
+#: index kernel in the chain.
 STATE = Layout(
     "state",
     Block("phi", 1, "shaft angle φ [rad]"),
     Block("t", 1, "time t [s]"),
     Block("omega", 1, "shaft speed ω [rad/s] in time; kinetic energy K = ½Jω² [J] in crank angle"),
     Block("work", 3, "work of the gas forces, of the load, of the starter [J]"),
-    Block("loss", Sized(lambda m: m.n_pairs, "one per non-ideal pair"),
+    Block("loss", Sized(n_losses, "one per non-ideal pair"),
           "energy lost in each non-ideal pair [J]"),
-    Block("governor", Sized(lambda m: gv.n_states(m.gov_dyn), "the governor's states"),
+    Block("governor", Sized(n_governor_states, "the governor's states"),
           "the dynamic governor's states (governor.STATE_NAMES)"),
-    Block("latched", Sized(lambda m: m.ncyl if m.latch else 0, "one per cylinder with latching"),
+    Block("latched", Sized(n_latched, "one per cylinder with latching"),
           "the fuel each cylinder latched at its last injection [1]"),
-    Block("pressure", Sized(lambda m: m.ncyl if m.woschni else 0,
-                            "one per cylinder with wall heat"),
+    Block("pressure", Sized(n_pressures, "one per cylinder with wall heat"),
           "each cylinder's pressure in its closed part [Pa]"),
 )
-#: The blocks' numbers (places in :data:`STATE`, the indices of ``Model.state_at``).
+#: The blocks' numbers (places in :data:`STATE`).
 B_PHI, B_T, B_OMEGA, B_WORK, B_LOSS, B_GOVERNOR, B_LATCHED, B_PRESSURE = range(len(STATE))
-N_STATE_BLOCKS = len(STATE)
 #: The components at offsets known at import (every block before them has a fixed size).
 PHI, T, OMEGA = STATE.fixed_offset("phi"), STATE.fixed_offset("t"), STATE.fixed_offset("omega")
 KINETIC = OMEGA
@@ -76,28 +104,11 @@ CONTROL = {"phi": BY_INCREMENT, "t": BY_INCREMENT, "omega": BY_SIZE, "work": NOT
            "pressure": BY_SIZE}
 
 
-def layout_fields(fields: dict) -> dict:
-    """The Model's fields that lay out its state and its output row, from its other ``fields``
-    (by name): ``state_at``, the offset of each block of :data:`STATE` and then the state's
-    length; ``state_control``, the error control of each component (:data:`CONTROL`);
-    ``out_at``, the offsets of :data:`OUTPUT`'s blocks and then the row's length."""
-    view = _Fields(fields)
-    at = STATE.offsets_for(view)
-    if at[B_LOSS] != W_LOSS0 or OUTPUT.offsets_for(view)[O_GAS] != N_OUT_FIXED:
-        # (the kernels index what comes before these by constants)
-        raise AssertionError("the layouts' fixed blocks moved: STATE's loss block starts at "
-                             f"{at[B_LOSS]}, not {W_LOSS0}")
-    control = np.concatenate([np.full(n, CONTROL[b.name], dtype=np.int64)
-                              for b, n in zip(STATE.blocks, STATE.sizes_for(view))])
-    return dict(state_at=np.array(at, dtype=np.int64), state_control=control,
-                out_at=np.array(OUTPUT.offsets_for(view), dtype=np.int64))
-
-
-class _Fields:
-    """A Model's fields by attribute, before the Model is made (for the size rules)."""
-
-    def __init__(self, fields: dict):
-        self.__dict__.update(fields)
+def state_control(m) -> np.ndarray:
+    """The error control of each component of model ``m``'s state (:data:`CONTROL`): the
+    argument ``control`` of the integrator's error norm (the stepper's ``Work.control``)."""
+    return np.concatenate([np.full(n, CONTROL[b.name], dtype=np.int64)
+                           for b, n in zip(STATE.blocks, STATE.sizes_for(m))])
 
 
 #: Discrete switches held constant over a step (an int array ``sw``, the first block of the
@@ -146,26 +157,42 @@ COL_M_GAS, COL_M_LOAD = OUTPUTS.index("M_gas"), OUTPUTS.index("M_load")
 #: η*_k S_k), η*_k in use, the power lost (1 − η*_k) S_k ω and the energy lost so far.
 PAIR_OUTPUTS = ("S", "eta", "P_loss", "W_loss")
 PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
+@kernel(inline=True)
+def n_gas_columns(m):
+    """The output row's applied pressures (forces): one per cylinder."""
+    return m.ncyl
+
+
+@kernel(inline=True)
+def n_pair_columns(m):
+    """The output row's PAIR_OUTPUTS of every non-ideal pair."""
+    return len(PAIR_OUTPUTS) * m.n_pairs
+
+
+@kernel(inline=True)
+def n_cylinder_loss_columns(m):
+    """The output row's losses of every reaction pair in every cylinder."""
+    return m.n_pairs * m.ncyl if m.reaction else 0
+
+
 #: The output row's blocks (``transient.outputs.output_columns`` names the columns in this
-#: order); the offsets of the sized ones in ``Model.out_at``, computed at assembly
-#: (:func:`layout_fields`) as the state's.
+#: order), sized per scene as the state's and indexed through the chained kernels
+#: :func:`pair_col`, :func:`governor_col`, :func:`cylinder_loss_col` and :func:`n_outputs`.
 OUTPUT = Layout(
     "output row",
     Block("fixed", len(OUTPUTS), "the columns OUTPUTS"),
-    Block("gas", Sized(lambda m: m.ncyl, "one per cylinder"),
+    Block("gas", Sized(n_gas_columns, "one per cylinder"),
           "the pressure (force) applied in each cylinder"),
-    Block("pairs", Sized(lambda m: len(PAIR_OUTPUTS) * m.n_pairs, "PAIR_OUTPUTS per pair"),
+    Block("pairs", Sized(n_pair_columns, "PAIR_OUTPUTS per pair"),
           "each non-ideal pair's PAIR_OUTPUTS"),
-    Block("governor", Sized(lambda m: gv.n_states(m.gov_dyn), "the governor's states"),
+    Block("governor", Sized(n_governor_states, "the governor's states"),
           "the dynamic governor's states"),
-    Block("latched", Sized(lambda m: m.ncyl if m.latch else 0, "one per cylinder with latching"),
+    Block("latched", Sized(n_latched, "one per cylinder with latching"),
           "the fuel each cylinder latched"),
-    Block("cyl_loss", Sized(lambda m: m.n_pairs * m.ncyl if m.reaction else 0,
-                            "one per reaction pair and cylinder"),
+    Block("cyl_loss", Sized(n_cylinder_loss_columns, "one per reaction pair and cylinder"),
           "the power each reaction pair loses in each cylinder (pair 1 in cylinders 1 … n, …)"),
 )
 O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS = range(len(OUTPUT))
-N_OUTPUT_BLOCKS = len(OUTPUT)
 
 #: Rows of the work array ``wk`` (see :func:`work_array`), one column per cylinder, pair or link:
 #: transfer functions u, u′ per cylinder; per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the
@@ -184,8 +211,8 @@ N_OUTPUT_BLOCKS = len(OUTPUT)
 #: :mod:`.reactions`): the rows every solver shares (``reactions.SHARED``: each piston's gas
 #: force, the angle its joints' directions are for, the pairs' loss moments), then each solver's
 #: own, which it declares (``joint_friction.ROWS``, ``swash_friction.ROWS``,
-#: ``articulated_friction.ROWS``), laid over one another: a scene has one mechanism. A scene's
-#: array has its own solver's rows (``Model.wk_rows``, ``reactions.work_rows``).
+#: ``articulated_friction.ROWS``), laid over one another: a scene has one mechanism
+#: (:mod:`.work` allocates the array, with the rows of the solver that needs most).
 WORK = Layout(
     "work array rows",
     "u", "du", "J", "dJ", "M", "eta", "S", "g", "g_min", "eta_try", "S_try", "speed", "demand",
@@ -289,12 +316,6 @@ Model = namedtuple(
         "et_size",  # int64[n_pairs, 2]: the lengths of pair k's two axes
         "et_eta",  # float64[n_pairs, 2, nw_max, ns_max]: η_fwd, η_bwd on pair k's grid [1]
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
-        # the layouts of the arrays whose blocks' lengths depend on the scene (computed at
-        # assembly from the declarations: layout_fields, reactions.work_rows)
-        "state_at",  # int64[len(STATE) + 1]: the offset of each block of the state, then its size
-        "state_control",  # int64[n_state]: each component's error control (CONTROL)
-        "out_at",  # int64[len(OUTPUT) + 1]: the offset of each block of the output row, its size
-        "wk_rows",  # int: rows of the work array: WORK, then the scene's reaction solver's
     ],
 )
 
@@ -318,46 +339,48 @@ def extras_of(m):
 
 @kernel(inline=True)
 def gov_index(m):
-    """Index of the dynamic governor's first state."""
-    return m.state_at[B_GOVERNOR]
+    """Index of the dynamic governor's first state (:data:`STATE`: after the losses)."""
+    return W_LOSS0 + n_losses(m)
 
 
 @kernel(inline=True)
 def latch_index(m):
-    """Index of cylinder 0's latched fuel (with ``m.latch``)."""
-    return m.state_at[B_LATCHED]
+    """Index of cylinder 0's latched fuel (with ``m.latch``), after the governor's states."""
+    return gov_index(m) + n_governor_states(m)
 
 
 @kernel(inline=True)
 def cyl_index(m):
     """Index of cylinder 0's pressure state (with ``m.woschni``), after the latched fuels."""
-    return m.state_at[B_PRESSURE]
+    return latch_index(m) + n_latched(m)
 
 
 @kernel
 def n_state(m):
-    """Length of the state vector of model ``m``."""
-    return m.state_at[N_STATE_BLOCKS]
+    """Length of the state vector of model ``m``: after the pressures."""
+    return cyl_index(m) + n_pressures(m)
 
 
-@kernel
-def n_outputs(m):
-    """Columns of an output row of model ``m``."""
-    return m.out_at[N_OUTPUT_BLOCKS]
+@kernel(inline=True)
+def pair_col(m):
+    """Column of an output row where the pairs' PAIR_OUTPUTS start (:data:`OUTPUT`)."""
+    return N_OUT_FIXED + n_gas_columns(m)
+
+
+@kernel(inline=True)
+def governor_col(m):
+    """Column of an output row where the governor's states start, then the latched fuels."""
+    return pair_col(m) + n_pair_columns(m)
 
 
 @kernel(inline=True)
 def cylinder_loss_col(m):
     """Column of an output row where the reaction pairs' losses per cylinder start (the last
     columns: pair 1 in cylinders 1 … n, then pair 2, …)."""
-    return m.out_at[O_CYL_LOSS]
+    return governor_col(m) + n_governor_states(m) + n_latched(m)
 
 
-@compiled
-def work_array(m):
-    """Scratch space of the right-hand side (rows ``WK_*``, ``Model.wk_rows`` of them),
-    allocated once per run."""
-    wk = np.empty((m.wk_rows, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
-    wk[WK_SEL, 0] = np.nan  # no pieces selected yet
-    wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
-    return wk
+@kernel
+def n_outputs(m):
+    """Columns of an output row of model ``m``."""
+    return cylinder_loss_col(m) + n_cylinder_loss_columns(m)

@@ -12,8 +12,9 @@ from ..jit import kernel
 
 from .reactions import loss_moment
 from .forcing import command, cylinder_value, moments
-from .layout import (N_OUT_FIXED, O_CYL_LOSS, O_GOVERNOR, O_PAIRS, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER,
-                     WK_CYL_LOSS, WK_ETA, WK_FUEL, WK_S, cyl_index, gov_index, latch_index)
+from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER,
+                     WK_CYL_LOSS, WK_ETA, WK_FUEL, WK_S, cyl_index, cylinder_loss_col, gov_index,
+                     governor_col, latch_index, pair_col)
 from .rhs import acceleration
 from .variation import PRESSURE
 
@@ -58,13 +59,13 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
             p_k = m.gas_offset + beta * (p_k - m.gas_offset)
         row[N_OUT_FIXED + k] = p_k
     if extras is not None:
-        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[m.out_at[O_PAIRS]:])
-    j = m.out_at[O_GOVERNOR]
+        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[pair_col(m):])
+    j = governor_col(m)
     for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels
         row[j] = y[i]
         j += 1
     if extras is not None and m.reaction:
-        cylinder_loss_rows(m, w, wk, row[m.out_at[O_CYL_LOSS]:])
+        cylinder_loss_rows(m, w, wk, row[cylinder_loss_col(m):])
 
 
 @kernel(inline=True)

@@ -56,24 +56,12 @@ from . import articulated_friction as af
 from . import eta_table as et
 from . import joint_friction as jf
 from . import swash_friction as sf
-from .layout import (ARTICULATED, CRANK_SLIDER, RX_ETA_BWD, RX_ETA_FWD, SWASH_PLATE, TABULATED,
-                     WK_CYL_LOSS, WK_ETA, WK_RX, WK_S)
+from .layout import (ARTICULATED, RX_ETA_BWD, RX_ETA_FWD, SWASH_PLATE, WK_CYL_LOSS, WK_ETA, WK_RX,
+                     WK_S)
 
 #: Rows (offsets from ``layout.WK_RX``) every mechanism's solver shares: the gas force on each
 #: piston, the pairs' loss moments (``joint_friction.SHARED``).
 R_P, R_LOSS = jf.R_P, jf.R_LOSS
-#: The rows from ``layout.WK_RX`` on of each mechanism's solver (its declared ``ROWS``, laid after
-#: the shared ones); a tabulated mechanism with reaction friction is a crank-slider's.
-SOLVER_ROWS = {CRANK_SLIDER: jf.ROWS.end, TABULATED: jf.ROWS.end, SWASH_PLATE: sf.ROWS.end,
-               ARTICULATED: af.ROWS.end}
-#: Rows of a work array that holds any mechanism's solver.
-N_WK = WK_RX + max(SOLVER_ROWS.values())
-
-
-def work_rows(kind: int, reaction: bool) -> int:
-    """``Model.wk_rows``: the work array's rows for a model of mechanism ``kind``, those of
-    ``layout.WORK`` and, with reaction friction, its solver's."""
-    return WK_RX + (SOLVER_ROWS[kind] if reaction else 0)
 
 
 @kernel(inline=True)

@@ -19,7 +19,7 @@ from ..jit import kernel
 from ..model.forcing import inertia, speed
 from ..declare import Block, Layout, Sized
 from ..model.layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
-                            SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, T)
+                            SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, STATE, T)
 from ..model.outputs import output_row, output_row_inline
 from ..integrator.rk import dense_eval
 
@@ -44,7 +44,7 @@ N_CFG = SETTINGS.size
 FLOATS = Layout(
     "stepper floats", "h", "sel", "next_out", "last_t", "last_phi", "passed_bp", "redo_level",
     "last_switch", "err_old",
-    Block("deriv", Sized(lambda m: int(m.state_at[-1]), "the state's length"),
+    Block("deriv", Sized(lambda m: STATE.offsets_for(m)[-1], "the state's length"),
           "the carried derivative"),
     Block("margins", Sized(lambda m: max(m.n_pairs, 1), "one per pair, at least one"),
           "the pairs' margins at y"),
@@ -85,13 +85,14 @@ if I_SWITCHES != 0:  # (the stepper passes ist[:N_SWITCHES] on as the switches)
 #: breakpoints, the float and integer state kept between chunks, the output and event buffers.
 #: ``Work``: the work arrays of one call (:func:`~transient.core.stepper.loop.buffers`), the
 #: stages, the dense output's coefficients, the derivative at the state, the new state, the
-#: state at an event, a scratch state, the right-hand side's work array and the pairs' margins
-#: over a step. ``At``: the step attempt at hand, whether crank angle is the independent
+#: state at an event, a scratch state, the right-hand side's work array, the pairs' margins
+#: over a step and the error control of each state component (``layout.state_control``).
+#: ``At``: the step attempt at hand, whether crank angle is the independent
 #: variable and its index in the state, the step's start and size, the angle ``sel`` that picks
 #: the tables' pieces for it, the switches. ``Segment``: where the segment ends and what bounds
 #: the step (:func:`~transient.core.stepper.breakpoints._segment_end`).
 Chunk = namedtuple("Chunk", ["cfg", "bp", "fst", "ist", "outbuf", "evbuf"])
-Work = namedtuple("Work", ["K", "F", "f", "y_new", "y_evt", "tmp", "wk", "gs"])
+Work = namedtuple("Work", ["K", "F", "f", "y_new", "y_evt", "tmp", "wk", "gs", "control"])
 At = namedtuple("At", ["angle_mode", "ix", "x", "h", "sel", "sw"])
 Segment = namedtuple("Segment", ["x_end", "up", "down", "h_max", "tol_end", "corner"])
 

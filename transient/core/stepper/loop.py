@@ -54,7 +54,9 @@ from ..model import governor as gv
 from ..model.forcing import (generator_branch, governor_branch, inertia, load_segment, moments,
                              speed, speed_knot_segment, start_branch)
 from ..model.layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND,
-                            WK_G, WK_G_MIN, WK_SPEED, gov_index, n_state, work_array)
+                            WK_G, WK_G_MIN, WK_SPEED, gov_index, n_state,
+                            state_control)
+from ..model.work import work_array
 from ..model.rhs import (choose_modes, derivative, kink_in_attempt, margins_at, model_rhs,
                          release, reset_kinks, watches_kinks)
 from ..model import stuck as st
@@ -87,12 +89,13 @@ MIN_KINK_FRACTION = 0.05
 def buffers(m, tab, n: int) -> Work:
     """The work arrays of one call of :func:`advance`, its last argument (a ``Work``): the
     stages ``K``, the dense output ``F``, the derivative ``f``, three states, the right-hand
-    side's scratch ``wk`` and the pairs' margins over a step ``gs``. Allocated by the caller,
+    side's scratch ``wk``, the pairs' margins over a step ``gs`` and the state's error control
+    ``control`` (:func:`~transient.core.model.layout.state_control`). Allocated by the caller,
     so that the stepper is one compile unit of its own, without reference counting. ``n``: the
     length of the state."""
     return Work(np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
                 np.empty(n), np.empty(n), np.empty(n), work_array(m),
-                np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))))
+                np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))), state_control(m))
 
 
 @compiled(nogil=True, _nrt=False)  # (nogil: the previous block is written meanwhile, simulate)
@@ -236,7 +239,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         h_next, fst[F_ERR_OLD] = accepted_size(tab, err, fst[F_ERR_OLD], h, h_planned, cut,
                                                rejected)
         rejected = False
-        if not fixed and _stiff(tab, K, h, y, ix, m.state_control, rtol, atol, ist):
+        if not fixed and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist):
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
@@ -403,7 +406,7 @@ def _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner, corner):
         g_min = wk[WK_G_MIN, k]
         dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
     ist[I_NFEV] += tab.n_stages
-    err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, m.state_control)
+    err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, work.control)
     finite = np.isfinite(err)
     for i in range(n):
         finite = finite and np.isfinite(y_new[i])
