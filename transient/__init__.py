@@ -4,18 +4,20 @@ The package is laid out as its data flow, scene → mechanism → reduced model 
 result → analysis, and each layer imports only those below it (the contracts in
 ``pyproject.toml``, checked by ``make test``). From the bottom up:
 
-- ``core``           numba only: kinematics per mechanism, the reduced model (18), the serial
-                     chain (22), (27) with constant or mapped efficiencies, reaction friction,
-                     governor, cylinder, RK tableaus, events, the stepper
+- ``core``           numba only: the integrator (Runge–Kutta pairs, step control, dense
+                     output, event location), the model (kinematics per mechanism, the reduced
+                     model (18), the serial chain (22), (27) with constant or mapped
+                     efficiencies, reaction friction, governor, cylinder) and the stepper that
+                     composes them, each array's layout declared once
 - ``errors``, ``roots``, ``tomlout``, ``units``, ``version``, ``precompile``
                      what every layer shares: errors, scalar roots, TOML values, unit suffixes,
                      the version, the compile helper process
 - ``mechanisms``     crank_slider, swash_plate, articulated: geometry, checks, kinematics
 - ``forces``         gas pressure tables and cycles (mixed, Wiebe, Woschni), pulses, their cache
+- ``scene``          TOML or dict → frozen records in SI, validated; resolved TOML out; what a
+                     scene implies (its gas tables, phases, governor, the trajectory's columns)
 - ``tabulate``, ``assemble``
                      scene → compiled model arrays and breakpoints (angle-only terms tabulated)
-- ``outputs``        the trajectory columns of a scene and their units
-- ``scene``          TOML or dict → frozen records in SI, validated; resolved TOML out
 - ``results``        the in-memory run, the HDF5 writer (streaming) and reader
 - ``reference``      the same model in plain numpy through ``scipy.integrate.solve_ivp``
 - ``analysis``       irregularity, steady state, efficiency, orders, transient response, loads,

@@ -111,7 +111,7 @@ def work_columns(model, motion: Motion, t: NDArray[np.float64], phi: NDArray[np.
                  ) -> tuple[dict[str, NDArray[np.float64]], dict[str, int]]:
     """The work columns at the sample times ``t`` (angles ``phi``): W_gas, W_load, W_starter,
     W_drive and W_loss_k for k = 1 … ``n_pairs``, from 0 at t[0] (module docstring). ``columns``:
-    the output row's column names (``transient.outputs.output_columns``), ``model`` the one the
+    the output row's column names (``transient.scene.outputs.output_columns``), ``model`` the one the
     rows come from. Returns the columns and the quadrature's counts (``quadrature_pieces``,
     ``quadrature_evaluations``, ``quadrature_unresolved``: pieces left above their tolerance).
     """

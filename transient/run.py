@@ -15,7 +15,8 @@ from typing import Callable
 
 import numpy as np
 
-from .assemble import build_model, initial_governor, part_load_refusal
+from .assemble import build_model, initial_governor
+from .scene.queries import part_load_refusal
 from .core.model import forcing, layout, work
 from .core import stepper
 from .core.stepper import io as sio
@@ -24,7 +25,7 @@ from .core.model.layout import n_outputs, n_state
 from .core.integrator.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
 from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of)
-from .outputs import output_columns
+from .scene.outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .prescribed_work import Motion, work_columns
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
@@ -286,7 +287,7 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot zero
     force for a force pulse): the tables' cubics are blended, so the ``p_<k>`` columns hold the
     pressure applied. A fuel below 1 for a model that cannot burn less (a table without its
-    motored curve, a compressor: :func:`transient.assemble.part_load_refusal`) is a SceneError.
+    motored curve, a compressor: :func:`transient.scene.queries.part_load_refusal`) is a SceneError.
     The work columns are integrated over the motion to the scene's tolerance
     (:mod:`.prescribed_work`)."""
     why = part_load_refusal(scene) if fuel != 1.0 else None

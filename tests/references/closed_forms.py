@@ -26,7 +26,8 @@ from sample_integrals import sample_integral_impl
 from scipy.integrate import quad
 
 from transient.analysis.summary import summarize
-from transient.assemble import build_model, gas_table
+from transient.assemble import build_model
+from transient.scene.queries import gas_table
 from transient.core.model.forcing import inertia
 from transient.core.model.work import work_array
 from transient.run import integrate

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from transient.assemble import cycle_figures
+from transient.scene.queries import cycle_figures
 from transient.cli import main
 from transient.core.model import crank_slider as cs_core
 from transient.mechanisms import articulated as art

@@ -5,7 +5,7 @@ known joint moments).
 
 The reference knows nothing of friction: its joint moments and the slider's axial force are
 computed from its own joint forces by the friction laws written out again in numpy
-(:func:`transient.reference.crank_slider_friction_laws`), and iterated to a fixed point (plain
+(:func:`transient.reference.joints.crank_slider_friction_laws`), and iterated to a fixed point (plain
 substitution; the friction changes the forces by a few per mille, so the
 iteration contracts by about that factor each turn and 60 turns are far past rounding). Then, at
 many states of three mechanisms (central two-mass, offset two-mass, offset rigid rod; speeds

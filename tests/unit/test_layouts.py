@@ -1,8 +1,8 @@
 """The declared layouts of the compiled arrays (:mod:`transient.core.declare`): offsets derived
 from the declarations, the compiled index kernels against the declaration's offsets on every case,
-and each checked against something counted another way: the state's and the output row's lengths against the trajectory's
-columns that ``transient.outputs`` names from the scene, the reaction solvers' rows against the
-rows they share, the event tables against each other."""
+and each checked against something counted another way: the state's and the output row's lengths
+against the trajectory's columns that ``transient.scene.outputs`` names from the scene, the
+reaction solvers' rows against the rows they share, the event tables against each other."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -20,7 +20,7 @@ from transient.core.model import swash_friction as sf
 from transient.core.model.work import N_WK, work_array
 from transient.core.stepper import events
 from transient.core.stepper import io as sio
-from transient.outputs import output_columns
+from transient.scene.outputs import output_columns
 from transient.scene import load_scene
 
 CASES = sorted((Path(__file__).resolve().parents[2] / "cases").glob("*.toml"))

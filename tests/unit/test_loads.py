@@ -301,7 +301,7 @@ def test_running_torques():
 
 def test_gas_forces_and_trajectory():
     """Gas forces read from the scene's tables at φ − gas_phases, and from a trajectory's p_k."""
-    from transient.assemble import gas_phases, gas_table, gas_tables
+    from transient.scene.queries import gas_phases, gas_table, gas_tables
     from transient.scene import load_scene
 
     scene = load_scene(Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_4400.toml")

@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.assemble import build_model, gas_tables, wiebe_levels
+from transient.assemble import build_model
+from transient.scene.queries import gas_tables, wiebe_levels
 from transient.cli import main
 from transient.errors import SceneError
 from transient.forces.wiebe import WiebeCycle, wiebe_cycle

@@ -57,7 +57,7 @@ import re
 import numpy as np
 from numpy.typing import NDArray
 
-from ..outputs import cylinder_loss_column
+from ..scene.outputs import cylinder_loss_column
 from .irregularity import cycle_boundaries, cycle_means, steady_state_time
 
 #: |P_in| below this fraction of its mean is left out of (30) as printed.

@@ -25,7 +25,7 @@ def cmd_plot(args) -> int:
     from .. import plots
     import numpy as np
 
-    from ..assemble import gas_is_force, gas_tables
+    from ..scene.queries import gas_is_force, gas_tables
 
     if len(args.result) > 1:
         return _plot_comparison(args)

@@ -63,7 +63,7 @@ rotation), û = (A − B)/l = (sin β, −cos β) (along the rod, from the pin t
 Multi-cylinder engines
 ----------------------
 Cylinder k sits at local angle α_k = φ − ``firing_angles[k]`` (its crank is at the cylinder axis
-at ``firing_angles[k]``). Its gas table is read at φ − :func:`transient.assemble.gas_phases`
+at ``firing_angles[k]``). Its gas table is read at φ − :func:`transient.scene.queries.gas_phases`
 (local 0 = gas-exchange TDC of a 4-stroke). Its crankpin stands θ_k = δ_k − ``firing_angles[k]``
 ahead of the shaft's reference line (δ_k its bank; ``CrankSlider.pin_angles``), so crankpin k
 leads crankpin 1 by γ_k = θ_k − θ_1 (mod 2π) in the direction of rotation (Gots §2.7.1:

@@ -111,7 +111,7 @@ def applied_value(m, extras, k, phi, sel, f, wk):
     that the fuel scales the combustion, never the compression.
 
     Without a paired motored table either the scene burns full-load fuel throughout (f = 1,
-    ``transient.assemble.burns_part_load``) or the model is a force pulse whose motored force is
+    ``transient.scene.queries.burns_part_load``) or the model is a force pulse whose motored force is
     ``gas_offset`` = 0; the value is then gas_offset + f·(p − gas_offset), at f = 1 the table's
     to the last bit.
     """

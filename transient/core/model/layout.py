@@ -175,7 +175,7 @@ def n_cylinder_loss_columns(m):
     return m.n_pairs * m.ncyl if m.reaction else 0
 
 
-#: The output row's blocks (``transient.outputs.output_columns`` names the columns in this
+#: The output row's blocks (``transient.scene.outputs.output_columns`` names the columns in this
 #: order), sized per scene as the state's and indexed through the chained kernels
 #: :func:`pair_col`, :func:`governor_col`, :func:`cylinder_loss_col` and :func:`n_outputs`.
 OUTPUT = Layout(

@@ -1,16 +1,17 @@
 """The trajectory columns a scene's run writes, with their units (the result file's layout:
 docs/guide/results.md).
 
-Below the scene reader: the scene's checks ask which columns a run will have (an ``[analysis]``
-request must name one), so this module reads a scene's records without importing their module.
+A query on the scene, with it: the scene's checks ask which columns a run will have (an
+``[analysis]`` request must name one), and the layers above (the run, the results, the analyses)
+name the columns through it. It reads a scene's records without importing their module.
 """
 from __future__ import annotations
 
 import re
 
-from .assemble import gas_is_force, governor_kind, reaction_friction
-from .core.model import governor as gv
-from .core.model.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
+from .queries import gas_is_force, governor_kind, reaction_friction
+from ..core.model import governor as gv
+from ..core.model.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
 
 
 def output_columns(scene) -> dict[str, str]:
@@ -92,4 +93,4 @@ def describe(column: str) -> str:
     pattern = f"{head}_{{k}}"
     if k.isdigit() and pattern in DESCRIPTIONS:
         return DESCRIPTIONS[pattern].replace("{k}", k)
-    raise KeyError(f"{column}: no description; add one to transient.outputs.DESCRIPTIONS")
+    raise KeyError(f"{column}: no description; add one to transient.scene.outputs.DESCRIPTIONS")
