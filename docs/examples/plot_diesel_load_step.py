@@ -29,6 +29,6 @@ for k in (1, 2):
           f"steady change {res.analysis[p + 'droop_pct'][0]:+.2f} %")
 
 fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
-plots.load_response(axes, res.trajectory, scene.mechanism.cycle, res.analysis)
+plots.load_response(axes, res.trajectory, scene, res.analysis)
 axes[0].set_title("Load acceptance and rejection")
 plt.show()
