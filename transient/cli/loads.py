@@ -174,7 +174,8 @@ def crank_slider_figures(scene, d):
             (axes[1], d.journal_wear, f"main journal {best + 1}: the frame of crank 1")):
         plots.wear_diagram(ax, rays, sums / d.wear_weight)
         ax.set_title(words, fontsize=9)
-    axes[1].legend(loc="upper left", bbox_to_anchor=(0.85, 1.08), fontsize=8)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2,
+               fontsize=8)
     fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6): each ray's load, the cycle mean of "
                  f"the loads within ±60° of it [kN], drawn inward from the rim", fontsize=10)
     yield "loads_wear", fig
