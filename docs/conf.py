@@ -66,6 +66,7 @@ sphinx_gallery_conf = {
     "remove_config_comments": True,
     "matplotlib_animations": False,
     "image_scrapers": ("matplotlib",),
+    "image_srcset": ["2x"],  # (a second image at twice the dpi: sharp on high-density screens)
     "within_subsection_order": "FileNameSortKey",
 }
 
