@@ -19,8 +19,9 @@ def register(sub) -> None:
                     "the gas torque M_gas and each cylinder's, and the piston acceleration of "
                     "one cylinder (any mechanism) against the same engine at constant mean "
                     "speed (odd-harmonic report); δ of the last cycle; with two or more whole "
-                    "cycles, a run-up waterfall (a colour map), a Campbell chart and order "
-                    "tracks of ω against the cycle-mean speed. Results are written as files "
+                    "cycles, for a run-up a waterfall (a colour map), a Campbell chart and "
+                    "order tracks of ω against the cycle-mean speed, for any other run the "
+                    "waterfall and order tracks cycle by cycle. Results are written as files "
                     "into DIR, never into the HDF5 result (read only here).")
     od.add_argument("result")
     od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
