@@ -72,3 +72,7 @@ sphinx_gallery_conf = {
 
 # Results, scenes and benchmark records are read from the repository, never from elsewhere.
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+# The guide's pictures and a first run's output, made in the build from the model's own code
+# (_ext/guide_figures.py), and the landing page's cards.
+extensions += ["sphinx_design", "guide_figures"]
