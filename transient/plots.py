@@ -459,10 +459,9 @@ def speed_over_cycle(ax, traj, scene):
         raise ValueError("the run holds no whole cycle")
     a, b = marks[-2], marks[-1]
     sel = (traj["phi"] >= a) & (traj["phi"] <= b)
-    rpm = 30.0 / math.pi
     x = np.degrees(traj["phi"][sel] - a)
-    w = traj["omega"][sel] * rpm
-    mean = cycle / (tb[-1] - tb[-2]) * rpm
+    w = traj["omega"][sel] * RPM
+    mean = cycle / (tb[-1] - tb[-2]) * RPM
     artists = ax.plot(x, w, lw=1.2, label="ω")
     i, j = int(np.argmax(w)), int(np.argmin(w))
     artists.append(ax.axhline(mean, color="k", lw=0.6, ls="--", label="cycle mean"))

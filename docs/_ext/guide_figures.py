@@ -451,10 +451,9 @@ def show(command: str, name: str, case: str = "diesel_4cyl_misfire.toml",
             plt.close(fig)
     if found is None:
         raise ValueError(f"transient {command} draws no {name!r} figure of {case}")
-    for text in [ax.title for ax in found.axes] + list(found.texts):
-        text.set_wrap(True)
-    if found.get_layout_engine() is None:
-        found.tight_layout()
+    from transient.cli.common import lay_out
+
+    lay_out(found)  # (as the command does before it saves)
     return found
 
 

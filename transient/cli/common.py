@@ -205,14 +205,20 @@ def _created(path, force: bool):
 DPI = 200
 
 
-def save(fig, path, force: bool, source=None):
-    """Write ``fig`` as a PNG at ``path`` (as :func:`output_file` creates files) and close it
-    (a long command draws many); returns ``path``. Titles wrap within the figure; a figure of
-    an incomplete result ``source`` says so across its top."""
-    for text in [ax.title for ax in fig.axes] + list(fig.texts):  # (the suptitle among them)
+def lay_out(fig) -> None:
+    """The figure's titles wrapped within it (the suptitle among its texts), its axes laid out
+    around their labels and legends unless a layout engine does that."""
+    for text in [ax.title for ax in fig.axes] + list(fig.texts):
         text.set_wrap(True)
     if fig.get_layout_engine() is None:
         fig.tight_layout()
+
+
+def save(fig, path, force: bool, source=None):
+    """Write ``fig`` as a PNG at ``path`` (as :func:`output_file` creates files) and close it
+    (a long command draws many); returns ``path``. A figure of an incomplete result ``source``
+    says so across its top."""
+    lay_out(fig)
     if source is not None and not source.complete:
         if fig.get_layout_engine() is None:
             fig.subplots_adjust(top=0.9)
