@@ -387,7 +387,7 @@ def eta_map():
     maps = np.stack([np.asarray(pair.eta_forward_map), np.asarray(pair.eta_backward_map)])
     size = np.array([[speed.size, torque.size]])
     S = np.linspace(0.0, 1.1 * torque[-1], 300)
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), layout="constrained", sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), layout="constrained", sharey=True)
     for ax, d, words in ((axes[0], FORWARD, "η_forward (shaft side drives)"),
                          (axes[1], BACKWARD, "η_backward (far side drives)")):
         for j, w in enumerate(speed):
@@ -397,13 +397,13 @@ def eta_map():
             ax.plot(S, eta, color=colour, lw=1.2, label=f"{w * 30 / math.pi:.0f} rpm")
             ax.plot(torque, maps[d, j], "o", color=colour, ms=3)
         ax.set_xscale("symlog", linthresh=torque[1] if torque.size > 1 else 1.0)
-        ax.set_xlabel("moment taken from the shaft side |S| [N m] (linear below the first "
-                      "step)")
+        ax.set_xlabel("moment taken from the shaft side |S| [N m]")
         ax.set_title(words, fontsize=9)
         ax.grid(True, alpha=0.3)
     axes[0].set_ylabel("η [1]")
     axes[1].legend(fontsize=7, loc="lower right", title="|ω|", title_fontsize=7)
-    fig.suptitle(f"{pair.name}: efficiency map, held at its edge beyond the grid", fontsize=10)
+    fig.suptitle(f"{pair.name}: efficiency map, held at its edge beyond the grid (|S| "
+                 f"logarithmic above {torque[1]:g} N m, linear below)", fontsize=10)
     return fig
 
 
