@@ -1,4 +1,4 @@
-"""Unit suffixes allowed on scene keys, converted once at the edge (DESIGN §4)."""
+"""Unit suffixes allowed on scene keys, converted once at the edge (docs/guide/scenes.md, Units)."""
 from __future__ import annotations
 
 from math import pi

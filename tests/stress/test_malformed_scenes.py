@@ -208,7 +208,7 @@ CASES = [
      "gas.phi_deg: needs at least 2 finite angles from 0° to 720°, got 0"),
     ("empty-pair", VALID + "\n[friction]\n\n[[friction.pairs]]\n",
      "friction.pairs[0].between: must be two link names, got None; the links are shaft – crank "
-     "– rod"),
+     "– rod – piston – cylinder"),
     ("empty-scene-name", sub('name = "small"', 'name = ""'),  # was a bug: accepted
      "scene.name: must not be empty; it names the result (leave it out to use the file's name)"),
     # duplicate names and abscissae
@@ -307,8 +307,8 @@ def _holds_a_block(part):
 
 
 def test_sigkill_during_writing_leaves_an_incomplete_file(tmp_path):
-    """DESIGN §4: written under a temporary name, flushed after every block; killed with SIGKILL
-    the file opens and says complete = false."""
+    """docs/guide/results.md: written under a temporary name, flushed after every block; killed with
+    SIGKILL the file opens and says complete = false."""
     scene = tmp_path / "long.toml"
     scene.write_text(LONG, encoding="utf-8")
     out = tmp_path / "out"

@@ -38,7 +38,7 @@ def figures(res, cylinders=None, cycles=None, held=None):
     """The figures ``transient plot`` writes of the result ``res``, as (name, figure) pairs in
     the order written (each saved as ``<stem>_<name>.png``): ``cylinders`` and ``cycles`` those
     of the indicator diagrams (None: all cylinders, the last cycle); ``held`` the whole cycles
-    of their own those cylinders hold (:func:`_check_choices`; None: counted here)."""
+    of their own those cylinders hold (as ``_check_choices`` counts them; None: counted here)."""
     plt = pyplot()
 
     from .. import plots
