@@ -596,8 +596,8 @@ def test_a_wiebe_cycle_no_gas_has_is_refused(tmp_path, capsys):
     scene = tmp_path / "w.toml"
     write(scene, "\n".join("gamma = 1.7" if line.startswith("gamma = ") else line
                            for line in wiebe.splitlines()) + "\n")
-    assert one_line(capsys, ["check", scene]) == (f"{scene}: gas.wiebe.gamma: must be ≤ 1.66667, "
-                                                  f"got 1.7")
+    assert one_line(capsys, ["check", scene]) == (f"{scene}: gas.wiebe.gamma: must be ≤ 5/3 = "
+                                                  f"1.66667, got 1.7")
     assert "\ngamma = " in wiebe and "\nfuel_mass = " in wiebe
     write(scene, "\n".join("fuel_mass = 1e300" if line.startswith("fuel_mass = ") else line
                            for line in wiebe.splitlines()) + "\n")
