@@ -75,7 +75,7 @@ $(DOCS_STAMP): $(STAMP) pyproject.toml
 # The API stubs are made afresh (autosummary leaves those of renamed modules behind).
 docs: $(DOCS_STAMP)
 	rm -rf docs/generated
-	$(VENV)/bin/sphinx-build -E -W --keep-going -b html docs docs/_build/html
+	$(VENV)/bin/sphinx-build -E -n -W --keep-going -b html docs docs/_build/html
 
 clean:
 	rm -rf $(VENV) results/*.h5 results/*.png docs/_build docs/generated docs/auto_examples \

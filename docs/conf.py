@@ -20,7 +20,10 @@ version = release = transient.__version__
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
+    "sphinx.ext.intersphinx",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",
+    "sphinxcontrib.bibtex",
     "numpydoc",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
@@ -28,14 +31,41 @@ extensions = [
     "scene_keys",
     "plain_docstrings",
     "validation_pages",
+    "public_api",
+    "citations",
 ]
 
-# Docstrings refer to sibling modules by their short names (``crank_slider`` of the mechanisms
-# and of the loads): the first match is the one meant, so the ambiguity is no warning here.
-suppress_warnings = ["ref.python"]
+# Every cross-reference must resolve (``make docs`` runs with -n -W): a dead or ambiguous link
+# fails the build. Ignored are only numpy's typing internals, which a type alias expands to
+# (``transient.forces.gas.PieceFunction``) and numpy does not document, and its scalar types,
+# which its inventory lists as attributes where an annotation refers to a class.
+nitpicky = True
+nitpick_ignore_regex = [("py:class", r"numpy\._typing\..*"), ("py:class", r"numpy\.(float|int)64")]
+
+# The other projects' inventories are in the repository (docs/_intersphinx/README.md says where
+# each comes from), so the build reads nothing from the network and links the same every time.
+_INVENTORIES = HERE / "_intersphinx"
+intersphinx_mapping = {
+    name: (url, str(_INVENTORIES / f"{name}.inv"))
+    for name, url in {
+        "python": "https://docs.python.org/3/",
+        "numpy": "https://numpy.org/doc/stable/",
+        "scipy": "https://docs.scipy.org/doc/scipy/",
+        "matplotlib": "https://matplotlib.org/stable/",
+        "h5py": "https://docs.h5py.org/en/stable/",
+        "dask": "https://docs.dask.org/en/stable/",
+        "distributed": "https://distributed.dask.org/en/stable/",
+    }.items()
+}
+
+# The works the code and the pages cite (docs/references.bib), listed on docs/references.md.
+bibtex_bibfiles = ["references.bib"]
+bibtex_default_style = "plain"
+bibtex_reference_style = "author_year"
+bibtex_cite_id = "cite-{key}"  # stable anchors: references.html#cite-gots2006
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
-exclude_patterns = ["_build", "examples/README.txt", "**/GALLERY_HEADER.rst"]
+exclude_patterns = ["_build", "_intersphinx", "examples/README.txt", "**/GALLERY_HEADER.rst"]
 templates_path = ["_templates"]
 html_static_path = ["_static"]
 html_theme = "pydata_sphinx_theme"
@@ -55,7 +85,19 @@ autodoc_default_options = {"members": True, "member-order": "bysource"}
 autodoc_typehints = "none"  # numpydoc docstrings carry the types
 numpydoc_show_class_members = False
 numpydoc_validation_checks = set()
-numpydoc_xref_param_type = False
+# Types in Parameters and Returns link where a name below says where to; any other word of a
+# type stays text (so that "float, optional" or "array of float [rad]" need no entry).
+numpydoc_xref_param_type = True
+numpydoc_xref_ignore = "all"
+numpydoc_xref_aliases = {
+    "Path": "pathlib.Path",
+    "Scene": "transient.Scene",
+    "Result": "transient.Result",
+    "SweepResult": "transient.sweeps.api.SweepResult",
+    "SceneError": "transient.SceneError",
+    "SimulationError": "transient.SimulationError",
+    "Client": "distributed.Client",
+}
 
 sphinx_gallery_conf = {
     "examples_dirs": "examples",
@@ -67,6 +109,9 @@ sphinx_gallery_conf = {
     "matplotlib_animations": False,
     "image_scrapers": ("matplotlib",),
     "within_subsection_order": "FileNameSortKey",
+    # The API pages of the public names list the examples that use them (``minigallery``).
+    "doc_module": ("transient",),
+    "backreferences_dir": "generated/backreferences",
 }
 
 # Results, scenes and benchmark records are read from the repository, never from elsewhere.

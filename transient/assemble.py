@@ -38,7 +38,7 @@ def gas_table(scene) -> PressureTable | None:
 def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
     """``(full, motored)``: the full-load table and the motored one, between which the fuel f
     interpolates, p = p_mot + f·(p_full − p_mot): the fuel scales the combustion, never the
-    compression (:class:`transient.scene.Gas`).
+    compression (:class:`transient.scene.records.Gas`).
 
     ``motored`` is the cycle without fuel on the same corners as the full-load one: for
     ``"mixed-cycle"`` the compression polytrope both ways

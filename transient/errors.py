@@ -1,5 +1,5 @@
-"""Errors that reach the user, each with what the CLI needs to print it, and :func:`show_value`,
-the one way a message quotes what the user gave."""
+"""Errors that reach the user, each with what the CLI needs to print it, and
+:func:`~transient.errors.show_value`, the one way a message quotes what the user gave."""
 from __future__ import annotations
 
 from typing import Any
@@ -38,6 +38,15 @@ class SceneError(ValueError):
         What is wrong and what is allowed, in one line.
     file
         The scene file, filled in by the loader if the raiser does not know it.
+
+    Examples
+    --------
+    >>> import transient
+    >>> try:
+    ...     transient.Scene.from_dict({"mechanism": {}})
+    ... except transient.SceneError as exc:
+    ...     print(exc.key)
+    mechanism.type
     """
 
     def __init__(self, key: str, message: str, file: str = "") -> None:
@@ -47,7 +56,8 @@ class SceneError(ValueError):
         super().__init__(self.line())
 
     def line(self) -> str:
-        """The one line the CLI prints; a key the user wrote is quoted as :func:`clip` does
+        """The one line the CLI prints; a key the user wrote is quoted as
+        :func:`~transient.errors.clip` does
         (a TOML key may hold any character), and no part may start a second line."""
         prefix = f"{self.file}: " if self.file else ""
         line = f"{prefix}{clip(self.key, 4 * QUOTE_LIMIT)}: {self.message}"
@@ -56,7 +66,33 @@ class SceneError(ValueError):
 
 class SimulationError(RuntimeError):
     """The integration failed; carries where (time, angle, state), and ``result``, the run up to
-    there (a :class:`transient.results.Result`, when there is one)."""
+    there (a :class:`transient.Result`, when there is one).
+
+    Examples
+    --------
+    A load torque brakes the coasting shaft to a stop two revolutions in, long before the
+    50 revolutions the run asks for:
+
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> stalls = scene.replace(load={"torque": 10.0},
+    ...                        run={"revolutions": 50})
+    >>> try:
+    ...     transient.simulate(stalls)
+    ... except transient.SimulationError as exc:
+    ...     print(exc.result.status, exc.result.complete)
+    stalled False
+    """
 
     def __init__(self, message: str, result=None) -> None:
         super().__init__(message)

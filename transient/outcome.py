@@ -1,4 +1,5 @@
-"""What a run did, said: its status (the result's root attribute ``status``, :data:`STATUSES`),
+"""What a run did, said: its status (the result's root attribute ``status``,
+:data:`~transient.outcome.STATUSES`),
 a one-line message with the time, angle and speed where it happened, and warnings; and the
 watch over a run's blocks that stops a run exceeding its output budget or no longer advancing.
 

@@ -1,4 +1,5 @@
-"""The trajectory columns a scene's run writes, with their units (the result-file layout, DESIGN §4).
+"""The trajectory columns a scene's run writes, with their units (the result file's layout:
+docs/guide/results.md).
 
 Below the scene reader: the scene's checks ask which columns a run will have (an ``[analysis]``
 request must name one), so this module reads a scene's records without importing their module.
@@ -13,7 +14,7 @@ from .core.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
 
 
 def output_columns(scene) -> dict[str, str]:
-    """Trajectory datasets of a run and their units (DESIGN §4)."""
+    """Trajectory datasets of a run and their units."""
     cols = dict(zip(OUTPUTS, OUTPUT_UNITS))
     for k in range(scene.mechanism.n_cylinders):
         # p_k: cylinder pressure, or the force per piston for force-pulse models
@@ -40,7 +41,7 @@ def cylinder_loss_column(pair: int, cylinder: int) -> str:
 
 
 #: What each trajectory column holds, with its sign convention (torques and speeds positive in
-#: the direction of rotation, forces toward the crank axis: DESIGN §4, after Gots §1). ``{k}`` is
+#: the direction of rotation, forces toward the crank axis, after Gots §1). ``{k}`` is
 #: a cylinder's or a pair's number.
 DESCRIPTIONS = {
     "t": "time since the start of the run",

@@ -10,7 +10,7 @@ stepper's compile loads each callee the helper has saved, waits for the one the 
 compiling, and compiles the others itself; nothing is compiled twice.
 
 The helper needs each callee's argument types before the stepper's compile has found them: they
-are named by the callees' parameters (:func:`_types_by_parameter`), plain types, because
+are named by the callees' parameters (``_types_by_parameter``), plain types, because
 :func:`transient.core.jit._compile_per_type` widens the constants the stepper passes. Were one
 wrong, the helper would compile a signature the stepper does not call and the stepper would
 compile its own; the test ``test_helper_compiles_the_signatures_the_stepper_calls`` checks each

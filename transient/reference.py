@@ -67,7 +67,8 @@ class ChainNumpy:
         self.J0 = scene.inertia.total
 
     def inputs(self, phi, J, dJ, M_gas, M_shaft, forces, sel):
-        """What :meth:`solve` and :meth:`start_direction` take at a state: the sub-chains."""
+        """What :meth:`solve` and :meth:`~transient.reference.ChainNumpy.start_direction` take
+        at a state: the sub-chains."""
         return self.split(phi, J, dJ, M_gas, M_shaft)
 
     def split(self, phi, J, dJ, M_gas, M_shaft):

@@ -1,4 +1,5 @@
-"""Result files (HDF5, format 1; DESIGN §4): the layout, a streaming writer and a reader.
+"""Result files (HDF5, format 1; docs/guide/results.md): the layout, a streaming writer and a
+reader.
 
 The layout of a run — header attributes, ``scene/toml``, ``trajectory/<column>``,
 ``events/<name>/{t,phi}``, ``solver`` attributes, ``analysis/<name>`` — is written by the
@@ -13,7 +14,7 @@ leaves a file that opens (read in SWMR mode, :func:`open_file`). After each bloc
 appends a *checkpoint* — the trajectory's and the events' lengths and the stepper's state — once
 the block's data are flushed; a reader of an unfinished file takes the trajectory up to the last
 checkpoint only (every block completed before it, never a torn tail), and a run resumes from it
-bit-identically (:func:`read_checkpoint`, :meth:`ResultWriter.resume`).
+bit-identically (:func:`resumable`, and :class:`ResultWriter` with ``resume=True``).
 """
 from __future__ import annotations
 
@@ -710,8 +711,8 @@ class _Columns(Mapping):
 
 @dataclass
 class Result:
-    """A run's result, from its file (:func:`open_result`, or :func:`transient.simulate` with a
-    path) or in memory (:func:`transient.simulate` without one); the same either way.
+    """A run's result, from its file (:func:`~transient.open_result`, or :func:`transient.simulate`
+    with a path) or in memory (:func:`transient.simulate` without one); the same either way.
 
     Attributes
     ----------
@@ -735,6 +736,28 @@ class Result:
     scene_source
         The file the scene was read from and its text, comments included (``("", "")`` for a
         scene built in code).
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> res = transient.simulate(scene)
+    >>> res.complete, res.path is None  # held in memory
+    (True, True)
+    >>> [name for name in res.trajectory][:4]
+    ['t', 'phi', 'omega', 'epsilon']
+    >>> res.scene() == scene
+    True
     """
 
     path: Path | None
@@ -815,8 +838,46 @@ def result_in_memory(scene_name: str, scene_toml: str, data: RunData, units: dic
 
 
 def open_result(path: str | Path) -> Result:
-    """Read a result file into a :class:`Result`: complete, incomplete, or the partial file
-    (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint."""
+    """Read a result file into a :class:`~transient.Result`: complete, incomplete, or the partial
+    file (``.NAME.h5.part``) of a run that was killed, read up to its last checkpoint.
+
+    Parameters
+    ----------
+    path : str or Path
+        The result file (HDF5) that :func:`transient.simulate` or ``transient run`` wrote.
+
+    Returns
+    -------
+    Result
+        The run; its trajectory's columns are read from the file when first used.
+
+    Raises
+    ------
+    ValueError
+        The file is HDF5 but not a result of transient.
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "single.h5"
+    ...     written = transient.simulate(scene, path)
+    ...     res = transient.open_result(path)
+    ...     print(res.status, res.path.name, res.scene() == scene)
+    finished single.h5 True
+    """
     path = Path(path)
     with open_file(path) as f:
         if f.attrs.get("creator") != CREATOR:

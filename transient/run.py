@@ -1,6 +1,7 @@
 """Drive a run: the compiled stepper chunk by chunk (or the reference path), streaming to HDF5.
 
-:func:`integrate` returns the run as :class:`RunData`; :func:`simulate`, the public entry,
+:func:`integrate` returns the run as :class:`~transient.results.RunData`;
+:func:`transient.simulate`, the public entry,
 returns a :class:`~transient.results.Result`, of a run kept in memory or written to a file.
 Prescribed-speed runs (inverse dynamics) take :func:`prescribed`.
 """
@@ -433,23 +434,55 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
 
     Parameters
     ----------
-    scene
-        A scene from :func:`transient.load_scene` or :meth:`Scene.from_dict`.
-    path
+    scene : Scene
+        A scene from :func:`transient.load_scene` or :meth:`Scene.from_dict
+        <transient.Scene.from_dict>`.
+    path : str or Path, optional
         The result file; none keeps the run in memory.
-    force
+    force : bool
         Replace an existing result (and a partial one) at ``path``.
-    resume
+    resume : bool
         Continue the run that an interrupt or a kill stopped, from the last checkpoint of its
         partial file (or of its incomplete result), bit-identically to a run never stopped.
-    progress
-        Called with the fraction done after each block.
+    progress : callable, optional
+        Called with the fraction done (0 … 1) after each block.
+
+    Returns
+    -------
+    Result
+        The finished run: its trajectory, events, solver statistics and analyses.
 
     Raises
     ------
-    transient.errors.SimulationError
+    transient.SimulationError
         The run failed or was interrupted; its ``result`` holds the run up to there (written
         to ``path``, marked incomplete, when one was given).
+    transient.SceneError
+        ``force`` or ``resume`` without a ``path``; a result at ``path`` without ``force``.
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> res = transient.simulate(scene)
+    >>> res.status
+    'finished'
+    >>> res.units["omega"], res.summary()["revolutions"]
+    ('rad/s', 2.0)
+    >>> import math
+    >>> omega0 = res.trajectory["omega"][0]  # [rad/s]
+    >>> math.isclose(omega0, 1000 * 2 * math.pi / 60)
+    True
     """
     if path is None:
         if force or resume:

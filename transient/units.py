@@ -1,6 +1,7 @@
-"""Units of scene keys: every number a scene gives is of a quantity kind with an SI unit, and a
-few kinds also take unit suffixes (``crank_radius_mm``), converted once at the edge; a bound
-or default that is another key's value carries that key's name (:class:`Named`)."""
+"""Units of scene keys (docs/guide/scenes.md, Units): every number a scene gives is of a quantity
+kind with an SI unit, and a few kinds also take unit suffixes (``crank_radius_mm``), converted
+once at the edge; a bound or default that is another key's value carries that key's name
+(:class:`Named`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -1,4 +1,4 @@
-"""The ``transient`` command end to end (DESIGN §4): run, check, info, plot, kinematics.
+"""The ``transient`` command end to end (docs/guide/cli.md): run, check, info, plot, kinematics.
 
 Every run is small (a few revolutions, coarse output) and goes through ``transient.cli.main``
 in-process, so the numba cache is loaded once for the whole file. One test starts

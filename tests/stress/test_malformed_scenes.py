@@ -307,8 +307,8 @@ def _holds_a_block(part):
 
 
 def test_sigkill_during_writing_leaves_an_incomplete_file(tmp_path):
-    """DESIGN §4: written under a temporary name, flushed after every block; killed with SIGKILL
-    the file opens and says complete = false."""
+    """docs/guide/results.md: written under a temporary name, flushed after every block; killed with
+    SIGKILL the file opens and says complete = false."""
     scene = tmp_path / "long.toml"
     scene.write_text(LONG, encoding="utf-8")
     out = tmp_path / "out"

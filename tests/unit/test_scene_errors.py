@@ -1,6 +1,7 @@
 """Invalid scenes reach the user as one line, ``file: key: what is wrong and what is allowed``.
 
-DESIGN §4: exit code 2 for invalid input, one line on stderr, no traceback, and ``run`` creates no
+docs/guide/cli.md: exit code 2 for invalid input, one line on stderr, no traceback, and ``run``
+creates no
 result file. Each case starts from the valid small scene ``VALID`` and breaks one thing; it goes
 through ``transient check`` and ``transient run`` in-process. The expected key is the dotted TOML
 key that ``transient.scene`` (or the mechanism / gas-table validation it calls) reports.

@@ -3,7 +3,7 @@ and the same message as the same value written into the TOML file."""
 from __future__ import annotations
 
 import pytest
-from scene_texts import SMALL
+from scene_texts import MIXED_CYCLE, SMALL
 
 from transient import SceneError, load_scene
 
@@ -59,3 +59,17 @@ def test_a_key_in_another_unit_replaces_the_scene_own():
 def test_a_table_must_be_given_as_a_dict():
     with pytest.raises(SceneError, match="give the table's keys as a dict, got float"):
         load_scene("small.toml", text=SMALL).replace(inertia=0.5)
+
+
+def test_a_key_given_as_none_is_taken_out_in_any_unit():
+    """None takes a key out, whatever unit the scene wrote it in, and the default applies again;
+    a 4-stroke made a 2-stroke drops the gas-exchange pressures a 2-stroke refuses."""
+    scene = load_scene("small.toml", text=SMALL)
+    faster = scene.replace(initial={"omega_rpm": 1500})
+    with pytest.raises(SceneError, match="at rest with no starter"):  # (the default: at rest)
+        faster.replace(initial={"omega": None})
+    diesel = load_scene("small.toml", text=SMALL + MIXED_CYCLE.format(cr=18))
+    with pytest.raises(SceneError, match="has no intake or exhaust stroke"):
+        diesel.replace(mechanism={"strokes": 2})
+    two = diesel.replace(mechanism={"strokes": 2}, gas={"p_intake": None, "p_exhaust": None})
+    assert (two.mechanism.strokes, two.gas.p_intake, two.gas.p_exhaust) == (2, 0.0, 0.0)

@@ -1,6 +1,6 @@
 """Work–energy balance of a two-inertia gear with one non-ideal pair (transient.core.chain):
 ΔKE = W_in − W_out − W_loss with the loss integrated as an extra state, in forward and backward
-power flow, and the locking case at rest (DESIGN §5)."""
+power flow, and the locking case at rest."""
 from __future__ import annotations
 
 import numpy as np

@@ -20,6 +20,7 @@ from transient.forces.gas import mixed_cycle
 
 DEG = math.pi / 180
 volume = gots.volume
+dvolume = gots.dvolume
 
 
 @pytest.fixture(scope="module")

@@ -134,6 +134,7 @@ STEADY = {
     "articulated": lambda: load_scene(CASES / "v_twin_fork_blade.toml").replace(
         mechanism={"bank_deg": [180], "strokes": 2,
                    "slave_rod": {"mass": 0.75, "cg_from_pin_mm": 133}},
+        gas={"p_intake": None, "p_exhaust": None},  # (a 2-stroke has no gas exchange strokes)
         inertia={"flywheel": 0.04}, initial={"omega_rpm": 3000}, run={"revolutions": 200},
         solver=TIGHT),
     "swash-plate": lambda: load_scene(CASES / "swash_plate_4cyl.toml").replace(

@@ -23,7 +23,7 @@ def python_blocks(page: Path) -> list[str]:
 def run_blocks(page: Path, folder: Path, monkeypatch) -> dict:
     """Execute ``page``'s Python blocks in ``folder`` as described above; their namespace."""
     monkeypatch.chdir(folder)
-    namespace = {"__name__": page.stem}
+    namespace = {"__name__": "__main__"}  # (as a script runs them: the sweep's guard holds)
     for code in python_blocks(page):
         for path in sorted(set(re.findall(r'"(cases/[^"]+\.toml)"', code))):
             (folder / path).parent.mkdir(parents=True, exist_ok=True)

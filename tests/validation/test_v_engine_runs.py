@@ -47,7 +47,7 @@ def independent_terms(scene):
 
     def terms(phi):
         parts = [single.terms(phi + PINS[c] - BANKS[c]) for c in range(8)]
-        return sum(j for j, _, _ in parts) + constant, np.array([u[0] for _, _, u in parts])
+        return sum(p[0] for p in parts) + constant, np.array([p[2][0] for p in parts])
     return terms
 
 

@@ -1,6 +1,6 @@
 """Every piston's travel and its derivatives in the shaft angle, for any mechanism: what the
-cylinder volumes (:mod:`.thermo`) and the piston accelerations W = ω²s″ + εs′ (:mod:`.orders`,
-Semenov §4) are made of.
+cylinder volumes (:mod:`.thermo`) and the piston accelerations W = ω²s″ + εs′
+(:mod:`transient.analysis.orders`, Semenov §4) are made of.
 
 s_k(φ) is the travel of cylinder k's piston from its top (for a swash plate: inner) dead centre
 toward the crank axis [m], s′_k = ds_k/dφ [m/rad], s″_k [m/rad²], from each mechanism's exact

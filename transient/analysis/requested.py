@@ -1,8 +1,10 @@
-"""The analyses a scene asks for in its ``[analysis]`` table (:class:`transient.scene.Analysis`),
-computed at the end of a run and stored under ``/analysis/<name>`` with a unit each (DESIGN §4).
+"""The analyses a scene asks for in its ``[analysis]`` table
+(:class:`transient.scene.records.Analysis`),
+computed at the end of a run and stored under ``/analysis/<name>`` with a unit each
+(docs/guide/analyses.md).
 
 Nothing here runs unless the scene asks. :func:`requested_analyses` returns name → (value, unit)
-like the end-of-run summary (:func:`transient.analysis.irregularity.summarize`, which calls it);
+like the end-of-run summary (:func:`transient.analysis.summary.summarize`, which calls it);
 values are scalars, strings or arrays. A part that cannot be computed (the run holds no whole
 cycle) is left out and ``<part>_skipped`` says why: never guessed.
 

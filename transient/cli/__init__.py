@@ -1,4 +1,5 @@
-"""The ``transient`` command (DESIGN §4): run, check, info, plot, kinematics, bench, efficiency.
+"""The ``transient`` command: simulate a scene, then read, plot and analyse its result
+(docs/guide/cli.md).
 
 Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulation failed (the
 partial result is kept and marked incomplete).
@@ -29,6 +30,24 @@ _BROKEN_WRITE: WriteFailed | None = None
 _COMMANDS = (run.register, plot.register, kinematics.register, verify.register_bench,
              efficiency.register, loads.register, orders.register, verify.register_stress,
              sweep.register)
+
+#: One example of each command, in the order ``transient --help`` lists them: the end of
+#: ``transient --help`` lists them all, and each command's own help ends with its own.
+EXAMPLES = {
+    "run": "transient run cases/swash_plate_4cyl.toml -o results",
+    "check": "transient check cases/gots_diesel_4400.toml",
+    "info": "transient info results/swash_plate_4cyl.h5",
+    "warmup": "transient warmup cases/radial_9cyl.toml",
+    "plot": "transient plot results/swash_plate_4cyl.h5 -o results",
+    "kinematics": "transient kinematics cases/radial_5cyl.toml --points 721 -o results",
+    "bench": "transient bench --quick -o results/benchmarks",
+    "efficiency": "transient efficiency cases/gots_diesel_friction.toml --rpm 1000,2000",
+    "loads": "transient loads results/gots_diesel_4400.h5 --cylinder 2 -o results",
+    "orders": "transient orders results/diesel_4cyl_misfire.h5 --max-order 6",
+    "stress": "transient stress --quick -o results",
+    "sweep": "transient sweep cases/sweeps/gots_pi_gains.toml -o results",
+    "sweep-plot": "transient sweep-plot results/gots_pi_gains.h5 -o results",
+}
 
 
 def entry() -> None:
@@ -79,8 +98,16 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = OptionParser(prog="transient", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    width = max(map(len, EXAMPLES))
+    examples = "\n".join(f"  {name:<{width}}  {line}" for name, line in EXAMPLES.items())
+    p = OptionParser(prog="transient",
+                     description="Transient dynamics of piston machines: simulate a scene, then "
+                                 "read, plot and analyse its result.",
+                     epilog=f"examples, one per command:\n{examples}",
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True, metavar="command")
     for register in _COMMANDS:
         register(sub)
+    for name, command in sub.choices.items():
+        command.epilog = f"example: {EXAMPLES[name]}"
     return p

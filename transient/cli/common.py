@@ -42,6 +42,7 @@ class OptionParser(argparse.ArgumentParser):
     prints a scene's, instead of a usage block; a value it quotes is cut to a token's length."""
 
     def error(self, message: str):
+        """Raise argparse's complaint ``message`` as the one-line error (never returns)."""
         message = re.sub(r"'([^']*)'", lambda m: show_value(m.group(1)), message)
         head, _, rest = message.partition(": ")
         if head.startswith("argument ") and rest:

@@ -17,9 +17,7 @@ CSV_NAMES = {"S": "S_rod"}
 
 def register(sub) -> None:
     lo = sub.add_parser(
-        "loads", help="crankpin, main-journal loads and running torques along a crank-slider "
-                      "result, crankpin and link-pin loads along an articulated one (PNG + CSV "
-                      "files; the result file is not changed)",
+        "loads", help="bearing loads and running torques along a result (PNG + CSV)",
         description="Loads along the stored trajectory (transient.analysis.loads): polar "
                     "diagrams of the crankpin and of the most loaded main journal, |R| over the "
                     "last cycle, the wear diagram (Gots §2.6, ±60° rule), running torques; peak "

@@ -13,8 +13,7 @@ from .common import (EXIT_OK, MAX_POINTS, add_force, output_folder, pyplot, read
 
 def register(sub) -> None:
     od = sub.add_parser(
-        "orders", help="order spectra of ω, M_gas and the piston acceleration (PNG + CSV "
-                       "files; the result file is not changed)",
+        "orders", help="order spectra of ω, M_gas and piston acceleration (PNG + CSV)",
         description="Order spectra over the last whole cycle (transient.analysis.orders): ω, "
                     "the gas torque M_gas and each cylinder's, and the piston acceleration of "
                     "one cylinder (any mechanism) against the same engine at constant mean "

@@ -14,7 +14,7 @@ from .common import (EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, MAX_WORKERS, add_forc
 
 def register(sub) -> None:
     sw = sub.add_parser(
-        "sweep", help="run a parameter sweep on Dask → DIR/<stem>.h5 and <stem>_summary.csv",
+        "sweep", help="run a parameter sweep on Dask → DIR/<stem>.h5 + summary CSV",
         description="A base scene, parameter axes and quantities to collect (transient.sweeps). "
                     "Every scene is validated before any work. Run again, the command mends "
                     "its file: a stored run whose resolved scene is unchanged is reused, "
@@ -34,8 +34,9 @@ def register(sub) -> None:
                     help="delete the stored runs the sweep no longer holds (kept by default)")
     sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no summary")
     sw.set_defaults(func=cmd_sweep)
-    sp = sub.add_parser("sweep-plot", help="plot a sweep's summary: lines (one axis), heat maps "
-                                           "(two-axis grid), scatter (otherwise)")
+    sp = sub.add_parser("sweep-plot", help="plot a sweep's summary: lines, heat maps or scatter",
+                        description="Plot a sweep's summary: lines (one axis), heat maps "
+                                    "(two-axis grid), scatter (otherwise).")
     sp.add_argument("result", help="a sweep file (DIR/<stem>.h5)")
     sp.add_argument("-o", "--output", default=None, help="folder (default: beside the file)")
     sp.add_argument("--quantity", action="append", default=None,

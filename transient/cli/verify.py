@@ -15,8 +15,9 @@ MAX_REPEAT = 100
 
 
 def register_bench(sub) -> None:
-    b = sub.add_parser("bench", help="work-precision record: error against run time, transient "
-                                     "against solve_ivp (and CyRK if installed)")
+    b = sub.add_parser("bench", help="work–precision record: error against run time, vs solve_ivp",
+                       description="The work–precision record: error against run time, "
+                                   "transient against solve_ivp (and CyRK if installed).")
     b.add_argument("scenes", nargs="*", help="scene files (default: the three benchmark scenes)")
     b.add_argument("--revolutions", type=real(gt=0.0, le=MAX_BENCH_REVOLUTIONS), default=1000.0,
                    help="revolutions of each timed run (default 1000)")

@@ -3,7 +3,8 @@ exactly with the motion, as :mod:`.joint_friction` does for the crank-slider.
 
 The friction laws are that module's: a journal or pin loses μ·r·|R| + c·q, opposing its relative
 angular speed q; a piston in its cylinder μ·|N| + F_ring + c_p·P⁺ + c·v, opposing its speed v.
-The joints of a row (:mod:`.articulated`; ``transient.mechanisms.articulated`` names them for
+The joints of a row (:mod:`transient.core.articulated`; ``transient.mechanisms.articulated`` names
+them for
 the scene): the main bearing (frame – throw), the master crankpin (throw – master rod), the link
 pins (master rod – slave rod i; with central articulation, r_i = 0, the slave rod sits on the
 crankpin, which then carries it through the master rod's big end), the master and the slave
@@ -11,7 +12,8 @@ piston pins (rod – piston) and the pistons in their cylinders.
 
 The reactions by Newton–Euler
 -----------------------------
-In the row frame of :mod:`.articulated` (x along the master cylinder, rotation positive, so every
+In the row frame of :mod:`transient.core.articulated` (x along the master cylinder, rotation
+positive, so every
 moment below is about z in the direction of rotation; a × b = a_x b_y − a_y b_x). Every point p
 of the row moves as p(α), α = φ − φ_j, so its acceleration is p″ω² + p′ε, affine in ε = φ̈:
 A, A′, A″ the crankpin, B = X₀ x̂ the master piston pin (X₀′ = −s′, Semenov (31) through the

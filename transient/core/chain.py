@@ -87,7 +87,7 @@ locking is global. When locked, S_out[0] = M_0 (statics of sub-chain 0); for n =
 S′_0 = −M_1; for n ≥ 2 the interior reactions are statically indeterminate and S_out[1:] is NaN.
 A self-locking pair (η_bwd ≤ 0, the paper's ξ_ba regime) is outside this model.
 
-All kernels take plain float64 arrays; shapes: J, dJ, M: (n + 1,); eta_*, S_out: (n,).
+All kernels take plain float64 arrays; shapes: J, dJ, M: (n + 1,); ``eta_*``, S_out: (n,).
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """State events on a step: the event functions, their crossings located on the dense output
 (Illinois root finding, sampling for crossings that come and go inside a step), which events are
-watched in the current switches (:func:`_event_spec`), and the search for a step's earliest event
-(:func:`_locate_events`).
+watched in the current switches (:func:`~transient.core.events._event_spec`), and the search for a
+step's earliest event (:func:`~transient.core.events._locate_events`).
 
 The events are the switches between time and crank angle, starter cut-out, the governor
 characteristic's corners, the PI governor's limits, the flyweight governor's stops, the corners of

@@ -1,10 +1,12 @@
 """The applied terms of the reduced model at a state: the mechanism's inertia and transfer
 functions, the cylinders' gas values (tables, or pressure states with wall heat transfer), the
 governors' fuel command and branches, the load with its schedule and generator, the starter, and
-their sum into the reduced moments (:func:`moments`).
+their sum into the reduced moments
+(:func:`~transient.core.forcing.moments`).
 
-These are the physics the right-hand side (:mod:`.rhs`), the output rows (:mod:`.outputs`) and the
-inverse dynamics (:mod:`.inverse`) share; the discrete branches (governor, load segment,
+These are the physics the right-hand side (:mod:`.rhs`), the output rows
+(:mod:`transient.core.outputs`) and
+the inverse dynamics (:mod:`.inverse`) share; the discrete branches (governor, load segment,
 generator) are chosen here too, because each is the same formula the term evaluates, held fixed
 over a step so that the right-hand side is smooth inside it.
 """
@@ -70,7 +72,8 @@ def gas_value(m, extras, k, phi, sel, wk):
     """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
-    ends exactly on a corner keeps using the piece it integrates over (DESIGN §2, breakpoints).
+    ends exactly on a corner keeps using the piece it integrates over (docs/theory.md, Events and
+    breakpoints).
     The piece is the one :func:`select_pieces` left in ``wk`` for it. With combustion offsets
     the value is the curve's δ_k later, p_full(x − δ_k) (:func:`shifted`).
     """

@@ -2,8 +2,8 @@
 and the pairs' moments, solved through the serial chain from its far end.
 
 A run with prescribed speed calls this instead of the stepper; it shares the applied terms
-(:mod:`.forcing`) and the output rows (:mod:`.outputs`) with the dynamic run, so that both report
-the same columns.
+(:mod:`.forcing`) and the output rows (:mod:`transient.core.outputs`) with the dynamic run, so that
+both report the same columns.
 """
 from __future__ import annotations
 

@@ -12,12 +12,12 @@ opposes, so the power lost, Σ (μ r |R| + c|q|)|q| + (μ|N| + F_ring + c_p P⁺
 
 The reactions by Newton–Euler
 -----------------------------
-Per cylinder, in its own frame (:mod:`.crank_slider`;
+Per cylinder, in its own frame (:mod:`transient.core.crank_slider`;
 ``transient.reference.crank_slider_joint_forces`` solves the same bodies as eight linear
 equations and is the independent check): the piston
 (mass m_p at the pin B), the rod (point masses at B and A and a rigid part at G with inertia I
-about G — the packed masses of :mod:`.crank_slider`), the throw (m_k at the crankpin A). With
-F_B the rod's force on the piston, F_A the throw's on the rod, P_y = m_p a_By + P + F_s the
+about G — the packed masses of :mod:`transient.core.crank_slider`), the throw (m_k at the crankpin
+A). With F_B the rod's force on the piston, F_A the throw's on the rod, P_y = m_p a_By + P + F_s the
 piston's axial balance (F_s the slider's friction, toward the crank), D the rod's mass times
 acceleration and H its rate of angular momentum about B::
 

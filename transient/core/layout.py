@@ -1,4 +1,5 @@
-"""The layout of the compiled reduced model: the :data:`Model` tuple, the state vector, the
+"""The layout of the compiled reduced model: the :data:`~transient.core.layout.Model` tuple, the
+state vector, the
 switches, the output columns and the work array, with the index helpers that place the optional
 states (governor, latched fuels, cylinder pressures) after the fixed ones.
 

@@ -28,8 +28,8 @@ def output_row(m, extras, angle_mode, y, sel, sw, wk, row):
 @kernel(inline=True)
 def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     """Fill one output sample: columns ``OUTPUTS``, the gas value applied to each cylinder
-    (p_mot + f·(p_full − p_mot), see :func:`applied_value`, with a cylinder's fuel and pressure
-    factors), ``PAIR_OUTPUTS`` of each pair, the
+    (p_mot + f·(p_full − p_mot), see :func:`~transient.core.forcing.applied_value`, with a
+    cylinder's fuel and pressure factors), ``PAIR_OUTPUTS`` of each pair, the
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
     samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample."""
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)

@@ -27,7 +27,8 @@ from .layout import (KINETIC, LINK_FIXED, LINK_PISTONS, OMEGA, PHI, POWER_FLOW, 
 
 @kernel(inline=True)
 def split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk):
-    """J_k, J′_k and M_k of every sub-chain into ``wk`` (DESIGN §1, ``transient.core.chain``).
+    """J_k, J′_k and M_k of every sub-chain into ``wk`` (docs/theory.md, The serial chain;
+    :mod:`transient.core.chain`).
 
     Links in order (the mechanism's ``links``): the shaft (J0 with flywheel and load; load and
     starter act on it), links of constant reduced inertia ``link_J`` (the crank), the link

@@ -1,6 +1,6 @@
 """The compiled stepper: an embedded Runge–Kutta pair with dense output, driven segment by segment
-between breakpoints, with state events located on the dense output (DESIGN §2; Hairer, Nørsett &
-Wanner, *Solving ODEs I*, §II.6 and §II.10).
+between breakpoints, with state events located on the dense output (docs/theory.md, Steppers;
+Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
 
 One loop for every pair in :mod:`.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
 fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).

@@ -28,7 +28,8 @@ balance is a near-step in the spin, on which a Newton iteration carrying the spi
 unknowns oscillates; friction in the ball joints needs the spin solved apart (bracketed, it is
 monotone) and those angles as breakpoints.
 
-Frame, kinematics and equation numbers are those of :mod:`.swash_plate` (Antonyuk et al. §2:
+Frame, kinematics and equation numbers are those of :mod:`transient.core.swash_plate` (Antonyuk et
+al. §2:
 (5), (6), (8), (10)); the reduced model is their (18)–(21), which the frictionless Newton–Euler
 below reproduces (``tests/unit/test_swash_friction.py``).
 
@@ -82,7 +83,8 @@ f = 0) corrects δf_k = −g_k/g_k′ − (∂g_k/∂ε)/g_k′ δε, with δε 
 ∂g_k/∂f_k = 1 + s_k μ N̂_k·e_k⊥/e_kx ≥ 1 − μ tan(rod tilt) > 0 (the tilt is a few degrees), so
 each piston's equation has one root. The friction moments M_O, M_f are explicit in (ε, f): the
 forces do not depend on the moments. The stopping rule, the NaN on failure, and the absence of
-anything lagged are those of :mod:`.joint_friction` (:data:`TOL`, :data:`MAX_ITER`).
+anything lagged are those of :mod:`.joint_friction` (:data:`~transient.core.joint_friction.TOL`,
+:data:`~transient.core.joint_friction.MAX_ITER`).
 
 Directions: each piston's speed changes sign at its dead centres, which ``transient.assemble``
 makes breakpoints (signs taken at the step's angle ``sel``, per unit σ); the plate bearing's and

@@ -1,4 +1,4 @@
-"""Explicit Runge–Kutta pairs for the compiled stepper, as data (DESIGN §2).
+"""Explicit Runge–Kutta pairs for the compiled stepper, as data (docs/theory.md, Steppers).
 
 A :class:`Tableau` holds what :mod:`transient.core.rk` needs of an embedded pair with
 dense output, so that one compiled loop serves every method:

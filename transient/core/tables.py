@@ -3,7 +3,8 @@
 A table describes one periodic curve over a cycle ``[0, P)``. The cycle is cut at **corners**
 into **pieces**, and inside a piece the curve is a piecewise cubic on knots (C² for a cubic
 spline, C¹ for pchip). A jump or a kink may sit only at a corner, so the integrator, which stops
-on every corner (DESIGN.md §2, "breakpoints ... become segment ends"), only ever steps across
+on every corner (docs/theory.md, Events and
+breakpoints), only ever steps across
 smooth parts. The layout, shared by the right-hand side and by :mod:`transient.forces.gas`:
 
 ``knots``, float64[n + 1]

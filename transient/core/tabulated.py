@@ -1,5 +1,5 @@
 """Tabulated reduced model: J(φ) and the piston transfer functions u_k(φ) as periodic quintic
-splines on a uniform grid (DESIGN §2, tabulation; built by :mod:`transient.tabulate`).
+splines on a uniform grid (docs/theory.md, Tabulation; built by :mod:`transient.tabulate`).
 
 The angle-only terms of the reduced model are smooth and 2π-periodic. Evaluated exactly they
 cost a few trigonometric functions, square roots and an arcsine per cylinder; from a table they

@@ -280,7 +280,7 @@ def not_a_knot_coef(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[n
     knots' slopes from one tridiagonal system), which the tests compare it with.
 
     Written out because importing scipy.interpolate (it imports scipy.optimize) and
-    scipy.linalg, for a banded solver (:func:`_tridiagonal_solve`), would be a sizeable part of a
+    scipy.linalg, for a banded solver (``_tridiagonal_solve``), would be a sizeable part of a
     warm ``transient run``. With 3 points it is the parabola through them, with 2 the straight
     line (CubicSpline's choices there).
     """

@@ -75,7 +75,7 @@ __all__ = [
 WIEBE_STEP = math.radians(0.125)
 
 #: Default target of the tabulation error, relative to the cycle's largest pressure: intervals
-#: whose midpoint error exceeds it are halved (see :func:`_tabulate`). For m < 0 the pressure
+#: whose midpoint error exceeds it are halved (see ``_tabulate``). For m < 0 the pressure
 #: rises like ``y**(m + 1)`` with an infinite slope at the combustion start and the target is
 #: not met there (m = -0.5: 1.9e-5 with intervals down to 1e-9 rad);
 #: :attr:`WiebeCycle.interpolation_error` reports what was reached.
@@ -326,7 +326,8 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
     (first law of one ideal-gas zone, ``U = ∫ m c_v dT`` with ``c_v = R/(γ(T) - 1)``; exact
     also for a temperature-dependent γ), integrated with DOP853 at `rtol` and split at the
     combustion start and end, where the heat-release rate has kinks (these are table corners
-    too). The work ∫p dV/dx dx is a second ODE component, so :attr:`WiebeCycle.work` does not
+    too). The work ∫p dV/dx dx is a second ODE component, so
+    :attr:`~transient.forces.gas.IndicatedCycle.work` does not
     come from the table. Outside the closed part the pressure is constant: a 4-stroke is at
     `p_intake` from 0 to intake closing and at `p_exhaust` from exhaust opening to 4π; a
     2-stroke jumps to `p_a` at exhaust opening and stays there until intake closing.
@@ -354,7 +355,8 @@ def wiebe_cycle(volume: VolumeFunction, *, p_a: float, start: float, duration: f
     duration : float
         Combustion duration [rad], > 0 (``gas.wiebe.duration_deg``).
     a, m : float
-        Wiebe efficiency parameter (> 0) and shape exponent (> -1), see :func:`wiebe_fraction`.
+        Wiebe efficiency parameter (> 0) and shape exponent (> -1), see
+        :func:`~transient.forces.closed_cycle.wiebe_fraction`.
     lhv : float
         Lower heating value of the fuel [J/kg] (diesel 42.5e6).
     efficiency : float

@@ -401,8 +401,9 @@ class ClosedCycle(ClosedPart):
     """The closed part (IVC → EVO) with wall heat transfer: dense solution and totals.
 
     A :class:`~transient.forces.closed_cycle.ClosedPart` whose segments hold the components
-    (p, W, Q_w) (:meth:`state`). Angles are local and unwrapped: from `start` (intake closing) to
-    `end` (exhaust opening), past 2π for a 2-stroke.
+    (p, W, Q_w)
+    (:meth:`~transient.forces.closed_cycle.ClosedPart.state`). Angles are local and unwrapped: from
+    `start` (intake closing) to `end` (exhaust opening), past 2π for a 2-stroke.
 
     Attributes
     ----------

@@ -1,6 +1,6 @@
-"""The mechanisms: what each provides (:class:`Mechanism`) and the registry of them
-(:data:`MECHANISMS`), through which the scene reader, the reference path and the analyses reach
-a mechanism without naming its class.
+"""The mechanisms: what each provides (:class:`~transient.mechanisms.Mechanism`) and the registry
+of them (:data:`~transient.mechanisms.MECHANISMS`), through which the scene reader, the reference
+path and the analyses reach a mechanism without naming its class.
 
 A mechanism maps the shaft angle φ to the positions of its bodies and gives the reduced inertia
 J(φ), dJ/dφ and the piston transfer functions u_k(φ) = ds_k/dφ, u′_k(φ): in the compiled core

@@ -330,7 +330,8 @@ class Articulated:
         return mech
 
     def validate(self) -> None:
-        """Raise :class:`SceneError` for a geometry or mass set that cannot work or assemble."""
+        """Raise :class:`~transient.SceneError` for a geometry or mass set that cannot work or
+        assemble."""
         self.master().validate()
         n, l = self.n_slaves, self.rod_length
         for key, values in (("link_angle", self.link_angles), ("link_radius", self.link_radii),

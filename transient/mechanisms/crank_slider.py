@@ -276,7 +276,7 @@ class CrankSlider:
         return mech
 
     def validate(self) -> None:
-        """Raise :class:`SceneError` for a geometry or mass set that cannot work."""
+        """Raise :class:`~transient.SceneError` for a geometry or mass set that cannot work."""
         r, l, e = self.crank_radius, self.rod_length, self.offset
         if not r > 0:
             raise SceneError("mechanism.crank_radius", f"must be > 0, got {r * 1e3:g} mm")

@@ -324,7 +324,7 @@ class SwashPlate:
         return mech
 
     def validate(self) -> None:
-        """Raise :class:`SceneError` for a geometry or mass set that cannot work."""
+        """Raise :class:`~transient.SceneError` for a geometry or mass set that cannot work."""
         a, R, r1, ell = self.swash_angle, self.joint_radius, self.cylinder_radius, self.rod_length
         if not 0.0 < a < pi / 4.0:
             raise SceneError("mechanism.swash_deg", f"{degrees(a):g}° is not allowed; 0° < α < 45°")

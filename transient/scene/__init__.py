@@ -5,12 +5,13 @@ Every key may be written in SI (``crank_radius = 0.047``) or with one unit suffi
 (``crank_radius_mm = 47``). Unknown keys, wrong types and non-physical values raise
 :class:`transient.errors.SceneError` naming the file, the key, what is wrong and what is allowed.
 
-- :mod:`.reader`   :class:`~.reader.Section`, the typed-key reader of one table (unit suffixes,
-                   ranges, unknown keys)
+- :mod:`.reader`   :class:`~transient.scene.reader.Section`, the typed-key reader of one table
+                   (unit suffixes, ranges, unknown keys)
 - :mod:`.records`  the frozen dataclasses, one per table, with their units
-- :mod:`.read`     :func:`load_scene` and :func:`scene_from_dict`: the reader of each table
+- :mod:`.read`     :func:`~transient.load_scene` and :func:`~.read.scene_from_dict`: the reader
+                   of each table
 - :mod:`.checks`   the checks across tables
-- :mod:`.write`    :func:`to_toml`, the resolved scene back to TOML
+- :mod:`.write`    :func:`~.write.to_toml`, the resolved scene back to TOML
 """
 from .read import load_scene, replace_scene, scene_from_dict
 from .records import (POLICIES, Analysis, Cylinder, Friction, Gas, Governor, Inertia, Initial,

@@ -130,7 +130,8 @@ def _analysis_bytes(scene: Scene) -> float:
 
 def check_work(scene: Scene) -> None:
     """Refuse, naming the key, a scene whose run cannot be done within its budgets or cannot
-    advance: an unreachable tolerance, a time-domain spacing below :data:`MIN_OUTPUT_DT`, output
+    advance: an unreachable tolerance, a time-domain spacing below
+    :data:`~transient.scene.records.MIN_OUTPUT_DT`, output
     or an analysis grid beyond ``run.max_output_bytes``, steps beyond ``run.max_steps``, angle
     increments the shaft angle cannot resolve."""
     sv, run = scene.solver, scene.run

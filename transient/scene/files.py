@@ -91,7 +91,7 @@ def parse_toml(text: str, file: str) -> dict:
     quotes cut to a token's length) and where, or that arrays or tables are nested too deeply.
 
     Long arrays of plain decimal numbers (a pressure or load table inline) are read by
-    :func:`_numbers_apart`, not by tomllib, whose parser in Python takes some 35 µs a number:
+    ``_numbers_apart``, not by tomllib, whose parser in Python takes some 35 µs a number:
     the same values, at a small part of the cost."""
     try:
         return _numbers_apart(text) or tomllib.loads(text)
@@ -105,7 +105,7 @@ def parse_toml(text: str, file: str) -> dict:
 
 
 #: Arrays of numbers longer than this [characters] are read apart from tomllib
-#: (:func:`_numbers_apart`): shorter ones cost it little.
+#: (``_numbers_apart``): shorter ones cost it little.
 LONG_ARRAY_CHARS = 2000
 #: An array holding numbers, separators and TOML's whitespace only (no comment, no string, no
 #: nested array): its content between the brackets.

@@ -1,7 +1,7 @@
 """Reading a scene: TOML text or a parsed dict → a validated :class:`~.records.Scene`.
 
-:func:`load_scene` parses the file; :func:`scene_from_dict` reads one table at a time through a
-:class:`~.reader.Section` (the ``[mechanism]`` table by the class that
+:func:`transient.load_scene` parses the file; :func:`scene_from_dict` reads one table at a time
+through a :class:`~.reader.Section` (the ``[mechanism]`` table by the class that
 :data:`transient.mechanisms.MECHANISMS` names for its ``type``), then runs the checks across
 tables (:mod:`.checks`). Every error is one :class:`~transient.errors.SceneError` naming the file
 and the key as written.
@@ -32,7 +32,53 @@ from .write import to_toml
 
 
 def load_scene(source: str | Path, *, text: str | None = None) -> Scene:
-    """Read and validate a scene file (or TOML ``text``, with ``source`` naming it)."""
+    """Read and validate a scene file (or TOML ``text``, with ``source`` naming it).
+
+    Parameters
+    ----------
+    source : str or Path
+        The scene file (TOML); the files a scene names (pressure tables, maps) are read relative
+        to its folder.
+    text : str, optional
+        The scene as TOML, read instead of the file; ``source`` then only names it.
+
+    Returns
+    -------
+    Scene
+        The validated scene in SI units, every default filled in; its ``name`` is the file's
+        stem unless ``[scene] name`` says otherwise.
+
+    Raises
+    ------
+    transient.SceneError
+        The file cannot be read or a key is wrong: one line naming the file, the key, what is
+        wrong and what is allowed.
+
+    Examples
+    --------
+    >>> import transient
+    >>> scene = transient.load_scene("single.toml", text='''
+    ... [mechanism]
+    ... type = "crank-slider"
+    ... crank_radius_mm = 47
+    ... rod_length_mm = 148
+    ... bore_mm = 88
+    ... piston_mass = 1.52
+    ... crank_mass = 0.912
+    ... [mechanism.rod]
+    ... model = "two-mass"
+    ... mass = 1.752
+    ... cg_from_pin_mm = 107.3
+    ... [initial]
+    ... omega_rpm = 1000
+    ... [run]
+    ... revolutions = 2
+    ... ''')
+    >>> scene.name
+    'single'
+    >>> scene.mechanism.crank_radius  # [m]: keys are read into SI
+    0.047
+    """
     path = Path(source)
     if text is None:
         text = read_text(path, "scene")
@@ -51,12 +97,33 @@ class SweepNotScene(SceneError):
 
 def replace_scene(scene: Scene, /, **tables: dict) -> Scene:
     """A copy of ``scene`` with keys of its tables changed, validated exactly as a scene file is
-    (the same one-line :class:`SceneError`, naming the key).
+    (the same one-line :class:`~transient.SceneError`, naming the key).
 
     Each keyword names a table (``scene``, ``mechanism``, ``inertia``, ``load``, …) and gives
     its keys as a TOML file would, unit suffixes included, sub-tables as nested dicts:
     ``scene.replace(inertia={"flywheel": 0.5}, initial={"omega_rpm": 1500})``. A key given with
-    another unit replaces the scene's own (``omega_rpm`` replaces ``omega``).
+    another unit replaces the scene's own (``omega_rpm`` replaces ``omega``). A key given as
+    None is taken out, in whatever unit the scene has it (TOML has no null): a 4-stroke scene
+    made a 2-stroke drops its gas-exchange pressures with ``gas={"p_intake": None,
+    "p_exhaust": None}``.
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> heavier = scene.replace(inertia={"flywheel": 0.5})
+    >>> heavier.inertia.flywheel, scene.inertia.flywheel
+    (0.5, 0.0)
     """
     data = parse_toml(to_toml(scene), "(replace)")
     for table, keys in tables.items():
@@ -76,7 +143,10 @@ def _merge(base: dict, changes: dict) -> None:
         stem = _unsuffixed(key)
         for other in [k for k in base if k != key and _unsuffixed(k) == stem]:
             del base[other]
-        base[key] = value
+        if value is None:
+            base.pop(key, None)
+        else:
+            base[key] = value
 
 
 def _unsuffixed(key: str) -> str:
@@ -85,7 +155,27 @@ def _unsuffixed(key: str) -> str:
 
 
 def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) -> Scene:
-    """Build and validate a scene from parsed TOML. Raises :class:`SceneError`."""
+    """Build and validate a scene from parsed TOML: one dict per table, keys as a scene file
+    writes them. Raises :class:`~transient.SceneError`; ``file`` names the scene in its message,
+    ``base_dir`` is where the files it names are read from (default the working folder).
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> scene.mechanism.bore  # [m]
+    0.088
+    """
     base_dir = base_dir or Path.cwd()
     if isinstance(data.get("sweep"), dict) and "mechanism" not in data:
         raise SweepNotScene(file)
@@ -367,7 +457,7 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
 
     Ranges of single keys are checked here; what needs several of them (the combustion inside
     the closed part, γ(T) > 1 at intake closing) by :mod:`transient.forces.wiebe` when the table
-    is built, still inside :func:`load_scene` (:func:`~.checks.check_gas_table`).
+    is built, still inside :func:`~transient.load_scene` (:func:`~.checks.check_gas_table`).
     """
     d = Wiebe()
     ratio = s.number("compression_ratio", "1", gt=1.0)

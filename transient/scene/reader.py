@@ -1,5 +1,5 @@
-"""The typed-key TOML reader: :class:`Section` takes keys off one table, converts unit suffixes
-to SI and reports anything left over as an unknown key.
+"""The typed-key TOML reader: :class:`~transient.scene.reader.Section` takes keys off one
+table, converts unit suffixes to SI and reports anything left over as an unknown key.
 
 A quantity may be written in SI (``crank_radius = 0.047``) or with one unit suffix of its kind
 (``crank_radius_mm = 47``, :data:`transient.units.SUFFIXES`). Every problem raises

@@ -416,7 +416,8 @@ class Run:
 
 @dataclass(frozen=True)
 class Solver:
-    """Integration settings. ``method``: one of :data:`METHODS`; ``rtol`` [1] and ``atol`` (in the
+    """Integration settings. ``method``: one of
+    :data:`~transient.scene.records.METHODS`; ``rtol`` [1] and ``atol`` (in the
     units of each state) as scipy's; ``max_step`` [rad] in crank angle.
     ``switch_speed`` [rad/s]: below it time is the independent variable;
     ``domain``: ``"auto"`` (crank angle above the switch speed) or ``"time"`` (time throughout,
@@ -477,6 +478,7 @@ MIN_OUTPUT_DT = 1e-8
 
 #: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
 COMPILED_METHODS = ("dop853", "dopri5")
+#: Every ``[solver] method``: the compiled ones, then the reference path's.
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 
 
@@ -592,14 +594,40 @@ DETREND = ("auto", "ramp", "none")
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene: what :func:`transient.scene.load_scene` returns, one record per TOML
+    """A validated scene: what :func:`transient.load_scene` returns, one record per TOML
     table. ``name`` labels the result (the file's stem by default), ``description`` is free text;
     ``mechanism`` is one of :data:`transient.mechanisms.MECHANISMS`.
 
     ``source_file`` and ``source_text``: the file the scene was read from and its text as read,
     comments included (where each number comes from), which a result stores beside the resolved
     scene; empty for a scene built in code. Not part of what the scene is: two scenes that differ
-    only there are equal."""
+    only there are equal.
+
+    A scene is frozen: :meth:`~transient.Scene.replace` makes a changed copy, validated as a
+    file is; :meth:`~transient.Scene.to_toml` writes it back as TOML that
+    :func:`transient.load_scene` reads to an equal scene.
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> stroke, unit = scene.geometry()["stroke"]
+    >>> print(f"{stroke:.3f} {unit}")
+    0.094 m
+    >>> text = scene.to_toml()
+    >>> transient.load_scene("copy.toml", text=text) == scene
+    True
+    """
 
     name: str
     description: str

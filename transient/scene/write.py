@@ -1,5 +1,5 @@
 """Writing a scene back: the resolved scene as TOML in SI (no unit suffixes, every default
-filled in), which :func:`~.read.load_scene` reads back to an equal scene. A result file stores
+filled in), which :func:`~transient.load_scene` reads back to an equal scene. A result file stores
 it (``/scene/toml``) so that it can be rerun.
 """
 from __future__ import annotations

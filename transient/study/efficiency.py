@@ -109,8 +109,12 @@ def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
     ax_loss.set_xlabel("speed [rpm]")
     ax_loss.set_ylabel(f"loss [% of W_in] ({policy}, fuel {fuel:g})")
     twin.set_ylabel("energy circulated through the pair [× W_in]")
-    ax_loss.legend(loc="upper left", fontsize=8)
-    twin.legend(loc="upper right", fontsize=8)
+    if n_pairs:
+        ax_loss.legend(loc="upper left", fontsize=8)
+        twin.legend(loc="upper right", fontsize=8)
+    else:  # (an empty panel would read as losses of zero measured)
+        ax_loss.text(0.5, 0.5, "no friction pairs in the scene: no losses", ha="center",
+                     va="center", transform=ax_loss.transAxes)
     ax_loss.grid(alpha=0.3)
     return artists
 

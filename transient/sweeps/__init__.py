@@ -2,8 +2,8 @@
 
 - :mod:`.spec` reads and validates a sweep file (axes, points, dotted scene keys) and resolves
   every run's scene before any work;
-- :mod:`.execute` runs them: :func:`run_one` on Dask workers (or in this process), the client
-  and its local cluster, Ctrl-C handling;
+- :mod:`.execute` runs them: :func:`~.execute.run_one` on Dask workers (or in this process), the
+  client and its local cluster, Ctrl-C handling;
 - :mod:`.store` writes the one sweep file: each run in a result file's layout
   (:mod:`transient.results`), the sweep's axes, run index and status, and the summary table;
   run again, it mends the file, reusing every stored run whose resolved scene is unchanged.

@@ -1,4 +1,4 @@
-"""Sweeps from code: :func:`sweep` runs a scene over parameter axes with the engine of
+"""Sweeps from code: :func:`transient.sweep` runs a scene over parameter axes with the engine of
 ``transient sweep``, from a sweep file it writes beside its results, ``<name>.sweep.toml``
 (validated, stored and mended exactly as a sweep file given to the command is), into
 ``<name>.sweep.h5`` and ``<name>.sweep_summary.csv``.
@@ -56,35 +56,64 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
           output: str | Path | None = None, client=None, scheduler: str | None = None,
           workers: int | None = None, force: bool = False,
           progress: Callable[[int, int], None] | None = None) -> SweepResult:
-    """Run ``base`` (a :class:`~transient.scene.Scene`) over ``axes`` and collect quantities of
+    """Run ``base`` (a :class:`~transient.Scene`) over ``axes`` and collect quantities of
     every run, as ``transient sweep`` does.
 
     Parameters
     ----------
-    base
+    base : Scene
         The scene every run starts from.
-    axes
+    axes : dict
         Dotted scene key → values, e.g. ``{"load.torque": [50, 100], "inertia.flywheel":
         [0.1, 0.2]}``; unit suffixes allowed (``"initial.omega_rpm"``).
-    collect
-        Quantities of each run for the table (:data:`transient.sweeps.QUANTITIES` or any
+    collect : sequence of str
+        Quantities of each run for the table (:data:`transient.sweeps.spec.QUANTITIES` or any
         ``/analysis`` entry).
-    method
+    method : {"grid", "list"}
         ``"grid"``: every combination of the axes; ``"list"``: their i-th values together.
-    name
+    name : str, optional
         The sweep's name (its file's stem; a sweep of the same name in ``output`` is mended:
         unchanged runs reused). Default: the base scene's name.
-    columns
+    columns : sequence of str, optional
         Trajectory columns to keep of each run (default all).
-    output
+    output : str or Path, optional
         Folder of the sweep file and its summary CSV; default a temporary folder.
-    client, scheduler, workers
-        A ``dask.distributed.Client`` to run on, or a scheduler's address, or ``"serial"``;
+    client, scheduler, workers : Client, str, int, optional
+        A :class:`distributed.Client` to run on, or a scheduler's address, or ``"serial"``;
         default a local cluster of ``workers`` processes (one per core).
-    force
+    force : bool
         Replace a sweep file of another sweep of this name.
-    progress
+    progress : callable, optional
         Called with (runs done, runs in all) after each run.
+
+    Returns
+    -------
+    SweepResult
+        The summary table (one row per run) and each run's result.
+
+    Examples
+    --------
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 0.02},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 2}})
+    >>> axes = {"inertia.flywheel": [0.0, 0.5]}
+    >>> swept = transient.sweep(scene, axes, scheduler="serial")
+    >>> columns = swept.table.columns
+    >>> columns["inertia.flywheel"].tolist()
+    [0.0, 0.5]
+    >>> columns["status"].tolist()
+    ['finished', 'finished']
+    >>> swept.run(1).scene().inertia.flywheel
+    0.5
     """
     if not isinstance(axes, dict) or not axes:
         raise SceneError("axes", "give a dict of dotted scene keys and their values, e.g. "

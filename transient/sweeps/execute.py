@@ -202,7 +202,7 @@ def check_main_guarded() -> None:
     outside ``if __name__ == "__main__":``.
 
     The cluster's workers are processes that multiprocessing starts by "spawn" (Dask's default),
-    and spawn runs the main module again in each of them, as :mod:`multiprocessing.spawn`
+    and spawn runs the main module again in each of them, as ``multiprocessing.spawn``
     prepares it: by its name where it was run as ``python -m pkg.mod`` (not a package's
     ``__main__``), else by its file. There the call would start a cluster again while the worker
     is still starting, and Dask fails with a traceback from deep inside its nanny. The call is

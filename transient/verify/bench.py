@@ -43,9 +43,9 @@ from ..errors import SimulationError
 from ..scene import load_scene
 from ..run import integrate
 
+_CASES = Path(__file__).resolve().parents[2] / "cases"
 #: Benchmark scenes: the single-cylinder crank (equation (18) alone), the Gots diesel with
 #: friction pairs and a governor, the 4-cylinder swash-plate engine.
-_CASES = Path(__file__).resolve().parents[2] / "cases"
 BENCH_SCENES = {path.stem: path for path in (_CASES / "coasting_single.toml",
                                              _CASES / "gots_diesel_governed.toml",
                                              _CASES / "swash_plate_4cyl.toml")}
@@ -81,6 +81,7 @@ ADAPTIVE = {
 #: tables are made to 1e-12 (``table_tolerance``), near the splines' floor.
 FIXED = {"transient DOP853 fixed step, tabulated (crank angle)":
          {"method": "dop853", "kinematics": "tabulated", "table_tolerance": 1e-12}}
+#: The fixed-step path's steps per revolution N (a step of 2π/N).
 STEPS_PER_REV = (16, 32, 64, 128, 256, 512, 1024)
 #: The label of the default path, against which the others' speed is stated.
 DEFAULT = "transient DOP853 (crank angle)"

@@ -15,9 +15,9 @@ Every case ends in one of three ways, and the report says which:
   (``Case.known``): it stays in the report, marked, never hidden.
 
 Scenes are built from the ``cases/*.toml`` files as dicts (:func:`base`), changed in code and
-validated by :func:`transient.scene.scene_from_dict`, exactly as a scene file would be. A case
-runs as ``transient run`` does (:func:`transient.run.simulate` into
-``DIR/stress/<case>.h5``, read back with :func:`transient.results.open_result`), in a forked
+validated by :func:`transient.scene.read.scene_from_dict`, exactly as a scene file would be. A case
+runs as ``transient run`` does (:func:`transient.simulate` into
+``DIR/stress/<case>.h5``, read back with :func:`transient.open_result`), in a forked
 child process that is killed when the case's time bound passes; the long runs stream through
 :func:`transient.run.integrate` without keeping the trajectory.
 
@@ -186,7 +186,7 @@ class Run:
 
 
 def run_scene(d: dict, name: str, ctx: Context) -> Run:
-    """Run a scene dict as ``transient run`` would (:func:`transient.run.simulate` to
+    """Run a scene dict as ``transient run`` would (:func:`transient.simulate` to
     ``ctx.out/<name>.h5``) and read the file back, complete or not."""
     from ..errors import SimulationError
     from ..results import open_result
@@ -895,7 +895,7 @@ def _did_not_start(run: Run, o: Outcome) -> bool:
 
 def failed_starts(builds: dict[str, Callable[[bool], dict]]):
     """A case's ``run`` for scenes whose shaft never completes what they ask: the verdict is
-    :func:`_did_not_start`'s, whatever status the run ends with (the common checks still hold:
+    ``_did_not_start``'s, whatever status the run ends with (the common checks still hold:
     finite values, the balance, a diagnosis naming time and angle)."""
     def run(quick: bool, ctx: Context) -> Outcome:
         o = Outcome()

@@ -1,7 +1,8 @@
 """Forces in a master-and-articulated-rod engine (radial; V with fork-and-blade rods) along a
 trajectory φ(t), ω(t), ε(t): pistons, rods, link pins and the master crankpin.
 
-The crank-slider counterpart is :mod:`.crank_slider` (Gots §2.3–§2.6); its conventions are
+The crank-slider counterpart is
+:mod:`transient.analysis.loads.crank_slider` (Gots §2.3–§2.6); its conventions are
 kept, and what differs is that the master rod carries the slave rods' link pins, so it is not a
 two-force member. The kinematics are the mechanism's own exact ones
 (:mod:`transient.core.articulated`, Semenov (8), (31), (40)–(41) solved exactly), evaluated by the
@@ -45,7 +46,8 @@ the row has the outward axis d_k = e^{iδ_k} (δ_0 = 0 for the master) and the s
   C = ΔI β̈ + Σ_i (A_i − A) × F_i: the link pins make the master's side force differ from P tan β
   even with massless rods. The rod system's force on the crankpin is Φ_0 + Σ_i F_i, with
   components K (toward the crank axis) and T (direction of rotation), Gots (36)–(37) generalised.
-* **Crankpin load** of the row, a vector as in :mod:`.crank_slider`: R_K = K + K_rш,
+* **Crankpin load** of the row, a vector as in
+  :mod:`~transient.analysis.loads.crank_slider`: R_K = K + K_rш,
   R_T = T + T_rш with the master rod's rotating mass, K_rш = −m₂ r ω², T_rш = −m₂ r ε (Gots (32)
   and its ε term); the crank throw's m_k gives K_rk, T_rk the same way (the row's
   ``crank_mass``).
@@ -60,7 +62,8 @@ Virtual work (the independent checks, ``tests/unit/test_loads_radial_swash.py``)
   Σ_rows r (R_T + T_rk) = Σ_k P_g,k u_k − J ε − ½ J′ ω², with J, J′ of
   :func:`transient.core.articulated.articulated_terms` — every inertia force above is checked
   against the kinetic energy the simulation integrates.
-* The cylinder's share of the shaft torque is P_k u_k (:attr:`ArticulatedLoads.torque`): the
+* The cylinder's share of the shaft torque is P_k u_k
+  (:attr:`~transient.analysis.loads.common.PistonLoads.torque`): the
   slaves do not act on the crankpin directly, so the crank-slider's per-cylinder T r has no
   counterpart; Σ_k P_k u_k = T r − W_links/ω.
 
@@ -221,7 +224,9 @@ class ArticulatedLoads(CrankpinLoads):
     @property
     def engine_torque(self) -> Array:
         """Σ_rows T r [N m], shape (n,): the crank-slider's indicated torque Σ T r generalised
-        (Σ P u, the sum of :attr:`torque`, leaves out the link pins' power)."""
+        (Σ P u, the sum of
+        :attr:`~transient.analysis.loads.common.PistonLoads.torque`, leaves out the link pins'
+        power)."""
         return self.T.sum(axis=0) * self.r
 
     @property

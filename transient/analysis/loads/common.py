@@ -1,7 +1,8 @@
 """What the load analyses of every mechanism share: the records' common fields, the gas force on
 the pistons, the two-mass split of a rod and the d'Alembert force of a mass turning with the crank.
 
-Conventions as the crank-slider's (:mod:`.crank_slider`, Gots §2.3–§2.6): piston forces are
+Conventions as the crank-slider's (:mod:`transient.analysis.loads.crank_slider`, Gots §2.3–§2.6):
+piston forces are
 positive in the sense the gas pushes (toward the crank, or toward the swash plate), inertia forces
 are d'Alembert forces −m·a with the actual ω and ε, and arrays are ``(rows of the record, n
 samples)``. Units SI (N, N·m, m, rad).
@@ -138,8 +139,8 @@ def gas_forces(scene, phi: ArrayLike, fuel: ArrayLike = 1.0) -> Array:
 
     Cylinder k reads the table at φ − ``gas_phases(scene)[k]``; the pressure is
     p_mot + f·(p_full − p_mot) at the fuel command ``fuel`` (scalar or per sample), as the
-    compiled model applies it (:class:`transient.scene.Gas`). A force-pulse model (``trapezoid``)
-    gives the force directly.
+    compiled model applies it (:class:`transient.scene.records.Gas`). A force-pulse model
+    (``trapezoid``) gives the force directly.
     """
     # (lazily: the table builders import scipy)
     from ...assemble import gas_is_force, gas_phases, gas_tables

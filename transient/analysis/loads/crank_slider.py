@@ -3,12 +3,12 @@ big-end bearing, main journals and the running torques (Gots §2.3–§2.8).
 
 The textbook assumes a constant speed; here ω and ε are arbitrary, so every inertia force has a
 term in ε besides the one in ω². Everything is plain numpy over arrays of samples (this is the
-user-facing analysis layer, DESIGN §2); the kinematics are the exact crank-slider of
+user-facing analysis layer, above the compiled core); the kinematics are the exact crank-slider of
 :func:`transient.core.crank_slider.slider`, of which :func:`slider_arrays` is the vectorised twin
 (``tests/unit/test_loads.py`` checks them against each other to 1e-13).
 
-Frame and signs (DESIGN §4, Gots §1, Fig. 27)
----------------------------------------------
+Frame and signs (Gots §1, Fig. 27)
+----------------------------------
 One cylinder, as :mod:`transient.core.crank_slider`: origin on the crank axis, ``y`` along the
 cylinder axis toward the head, ``x`` to the side the crankpin moves at the top. Crankpin
 A = r(sin α, cos α) at the local crank angle α (from the cylinder axis, in the direction of
@@ -73,7 +73,8 @@ with two rods on a pin, cylinders 2k − 1 and 2k on throw k (:mod:`transient.me
 Each cylinder's record carries its share of its throw's unbalanced mass (K_rk, T_rk): all of it,
 or half where two cylinders share the throw.
 
-* **Engine torque**: Σ T_k r (Gots §2.8, table П4.2), :attr:`CylinderLoads.engine_torque`.
+* **Engine torque**: Σ T_k r (Gots §2.8, table П4.2),
+  :attr:`~transient.analysis.loads.common.PistonLoads.engine_torque`.
 * **Running torques** (§2.8, П4.4/П4.5): journal j carries the torque of the throws ahead of it
   (journal 1 at the nose carries none, the last one the total), a crankpin the journal ahead of
   it plus what its throw adds up to its middle: half of a rod's torque at the middle (one rod,
@@ -93,7 +94,8 @@ or half where two cylinders share the throw.
   axes Gots' positive K and T map onto, §2.7.3), a force with radial K_Σ and tangential T_Σ
   at a crankpin γ ahead of crank 1 has x: T_Σ cos γ − K_Σ sin γ, y: T_Σ sin γ + K_Σ cos γ.
 
-Units: SI (N, N·m, rad). Divide by :attr:`CylinderLoads.area` for Gots' specific forces.
+Units: SI (N, N·m, rad). Divide by
+:attr:`~transient.analysis.loads.common.PistonLoads.area` for Gots' specific forces.
 """
 from __future__ import annotations
 
@@ -174,7 +176,8 @@ class CylinderLoads(CrankpinLoads):
     R_K, R_T, R : crankpin load K + K_rш, T + T_rш and its magnitude (40)/(41) as vectors.
     R_axial, R_normal : the crankpin load in the rod frame (big-end bearing), see the module
         docstring.
-    torque : cylinder torque T r (38); its sum over the cylinders is :attr:`engine_torque`.
+    torque : cylinder torque T r (38); its sum over the cylinders is
+        :attr:`~transient.analysis.loads.common.PistonLoads.engine_torque`.
     throw_torque : r (T + T_rш + T_rk), what the throw passes to the shaft; = torque at ε = 0.
     r, area : crank radius [m] and piston area F_p [m²].
     """

@@ -1,7 +1,7 @@
 """Forces in a swash-plate engine along a trajectory φ(t), ω(t), ε(t): pistons, rods, the rods'
 joints on link 9 and the torque each cylinder puts on the shaft.
 
-The counterpart of :mod:`.crank_slider` for the mechanism of Antonyuk et
+The counterpart of :mod:`transient.analysis.loads.crank_slider` for the mechanism of Antonyuk et
 al. (§2, exact kinematics of :mod:`transient.core.swash_plate`).
 The paper gives the reduced equation (18) with M_П = Σ P_q u_q1 (19)–(20) and no piston or rod
 forces: they follow here from d'Alembert's principle on the same geometry with the actual ω and ε.
@@ -165,7 +165,8 @@ class SwashLoads(PistonLoads):
     ``x``, ``v`` joint D's x [m] and its rate [m/s]; ``P_g``, ``P_j``, ``P`` gas, inertia and total
     piston force along +x [N]; ``S`` rod force (compression > 0) [N]; ``N_radial``,
     ``N_tangential`` the wall's force on the piston [N]; ``joint_x``, ``joint_y``, ``joint_z`` the
-    force on link 9 at B, F_B [N]; ``torque`` halves·Φ·B′ (its sum is :attr:`engine_torque`, the
+    force on link 9 at B, F_B [N]; ``torque`` halves·Φ·B′ (its sum is
+    :attr:`~transient.analysis.loads.common.PistonLoads.engine_torque`, the
     crank-slider's Σ T r), ``joint_torque`` halves·F_B·B′ [N m]; ``rod_power``
     halves·(−ΔI ė·ë) [W]; ``link_torque`` (n,) −(J₉ε + ½J₉′ω²) [N m]; ``halves``, ``area``
     (piston area [m²]).
