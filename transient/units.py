@@ -1,7 +1,7 @@
 """Units of scene keys (docs/guide/scenes.md, Units): every number a scene gives is of a quantity
 kind with an SI unit, and a few kinds also take unit suffixes (``crank_radius_mm``), converted
 once at the edge; a bound or default that is another key's value carries that key's name
-(:class:`Named`)."""
+(:class:`~transient.units.Named`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -70,5 +70,5 @@ class Named:
 
 
 def value_of(x: Any) -> Any:
-    """The value of a default or bound, :class:`Named` or plain."""
+    """The value of a default or bound, :class:`~transient.units.Named` or plain."""
     return x.value if isinstance(x, Named) else x

@@ -163,7 +163,7 @@ class SceneKeys(SphinxDirective):
             ref += nodes.literal(f"[{row.name}]", f"[{row.name}]")
             body.append([[ref], self.inline(root.meaning(row.name)),
                          [nodes.Text("required" if row.required else "optional")]])
-        section += self.grid(["table", "what it holds", ""], [20, 65, 15], body)
+        section += self.grid(["table", "what it holds", "in a scene"], [20, 65, 15], body)
         return section
 
     # -- key tables --------------------------------------------------------------------------
@@ -305,7 +305,7 @@ class SceneKeys(SphinxDirective):
 
     @staticmethod
     def grid(header: list[str], widths: list[int], body: list[list[list]]) -> nodes.table:
-        table = nodes.table(classes=["scene-keys"])
+        table = nodes.table(classes=["scene-keys", "colwidths-given"])
         group = nodes.tgroup(cols=len(header))
         table += group
         for w in widths:

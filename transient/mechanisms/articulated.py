@@ -50,8 +50,8 @@ if TYPE_CHECKING:
 #: harmonics fall like λ^k, and 512 samples alias order 512 − k onto k).
 SAMPLES = 512
 
-#: What each key of its ``[mechanism]`` table and sub-tables means, in a line (the scene-key
-#: reference shows it beside what the reader asks of the key).
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
 KEY_MEANINGS = {
     "mechanism": {
         "crank_radius": "Crank radius r, half the master piston's stroke.",

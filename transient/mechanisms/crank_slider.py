@@ -38,8 +38,8 @@ if TYPE_CHECKING:
 #: Cylinders at most (a scene check: every per-cylinder array is sized by it).
 MAX_CYLINDERS = 64
 
-#: What each key of its ``[mechanism]`` table and sub-tables means, in a line (the scene-key
-#: reference shows it beside what the reader asks of the key).
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
 KEY_MEANINGS = {
     "mechanism": {
         **throws.KEY_MEANINGS,

@@ -67,8 +67,8 @@ HINGES = {"normal": (0.0, (0.0, 0.0, 1.0)), "in-plane": (pi / 2.0, (0.0, 1.0, 0.
 #: Cylinders at most (a scene check: every per-cylinder array is sized by it).
 MAX_CYLINDERS = 64
 
-#: What each key of its ``[mechanism]`` table and sub-tables means, in a line (the scene-key
-#: reference shows it beside what the reader asks of the key).
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
 KEY_MEANINGS = {
     "mechanism": {
         "swash": "Swash angle α: tilt of the plate from the plane normal to the shaft.",

@@ -36,7 +36,7 @@ SINGLE = "single"
 ANGLE_TOL = 1e-9
 
 TWO_PI = 2.0 * math.pi
-#: What the keys this module reads mean, in a line (the scene-key reference).
+# What the keys this module reads mean, in a line (the scene-key reference).
 KEY_MEANINGS = {
     "bank": "Each cylinder's axis from the reference axis, in the direction of rotation: one "
             "per cylinder, or two (one per bank, odd cylinders on the first) for an even count.",

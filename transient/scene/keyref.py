@@ -6,10 +6,10 @@ key before reading it: its type, quantity kind, default, bounds and choices
 and, to reach the keys that only some choice reads (``gas.model = "wiebe"``), reads each again
 with every value of every choice key, a value within its bounds filled in for each required key
 the variant lacks. What it gathers is what the reader asks, nothing restated; each key's one-line
-meaning comes from the tables beside the reader (:data:`.meanings.MEANINGS`, and each
-mechanism's ``key_meanings`` for the ``[mechanism]`` tables it reads itself). The documentation
-renders it (``docs/_ext/scene_keys.py``); the tests hold it to the case files and to what the
-reader enforces.
+meaning comes from the tables beside the reader (:mod:`~transient.scene.meanings`,
+and each mechanism's ``key_meanings`` for the ``[mechanism]`` tables it reads itself). The
+documentation renders it (``docs/_ext/scene_keys.py``); the tests hold it to the case files and
+to what the reader enforces.
 """
 from __future__ import annotations
 
@@ -263,8 +263,8 @@ def _rank(example: Example) -> tuple[bool, bool, bool]:
 
 
 def _spec(key: Key) -> tuple:
-    """What a row shows of a :class:`Key` but its kind: a :class:`Named` default or bound by
-    its name, a plain one by its value."""
+    """What a row shows of a :class:`~.reader.Key` but its kind: a
+    :class:`~transient.units.Named` default or bound by its name, a plain one by its value."""
     def shown(x):
         return ("named", x.name) if isinstance(x, Named) else ("value", _hashable(x))
     return (key.type, shown(key.default), tuple((w, shown(b)) for w, b in key.bounds),

@@ -25,9 +25,8 @@ from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
                       MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_GAMMA, MAX_SAMPLES_PER_REV,
                       METHODS, MIN_OUTPUT_DT, MIN_WIEBE_STEP, PAIR_MODELS, POLICIES, Analysis,
-                      Cylinder, Friction,
-                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
-                      Solver, Starter, Wiebe, Woschni)
+                      Cylinder, Friction, Gas, Governor, Inertia, Initial, Load, LoadTable, Output,
+                      Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
 
@@ -208,9 +207,9 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sl.finish()
         ss = root.sub("starter")
         torque = ss.number("torque", "torque", 0.0, ge=0.0)
-        noload = Named(ss.number("noload_speed", "speed", 1.0, gt=0.0), "noload_speed")
-        cutout = ss.number("cutout_speed", "speed", noload, gt=0.0, le=noload)
-        noload = noload.value
+        noload = ss.number("noload_speed", "speed", 1.0, gt=0.0)
+        cutout = ss.number("cutout_speed", "speed", Named(noload, "noload_speed"), gt=0.0,
+                           le=Named(noload, "noload_speed"))
         sections["starter"] = Starter(torque, noload, cutout)
         ss.finish()
         sgv = root.sub("governor")
@@ -406,11 +405,10 @@ def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, flo
     for name in ("p_intake", "p_exhaust"):
         written = next((k for k in s.data if _unsuffixed(k) == name), None)
         if written is not None:
-            raise SceneError(s.key(written), "a two-stroke cycle (mechanism.strokes = "
-                                                     "2) has no intake or exhaust stroke: it is "
-                                                     "scavenged to p_a at bottom dead centre; "
-                                                     "leave p_intake and p_exhaust out (they "
-                                                     "are for strokes = 4)")
+            raise SceneError(s.key(written), "a two-stroke cycle (mechanism.strokes = 2) has "
+                                             "no intake or exhaust stroke: it is scavenged to "
+                                             "p_a at bottom dead centre; leave p_intake and "
+                                             "p_exhaust out (they are for strokes = 4)")
     return 0.0, 0.0
 
 

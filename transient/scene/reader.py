@@ -67,7 +67,7 @@ def _bounds(gt=None, ge=None, lt=None, le=None) -> tuple[tuple[str, Any], ...]:
 
 
 def _why(default: Any) -> str:
-    """Why a key is required, if its default says (a :class:`Named` one)."""
+    """Why a key is required, if its default says (a :class:`~transient.units.Named` one)."""
     return f" ({default.name})" if isinstance(default, Named) else ""
 
 
@@ -78,6 +78,7 @@ def _shown(bound: Any, factor: float = 1.0) -> str:
     if not isinstance(bound, Named) or bound.name.startswith(text):  # ("0 with a …")
         return bound.name if isinstance(bound, Named) else text
     return f"{bound.name} = {text}"
+
 
 #: TOML integers are unbounded; one past a float's range could not be compared or converted.
 MAX_EXACT_INT = int(1.7976931348623157e308)
@@ -145,9 +146,9 @@ class Section:
 
     def number(self, name: str, kind: str, default: Any = MISSING, *, gt: Any = None,
                ge: Any = None, lt: Any = None, le: Any = None, or_zero: bool = False) -> float:
-        """A number of quantity ``kind`` (:data:`transient.units.UNITS`) in SI; the bounds (plain
-        or :class:`Named`) are in SI, and with ``or_zero`` 0 is allowed besides them (it turns
-        something off)."""
+        """A number of quantity ``kind`` (:data:`transient.units.UNITS`) in SI; the bounds
+        (plain or :class:`~transient.units.Named`) are in SI, and with ``or_zero`` 0 is allowed
+        besides them (it turns something off)."""
         self._ask("number", name, kind, default, _bounds(gt, ge, lt, le), or_zero=or_zero)
         value, factor, written = self._take(name, kind)
         if value is MISSING:
@@ -181,7 +182,7 @@ class Section:
 
     def integer(self, name: str, default: Any = MISSING, *, ge: Any = None,
                 choices: tuple[int, ...] | None = None, le: Any = None) -> int:
-        """A whole number; the bounds plain or :class:`Named`."""
+        """A whole number; the bounds plain or :class:`~transient.units.Named`."""
         self._ask("integer", name, None, default, _bounds(ge=ge, le=le), choices)
         value, _, written = self._take(name, None)
         if value is MISSING:
