@@ -178,7 +178,8 @@ class SceneKeys(SphinxDirective):
                 variants = frozenset()
             out.setdefault(variants, []).append(row)
         groups = sorted(out.items(), key=lambda kv: bool(kv[0]))  # (always first; stable)
-        return [(_when(v), rows) for v, rows in groups]
+        choices = {r.name: r.key.choices for r in table.rows if r.key.choices}
+        return [(_when(v, choices), rows) for v, rows in groups]
 
     def key_table(self, table, rows, caption: str | None) -> nodes.table:
         body = [self.key_row(table, row) for row in rows]
@@ -236,6 +237,7 @@ class SceneKeys(SphinxDirective):
         """What the reader allows, in words: the bounds (another key's by its name, linked),
         the choices, or the kind of value."""
         from transient.scene.keyref import shown_value
+        from transient.units import Named
 
         key = row.key
         if key.choices:
@@ -245,8 +247,8 @@ class SceneKeys(SphinxDirective):
                     nodes.literal(shown_value(c, None), shown_value(c, None))]
             return out
         kind = key.kind if key.type in ("number", "numbers") else None
-        parts = []
-        for word, bound in key.bounds:
+        parts = []  # (the plain bounds first, then those another key's value sets)
+        for word, bound in sorted(key.bounds, key=lambda wb: isinstance(wb[1], Named)):
             parts.append([nodes.Text(f"{word} ")] + self.bound(table, bound, kind))
         text = {"number": "a number", "numbers": "a list of numbers", "integer": "a whole number",
                 "integers": "a list of whole numbers", "flag": "true or false",
@@ -331,15 +333,25 @@ def _row(cells: list[list]) -> nodes.row:
     return row
 
 
-def _when(variants: frozenset) -> str | None:
-    """``{'model = "a"', 'model = "b"'}`` → ``model = "a" or "b"``."""
+def _when(variants: frozenset, choices: dict[str, tuple]) -> str | None:
+    """``{'model = "a"', 'model = "b"'}`` → ``model = "a" or "b"``; all choices of the key but
+    one or a few → ``model ≠ "none"``, ``model not "none" nor "compressor"``."""
     if not variants:
         return None
     by_key: dict[str, list[str]] = {}
     for v in sorted(variants):
         key, _, value = v.partition(" = ")
         by_key.setdefault(key, []).append(value)
-    return "; ".join(f"{key} = {' or '.join(values)}" for key, values in by_key.items())
+    out = []
+    for key, values in by_key.items():
+        others = [f'"{c}"' for c in choices.get(key, ()) if f'"{c}"' not in values]
+        if len(others) == 1 and len(values) > 1:
+            out.append(f"{key} ≠ {others[0]}")
+        elif others and len(others) < len(values):
+            out.append(f"{key} not {' nor '.join(others)}")
+        else:
+            out.append(f"{key} = {' or '.join(values)}")
+    return "; ".join(out)
 
 
 def _is_prose(named) -> bool:

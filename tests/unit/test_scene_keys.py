@@ -16,8 +16,9 @@ import pytest
 
 from transient.errors import SceneError
 from transient.scene import Scene, scene_from_dict
-from transient.scene.keyref import collect, shown_value, table_path
-from transient.units import SUFFIXES, UNITS, Named, value_of
+from transient.scene.keyref import collect, shown_value, table_at
+from transient.scene.reader import Section
+from transient.units import UNITS, Named, value_of
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 SCENES = [(p.stem, tomllib.loads(p.read_text(encoding="utf-8")), p.parent)
@@ -123,22 +124,12 @@ def bounds():
                     yield pytest.param(row, word, value, id=name)
 
 
-def _table_at(data: dict, path: str) -> dict:
-    node = data
-    for part in [p for p in path.split(".") if p]:
-        name, _, index = part.partition("[")
-        node = node.setdefault(name, [] if index else {})
-        if index:
-            node = node[int(index[:-1])]
-    return node
-
-
 def with_value(row, value) -> tuple[dict, str]:
     """The row's example scene with its key set to ``value`` (SI, written without a suffix;
     a list key: its first entry), and the key's full name."""
     ex = row.example
     data = copy.deepcopy(ex.data)
-    table = _table_at(data, ex.path)
+    table = table_at(data, ex.path)
     current = case_value(row)
     for spelling in [row.name] + [f"{row.name}_{s}" for s in row.suffixes]:
         table.pop(spelling, None)
@@ -151,7 +142,7 @@ def with_value(row, value) -> tuple[dict, str]:
 def case_value(row):
     """The key's value in its example scene, in SI (a list for a list key), or its default
     there; None if it has neither."""
-    table = _table_at(copy.deepcopy(row.example.data), row.example.path)
+    table = table_at(copy.deepcopy(row.example.data), row.example.path)
     for spelling, factor in [(row.name, 1.0)] + [(f"{row.name}_{s}", f)
                                                  for s, f in row.suffixes.items()]:
         if spelling in table:
@@ -251,12 +242,13 @@ def test_defaults_are_shown_in_the_unit_a_scene_writes(value, kind, shown):
     assert shown_value(value, kind) == shown
 
 
-def test_a_dimensional_number_names_its_unit_where_it_is_read():
-    """Every number of the reference has a kind of :data:`UNITS`; those with suffixes take
-    them (``_mm``), the others none."""
-    for table in REF.tables.values():
-        for row in table.rows:
-            if row.key.type in ("number", "numbers"):
-                assert row.kinds and set(row.kinds) <= set(UNITS), (table.path, row.name)
-                assert row.suffixes == SUFFIXES.get(row.kinds[0], {})
-    assert table_path("friction.pairs[3]") == "friction.pairs[]"
+def test_a_number_without_a_known_unit_is_refused_where_it_is_read():
+    """Every number the reader takes names its quantity kind, so that its unit is known where
+    it is read (:data:`transient.units.UNITS`): a call without one is a programming error,
+    raised before the key is read."""
+    with pytest.raises(ValueError, match="unknown quantity kind 'furlongs'"):
+        Section({"x": 1.0}, "t").number("x", "furlongs")
+    with pytest.raises(ValueError, match="unknown quantity kind None"):
+        Section({"x": [1.0]}, "t").numbers("x", None)
+    with pytest.raises(TypeError):
+        Section({"x": 1.0}, "t").number("x")  # (no kind)

@@ -79,10 +79,14 @@ class Row:
 
     name: str
     key: Key
-    variants: set[str] = field(default_factory=set)
+    contexts: set[tuple[str | None, str]] = field(default_factory=set)  # (mechanism, choice)
     example: Example | None = None
     kinds: list[str] = field(default_factory=list)
-    contexts: set[tuple[str | None, str]] = field(default_factory=set)  # (mechanism, variant)
+
+    @property
+    def variants(self) -> set[str]:
+        """The choices of its table under which it is read so ("": whatever the choice)."""
+        return {variant for _, variant in self.contexts}
 
     @property
     def required(self) -> bool:
@@ -153,7 +157,6 @@ class Recorder:
 
     def __init__(self) -> None:
         self.tables: dict[tuple[str, str | None], Table] = {}
-        self.problems: list[str] = []
         self.selectors: dict[str, dict[str, tuple]] = {}  # path → choice key → its choices
         self._read: tuple[str, dict, Path, bool] | None = None
         self._family: str | None = None
@@ -176,7 +179,6 @@ class Recorder:
         if row is None:
             row = Row(key.name, key)
             table.rows.append(row)
-        row.variants.add(variant)
         row.contexts.add((self._family, variant))
         if key.kind not in row.kinds:
             row.kinds.append(key.kind)
@@ -209,10 +211,10 @@ class Recorder:
                 value = _placeholder(key)
                 if value is None:
                     return
-                _table_at(data, path)[key.name] = value
+                table_at(data, path)[key.name] = value
 
     def reference(self) -> Reference:
-        problems = list(self.problems)
+        problems = []
         for table in self.tables.values():
             by_variant: dict[tuple, list[Row]] = {}
             for row in table.rows:
@@ -239,15 +241,13 @@ def collect(scenes: Iterable[tuple[str, dict, Path]]) -> Reference:
     rec = Recorder()
     with listening(rec.hear):
         for case, data, base_dir in scenes:
-            rec.read(case, data, base_dir)
-        for case, data, base_dir in scenes:
             rec.selectors.clear()
             rec.read(case, data, base_dir)
             for path, choices in list(rec.selectors.items()):
                 for name, values in choices.items():
                     for value in values:
                         variant = copy.deepcopy(data)
-                        _table_at(variant, path)[name] = value
+                        table_at(variant, path)[name] = value
                         rec.read(case, variant, base_dir, varied=True)
             for table, replacement in EXTRA_TABLES:
                 variant = copy.deepcopy(data)
@@ -281,7 +281,7 @@ def _hashable(x: Any) -> Any:
     return x
 
 
-def _table_at(data: dict, path: str) -> dict:
+def table_at(data: dict, path: str) -> dict:
     """The dict of the table at ``path`` (``friction.pairs[0]``) in parsed TOML, made if
     absent."""
     node = data

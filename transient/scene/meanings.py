@@ -126,7 +126,7 @@ MEANINGS: dict[str, dict[str, str]] = {
         "fan": "Fan-law load torque, ``fan``·ω\\|ω\\| (resisting).",
         "generator_power": "Electrical power P drawn by a generator: torque P/ω (resisting).",
         "generator_min_speed": "Below this speed the generator's torque is held at "
-                               "P/ω_min; > 0 with a generator.",
+                               "P/ω_min (finite at rest).",
         "schedule_time": "Times of the load schedule's points (not with "
                          "``schedule_revolutions``).",
         "schedule_revolutions": "Shaft revolutions from the start of the load schedule's "
