@@ -135,8 +135,8 @@ class SceneKeys(SphinxDirective):
         return section
 
     def record(self, table):
-        """"Held in :class:`Record`": where the table's keys go, the record's docstring
-        the equations behind them."""
+        """"Read into :class:`Record`": where the table's keys go, whose docstring gives the
+        equations behind them (None for a table no record class of its own holds)."""
         from transient.mechanisms import MECHANISMS
 
         if table.family is not None:
