@@ -184,7 +184,7 @@ class SceneKeys(SphinxDirective):
     def key_table(self, table, rows, caption: str | None) -> nodes.table:
         body = [self.key_row(table, row) for row in rows]
         grid = self.grid(["key", "meaning", "unit", "default", "allowed"],
-                         [19, 37, 13, 14, 17], body)
+                         [17, 35, 15, 15, 18], body)
         if caption:
             heading = nodes.title(caption, "read when ", nodes.literal(caption, caption))
             self.set_source_info(heading)
