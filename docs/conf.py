@@ -75,7 +75,7 @@ html_theme_options = {
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
 }
-html_sidebars = {"changelog": [], "performance": [], "validation": []}
+html_sidebars = {"changelog": [], "performance": [], "validation": [], "guide/scene_keys": []}
 
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3

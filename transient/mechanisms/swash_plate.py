@@ -43,7 +43,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from math import asin, cos, degrees, pi, sin
+from math import asin, cos, degrees, inf, pi, sin
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
@@ -54,6 +54,7 @@ from ..core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH, SWASH
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
+from ..units import Named
 from .twins import KernelTwin
 
 if TYPE_CHECKING:
@@ -65,6 +66,41 @@ HINGES = {"normal": (0.0, (0.0, 0.0, 1.0)), "in-plane": (pi / 2.0, (0.0, 1.0, 0.
 
 #: Cylinders at most (a scene check: every per-cylinder array is sized by it).
 MAX_CYLINDERS = 64
+
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
+KEY_MEANINGS = {
+    "mechanism": {
+        "swash": "Swash angle α: tilt of the plate from the plane normal to the shaft.",
+        "joint_radius": "Radius R of the circle of the rods' joints B on link 9.",
+        "rod_length": "Rod length ℓ between its spherical joints B and D; it must bridge the "
+                      "joints' largest lateral offset over a turn.",
+        "cylinder_radius": "Radius r₁ of the circle of the cylinder axes.",
+        "cylinders": "Cylinders z per half, evenly spaced around the shaft.",
+        "bore": "Cylinder bore.",
+        "halves": "1, or 2 for the opposed-piston engine with the mirror half (two pistons per "
+                  "cylinder).",
+        "hinge": "Housing hinge of cross 13: ``in-plane`` (along Oy, as the paper's text) or "
+                 "``normal`` (along Oz, as its printed equation (1)).",
+        "piston_mass": "Mass of one piston.",
+        "link_inertia": "Moment of inertia of an isotropic link 9 (instead of the polar and "
+                        "diametral ones).",
+        "link_polar_inertia": "Link 9's moment of inertia about the plate normal (with "
+                              "``link_diametral_inertia``).",
+        "link_diametral_inertia": "Link 9's moment of inertia about a diameter in the plate "
+                                  "plane (with ``link_polar_inertia``).",
+        "cross_inertia": "Moment of inertia I₁₃ of cross 13 about its housing hinge.",
+        "rod": "The rods (``[mechanism.rod]``).",
+    },
+    "mechanism.rod": {
+        "model": "``two-mass``: masses at the joints; ``rigid``: a rigid body with its moment "
+                 "of inertia.",
+        "mass": "Mass of one rod.",
+        "cg_from_pin": "Distance from the piston joint D to the rod's centre of mass.",
+        "inertia_cg": "Moment of inertia of a rod about its centre of mass, across its axis "
+                      "(``rigid``).",
+    },
+}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -134,6 +170,8 @@ class SwashPlate:
     kind = SWASH_PLATE
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
+    cylinder_count = "mechanism.cylinders"
+    key_meanings = KEY_MEANINGS
     #: Its pistons do not follow the crank-slider's law, from which the analyses derive W_k.
     slider_law = False
     #: Two-stroke: one gas pulse per cylinder and turn.
@@ -230,18 +268,23 @@ class SwashPlate:
         reports its canonical keys (angles as ``*_deg``, everything else by its SI name), which
         are mapped here.
         """
-        swash = s.number("swash", "angle")
+        swash = s.number("swash", "angle", gt=0.0, lt=pi / 4.0)
         R = s.number("joint_radius", "length", gt=0.0)
-        r1 = s.number("cylinder_radius", "length", gt=0.0)
         ell = s.number("rod_length", "length", gt=0.0)
-        bore = s.number("bore", "length", gt=0.0)
+        # (B's distance from the axis swings over R cos α … R: a rod of ℓ must reach the axis)
+        r1 = s.number("cylinder_radius", "length",
+                      gt=Named(max(R - ell, 0.0), "max(joint_radius − rod_length, 0)"),
+                      lt=Named(R * cos(swash) + ell, "joint_radius · cos(swash) + rod_length"))
         z = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
+        gap = Named(2.0 * r1 * sin(pi / z) if z > 1 else inf,  # (cylinders must not overlap)
+                    "2 · cylinder_radius · sin(180°/cylinders) (cylinders > 1)")
+        bore = s.number("bore", "length", gt=0.0, lt=gap)
         halves = s.integer("halves", 1, choices=(1, 2))
         hinge = s.string("hinge", "in-plane", choices=tuple(HINGES))
-        piston_mass = s.number("piston_mass", ge=0.0)
-        iso = s.number("link_inertia", default=None, ge=0.0)
-        polar = s.number("link_polar_inertia", default=None, ge=0.0)
-        diametral = s.number("link_diametral_inertia", default=None, ge=0.0)
+        piston_mass = s.number("piston_mass", "mass", ge=0.0)
+        iso = s.number("link_inertia", "inertia", None, ge=0.0)
+        polar = s.number("link_polar_inertia", "inertia", None, ge=0.0)
+        diametral = s.number("link_diametral_inertia", "inertia", None, ge=0.0)
         if iso is not None:
             if polar is not None or diametral is not None:
                 raise SceneError(s.key("link_inertia"),
@@ -259,15 +302,16 @@ class SwashPlate:
                     raise SceneError(s.key(key), "is missing; link_polar_inertia and "
                                                  "link_diametral_inertia go together (or give "
                                                  "link_inertia alone for an isotropic link 9)")
-        cross = s.number("cross_inertia", default=0.0, ge=0.0)
+        cross = s.number("cross_inertia", "inertia", 0.0, ge=0.0)
         rod = s.sub("rod", required=True)
         model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
         mech = cls(
             swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell, bore=bore,
             cylinders=z, halves=halves, hinge=hinge, piston_mass=piston_mass, rod_model=model,
-            rod_mass=rod.number("mass", ge=0.0),
-            rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0),
-            rod_inertia_cg=(rod.number("inertia_cg", default=0.0, ge=0.0) if model == "rigid"
+            rod_mass=rod.number("mass", "mass", ge=0.0),
+            rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0,
+                                       le=Named(ell, "rod_length")),
+            rod_inertia_cg=(rod.number("inertia_cg", "inertia", 0.0, ge=0.0) if model == "rigid"
                             else 0.0),
             link_polar_inertia=polar, link_diametral_inertia=diametral, cross_inertia=cross)
         rod.finish()
