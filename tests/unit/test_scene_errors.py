@@ -528,7 +528,7 @@ SWASH_CASES = [
     ("rod_length_mm = 300", "rod_length_mm = 5", "mechanism.rod.cg_from_pin_mm",
      "must be ≤ rod_length = 5, got 150"),
     ("cylinder_radius_mm = 131.31", "cylinder_radius_mm = 500", "mechanism.cylinder_radius_mm",
-     "must be < joint_radius · cos(swash) + rod_length = 426.624, got 500"),
+     "must be < the largest r₁ whose pistons turn at their dead centres only = 405.943, got 500"),
     ("cylinders = 4", "cylinders = 0", "mechanism.cylinders", "must be ≥ 1"),
 ]
 
