@@ -75,7 +75,7 @@ html_theme_options = {
     "show_toc_level": 2,
     "secondary_sidebar_items": ["page-toc"],
 }
-html_sidebars = {"changelog": [], "performance": [], "validation": []}
+html_sidebars = {"changelog": [], "performance": [], "validation": [], "guide/scene_keys": []}
 
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
@@ -108,6 +108,7 @@ sphinx_gallery_conf = {
     "remove_config_comments": True,
     "matplotlib_animations": False,
     "image_scrapers": ("matplotlib",),
+    "image_srcset": ["2x"],  # (a second image at twice the dpi: sharp on high-density screens)
     "within_subsection_order": "FileNameSortKey",
     # The API pages of the public names list the examples that use them (``minigallery``).
     "doc_module": ("transient",),
@@ -116,3 +117,7 @@ sphinx_gallery_conf = {
 
 # Results, scenes and benchmark records are read from the repository, never from elsewhere.
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+# The guide's pictures and a first run's output, made in the build from the model's own code
+# (_ext/guide_figures.py), and the landing page's cards.
+extensions += ["sphinx_design", "guide_figures"]

@@ -28,7 +28,7 @@ for k in (1, 2):
           f"recovery {res.analysis[p + 'recovery_s'][0]:.3f} s, "
           f"steady change {res.analysis[p + 'droop_pct'][0]:+.2f} %")
 
-fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
-plots.load_response(axes, res.trajectory, scene.mechanism.cycle, res.analysis)
+fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True, layout="constrained")
+plots.load_response(axes, res.trajectory, scene, res.analysis)
 axes[0].set_title("Load acceptance and rejection")
 plt.show()

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 import transient
 from transient.analysis.orders import order_spectrum, to_angle_grid
@@ -55,10 +56,12 @@ for index, colour in ((1, "C0"), (3, "C1")):
           f"{np.max(np.abs(amplitude / estimate - 1)):.3f}")
 print(f"order 2 (firing), last cycle: {abs(speed.coef[-1, 4]):.2f} rad/s")
 ax.set_xlabel("engine cycle")
+ax.xaxis.set_major_locator(MaxNLocator(integer=True))
 ax.set_ylabel("amplitude of ω [rad/s]")
 ax.grid(True, alpha=0.3)
 ax.legend()
-ax.set_title("Half orders of the speed: cylinder 2 at 80 %, cylinder 3 misfires every 10th cycle")
+ax.set_title("Half orders of the speed\n"
+             "cylinder 2 at 80 % fuel, cylinder 3 misfires every 10th cycle", fontsize=10)
 plt.show()
 
 # %%
@@ -70,7 +73,7 @@ run_indicator_phi(ax, result, scene, cylinders=[3], cycles=(-2, -1), table=full,
                   motored=motored)
 run_indicator_phi(ax, result, scene, cylinders=[2], cycles=(-1,))
 ax.set_xlim(270, 480)
-ax.set_title("A misfire on the motored curve, 80 % fuel between it and full load")
+ax.set_title("A misfire on the motored curve,\n80 % fuel between it and full load", fontsize=10)
 phi = df["phi"].to_numpy()
 for k, c in ((3, -2), (3, -1), (2, -1)):
     a = own_cycles(scene, result.trajectory, k)[c]

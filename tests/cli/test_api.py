@@ -127,7 +127,8 @@ def test_plot_helpers_take_a_result(small):
     (line,) = plots.speed(a, res)
     (same,) = plots.speed(b, res.trajectory)
     assert np.array_equal(line.get_ydata(), same.get_ydata())
-    assert np.array_equal(line.get_ydata(), res.trajectory["omega"] * 30.0 / np.pi)
+    np.testing.assert_allclose(line.get_ydata(), res.trajectory["omega"] * 30.0 / np.pi,
+                               rtol=1e-15)
     plt.close(fig)
 
 

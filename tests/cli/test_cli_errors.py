@@ -59,3 +59,27 @@ def test_every_command_reports_a_missing_file_in_one_line(tmp_path, capsys, argv
     assert len(captured.err.splitlines()) == 1 and str(missing) in captured.err
     assert "Traceback" not in captured.err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_reader_that_stops_reading_ends_the_command_without_a_traceback(tmp_path):
+    """``transient info … | head -1``: the command ends as ``cat`` ends when its reader closes
+    the pipe (exit 128 + SIGPIPE), with nothing on standard error."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import transient
+
+    scene = transient.load_scene(Path(__file__).resolve().parents[2] / "cases"
+                                 / "coasting_single.toml").replace(run={"revolutions": 5})
+    transient.simulate(scene, tmp_path / "r.h5")
+    command = [sys.executable, "-c", "from transient.cli import entry; entry()", "info",
+               str(tmp_path / "r.h5")]
+    read, write = os.pipe()
+    os.close(read)  # (the reader gone before the first line: every write meets a closed pipe)
+    try:
+        done = subprocess.run(command, stdout=write, stderr=subprocess.PIPE, timeout=120)
+    finally:
+        os.close(write)
+    assert (done.returncode, done.stderr.decode()) == (cli.EXIT_BROKEN_PIPE, "")

@@ -221,7 +221,10 @@ def test_scene_round_trip_and_defaults():
     ("slave_rod_length_mm = 238", "slave_rod_length_mm = [238, 238, 50, 238]",
      "mechanism.slave_rod_length_mm", "slave rod 3 (50 mm) is too short for its cylinder at 216°"),
     ("link_radius_mm = 75", "link_radius_mm = 320",
-     "mechanism.link_radius_mm", "link pin 1 at 320 mm is outside the master rod; allowed 0 ≤ r_i"),
+     "mechanism.link_radius_mm", "must be < rod_length = 313, got 320"),
+    ("cg_from_pin_mm = 131", "cg_from_pin_mm = 240",
+     "mechanism.slave_rod.cg_from_pin_mm",
+     "must be ≤ the shortest slave_rod_length = 238, got 240"),
     ("link_radius_mm = 75\n", "",  # r_i from (7): 316 mm for l_i = 10 mm, beyond the rod
      "mechanism.slave_rod_length_mm", ""),
     ("link_radius_mm = 75\nslave_rod_length_mm = 238\n", "",
@@ -230,7 +233,8 @@ def test_scene_round_trip_and_defaults():
      "mechanism.link_angle_deg", "has 1 entries; must have one per slave cylinder (4)"),
 ])
 def test_bad_geometry_exits_2_with_one_line(tmp_path, capsys, old, new, key, message):
-    text = SCENE.replace(old, new)
+    # (a slave rod's centre of mass on the shortest slave rod, read before the rods' reach)
+    text = SCENE.replace(old, new).replace("cg_from_pin_mm = 131", "cg_from_pin_mm = 5")
     if not message:  # r_i omitted is fine (7): make the r_i it gives impossible
         text = text.replace("slave_rod_length_mm = 238", "slave_rod_length_mm = 10")
         message = "is outside the master rod; allowed 0 ≤ r_i < l = 313 mm (link_radius from"

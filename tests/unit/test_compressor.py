@@ -167,10 +167,10 @@ def refused(tmp_path, capsys, text, key, fragment):
 
 @pytest.mark.parametrize("old, new, key, fragment", [
     ("p_discharge_bar = 8", "p_discharge_bar = 0.5", "gas.p_discharge_bar",
-     "it must be finite and above p_suction = 100000.0 Pa"),
+     "must be > p_suction = 1, got 0.5"),
     ("n = 1.3", "n = 1", "gas.n", "must be > 1"),
     ("clearance_ratio = 0.05", "clearance_ratio = 0.4", "gas.clearance_ratio",
-     "so the compressor delivers nothing"),
+     "must be < 1/((p_discharge/p_suction)^(1/min(n, n_reexpansion)) − 1) = "),
     ("clearance_ratio = 0.05", "clearance_ratio = -0.05", "gas.clearance_ratio", "must be > 0"),
     ("strokes = 2\n", "", "gas.model", "the mechanism's cycle is 720° (strokes = 4)"),
     ("n = 1.3", "n = 1.3\ninjection_deg = 10", "gas.injection_deg", "unknown key; allowed here:"),

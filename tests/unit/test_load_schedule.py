@@ -122,7 +122,8 @@ ERRORS = [
     ("power-suffix", "generator_power_kW = 20", "load.generator_power_kW",
      "unknown unit suffix '_kW'; give 'generator_power'"),
     ("generator-without-min-speed", "generator_power = 1e3", "load.generator_min_speed",
-     "is missing with a generator_power: below it the torque −P/ω is held at −P/ω_min"),
+     "is missing (required with a generator_power, else 0); give 'generator_min_speed' or "
+     "'generator_min_speed_rpm'"),
     ("generator-min-speed-zero", "generator_power = 1e3\ngenerator_min_speed_rpm = 0",
      "load.generator_min_speed_rpm", "must be > 0 with a generator_power"),
     ("min-speed-negative", "generator_min_speed = -1", "load.generator_min_speed",

@@ -17,7 +17,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from transient import plots, simulate  # noqa: E402
-from transient.analysis.irregularity import fluctuation  # noqa: E402
+from transient.analysis.irregularity import cycle_boundaries, fluctuation  # noqa: E402
 from transient.scene import Initial, Output, Run, load_scene  # noqa: E402
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -57,9 +57,15 @@ def test_speed_over_cycle_marks_the_summarys_delta(result):
     tr = res.trajectory
     fig, ax = plt.subplots()
     artists = plots.speed_over_cycle(ax, res, scene)
-    text = next(a for a in artists if isinstance(a, matplotlib.text.Text) and "δ" in a.get_text())
+    marks = next(a for a in artists if a.get_label().startswith("δ"))
     delta = fluctuation(tr["t"], tr["phi"], tr["omega"], scene.mechanism.cycle, scene.initial.phi)
-    assert text.get_text().strip() == f"δ = {delta:.4g}"
+    assert marks.get_label().startswith(f"δ = {delta:.4g} ")
+    # the marks are the last whole cycle's extremes (its samples; the run ends on its end)
+    _, ends = cycle_boundaries(tr["t"], tr["phi"], scene.mechanism.cycle, scene.initial.phi)
+    inside = (tr["phi"] >= ends[-2]) & (tr["phi"] <= ends[-1])
+    np.testing.assert_allclose(marks.get_ydata(), [tr["omega"][inside].max() * 30.0 / math.pi,
+                                                   tr["omega"][inside].min() * 30.0 / math.pi],
+                               rtol=1e-15)
     plt.close(fig)
 
 

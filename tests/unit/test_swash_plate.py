@@ -272,3 +272,44 @@ def test_validate_accepts_the_example_and_reports_user_units():
         sp.antonyuk_example(swash_angle=np.radians(50.0)).validate()
     with pytest.raises(SceneError, match="mm"):
         sp.antonyuk_example(rod_length=0.005).validate()
+
+
+def test_cylinder_radius_is_bounded_where_the_pistons_turn_at_their_dead_centres_only():
+    """Near a rod's full reach it toggles and the piston turns back between its dead centres:
+    the A/C compressor's r₁ = 102.7 mm (inside the reach limit R cos α + ℓ = 103.09 mm) gave
+    cylinder 1 a volume below its clearance and the compressor cycle a non-finite table. The
+    reader's bound stops short of that; inside it, sampled 20 times finer than the bound's own
+    search, every piston turns twice a turn and cylinder 1's volume never falls below V(0);
+    beyond it a piston turns back."""
+    import dataclasses
+    from pathlib import Path
+
+    from transient.scene import load_scene
+
+    case = Path(__file__).resolve().parents[2] / "cases" / "ac_compressor_7cyl.toml"
+    mech = load_scene(case).mechanism
+    low, high = sp.dead_centre_limits(mech.swash_angle, mech.joint_radius, mech.rod_length,
+                                      mech.cylinders, mech.hinge)
+    reach = mech.joint_radius * np.cos(mech.swash_angle) + mech.rod_length
+    assert low == 0.0 and 0.09 < high < 0.1027 < reach
+    phi = np.linspace(0.0, 2.0 * np.pi, 20 * sp.TRAVEL_SAMPLES)
+
+    def turns(r1):
+        geom = dataclasses.replace(mech, cylinder_radius=r1)
+        return sp.travel_turns(sp._points(geom._pack(), phi)[2][..., 0]), geom
+
+    # (the bound is where the search's grid first sees a piston turn back; the finer grid
+    # sees it within about 1e-7 of r₁ of there, a dip of 1e-9 of the stroke)
+    inside, geom = turns(high * (1.0 - 1e-6))
+    assert np.all(inside == 2)
+    volume = geom.volume_function(1e-6)(phi)
+    assert volume.min() >= 1e-6 * (1.0 - 1e-9)
+    beyond, _ = turns(high + 1e-3 * (reach - high))
+    assert np.any(beyond > 2)
+    text = case.read_text(encoding="utf-8").replace("cylinder_radius_mm = ",
+                                                    "cylinder_radius_mm = 102.7  # ", 1)
+    with pytest.raises(SceneError) as refused:
+        load_scene("c.toml", text=text)
+    assert refused.value.key == "mechanism.cylinder_radius_mm"
+    assert refused.value.message.startswith("must be < the largest r₁ whose pistons turn at "
+                                            "their dead centres only")

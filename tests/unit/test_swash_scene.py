@@ -162,8 +162,10 @@ BAD = [
     (dict(drop=["swash_deg"], swash=0.0), "mechanism.swash"),
     (dict(drop=["swash_deg"]), "mechanism.swash"),  # missing
     # A rod too short for the lateral offset (9.4 mm), and lengths ≤ 0.
-    (dict(rod_length_mm=5), "mechanism.rod_length_mm"),
-    (dict(drop=["rod_length_mm"], rod_length=0.005), "mechanism.rod_length"),
+    (dict(rod_length_mm=5, rod={"cg_from_pin_mm": 2}), "mechanism.rod_length_mm"),
+    (dict(drop=["rod_length_mm"], rod_length=0.005, rod={"cg_from_pin_mm": 2}),
+     "mechanism.rod_length"),
+    (dict(rod_length_mm=5), "mechanism.rod.cg_from_pin_mm"),  # (≤ rod_length, read first)
     (dict(rod_length_mm=0), "mechanism.rod_length_mm"),
     # r₁ that the rods cannot reach, or a negative one.
     (dict(cylinder_radius_mm=450), "mechanism.cylinder_radius_mm"),
@@ -207,11 +209,11 @@ def test_reader_rejects_with_the_key_as_written(change, key):
 
 
 def test_validate_messages_survive_the_key_mapping():
-    with pytest.raises(SceneError, match="50°") as info:
+    with pytest.raises(SceneError, match="must be < 45, got 50") as info:
         read(changed(swash_deg=50))
     assert info.value.key == "mechanism.swash_deg"
     with pytest.raises(SceneError, match="too short") as info:
-        read(changed(rod_length_mm=5))
+        read(changed(rod_length_mm=5, rod={"cg_from_pin_mm": 2}))
     assert info.value.key == "mechanism.rod_length_mm"
 
 

@@ -378,7 +378,7 @@ REFUSED = [  # cylinders, crank lines, the key as written, what the message says
      "does not apply: fork-and-blade rods are both in the throw's middle plane"),
     (4, V4 + SIDE + "\nrod_spacing_mm = 20", "mechanism.journal_spacing", "is missing"),
     (4, V4 + SIDE + "\nrod_spacing_mm = 120\njournal_spacing_mm = 110", "mechanism.rod_spacing_mm",
-     "less than the journal spacing (110 mm)"),
+     "must be < journal_spacing = 110, got 120"),
     (8, V8_LINES.replace(str(list(V8_ORDER)), "[1, 2, 3, 4, 5, 6, 7, 8]"),
      "mechanism.firing_order", "does not fit the crank: cylinder 4 cannot fire after cylinder 3"),
     (2, TWIN_FORK_LINES + "\nfiring_deg = [0, 100]", "mechanism.firing_deg",

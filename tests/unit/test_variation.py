@@ -138,7 +138,7 @@ def test_resolved_scene_reads_back_equal(scene):
 
 
 BAD = [
-    ({"cylinder": 5}, "gas.cylinders[0].cylinder", "must be ≤ 4"),
+    ({"cylinder": 5}, "gas.cylinders[0].cylinder", "must be ≤ mechanism.cylinders = 4"),
     ({"cylinder": 0}, "gas.cylinders[0].cylinder", "must be ≥ 1"),
     ({"cylinder": 1, "fuel": 2.5}, "gas.cylinders[0].fuel", "must be ≤ 2"),
     ({"cylinder": 1, "fuel": -0.1}, "gas.cylinders[0].fuel", "must be ≥ 0"),

@@ -35,6 +35,25 @@ def cycle_means(t, phi, cycle, phi0):
     return cycle / np.diff(tb), tb[1:]
 
 
+def cycle_extremes(t, values, bounds) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Least and greatest of a sampled quantity over each of the time windows between
+    consecutive ``bounds`` (the n + 1 times of :func:`cycle_boundaries`): the samples inside
+    and the values interpolated at the window's ends, so that a window between two samples
+    still has both. Returns two arrays of n."""
+    t, values, bounds = (np.asarray(a, dtype=float) for a in (t, values, bounds))
+    ends = np.interp(bounds, t, values)
+    lo = np.minimum(ends[:-1], ends[1:])
+    hi = np.maximum(ends[:-1], ends[1:])
+    first = np.searchsorted(t, bounds, side="left")  # the first sample at or after each bound
+    last = np.searchsorted(t, bounds, side="right")  # one past the last at or before it
+    for i in range(lo.size):
+        inside = values[first[i]:last[i + 1]]
+        if inside.size:
+            lo[i] = min(lo[i], inside.min())
+            hi[i] = max(hi[i], inside.max())
+    return lo, hi
+
+
 def steady_state_time(means, ends, rtol: float = 1e-4, cycles: int = 3) -> float:
     """End time of the first cycle after which the cycle-mean speed changes by < rtol for
     ``cycles`` cycles in a row; NaN if the run never settles."""

@@ -87,6 +87,18 @@ from .loads.crank_slider import slider_arrays
 #: up to rounding).
 _ORDER_TOL = 1e-9
 
+#: A run is a run-up (or a run-down) when its cycle-mean speeds span at least this fraction of
+#: the highest, and :data:`RUN_UP_CYCLES` cycles or more lie inside the span: its orders are
+#: then read against speed (waterfall over speed, Campbell chart, order tracks). Below it the
+#: speed hardly sweeps (a steady run, a load step, a misfire pattern: a tenth or less in the
+#: shipped cases) and a speed axis would only sort the cycles by their small differences; the
+#: run-ups shipped span a quarter and more.
+RUN_UP_SPAN = 0.2
+#: Cycles a run-up must have inside its span (their mean speeds more than a tenth of the span
+#: from either end): a machine that is up to speed within its first cycle or two samples no
+#: speed between, and its Campbell chart would be two columns.
+RUN_UP_CYCLES = 4
+
 
 # ------------------------------------------------------------------------------------------------
 # Resampling onto a crank-angle grid
@@ -494,6 +506,18 @@ def resolve_detrend(mode: str, initial_omega: float, final_omega: float) -> str:
     if mode != "auto":
         return mode
     return "ramp" if is_spin_up(initial_omega, final_omega) else "none"
+
+
+def is_run_up(omega_mean: ArrayLike) -> bool:
+    """Whether cycle-mean speeds ``omega_mean`` sweep enough of the speed range, in enough
+    cycles, to be read against speed: max − min ≥ :data:`RUN_UP_SPAN` · max, with
+    :data:`RUN_UP_CYCLES` of them inside the span."""
+    w = np.asarray(omega_mean, dtype=float)
+    if w.size < 2:
+        return False
+    span = float(np.ptp(w))
+    inside = np.count_nonzero((w > w.min() + 0.1 * span) & (w < w.max() - 0.1 * span))
+    return bool(span >= RUN_UP_SPAN * np.max(np.abs(w)) and inside >= RUN_UP_CYCLES)
 
 
 def cycle_spectra(traj: Mapping[str, NDArray[np.float64]], name: str, samples_per_cycle: int,

@@ -512,6 +512,62 @@ def own_cycles(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int
     return cycle_marks(phi, scene.mechanism.cycle, begin)[:-1]
 
 
+def own_cycle_numbers(scene, cylinder: int, starts: ArrayLike) -> NDArray[np.int64]:
+    """The numbers of ``cylinder``'s (1-based) own cycles that begin at the shaft angles
+    ``starts`` (:func:`own_cycles`), as ``[[gas.cylinders]]`` counts them for its misfires: 1
+    the cycle in progress at the initial angle (:func:`transient.assemble.variation_fields`)."""
+    from ..assemble import variation_fields
+    from ..scene.queries import gas_phases
+    from ..core.model.variation import START
+
+    first = variation_fields(scene, gas_phases(scene))["var_par"][cylinder - 1, START]
+    return np.rint((np.asarray(starts, dtype=float) - first) / scene.mechanism.cycle
+                   ).astype(np.int64) + 1
+
+
+def cycle_fuel_of(scene):
+    """``fuel(cylinder, φ)``: the fuel factor [1] the run applied in the cylinder's (1-based)
+    own cycle that the shaft angle φ lies in, and whether that cylinder is cut out for the whole
+    run: ``(factor, cut_out)``; ``[[gas.cylinders]]`` sets them (its factor, 0 in a misfiring
+    cycle). Every cycle of a scene without such entries burns full fuel, (1, False)."""
+    if not scene.gas.cylinders:
+        return lambda cylinder, phi: (1.0, False)
+    from ..assemble import build_model
+    from ..core.model.variation import FUEL, cycle_fuel
+
+    model = build_model(scene)[0]
+    return lambda cylinder, phi: (float(cycle_fuel(model, cylinder - 1, phi)),
+                                  bool(model.var_par[cylinder - 1, FUEL] == 0.0))
+
+
+def misfires(scene, traj: Mapping[str, NDArray[np.float64]]
+             ) -> list[tuple[int, int, float]]:
+    """The misfires of a run: (cylinder, its cycle's number, time of that cycle's firing TDC
+    [s]) for every own cycle that the run reaches the firing TDC of and that burned no fuel
+    though its cylinder is not cut out; in time order."""
+    from ..scene.queries import cycle_begin, gas_phases
+
+    if not scene.gas.cylinders:
+        return []
+    fuel = cycle_fuel_of(scene)
+    part = _increasing_part(traj)
+    phi, t = np.asarray(traj["phi"], float)[part], np.asarray(traj["t"], float)[part]
+    mech = scene.mechanism
+    to_firing = 2.0 * math.pi - cycle_begin(mech)  # from a cycle's first angle to its firing TDC
+    out = []
+    for entry in scene.gas.cylinders:
+        k = entry.cylinder
+        begin = float(gas_phases(scene)[k - 1]) + cycle_begin(mech)
+        j0 = math.ceil((phi[0] - to_firing - begin) / mech.cycle)
+        j1 = math.floor((phi[-1] - to_firing - begin) / mech.cycle)
+        starts = begin + mech.cycle * np.arange(j0, j1 + 1)
+        for a, n in zip(starts, own_cycle_numbers(scene, k, starts)):
+            f, cut = fuel(k, a + 0.5 * mech.cycle)
+            if f == 0.0 and not cut:
+                out.append((k, int(n), float(np.interp(a + to_firing, phi, t))))
+    return sorted(out, key=lambda m: m[2])
+
+
 def local_angle(scene, phi: ArrayLike, start: float) -> NDArray[np.float64]:
     """A cylinder's local angle (as its gas table counts it) at the shaft angles ``phi`` of its
     own cycle that begins at ``start`` (:func:`own_cycles`), increasing through the whole cycle

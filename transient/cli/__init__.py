@@ -31,6 +31,10 @@ _COMMANDS = (run.register, plot.register, kinematics.register, verify.register_b
              efficiency.register, loads.register, orders.register, verify.register_stress,
              sweep.register)
 
+#: The exit code of a command whose reader closed its standard output: 128 + SIGPIPE, as a
+#: shell reports ``cat`` ended by the signal.
+EXIT_BROKEN_PIPE = 128 + 13
+
 #: One example of each command, in the order ``transient --help`` lists them: the end of
 #: ``transient --help`` lists them all, and each command's own help ends with its own.
 EXAMPLES = {
@@ -57,8 +61,16 @@ def entry() -> None:
 
     Before exiting, every live object is frozen out of the garbage collector: the interpreter's
     final collections would otherwise walk numba's type system, a large part of a short run.
-    Files are closed by then; reference counting still tears the modules down."""
-    code = main()
+    Files are closed by then; reference counting still tears the modules down.
+
+    A reader that stops reading (``transient info … | head``) ends the command as it ends
+    ``cat``: exit 128 + SIGPIPE, no traceback; standard output goes to the null device, so that
+    the interpreter's final flush does not raise again."""
+    try:
+        code = main()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        code = EXIT_BROKEN_PIPE
     gc.freeze()
     if _BROKEN_WRITE is not None:
         sys.stdout.flush()

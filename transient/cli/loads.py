@@ -74,46 +74,9 @@ def _crank_slider_loads(args, res, scene) -> int:
     k = args.cylinder - 1
     out = output_folder(args.output, res.path.parent)
     stem = result_stem(res.path)
-    plt = pyplot()
-
-    from .. import plots
-
-    written = []
-    best = d.most_loaded
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5.5), squeeze=False)
-    plots.polar_load(axes[0, 0], d.crankpin_x, d.crankpin_y)
-    axes[0, 0].set_xlabel("R_T = T + T_rш [kN] (direction of rotation)")
-    axes[0, 0].set_ylabel("−R_K = −(K + K_rш) [kN] (crank outward)")
-    axes[0, 0].set_title(f"{_pin(mech, k)}, crank frame", fontsize=9)
-    plots.polar_load(axes[0, 1], d.journal_x, d.journal_y)
-    axes[0, 1].set_xlabel("R_x [kN] (along T₁, direction of rotation)")
-    axes[0, 1].set_ylabel("−R_y [kN] (crank 1 outward)")
-    axes[0, 1].set_title(f"main journal {best + 1} (the most loaded), frame of crank 1 "
-                         f"(split beam, (58))", fontsize=9)
-    fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle")
-    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force, res))
-
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    for j in range(n_cyl):
-        plots.load_against_angle(ax, deg, loads.R[j], label=_pin(mech, j))
-    ax.legend(fontsize=8)
-    ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
-    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force, res))
-
+    written = [save(fig, out / f"{stem}_{name}.png", args.force, res)
+               for name, fig in crank_slider_figures(scene, d)]
     rays, sums = d.crankpin_wear
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5.5), squeeze=False)
-    plots.wear_diagram(axes[0, 0], rays, sums)
-    axes[0, 0].set_title(f"{_pin(mech, k)} (frame of its polar diagram)", fontsize=9)
-    plots.wear_diagram(axes[0, 1], *d.journal_wear)
-    axes[0, 1].set_title(f"main journal {best + 1} (frame of crank 1)", fontsize=9)
-    fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6: each load wears ±60° around its "
-                 f"direction)", fontsize=10)
-    written.append(save(fig, out / f"{stem}_loads_wear.png", args.force, res))
-
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
-    ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
-    written.append(save(fig, out / f"{stem}_loads_running_torques.png", args.force, res))
 
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
@@ -166,6 +129,69 @@ def _crank_slider_loads(args, res, scene) -> int:
     return EXIT_OK
 
 
+def crank_slider_figures(scene, d):
+    """The figures ``transient loads`` draws of a crank-slider run's diagrams ``d``
+    (:func:`~transient.analysis.loads.diagrams.crank_slider_diagrams`): (name, figure) pairs,
+    each saved as ``<stem>_<name>.png``."""
+    from .. import plots
+    from ..analysis.loads.diagrams import dead_centres
+
+    plt = pyplot()
+    mech = scene.mechanism
+    k, best, deg = d.cylinder - 1, d.most_loaded, d.window.angle_deg
+    fig, axes = plt.subplots(1, 2, figsize=(13, 7), layout="constrained")
+    plots.polar_load(axes[0], d.crankpin_x, d.crankpin_y, angle_deg=deg,
+                     dead_centres=dead_centres(scene, d.window, d.cylinder), legend=False,
+                     title=f"{_pin(mech, k)}, crank frame; TDCs of cylinder {d.cylinder}")
+    axes[0].set_xlabel("R_T = T + T_rod [kN] (direction of rotation)")
+    axes[0].set_ylabel("−R_K = −(K + K_rod) [kN] (crank outward)")
+    plots.polar_load(axes[1], d.journal_x, d.journal_y, angle_deg=deg,
+                     dead_centres=dead_centres(scene, d.window, 1), legend=False,
+                     title=f"main journal {best + 1} (the most loaded), frame of crank 1 "
+                           f"(split beam, (58)); TDCs of cylinder 1")
+    axes[1].set_xlabel("R_x [kN] (along T₁, direction of rotation)")
+    axes[1].set_ylabel("−R_y [kN] (crank 1 outward)")
+    _polar_legend(fig, axes[0])
+    fig.suptitle(f"{scene.name}: polar load diagrams over the last cycle (angles: crank angle "
+                 f"in the cycle)")
+    yield "loads_polar", fig
+
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    for j in range(mech.n_cylinders):
+        plots.load_against_angle(ax, deg, d.loads.R[j], label=_pin(mech, j),
+                                 style=plots.cylinder_style(j + 1))
+    plots.legend_outside(ax)
+    ax.set_title(f"{scene.name}: crankpin load |R| over the last cycle (dashed: mean)")
+    yield "loads_crankpin", fig
+
+    fig, axes = plt.subplots(1, 2, figsize=(12, 6.5), layout="constrained",
+                             subplot_kw={"projection": "polar"})
+    for ax, (rays, sums), words in (
+            (axes[0], d.crankpin_wear, f"{_pin(mech, k)}: its crank frame, 0° the direction "
+                                       f"of rotation, 90° the crank outward"),
+            (axes[1], d.journal_wear, f"main journal {best + 1}: the frame of crank 1")):
+        plots.wear_diagram(ax, rays, sums / d.wear_weight)
+        ax.set_title(words, fontsize=9)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2,
+               fontsize=8)
+    fig.suptitle(f"{scene.name}: wear diagrams (Gots §2.6): each ray's load, the cycle mean of "
+                 f"the loads within ±60° of it [kN], drawn inward from the rim", fontsize=10)
+    yield "loads_wear", fig
+
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    plots.running_torque_curves(ax, deg, d.journal_torques, d.crankpin_torques)
+    ax.set_title(f"{scene.name}: running torques over the last cycle (Gots §2.8)")
+    yield "loads_running_torques", fig
+
+
+def _polar_legend(fig, ax):
+    """One legend below the polar diagrams, which share their marks, from ``ax``'s (the dead
+    centres named without their angles, which differ from diagram to diagram)."""
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, [label.split(" (")[0] if "TDC" in label else label for label in labels],
+               loc="outside lower center", ncol=len(labels), fontsize=8)
+
+
 def _pin(mech, k: int) -> str:
     """Where cylinder k's (0-based) rod bears: its crankpin, or a crankpin two rods share."""
     if mech.cylinders_per_throw == 1:
@@ -177,7 +203,6 @@ def _radial_loads(args, res, scene) -> int:
     """``transient loads`` of an articulated engine: each row's master crankpin in its crank
     frame (polar), the crankpin and link-pin loads over the last cycle, and a CSV; main journals
     and running torques do not apply."""
-    from .. import plots
     from ..analysis.loads.diagrams import articulated_diagrams
 
     mech = scene.mechanism
@@ -186,22 +211,8 @@ def _radial_loads(args, res, scene) -> int:
     rows, n_links = loads.R.shape[0], loads.link_x.shape[0]
     out = output_folder(args.output, res.path.parent)
     stem = result_stem(res.path)
-    plt = pyplot()
-    written = []
-    fig, axes = plt.subplots(1, rows, figsize=(6 * rows, 5.5), squeeze=False)
-    for j in range(rows):
-        plots.crankpin_polar(axes[0, j], loads.R_K[j], loads.R_T[j])
-        axes[0, j].set_title(f"master crankpin of row {j + 1}, crank frame", fontsize=9)
-    fig.suptitle(f"{scene.name}: polar load diagram over the last cycle")
-    written.append(save(fig, out / f"{stem}_loads_polar.png", args.force, res))
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    for j in range(rows):
-        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin, row {j + 1}")
-    for i in range(n_links):
-        plots.load_against_angle(ax, deg, d.link_load[i], label=f"link pin {i + 1}")
-    ax.legend(fontsize=8)
-    ax.set_title(f"{scene.name}: crankpin and link-pin loads over the last cycle (dashed: mean)")
-    written.append(save(fig, out / f"{stem}_loads_crankpin.png", args.force, res))
+    written = [save(fig, out / f"{stem}_{name}.png", args.force, res)
+               for name, fig in articulated_figures(scene, d)]
     cols = {"t_s": win["t"], "phi_rad": win["phi"], "cycle_angle_deg": deg,
             "omega_rad_s": win["omega"], "epsilon_rad_s2": win["epsilon"]}
     for k in range(loads.P.shape[0]):
@@ -228,6 +239,41 @@ def _radial_loads(args, res, scene) -> int:
     for path in written:
         print(f"  wrote {path}")
     return EXIT_OK
+
+
+def articulated_figures(scene, d):
+    """The figures ``transient loads`` draws of an articulated run's diagrams ``d``
+    (:func:`~transient.analysis.loads.diagrams.articulated_diagrams`): (name, figure)
+    pairs."""
+    from .. import plots
+    from ..analysis.loads.diagrams import dead_centres
+
+    plt = pyplot()
+    loads, deg = d.loads, d.window.angle_deg
+    rows, n_links = loads.R.shape[0], loads.link_x.shape[0]
+    per_row = scene.mechanism.n_cylinders // rows
+    fig, axes = plt.subplots(1, rows, figsize=(7.5 * rows, 6.5), squeeze=False,
+                             layout="constrained")
+    for j in range(rows):
+        plots.crankpin_polar(axes[0, j], loads.R_K[j], loads.R_T[j], angle_deg=deg,
+                             dead_centres=dead_centres(scene, d.window, j * per_row + 1),
+                             legend=False,
+                             title=f"master crankpin of row {j + 1}, crank frame; TDCs of its "
+                                   f"master cylinder {j * per_row + 1}")
+    _polar_legend(fig, axes[0, 0])
+    fig.suptitle(f"{scene.name}: polar load diagram over the last cycle (angles: crank angle "
+                 f"in the cycle)")
+    yield "loads_polar", fig
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    for j in range(rows):
+        plots.load_against_angle(ax, deg, loads.R[j], label=f"crankpin, row {j + 1}",
+                                 style={"color": "k", "ls": plots.DASHES[j % len(plots.DASHES)]})
+    for i in range(n_links):
+        plots.load_against_angle(ax, deg, d.link_load[i], label=f"link pin {i + 1}",
+                                 style=plots.cylinder_style(i + 1))
+    plots.legend_outside(ax)
+    ax.set_title(f"{scene.name}: crankpin and link-pin loads over the last cycle (dashed: mean)")
+    yield "loads_crankpin", fig
 
 
 #: What ``transient loads`` draws, by the mechanism's name in

@@ -18,8 +18,9 @@ def register(sub) -> None:
                     "the gas torque M_gas and each cylinder's, and the piston acceleration of "
                     "one cylinder (any mechanism) against the same engine at constant mean "
                     "speed (odd-harmonic report); δ of the last cycle; with two or more whole "
-                    "cycles, a run-up waterfall (a colour map), a Campbell chart and order "
-                    "tracks of ω against the cycle-mean speed. Results are written as files "
+                    "cycles, for a run-up a waterfall (a colour map), a Campbell chart and "
+                    "order tracks of ω against the cycle-mean speed, for any other run the "
+                    "waterfall and order tracks cycle by cycle. Results are written as files "
                     "into DIR, never into the HDF5 result (read only here).")
     od.add_argument("result")
     od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
@@ -36,6 +37,126 @@ def register(sub) -> None:
                          "acceleration (default 1)")
     add_force(od)
     od.set_defaults(func=cmd_orders)
+
+
+def figures(res, ro, top: float, cylinder: int):
+    """The figures ``transient orders`` writes of the result ``res`` and its order spectra
+    ``ro`` (:func:`transient.analysis.orders.run_orders`), orders up to ``top``, the piston of
+    ``cylinder``: (name, figure) pairs, each saved as ``<stem>_<name>.png``. With two or more
+    whole cycles, ``orders_runup`` for a run-up (:func:`~transient.analysis.orders.is_run_up`),
+    else ``orders_cycles``, the cycles in the order they ran."""
+    plt = pyplot()
+
+    from .. import plots
+    from ..analysis.orders import is_run_up, strongest_orders
+
+    scene = res.scene()
+    spec_w, spec_m, rep, per_cyl = ro.omega, ro.gas_torque, ro.piston, ro.cylinder_torques
+    means, orders, rpm = ro.omega_mean, ro.orders, plots.RPM
+    rows = 1 + (spec_m is not None) + (rep is not None) + (per_cyl is not None)
+    fig, axes = plt.subplots(rows, 1, figsize=(10, 3.2 * rows), squeeze=False)
+    axes = axes[:, 0]
+    plots.order_bars(axes[0], orders, spec_w.amplitude[-1], "ω amplitude [rad/s]", top)
+    axes[0].set_title(f"{scene.name}: orders over the last cycle (mean ω "
+                      f"{means[-1] * rpm:.5g} rpm, δ = {ro.delta:.4g}"
+                      f"{', detrended' if ro.detrend == 'ramp' else ''})", fontsize=10)
+    i = 1
+    if spec_m is not None:
+        plots.order_bars(axes[i], orders, spec_m.amplitude[-1], "M_gas amplitude [N m]", top)
+        i += 1
+    if per_cyl is not None:
+        z = per_cyl.coef.shape[0]
+        width = 0.8 * float(orders[1]) / z
+        for k in range(z):
+            plots.order_bars(axes[i], orders, per_cyl.amplitude[k], "cylinder torque [N m]",
+                             top, width=width, offset=(k - (z - 1) / 2) * width,
+                             label=f"cylinder {k + 1}", color=f"C{k % 10}")
+        plots.legend_outside(axes[i], above=True, ncol=min(z, 8))
+        i += 1
+    if rep is not None:
+        label = f"W / W₁ (cylinder {cylinder})"
+        floors = _relative_floors(scene, orders)
+        plots.order_bars(axes[i], orders, rep.relative[-1], label, top, width=0.2, offset=-0.1,
+                         label="run", log=True, floor=floors["run"][0])
+        plots.order_bars(axes[i], orders, rep.relative_constant[-1], label, top, width=0.2,
+                         offset=0.1, label="constant ω̄", log=True,
+                         floor=floors["constant"][0])
+        for (level, words), colour in zip(floors.values(), ("C0", "C1")):
+            plots.noise_floor(axes[i], level, words, color=colour)
+        axes[i].set_ylim(bottom=0.3 * min(level for level, _ in floors.values()))
+        plots.legend_outside(axes[i], above=True, ncol=2)
+    yield "orders", fig
+
+    if ro.cycles < 2:
+        return
+    amp = spec_w.amplitude
+    # the last cycle's strongest orders, in order of the order
+    tracks = {f"order {orders[j]:g}": amp[:, j]
+              for j in sorted(strongest_orders(orders, amp[-1], top))}
+    level = RUN_FLOOR_RTOL * scene.solver.rtol * float(np.mean(means))
+    floor = (level, f"noise floor: {RUN_FLOOR_RTOL:g} × rtol · ω̄ = {level:.2g} rad/s")
+    if is_run_up(means):
+        fig, (a1, a3, a2) = plt.subplots(1, 3, figsize=(20, 5.5), layout="constrained")
+        plots.order_waterfall(a1, means * rpm, orders, amp, top, label="ω amplitude [rad/s]")
+        a1.set_title(f"ω spectrum per cycle ({ro.cycles} cycles) over speed", fontsize=9)
+        plots.campbell(a3, means * rpm, orders, amp, top, label="ω amplitude [rad/s]")
+        a3.set_title("Campbell chart of ω: orders over speed", fontsize=9)
+        plots.order_tracks(a2, means * rpm, tracks, "ω amplitude [rad/s]", floor=floor)
+        a2.set_title("order tracks of ω against the cycle-mean speed", fontsize=9)
+        fig.suptitle(f"{scene.name}: run-up orders of ω (cycle-mean speed "
+                     f"{means.min() * rpm:.0f} … {means.max() * rpm:.0f} rpm)")
+        yield "orders_runup", fig
+        return
+    cycles = np.arange(1, ro.cycles + 1)
+    fig = plt.figure(figsize=(16, 7), layout="constrained")
+    left, right = fig.subfigures(1, 2, width_ratios=(1.0, 1.3))
+    a1 = left.subplots()
+    plots.order_waterfall_cycles(a1, cycles, orders, amp, top, label="ω amplitude [rad/s]")
+    a1.set_title(f"ω spectrum of each cycle ({ro.cycles} cycles)", fontsize=9)
+    a2, a3 = right.subplots(2, 1, sharex=True, height_ratios=(2.0, 1.0))
+    plots.order_tracks(a2, cycles, tracks, "ω amplitude [rad/s]", xlabel="", floor=floor)
+    a2.set_title("order tracks of ω, cycle by cycle", fontsize=9)
+    a3.plot(cycles, means * rpm, lw=1.0, marker="." if cycles.size <= 60 else None, color="k")
+    a3.set_xlabel("cycle of the run")
+    a3.set_ylabel("cycle-mean ω [rpm]")
+    a3.grid(True, alpha=0.3)
+    _mark_cycles((a2, a3), res, scene, ro)
+    fig.suptitle(f"{scene.name}: orders of ω, cycle by cycle (cycle-mean speed "
+                 f"{means.min() * rpm:.0f} … {means.max() * rpm:.0f} rpm)")
+    yield "orders_cycles", fig
+
+
+#: The run's noise floor in solver tolerances: the error the solver leaves in ω and ε (and the
+#: resampling onto the angle grid adds) is a few times its local tolerance rtol; a cross-plane
+#: V8's half orders of W/W₁, nought in exact arithmetic, come out at about 2·rtol.
+RUN_FLOOR_RTOL = 10.0
+
+
+def _relative_floors(scene, orders) -> dict[str, tuple[float, str]]:
+    """Noise floors of the piston acceleration's orders relative to its first: the run's,
+    :data:`RUN_FLOOR_RTOL` times the solver's relative tolerance; the same engine's at constant
+    ω̄ (computed in closed form, no solver), the rounding of an N-point DFT, N·ε_mach."""
+    n = 2 * (len(orders) - 1)
+    run = RUN_FLOOR_RTOL * scene.solver.rtol
+    return {"run": (run, f"run: {RUN_FLOOR_RTOL:g} × solver rtol = {run:.0e}"),
+            "constant": (n * np.finfo(float).eps, f"constant ω̄: rounding, N·ε = "
+                                                   f"{n * np.finfo(float).eps:.0e}")}
+
+
+def _mark_cycles(axes, res, scene, ro):
+    """The run's events (:func:`transient.plots.run_events`) on axes over the cycle number:
+    each at the cycle it happened in."""
+    from .. import plots
+    from ..analysis.irregularity import cycle_boundaries
+
+    tb, marks = cycle_boundaries(res.trajectory["t"], res.trajectory["phi"],
+                                 scene.mechanism.cycle, scene.initial.phi)
+    first = int(np.argmin(np.abs(marks - ro.cycle_start[0])))  # the bound of cycle 1
+    events = [(kind, words, np.searchsorted(tb[first:], times, side="right").astype(float))
+              for kind, words, times in plots.run_events(res, scene)]
+    handles = plots.mark_events(axes, events, ro.cycles)
+    if handles:
+        plots.legend_outside(axes[1], handles=handles)
 
 
 def cmd_orders(args) -> int:
@@ -86,53 +207,10 @@ def cmd_orders(args) -> int:
     write_columns(csv, cols_csv, args.force)
     written.append(csv)
 
-    plt = pyplot()
-
-    from .. import plots
-
-    rows = 1 + (spec_m is not None) + (rep is not None) + (per_cyl is not None)
-    fig, axes = plt.subplots(rows, 1, figsize=(9, 3.2 * rows), squeeze=False)
-    axes = axes[:, 0]
-    plots.order_bars(axes[0], orders, spec_w.amplitude[-1], "ω amplitude [rad/s]", top)
-    axes[0].set_title(f"{scene.name}: orders over the last cycle (mean ω "
-                      f"{means[-1] * rpm:.5g} rpm, δ = {ro.delta:.4g}"
-                      f"{', detrended' if detrend == 'ramp' else ''})", fontsize=10)
-    i = 1
-    if spec_m is not None:
-        plots.order_bars(axes[i], orders, spec_m.amplitude[-1], "M_gas amplitude [N m]", top)
-        i += 1
-    if per_cyl is not None:
-        z = per_cyl.coef.shape[0]
-        width = 0.8 * float(orders[1]) / z
-        for k in range(z):
-            plots.order_bars(axes[i], orders, per_cyl.amplitude[k], "cylinder torque [N m]",
-                             top, width=width, offset=(k - (z - 1) / 2) * width,
-                             label=f"cylinder {k + 1}")
-        axes[i].legend(fontsize=7, ncol=min(z, 6))
-        i += 1
-    if rep is not None:
-        label = f"W / W₁ (cylinder {k_w})"
-        plots.order_bars(axes[i], orders, rep.relative[-1], label, top,
-                         width=0.2, offset=-0.1, label="run", log=True)
-        plots.order_bars(axes[i], orders, rep.relative_constant[-1], label, top,
-                         width=0.2, offset=0.1, label="constant ω̄", log=True)
-        axes[i].legend(fontsize=8)
-    written.append(save(fig, out / f"{stem}_orders.png", args.force, res))
-
+    for name, fig in figures(res, ro, top, args.cylinder):
+        written.append(save(fig, out / f"{stem}_{name}.png", args.force, res))
     if n_cyc >= 2:
         amp = spec_w.amplitude
-        fig, (a1, a3, a2) = plt.subplots(1, 3, figsize=(19, 5.5))
-        plots.order_waterfall(a1, means * rpm, orders, amp, top, label="ω amplitude [rad/s]")
-        a1.set_title(f"ω spectrum per cycle ({n_cyc} cycles)", fontsize=9)
-        plots.campbell(a3, means * rpm, orders, amp, top, label="ω amplitude [rad/s]")
-        a3.set_title("Campbell chart of ω: orders over speed", fontsize=9)
-        # the last cycle's strongest orders, in order of the order
-        tracks = {f"order {orders[j]:g}": amp[:, j]
-                  for j in sorted(strongest_orders(orders, amp[-1], top))}
-        plots.order_tracks(a2, means * rpm, tracks, "ω amplitude [rad/s]")
-        a2.set_title("order tracks of ω against the cycle-mean speed", fontsize=9)
-        fig.suptitle(f"{scene.name}: run-up orders of ω")
-        written.append(save(fig, out / f"{stem}_orders_runup.png", args.force, res))
         run = {"cycle": np.arange(1, n_cyc + 1), "cycle_start_rad": starts,
                "cycle_omega_mean_rad_s": means}
         run.update({f"omega_order_{orders[j]:g}_rad_s": amp[:, j]

@@ -20,6 +20,25 @@ def register(sub) -> None:
 
 
 def cmd_plot(args) -> int:
+    if len(args.result) > 1:
+        return _plot_comparison(args)
+    res = read_result(args.result[0])
+    scene = res.scene()
+    out = output_folder(args.output, res.path.parent)
+    stem = result_stem(res.path)
+    held = _check_choices(args, scene, res)
+    written = [save(fig, out / f"{stem}_{name}.png", args.force, res)
+               for name, fig in figures(res, args.cylinder, args.cycles, held)]
+    for w in written:
+        print(f"wrote {w}")
+    return EXIT_OK
+
+
+def figures(res, cylinders=None, cycles=None, held=None):
+    """The figures ``transient plot`` writes of the result ``res``, as (name, figure) pairs in
+    the order written (each saved as ``<stem>_<name>.png``): ``cylinders`` and ``cycles`` those
+    of the indicator diagrams (None: all cylinders, the last cycle); ``held`` the whole cycles
+    of their own those cylinders hold (as ``_check_choices`` counts them; None: counted here)."""
     plt = pyplot()
 
     from .. import plots
@@ -27,34 +46,29 @@ def cmd_plot(args) -> int:
 
     from ..scene.queries import gas_is_force, gas_tables
 
-    if len(args.result) > 1:
-        return _plot_comparison(args)
-    res = read_result(args.result[0])
     scene = res.scene()
-    out = output_folder(args.output, res.path.parent)
-    stem = result_stem(res.path)
     traj = res.trajectory
-    held = _check_choices(args, scene, res)
-    written = []
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-    plots.speed(a1, traj)
-    plots.acceleration(a2, traj)
+    cycles = cycles or [-1]
+    if held is None:
+        held = _held(scene, res, cylinders)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    plots.speed_over_run((a1, a2), res, scene)
     a1.set_title(f"{scene.name}: speed and acceleration")
-    written.append(save(fig, out / f"{stem}_speed.png", args.force, res))
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    yield "speed", fig
+    fig, ax = plt.subplots(figsize=(9, 4.5))
     plots.torques(ax, traj, scene.mechanism.cycle)
     ax.set_title(f"{scene.name}: moments over the last cycle")
-    written.append(save(fig, out / f"{stem}_torques.png", args.force, res))
+    yield "torques", fig
     if "load_change_1_t_s" in res.analysis:
-        fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
-        plots.load_response(axes, traj, scene.mechanism.cycle, res.analysis)
+        fig, axes = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+        plots.load_response(axes, traj, scene, res.analysis)
         axes[0].set_title(f"{scene.name}: load steps (ISO 8528-5 band around the new speed)")
-        written.append(save(fig, out / f"{stem}_response.png", args.force, res))
+        yield "response", fig
     if scene.friction.pairs:
-        fig, ax = plt.subplots(figsize=(8, 4.5))
+        fig, ax = plt.subplots(figsize=(9, 4.5))
         plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)
         ax.set_title(f"{scene.name}: power through the non-ideal pairs ({scene.friction.policy})")
-        written.append(save(fig, out / f"{stem}_pairs.png", args.force, res))
+        yield "pairs", fig
     if "fmep_1" in res.analysis:  # the friction budget of the steady cycles
         names = [p.name for p in scene.friction.pairs]
         labels, suffixes = ["steady cycles"], [""]
@@ -62,52 +76,52 @@ def cmd_plot(args) -> int:
             n = scene.mechanism.n_cylinders
             labels = ["engine"] + [f"cylinder {c + 1}" for c in range(n)]
             suffixes += [f"_cyl{c + 1}" for c in range(n)]
-        fig, ax = plt.subplots(figsize=(4 + 0.8 * len(labels), 4.5))
+        fig, ax = plt.subplots(figsize=(5 + 0.8 * len(labels), 4.5))
         # (a pair every cylinder loads has no share per cylinder: the engine's bar alone)
         plots.friction_budget(ax, labels, [res.analysis.get(f"fmep_{k + 1}{s}", (0.0,))[0]
                                            for k in range(len(names)) for s in suffixes], names)
-        ax.set_title(f"{scene.name}: FMEP per pair (η_mech = "
+        ax.set_title(f"{scene.name}\nFMEP per pair (η_mech = "
                      f"{res.analysis['eta_mech_work'][0]:.4f})")
-        written.append(save(fig, out / f"{stem}_budget.png", args.force, res))
+        yield "budget", fig
     whole = _has_whole_cycle(scene, traj)
     if whole:
-        fig, ax = plt.subplots(figsize=(8, 4.5))
+        fig, ax = plt.subplots(figsize=(9, 4.5))
         plots.speed_over_cycle(ax, traj, scene)
         ax.set_title(f"{scene.name}: speed over the last cycle")
-        written.append(save(fig, out / f"{stem}_speed_cycle.png", args.force, res))
-        fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+        yield "speed_cycle", fig
+        fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
         plots.inertia_and_gas((a1, a2), traj, scene.mechanism.cycle)
         a1.set_title(f"{scene.name}: J(φ) and the inertia moment ½J′ω² beside the gas torque")
-        written.append(save(fig, out / f"{stem}_inertia.png", args.force, res))
+        yield "inertia", fig
     if whole and scene.gas.model != "none":
-        fig, ax = plt.subplots(figsize=(8, 4.5))
+        fig, ax = plt.subplots(figsize=(9, 4.5))
         plots.cylinder_torque_curves(ax, traj, scene)
         ax.set_title(f"{scene.name}: each cylinder's gas torque over the last cycle")
-        written.append(save(fig, out / f"{stem}_cylinder_torques.png", args.force, res))
+        yield "cylinder_torques", fig
     table, motored = gas_tables(scene)
     if table is not None and not gas_is_force(scene) and held:
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.8))
-        plots.run_indicator_phi(a1, traj, scene, args.cylinder, args.cycles or [-1],
-                                table=table, motored=motored)
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5.5), layout="constrained")
+        plots.run_indicator_phi(a1, traj, scene, cylinders, cycles, table=table,
+                                motored=motored, legend=False)
         # a gas table gives no clearance volume: V is then the swept part F_p·s
-        plots.run_indicator_pv(a2, traj, scene, args.cylinder, args.cycles or [-1],
-                               log=scene.gas.model != "table")
+        plots.run_indicator_pv(a2, traj, scene, cylinders, cycles,
+                               log=scene.gas.model != "table", legend=False)
         if scene.gas.model == "table":
             a2.set_xlabel("swept volume F_p·s [dm³]")
-        a1.set_title(f"{scene.name}: indicator diagrams of the run")
-        written.append(save(fig, out / f"{stem}_indicator.png", args.force, res))
+        handles, labels = a1.get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncol=min(3, len(labels)),
+                   fontsize=8)
+        fig.suptitle(f"{scene.name}: indicator diagrams of the run")
+        yield "indicator", fig
     if scene.gas.model == "wiebe" and held:
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        if plots.heat_release(ax, traj, scene, args.cylinder, args.cycles or [-1]):
+        fig, ax = plt.subplots(figsize=(9, 4.5))
+        if plots.heat_release(ax, traj, scene, cylinders, cycles):
             ax.set_xlim(np.degrees(scene.gas.wiebe.start) - 20.0,
                         np.degrees(scene.gas.wiebe.start + scene.gas.wiebe.duration) + 30.0)
             ax.set_title(f"{scene.name}: apparent heat-release rate of the run")
-            written.append(save(fig, out / f"{stem}_heat_release.png", args.force, res))
+            yield "heat_release", fig
         else:
             plt.close(fig)
-    for w in written:
-        print(f"wrote {w}")
-    return EXIT_OK
 
 
 def _has_whole_cycle(scene, traj) -> bool:
@@ -120,15 +134,12 @@ def _has_whole_cycle(scene, traj) -> bool:
 def _check_choices(args, scene, res) -> int:
     """--cylinder and --cycles within what the result holds, before any figure is drawn; returns
     how many whole cycles of their own the cylinders drawn hold (0: no indicator diagram)."""
-    from ..analysis.thermo import own_cycles
-
     n = scene.mechanism.n_cylinders
     for k in args.cylinder or ():
         if not 1 <= k <= n:
             raise SceneError("--cylinder", f"cylinder {k} is out of range; allowed: 1 … {n}",
                              file=str(res.path))
-    held = min(own_cycles(scene, res.trajectory, k).size
-               for k in (args.cylinder or range(1, n + 1)))
+    held = _held(scene, res, args.cylinder)
     if args.cycles is not None:  # (by default the last cycle, or none if there is none)
         for c in args.cycles:
             if not -held <= c < held:
@@ -136,6 +147,14 @@ def _check_choices(args, scene, res) -> int:
                                              f"cycle(s) of the cylinders drawn; allowed "
                                              f"{-held} … {held - 1}", file=str(res.path))
     return held
+
+
+def _held(scene, res, cylinders) -> int:
+    """How many whole cycles of their own ``cylinders`` (None: all) hold, the fewest of them."""
+    from ..analysis.thermo import own_cycles
+
+    return min(own_cycles(scene, res.trajectory, k).size
+               for k in (cylinders or range(1, scene.mechanism.n_cylinders + 1)))
 
 
 def _plot_comparison(args) -> int:
@@ -151,8 +170,8 @@ def _plot_comparison(args) -> int:
     fig, axes = plt.subplots(3, n, figsize=(5 * n, 8), sharex=True, sharey="row", squeeze=False)
     for j, res in enumerate(results):
         scene = res.scene()
-        plots.speed(axes[0, j], res.trajectory)
-        plots.acceleration(axes[1, j], res.trajectory)
+        plots.speed(axes[0, j], res.trajectory, scene=scene)
+        plots.acceleration(axes[1, j], res.trajectory, scene=scene)
         plots.piston_force(axes[2, j], res.trajectory, scene)
         axes[0, j].set_title(f"{scene.name}\n{scene.mechanism.n_cylinders} cylinder(s)", fontsize=9)
     path = out / ("compare_" + "_".join(result_stem(r.path) for r in results) + ".png")

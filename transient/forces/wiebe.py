@@ -259,7 +259,7 @@ def _tabulate(solved: Sequence[_Solved], period: float, step: float, tolerance: 
             continue
         n = max(1, math.ceil((b - a) / step * (1.0 - 1e-12)))
         x = np.linspace(a, b, n + 1)
-        for _ in range(_MAX_REFINE):
+        for attempt in range(_MAX_REFINE):
             h = np.diff(x)
             xm = x[:-1] + 0.5 * h
             piece_coef, piece_err = [], []
@@ -273,8 +273,8 @@ def _tabulate(solved: Sequence[_Solved], period: float, step: float, tolerance: 
                 piece_err.append(e)
                 bad |= e > tolerance
             bad &= h > 2.0 * _MIN_SPACING
-            if not np.any(bad):
-                break
+            if not np.any(bad) or attempt == _MAX_REFINE - 1:
+                break  # (the coefficients fit these knots; the error says what they reach)
             x = np.sort(np.concatenate([x, xm[bad]]))
         knots.append(x)
         for i in range(n_cycles):

@@ -64,6 +64,12 @@ class Mechanism(Protocol):
     #: Whether a scene may give it wall heat transfer (``[gas.woschni]``): the cylinder ODE of
     #: ``transient.core.model.cylinder`` is built for the crank-slider's volume.
     wall_heat_transfer: ClassVar[bool]
+    #: The keys its :attr:`n_cylinders` follows from, as the bounds of per-cylinder keys
+    #: (``[[gas.cylinders]] cylinder``) name them.
+    cylinder_count: ClassVar[str]
+    #: What each key of its ``[mechanism]`` table (``"mechanism"``) and sub-tables
+    #: (``"mechanism.rod"``) means, in a line: key → meaning, for the scene-key reference.
+    key_meanings: ClassVar[dict[str, dict[str, str]]]
     #: Whether every piston follows the crank-slider law s(φ − φ_k) of ``crank_radius``,
     #: ``rod_length`` and ``offset`` (the odd-harmonic report then uses that closed form; other
     #: pistons' s′, s″ come from ``transient.analysis.pistons``, which needs a line for a new

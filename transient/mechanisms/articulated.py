@@ -39,6 +39,7 @@ from ..core.model.layout import ARTICULATED, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
+from ..units import Named
 from .crank_slider import CrankSlider
 from .twins import KernelTwin
 
@@ -49,17 +50,61 @@ if TYPE_CHECKING:
 #: harmonics fall like λ^k, and 512 samples alias order 512 − k onto k).
 SAMPLES = 512
 
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
+KEY_MEANINGS = {
+    "mechanism": {
+        "crank_radius": "Crank radius r, half the master piston's stroke.",
+        "rod_length": "Master rod length l, crankpin to master piston pin; λ = r/l < 1.",
+        "strokes": "Strokes per cycle: 4 (a cycle of 720°) or 2 (360°).",
+        "bank": "Each slave cylinder's axis δ_i from the master cylinder's, in the direction "
+                "of rotation; one per slave.",
+        "link_angle": "Each link pin's angle ψ_i from the master-rod axis; one per slave.",
+        "link_radius": "Each link pin's distance r_i from the crankpin centre (0: central "
+                       "articulation); one number or one per slave; without it, from "
+                       "``slave_rod_length`` by Semenov (6)–(7).",
+        "slave_rod_length": "Each slave rod's length l_i, link pin to piston pin; one number "
+                            "or one per slave; without it, from ``link_radius`` by Semenov "
+                            "(6)–(7); it must reach its cylinder's axis.",
+        "rows": "Rows of cylinders, one crankpin and master rod each.",
+        "row_bank": "Each row's master cylinder axis from row 1's.",
+        "row_crank": "Each row's crankpin from row 1's.",
+        "rod": "The master rod (``[mechanism.rod]``).",
+        "slave_rod": "Every slave rod (``[mechanism.slave_rod]``).",
+        "bore": "Cylinder bore, every cylinder.",
+        "piston_mass": "Mass of each piston group.",
+        "crank_mass": "Unbalanced crank-throw mass reduced to the crank radius, per row.",
+        "firing": "Each cylinder's firing angle, one per cylinder, in [0, cycle).",
+    },
+    "mechanism.rod": {
+        "model": "``two-mass`` or ``rigid``, as the crank-slider's rod; its link pins are part "
+                 "of it.",
+        "mass": "Mass of the master rod.",
+        "cg_from_pin": "Distance from the master piston pin to its centre of mass, along its "
+                       "axis.",
+        "inertia_cg": "Moment of inertia about its centre of mass (``rigid``).",
+    },
+    "mechanism.slave_rod": {
+        "model": "``two-mass`` or ``rigid``, as the master rod.",
+        "mass": "Mass of each slave rod.",
+        "cg_from_pin": "Distance from the slave piston pin to its centre of mass.",
+        "inertia_cg": "Moment of inertia about its centre of mass (``rigid``).",
+    },
+}
 
-def _per_slave(s: Section, name: str, n: int) -> tuple[float, ...] | None:
-    """A length given once for every slave or as a list of one per slave; None if absent."""
+
+def _per_slave(s: Section, name: str, n: int, **bounds) -> tuple[float, ...] | None:
+    """A length given once for every slave or as a list of one per slave, within ``bounds``
+    (:meth:`Section.number`'s); None if absent."""
     raw = next((s.data[k] for k in (name, f"{name}_mm") if k in s.data), None)
+    other = Named(None, "from the other of link_radius, slave_rod_length (Semenov (6)–(7))")
     if isinstance(raw, list):
-        values = s.numbers(name, "length")
+        values = s.numbers(name, "length", other, **bounds)
         if len(values) != n:
             raise s.rename(SceneError(s.key(name), f"has {len(values)} entries; must have one per "
                                                    f"slave cylinder ({n}), or give one number"))
         return values
-    value = s.number(name, "length", None)
+    value = s.number(name, "length", other, **bounds)
     return None if value is None else (value,) * n
 
 
@@ -127,6 +172,8 @@ class Articulated:
     kind = ARTICULATED
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
+    cylinder_count = "mechanism.rows × (1 + the slaves in mechanism.bank)"
+    key_meanings = KEY_MEANINGS
     #: The slave pistons do not follow the crank-slider's law, from which the analyses derive W_k.
     slider_law = False
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, the rods
@@ -219,25 +266,22 @@ class Articulated:
         cylinder).
         """
         r = s.number("crank_radius", "length", gt=0.0)
-        l = s.number("rod_length", "length", gt=0.0)
+        l = s.number("rod_length", "length", gt=Named(r, "crank_radius"))
         strokes_ = s.integer("strokes", 4, choices=(2, 4))
         banks = s.numbers("bank", "angle")
         n = len(banks)
         if n < 1:
             raise s.rename(SceneError(s.key("bank"), "must list at least one slave cylinder"))
-        psi = s.numbers("link_angle", "angle", banks)
+        psi = s.numbers("link_angle", "angle", Named(banks, "bank"))
         if len(psi) != n:
             raise s.rename(SceneError(s.key("link_angle"), f"has {len(psi)} entries; must have one "
                                                            f"per slave cylinder ({n})"))
-        ri = _per_slave(s, "link_radius", n)
-        li = _per_slave(s, "slave_rod_length", n)
+        ri = _per_slave(s, "link_radius", n, ge=0.0, lt=Named(l, "rod_length"))
+        li = _per_slave(s, "slave_rod_length", n, gt=0.0)
         if ri is None and li is None:
             raise SceneError(s.key("link_radius"), "is missing; give link_radius and/or "
                                                    "slave_rod_length (the other follows from "
                                                    "Semenov (6)–(7))")
-        if (ri is None or li is None) and r >= l:
-            raise s.rename(SceneError(s.key("rod_length"), f"must be longer than the crank radius "
-                                                           f"({r * 1e3:g} mm)"))
         if ri is None or li is None:
             dims = [slave_dimensions(r, l, d, None if ri is None else ri[i],
                                      None if li is None else li[i]) for i, d in enumerate(banks)]
@@ -246,28 +290,35 @@ class Articulated:
         else:
             computed = None
         rows = s.integer("rows", 1, ge=1)
-        row_bank = s.numbers("row_bank", "angle", (0.0,) * rows)
-        row_crank = s.numbers("row_crank", "angle", tuple(2 * pi * j / rows for j in range(rows)))
+        row_bank = s.numbers("row_bank", "angle", Named((0.0,) * rows, "0° for every row"))
+        row_crank = s.numbers("row_crank", "angle", Named(
+            tuple(2 * pi * j / rows for j in range(rows)), "360° · (row − 1)/rows"))
         if len(row_bank) != rows:
             raise s.rename(SceneError(s.key("row_bank"), f"has {len(row_bank)} entries; must have "
                                                          f"one per row ({rows})"))
         rods = {}
-        for table in ("rod", "slave_rod"):
+        # (the master rod carries the master piston: a mass; a slave rod may be massless)
+        for table, mass, length in (("rod", {"gt": 0.0}, Named(l, "rod_length")),
+                                    ("slave_rod", {"ge": 0.0},
+                                     Named(min(li), "the shortest slave_rod_length"))):
             rod = s.sub(table, required=True)
             model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
-            rods[table] = dict(model=model, mass=rod.number("mass", ge=0.0),
-                               cg_from_pin=rod.number("cg_from_pin", "length"),
-                               inertia_cg=(rod.number("inertia_cg", default=0.0, ge=0.0)
+            rods[table] = dict(model=model, mass=rod.number("mass", "mass", **mass),
+                               cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0,
+                                                      le=length),
+                               inertia_cg=(rod.number("inertia_cg", "inertia", 0.0, ge=0.0)
                                            if model == "rigid" else 0.0))
             rod.finish()
         mech = cls(
-            crank_radius=r, rod_length=l, bore=s.number("bore", "length"),
-            piston_mass=s.number("piston_mass"), crank_mass=s.number("crank_mass", default=0.0),
+            crank_radius=r, rod_length=l, bore=s.number("bore", "length", gt=0.0),
+            piston_mass=s.number("piston_mass", "mass", gt=0.0),
+            crank_mass=s.number("crank_mass", "mass", 0.0, ge=0.0),
             **{f"rod_{k}": v for k, v in rods["rod"].items()},
             slave_banks=banks, link_angles=psi, link_radii=ri, slave_lengths=li,
             **{f"slave_rod_{k}": v for k, v in rods["slave_rod"].items()},
             strokes=strokes_, row_banks=row_bank, row_cranks=row_crank,
-            firing=s.numbers("firing", "angle", ()))
+            firing=s.numbers("firing", "angle", Named((), "each cylinder's outer dead centre, "
+                                                          "firing evenly (1-3-5-2-4 for five)")))
         try:
             mech.validate()
         except SceneError as exc:

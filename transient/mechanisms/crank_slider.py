@@ -27,6 +27,8 @@ from ..core.model import crank_slider as core
 from ..core.model.layout import CRANK_SLIDER, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..tomlout import toml_value
+from ..units import Named
+from . import throws
 from .throws import ANGLE_TOL, SHARED, SINGLE, equal_angles, read_crank, wrap_angle
 from .twins import CrankSliderNumpy
 
@@ -35,6 +37,32 @@ if TYPE_CHECKING:
 
 #: Cylinders at most (a scene check: every per-cylinder array is sized by it).
 MAX_CYLINDERS = 64
+
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
+KEY_MEANINGS = {
+    "mechanism": {
+        **throws.KEY_MEANINGS,
+        "crank_radius": "Crank radius r, half the stroke.",
+        "rod_length": "Connecting-rod length l between pin centres; λ = r/l < 1.",
+        "strokes": "Strokes per cycle: 4 (a cycle of 720°) or 2 (360°).",
+        "cylinders": "Number of cylinders, all of one geometry.",
+        "firing_order": "The cylinders in the order they fire, each once.",
+        "offset": "Cylinder-axis offset e, positive in the direction of rotation (Gots §1.4).",
+        "rod": "The connecting rod (``[mechanism.rod]``).",
+        "bore": "Cylinder bore D; piston area πD²/4.",
+        "piston_mass": "Mass of the piston group (piston, rings, pin).",
+        "crank_mass": "Unbalanced crank-throw mass reduced to the crank radius, Gots (28), per "
+                      "throw.",
+    },
+    "mechanism.rod": {
+        "model": "``two-mass``: masses at pin and crankpin, Gots (20); ``rigid``: a rigid body "
+                 "with its moment of inertia.",
+        "mass": "Mass of the rod.",
+        "cg_from_pin": "Distance from the piston pin to the rod's centre of mass, Gots l₁.",
+        "inertia_cg": "Moment of inertia of the rod about its centre of mass (``rigid``).",
+    },
+}
 
 
 @dataclass(frozen=True)
@@ -108,6 +136,8 @@ class CrankSlider:
     kind = CRANK_SLIDER
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
     wall_heat_transfer = True
+    cylinder_count = "mechanism.cylinders"
+    key_meanings = KEY_MEANINGS
     #: Its pistons follow the slider law the analyses derive piston accelerations W_k from.
     slider_law = True
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
@@ -212,24 +242,31 @@ class CrankSlider:
     def read(cls, s: Section) -> CrankSlider:
         """A :class:`CrankSlider` from the ``[mechanism]`` table (its ``type`` is read by the
         caller, who also finishes ``s``); errors name the keys as written."""
-        r = s.number("crank_radius", "length")
-        l = s.number("rod_length", "length")
+        r = s.number("crank_radius", "length", gt=0.0)
+        l = s.number("rod_length", "length", gt=Named(r, "crank_radius"))
         strokes = s.integer("strokes", 4, choices=(2, 4))
         n = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
         cycle = math.pi * strokes
-        order = s.integers("firing_order", tuple(range(1, n + 1)))
+        order = s.integers("firing_order", Named(tuple(range(1, n + 1)), "1, 2, …, cylinders"))
         if sorted(order) != list(range(1, n + 1)):
             raise SceneError(s.key("firing_order"),
                              f"must list each cylinder 1 … {n} once, got {list(order)}")
         crank = read_crank(s, n, cycle, order)
+        reach = l - r  # (the rod must reach the axis at both dead centres: |e| < l − r)
+        offset = s.number("offset", "length", 0.0, gt=Named(-reach, "−(rod_length − crank_radius)"),
+                          lt=Named(reach, "rod_length − crank_radius"))
         rod = s.sub("rod", required=True)
         model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
         mech = cls(
-            crank_radius=r, rod_length=l, offset=s.number("offset", "length", 0.0),
-            bore=s.number("bore", "length"), piston_mass=s.number("piston_mass"),
-            crank_mass=s.number("crank_mass", default=0.0), rod_model=model,
-            rod_mass=rod.number("mass"), rod_cg_from_pin=rod.number("cg_from_pin", "length"),
-            rod_inertia_cg=rod.number("inertia_cg", default=0.0) if model == "rigid" else 0.0,
+            crank_radius=r, rod_length=l, offset=offset,
+            bore=s.number("bore", "length", gt=0.0),
+            piston_mass=s.number("piston_mass", "mass", gt=0.0),
+            crank_mass=s.number("crank_mass", "mass", 0.0, ge=0.0), rod_model=model,
+            rod_mass=rod.number("mass", "mass", gt=0.0),
+            rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0,
+                                       le=Named(l, "rod_length")),
+            rod_inertia_cg=(rod.number("inertia_cg", "inertia", 0.0, ge=0.0) if model == "rigid"
+                            else 0.0),
             strokes=strokes, **crank)
         rod.finish()
         try:

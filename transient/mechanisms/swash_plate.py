@@ -35,15 +35,16 @@ How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
   rods' swing adding a little): the pistons really reach their dead centres at uneven intervals,
   and a gas pulse timed by the even spacing would start before the piston has stopped.
 * ``volume_function(clearance)`` and ``stroke()`` describe cylinder 1 (ψ_D = 0), whose dead
-  centres are exactly at φ = 0 and π for every geometry (x_D is even about both, δ being odd), so
+  centres are exactly at φ = 0 and π for every geometry whose pistons turn at their dead centres
+  only (x_D is even about both, δ being odd; :func:`dead_centre_limits` bounds r₁ so), so
   that V(π) − V(0) = halves·F_p·stroke() exactly, as the mixed cycle requires. The other cylinders'
   strokes differ by < 1e-5 relative at the example geometry (module function :func:`stroke`).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
-from math import asin, cos, degrees, pi, sin
+from functools import cached_property, lru_cache
+from math import asin, cos, degrees, inf, pi, sin
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
@@ -54,6 +55,7 @@ from ..core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH,
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
+from ..units import Named
 from .twins import KernelTwin
 
 if TYPE_CHECKING:
@@ -65,6 +67,41 @@ HINGES = {"normal": (0.0, (0.0, 0.0, 1.0)), "in-plane": (pi / 2.0, (0.0, 1.0, 0.
 
 #: Cylinders at most (a scene check: every per-cylinder array is sized by it).
 MAX_CYLINDERS = 64
+
+# What each key of its ``[mechanism]`` table and sub-tables means, in a line: the scene-key
+# reference (docs/guide/scene_keys) shows it beside what the reader asks of the key.
+KEY_MEANINGS = {
+    "mechanism": {
+        "swash": "Swash angle α: tilt of the plate from the plane normal to the shaft.",
+        "joint_radius": "Radius R of the circle of the rods' joints B on link 9.",
+        "rod_length": "Rod length ℓ between its spherical joints B and D; it must bridge the "
+                      "joints' largest lateral offset over a turn.",
+        "cylinder_radius": "Radius r₁ of the circle of the cylinder axes.",
+        "cylinders": "Cylinders z per half, evenly spaced around the shaft.",
+        "bore": "Cylinder bore.",
+        "halves": "1, or 2 for the opposed-piston engine with the mirror half (two pistons per "
+                  "cylinder).",
+        "hinge": "Housing hinge of cross 13: ``in-plane`` (along Oy, as the paper's text) or "
+                 "``normal`` (along Oz, as its printed equation (1)).",
+        "piston_mass": "Mass of one piston.",
+        "link_inertia": "Moment of inertia of an isotropic link 9 (instead of the polar and "
+                        "diametral ones).",
+        "link_polar_inertia": "Link 9's moment of inertia about the plate normal (with "
+                              "``link_diametral_inertia``).",
+        "link_diametral_inertia": "Link 9's moment of inertia about a diameter in the plate "
+                                  "plane (with ``link_polar_inertia``).",
+        "cross_inertia": "Moment of inertia I₁₃ of cross 13 about its housing hinge.",
+        "rod": "The rods (``[mechanism.rod]``).",
+    },
+    "mechanism.rod": {
+        "model": "``two-mass``: masses at the joints; ``rigid``: a rigid body with its moment "
+                 "of inertia.",
+        "mass": "Mass of one rod.",
+        "cg_from_pin": "Distance from the piston joint D to the rod's centre of mass.",
+        "inertia_cg": "Moment of inertia of a rod about its centre of mass, across its axis "
+                      "(``rigid``).",
+    },
+}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -134,6 +171,8 @@ class SwashPlate:
     kind = SWASH_PLATE
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
+    cylinder_count = "mechanism.cylinders"
+    key_meanings = KEY_MEANINGS
     #: Its pistons do not follow the crank-slider's law, from which the analyses derive W_k.
     slider_law = False
     #: Two-stroke: one gas pulse per cylinder and turn.
@@ -230,18 +269,28 @@ class SwashPlate:
         reports its canonical keys (angles as ``*_deg``, everything else by its SI name), which
         are mapped here.
         """
-        swash = s.number("swash", "angle")
+        swash = s.number("swash", "angle", gt=0.0, lt=pi / 4.0)
         R = s.number("joint_radius", "length", gt=0.0)
-        r1 = s.number("cylinder_radius", "length", gt=0.0)
         ell = s.number("rod_length", "length", gt=0.0)
-        bore = s.number("bore", "length", gt=0.0)
         z = s.integer("cylinders", 1, ge=1, le=MAX_CYLINDERS)
-        halves = s.integer("halves", 1, choices=(1, 2))
         hinge = s.string("hinge", "in-plane", choices=tuple(HINGES))
-        piston_mass = s.number("piston_mass", ge=0.0)
-        iso = s.number("link_inertia", default=None, ge=0.0)
-        polar = s.number("link_polar_inertia", default=None, ge=0.0)
-        diametral = s.number("link_diametral_inertia", default=None, ge=0.0)
+        # (B's distance from the axis swings over R cos α … R: a rod of ℓ must reach the axis,
+        # and stay far enough from its full reach that each piston turns at its dead centres)
+        low, high = dead_centre_limits(swash, R, ell, z, hinge)
+        r1 = s.number("cylinder_radius", "length",
+                      gt=Named(low, "max(joint_radius − rod_length, 0)" if low == max(R - ell, 0.0)
+                               else "the least r₁ whose pistons turn at their dead centres only"),
+                      lt=Named(high, "joint_radius · cos(swash) + rod_length"
+                               if high == R * cos(swash) + ell
+                               else "the largest r₁ whose pistons turn at their dead centres only"))
+        gap = Named(2.0 * r1 * sin(pi / z) if z > 1 else inf,  # (cylinders must not overlap)
+                    "2 · cylinder_radius · sin(180°/cylinders) (cylinders > 1)")
+        bore = s.number("bore", "length", gt=0.0, lt=gap)
+        halves = s.integer("halves", 1, choices=(1, 2))
+        piston_mass = s.number("piston_mass", "mass", ge=0.0)
+        iso = s.number("link_inertia", "inertia", None, ge=0.0)
+        polar = s.number("link_polar_inertia", "inertia", None, ge=0.0)
+        diametral = s.number("link_diametral_inertia", "inertia", None, ge=0.0)
         if iso is not None:
             if polar is not None or diametral is not None:
                 raise SceneError(s.key("link_inertia"),
@@ -259,15 +308,16 @@ class SwashPlate:
                     raise SceneError(s.key(key), "is missing; link_polar_inertia and "
                                                  "link_diametral_inertia go together (or give "
                                                  "link_inertia alone for an isotropic link 9)")
-        cross = s.number("cross_inertia", default=0.0, ge=0.0)
+        cross = s.number("cross_inertia", "inertia", 0.0, ge=0.0)
         rod = s.sub("rod", required=True)
         model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
         mech = cls(
             swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell, bore=bore,
             cylinders=z, halves=halves, hinge=hinge, piston_mass=piston_mass, rod_model=model,
-            rod_mass=rod.number("mass", ge=0.0),
-            rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0),
-            rod_inertia_cg=(rod.number("inertia_cg", default=0.0, ge=0.0) if model == "rigid"
+            rod_mass=rod.number("mass", "mass", ge=0.0),
+            rod_cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0,
+                                       le=Named(ell, "rod_length")),
+            rod_inertia_cg=(rod.number("inertia_cg", "inertia", 0.0, ge=0.0) if model == "rigid"
                             else 0.0),
             link_polar_inertia=polar, link_diametral_inertia=diametral, cross_inertia=cross)
         rod.finish()
@@ -308,6 +358,12 @@ class SwashPlate:
             raise SceneError("mechanism.rod_length",
                              f"{ell * 1e3:g} mm is too short: over a turn a rod must bridge a lateral "
                              f"offset of {reach * 1e3:.4g} mm; allowed ℓ > {reach * 1e3:.4g} mm")
+        if not turns_at_dead_centres_only(self):
+            low, high = dead_centre_limits(a, R, ell, self.cylinders, self.hinge)
+            raise SceneError("mechanism.cylinder_radius",
+                             f"{r1 * 1e3:g} mm puts the rods so near their full reach that a "
+                             f"piston turns back between its dead centres; allowed "
+                             f"{low * 1e3:.6g} < r₁ < {high * 1e3:.6g} mm (or a longer rod)")
         if not self.bore > 0:
             raise SceneError("mechanism.bore", f"must be > 0, got {self.bore * 1e3:g} mm")
         if self.cylinders > 1 and self.bore >= 2.0 * r1 * sin(pi / self.cylinders):
@@ -490,6 +546,83 @@ def _points(mp: NDArray[np.float64], phi: NDArray[np.float64]):
     pts = np.empty((phi.size, z, 6))
     core.swash_points(mp, np.ascontiguousarray(phi, dtype=np.float64), theta, pts)
     return theta, pts[..., :3], pts[..., 3:]
+
+
+#: Shaft angles at which :func:`turns_at_dead_centres_only` samples the pistons' travel.
+TRAVEL_SAMPLES = 2881
+
+
+def turns_at_dead_centres_only(geom: SwashPlate) -> bool:
+    """Whether every piston moves in and out once a turn: its travel x_D(φ), sampled, turns
+    twice, at its inner and outer dead centre. A rod working near its full reach (its lateral
+    offset near ℓ) toggles, and the piston turns back in between: cylinder 1's inner dead
+    centre is then no longer its least volume (the gas cycles' V(x) would fall below the
+    clearance), nor its firing angle the end of its compression."""
+    _, _, D = _points(geom._pack(), np.linspace(0.0, 2.0 * pi, TRAVEL_SAMPLES))
+    return bool(np.all(travel_turns(D[..., 0]) == 2))
+
+
+#: A piston that turns back by less than this share of its stroke does not turn: at a dead
+#: centre about to toggle the travel is flat to fourth order, and what it does there is
+#: rounding, or a dip of no consequence to the cylinder volume.
+TRAVEL_ROUNDING = 1e-9
+
+
+def travel_turns(x: NDArray[np.float64]) -> NDArray[np.int64]:
+    """How often each column of the sampled travel ``x`` (samples over one turn, pistons)
+    turns between in and out, going round once from its least value; a turn back by less than
+    :data:`TRAVEL_ROUNDING` of its stroke is none."""
+    out = np.empty(x.shape[1], dtype=np.int64)
+    for k in range(x.shape[1]):
+        xs = np.roll(x[:-1, k], -int(np.argmin(x[:-1, k])))  # (the closing sample repeats)
+        xs = np.append(xs, xs[0])
+        step = np.sign(np.diff(xs))
+        ends = np.flatnonzero(step[1:] != step[:-1]) + 1  # candidate turns, rounding included
+        tol = TRAVEL_ROUNDING * (xs.max() - xs.min())
+        turns, rising, extreme = 0, True, xs[0]
+        for v in xs[ends].tolist() + [xs[-1]]:
+            if (v > extreme) == rising:
+                extreme = v
+            elif abs(v - extreme) > tol:
+                turns, rising, extreme = turns + 1, not rising, v
+        out[k] = turns + (not rising)  # (back at the least value: the last turn, if rising)
+    return out
+
+
+@lru_cache(maxsize=64)
+def dead_centre_limits(swash: float, R: float, ell: float, z: int, hinge: str
+                       ) -> tuple[float, float]:
+    """The range (r_low, r_high) [m] of cylinder radii r₁ over which every rod reaches its
+    piston and every piston turns at its dead centres only (:func:`turns_at_dead_centres_only`):
+    the reach limits max(R − ℓ, 0) and R cos α + ℓ, closed in on by bisection (to 1e-12 of the
+    range) from the middle of the joints' swing, R(1 + cos α)/2, where the rods' offsets are
+    least. Where even the middle toggles, the reach limits (the rod is then too short:
+    :meth:`SwashPlate.validate` says so). The limits are where :data:`TRAVEL_SAMPLES` samples
+    first see a piston turn back; a grid 20 times finer sees it within about 1e-7 of r₁ of
+    there (a dip of 1e-9 of the stroke, the tolerance)."""
+    low, high = max(R - ell, 0.0), R * cos(swash) + ell
+    middle = R * (1.0 + cos(swash)) / 2.0
+
+    def good(r1: float) -> bool:
+        geom = SwashPlate(swash_angle=swash, joint_radius=R, cylinder_radius=r1, rod_length=ell,
+                          bore=0.0, cylinders=z, hinge=hinge, piston_mass=0.0, rod_mass=0.0,
+                          rod_cg_from_pin=0.0, link_polar_inertia=0.0,
+                          link_diametral_inertia=0.0, cross_inertia=0.0)
+        return max_offset(geom) < ell and turns_at_dead_centres_only(geom)
+
+    if not low < middle < high or not good(middle):
+        return low, high
+
+    def closed_in(inside: float, outside: float) -> float:
+        """The last r₁ found good between a good ``inside`` and the ``outside`` limit."""
+        if good(np.nextafter(outside, inside)):
+            return outside
+        while abs(outside - inside) > 1e-12 * (high - low):
+            mid = 0.5 * (inside + outside)
+            inside, outside = (mid, outside) if good(mid) else (inside, mid)
+        return inside
+
+    return closed_in(middle, low), closed_in(middle, high)
 
 
 def max_offset(geom: SwashPlate, samples: int = 1441) -> float:

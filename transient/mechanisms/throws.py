@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import SceneError
-from ..units import SUFFIXES
+from ..units import SUFFIXES, Named
 
 if TYPE_CHECKING:
     from ..scene.reader import Section
@@ -36,6 +36,22 @@ SINGLE = "single"
 ANGLE_TOL = 1e-9
 
 TWO_PI = 2.0 * math.pi
+# What the keys this module reads mean, in a line (the scene-key reference).
+KEY_MEANINGS = {
+    "bank": "Each cylinder's axis from the reference axis, in the direction of rotation: one "
+            "per cylinder, or two (one per bank, odd cylinders on the first) for an even count.",
+    "throws": "Each throw's crankpin angle ahead of the shaft's reference line: one per "
+              "cylinder, or one per two cylinders (2t − 1 and 2t on throw t).",
+    "rod_arrangement": "Two rods on one throw: ``side-by-side`` big ends along the pin, or "
+                       "``fork-and-blade`` in one plane; needs ``throws``, one per two "
+                       "cylinders.",
+    "firing": "Each cylinder's firing angle, at one of its top dead centres (instead of "
+              "``firing_order``).",
+    "pin_split": "Angle between the two crankpins of a split throw (side-by-side rods).",
+    "rod_spacing": "Distance along the pin between two side-by-side big ends' middle planes.",
+    "journal_spacing": "Distance between the two main journals beside a throw (side-by-side "
+                       "rods).",
+}
 #: The keys of two cylinders on one throw besides ``rod_arrangement``, with their kinds.
 SHARED_KEYS = (("pin_split", "angle"), ("rod_spacing", "length"), ("journal_spacing", "length"))
 
@@ -45,9 +61,11 @@ def read_crank(s: Section, n: int, cycle: float, order: tuple[int, ...]) -> dict
     ``firing_angles``, ``bank_angles``, ``rod_arrangement``, ``rod_spacing``,
     ``journal_spacing``; errors name the keys as written."""
     banks = _read_banks(s, n)
-    throws = s.numbers("throws", "angle", None)
-    arrangement = s.string("rod_arrangement", None, choices=SHARED)
-    firing = s.numbers("firing", "angle", None)
+    throws = s.numbers("throws", "angle", Named(None, "a throw per cylinder, from the firing "
+                                                      "(in-line engines)"))
+    arrangement = s.string("rod_arrangement", Named(None, "a throw per cylinder"),
+                           choices=SHARED)
+    firing = s.numbers("firing", "angle", Named(None, "from firing_order"))
     if firing is not None:
         _check_count(s, "firing", firing, n)
     if throws is None:
@@ -69,7 +87,7 @@ def read_crank(s: Section, n: int, cycle: float, order: tuple[int, ...]) -> dict
 def _read_banks(s: Section, n: int) -> tuple[float, ...]:
     """``bank``: one angle per cylinder, or (an even count) one per bank, odd cylinders on the
     first, even ones on the second."""
-    banks = s.numbers("bank", "angle", (0.0,) * n)
+    banks = s.numbers("bank", "angle", Named((0.0,) * n, "0° for every cylinder"))
     if len(banks) == 2 and n % 2 == 0:
         return banks * (n // 2)
     _check_count(s, "bank", banks, n, " (or two for an even count: one per bank, odd cylinders "
@@ -139,7 +157,7 @@ def _cylinders_per_throw(s: Section, n, n_throws, arrangement, banks) -> int:
 def _read_shared(s: Section, throws, arrangement) -> tuple[list[float], dict]:
     """Each cylinder's crankpin angle and the keys of two cylinders per throw: a split of the
     throw's pins (side by side only) and the rods' and journals' spacing."""
-    split = s.number("pin_split", "angle", 0.0)
+    split = s.number("pin_split", "angle", 0.0, gt=-math.pi, lt=math.pi)
     if arrangement == "fork-and-blade":
         if split != 0.0:
             raise s.rename(SceneError(s.key("pin_split"),
@@ -151,12 +169,10 @@ def _read_shared(s: Section, throws, arrangement) -> tuple[list[float], dict]:
                                            "it applies to side-by-side rods")
         keys = {}
     else:
-        if not abs(split) < math.pi:
-            raise s.rename(SceneError(s.key("pin_split"),
-                                      f"must be between −180° and 180°, got "
-                                      f"{math.degrees(split):g}°"))
-        keys = {"rod_spacing": s.number("rod_spacing", "length", gt=0.0),
-                "journal_spacing": s.number("journal_spacing", "length", gt=0.0)}
+        journals = s.number("journal_spacing", "length", gt=0.0)  # (both big ends between them)
+        keys = {"rod_spacing": s.number("rod_spacing", "length", gt=0.0,
+                                        lt=Named(journals, "journal_spacing")),
+                "journal_spacing": journals}
     pins = [theta + half for theta in throws for half in (-split / 2.0, split / 2.0)]
     return pins, {"rod_arrangement": arrangement, **keys}
 

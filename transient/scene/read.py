@@ -20,13 +20,13 @@ from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table, check_magnitudes
 from .files import parse_toml, read_text, table_number, table_rows
 from .eta_map import check_map, grid_from_points
-from .reader import MISSING, Section, finite_number, show_value
+from .reader import MISSING, Named, Section, finite_number, show_value
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
                       MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_GAMMA, MAX_SAMPLES_PER_REV,
-                      METHODS, MIN_OUTPUT_DT, PAIR_MODELS, POLICIES, Analysis, Cylinder, Friction,
-                      Gas, Governor, Inertia, Initial, Load, LoadTable, Output, Pair, Run, Scene,
-                      Solver, Starter, Wiebe, Woschni)
+                      METHODS, MIN_OUTPUT_DT, MIN_WIEBE_STEP, PAIR_MODELS, POLICIES, Analysis,
+                      Cylinder, Friction, Gas, Governor, Inertia, Initial, Load, LoadTable, Output,
+                      Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
 from .write import to_toml
 
 
@@ -181,7 +181,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
     try:
         root = Section(data, "")
         head = root.sub("scene")
-        name = _label(head, Path(file).stem if file else "scene")
+        name = _label(head, Named(Path(file).stem if file else "scene", "the file's name"))
         if not name.strip():
             raise SceneError(head.key(head.written.get("name", "name")),
                              "must not be empty; it names the result (leave it out to use the "
@@ -194,20 +194,22 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         ms.finish()
         sections = {}
         si = root.sub("inertia")
-        sections["inertia"] = Inertia(si.number("shaft", default=0.0, ge=0.0),
-                                      si.number("flywheel", default=0.0, ge=0.0),
-                                      si.number("load", default=0.0, ge=0.0))
+        sections["inertia"] = Inertia(si.number("shaft", "inertia", 0.0, ge=0.0),
+                                      si.number("flywheel", "inertia", 0.0, ge=0.0),
+                                      si.number("load", "inertia", 0.0, ge=0.0))
         si.finish()
         sg = root.sub("gas")
-        sections["gas"] = _read_gas(sg, base_dir, mech.strokes, mech.n_cylinders)
+        sections["gas"] = _read_gas(sg, base_dir, mech.strokes,
+                                    Named(mech.n_cylinders, mech.cylinder_count))
         sg.finish()
         sl = root.sub("load")
         sections["load"] = _read_load(sl, base_dir, mech.cycle)
         sl.finish()
         ss = root.sub("starter")
-        torque = ss.number("torque", default=0.0, ge=0.0)
+        torque = ss.number("torque", "torque", 0.0, ge=0.0)
         noload = ss.number("noload_speed", "speed", 1.0, gt=0.0)
-        cutout = ss.number("cutout_speed", "speed", noload, gt=0.0, le=noload)
+        cutout = ss.number("cutout_speed", "speed", Named(noload, "noload_speed"), gt=0.0,
+                           le=Named(noload, "noload_speed"))
         sections["starter"] = Starter(torque, noload, cutout)
         ss.finish()
         sgv = root.sub("governor")
@@ -223,25 +225,20 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sv = root.sub("solver")
         sections["solver"] = Solver(
             method=sv.string("method", "dop853", choices=METHODS),
-            rtol=sv.number("rtol", default=1e-8, gt=0.0, lt=1.0),
-            atol=sv.number("atol", default=1e-10, gt=0.0),
+            rtol=sv.number("rtol", "1", 1e-8, gt=0.0, lt=1.0),
+            atol=sv.number("atol", "state", 1e-10, gt=0.0),
             switch_speed=sv.number("switch_speed", "speed", math.pi / 3.0, gt=0.0),
             max_step=sv.number("max_step", "angle", math.pi, gt=0.0),
             domain=sv.string("domain", "auto", choices=("auto", "time")),
             fixed_step=sv.number("fixed_step", "angle", 0.0, ge=0.0),
             kinematics=sv.string("kinematics", "exact", choices=("exact", "tabulated")),
-            table_tolerance=sv.number("table_tolerance", default=0.0, ge=0.0, lt=1.0))
+            table_tolerance=sv.number("table_tolerance", "1", 0.0, ge=0.0, lt=1.0))
         sv.finish()
         so = root.sub("output")
-        spr = so.integer("samples_per_rev", 72, ge=4)
-        if spr > MAX_SAMPLES_PER_REV:  # (every sample is written: a run must stay finite)
-            raise SceneError(so.key("samples_per_rev"), f"must be ≤ {MAX_SAMPLES_PER_REV}, got "
-                                                        f"{spr}")
-        dt = so.number("dt", default=0.0, ge=0.0)
-        if 0.0 < dt < MIN_OUTPUT_DT:  # (every sample is written: a run must stay finite)
-            raise SceneError(so.key("dt"), f"must be 0 (the default spacing) or ≥ "
-                                           f"{MIN_OUTPUT_DT:g} s, got {dt:g}")
-        sections["output"] = Output(spr, dt)
+        # (every sample is written: a run must stay finite)
+        sections["output"] = Output(so.integer("samples_per_rev", 72, ge=4,
+                                               le=MAX_SAMPLES_PER_REV),
+                                    so.number("dt", "time", 0.0, ge=MIN_OUTPUT_DT, or_zero=True))
         so.finish()
         sf = root.sub("friction")
         sections["friction"] = _read_friction(sf, mech, base_dir, sections["gas"].model)
@@ -273,7 +270,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         raise
 
 
-def _label(s: Section, default: str) -> str:
+def _label(s: Section, default: Named) -> str:
     """The ``name`` of a table (the scene's, a pair's): it labels terminal lines, figures and
     result files, so a character a terminal would act on (an escape sequence, a newline) is
     refused, not printed."""
@@ -287,36 +284,31 @@ def _label(s: Section, default: str) -> str:
     return name
 
 
-def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: int) -> Gas:
+def _read_gas(s: Section, base_dir: Path, strokes: int, n_cylinders: Named) -> Gas:
     gas = _read_gas_model(s, base_dir, strokes)
-    cylinders = _read_cylinders(s, n_cylinders, burns=gas.model != "compressor")
     if gas.model == "none":
-        if cylinders:
+        if "cylinders" in s.data:
             raise SceneError(s.key("cylinders"), "varies the gas force of cylinders that have "
                                                  "none; give a gas model (gas.model) or leave "
                                                  "[[gas.cylinders]] out")
         return gas
+    cylinders = _read_cylinders(s, n_cylinders, burns=gas.model != "compressor")
     if gas.model == "compressor":  # no fuel: nothing to inject
         return replace(gas, cylinders=cylinders)
-    cycle = 2.0 * math.pi * strokes / 2
-    return replace(gas, injection=s.number("injection", "angle", None, ge=0.0, lt=cycle),
+    cycle = Named(2.0 * math.pi * strokes / 2, "the cycle (mechanism.strokes × 180°)")
+    at_once = Named(None, "not set: every cylinder follows the fuel command at once")
+    return replace(gas, injection=s.number("injection", "angle", at_once, ge=0.0, lt=cycle),
                    cylinders=cylinders)
 
 
-def _read_cylinders(s: Section, n_cylinders: int, burns: bool = True) -> tuple[Cylinder, ...]:
+def _read_cylinders(s: Section, n_cylinders: Named, burns: bool = True) -> tuple[Cylinder, ...]:
     """The [[gas.cylinders]] entries: per cylinder its fuel and pressure factors, cut-out and
     misfires (:class:`~.records.Cylinder`), sorted by cylinder. A model that ``burns`` no fuel
     (a compressor) takes the pressure factor only."""
-    s.known.append("cylinders")
-    raw = s.data.pop("cylinders", [])
-    if not isinstance(raw, list):
-        raise SceneError(s.key("cylinders"), "must be an array of tables ([[gas.cylinders]])")
     out, seen = [], {}
     top = MAX_CYLINDER_FACTOR
-    for i, item in enumerate(raw):
-        cs = Section(item, f"{s.key('cylinders')}[{i}]")
-        other = [k for k in (item if isinstance(item, dict) else ())
-                 if k not in ("cylinder", "pressure")]
+    for i, cs in enumerate(s.tables("cylinders")):
+        other = [k for k in cs.data if k not in ("cylinder", "pressure")]
         if not burns and other:
             raise SceneError(cs.key(other[0]), "a compressor burns no fuel: its "
                                                "[[gas.cylinders]] entries take 'cylinder' and "
@@ -327,8 +319,8 @@ def _read_cylinders(s: Section, n_cylinders: int, burns: bool = True) -> tuple[C
                                                  f"({s.key('cylinders')}[{seen[k]}]); give each "
                                                  f"cylinder one entry")
         seen[k] = i
-        fuel = cs.number("fuel", default=1.0, ge=0.0, le=top)
-        pressure = cs.number("pressure", default=1.0, ge=0.0, le=top)
+        fuel = cs.number("fuel", "1", 1.0, ge=0.0, le=top)
+        pressure = cs.number("pressure", "1", 1.0, ge=0.0, le=top)
         cut_out = cs.flag("cut_out", False)
         if cut_out and cs.written.get("fuel"):
             raise SceneError(cs.key("cut_out"), "is given with 'fuel'; a cut-out cylinder gets "
@@ -344,8 +336,9 @@ def _read_cylinders(s: Section, n_cylinders: int, burns: bool = True) -> tuple[C
         entry = Cylinder(cylinder=k, fuel=0.0 if cut_out else fuel, pressure=pressure,
                          cut_out=cut_out, misfire_cycles=tuple(sorted(set(cycles))),
                          misfire_every=cs.integer("misfire_every", 0, ge=0),
-                         misfire_rate=cs.number("misfire_rate", default=0.0, ge=0.0, le=1.0),
-                         misfire_seed=cs.integer("misfire_seed", 0, ge=0, le=2 ** 63 - 1),
+                         misfire_rate=cs.number("misfire_rate", "1", 0.0, ge=0.0, le=1.0),
+                         misfire_seed=cs.integer("misfire_seed", 0, ge=0,
+                                                 le=Named(2 ** 63 - 1, "2⁶³ − 1")),
                          combustion_offset=offset)
         cs.finish()
         out.append(entry)
@@ -356,9 +349,12 @@ def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
     model = s.string("model", "none",
                      choices=("none", "table", "mixed-cycle", "trapezoid", "wiebe", "compressor"))
     if model == "trapezoid":  # a force per piston [N] (Antonyuk §4): no pressure, no p0
-        return Gas(model="trapezoid", p0=0.0, amplitude=s.number("amplitude", ge=0.0),
-                   ramp=s.number("ramp", "angle", gt=0.0),
-                   duration=s.number("duration", "angle", math.pi, gt=0.0))
+        amplitude = s.number("amplitude", "force", ge=0.0)
+        duration = s.number("duration", "angle", math.pi, gt=0.0,
+                            lt=Named(math.pi * strokes, "the cycle (mechanism.strokes × 180°)"))
+        return Gas(model="trapezoid", p0=0.0, amplitude=amplitude, duration=duration,
+                   ramp=s.number("ramp", "angle", gt=0.0, le=Named(duration / 2.0,
+                                                                   "duration/2")))
     if model == "table":
         return _read_gas_table(s, base_dir)
     p0 = s.number("p0", "pressure", 1.0e5, ge=0.0)
@@ -366,19 +362,36 @@ def _read_gas_model(s: Section, base_dir: Path, strokes: int) -> Gas:
         return Gas(model="none", p0=p0)
     if model == "wiebe":
         return _read_wiebe(s, p0, strokes)
-    if model == "compressor":  # p_discharge > p_suction and the clearance: forces.compressor
-        n = s.number("n", gt=1.0)
-        return Gas(model="compressor", p0=p0, p_suction=s.number("p_suction", "pressure", gt=0.0),
-                   p_discharge=s.number("p_discharge", "pressure", gt=0.0), n=n,
-                   n_reexpansion=s.number("n_reexpansion", default=n, gt=1.0),
-                   clearance_ratio=s.number("clearance_ratio", gt=0.0))
+    if model == "compressor":
+        return _read_compressor(s, p0)
     p_in, p_ex = _gas_exchange(s, strokes, gt=0.0)
+    ratio = s.number("compression_ratio", "1", gt=1.0)
+    p_a = s.number("p_a", "pressure", gt=0.0)
+    n1 = s.number("n1", "1", gt=1.0)
+    try:
+        p_c = p_a * ratio ** n1  # (the compression's end, which the combustion starts from)
+    except OverflowError:
+        p_c = math.inf
     return Gas(
-        model="mixed-cycle", p0=p0,
-        compression_ratio=s.number("compression_ratio", gt=1.0),
-        p_a=s.number("p_a", "pressure", gt=0.0), n1=s.number("n1", gt=1.0),
-        p_z=s.number("p_z", "pressure", gt=0.0), rho=s.number("rho", ge=1.0),
-        n2=s.number("n2", gt=1.0), p_intake=p_in, p_exhaust=p_ex)
+        model="mixed-cycle", p0=p0, compression_ratio=ratio, p_a=p_a, n1=n1,
+        p_z=s.number("p_z", "pressure", ge=Named(p_c, "p_a · compression_ratio^n1")),
+        rho=s.number("rho", "1", ge=1.0, lt=Named(ratio, "compression_ratio")),
+        n2=s.number("n2", "1", gt=1.0), p_intake=p_in, p_exhaust=p_ex)
+
+
+def _read_compressor(s: Section, p0: float) -> Gas:
+    """``model = "compressor"`` (:mod:`transient.forces.compressor`): the clearance gas must
+    re-expand to p_s before the bottom dead centre and the compression reach p_d before the top
+    one, c·((p_d/p_s)^(1/n) − 1) < 1 for the smaller exponent."""
+    n = s.number("n", "1", gt=1.0)
+    p_s = s.number("p_suction", "pressure", gt=0.0)
+    p_d = s.number("p_discharge", "pressure", gt=Named(p_s, "p_suction"))
+    n_e = s.number("n_reexpansion", "1", Named(n, "n"), gt=1.0)
+    top = 1.0 / ((p_d / p_s) ** (1.0 / min(n, n_e)) - 1.0)
+    clearance = s.number("clearance_ratio", "1", gt=0.0, lt=Named(
+        top, "1/((p_discharge/p_suction)^(1/min(n, n_reexpansion)) − 1)"))
+    return Gas(model="compressor", p0=p0, p_suction=p_s, p_discharge=p_d, n=n,
+               n_reexpansion=n_e, clearance_ratio=clearance)
 
 
 def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, float]:
@@ -390,14 +403,17 @@ def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, flo
         return (s.number("p_intake", "pressure", **bounds),
                 s.number("p_exhaust", "pressure", **bounds))
     for name in ("p_intake", "p_exhaust"):
-        if s.has(name, "pressure"):
-            s.number(name, "pressure")  # (taken off the table: its key as written)
-            raise SceneError(s.key(s.written[name]), "a two-stroke cycle (mechanism.strokes = "
-                                                     "2) has no intake or exhaust stroke: it is "
-                                                     "scavenged to p_a at bottom dead centre; "
-                                                     "leave p_intake and p_exhaust out (they "
-                                                     "are for strokes = 4)")
+        written = next((k for k in s.data if _unsuffixed(k) == name), None)
+        if written is not None:
+            raise SceneError(s.key(written), "a two-stroke cycle (mechanism.strokes = 2) has "
+                                             "no intake or exhaust stroke: it is scavenged to "
+                                             "p_a at bottom dead centre; leave p_intake and "
+                                             "p_exhaust out (they are for strokes = 4)")
     return 0.0, 0.0
+
+
+#: The default of a pressure table's ``p`` and ``force``: one of them is required.
+P_OR_FORCE = Named((), "none: give p or force")
 
 
 def _read_gas_table(s: Section, base_dir: Path) -> Gas:
@@ -409,18 +425,18 @@ def _read_gas_table(s: Section, base_dir: Path) -> Gas:
         force = column in FORCE_COLUMNS
     else:
         phi = s.numbers("phi", "angle")
-        values = s.numbers("force", "force", ())
+        values = s.numbers("force", "force", P_OR_FORCE)
         force = bool(values)
         if force and s.has("p", "pressure"):
             raise SceneError(s.key("force"), "is given with 'p'; a table holds the pressure in "
                                              "the cylinder or the force on its piston: give one "
                                              "of them")
         if not force and not s.has("p", "pressure"):
-            s.numbers("p", "pressure", ())  # (a 'p' with a wrong unit suffix is named first)
+            s.numbers("p", "pressure", P_OR_FORCE)  # (a 'p' with a wrong suffix is named first)
             raise SceneError(s.key("p"), "is missing; give the pressures 'p' (or 'p_bar', "
                                          "'p_MPa') or the forces on the piston 'force' (or "
                                          "'force_kN'), one per angle")
-        values = values or s.numbers("p", "pressure")
+        values = values or s.numbers("p", "pressure", P_OR_FORCE)
         motored = s.numbers("motored_p", "pressure", ())
     if force and motored:
         key = "file" if "file" in s.written else s.written.get("motored_p", "motored_p")
@@ -442,31 +458,34 @@ def _read_wiebe(s: Section, p0: float, strokes: int) -> Gas:
     is built, still inside :func:`~transient.load_scene` (:func:`~.checks.check_gas_table`).
     """
     d = Wiebe()
-    ratio = s.number("compression_ratio", gt=1.0)
+    ratio = s.number("compression_ratio", "1", gt=1.0)
     p_a = s.number("p_a", "pressure", gt=0.0)
     p_in, p_ex = _gas_exchange(s, strokes, ge=0.0)
     w = s.sub("wiebe", required=True)
     wiebe = Wiebe(
         start=w.number("start", "angle"), duration=w.number("duration", "angle", gt=0.0),
-        fuel_mass=w.number("fuel_mass", ge=0.0), a=w.number("a", default=d.a, gt=0.0),
-        m=w.number("m", default=d.m, gt=-1.0), lhv=w.number("lhv", default=d.lhv, gt=0.0),
-        efficiency=w.number("efficiency", default=d.efficiency, gt=0.0, le=1.0),
-        gamma=w.number("gamma", default=d.gamma, gt=1.0, le=MAX_GAMMA),
-        gamma_slope=w.number("gamma_slope", default=d.gamma_slope),
-        gamma_t_ref=w.number("gamma_t_ref", default=d.gamma_t_ref, gt=0.0),
-        t_a=w.number("t_a", default=d.t_a, gt=0.0),
-        intake_closing=w.number("intake_closing", "angle", None),
-        exhaust_opening=w.number("exhaust_opening", "angle", None),
-        step=w.number("step", "angle", d.step, gt=0.0),
-        tolerance=w.number("tolerance", default=d.tolerance, gt=0.0))
+        fuel_mass=w.number("fuel_mass", "mass", ge=0.0), a=w.number("a", "1", d.a, gt=0.0),
+        m=w.number("m", "1", d.m, gt=-1.0),
+        lhv=w.number("lhv", "specific energy", d.lhv, gt=0.0),
+        efficiency=w.number("efficiency", "1", d.efficiency, gt=0.0, le=1.0),
+        gamma=w.number("gamma", "1", d.gamma, gt=1.0, le=Named(MAX_GAMMA, "5/3")),
+        gamma_slope=w.number("gamma_slope", "per kelvin", d.gamma_slope),
+        gamma_t_ref=w.number("gamma_t_ref", "temperature", d.gamma_t_ref, gt=0.0),
+        t_a=w.number("t_a", "temperature", d.t_a, gt=0.0),
+        intake_closing=w.number("intake_closing", "angle",
+                                Named(None, "the BDC before the firing TDC")),
+        exhaust_opening=w.number("exhaust_opening", "angle",
+                                 Named(None, "the BDC after the firing TDC")),
+        step=w.number("step", "angle", d.step, ge=MIN_WIEBE_STEP),
+        tolerance=w.number("tolerance", "1", d.tolerance, ge=1e-13, le=1e-3))
     w.finish()
     woschni = None
     if s.has("woschni"):
         h, dh = s.sub("woschni"), Woschni()
-        woschni = Woschni(c1=h.number("c1", default=dh.c1, ge=0.0),
-                          c2=h.number("c2", default=dh.c2, ge=0.0),
-                          wall_temperature=h.number("wall_temperature", default=dh.wall_temperature,
-                                                    gt=0.0))
+        woschni = Woschni(c1=h.number("c1", "1", dh.c1, ge=0.0),
+                          c2=h.number("c2", "woschni c2", dh.c2, ge=0.0),
+                          wall_temperature=h.number("wall_temperature", "temperature",
+                                                    dh.wall_temperature, gt=0.0))
         h.finish()
     return Gas(model="wiebe", p0=p0, compression_ratio=ratio, p_a=p_a, p_intake=p_in,
                p_exhaust=p_ex, wiebe=wiebe, woschni=woschni)
@@ -539,13 +558,10 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
     mapped pair into the cylinders (the last link, ``gas_model`` its gas) needs gas forces to
     pass on."""
     policy = s.string("policy", "power-flow", choices=POLICIES)
-    s.known.append("pairs")
-    raw = s.data.pop("pairs", [])
-    if not isinstance(raw, list):
-        raise SceneError(s.key("pairs"), "must be an array of tables ([[friction.pairs]])")
+    sections = s.tables("pairs")
+    raw = [dict(ps.data) for ps in sections]  # (as written, for the wedging checks' messages)
     pairs, seen = [], {}
-    for i, item in enumerate(raw):
-        ps = Section(item, f"{s.key('pairs')}[{i}]")
+    for i, ps in enumerate(sections):
         model = ps.string("model", "constant-eta", choices=PAIR_MODELS)
         links = mech.links
         if model == "reaction":
@@ -579,7 +595,7 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
             raise SceneError(ps.key("between"), f"the same pair as "
                                                 f"{s.key('pairs')}[{seen[tuple(between)]}]")
         seen[tuple(between)] = i
-        name = _label(ps, f"{between[0]}-{between[1]}")
+        name = _label(ps, Named(f"{between[0]}-{between[1]}", "its two links, as “crank-rod”"))
         if model == "reaction":
             pair = _reaction_pair(ps, between, name, slider=between[1] == links[-1])
         elif model == "table":
@@ -638,8 +654,8 @@ def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
 def _link_names(ps: Section, links, allowed: str, known: str) -> tuple[str, str]:
     """The key ``between``: two names of ``links``; ``allowed`` ends the message of a malformed
     value, ``known`` that of an unknown link."""
-    ps.known.append("between")
-    between = ps.data.pop("between", None)
+    between = ps.raw("between", "two link names", required=True)
+    between = None if between is MISSING else between
     if (not isinstance(between, list) or len(between) != 2
             or not all(isinstance(b, str) for b in between)):
         raise SceneError(ps.key("between"), f"must be two link names, got {show_value(between)}; "
@@ -685,15 +701,16 @@ def _between(ps: Section, links: tuple[str, ...], hint: str) -> tuple[str, str]:
 def _reaction_pair(ps: Section, between: tuple[str, str], name: str, slider: bool) -> Pair:
     """A pair with friction on its reaction: a journal or pin (μ, radius, viscous) or the piston
     in its cylinder (μ, ring force, ring pressure share, viscous)."""
-    mu = ps.number("mu", ge=0.0, le=1.0)
+    mu = ps.number("mu", "1", ge=0.0, le=1.0)
     if slider:
         return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name,
-                    model="reaction", mu=mu, viscous=ps.number("viscous", default=0.0, ge=0.0),
-                    ring_force=ps.number("ring_force", default=0.0, ge=0.0),
-                    ring_pressure=ps.number("ring_pressure", default=0.0, ge=0.0, le=1.0))
+                    model="reaction", mu=mu,
+                    viscous=ps.number("viscous", "linear damping", 0.0, ge=0.0),
+                    ring_force=ps.number("ring_force", "force", 0.0, ge=0.0),
+                    ring_pressure=ps.number("ring_pressure", "1", 0.0, ge=0.0, le=1.0))
     return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name, model="reaction",
                 mu=mu, radius=ps.number("radius", "length", gt=0.0),
-                viscous=ps.number("viscous", default=0.0, ge=0.0))
+                viscous=ps.number("viscous", "rotary damping", 0.0, ge=0.0))
 
 
 #: Column names of an efficiency map (CSV) and their factors to SI.
@@ -723,7 +740,7 @@ def _table_pair(ps: Section, between: tuple[str, str], name: str, base_dir: Path
                                              f"{exc.message}") from None
     else:
         speed = ps.numbers("speed", "speed")
-        torque = ps.numbers("torque")
+        torque = ps.numbers("torque", "torque")
         fwd = _rows(ps, "eta_forward")
         bwd = _rows(ps, "eta_backward")
         check_map(lambda k: ps.key(ps.written.get(k, k)), speed, torque, fwd, bwd)
@@ -733,11 +750,10 @@ def _table_pair(ps: Section, between: tuple[str, str], name: str, base_dir: Path
 
 def _rows(ps: Section, name: str) -> tuple[tuple[float, ...], ...]:
     """A map's values inline: a list of rows (one per speed) of finite numbers."""
-    ps.known.append(name)
-    if name not in ps.data:
+    value = ps.raw(name, "rows of numbers", required=True)
+    if value is MISSING:
         raise SceneError(ps.key(name), "is missing; give one row per speed of one value per "
                                        "torque, e.g. [[0.97, 0.98], [0.96, 0.975]]")
-    value = ps.data.pop(name)
     if (not isinstance(value, list) or not value
             or not all(isinstance(r, list) and all(finite_number(v) for v in r) for r in value)):
         raise SceneError(ps.key(name), f"must be a list of rows of finite numbers (one row per "
@@ -818,32 +834,27 @@ def _check_piston_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> Non
 
 
 def _efficiency(s: Section, name: str) -> float:
-    """An efficiency in (0, 1]; η ≤ 0 would be a self-locking pair, which the model excludes."""
-    eta = s.number(name, le=1.0)
-    if eta <= 0.0:
-        raise SceneError(s.key(name), f"must be > 0, got {eta:g}; an efficiency ≤ 0 is a "
-                                      f"self-locking pair (the paper's ξ regime), not modelled")
-    return eta
+    """An efficiency in (0, 1]; η ≤ 0 would be a self-locking pair (the paper's ξ regime),
+    which the model excludes."""
+    return s.number(name, "1", gt=0.0, le=1.0)
 
 
 def _read_load(s: Section, base_dir: Path, cycle: float) -> Load:
     """The [load] table: resisting torques (``torque`` of either sign), a generator, a load from
     data ([load.table]) and the schedule of their scale."""
-    torque = s.number("torque", default=0.0)
-    linear = s.number("linear", default=0.0, ge=0.0)
-    fan = s.number("fan", default=0.0, ge=0.0)
-    power = s.number("generator_power", default=0.0, ge=0.0)
-    given = s.has("generator_min_speed", "speed")
-    w_min = s.number("generator_min_speed", "speed", 0.0, ge=0.0)
-    if power > 0.0 and w_min <= 0.0:
-        key = s.key(s.written.get("generator_min_speed", "generator_min_speed"))
-        what = "must be > 0" if given else "is missing"
-        raise SceneError(key, f"{what} with a generator_power: below it the torque −P/ω is held "
-                              f"at −P/ω_min (finite at rest); give 'generator_min_speed' or "
-                              f"'generator_min_speed_rpm' > 0")
-    times = s.numbers("schedule_time", default=())
-    revs = s.numbers("schedule_revolutions", default=())
-    scale = s.numbers("schedule_scale", default=())
+    torque = s.number("torque", "torque", 0.0)
+    linear = s.number("linear", "rotary damping", 0.0, ge=0.0)
+    fan = s.number("fan", "quadratic rotary damping", 0.0, ge=0.0)
+    power = s.number("generator_power", "power", 0.0, ge=0.0)
+    # (below it the torque −P/ω is held at −P/ω_min, finite at rest)
+    w_min = s.number("generator_min_speed", "speed",
+                     Named(MISSING if power > 0.0 else 0.0,
+                           "required with a generator_power, else 0"),
+                     ge=0.0, gt=Named(0.0 if power > 0.0 else -math.inf,
+                                      "0 with a generator_power"))
+    times = s.numbers("schedule_time", "time", ())
+    revs = s.numbers("schedule_revolutions", "revolutions", ())
+    scale = s.numbers("schedule_scale", "1", (), ge=0.0)  # (it multiplies a resisting load)
     if times and revs:
         raise SceneError(s.key("schedule_revolutions"),
                          "given together with 'schedule_time'; a schedule runs against time or "
@@ -873,12 +884,9 @@ def _read_load(s: Section, base_dir: Path, cycle: float) -> Load:
             raise SceneError(s.key(name), f"{a!r} and {b!r} (entries {i} and {i + 1}) are closer "
                                           f"than {SCHEDULE_MIN_GAP:g} (relative); give equal "
                                           f"entries for a step, or a longer ramp")
-    for i, v in enumerate(scale):
-        if v < 0.0:
-            raise SceneError(s.key("schedule_scale"), f"must be ≥ 0, got {v:g} (entry {i + 1}); "
-                                                      f"the scale multiplies a resisting load")
-    extra = s.number("inertia", default=0.0, ge=0.0)
-    at = s.number("inertia_time", default=MISSING if extra > 0.0 else 0.0, gt=0.0)
+    extra = s.number("inertia", "inertia", 0.0, ge=0.0)
+    at = s.number("inertia_time", "time", Named(MISSING if extra > 0.0 else 0.0,
+                                                "required with an inertia > 0"), gt=0.0)
     table = None
     s.known.append("table")
     if s.has("table"):
@@ -898,8 +906,12 @@ def _read_load(s: Section, base_dir: Path, cycle: float) -> Load:
 LOAD_TABLE_ABSCISSAE = {
     "speed": ("speed", {"speed": 1.0, "speed_rpm": math.pi / 30.0}),
     "phi": ("angle", {"phi": 1.0, "phi_deg": math.pi / 180.0}),
-    "time": (None, {"time": 1.0}),
+    "time": ("time", {"time": 1.0}),
 }
+
+
+#: The default of each abscissa of [load.table]: exactly one of them is required, or a file.
+ONE_ABSCISSA = Named((), "none: give one of speed, phi, time (or a file)")
 
 
 def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
@@ -919,7 +931,7 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
         given = [n for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items() if s.has(n, kind)]
         if not given:  # (a key with a unit suffix its quantity does not take is named first)
             for n, (kind, _) in LOAD_TABLE_ABSCISSAE.items():
-                s.numbers(n, kind, ())
+                s.numbers(n, kind, ONE_ABSCISSA)
         if len(given) != 1:
             names = ", ".join(repr(n) for n in LOAD_TABLE_ABSCISSAE)
             what = "none" if not given else " and ".join(repr(n) for n in given)
@@ -927,8 +939,8 @@ def _read_load_table(s: Section, base_dir: Path, cycle: float) -> LoadTable:
                              f"needs exactly one abscissa of {names} (or a CSV 'file'), got "
                              f"{what}")
         name = given[0]  # (read as optional: any one of them is, none alone is required)
-        x = s.numbers(name, LOAD_TABLE_ABSCISSAE[name][0], ())
-        torque = s.numbers("torque")
+        x = s.numbers(name, LOAD_TABLE_ABSCISSAE[name][0], ONE_ABSCISSA)
+        torque = s.numbers("torque", "torque")
         key = s.key(s.written.get(name, name))
         where = ""
         if len(torque) != len(x):
@@ -974,63 +986,68 @@ def _read_governor(s: Section) -> Governor:
         return Governor()
     if model == "droop":
         full = s.number("speed_full", "speed", gt=0.0)
-        zero = s.number("speed_zero", "speed", gt=full)
+        zero = s.number("speed_zero", "speed", gt=Named(full, "speed_full"))
         return Governor(model, full, zero)
     d = Governor()
-    f_min = s.number("fuel_min", default=d.fuel_min, ge=0.0)
-    f_max = s.number("fuel_max", default=d.fuel_max, gt=f_min)
+    f_min = Named(s.number("fuel_min", "1", d.fuel_min, ge=0.0), "fuel_min")
+    f_max = Named(s.number("fuel_max", "1", d.fuel_max, gt=f_min), "fuel_max")
     if model == "flyweight":
         return Governor(
-            model, fuel_min=f_min, fuel_max=f_max, weights=s.integer("weights", d.weights, ge=1),
-            weight_mass=s.number("weight_mass", gt=0.0), radius=s.number("radius", "length", gt=0.0),
-            arm_ratio=s.number("arm_ratio", default=d.arm_ratio, gt=0.0),
-            gear_ratio=s.number("gear_ratio", default=d.gear_ratio, gt=0.0),
-            sleeve_mass=s.number("sleeve_mass", default=0.0, ge=0.0),
-            spring_rate=s.number("spring_rate", ge=0.0),
-            spring_preload=s.number("spring_preload", gt=0.0),
-            damping=s.number("damping", ge=0.0), travel=s.number("travel", "length", gt=0.0))
-    gain_p = s.number("gain_p", ge=0.0)
-    gain_i = s.number("gain_i", ge=0.0)
+            model, fuel_min=f_min.value, fuel_max=f_max.value,
+            weights=s.integer("weights", d.weights, ge=1),
+            weight_mass=s.number("weight_mass", "mass", gt=0.0),
+            radius=s.number("radius", "length", gt=0.0),
+            arm_ratio=s.number("arm_ratio", "1", d.arm_ratio, gt=0.0),
+            gear_ratio=s.number("gear_ratio", "1", d.gear_ratio, gt=0.0),
+            sleeve_mass=s.number("sleeve_mass", "mass", 0.0, ge=0.0),
+            spring_rate=s.number("spring_rate", "stiffness", ge=0.0),
+            spring_preload=s.number("spring_preload", "force", gt=0.0),
+            damping=s.number("damping", "linear damping", ge=0.0),
+            travel=s.number("travel", "length", gt=0.0))
+    gain_p = s.number("gain_p", "1", ge=0.0)
+    gain_i = s.number("gain_i", "rate", ge=0.0)
     if gain_p == 0.0 and gain_i == 0.0:
         raise SceneError(s.key("gain_i"), "gain_p and gain_i are both 0: the governor would never "
                                           "move the rack; give gain_i > 0 (isochronous)")
     return Governor(
         model, speed=s.number("speed", "speed", gt=0.0), gain_p=gain_p, gain_i=gain_i,
-        gain_d=s.number("gain_d", default=0.0, ge=0.0),
-        derivative_time=s.number("derivative_time", default=d.derivative_time, gt=0.0),
-        actuator_time=s.number("actuator_time", default=d.actuator_time, gt=0.0),
-        rate_limit=s.number("rate_limit", default=0.0, ge=0.0),
-        fuel_min=f_min, fuel_max=f_max, anti_windup=s.flag("anti_windup", True),
-        tracking_time=s.number("tracking_time", default=0.0, ge=0.0),
-        fuel_initial=s.number("fuel_initial", default=f_max, ge=f_min, le=f_max))
+        gain_d=s.number("gain_d", "time", 0.0, ge=0.0),
+        derivative_time=s.number("derivative_time", "time", d.derivative_time, gt=0.0),
+        actuator_time=s.number("actuator_time", "time", d.actuator_time, gt=0.0),
+        rate_limit=s.number("rate_limit", "rate", 0.0, ge=0.0),
+        fuel_min=f_min.value, fuel_max=f_max.value, anti_windup=s.flag("anti_windup", True),
+        tracking_time=s.number("tracking_time", "time", 0.0, ge=0.0),
+        fuel_initial=s.number("fuel_initial", "1", f_max, ge=f_min, le=f_max))
+
+
+#: A prescribed speed is constant (``speed``) or a table (``time`` with ``speed_table``).
+SPEED_OR_TABLE = Named(MISSING, "required: speed, or time with speed_table")
 
 
 def _read_run(s: Section) -> Run:
     mode = s.string("mode", "dynamic", choices=("dynamic", "prescribed-speed"))
-    t_end = s.number("t_end", default=math.inf, gt=0.0)
-    revs = s.number("revolutions", default=math.inf, gt=0.0)
+    t_end = s.number("t_end", "time", math.inf, gt=0.0)
+    revs = s.number("revolutions", "revolutions", math.inf, gt=0.0)
     if math.isinf(t_end) and math.isinf(revs):
         raise SceneError(s.key("t_end"), "the run needs an end: give t_end [s] and/or revolutions")
-    budgets = {"max_output_bytes": s.number("max_output_bytes", default=DEFAULT_MAX_OUTPUT_BYTES,
-                                            gt=0.0),
-               "max_steps": s.number("max_steps", default=DEFAULT_MAX_STEPS, ge=1.0)}
+    budgets = {"max_output_bytes": s.number("max_output_bytes", "bytes",
+                                            DEFAULT_MAX_OUTPUT_BYTES, gt=0.0),
+               "max_steps": s.number("max_steps", "1", DEFAULT_MAX_STEPS, ge=1.0)}
     if mode == "dynamic":
         return Run(mode=mode, t_end=t_end, revolutions=revs, **budgets)
     if s.has("speed", "speed"):
-        speed = s.number("speed", "speed", gt=0.0)
+        speed = s.number("speed", "speed", SPEED_OR_TABLE, gt=0.0)
         return Run(mode=mode, t_end=t_end, revolutions=revs, speed=speed, **budgets)
     if not s.has("time") and not s.has("speed_table", "speed"):
         raise SceneError(s.key("speed"), "is missing; a prescribed-speed run needs 'speed' (or "
                                          "'speed_rpm'), or a table 'time' [s] with 'speed_table'")
-    time = s.numbers("time")
-    table = s.numbers("speed_table", "speed")
+    time = s.numbers("time", "time", SPEED_OR_TABLE)
+    table = s.numbers("speed_table", "speed", SPEED_OR_TABLE, gt=0.0)
     if len(time) != len(table) or len(time) < 2:
         raise SceneError(s.key("speed_table"), f"needs as many entries as 'time' (≥ 2); got "
                                                f"{len(table)} and {len(time)}")
     if any(b <= a for a, b in zip(time, time[1:])):
         raise SceneError(s.key("time"), "must increase strictly")
-    if min(table) <= 0:
-        raise SceneError(s.key("speed_table"), "speeds must be > 0 in a prescribed-speed run")
     interpolation = s.string("interpolation", "linear", choices=INTERPOLATIONS)
     return Run(mode=mode, t_end=min(t_end, time[-1]), revolutions=revs, time=time,
                speed_table=table, interpolation=interpolation, **budgets)
@@ -1040,7 +1057,7 @@ def _read_analysis(s: Section) -> Analysis:
     return Analysis(loads=s.flag("loads", False), orders=s.strings("orders", ()),
                     irregularity=s.flag("irregularity", False),
                     thermodynamics=s.flag("thermodynamics", False),
-                    max_order=s.number("max_order", default=12.0, gt=0.0),
+                    max_order=s.number("max_order", "order", 12.0, gt=0.0),
                     samples_per_cycle=s.integer("samples_per_cycle", 720, ge=16),
                     detrend=s.string("detrend", "auto", choices=DETREND))
 

@@ -9,16 +9,76 @@ is allowed.
 from __future__ import annotations
 
 import math
-from typing import Any
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
 from ..errors import SceneError, show_value
-from ..units import ALL_SUFFIXES, SUFFIXES
+from ..units import ALL_SUFFIXES, SUFFIXES, UNITS, Named, value_of
 
 #: The default of a required key: reading it when absent is an error (``None`` is a valid
 #: default, so it cannot mark one).
 MISSING = object()
+
+
+@dataclass(frozen=True)
+class Key:
+    """What the reader asks of one key, as it asks it: the table's ``path`` (``gas.wiebe``,
+    ``friction.pairs[0]``), the key's ``name``, its ``type`` (the :class:`Section` method's
+    name, or what a value the caller checks is), the quantity ``kind`` of a number
+    (:data:`transient.units.UNITS`), its ``default`` (:data:`MISSING`: required), its
+    ``bounds`` (``(">", 0.0)``, ``("≤", Named(…))``; ``or_zero``: 0 is allowed besides) and its
+    ``choices``. A :func:`listening` callback hears each one before the key is read."""
+
+    path: str
+    name: str
+    type: str
+    kind: str | None = None
+    default: Any = MISSING
+    bounds: tuple[tuple[str, Any], ...] = ()
+    choices: tuple | None = None
+    or_zero: bool = False
+
+
+_LISTENER: ContextVar[Callable[["Section", Key], None] | None] = ContextVar("scene_key_listener",
+                                                                           default=None)
+
+
+@contextmanager
+def listening(callback: Callable[["Section", Key], None]) -> Iterator[None]:
+    """Within the block, ``callback(section, key)`` hears every key any :class:`Section` asks
+    for, before it is read (the key reference is built from this: :mod:`.keyref`)."""
+    token = _LISTENER.set(callback)
+    try:
+        yield
+    finally:
+        _LISTENER.reset(token)
+
+
+_COMPARE = {">": np.greater, "≥": np.greater_equal, "<": np.less, "≤": np.less_equal}
+
+
+def _bounds(gt=None, ge=None, lt=None, le=None) -> tuple[tuple[str, Any], ...]:
+    return tuple((word, b) for word, b in ((">", gt), ("≥", ge), ("<", lt), ("≤", le))
+                 if b is not None)
+
+
+def _why(default: Any) -> str:
+    """Why a key is required, if its default says (a :class:`~transient.units.Named` one)."""
+    return f" ({default.name})" if isinstance(default, Named) else ""
+
+
+def _shown(bound: Any, factor: float = 1.0) -> str:
+    """A bound in the units the user wrote, with its name if it has one."""
+    value = value_of(bound)
+    text = str(value) if isinstance(value, int) and factor == 1.0 else f"{value / factor:g}"
+    if not isinstance(bound, Named) or bound.name.startswith(text):  # ("0 with a …")
+        return bound.name if isinstance(bound, Named) else text
+    return f"{bound.name} = {text}"
+
 
 #: TOML integers are unbounded; one past a float's range could not be compared or converted.
 MAX_EXACT_INT = int(1.7976931348623157e308)
@@ -39,6 +99,16 @@ class Section:
 
     def key(self, name: str) -> str:
         return f"{self.path}.{name}" if self.path else name
+
+    def _ask(self, type_: str, name: str, kind: str | None = None, default: Any = MISSING,
+             bounds: tuple = (), choices: tuple | None = None, or_zero: bool = False) -> None:
+        """Tell a listener what is asked of key ``name`` (:func:`listening`)."""
+        if type_ in ("number", "numbers") and kind not in UNITS:
+            raise ValueError(f"{self.key(name)}: unknown quantity kind {kind!r}; one of "
+                             f"{', '.join(map(repr, UNITS))}")
+        listener = _LISTENER.get()
+        if listener is not None:
+            listener(self, Key(self.path, name, type_, kind, default, bounds, choices, or_zero))
 
     def _take(self, name: str, kind: str | None):
         """(value, SI factor, key as written) for a quantity given plain or with one unit suffix."""
@@ -74,14 +144,18 @@ class Section:
             return f"unit suffix '_{suffix}' does not fit this quantity; {hint}"
         return f"unknown unit suffix '_{suffix}'; {hint}"
 
-    def number(self, name: str, kind: str | None = None, default: Any = MISSING, *,
-               gt: float | None = None, ge: float | None = None, lt: float | None = None,
-               le: float | None = None) -> float:
+    def number(self, name: str, kind: str, default: Any = MISSING, *, gt: Any = None,
+               ge: Any = None, lt: Any = None, le: Any = None, or_zero: bool = False) -> float:
+        """A number of quantity ``kind`` (:data:`transient.units.UNITS`) in SI; the bounds
+        (plain or :class:`~transient.units.Named`) are in SI, and with ``or_zero`` 0 is allowed
+        besides them (it turns something off)."""
+        self._ask("number", name, kind, default, _bounds(gt, ge, lt, le), or_zero=or_zero)
         value, factor, written = self._take(name, kind)
         if value is MISSING:
-            if default is MISSING:
-                raise SceneError(self.key(name), f"is missing; {self._unit_hint(name, kind)}")
-            return default
+            if value_of(default) is MISSING:
+                raise SceneError(self.key(name), f"is missing{_why(default)}; "
+                                                 f"{self._unit_hint(name, kind)}")
+            return value_of(default)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise SceneError(self.key(written), f"must be a number, got {show_value(value)}")
         if isinstance(value, int) and abs(value) > MAX_EXACT_INT:
@@ -89,30 +163,38 @@ class Section:
                                                 f"a float's range)")
         if not math.isfinite(value):
             raise SceneError(self.key(written), f"must be finite, got {value}")
-        self._check_range(written, value, gt, ge, lt, le, factor)
+        if not (or_zero and value == 0):
+            self._check_range(written, [value], _bounds(gt, ge, lt, le), factor, or_zero)
         return float(value) * factor
 
-    def _check_range(self, written, value, gt, ge, lt, le, factor):
+    def _check_range(self, written, values, bounds, factor, or_zero=False, entries=False):
         # Bounds are given in SI; compare in the units the user wrote.
-        for bound, ok, word in ((gt, lambda v, b: v > b, ">"), (ge, lambda v, b: v >= b, "≥"),
-                                (lt, lambda v, b: v < b, "<"), (le, lambda v, b: v <= b, "≤")):
-            if bound is not None and not ok(value * factor, bound):
-                raise SceneError(self.key(written),
-                                 f"must be {word} {bound / factor:g}, got {value:g}")
+        si = np.asarray(values, dtype=float) * factor
+        for word, bound in bounds:
+            bad = np.flatnonzero(~_COMPARE[word](si, value_of(bound)))
+            if bad.size:
+                i = int(bad[0])
+                zero = "0 or " if or_zero else ""
+                entry = f" (entry {i + 1})" if entries else ""
+                raise SceneError(self.key(written), f"must be {zero}{word} "
+                                                    f"{_shown(bound, factor)}, got "
+                                                    f"{values[i]:g}{entry}")
 
-    def integer(self, name: str, default: Any = MISSING, *, ge: int | None = None,
-                choices: tuple[int, ...] | None = None, le: int | None = None) -> int:
+    def integer(self, name: str, default: Any = MISSING, *, ge: Any = None,
+                choices: tuple[int, ...] | None = None, le: Any = None) -> int:
+        """A whole number; the bounds plain or :class:`~transient.units.Named`."""
+        self._ask("integer", name, None, default, _bounds(ge=ge, le=le), choices)
         value, _, written = self._take(name, None)
         if value is MISSING:
-            if default is MISSING:
+            if value_of(default) is MISSING:
                 raise SceneError(self.key(name), "is missing; give a whole number")
-            return default
+            return value_of(default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise SceneError(self.key(written), f"must be a whole number, got {show_value(value)}")
-        if ge is not None and value < ge:
-            raise SceneError(self.key(written), f"must be ≥ {ge}, got {show_value(value)}")
-        if le is not None and value > le:
-            raise SceneError(self.key(written), f"must be ≤ {le}, got {show_value(value)}")
+        if ge is not None and value < value_of(ge):
+            raise SceneError(self.key(written), f"must be ≥ {_shown(ge)}, got {show_value(value)}")
+        if le is not None and value > value_of(le):
+            raise SceneError(self.key(written), f"must be ≤ {_shown(le)}, got {show_value(value)}")
         if choices is not None and value not in choices:
             raise SceneError(self.key(written),
                              f"must be one of {', '.join(map(str, choices))}, got "
@@ -120,6 +202,7 @@ class Section:
         return value
 
     def flag(self, name: str, default: bool) -> bool:
+        self._ask("flag", name, default=default)
         value, _, written = self._take(name, None)
         if value is MISSING:
             return default
@@ -128,11 +211,12 @@ class Section:
         return value
 
     def strings(self, name: str, default: Any = MISSING) -> tuple:
+        self._ask("strings", name, default=default)
         value, _, written = self._take(name, None)
         if value is MISSING:
-            if default is MISSING:
+            if value_of(default) is MISSING:
                 raise SceneError(self.key(name), "is missing; give a list of strings")
-            return default
+            return value_of(default)
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             raise SceneError(self.key(written),
                              f"must be a list of strings, got {show_value(value)}")
@@ -140,12 +224,13 @@ class Section:
 
     def string(self, name: str, default: Any = MISSING, *,
                choices: tuple[str, ...] | None = None) -> str:
+        self._ask("string", name, default=default, choices=choices)
         value, _, written = self._take(name, None)
         if value is MISSING:
-            if default is MISSING:
+            if value_of(default) is MISSING:
                 allowed = f"; allowed: {', '.join(choices)}" if choices else ""
                 raise SceneError(self.key(name), f"is missing{allowed}")
-            return default
+            return value_of(default)
         if not isinstance(value, str):
             raise SceneError(self.key(written), f"must be a string, got {show_value(value)}")
         if choices is not None and value not in choices:
@@ -154,23 +239,30 @@ class Section:
                              f"{', '.join(map(repr, choices))}")
         return value
 
-    def numbers(self, name: str, kind: str | None = None, default: Any = MISSING) -> tuple:
+    def numbers(self, name: str, kind: str, default: Any = MISSING, *, gt: Any = None,
+                ge: Any = None, lt: Any = None, le: Any = None) -> tuple:
+        """A list of numbers of quantity ``kind`` in SI, each within the bounds (as
+        :meth:`number`'s)."""
+        self._ask("numbers", name, kind, default, _bounds(gt, ge, lt, le))
         value, factor, written = self._take(name, kind)
         if value is MISSING:
-            if default is MISSING:
-                raise SceneError(self.key(name), f"is missing; {self._unit_hint(name, kind)} list")
-            return default
+            if value_of(default) is MISSING:
+                raise SceneError(self.key(name), f"is missing{_why(default)}; "
+                                                 f"{self._unit_hint(name, kind)} list")
+            return value_of(default)
         if not isinstance(value, list) or not finite_numbers(value):
             raise SceneError(self.key(written), f"must be a list of finite numbers, got "
                                                 f"{show_value(value)}")
+        self._check_range(written, value, _bounds(gt, ge, lt, le), factor, entries=True)
         return tuple((np.asarray(value, dtype=float) * factor).tolist())
 
     def integers(self, name: str, default: Any = MISSING) -> tuple:
+        self._ask("integers", name, default=default)
         value, _, written = self._take(name, None)
         if value is MISSING:
-            if default is MISSING:
+            if value_of(default) is MISSING:
                 raise SceneError(self.key(name), "is missing; give a list of whole numbers")
-            return default
+            return value_of(default)
         if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool)
                                                   for v in value):
             raise SceneError(self.key(written), f"must be a list of whole numbers, got "
@@ -178,6 +270,7 @@ class Section:
         return tuple(value)
 
     def sub(self, name: str, required: bool = False) -> "Section":
+        self._ask("table", name, default=MISSING if required else None)
         self.known.append(name)
         if name not in self.data:
             if required:
@@ -187,6 +280,24 @@ class Section:
             child = Section(self.data.pop(name), self.key(name))
         self.subs[name] = child
         return child
+
+    def tables(self, name: str) -> list["Section"]:
+        """The array of tables ``[[name]]`` under this table, a :class:`Section` each ([] if
+        absent)."""
+        self._ask("tables", name, default=())
+        self.known.append(name)
+        raw = self.data.pop(name, [])
+        if not isinstance(raw, list):
+            raise SceneError(self.key(name), f"must be an array of tables ([[{self.key(name)}]])")
+        return [Section(item, f"{self.key(name)}[{i}]") for i, item in enumerate(raw)]
+
+    def raw(self, name: str, what: str, required: bool = False) -> Any:
+        """The value of ``name`` as the file gives it (:data:`MISSING` if absent), for a
+        structure the typed methods do not read; the caller checks it. ``what`` says what it is
+        (``"two link names"``), as the key reference shows it."""
+        self._ask(what, name, default=MISSING if required else None)
+        self.known.append(name)
+        return self.data.pop(name, MISSING)
 
     def has(self, name: str, kind: str | None = None) -> bool:
         names = [name] + [f"{name}_{s}" for s in SUFFIXES.get(kind, {})] if kind else [name]
@@ -217,9 +328,11 @@ class Section:
 
     @staticmethod
     def _unit_hint(name: str, kind: str | None) -> str:
-        options = [name] + [f"{name}_{s}" for s in SUFFIXES.get(kind, {})] if kind else [name]
-        return "give " + " or ".join(repr(o) for o in options) + (" (SI without a suffix)"
-                                                                   if kind else "")
+        suffixes = SUFFIXES.get(kind, {})
+        if not suffixes:  # (one unit: name it, unless the number has none)
+            return f"give {name!r}" + (f" [{UNITS[kind]}]" if kind and kind != "1" else "")
+        options = [name] + [f"{name}_{s}" for s in suffixes]
+        return "give " + " or ".join(repr(o) for o in options) + " (SI without a suffix)"
 
 
 #: Suffixes that read as a unit: an unknown one is reported as a unit suffix, not an unknown key.

@@ -468,6 +468,10 @@ MAX_GAMMA = 5.0 / 3.0
 #: Output samples per revolution at most (0.00036° apart).
 MAX_SAMPLES_PER_REV = 1_000_000
 
+#: Smallest knot spacing of the Wiebe tables [rad] (0.00057°): 1.3 million knots a 720° cycle,
+#: and a finer one would only fill memory (their tolerance refines them where it matters).
+MIN_WIEBE_STEP = 1e-5
+
 #: Smallest time-mode output spacing [s]: 10⁸ samples per second of engine time, already
 #: 0.8 GB per column and second before compression.
 MIN_OUTPUT_DT = 1e-8

@@ -9,6 +9,7 @@ each weighted in the wear diagram by the crank angle it stands for.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -61,6 +62,22 @@ def cycle_window(scene, traj: Mapping[str, Array]) -> CycleWindow:
     return CycleWindow(columns, start, np.degrees(columns["phi"] - start), int(mask.sum()))
 
 
+def dead_centres(scene, window: CycleWindow, cylinder: int) -> dict[str, float]:
+    """The top dead centres of ``cylinder`` (1-based) as angles in the ``window`` [deg], in
+    [0, cycle): a 4-stroke's firing and gas-exchange TDC, a 2-stroke's TDC (a firing one); at
+    the mechanism's true dead centre (an offset moves it off the crank's local 0)."""
+    mech = scene.mechanism
+    tdc = mech.firing_angles[cylinder - 1] + mech.dead_centre_angles()[0]
+
+    def at(angle):
+        a = (angle - window.start) % mech.cycle
+        return 0.0 if a > mech.cycle * (1.0 - 1e-12) else math.degrees(a)  # (the cycle's end is 0)
+
+    if mech.strokes == 4:
+        return {"firing TDC": at(tdc), "gas-exchange TDC": at(tdc + math.pi * 2.0)}
+    return {"TDC (firing)": at(tdc)}
+
+
 @dataclass(frozen=True)
 class CrankSliderDiagrams:
     """What the load diagrams of a crank-slider engine draw, over the last whole cycle.
@@ -82,6 +99,10 @@ class CrankSliderDiagrams:
         Its load in its crank's frame [N].
     crankpin_wear : (rays [deg], sums [N])
         Its wear diagram (:func:`~.wear.wear_rays`, 36 rays).
+    wear_weight : float
+        Σ of the samples' angle weights (:func:`~.wear.angle_weights`): a ray's sum over it is
+        the cycle-mean load within the wear arc of the ray [N] (loads outside count 0), which
+        does not depend on how densely the cycle is sampled.
     journal_torques : (n_throws + 1, n) array
         Running torques of the main journals [N m].
     crankpin_torques : (n_throws, n) array
@@ -103,6 +124,7 @@ class CrankSliderDiagrams:
     crankpin_x: Array
     crankpin_y: Array
     crankpin_wear: tuple[Array, Array]
+    wear_weight: float
     journal_torques: Array
     crankpin_torques: Array
     main_journals: MainJournalLoads
@@ -145,6 +167,7 @@ def crank_slider_diagrams(scene, traj: Mapping[str, Array], cylinder: int = 1
     return CrankSliderDiagrams(
         window=window, loads=loads, engine_torque=loads.engine_torque, cylinder=cylinder,
         crankpin_x=x, crankpin_y=y, crankpin_wear=wear_rays(np.arctan2(y, x), loads.R[k], weight),
+        wear_weight=float(weight.sum()),
         journal_torques=journals, crankpin_torques=crankpins, main_journals=mj,
         most_loaded=best, journal_x=jx, journal_y=jy,
         journal_wear=wear_rays(np.arctan2(jy, jx), mj.magnitude[best], weight))
