@@ -19,6 +19,7 @@ from .assemble import build_model, initial_governor
 from .scene.queries import part_load_refusal
 from .core.model import forcing, layout, work
 from .core import stepper
+from .core.stepper import loop
 from .core.stepper import io as sio
 from .core.model.inverse import inverse_dynamics
 from .core.model.layout import n_outputs, n_state
@@ -202,13 +203,13 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
                    f"applied moments in both directions ({why})")
     if status == sio.CHATTERING:
         event = sio.EVENT_NAMES[int(ist[sio.I_CHATTER_CODE])]
-        message = (f"chattering: {stepper.CHATTER_COUNT} state events in a row ({event}) without "
+        message = (f"chattering: {loop.CHATTER_COUNT} state events in a row ({event}) without "
                    f"progress at {at} (last sample {where})"
                    + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
                       f"sliding mode), the power-flow policy has one at every state"
                       if event == "pair_mode" and scene.friction.policy != "power-flow" else ""))
     if status == sio.STIFF:
-        message = (f"stiff at {at}: in {stepper.STIFF_COUNT} steps the estimate h·λ of the "
+        message = (f"stiff at {at}: in {loop.STIFF_COUNT} steps the estimate h·λ of the "
                    f"dominant eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
                    f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
                    f"the step (a governor or actuator far faster than the engine?)")
