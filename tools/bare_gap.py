@@ -16,13 +16,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-import transient.core.forcing as forcing
-import transient.core.layout as layout
-import transient.core.rhs as rhs
-from transient.verify.targets import (BARE_SCENE, CALLS_PER_STEP, per_call, rhs_arguments,
-                                     rhs_loop)
-from transient.core import governor as gv
-from transient.core.crank_slider import crank_slider_terms
+import transient.core.model.forcing as forcing
+import transient.core.model.layout as layout
+import transient.core.model.rhs as rhs
+from transient.verify.targets import (BARE_SCENE, CALLS_PER_STEP, per_call, rhs_arguments, rhs_loop)
+from transient.core.model import governor as gv
+from transient.core.model.crank_slider import crank_slider_terms
 from transient.scene import load_scene
 
 

@@ -16,8 +16,8 @@ from pathlib import Path
 
 os.environ["NUMBA_DISABLE_JIT"] = "1"
 
-import transient.core.events as events  # noqa: E402
-import transient.core.rhs as rhs  # noqa: E402
+import transient.core.stepper.events as events  # noqa: E402
+import transient.core.model.rhs as rhs  # noqa: E402
 from transient.scene import load_scene  # noqa: E402
 from transient.run import integrate  # noqa: E402
 

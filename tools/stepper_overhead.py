@@ -13,9 +13,9 @@ from pathlib import Path
 
 from transient.verify.bench import BENCH_SCENES
 from transient.verify.targets import (CALLS_PER_STEP, per_call, rhs_arguments, stepper_overhead,
-                                     timed_scene)
-from transient.core import layout
-from transient.core import rhs
+                                      timed_scene)
+from transient.core.model import layout
+from transient.core.model import rhs
 from transient.core.jit import kernel
 from transient.scene import load_scene
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-import transient.assemble as assemble
+import transient.scene.queries as queries
 import transient.forces.gas as gas
 from transient.run import integrate
 from transient.scene import load_scene
@@ -42,7 +42,7 @@ def scene_of(kind: str, rtol: float):
 
 def cycle_work(scene) -> float:
     """∮(p − p0) dV over the table's knot intervals [J]."""
-    table = assemble.gas_table(scene)
+    table = queries.gas_table(scene)
     m = scene.mechanism
     r, l, e, area = m.crank_radius, m.rod_length, m.offset, m.piston_area
     nodes, weights = np.polynomial.legendre.leggauss(20)
@@ -59,8 +59,8 @@ def main(argv) -> None:
     if other:
         every_knot = gas.every_knot_a_corner
         gas.every_knot_a_corner = lambda table: table
-        mixed_cycle = assemble.mixed_cycle
-        assemble.mixed_cycle = lambda *a, **k: every_knot(mixed_cycle(*a, **k))
+        mixed_cycle = queries.mixed_cycle
+        queries.mixed_cycle = lambda *a, **k: every_knot(mixed_cycle(*a, **k))
     for kind in kinds:
         for rtol in RTOLS:
             scene = scene_of(kind, rtol)

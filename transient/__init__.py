@@ -4,18 +4,20 @@ The package is laid out as its data flow, scene → mechanism → reduced model 
 result → analysis, and each layer imports only those below it (the contracts in
 ``pyproject.toml``, checked by ``make test``). From the bottom up:
 
-- ``core``           numba only: kinematics per mechanism, the reduced model (18), the serial
-                     chain (22), (27) with constant or mapped efficiencies, reaction friction,
-                     governor, cylinder, RK tableaus, events, the stepper
+- ``core``           numba only: the integrator (Runge–Kutta pairs, step control, dense
+                     output, event location), the model (kinematics per mechanism, the reduced
+                     model (18), the serial chain (22), (27) with constant or mapped
+                     efficiencies, reaction friction, governor, cylinder) and the stepper that
+                     composes them, each array's layout declared once
 - ``errors``, ``roots``, ``tomlout``, ``units``, ``version``, ``precompile``
                      what every layer shares: errors, scalar roots, TOML values, unit suffixes,
                      the version, the compile helper process
 - ``mechanisms``     crank_slider, swash_plate, articulated: geometry, checks, kinematics
 - ``forces``         gas pressure tables and cycles (mixed, Wiebe, Woschni), pulses, their cache
+- ``scene``          TOML or dict → frozen records in SI, validated; resolved TOML out; what a
+                     scene implies (its gas tables, phases, governor, the trajectory's columns)
 - ``tabulate``, ``assemble``
                      scene → compiled model arrays and breakpoints (angle-only terms tabulated)
-- ``outputs``        the trajectory columns of a scene and their units
-- ``scene``          TOML or dict → frozen records in SI, validated; resolved TOML out
 - ``results``        the in-memory run, the HDF5 writer (streaming) and reader
 - ``reference``      the same model in plain numpy through ``scipy.integrate.solve_ivp``
 - ``analysis``       irregularity, steady state, efficiency, orders, transient response, loads,
@@ -34,22 +36,29 @@ Public API: :func:`load_scene` and :class:`Scene` (``Scene.from_dict``, ``scene.
 the errors :class:`SceneError` (invalid input) and :class:`SimulationError` (a run that
 failed).
 """
-from . import errors  # noqa: E402
-from .errors import SceneError, SimulationError  # noqa: E402
-from .results import Result, open_result  # noqa: E402
-from .run import simulate  # noqa: E402
-from .scene import Scene, load_scene  # noqa: E402
+from . import errors
+from .errors import SceneError, SimulationError
 from .version import __version__
 
 __all__ = ["load_scene", "Scene", "simulate", "Result", "open_result", "sweep", "SceneError",
            "SimulationError", "errors", "__version__"]
 
+#: The public names imported when first used (PEP 562), each from its module: importing a part
+#: of the package (``transient.core.integrator`` alone, say) does not import the rest, and a
+#: tool that needs only the scene reader does not start the stepper's modules.
+_LAZY = {"load_scene": "scene", "Scene": "scene", "simulate": "run", "Result": "results",
+         "open_result": "results", "sweep": "sweeps.api"}
+
 
 def __getattr__(name: str):
-    """``transient.sweep``, imported when first used: the sweep machinery is not part of a
-    single run's start."""
-    if name == "sweep":
-        from .sweeps.api import sweep
+    if name in _LAZY:
+        from importlib import import_module
 
-        return sweep
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'transient' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

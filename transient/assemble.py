@@ -1,5 +1,6 @@
-"""Scene → compiled model: packs the mechanism, builds the pressure table, the breakpoints and the
-load schedule.
+"""Scene → compiled model: packs the mechanism, the pressure tables the scene's gas gives
+(:mod:`transient.scene.queries`, where every layer asks what a scene implies), the breakpoints
+and the load schedule into the :data:`~transient.core.model.layout.Model`'s arrays.
 
 One place where the scene's dataclasses meet the unit-free arrays of :mod:`transient.core`.
 """
@@ -11,193 +12,23 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from .core import cylinder as cyl
-from .core import governor as gv
-from .core.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
-from .core import variation as var
-from .core.variation import cycle_fuel
-from .core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER, PHI,
-                          POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                          RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T, extras_of,
-                          work_array)
-from .core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
-from .errors import SceneError
-from .forces.compressor import compressor_cycle
-from .forces.gas import PressureTable, mixed_cycle, shift_cubic, table_from_points
+from .core.model import cylinder as cyl
+from .core.model import governor as gv
+from .core.model.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core.model import variation as var
+from .core.model.variation import cycle_fuel
+from .core.model.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER,
+                                PHI, POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS,
+                                RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T,
+                                extras_of)
+from .core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
+from .core.model.work import work_array
+from .forces.gas import PressureTable, shift_cubic
 from .mechanisms import reaction_joints
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
-from .forces.trapezoid import trapezoid_table
-
-
-def gas_table(scene) -> PressureTable | None:
-    """The cylinder pressure table of the scene (absolute pressure [Pa] over the local angle) at
-    full load (governor fuel 1); see :func:`gas_tables` for the motored one."""
-    return gas_tables(scene)[0]
-
-
-def gas_tables(scene) -> tuple[PressureTable | None, PressureTable | None]:
-    """``(full, motored)``: the full-load table and the motored one, between which the fuel f
-    interpolates, p = p_mot + f·(p_full − p_mot): the fuel scales the combustion, never the
-    compression (:class:`transient.scene.records.Gas`).
-
-    ``motored`` is the cycle without fuel on the same corners as the full-load one: for
-    ``"mixed-cycle"`` the compression polytrope both ways
-    (:func:`~transient.forces.gas.mixed_cycle`), for ``"wiebe"`` the cycle without fuel (both
-    from one :func:`~transient.forces.wiebe.wiebe_tables`; with ``fuel_mass = 0`` both are that
-    cycle), for ``"table"`` the user's ``motored_p`` at the table's angles. It is None for a
-    force pulse (``"trapezoid"``, whose motored force is 0), and for a table without
-    ``motored_p`` and a compressor, which cannot burn less than full-load fuel
-    (:func:`part_load_refusal`).
-    """
-    gas = scene.gas
-    mech = scene.mechanism
-    if gas.model == "none":
-        return None, None
-    if gas.model == "trapezoid":  # a force per piston [N] (Antonyuk §4)
-        return trapezoid_table(gas.amplitude, gas.ramp, mech.cycle, gas.duration), None
-    if gas.model == "table":  # pressures [Pa] (and the motored ones), or forces per piston [N]
-        return (_points_table(scene, gas.force or gas.p, "gas.p"),
-                _points_table(scene, gas.motored_p, "gas.motored_p") if gas.motored_p else None)
-    if gas.model == "wiebe":
-        tables = wiebe_levels(mech, gas)
-        return tables[-1], tables[0]
-    if gas.model == "compressor":  # no fuel: the one cycle at every command
-        return compressor_cycle(mech.volume_function(clearance_volume(scene)),
-                                p_suction=gas.p_suction, p_discharge=gas.p_discharge, n=gas.n,
-                                n_reexpansion=gas.n_reexpansion,
-                                clearance_ratio=gas.clearance_ratio, strokes=mech.strokes,
-                                dead_centres=mech.dead_centre_angles()), None
-    cycle = mixed_cycle(mech.volume_function(clearance_volume(scene)),
-                        compression_ratio=gas.compression_ratio, p_a=gas.p_a, n1=gas.n1,
-                        p_z=gas.p_z, rho=gas.rho, n2=gas.n2, p_intake=gas.p_intake,
-                        p_exhaust=gas.p_exhaust, strokes=mech.strokes,
-                        dead_centres=mech.dead_centre_angles())
-    return cycle, cycle.motored
-
-
-def _points_table(scene, values, key: str) -> PressureTable:
-    """The table through ``values`` (pressures or forces) at the scene's table angles, its errors
-    on the values reported under ``key``."""
-    gas = scene.gas
-    try:
-        return table_from_points(np.asarray(gas.phi), np.asarray(values), scene.mechanism.cycle,
-                                 corners=gas.corners, interpolation=gas.interpolation)
-    except SceneError as exc:
-        if exc.key == "gas.p":
-            exc.key = key
-        raise
-
-
-def burns_part_load(scene) -> bool:
-    """Whether a cylinder of the scene can burn less than full-load fuel in a run: under a
-    governor's command, or by a ``[[gas.cylinders]]`` entry that changes its combustion
-    (:attr:`transient.scene.records.Cylinder.combustion_keys`). Only then does the model pair
-    the motored curve with the full-load one: at full fuel throughout the pressure is the
-    full-load table's, and the kernels keep their one-table path."""
-    return (scene.governor.model != "none"
-            or any(c.combustion_keys for c in scene.gas.cylinders))
-
-
-def part_load_refusal(scene) -> str | None:
-    """Why the scene's gas model cannot burn less than full-load fuel, or None. A fuel below 1
-    scales the combustion only, so a model needs its motored curve for it: a table of pressures
-    or forces holds no account of which part of it is compression (unless the motored
-    pressures come with it), and a compressor burns nothing."""
-    gas = scene.gas
-    if gas.model == "compressor":
-        return "a compressor burns no fuel: its cycle is the same at every fuel"
-    if gas.model != "table" or gas.motored_p:
-        return None
-    return ("a fuel below 1 scales the combustion only, p_mot + f·(p_full − p_mot), and a "
-            f"{'force' if gas.force else 'pressure'} table holds no account of which part of it "
-            "is compression; give the pressures with the motored ones at the table's angles, "
-            "gas.motored_p (or a motored_p column of its file)")
-
-
-def cycle_figures(scene) -> dict[str, tuple[float, str]]:
-    """What the scene's gas cycle implies, without a run, name → (value, unit) in SI: for a
-    cycle with a loop work (mixed, Wiebe, compressor) ∮p dV per cylinder and cycle and the mean
-    moment all cylinders put on the shaft (signed as ``M_gas``); for a compressor also the work
-    done on the gas, the volumetric efficiency, the volume drawn in and the local angles where
-    the valves open; at a constant prescribed speed the indicated power, and the mean drive
-    moment that speed needs without friction. Empty for the other models."""
-    from .forces.gas import IndicatedCycle
-
-    table = gas_table(scene)
-    if not isinstance(table, IndicatedCycle):
-        return {}
-    n = scene.mechanism.n_cylinders
-    out = {"cycle_work": (table.work, "J"), "mean_gas_torque": (n * table.mean_torque, "N m")}
-    if scene.gas.model == "compressor":
-        out.update(indicated_work=(table.indicated_work, "J"),
-                   volumetric_efficiency=(table.volumetric_efficiency, "1"),
-                   suction_volume=(table.suction_volume, "m^3"),
-                   suction_opens=(table.angle_suction, "rad"),
-                   discharge_opens=(table.angle_discharge, "rad"))
-    if scene.run.mode == "prescribed-speed" and not scene.run.time:
-        out["indicated_power"] = (n * table.mean_torque * scene.run.speed, "W")
-        out["mean_drive_torque_ideal"] = (-n * table.mean_torque, "N m")
-    return out
-
-
-@lru_cache(maxsize=8)
-def wiebe_levels(mech, gas) -> tuple:
-    """The Wiebe cycles of ``gas`` (``model = "wiebe"``) on the mechanism's cylinder volume:
-    ``(motored, full load)``, or ``(motored,)`` with no fuel
-    (:class:`~transient.forces.wiebe.WiebeCycle`).
-
-    Cached in the process (the mechanism and the gas model are frozen: ``load_scene`` builds them
-    to validate the scene, and every run of a scene with the same engine and cycle uses them
-    again) and on disk between processes (:mod:`transient.forces.wiebe_cache`; a warm start
-    then neither integrates them nor imports scipy's integrators).
-    """
-    from .forces.wiebe_cache import cached_cycles  # (lazily: only Wiebe scenes need it)
-
-    w = gas.wiebe
-    clearance = mech.swept_volume() / (gas.compression_ratio - 1.0)
-    levels = [0.0, w.fuel_mass] if w.fuel_mass > 0.0 else [0.0]
-    cycle = dict(
-        p_a=gas.p_a, start=w.start, duration=w.duration, a=w.a, m=w.m, lhv=w.lhv,
-        efficiency=w.efficiency, gamma=w.gamma, gamma_slope=w.gamma_slope,
-        gamma_t_ref=w.gamma_t_ref, t_a=w.t_a,
-        p_intake=gas.p_intake if mech.strokes == 4 else None,
-        p_exhaust=gas.p_exhaust if mech.strokes == 4 else None, strokes=mech.strokes,
-        intake_closing=w.intake_closing, exhaust_opening=w.exhaust_opening, step=w.step,
-        tolerance=w.tolerance)
-
-    def compute() -> tuple:
-        from .forces.wiebe import wiebe_tables
-
-        return wiebe_tables(mech.volume_function(clearance), levels, **cycle)
-
-    # Everything the cycles depend on besides the code, as exact text (floats' reprs round-trip).
-    return cached_cycles(f"{mech!r}\nclearance={clearance!r}\nlevels={levels!r}\n{cycle!r}",
-                         compute)
-
-
-def clearance_volume(scene) -> float:
-    """V_c [m³]: c·V_h of a compressor's clearance ratio c, V_h/(ε − 1) of a cycle's compression
-    ratio ε (mixed cycle, Wiebe); 0 for a model that gives neither (a table, a force)."""
-    gas, swept = scene.gas, scene.mechanism.swept_volume()
-    if gas.model == "compressor":
-        return gas.clearance_ratio * swept
-    return swept / (gas.compression_ratio - 1.0) if gas.compression_ratio > 1.0 else 0.0
-
-
-def gas_is_force(scene) -> bool:
-    """True when the gas table holds a force per piston [N] rather than a pressure [Pa]."""
-    return scene.gas.model == "trapezoid" or bool(scene.gas.force)
-
-
-def gas_phases(scene) -> NDArray[np.float64]:
-    """Shaft angle at which each cylinder's pressure table is at local angle 0.
-
-    Tables are written with 0 at the gas-exchange TDC of a 4-stroke (firing TDC at 360°, the Gots
-    tables' convention) and at the firing TDC of a 2-stroke.
-    """
-    mech = scene.mechanism
-    shift = 2.0 * math.pi if mech.strokes == 4 else 0.0
-    return np.mod(np.asarray(mech.firing_angles) - shift, mech.cycle)
+from .scene.queries import (burns_part_load, clearance_volume, cycle_begin, gas_is_force,
+                            gas_phases, gas_tables, governor_kind, reaction_friction,
+                            wiebe_levels)
 
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
@@ -273,7 +104,7 @@ def _piston_moves(mech, k: int, angle: float) -> bool:
 
 def paired_table(full: PressureTable, motored: PressureTable
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
-    """Both curves on common knots, as the model holds them (``transient.core.tables``, paired):
+    """Both curves on common knots, as the model holds them (``transient.core.model.tables``, paired):
     ``(knots, coef, piece_knot)`` with ``coef`` float64[n, 8], the full-load cubic in columns
     0–3 and the motored one in 4–7, so that the right-hand side finds the interval once.
 
@@ -337,7 +168,7 @@ def load_schedule(scene) -> tuple[NDArray[np.float64], NDArray[np.float64], int]
 
 
 def load_table_fields(scene) -> dict:
-    """The tabulated load's part of the Model (``transient.core.forcing.table_load``): its
+    """The tabulated load's part of the Model (``transient.core.model.forcing.table_load``): its
     abscissa, knots and cubics; one zero interval without a table (the kernels never read it)."""
     curve = load_table_curve(scene)
     if curve is None:
@@ -422,16 +253,8 @@ def build_model(scene, part_load: bool = False
     return model, model.breakpoints, table
 
 
-def cycle_begin(mech) -> float:
-    """Local angle where a cylinder's cycle begins, for its fuel factor and misfires
-    (:mod:`transient.core.variation`): 0, the gas-exchange TDC of a 4-stroke, whose cycle then
-    holds one intake, compression, combustion and exhaust; π, the BDC of a 2-stroke, whose
-    local 0 is its firing TDC, so that no combustion straddles two cycles."""
-    return 0.0 if mech.strokes == 4 else math.pi
-
-
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
-    """The per-cylinder variation's part of the Model (:mod:`transient.core.variation`) from the
+    """The per-cylinder variation's part of the Model (:mod:`transient.core.model.variation`) from the
     ``[[gas.cylinders]]`` entries; factors of 1 and no misfires for cylinders without one, and
     ``var_on`` False without any, so that such a scene runs the kernels' plain path."""
     mech, entries = scene.mechanism, scene.gas.cylinders
@@ -470,7 +293,7 @@ def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model,
 
 def cylinder_fields(scene) -> dict:
     """The cylinder-pressure states' part of the Model: with ``[gas.woschni]`` the closed part's
-    parameters of :mod:`transient.core.cylinder` (from the full-load Wiebe cycle, whose closed
+    parameters of :mod:`transient.core.model.cylinder` (from the full-load Wiebe cycle, whose closed
     part it integrates again, now with wall heat)."""
     gas = scene.gas
     par = np.zeros(cyl.N_PAR)
@@ -506,17 +329,8 @@ def _on_closed_part_corner(bp: NDArray[np.float64], phases: NDArray[np.float64],
     return np.any(np.minimum(d, model.period - d) <= 1e-9, axis=1)
 
 
-def governor_kind(governor) -> int:
-    """The dynamic governor (``transient.core.governor``) of a scene's governor: none for the
-    static droop; PID only with a derivative gain (else the filter state would be integrated for
-    nothing)."""
-    if governor.model == "pi":
-        return gv.PID if governor.gain_d > 0.0 else gv.PI
-    return gv.FLYWEIGHT if governor.model == "flyweight" else gv.NONE
-
-
 def governor_fields(scene) -> dict:
-    """The dynamic governor's and the fuel latching's part of the Model (``transient.core.governor``
+    """The dynamic governor's and the fuel latching's part of the Model (``transient.core.model.governor``
     for the parameters' meaning)."""
     g = scene.governor
     latch = dict(latch=scene.gas.injection is not None,
@@ -624,7 +438,7 @@ def chain_fields(scene) -> dict:
 
 
 def link_fields(mech, link_sub: list[int]) -> dict:
-    """The links' part of the Model (``transient.core.rhs.split_subchains``): the sub-chain of
+    """The links' part of the Model (``transient.core.model.rhs.split_subchains``): the sub-chain of
     each, their constant inertias, the link with the rest of J(φ), and the law of each link
     whose φ-dependent inertia a pair cuts from the rest's sub-chain (elsewhere it stays in the
     rest: a chain cut only where the links' inertias are constant adds nothing to compute)."""
@@ -639,7 +453,7 @@ def link_fields(mech, link_sub: list[int]) -> dict:
 
 
 def eta_table_fields(pairs) -> dict:
-    """The Model's efficiency maps (:mod:`transient.core.eta_table`), padded to one shape: each
+    """The Model's efficiency maps (:mod:`transient.core.model.eta_table`), padded to one shape: each
     pair's speed and moment axes and its two maps; a constant-η pair among mapped ones becomes a
     one-point map of its two efficiencies (held everywhere: the same η). Without mapped pairs,
     one row of zeros of the same types."""
@@ -656,7 +470,7 @@ def eta_table_fields(pairs) -> dict:
 
 
 def pack_maps(maps) -> tuple:
-    """The arrays (speed, torque, size, eta, η_min) of :mod:`transient.core.eta_table` from one
+    """The arrays (speed, torque, size, eta, η_min) of :mod:`transient.core.model.eta_table` from one
     (speed axis, moment axis, η_fwd grid, η_bwd grid) per pair, padded to one shape."""
     n = len(maps)
     nw = max(len(m[0]) for m in maps)
@@ -671,14 +485,8 @@ def pack_maps(maps) -> tuple:
     return speed, torque, size, eta, et_min
 
 
-def reaction_friction(scene) -> bool:
-    """Whether the scene's pairs have friction on their reactions (then all do, but for a
-    constant-η or mapped pair at the shaft's coupling)."""
-    return any(p.model == "reaction" for p in scene.friction.pairs)
-
-
 def reaction_fields(scene) -> dict:
-    """The chain's part of the Model with reaction friction (:mod:`transient.core.reactions`):
+    """The chain's part of the Model with reaction friction (:mod:`transient.core.model.reactions`):
     no sub-chain is cut (the chain is rigid, its joints lose on their reactions); joint j of
     the mechanism's ``reaction_joints`` (:func:`transient.mechanisms.reaction_joints`) has its
     pair's coefficients and reports as that pair; a constant-η pair among them (at the shaft's
@@ -714,7 +522,7 @@ def reaction_breakpoints(scene) -> NDArray[np.float64]:
     ``joint_reversals`` (the swash plate's: its pistons' dead centres); the local angles of a row
     where any joint of the articulated mechanism reverses (``Articulated.reaction_reversals``),
     repeated at each row's phase; else the crank-slider's, each piston's dead centres (its speed)
-    and its local 90° and 270° (the rod's rate β̇ ∝ cos α, ``transient.core.joint_friction``)."""
+    and its local 90° and 270° (the rod's rate β̇ ∝ cos α, ``transient.core.model.joint_friction``)."""
     mech = scene.mechanism
     own = getattr(mech, "joint_reversals", None)
     if own is not None:

@@ -67,10 +67,10 @@ class RunStopped(SimulationError):
 
 
 def code_status(code: int) -> str:
-    """The status of the stepper's return code ``code`` (:mod:`transient.core.stepper_io`;
+    """The status of the stepper's return code ``code`` (:mod:`transient.core.stepper.io`;
     RUNNING is left only by an interrupt). Imported here, so that the command line reads the
     statuses without loading the compiled core."""
-    from .core import stepper_io as sio
+    from .core.stepper import io as sio
 
     return {sio.RUNNING: "interrupted", sio.FINISHED: FINISHED, sio.STALLED: "stalled",
             sio.LOCKED: "locked", sio.CHATTERING: "chattering", sio.STIFF: "stiff",

@@ -204,7 +204,7 @@ def piston_force(ax, traj, scene, cylinder=1):
     pressure applied (the governor's fuel included) for force models, (p − p0)·F_p for pressure
     models."""
     traj = _columns(traj)
-    from .assemble import gas_is_force
+    from .scene.queries import gas_is_force
 
     value = traj[f"p_{cylinder}"]
     force = value if gas_is_force(scene) else (value - scene.gas.p0) * scene.mechanism.piston_area

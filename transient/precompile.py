@@ -28,33 +28,37 @@ import pickle
 import subprocess
 import sys
 
+import numpy as np
 from numba import config, typeof, types
 
-from .core import breakpoints, events, jit, layout, rhs, rk, stepper
-from .core import stepper_io as sio
+from .core import jit
+from .core.integrator import rk
+from .core.model import layout, rhs
+from .core.stepper import breakpoints, events, loop
+from .core.stepper import io as sio
 
 #: The stepper's callees, each compiled apart with its own callees (:func:`.core.jit.kernel`), in
 #: the reverse of the order in which the stepper's compile first calls for them (recorded with
 #: numba's "numba:compile" events), so that the helper and the stepper's compile meet in the
 #: middle.
 CALLEES = (
-    stepper._switch_at_event,
-    stepper._record_event,
-    stepper._move_to_event,
-    stepper._take_step,
-    stepper._emit_step_samples,
+    loop._switch_at_event,
+    loop._record_event,
+    loop._move_to_event,
+    loop._take_step,
+    loop._emit_step_samples,
     events._locate_events,
     breakpoints._aim_at_breakpoint,
-    stepper._stiff,
-    stepper._accepted_size,
-    stepper._judge_attempt,
-    rk._step,
+    loop._stiff,
+    rk.accepted_size,
+    loop._judge_attempt,
+    rk.step,
     sio._finish,
     breakpoints._segment_end,
-    stepper._settle_at_restart,
+    loop._settle_at_restart,
     rhs.derivative,
     sio._emit_row,
-    stepper._start_run,
+    loop._start_run,
 )
 
 
@@ -63,23 +67,45 @@ def _types_by_parameter(model, tab) -> dict:
     scalar = {types.boolean: ("angle_mode", "upward", "rising", "fixed", "on_corner",
                               "at_segment_end", "after_rejection", "dip", "dense_ready",
                               "redo_hit_breakpoint", "ends_on_breakpoint", "on_breakpoint",
-                              "ev_rising", "keep"),
+                              "ev_rising", "keep", "cut"),
               types.float64: ("h", "sel", "x", "level", "theta", "theta_end", "x_stop", "d_out",
                               "ga", "gb", "a", "b", "phi", "period", "w", "x_end", "h_max",
                               "tol_end", "rtol", "atol", "corner", "err", "h_planned", "up",
                               "down", "min_step", "w_lo", "w_hi", "ev_theta", "ev_level",
-                              "h_next"),
+                              "h_next", "err_old"),
               types.int64: ("comp", "k", "direction", "code", "ix", "n_samples", "g0", "g1", "c0",
                             "ev_code", "ev_comp", "n_pairs")}
     array = {types.float64[::1]: ("y", "y_new", "tmp", "out", "row", "cfg", "fst", "bp", "f",
                                   "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
-             types.int64[::1]: ("ist", "sw")}
+             types.int64[::1]: ("ist", "sw", "control")}
     # (``extras`` is None or True: the plain or the full variant, :func:`.core.layout.extras_of`)
-    by_name = {"m": typeof(model), "tab": typeof(tab), "extras": typeof(layout.extras_of(model))}
+    extras = typeof(layout.extras_of(model))
+    by_name = {"m": typeof(model), "tab": typeof(tab), "extras": extras,
+               # the model's derivative in the integrator's form, and its context
+               "rhs": typeof(rhs.model_rhs),
+               "ctx": types.Tuple((typeof(model), extras, types.boolean, types.float64,
+                                   types.int64[::1], types.float64[:, ::1])),
+               # the loop's records (stepper.io)
+               "io": typeof(sio.Chunk(*_vectors(3), np.zeros(1, np.int64), *_matrices(2))),
+               "work": typeof(sio.Work(*_matrices(2), *_vectors(4), *_matrices(2),
+                                       np.zeros(1, np.int64))),
+               "at": typeof(sio.At(True, 0, 0.0, 0.0, 0.0, np.zeros(1, np.int64))),
+               "seg": typeof(sio.Segment(*(6 * [0.0]))),
+               "seen": types.Tuple((types.boolean, types.float64, types.float64)),
+               "crossing": types.Tuple((types.float64, types.int64, types.float64)),
+               "event": types.Tuple((types.int64, types.int64, types.float64, types.boolean))}
     for numba_type, names in (scalar | array).items():
         by_name.update(dict.fromkeys(names, numba_type))
     return by_name
+
+
+def _vectors(n: int) -> list:
+    return [np.zeros(1) for _ in range(n)]
+
+
+def _matrices(n: int) -> list:
+    return [np.zeros((1, 1)) for _ in range(n)]
 
 
 def signature(fn, model, tab) -> tuple:
@@ -95,7 +121,7 @@ def compile_callees(model, tab, callees=CALLEES) -> None:
 
 
 #: The stepper, whose compile the helper joins (taken at import: tests wrap ``stepper.advance``).
-STEPPER = stepper.advance
+STEPPER = loop.advance
 
 
 def stepper_is_cached(model, tab) -> bool:

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .core import layout
-from .core.inverse import inverse_dynamics
-from .core.layout import n_outputs
+from .core.model import layout
+from .core.model.inverse import inverse_dynamics
+from .core.model.layout import n_outputs
 from .forces.load_table import interpolant
 from .quadrature import integrals
 
@@ -111,7 +111,7 @@ def work_columns(model, motion: Motion, t: NDArray[np.float64], phi: NDArray[np.
                  ) -> tuple[dict[str, NDArray[np.float64]], dict[str, int]]:
     """The work columns at the sample times ``t`` (angles ``phi``): W_gas, W_load, W_starter,
     W_drive and W_loss_k for k = 1 … ``n_pairs``, from 0 at t[0] (module docstring). ``columns``:
-    the output row's column names (``transient.outputs.output_columns``), ``model`` the one the
+    the output row's column names (``transient.scene.outputs.output_columns``), ``model`` the one the
     rows come from. Returns the columns and the quadrature's counts (``quadrature_pieces``,
     ``quadrature_evaluations``, ``quadrature_unresolved``: pieces left above their tolerance).
     """

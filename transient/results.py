@@ -31,7 +31,7 @@ import h5py
 import numpy as np
 
 from .errors import WriteFailed
-from .outputs import describe
+from .scene.outputs import describe
 from .version import __version__
 
 #: Root attribute ``creator`` of every file written here (result or sweep).

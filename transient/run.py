@@ -15,16 +15,18 @@ from typing import Callable
 
 import numpy as np
 
-from .assemble import build_model, initial_governor, part_load_refusal
-from .core import forcing, layout, stepper
-from .core import stepper_io as sio
-from .core.inverse import inverse_dynamics
-from .core.layout import n_outputs, n_state
-from .core.tableaus import TABLEAUS
+from .assemble import build_model, initial_governor
+from .scene.queries import part_load_refusal
+from .core.model import forcing, layout, work
+from .core import stepper
+from .core.stepper import loop
+from .core.stepper import io as sio
+from .core.model.inverse import inverse_dynamics
+from .core.model.layout import n_outputs, n_state
+from .core.integrator.tableaus import TABLEAUS
 from .errors import SceneError, SimulationError
-from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge,
-                      status_of)
-from .outputs import output_columns
+from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of)
+from .scene.outputs import output_columns
 from .precompile import start_helper, stop_helper
 from .prescribed_work import Motion, work_columns
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
@@ -95,7 +97,7 @@ def _compile(model, tab, cfg, bp) -> float:
         stepper.advance(model, layout.extras_of(model), tab, warm, bp, y,
                         np.zeros(sio.fst_size(model)), np.zeros(sio.N_IST, dtype=np.int64),
                         np.empty((1024, n_outputs(model))), np.empty((64, 4)),
-                        *stepper.buffers(model, tab, y.shape[0]))
+                        stepper.buffers(model, tab, y.shape[0]))
     finally:
         stop_helper(helper)
     return time.perf_counter() - t0
@@ -157,7 +159,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     try:
         while status == sio.RUNNING:
             status = stepper.advance(model, extras, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf,
-                                     *stepper.buffers(model, tab, y.shape[0]))
+                                     stepper.buffers(model, tab, y.shape[0]))
             switching = status == sio.FINISHED and y[layout.T] == switch_at
             block = {name: outbuf[: ist[sio.I_NOUT], j].copy() for j, name in enumerate(names)}
             ev = _events_by_name(evbuf[: ist[sio.I_NEV]], switching)
@@ -201,13 +203,13 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
                    f"applied moments in both directions ({why})")
     if status == sio.CHATTERING:
         event = sio.EVENT_NAMES[int(ist[sio.I_CHATTER_CODE])]
-        message = (f"chattering: {stepper.CHATTER_COUNT} state events in a row ({event}) without "
+        message = (f"chattering: {loop.CHATTER_COUNT} state events in a row ({event}) without "
                    f"progress at {at} (last sample {where})"
                    + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
                       f"sliding mode), the power-flow policy has one at every state"
                       if event == "pair_mode" and scene.friction.policy != "power-flow" else ""))
     if status == sio.STIFF:
-        message = (f"stiff at {at}: in {stepper.STIFF_COUNT} steps the estimate h·λ of the "
+        message = (f"stiff at {at}: in {loop.STIFF_COUNT} steps the estimate h·λ of the "
                    f"dominant eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
                    f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
                    f"the step (a governor or actuator far faster than the engine?)")
@@ -249,7 +251,7 @@ def switch_inertia(model, extra: float, y, ist):
     (the governor's branch, the generator's, the speed map's interval); returns the model with
     the extra inertia on the shaft (``J0``)."""
     angle_mode = ist[sio.I_ANGLE_MODE] == 1
-    J = forcing.inertia(model, y[layout.PHI], layout.work_array(model))
+    J = forcing.inertia(model, y[layout.PHI], work.work_array(model))
     w = forcing.speed(J, angle_mode, y)
     w_new = J * w / (J + extra)
     y[layout.W_LOAD] -= 0.5 * J * w * w - 0.5 * (J + extra) * w_new * w_new
@@ -286,7 +288,7 @@ def prescribed(scene, fuel: float = 1.0) -> RunData:
     full-load curve as the governor's command does, p = p_mot + fuel·(p_full − p_mot) (p_mot zero
     force for a force pulse): the tables' cubics are blended, so the ``p_<k>`` columns hold the
     pressure applied. A fuel below 1 for a model that cannot burn less (a table without its
-    motored curve, a compressor: :func:`transient.assemble.part_load_refusal`) is a SceneError.
+    motored curve, a compressor: :func:`transient.scene.queries.part_load_refusal`) is a SceneError.
     The work columns are integrated over the motion to the scene's tolerance
     (:mod:`.prescribed_work`)."""
     why = part_load_refusal(scene) if fuel != 1.0 else None

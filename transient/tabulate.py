@@ -1,4 +1,4 @@
-"""Build the tabulated reduced model of a scene (:mod:`transient.core.tabulated`), with an
+"""Build the tabulated reduced model of a scene (:mod:`transient.core.model.tabulated`), with an
 estimate of its error against the exact mechanism kernel.
 
 The grid is refined (doubling the number of intervals) until the largest relative deviation of
@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import PPoly, make_interp_spline
 
-from .core.forcing import mechanism_terms
+from .core.model.forcing import mechanism_terms
 
 #: Table sizes tried: 64, 128, … intervals per revolution.
 MIN_INTERVALS, MAX_INTERVALS = 64, 1 << 15
@@ -28,7 +28,7 @@ ERROR_FLOOR = 1e-14
 
 @dataclass(frozen=True)
 class KinematicsTable:
-    """Spline coefficients (``coef``, layout in :mod:`transient.core.tabulated`; None when the
+    """Spline coefficients (``coef``, layout in :mod:`transient.core.model.tabulated`; None when the
     target was not reached), the intervals per revolution and the estimated relative error."""
 
     coef: NDArray[np.float64] | None
@@ -66,7 +66,7 @@ def _tables(terms: NDArray[np.float64], ncyl: int, n: int) -> NDArray[np.float64
 
 def _error(coef, kind, mech, ncyl, scale) -> float:
     """Largest relative deviation from the exact kernel at the quarter points of every interval."""
-    from .core.tabulated import tabulated_terms
+    from .core.model.tabulated import tabulated_terms
 
     n = coef.shape[1]
     h = 2.0 * math.pi / n

@@ -7,7 +7,7 @@ time the user chooses — at install, or on each node of a cluster before a swee
 built-in scenes for a fraction of a revolution, and the user's scenes too where given; other
 commands compile a few small kernels of their own on first use (the kinematics tables of
 ``transient kinematics``, a loads analysis). The kernels come in two variants
-(:func:`transient.core.layout.extras_of`): the plain one that scenes without friction pairs,
+(:func:`transient.core.model.layout.extras_of`): the plain one that scenes without friction pairs,
 governor states, latched fuel, cylinder states, per-cylinder variation or a tabulated load run,
 and the full one that the others share (its Model's types do not depend on the features used);
 the built-in scenes compile both.

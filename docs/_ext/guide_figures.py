@@ -3,7 +3,7 @@ first run.
 
 * Mechanism sketches (:func:`crank_slider`, :func:`v_engine`, :func:`articulated`,
   :func:`swash_plate`): the bodies at a few angles placed by the mechanism's own kinematics
-  (``transient.core.crank_slider.slider``, ``transient.mechanisms.articulated.positions``,
+  (``transient.core.model.crank_slider.slider``, ``transient.mechanisms.articulated.positions``,
   ``transient.mechanisms.swash_plate.positions``) for a shipped case, with the symbols of its
   keys; each sketch checks what it draws (a rod keeps its length), so a sketch that no longer
   matches the model fails the build.
@@ -96,7 +96,7 @@ def _slider_points(mech, alpha):
     """Crankpin A and piston pin B of a crank-slider at local angle ``alpha``, in its cylinder's
     frame (axis up, x = e the axis' offset; the crank turns clockwise), from the kernel's
     ``slider``: B lies one rod length from A (checked)."""
-    from transient.core.crank_slider import slider
+    from transient.core.model.crank_slider import slider
 
     r, l, e = mech.crank_radius, mech.rod_length, mech.offset
     s, _, _, beta, _, _ = slider.py_func(alpha, r, l, e)
@@ -312,7 +312,7 @@ def eta_law():
     """A constant-η pair (the example's main bearings, η_forward 0.985, η_backward 0.98): the
     power it loses and the η* it applies against the power S·ω it takes from its shaft side,
     from the kernels' ``eta_star`` and ``pair_losses``."""
-    from transient.core.chain import eta_star, pair_losses
+    from transient.core.model.chain import eta_star, pair_losses
 
     eta_f, eta_b = 0.985, 0.98
     power = np.linspace(-50e3, 50e3, 401)  # S·ω [W] at ω = 100 rad/s

@@ -24,7 +24,7 @@ from matplotlib.ticker import MaxNLocator
 import transient
 from transient.analysis.orders import order_spectrum, to_angle_grid
 from transient.analysis.thermo import own_cycles
-from transient.assemble import gas_tables
+from transient.scene.queries import gas_tables
 from transient.plots import run_indicator_phi
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"

@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 
 import transient
 from transient import plots
-from transient.assemble import gas_table
+from transient.scene.queries import gas_table
 from transient.scene import scene_from_dict
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"

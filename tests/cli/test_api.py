@@ -101,9 +101,9 @@ def test_a_result_says_how_it_was_made_and_what_each_column_is(small, tmp_path):
 
 
 def test_every_column_a_run_can_write_is_described():
-    from transient.core import governor
-    from transient.core.layout import OUTPUTS, PAIR_OUTPUTS
-    from transient.outputs import describe
+    from transient.core.model import governor
+    from transient.core.model.layout import OUTPUTS, PAIR_OUTPUTS
+    from transient.scene.outputs import describe
 
     names = [*OUTPUTS, *(f"{c}_3" for c in PAIR_OUTPUTS), "p_2", "fuel_4", "M_drive", "W_drive",
              *(n for kind in governor.STATE_NAMES for n in kind)]

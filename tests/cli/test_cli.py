@@ -23,7 +23,7 @@ import pytest
 
 import transient
 import transient.core.stepper as stepper
-import transient.core.stepper_io as sio
+import transient.core.stepper.io as sio
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import to_toml
 
@@ -587,12 +587,12 @@ def interrupt_advance(monkeypatch, on_chunk: int):
     rows: list[int] = []
     calls = [0]
 
-    def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, *work):
+    def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         if outbuf.shape[0] == sim.BUFFER_ROWS:
             calls[0] += 1
             if calls[0] == on_chunk:
                 raise KeyboardInterrupt
-        status = real(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, *work)
+        status = real(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work)
         if outbuf.shape[0] == sim.BUFFER_ROWS:
             rows.append(int(ist[sio.I_NOUT]))
         return status

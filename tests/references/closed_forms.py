@@ -26,9 +26,10 @@ from sample_integrals import sample_integral_impl
 from scipy.integrate import quad
 
 from transient.analysis.summary import summarize
-from transient.assemble import build_model, gas_table
-from transient.core.forcing import inertia
-from transient.core.layout import work_array
+from transient.assemble import build_model
+from transient.scene.queries import gas_table
+from transient.core.model.forcing import inertia
+from transient.core.model.work import work_array
 from transient.run import integrate
 from transient.scene import load_scene
 from transient.scene.read import scene_from_dict

@@ -21,7 +21,7 @@ import numpy as np
 
 from transient.analysis.loads.crank_slider import slider_arrays
 from transient.analysis.orders import order_spectrum, piston_acceleration
-from transient.core.articulated import articulated_terms
+from transient.core.model.articulated import articulated_terms
 from transient.mechanisms import articulated as art
 
 from . import Comparison, Tolerance, case

@@ -31,7 +31,8 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, reject, settings
 from hypothesis import strategies as st
 
-from transient.verify.stress import balance_residual, balance_tolerance, base, nonfinite, put, scene_of
+from transient.verify.stress import (balance_residual, balance_tolerance, base, nonfinite, put,
+                                     scene_of)
 from transient.run import integrate
 
 FULL = os.environ.get("TRANSIENT_STRESS_FULL", "") not in ("", "0")
@@ -316,7 +317,7 @@ def test_governor_corner_compiled_against_reference():
 # A massless crank between two pairs with η = 1 makes both pairs' margins one function of the
 # state: their events fall within rounding of each other at the BDC, and a state left a hair
 # before the root would let each pair's switch undo the other's ("chattering" at φ = 180°; an
-# event's state is on the crossed side, transient.core.events._root). With a denormal crank
+# event's state is on the crossed side, transient.core.stepper.events._root). With a denormal crank
 # mass (2.2e-313 kg), a bracket for φ̈ divided by that link's inertia would overflow and hand
 # Brent a NaN (the reference path bounds it through ΣJ, transient.reference).
 MASSLESS_CRANK = {
@@ -350,7 +351,7 @@ def test_simultaneous_pair_switches_and_a_denormal_link(crank_mass):
 # margin below zero in its stages but not at its four samples, so only the fine search (64
 # samples) finds the event; and the switch it makes at 2π must not be taken for a touch and
 # undone a quarter step on (the rule looks for the rise first,
-# transient.core.events._fall_after_rise).
+# transient.core.stepper.events._fall_after_rise).
 SHORT_REVERSAL = {
     "mechanism": {"type": "crank-slider", "crank_radius_mm": 35.252687217558076,
                   "rod_length_mm": 144.42229924612502, "bore_mm": 50.0,

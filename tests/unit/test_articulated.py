@@ -16,7 +16,7 @@ import pytest
 from references import check_all, semenov
 
 from transient.cli import main
-from transient.core.articulated import articulated_terms
+from transient.core.model.articulated import articulated_terms
 from transient.mechanisms import articulated as art
 from transient.scene import scene_from_dict
 

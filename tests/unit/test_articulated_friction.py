@@ -1,5 +1,5 @@
 """Friction on the articulated mechanism's joint reactions
-(:mod:`transient.core.articulated_friction`) against the Newton–Euler model written separately in
+(:mod:`transient.core.model.articulated_friction`) against the Newton–Euler model written separately in
 numpy (:func:`transient.reference.articulated_joint_forces`: its own loop-closure kinematics, every
 body's equations of a row as one linear system with φ̈ among the unknowns, the friction iterated
 to a fixed point).
@@ -12,7 +12,7 @@ to a fixed point).
   two ways, so to rounding (bound 1e-12 of the largest force, of φ̈'s terms, × r for moments).
 * Without friction the reference's shaft torque at a prescribed φ̈ is the reduced model's
   Σ T = M_gas − J(φ)φ̈ − ½J′(φ)φ̇² (Lagrange, the kernel's J of
-  :func:`transient.core.articulated.articulated_terms`): an invariant between two models written
+  :func:`transient.core.model.articulated.articulated_terms`): an invariant between two models written
   apart, at many angles.
 * The breakpoints: no joint's relative rate changes sign between two of them.
 """
@@ -26,11 +26,12 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core import articulated as core
-from transient.core import articulated_friction as af
-from transient.core.joint_friction import R_LOSS, R_P
-from transient.core.layout import (N_JOINTS, N_RX_PAR, N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                                   RX_RING_PRESSURE, RX_VISCOUS, WK_AX, WK_ETA, WK_RX, WK_S)
+from transient.core.model import articulated as core
+from transient.core.model import articulated_friction as af
+from transient.core.model.joint_friction import R_LOSS, R_P
+from transient.core.model.layout import (N_JOINTS, N_RX_PAR, RX_MU, RX_RADIUS, RX_RING_FORCE,
+                                         RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model.work import N_WK
 from transient.mechanisms.articulated import _slave_rates
 from transient.reference import articulated_joint_forces
 from transient.scene import load_scene, to_toml
@@ -108,11 +109,11 @@ def test_the_solve_agrees_with_newton_euler(name):
         e_scale = (abs(M_gas) + abs(M_shaft) + abs(0.5 * dJ * w * w) + m) / (J + J0)
         masters = np.arange(rows) * (1 + ns)
         errs = (abs(eps - ref.epsilon) / e_scale,
-                np.max(np.abs(wk[WK_AX + af.A_N, :n] - ref.N)) / f,
-                np.max(np.abs(wk[WK_AX + af.A_FX, :n] - ref.big_end[0])) / f,
-                np.max(np.abs(wk[WK_AX + af.A_FY, :n] - ref.big_end[1])) / f,
-                np.max(np.abs(wk[WK_AX + af.A_FOX, masters] - ref.main[0])) / f,
-                np.max(np.abs(wk[WK_AX + af.A_FOY, masters] - ref.main[1])) / f,
+                np.max(np.abs(wk[WK_RX + af.A_N, :n] - ref.N)) / f,
+                np.max(np.abs(wk[WK_RX + af.A_FX, :n] - ref.big_end[0])) / f,
+                np.max(np.abs(wk[WK_RX + af.A_FY, :n] - ref.big_end[1])) / f,
+                np.max(np.abs(wk[WK_RX + af.A_FOX, masters] - ref.main[0])) / f,
+                np.max(np.abs(wk[WK_RX + af.A_FOY, masters] - ref.main[1])) / f,
                 np.max(np.abs(wk[WK_S, :N_JOINTS] - ref.S)) / m,
                 np.max(np.abs(wk[WK_RX + R_LOSS, :N_JOINTS] - ref.L)) / m)
         worst = max(worst, *errs)

@@ -173,7 +173,7 @@ def test_the_models_left_out_copy_matches_the_sources(tmp_path):
         text = (copy / "core" / name).read_text(encoding="utf-8")
         assert not re.search(r"(?<!False and )\bm\.(reaction|eta_table)\b", text), name
         assert "== st.STUCK" not in text, name
-    original = models_out.PACKAGE / "core" / "chain.py"
-    assert (copy / "core" / "chain.py").read_text(encoding="utf-8") == original.read_text(
+    original = models_out.PACKAGE / "core" / "model" / "chain.py"
+    assert (copy / "core" / "model" / "chain.py").read_text(encoding="utf-8") == original.read_text(
         encoding="utf-8")
 

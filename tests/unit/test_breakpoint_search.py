@@ -1,7 +1,7 @@
 """The breakpoint search by bisection against a plain scan over every breakpoint.
 
 A table from points makes every knot of every cylinder a breakpoint, so the stepper finds the
-next one by bisection (:func:`transient.core.breakpoints.next_breakpoint`) and the jump flag of
+next one by bisection (:func:`transient.core.stepper.breakpoints.next_breakpoint`) and the jump flag of
 the one it sits on near φ only (``_jumps_at``); both must answer what a scan of all of them
 answers, to the bit, at and around breakpoints and across the cycle's ends.
 """
@@ -12,7 +12,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from transient.core.breakpoints import BP_LANDING, _jumps_at, next_breakpoint
+from transient.core.stepper.breakpoints import BP_LANDING, _jumps_at, next_breakpoint
 
 PERIOD = 4.0 * math.pi
 

@@ -9,7 +9,7 @@ import pytest
 from scene_texts import SMALL
 
 from transient.cli import main
-from transient.outputs import output_columns
+from transient.scene.outputs import output_columns
 from transient.scene import load_scene
 from transient.scene.budget import RTOL_MIN, estimate
 

@@ -1,12 +1,12 @@
-"""The serial chain with non-ideal pairs (transient.core.chain) against (18), (22), (26)–(29) of
+"""The serial chain with non-ideal pairs (transient.core.model.chain) against (18), (22), (26)–(29) of
 Antonyuk et al. §3, an independent linear solve, the power balance and the power-flow claims."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from transient.core import chain
-from transient.core.chain import (
+from transient.core.model import chain
+from transient.core.model.chain import (
     AMBIGUOUS,
     LOCKED,
     NONE_CONSISTENT,

@@ -1,6 +1,6 @@
 """Crank-slider kinematics and reduced inertia (Gots ch. 1, §2.2, §2.5).
 
-Three independent checks of ``transient.core.crank_slider``:
+Three independent checks of ``transient.core.model.crank_slider``:
 
 * **finite differences** of the kernel's own outputs: s → ds → dds and β → dβ → ddβ of
   :func:`slider`, J → dJ of :func:`crank_slider_terms` and u = ds/dφ of every cylinder;
@@ -26,7 +26,7 @@ from math import asin, pi
 import numpy as np
 import pytest
 
-from transient.core import crank_slider as core
+from transient.core.model import crank_slider as core
 from transient.mechanisms.crank_slider import CrankSlider
 
 H = 1e-5

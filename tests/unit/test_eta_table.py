@@ -1,4 +1,4 @@
-"""Efficiency maps η(|ω|, |S|) in the serial chain (transient.core.eta_table): the bilinear map
+"""Efficiency maps η(|ω|, |S|) in the serial chain (transient.core.model.eta_table): the bilinear map
 against scipy's interpolator, the exact solve against the sub-chain equations, a closed form (a
 map linear in S makes S solve a quadratic), enumeration of every mode vector (exactly one is
 power-flow consistent) and the constant-η chain, which a constant map reproduces bit for bit."""
@@ -9,8 +9,8 @@ import pytest
 from scipy.interpolate import RegularGridInterpolator
 
 from transient.assemble import pack_maps
-from transient.core import eta_table as et
-from transient.core.chain import chain_solve, eta_star, modes_power_flow
+from transient.core.model import eta_table as et
+from transient.core.model.chain import chain_solve, eta_star, modes_power_flow
 from transient.errors import SceneError
 from transient.scene.eta_map import check_map
 

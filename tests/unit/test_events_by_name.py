@@ -2,7 +2,7 @@
 row-by-row grouping it replaced (the events' order within a name kept)."""
 import numpy as np
 
-from transient.core import stepper_io as sio
+from transient.core.stepper import io as sio
 from transient.run import _events_by_name
 
 

@@ -1,6 +1,6 @@
 """The general serial chain from a scene: constant-η pairs between any neighbouring links of a
 mechanism (crank-slider ``shaft`` – ``crank`` – ``rod`` – ``piston`` – ``cylinder``), each
-passing on the power it really transmits (``transient.core.rhs.split_subchains``).
+passing on the power it really transmits (``transient.core.model.rhs.split_subchains``).
 
 Independent checks:
 
@@ -30,8 +30,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from transient.assemble import build_model
-from transient.core import forcing, inverse, layout, rhs
-from transient.core.chain import UNIQUE
+from transient.core.model import forcing, inverse, layout, rhs, work
+from transient.core.model.chain import UNIQUE
 from transient.errors import SceneError
 from transient.run import integrate
 from transient.scene import Friction, Pair, load_scene
@@ -186,7 +186,7 @@ def own_acceleration(phi, omega, pairs=tuple(ETA), check_unique=True):
 def compiled_at(model, phi, omega):
     """φ̈, the sub-chains' J, J′, M and the pairs' S, η* of the compiled model at (φ, ω), with
     the modes it chooses there."""
-    wk = layout.work_array(model)
+    wk = work.work_array(model)
     ex = layout.extras_of(model)
     y = np.zeros(layout.n_state(model))
     y[layout.PHI], y[layout.OMEGA] = phi, omega

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from transient.assemble import cycle_figures
+from transient.scene.queries import cycle_figures
 from transient.cli import main
-from transient.core import crank_slider as cs_core
+from transient.core.model import crank_slider as cs_core
 from transient.mechanisms import articulated as art
 from transient.mechanisms import swash_plate as sp
 from transient.mechanisms.crank_slider import CrankSlider

@@ -135,3 +135,66 @@ def test_constants_passed_to_a_kernel_share_its_machine_code(tmp_path, monkeypat
     assert caller(5) == 2 * (3 + 4 + 5 + 1)
     assert [str(sig) for sig in double.signatures] == ["(int64,)", "(bool,)"], (
         f"transient.core.jit._compile_per_type: {double.signatures} (compiled once per constant?)")
+
+
+KERNELS_AS_VALUES = """
+from transient.core.jit import compiled, kernel
+
+
+@kernel(inline=True)
+def square(ctx, x):
+    return ctx[0] * x * x
+
+
+@kernel(inline=True)
+def cube(ctx, x):
+    return ctx[0] * x * x * x
+
+
+@kernel
+def apply(f, ctx, x):
+    return f(ctx, x)
+
+
+@compiled
+def both(x):
+    return apply(square, (2.0,), x) + apply(cube, (1.0,), x)
+"""
+
+LOAD_BOTH = """
+import importlib.util, os, sys
+spec = importlib.util.spec_from_file_location("kernarg", sys.argv[1])
+module = sys.modules["kernarg"] = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+if sys.argv[2] == "fresh":  # (only the callee's cache left: both compiles, apply loads)
+    for name in os.listdir(module.both._cache._cache_path):
+        if name.startswith("kernarg.both"):
+            os.remove(os.path.join(module.both._cache._cache_path, name))
+assert module.both(3.0) == 2.0 * 9.0 + 27.0
+for d in (module.both, module.apply):
+    print(sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values()))
+"""
+
+
+def test_a_function_taking_kernels_as_arguments_is_cached_across_processes(tmp_path):
+    """A kernel passed as an argument (the model's derivative to the integrator) types by its
+    module and name (``jit._KernelArgument``): the callee compiled for it is found in the cache
+    by another process, once per kernel, and the caller, which passes it as a constant without
+    its address, is cached too."""
+    source = tmp_path / "kernarg.py"
+    source.write_text(KERNELS_AS_VALUES)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+
+    def run(mode):
+        done = subprocess.run([sys.executable, "-W", "error::numba.NumbaWarning", "-c",
+                               LOAD_BOTH, str(source), mode], env=env, capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        return [tuple(map(int, line.split())) for line in done.stdout.splitlines()]
+
+    assert run("first") == [(0, 1), (0, 2)]  # both compiled, apply for each kernel
+    assert run("again") == [(1, 0), (0, 0)]  # both loaded (no dynamic address in it)
+    assert run("fresh") == [(0, 1), (2, 0)]  # both compiled anew, apply's two loaded
+    index = [n for n in os.listdir(tmp_path / "numba" / "kernarg") if n.startswith("kernarg.apply")
+             and n.endswith(".nbc")]
+    assert len(index) == 2  # (one entry per kernel, not one per process)

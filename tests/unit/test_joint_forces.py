@@ -6,7 +6,7 @@ eight linear equations per cylinder and sample, kinematics of its own) against
   the crankpin load R_K, R_T, the throw's torque on the shaft, and, summed over the throws of an
   in-line engine, the main-journal loads of (58) (their sum is the shaft's bearing load);
 * the reduced model (Lagrange): the throw torque equals P_g s′ − J ε − ½ J′ ω² with J, J′ of the
-  compiled :func:`transient.core.crank_slider.cylinder_terms`;
+  compiled :func:`transient.core.model.crank_slider.cylinder_terms`;
 * the power balance with known joint moments: for the same motion, the throw's torque on the
   shaft changes by the moments' power over ω.
 
@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from transient.analysis.loads import crank_slider as L
-from transient.core import crank_slider as core
+from transient.core.model import crank_slider as core
 from transient.reference import crank_slider_joint_forces
 
 from engines import MECHS

@@ -1,11 +1,11 @@
-"""Friction on the crank-slider's joint reactions (:mod:`transient.core.joint_friction`) against
+"""Friction on the crank-slider's joint reactions (:mod:`transient.core.model.joint_friction`) against
 the Newton–Euler model written separately in numpy
 (:func:`transient.reference.crank_slider_joint_forces`, eight linear equations per cylinder with
 known joint moments).
 
 The reference knows nothing of friction: its joint moments and the slider's axial force are
 computed from its own joint forces by the friction laws written out again in numpy
-(:func:`transient.reference.crank_slider_friction_laws`), and iterated to a fixed point (plain
+(:func:`transient.reference.joints.crank_slider_friction_laws`), and iterated to a fixed point (plain
 substitution; the friction changes the forces by a few per mille, so the
 iteration contracts by about that factor each turn and 60 turns are far past rounding). Then, at
 many states of three mechanisms (central two-mass, offset two-mass, offset rigid rod; speeds
@@ -15,7 +15,7 @@ identities computed two ways, so to rounding (bound 1e-12 of the largest force, 
 
 The exact solve of the shaft's equation: at the compiled φ̈ the reference's throw torques leave
 J₀ φ̈ − M_shaft − Σ T = 0 to rounding; with every coefficient zero the solve gives the reduced
-model's φ̈ = (M − ½J′ω²)/J (Lagrange: J, J′ of :func:`transient.core.crank_slider.cylinder_terms`).
+model's φ̈ = (M − ½J′ω²)/J (Lagrange: J, J′ of :func:`transient.core.model.crank_slider.cylinder_terms`).
 
 Where a step's stages see a side force change side, the step end the stepper aims at is the
 root of N between the nearest stages of either side: exact for a linear N, checked against the
@@ -30,11 +30,12 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core import crank_slider as core
-from transient.core import joint_friction as jf
-from transient.core.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, N_JOINTS,
-                                   N_RX_PAR, N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                                   RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model import crank_slider as core
+from transient.core.model import joint_friction as jf
+from transient.core.model.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER,
+                                         N_JOINTS, N_RX_PAR, RX_MU, RX_RADIUS, RX_RING_FORCE,
+                                         RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model.work import N_WK
 from transient.reference import crank_slider_friction, crank_slider_joint_signs
 from transient.scene import load_scene, to_toml
 
@@ -204,7 +205,7 @@ def test_every_reversal_of_a_joint_is_a_breakpoint_where_the_derivative_jumps():
 def stage_abscissae(x0, h):
     """The abscissae at which a DOP853 attempt from x0 of size h evaluates the right-hand side:
     its stages after the first (carried over) and the step's end."""
-    from transient.core.tableaus import TABLEAUS
+    from transient.core.integrator.tableaus import TABLEAUS
 
     tab = TABLEAUS["dop853"]
     return x0 + h * tab.A[1: tab.n_stages + 1].sum(axis=1)

@@ -22,8 +22,9 @@ import pytest
 from scene_texts import SMALL, check_text
 
 from transient.assemble import build_model
-from transient.core import forcing
-from transient.core import layout
+from transient.core.model import forcing
+from transient.core.model import layout
+from transient.core.model import work
 from transient.scene import Load, load_scene, scene_from_dict, to_toml
 
 # the small scene from 30°, with the default output
@@ -239,7 +240,7 @@ def moments_load(m, w, seg=0, gen_low=0, x=0.0):
     sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
     sw[layout.SW_LOAD] = seg
     sw[layout.SW_GENERATOR] = gen_low
-    return forcing.moments(m, layout.extras_of(m), False, y, 0.0, sw, layout.work_array(m), True)[4]
+    return forcing.moments(m, layout.extras_of(m), False, y, 0.0, sw, work.work_array(m), True)[4]
 
 
 def test_default_load_moment_is_the_formula_bit_for_bit():

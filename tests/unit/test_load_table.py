@@ -10,7 +10,7 @@ twin.
   periodic curve over the cycle C¹ across the cycle's end; values held beyond a speed or time
   table; no overshoot on data with a corner, where a cubic spline overshoots.
 * The model: the angle table's points are breakpoints, a time table's knots load corners with
-  the schedule's scale there; :func:`transient.core.forcing.table_load` equals the numpy twin
+  the schedule's scale there; :func:`transient.core.model.forcing.table_load` equals the numpy twin
   :meth:`LoadCurve.evaluate` to rounding, and M_load of ``moments`` is −s·T(x).
 """
 from __future__ import annotations
@@ -23,9 +23,10 @@ import pytest
 from scene_texts import SMALL, check_text
 
 from transient.assemble import build_model, load_table_curve
-from transient.core import forcing
-from transient.core.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI, SW_LOAD_TABLE,
-                                   T, extras_of, work_array)
+from transient.core.model import forcing
+from transient.core.model.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI,
+                                         SW_LOAD_TABLE, T, extras_of)
+from transient.core.model.work import work_array
 from transient.forces.load_table import interpolant, load_curve
 from transient.scene import LoadTable, load_scene, to_toml
 

@@ -1,7 +1,7 @@
 """Forces along a trajectory, :mod:`transient.analysis.loads.crank_slider` (Gots
 §2.3–§2.8): identities that hold exactly, so the bounds are round-off bounds.
 
-* the vectorised kinematics against the compiled :func:`transient.core.crank_slider.slider`;
+* the vectorised kinematics against the compiled :func:`transient.core.model.crank_slider.slider`;
 * **the ε term**: P_j = −m_j d²s/dt² against a finite difference of the piston velocity
   ds/dt = s′(φ(t)) φ̇(t) along a synthetic motion with a strongly varying speed;
 * **force balance** in Gots' convention: S cos β = P, N = P tan β = S sin β, K = S cos(α+β),
@@ -27,7 +27,7 @@ import pytest
 
 from transient.analysis.loads import crank_slider as L
 from transient.analysis.loads.common import gas_forces, rod_split
-from transient.core import crank_slider as core
+from transient.core.model import crank_slider as core
 
 from engines import MECHS, gots_mech
 
@@ -202,7 +202,7 @@ def test_torque_power_equals_piston_power(name):
 @pytest.mark.parametrize("name", list(MECHS))
 def test_torque_equals_the_reduced_model(name):
     """r(T + T_rш + T_rk) = P_g s′ − J ε − ½ J′ ω² per cylinder, J and J′ from the compiled
-    :func:`transient.core.crank_slider.cylinder_terms` (Lagrange; rigid rod: the couple ΔI β̈)."""
+    :func:`transient.core.model.crank_slider.cylinder_terms` (Lagrange; rigid rod: the couple ΔI β̈)."""
     mech = MECHS[name]
     mp = mech.pack()
     phi, omega, eps = motion(T_GRID)
@@ -301,7 +301,7 @@ def test_running_torques():
 
 def test_gas_forces_and_trajectory():
     """Gas forces read from the scene's tables at φ − gas_phases, and from a trajectory's p_k."""
-    from transient.assemble import gas_phases, gas_table, gas_tables
+    from transient.scene.queries import gas_phases, gas_table, gas_tables
     from transient.scene import load_scene
 
     scene = load_scene(Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_4400.toml")

@@ -33,8 +33,8 @@ import pytest
 from transient.analysis.loads import crank_slider as L
 from transient.analysis.loads.articulated import articulated_loads, row_kinematics
 from transient.analysis.loads.swash_plate import swash_kinematics, swash_loads
-from transient.core import swash_plate as swash_core
-from transient.core.articulated import articulated_terms
+from transient.core.model import swash_plate as swash_core
+from transient.core.model.articulated import articulated_terms
 from transient.mechanisms import articulated as art
 from transient.mechanisms import swash_plate as sp
 from transient.mechanisms.crank_slider import CrankSlider

@@ -1,4 +1,4 @@
-"""The serial chain inside the compiled model (``transient.core.rhs``): how a mechanism's links
+"""The serial chain inside the compiled model (``transient.core.model.rhs``): how a mechanism's links
 become sub-chains, the right-hand side with held pair modes, the forward/inverse consistency of the
 chain, and the choice of modes at a state."""
 from __future__ import annotations
@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core import forcing
-from transient.core import inverse
-from transient.core import layout
-from transient.core import rhs
-from transient.core.chain import LOCKED, UNIQUE
+from transient.core.model import forcing
+from transient.core.model import inverse
+from transient.core.model import layout
+from transient.core.model import rhs
+from transient.core.model import work
+from transient.core.model.chain import LOCKED, UNIQUE
 from transient.scene import Friction, Pair, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -35,7 +36,7 @@ def state(model, phi, omega):
 
 def forward(model, phi, omega, modes):
     """φ̈, J, dJ and the per-sub-chain terms at a time-domain state with held ``modes``."""
-    wk = layout.work_array(model)
+    wk = work.work_array(model)
     sw = np.array([0, 0, modes, 1 if omega >= 0 else -1])
     y = state(model, phi, omega)
     J, dJ, w, Mg, Ml, Ms = forcing.moments(model, layout.extras_of(model), False, y, phi, sw, wk,
@@ -107,7 +108,7 @@ def test_inverse_chain_recovers_the_forward_motion():
     model, _, _ = build_model(gots())
     n = model.n_pairs
     for phi, omega in zip(RNG.uniform(0, 4 * math.pi, 40), RNG.uniform(-500, 500, 40)):
-        wk = layout.work_array(model)
+        wk = work.work_array(model)
         y = state(model, phi, omega)
         sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
         assert rhs.choose_modes(model, layout.extras_of(model), False, y, phi, sw, wk) == UNIQUE
@@ -128,7 +129,7 @@ def test_modes_chosen_at_a_state_follow_the_policy(policy):
     model, _, _ = build_model(gots(policy=policy))
     n = model.n_pairs
     for phi, omega in zip(RNG.uniform(0, 4 * math.pi, 40), RNG.uniform(-500, 500, 40)):
-        wk = layout.work_array(model)
+        wk = work.work_array(model)
         y = state(model, phi, omega)
         sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
         rhs.choose_modes(model, layout.extras_of(model), False, y, phi, sw, wk)
@@ -151,7 +152,7 @@ def test_locked_at_rest_when_friction_holds_starter_against_compression():
     model, _, _ = build_model(base)
     phi = 1.5  # cylinder 3 compressing (its firing TDC at 120°)
     y = state(model, phi, 0.0)
-    wk = layout.work_array(model)
+    wk = work.work_array(model)
     sw = np.zeros(layout.N_SWITCHES, dtype=np.int64)
     _, _, _, Mg, _, _ = forcing.moments(model, layout.extras_of(model), False, y, phi, sw, wk, True)
     assert Mg < 0  # the gas resists forward motion here

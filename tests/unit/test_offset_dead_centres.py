@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scene_texts import MIXED_CYCLE, SMALL
 
-from transient.assemble import clearance_volume, gas_table
+from transient.scene.queries import clearance_volume, gas_table
 from transient.cli import main
 from transient.forces.gas import mixed_cycle
 from transient.scene import load_scene

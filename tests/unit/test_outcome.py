@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from transient.errors import SimulationError
-from transient.outcome import (IDLE_CHUNKS, STATUSES, RunStopped, Watch, code_status,
-                               failure_cause, status_in, status_of)
+from transient.outcome import (IDLE_CHUNKS, STATUSES, RunStopped, Watch, code_status, failure_cause,
+                               status_in, status_of)
 
 
 def scene(omega0=100.0, budget=4e9, policy="power-flow", pairs=(), revolutions=math.inf,
@@ -299,7 +299,7 @@ def test_negative_losses_of_paper_pairs_are_a_warning():
 
 
 def test_statuses_from_codes_messages_and_exceptions():
-    from transient.core import stepper_io as sio
+    from transient.core.stepper import io as sio
 
     assert code_status(sio.FINISHED) == "finished" and code_status(sio.RUNNING) == "interrupted"
     assert code_status(sio.FAIL_STEP) == code_status(sio.FAIL_NONFINITE) == "failed"

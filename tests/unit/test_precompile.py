@@ -12,8 +12,9 @@ from numba import config, types
 
 from transient import precompile
 from transient.assemble import build_model
-from transient.core import breakpoints, jit
-from transient.core.tableaus import TABLEAUS
+from transient.core.stepper import breakpoints
+from transient.core import jit
+from transient.core.integrator.tableaus import TABLEAUS
 from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -89,7 +90,7 @@ def test_stop_helper_ends_the_process(monkeypatch, tmp_path):
 
 def test_the_stepper_counts_as_cached_in_the_models_variant_only(monkeypatch):
     """A cache holding the stepper's plain variant leaves a scene of the full variant to compile
-    with the helper's help, and the other way round (:func:`transient.core.layout.extras_of`)."""
+    with the helper's help, and the other way round (:func:`transient.core.model.layout.extras_of`)."""
     plain, tab = _model_and_tableau()
     full = build_model(load_scene(CASES / "gots_diesel_friction.toml"))[0]
     saved = {}

@@ -630,7 +630,7 @@ def test_invalid_swash_reaction_pair_is_one_line_exit_2(tmp_path, capsys, name, 
 
 def test_swash_reaction_pairs_run_on_the_reference_path(tmp_path, capsys):
     """The reference path has the swash plate's reaction friction
-    (:class:`transient.reference.SwashReactionNumpy`): the scene passes the check with a scipy-*
+    (:class:`transient.reference.twins.SwashReactionNumpy`): the scene passes the check with a scipy-*
     method and runs there, every pair losing energy (the agreement with the compiled path is
     ``tests/validation/test_reference_path.py``'s)."""
     text = SWASH_REACTION

@@ -1,11 +1,11 @@
-"""Friction on the swash plate's joint reactions (:mod:`transient.core.swash_friction`) against
+"""Friction on the swash plate's joint reactions (:mod:`transient.core.model.swash_friction`) against
 the Newton–Euler model written separately in numpy
 (:func:`transient.reference.swash_plate_reactions`: every body's equations one linear system, the kinematics from positions and rotation matrices;
 :func:`transient.reference.swash_plate_friction` closes the friction laws, written out again
 there, by ``scipy.optimize.fsolve``).
 
 * Without friction the reference's torque on the plates equals the reduced model's
-  J ε + ½J′ω² − Σ P u (Lagrange, :func:`transient.core.swash_plate.swash_terms`, written apart
+  J ε + ½J′ω² − Σ P u (Lagrange, :func:`transient.core.model.swash_plate.swash_terms`, written apart
   from both), and the compiled solve's φ̈ is (M − ½J′ω²)/J: bound 1e-12 of the terms.
 * With friction, at many states of five mechanisms (both hinges, a rigid rod, two halves with an
   anisotropic link 9, five cylinders; speeds both ways, gas forces of both signs), the compiled
@@ -24,10 +24,11 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core import swash_friction as sf
-from transient.core import swash_plate as core
-from transient.core.layout import (N_JOINTS, N_RX_PAR, N_WK, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                                   RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model import swash_friction as sf
+from transient.core.model import swash_plate as core
+from transient.core.model.layout import (N_JOINTS, N_RX_PAR, RX_MU, RX_RADIUS, RX_RING_FORCE,
+                                         RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model.work import N_WK
 from transient.mechanisms.swash_plate import antonyuk_example, dead_centres
 from transient.reference import swash_plate_friction, swash_plate_motion, swash_plate_reactions
 from transient.scene import load_scene, to_toml

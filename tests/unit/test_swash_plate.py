@@ -11,7 +11,7 @@ import pytest
 from references import antonyuk, check_all
 from references.antonyuk import D6, angular_velocity, derivative, paper_13
 
-from transient.core import swash_plate as core
+from transient.core.model import swash_plate as core
 from transient.errors import SceneError
 from transient.mechanisms import swash_plate as sp
 

@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.core import swash_plate as core
-from transient.core.layout import SWASH_PLATE
+from transient.core.model import swash_plate as core
+from transient.core.model.layout import SWASH_PLATE
 from transient.errors import SceneError
 from transient.forces.gas import mixed_cycle
 from transient.mechanisms import swash_plate as sp

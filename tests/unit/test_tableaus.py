@@ -1,5 +1,5 @@
-"""The Runge–Kutta pairs of :mod:`transient.core.tableaus` and the dense-output layout of
-:mod:`transient.core.rk`, against SciPy's independent implementations (``RK45`` with its
+"""The Runge–Kutta pairs of :mod:`transient.core.integrator.tableaus` and the dense-output layout of
+:mod:`transient.core.integrator.rk`, against SciPy's independent implementations (``RK45`` with its
 own interpolant matrix P, ``DOP853``): one step of the same size on a nonlinear system must give
 the same new state, the same error estimate's size and the same dense output.
 """
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from scipy.integrate import DOP853, RK45
 
-from transient.core.rk import _dense_eval
-from transient.core.tableaus import TABLEAUS
+from transient.core.integrator.rk import dense_eval
+from transient.core.integrator.tableaus import TABLEAUS
 
 SCIPY = {"dopri5": RK45, "dop853": DOP853}
 
@@ -22,7 +22,7 @@ def pendulum(t, y):
 
 def one_step(tab, y0, h):
     """Stages, new state and dense-output rows F of one step, following the layout documented in
-    :mod:`transient.core.tableaus` (written here in numpy, independently of the compiled loop)."""
+    :mod:`transient.core.integrator.tableaus` (written here in numpy, independently of the compiled loop)."""
     K = np.zeros((tab.n_ext, y0.size))
     K[0] = pendulum(0.0, y0)
     for s in range(1, tab.n_ext):
@@ -59,7 +59,7 @@ def test_step_and_dense_output_match_scipy(name):
     sol = solver.dense_output()
     out = np.empty(2)
     for theta in (0.0, 0.13, 0.5, 0.77, 1.0):
-        _dense_eval(F, y0, theta, out)
+        dense_eval(F, y0, theta, out)
         np.testing.assert_allclose(out, sol(theta * h), rtol=1e-13, atol=1e-15,
                                    err_msg=f"{name} at θ = {theta}")
 
@@ -79,7 +79,7 @@ def test_dense_output_order(name):
         ref = solve_ivp(pendulum, (0.0, 0.5 * h), y0, method="DOP853", rtol=1e-13,
                         atol=1e-15).y[:, -1]
         out = np.empty(2)
-        _dense_eval(F, y0, 0.5, out)
+        dense_eval(F, y0, 0.5, out)
         errs.append(np.max(np.abs(out - ref)))
     order = np.log2(errs[0] / errs[1])
     print(f"{name}: midpoint errors {errs}, order {order:.2f}")

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from transient.core.tables import find_piece, table_eval, table_value, wrap_angle
+from transient.core.model.tables import find_piece, table_eval, table_value, wrap_angle
 from transient.errors import SceneError
 from transient.forces.gas import PressureTable, table_from_function, table_from_points
 

@@ -1,4 +1,4 @@
-"""The tabulated reduced model (:mod:`transient.tabulate`, :mod:`transient.core.tabulated`)
+"""The tabulated reduced model (:mod:`transient.tabulate`, :mod:`transient.core.model.tabulated`)
 against the exact kernels: values at angles the error estimate never looked at, derivatives by
 finite differences of the tables themselves, the refinement rule; runs with the tables are in
 ``tests/validation/test_tabulated_runs.py``."""
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.core.tabulated import tabulated_terms
+from transient.core.model.tabulated import tabulated_terms
 from transient.errors import SceneError
 from transient.scene import load_scene
 from transient.tabulate import MIN_INTERVALS, build_table, exact_terms

@@ -36,7 +36,7 @@ import numpy as np
 import pytest
 
 from transient.analysis.loads import crank_slider as L
-from transient.core import crank_slider as core
+from transient.core.model import crank_slider as core
 from transient.mechanisms.crank_slider import CrankSlider
 from transient.mechanisms.twins import CrankSliderNumpy
 from transient.reference import crank_slider_joint_forces

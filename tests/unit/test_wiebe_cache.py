@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.assemble import build_model, wiebe_levels
+from transient.assemble import build_model
+from transient.scene.queries import wiebe_levels
 from transient.core import CACHE_DIR_VARIABLE, source_hash
 from transient.errors import SceneError
 from transient.forces import wiebe_cache

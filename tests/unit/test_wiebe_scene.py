@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.assemble import build_model, gas_tables, wiebe_levels
+from transient.assemble import build_model
+from transient.scene.queries import gas_tables, wiebe_levels
 from transient.cli import main
 from transient.errors import SceneError
 from transient.forces.wiebe import WiebeCycle, wiebe_cycle
@@ -259,7 +260,7 @@ def test_paired_table_on_different_knots():
     """Two curves with different knots and corners go onto the union of both, each re-expanded
     exactly; the compiled pair look-up agrees with each table's numpy evaluation."""
     from transient.assemble import paired_table
-    from transient.core.tables import find_piece, table_eval, table_eval_pair
+    from transient.core.model.tables import find_piece, table_eval, table_eval_pair
     from transient.forces.gas import table_from_points
 
     period = 4 * math.pi

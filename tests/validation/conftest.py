@@ -24,7 +24,7 @@ def table_end_events_impl(data, scene, tol: float = 1e-6):
     (local angle 0 ≡ the cycle's end): the only corners of a smooth table's curve. Every other
     knot of a table from points is a breakpoint too, but the curve is C² there, so a quadrature
     of the samples needs no cut. ``tol`` [rad] covers a landing in time (to 1e-7 rad)."""
-    from transient.assemble import gas_phases
+    from transient.scene.queries import gas_phases
 
     ev = np.asarray(data.events.get("breakpoint", np.zeros((0, 2)))).reshape(-1, 2)
     period = scene.mechanism.cycle

@@ -1,5 +1,5 @@
 """Runs of the radial with friction on its joints' reactions
-(:mod:`transient.core.articulated_friction`, ``cases/radial_5cyl_reaction_friction.toml``), checked
+(:mod:`transient.core.model.articulated_friction`, ``cases/radial_5cyl_reaction_friction.toml``), checked
 against what holds independently of the friction model:
 
 * **Work–energy balance** in a spin-up with time as the independent variable throughout:
@@ -11,7 +11,7 @@ against what holds independently of the friction model:
 * **The case**: its steady budget closes and names the pair that loses most, the pistons.
 * **Prescribed speed** (inverse dynamics): the drive torque and each pair's S and loss are the
   Newton–Euler reference's at every state checked, to rounding.
-* **At rest** (the stuck mode, :mod:`transient.core.stuck`): without gas, the joints' friction
+* **At rest** (the stuck mode, :mod:`transient.core.model.stuck`): without gas, the joints' friction
   holds a drive between M₋ and M₊, computed by the independent static Newton–Euler
   (:func:`transient.reference.articulated_joint_forces` at ω = φ̈ = 0 with the friction opposing
   σ = ±1); a drive ramping past M₊ (past M₋) releases the shaft forward (backward) at the instant
@@ -31,9 +31,8 @@ from transient.run import integrate, prescribed
 from transient.reference import articulated_joint_forces
 from transient.scene import Gas, Initial, Output, Run, Starter, load_scene
 
-from balances import (check_release_at_holds, check_zero_friction_is_ideal, closure,
-                      dense_spin_up, gas_forces_at_rest, loss_is_share_of_transmitted,
-                      losses_nonnegative)
+from balances import (check_release_at_holds, check_zero_friction_is_ideal, closure, dense_spin_up,
+                      gas_forces_at_rest, loss_is_share_of_transmitted, losses_nonnegative)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 CASE = CASES / "radial_5cyl_reaction_friction.toml"

@@ -1,4 +1,4 @@
-"""Work–energy balance of a two-inertia gear with one non-ideal pair (transient.core.chain):
+"""Work–energy balance of a two-inertia gear with one non-ideal pair (transient.core.model.chain):
 ΔKE = W_in − W_out − W_loss with the loss integrated as an extra state, in forward and backward
 power flow, and the locking case at rest."""
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from transient.core.chain import LOCKED, UNIQUE, modes_power_flow
+from transient.core.model.chain import LOCKED, UNIQUE, modes_power_flow
 
 I_A, I_B, RATIO = 0.8, 2.5, 0.4  # shaft inertia, load inertia [kg m²], u = φ̇_b/φ̇_a (constant)
 ETA_F, ETA_B = 0.85, 0.7

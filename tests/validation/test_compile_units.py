@@ -1,7 +1,7 @@
 """The stepper's compile units (:func:`transient.core.jit.kernel`): every kernel is compiled on its
 own, and LLVM inlines those marked ``inline=True`` (the per-step work: the right-hand side, the
 step, the pieces of the loop) at each call site, so that no call copies the Model's flattened
-fields on the hot path; and the kernels' plain variant (:func:`transient.core.layout.extras_of`)
+fields on the hot path; and the kernels' plain variant (:func:`transient.core.model.layout.extras_of`)
 changes no result of a scene it serves. (That a plain scene's run compiles none of the other
 variant's feature kernels is checked on an empty cache in ``tests/cli/test_warmup.py``.)"""
 from __future__ import annotations
@@ -11,7 +11,9 @@ from dataclasses import replace
 import numpy as np
 
 from transient.assemble import build_model
-from transient.core import jit, layout, rk, stepper
+from transient.core import jit, stepper
+from transient.core.model import layout
+from transient.core.integrator import rk
 from transient.run import simulate
 from transient.scene import load_scene
 
@@ -34,7 +36,7 @@ def test_the_stepper_calls_no_kernel_marked_inline():
     assert len(inlined) > 50  # (the right-hand side, the step, the loop's pieces, …)
     assert [n for n in names if n.startswith(inlined)] == []
     # a kernel left a call (the dense output: run when output or an event needs it) is seen
-    assert any(n.startswith(jit._symbol_prefix(rk._dense.py_func)) for n in names)
+    assert any(n.startswith(jit._symbol_prefix(rk.dense.py_func)) for n in names)
 
 
 def test_a_plain_scene_runs_the_same_in_either_variant(monkeypatch):

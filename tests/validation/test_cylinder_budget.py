@@ -25,7 +25,7 @@ import pytest
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.outputs import cylinder_loss_column
+from transient.scene.outputs import cylinder_loss_column
 from transient.run import integrate
 from transient.scene import Cylinder, Friction, Output, Pair, Run, load_scene
 

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from transient.core.crank_slider import crank_slider_terms
+from transient.core.model.crank_slider import crank_slider_terms
 from transient.scene import Gas, Initial, Load, Output, Run, Solver, load_scene
 from transient.run import integrate
 

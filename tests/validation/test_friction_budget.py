@@ -35,7 +35,7 @@ import pytest
 from transient.analysis.efficiency import (chen_flynn_fmep, displacement, mean_piston_speed,
                                            mechanical_efficiency)
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.assemble import gas_table
+from transient.scene.queries import gas_table
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, load_scene
 from transient.study.efficiency import point_scene

@@ -20,10 +20,11 @@ import pytest
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
-from transient.core.chain import LOCKED, modes_power_flow
-from transient.core.forcing import moments
-from transient.core.layout import WK_DJ, WK_J, WK_M, extras_of, work_array
-from transient.core.rhs import split_subchains
+from transient.core.model.chain import LOCKED, modes_power_flow
+from transient.core.model.forcing import moments
+from transient.core.model.layout import WK_DJ, WK_J, WK_M, extras_of
+from transient.core.model.work import work_array
+from transient.core.model.rhs import split_subchains
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 from transient.run import integrate, prescribed
 

@@ -27,8 +27,8 @@ import numpy as np
 import pytest
 from references import check_all, closed_forms, gots, read_table
 
-from transient.assemble import gas_phases
-from transient.core import crank_slider as core
+from transient.scene.queries import gas_phases
+from transient.core.model import crank_slider as core
 from transient.scene import load_scene
 
 

@@ -1,7 +1,7 @@
 """Dynamic governors and fuel latching: the PI governor's zero steady error and its
 anti-windup, the flyweight governor's stops and static characteristic, the latching of each
 cylinder's fuel at its start of injection, and the compiled path against the reference path
-(whose governor is written out again in numpy, ``transient.reference.GovernorNumpy``).
+(whose governor is written out again in numpy, ``transient.reference.twins.GovernorNumpy``).
 
 Scenes: ``cases/gots_diesel_pi.toml`` (PI, generator load steps, crankpins with friction, fuel
 latched 15° before each firing TDC) and ``cases/gots_diesel_start_flyweight.toml`` (flyweight

@@ -17,7 +17,7 @@ from references import check_all, gots, read_table
 
 from transient.analysis.loads import crank_slider as L
 from transient.analysis.loads.common import rod_split
-from transient.assemble import gas_phases
+from transient.scene.queries import gas_phases
 from transient.scene import load_scene
 from transient.run import integrate
 

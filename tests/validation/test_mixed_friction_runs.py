@@ -2,7 +2,7 @@
 reactions`, *A constant-η pair at the main bearings*), checked against what is written apart:
 
 * **The chain of one pair**: with every reaction pair's coefficients zero, the mix is the serial
-  chain of its one constant-η pair (Antonyuk et al. (22)–(25), ``transient.core.chain``), a
+  chain of its one constant-η pair (Antonyuk et al. (22)–(25), ``transient.core.model.chain``), a
   model written apart from the joints' Newton–Euler: the same mode switches at the same angles,
   the same motion and the same loss, to the sum of the two runs' own errors (each measured
   against its run at a hundredth of the tolerance, ``tests/own_error.py``), for the

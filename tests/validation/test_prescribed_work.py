@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from transient.assemble import gas_table
+from transient.scene.queries import gas_table
 from transient.run import prescribed
 from transient.scene import load_scene
 

@@ -1,4 +1,4 @@
-"""Runs with friction on the joints' reactions (:mod:`transient.core.joint_friction`), checked
+"""Runs with friction on the joints' reactions (:mod:`transient.core.model.joint_friction`), checked
 against what holds independently of the friction model:
 
 * **Work–energy balance** in a spin-up of ``cases/gots_diesel_reaction_friction.toml`` with
@@ -35,7 +35,7 @@ import pytest
 
 from transient.analysis.efficiency import chen_flynn_fmep, mean_piston_speed, mechanical_efficiency
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.assemble import gas_table
+from transient.scene.queries import gas_table
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study, point_scene

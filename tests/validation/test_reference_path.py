@@ -46,7 +46,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicHermiteSpline
 
-import transient.reference as reference
+import transient.reference.integrate as reference
 from transient.scene import load_scene
 from transient.run import integrate
 
@@ -218,8 +218,8 @@ def test_compiled_agrees_with_reference(name, method, compiled_runs, monkeypatch
 def test_reaction_friction_agrees_with_reference(case, revolutions, mix, monkeypatch):
     """Friction on the joints' reactions, two ways: the compiled Newton solve of φ̈ and the side
     forces against the reference path's own Newton–Euler of the joint forces with the friction
-    laws closed on them (:class:`transient.reference.ReactionNumpy`, :class:`~transient.
-    reference.ArticulatedReactionNumpy`: a fixed point; :class:`~transient.reference.
+    laws closed on them (:class:`transient.reference.twins.ReactionNumpy`, :class:`~transient.
+    reference.twins.ArticulatedReactionNumpy`: a fixed point; :class:`~transient.reference.twins.
     SwashReactionNumpy`: fsolve), from the case's start: the Gots diesel over two revolutions,
     the radial and the swash plate over one; and with a constant-η pair at the main bearings
     (the diesel's mixed case over two, the radial's main bearings made one), where the compiled

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from transient.core.crank_slider import crank_slider_terms
+from transient.core.model.crank_slider import crank_slider_terms
 from transient.scene import Load, Run, load_scene
 from transient.run import integrate
 

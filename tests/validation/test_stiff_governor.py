@@ -4,7 +4,7 @@ compiled stepper and rerun by the implicit Radau method, with a message saying s
 The scene: the Gots PI generator set (``cases/gots_diesel_pi.toml``) with an actuator lag of
 2 µs — the rack's eigenvalue −1/τ_A = −5·10⁵ 1/s against the engine's 33 ms cycle — through a
 load step. The explicit DOP853 stops with ``stiff at t = …`` after 15 steps at hλ > 4
-(``transient.core.tableaus``); ``integrate`` then runs the scene by scipy's Radau. Independent
+(``transient.core.integrator.tableaus``); ``integrate`` then runs the scene by scipy's Radau. Independent
 check of that result: the compiled DOP853 with fixed crank-angle steps of 1e-3 rad, inside its
 stability region (|hλ| = h/(τ_A ω) ≈ 1.2), where no stiffness test runs.
 """

@@ -1,4 +1,4 @@
-"""The stuck mode (:mod:`transient.core.stuck`): a machine at rest held by its pairs' friction stays
+"""The stuck mode (:mod:`transient.core.model.stuck`): a machine at rest held by its pairs' friction stays
 there while the drive is within what the friction holds, and is released at the instant the drive
 exceeds it, checked against closed forms written apart from the kernels:
 
@@ -10,7 +10,7 @@ exceeds it, checked against closed forms written apart from the kernels:
 * **Constant-η pairs**: the Gots diesel with its main bearings and crankpins, at rest at an angle
   where the gas resists with a moment −G (constant at rest: the pressures depend on the angle
   only). A drive s·G on the shaft is held for η_b1 η_b2 ≤ s ≤ 1/(η_f1 η_f2) (the chain's static
-  reaction ratio, ``transient.core.chain``): the release instants follow from the schedule of s.
+  reaction ratio, ``transient.core.model.chain``): the release instants follow from the schedule of s.
 * **A load that reverses the machine**: turning forward, the rings bring the shaft to rest
   against a falling drive; it sticks there, ω exactly 0 and W_loss constant, and is released
   backward when the drive reaches −H at the angle where it stopped; every loss ≥ 0 and the

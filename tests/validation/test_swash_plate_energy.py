@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from transient.core import swash_plate as core
+from transient.core.model import swash_plate as core
 from transient.mechanisms import swash_plate as sp
 
 J_SHAFT = 1.0  # I₁ of the paper's example [kg m²]

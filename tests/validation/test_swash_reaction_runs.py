@@ -1,5 +1,5 @@
 """Runs of the swash plate with friction on its joints' reactions
-(:mod:`transient.core.swash_friction`), checked against what holds independently of it:
+(:mod:`transient.core.model.swash_friction`), checked against what holds independently of it:
 
 * **Work–energy balance** in a spin-up of ``cases/swash_plate_4cyl_reaction_friction.toml`` in
   time throughout at rtol = atol = 1e-11 (``tests/balances.py``), as given and with the mirror

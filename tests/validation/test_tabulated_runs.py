@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model, kinematics_table
-from transient.core.layout import TABULATED
+from transient.core.model.layout import TABULATED
 from transient.scene import Run, load_scene
 from transient.run import integrate
 

@@ -184,7 +184,7 @@ def wiebe_run():
 
 
 def test_wiebe_imep_and_burned_fraction_angles(wiebe_run):
-    from transient.assemble import gas_tables
+    from transient.scene.queries import gas_tables
 
     scene, _, th = wiebe_run
     full = gas_tables(scene)[0]
@@ -218,7 +218,7 @@ def test_wiebe_heat_release_rate_is_the_wiebe_law(wiebe_run):
     the end the rate jumps to 0, which the spline of dp/dφ rounds off): within 1e-4 of the
     peak rate (measured 9e-6 on 0.25° samples)."""
     from transient.analysis.thermo import heat_release_rate, own_cycles
-    from transient.assemble import gas_tables
+    from transient.scene.queries import gas_tables
 
     scene, data, th = wiebe_run
     w = scene.gas.wiebe
@@ -244,7 +244,7 @@ def test_woschni_state_pressure_work_and_net_heat():
     rtol 1e-12) plus the pumping loop, to 1e-6; the apparent heat release of the run's pressure
     is the fuel's heat less the wall's, Q_b − Q_w of that integration, to 1e-4 (measured 3.5e-5;
     the heat release is a trapezoid over 0.25° samples, and dp/dφ a spline of them)."""
-    from transient.assemble import clearance_volume
+    from transient.scene.queries import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
     from transient.scene import Inertia, Load
 

@@ -112,7 +112,7 @@ def test_misfire_follows_the_motored_cycle_and_the_fired_cylinders_their_tables(
     2e-9 of p_z, the tables' interpolation. The fired cylinders' pressure is the full-load
     table's to rounding; a misfiring cycle peaks at the motored compression end
     p_c = p_a·ε^n1; and the work–energy balance closes."""
-    from transient.assemble import gas_tables
+    from transient.scene.queries import gas_tables
 
     scene, traj = misfire_run()
     phi = traj["phi"]
@@ -260,7 +260,7 @@ def table_pressure(scene, k: int, phi, delta: float, fuel: float = 1.0):
     """p_k from the scene's tables in numpy (``PressureTable.evaluate``, not the kernels):
     p_mot(x) + fuel·(p_full(x − δ) − p_mot(x − δ)) at cylinder k's local angle x; and the
     distance of x and x − δ from the nearest corner (where a sample may hold either limit)."""
-    from transient.assemble import gas_phases, gas_tables
+    from transient.scene.queries import gas_phases, gas_tables
 
     full, motored = gas_tables(scene)
     P = scene.mechanism.cycle

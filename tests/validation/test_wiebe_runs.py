@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.assemble import build_model, gas_tables, wiebe_levels
+from transient.assemble import build_model
+from transient.scene.queries import gas_tables, wiebe_levels
 from transient.forces.wiebe import wiebe_tables
 from transient.scene import Friction, Governor, Initial, Output, Run, load_scene
 from transient.run import integrate

@@ -3,7 +3,7 @@
 Engine and cycle: ``cases/gots_diesel_wiebe.toml`` (r = 47 mm, L = 148 mm, D = 88 mm, ε = 18,
 p_a = 0.1436 MPa, T_a = 329.9 K, combustion from 358° for 50°, m = 0.5, 0.031 g of fuel, γ = 1.368
 constant), loaded with ``load_scene`` and built into wiebe.py's tables by
-``transient.assemble.wiebe_levels`` (the tables a run uses). Woschni's defaults c1 = 2.28,
+``transient.scene.queries.wiebe_levels`` (the tables a run uses). Woschni's defaults c1 = 2.28,
 c2 = 3.24e-3 m/(s K), T_w = 450 K.
 
 The checks are independent of the module's formulation: wiebe.py's own integration (h = 0), the
@@ -20,7 +20,7 @@ import pytest
 from conftest import CASES
 from scipy.integrate import quad
 
-from transient.assemble import clearance_volume, wiebe_levels
+from transient.scene.queries import clearance_volume, wiebe_levels
 from transient.errors import SceneError
 from transient.forces.wiebe import wiebe_cycle
 from transient.forces.woschni import (

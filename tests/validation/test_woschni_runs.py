@@ -1,5 +1,5 @@
 """Wall heat transfer in the ODE (``[gas.woschni]``): the cylinder pressures of the closed
-part are states of the compiled stepper (``transient.core.cylinder``).
+part are states of the compiled stepper (``transient.core.model.cylinder``).
 
 Independent checks:
 * with h = 0 (c1 = c2 = 0) the states integrate the Wiebe cycle again, so a run must reproduce the
@@ -100,7 +100,7 @@ def constant_speed_scene(rpm: float, revolutions: float = 6.0, **woschni) -> dic
 
 def numpy_closed_cycle(scene, omega):
     """The closed part of cylinder 1 by transient.forces.woschni (solve_ivp, rtol 1e-12)."""
-    from transient.assemble import clearance_volume
+    from transient.scene.queries import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
 
     mech, gas = scene.mechanism, scene.gas
@@ -152,7 +152,7 @@ def test_state_pressure_equals_the_numpy_closed_cycle(rpm):
 def test_compiled_agrees_with_the_reference_path():
     """The scene of cases/gots_diesel_woschni.toml (droop governor, latched fuel, two non-ideal
     pairs) for 4 revolutions: the compiled stepper against solve_ivp on the numpy twin
-    (``transient.reference.CylindersNumpy``, from transient.forces.woschni's functions)."""
+    (``transient.reference.twins.CylindersNumpy``, from transient.forces.woschni's functions)."""
     d = put(base("gots_diesel_woschni"), "run", revolutions=4)
     put(d, "solver", rtol=1e-10, atol=1e-10)
     compiled = integrate(scene_of(d, "woschni-compiled"))

@@ -25,7 +25,7 @@ for the ``power-flow`` policy, the measure of disagreement for ``paper``.
 
 The friction budget
 -------------------
-A pair's loss follows from the chain's own quantities (:mod:`transient.core.chain`): summing the
+A pair's loss follows from the chain's own quantities (:mod:`transient.core.model.chain`): summing the
 sub-chain equations ``J_k φ̈ + ½J′_k ω² = M_k + η*_{k−1} S_{k−1} − S_k`` times ω gives::
 
     d/dt ½J(φ)ω² = Σ_k M_k ω − Σ_k (1 − η*_k) S_k ω,
@@ -57,7 +57,7 @@ import re
 import numpy as np
 from numpy.typing import NDArray
 
-from ..outputs import cylinder_loss_column
+from ..scene.outputs import cylinder_loss_column
 from .irregularity import cycle_boundaries, cycle_means, steady_state_time
 
 #: |P_in| below this fraction of its mean is left out of (30) as printed.

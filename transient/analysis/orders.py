@@ -62,7 +62,7 @@ Functions
     Per-cycle amplitude and phase per order (:class:`OrderSpectrum`).
 :func:`piston_acceleration`, :func:`piston_inertia_force`, :func:`rod_angular_acceleration`
     Exact kinematics (:func:`transient.analysis.loads.crank_slider.slider_arrays`, the
-    vectorised twin of :func:`transient.core.crank_slider.slider`) with ω and ε.
+    vectorised twin of :func:`transient.core.model.crank_slider.slider`) with ω and ε.
 :func:`odd_harmonic_report`, :func:`report_for_scene`
     Orders of the piston acceleration of a run against the same engine at its mean speed
     (:class:`OddHarmonicReport`).

@@ -90,7 +90,7 @@ def cylinder_torques(scene, traj) -> NDArray[np.float64]:
     """Each cylinder's gas torque on the shaft at the samples of ``traj`` (``phi`` and
     ``p_<k>``), (n, samples) [N m]: (p_k − p0)·A_k·s′_k for a pressure, the force times s′_k
     (both pistons of a two-half swash plate) for a force model; their sum is ``M_gas``."""
-    from ..assemble import gas_is_force
+    from ..scene.queries import gas_is_force
 
     mech = scene.mechanism
     pk = piston_kinematics(mech, np.asarray(traj["phi"], dtype=float))

@@ -99,7 +99,7 @@ def cycle_irregularity(scene, traj) -> dict[str, tuple[Any, str]]:
 
 
 def _column_units(scene) -> dict[str, str]:
-    from ..outputs import output_columns
+    from ..scene.outputs import output_columns
 
     return output_columns(scene)
 

@@ -61,7 +61,7 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
 
 def stuck_phases(events: dict, t_last: float) -> dict[str, tuple[float, str]]:
     """How often and how long the machine was stuck at rest, held by its pairs' friction
-    (``transient.core.stuck``), from the events ``stuck`` and ``released`` (each stuck phase
+    (``transient.core.model.stuck``), from the events ``stuck`` and ``released`` (each stuck phase
     ends with the next release, or with the run at ``t_last``): ``stuck_phases`` [1],
     ``stuck_time`` [s] in all, and the first phase's start ``stuck_first_t`` [s] and angle
     ``stuck_first_phi`` [rad]; nothing if it never was."""

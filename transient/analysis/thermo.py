@@ -6,7 +6,7 @@ apparent heat-release rate and the burned-mass-fraction angles.
 **Cycles.** The engine's figures are taken over its cycles, counted from φ0 as
 :mod:`.irregularity` counts them; each cylinder's over its own cycles, from its own local angle
 0 (a 4-stroke's gas-exchange TDC) or π (a 2-stroke's BDC), where ``[[gas.cylinders]]`` begins
-its cycles too (:func:`transient.assemble.cycle_begin`), so that a misfire's cycle is one of
+its cycles too (:func:`transient.scene.queries.cycle_begin`), so that a misfire's cycle is one of
 its cycles and not two halves. Column j of a cylinder's figures is its cycle that ends in
 engine cycle j, its cycle j + 1 as ``[[gas.cylinders]]`` counts them; NaN where that cycle
 began before the run (or before its last backward motion), ``thermo_cylinder_cycle_start`` its
@@ -26,7 +26,7 @@ IMEP_k = W_i,k/V_d,k over the cylinder's own cycle, V_d,k its exact swept volume
 engine's IMEP is ΣW_i,k/ΣV_d,k with every W_i,k over the engine's cycle.
 
 **Brake and friction.** From the work integrals the stepper integrates with the motion
-(``W_load``, ``W_loss_<k>``, ``W_gas``: :mod:`transient.core.layout`), read at the cycle ends:
+(``W_load``, ``W_loss_<k>``, ``W_gas``: :mod:`transient.core.model.layout`), read at the cycle ends:
 BMEP = −ΔW_load/ΣV_d (the work the load takes), FMEP = ΣΔW_loss,k/ΣV_d (the pairs' losses), and
 the indicated work of the gas torque ΔW_gas = Σ∮(p_k − p0) dV_k = ΣW_i,k (∮dV = 0). Over a cycle
 the work–energy law gives
@@ -94,10 +94,10 @@ MFB_LEVELS = (0.1, 0.5, 0.9)
 
 
 def clearance(scene) -> float:
-    """V_c [m³] of the scene's cycle model (:func:`transient.assemble.clearance_volume`), else 0:
+    """V_c [m³] of the scene's cycle model (:func:`transient.scene.queries.clearance_volume`), else 0:
     a gas table gives no clearance, and V is then the swept part A·s only (the indicated work
     does not depend on it)."""
-    from ..assemble import clearance_volume
+    from ..scene.queries import clearance_volume
 
     return clearance_volume(scene)
 
@@ -228,7 +228,7 @@ def _corner_cuts(scene, phi_lo: float, phi_hi: float, events) -> list[NDArray[np
     its table's corners and cycle start (shifted by the cylinder's phase), and the events of
     :data:`FUEL_CORNERS`. Other events (a pair's mode switch) leave the pressure smooth, and a cut
     there would only shorten the quadrature's segments."""
-    from ..assemble import gas_phases, gas_tables
+    from ..scene.queries import gas_phases, gas_tables
 
     cycle = scene.mechanism.cycle
     tables = [t for t in gas_tables(scene) if t is not None]
@@ -263,7 +263,7 @@ def cycle_thermodynamics(scene, traj: Mapping[str, NDArray[np.float64]], events=
     ``events``: name → (n, 2) array of (t, φ), as :func:`.requested.requested_analyses` gets
     them. Raises ValueError (:class:`~.irregularity.NoWholeCycle`) if the run holds no whole
     cycle, and for a gas model whose ``p_<k>`` are forces (no pressure to integrate)."""
-    from ..assemble import gas_is_force
+    from ..scene.queries import gas_is_force
 
     if scene.gas.model == "none" or gas_is_force(scene):
         raise ValueError(f"gas model {scene.gas.model!r} applies no pressure (a force per piston "
@@ -366,7 +366,7 @@ def cylinder_cycle_starts(scene, marks: NDArray[np.float64], phi_first: float
     (between ``marks[j]`` and ``marks[j + 1]``, its end included) begins; NaN where that is
     before ``phi_first``, the run's first angle (module docstring, *Cycles*). A cylinder whose
     cycle begins within rounding of the engine's has the engine's marks themselves."""
-    from ..assemble import cycle_begin, gas_phases
+    from ..scene.queries import cycle_begin, gas_phases
 
     cycle = scene.mechanism.cycle
     d = np.mod(gas_phases(scene) + cycle_begin(scene.mechanism) - marks[0], cycle)
@@ -378,7 +378,7 @@ def cylinder_cycle_starts(scene, marks: NDArray[np.float64], phi_first: float
 def _peaks(scene, phi, traj, part, starts):
     """Largest stored pressure of each cylinder in each of its own cycles (``starts``, NaN: not
     held) and its local angle in [0, Φ)."""
-    from ..assemble import gas_phases
+    from ..scene.queries import gas_phases
 
     cycle = scene.mechanism.cycle
     p_max = np.full(starts.shape, np.nan)
@@ -399,7 +399,7 @@ def _closed_part(scene):
     """(γ, intake closing, exhaust opening) of the scene's Wiebe cycle, angles local [rad]; None
     if γ varies with temperature (``gamma_slope`` ≠ 0: the constant-γ form would not be the
     model's own first law)."""
-    from ..assemble import wiebe_levels
+    from ..scene.queries import wiebe_levels
 
     w = scene.gas.wiebe
     if w.gamma_slope != 0.0:
@@ -428,7 +428,7 @@ def _release(gamma, phi, p, V, dV, a, b):
 def _closed_window(scene, start: float, ivc: float, evo: float) -> tuple[float, float]:
     """Shaft angles of intake closing and exhaust opening (local ``ivc``, ``evo``) in the
     cylinder's own cycle that begins at the shaft angle ``start``."""
-    from ..assemble import cycle_begin
+    from ..scene.queries import cycle_begin
 
     a = start + (ivc - cycle_begin(scene.mechanism)) % scene.mechanism.cycle
     return a, a + (evo - ivc)
@@ -438,7 +438,7 @@ def heat_release(scene, phi, traj, part, starts, vol) -> dict[str, tuple[Any, st
     """Apparent heat released per cylinder over the closed part of each of its own cycles
     (``starts``, NaN: not held; Heywood (9.25), module docstring) and the MFB angles;
     ``thermo_heat_release_skipped`` if γ varies with temperature."""
-    from ..assemble import gas_phases
+    from ..scene.queries import gas_phases
 
     closed = _closed_part(scene)
     if closed is None:
@@ -502,7 +502,7 @@ def own_cycles(scene, traj: Mapping[str, NDArray[np.float64]], cylinder: int
     """Shaft angles [rad] at which the whole cycles of ``cylinder`` (1-based) in the run start:
     its own cycles (module docstring, *Cycles*) whose end the run reaches, after its last
     backward motion. Raises ValueError for a cylinder out of range."""
-    from ..assemble import cycle_begin, gas_phases
+    from ..scene.queries import cycle_begin, gas_phases
 
     n = scene.mechanism.n_cylinders
     if not 1 <= cylinder <= n:
@@ -516,8 +516,9 @@ def own_cycle_numbers(scene, cylinder: int, starts: ArrayLike) -> NDArray[np.int
     """The numbers of ``cylinder``'s (1-based) own cycles that begin at the shaft angles
     ``starts`` (:func:`own_cycles`), as ``[[gas.cylinders]]`` counts them for its misfires: 1
     the cycle in progress at the initial angle (:func:`transient.assemble.variation_fields`)."""
-    from ..assemble import gas_phases, variation_fields
-    from ..core.variation import START
+    from ..assemble import variation_fields
+    from ..scene.queries import gas_phases
+    from ..core.model.variation import START
 
     first = variation_fields(scene, gas_phases(scene))["var_par"][cylinder - 1, START]
     return np.rint((np.asarray(starts, dtype=float) - first) / scene.mechanism.cycle
@@ -532,7 +533,7 @@ def cycle_fuel_of(scene):
     if not scene.gas.cylinders:
         return lambda cylinder, phi: (1.0, False)
     from ..assemble import build_model
-    from ..core.variation import FUEL, cycle_fuel
+    from ..core.model.variation import FUEL, cycle_fuel
 
     model = build_model(scene)[0]
     return lambda cylinder, phi: (float(cycle_fuel(model, cylinder - 1, phi)),
@@ -544,7 +545,7 @@ def misfires(scene, traj: Mapping[str, NDArray[np.float64]]
     """The misfires of a run: (cylinder, its cycle's number, time of that cycle's firing TDC
     [s]) for every own cycle that the run reaches the firing TDC of and that burned no fuel
     though its cylinder is not cut out; in time order."""
-    from ..assemble import cycle_begin, gas_phases
+    from ..scene.queries import cycle_begin, gas_phases
 
     if not scene.gas.cylinders:
         return []
@@ -571,6 +572,6 @@ def local_angle(scene, phi: ArrayLike, start: float) -> NDArray[np.float64]:
     """A cylinder's local angle (as its gas table counts it) at the shaft angles ``phi`` of its
     own cycle that begins at ``start`` (:func:`own_cycles`), increasing through the whole cycle
     (a 2-stroke's, begun at π, runs on past 2π)."""
-    from ..assemble import cycle_begin
+    from ..scene.queries import cycle_begin
 
     return cycle_begin(scene.mechanism) + (np.asarray(phi, dtype=float) - start)

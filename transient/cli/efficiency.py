@@ -28,7 +28,7 @@ def register(sub) -> None:
 
 
 def cmd_efficiency(args) -> int:
-    from ..assemble import part_load_refusal
+    from ..scene.queries import part_load_refusal
     from ..scene import POLICIES, load_scene
     from ..study.efficiency import (efficiency_study, plot_budget, plot_map, plot_study,
                                     write_csv)

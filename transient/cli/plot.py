@@ -44,7 +44,7 @@ def figures(res, cylinders=None, cycles=None, held=None):
     from .. import plots
     import numpy as np
 
-    from ..assemble import gas_is_force, gas_tables
+    from ..scene.queries import gas_is_force, gas_tables
 
     scene = res.scene()
     traj = res.trajectory

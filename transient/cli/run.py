@@ -44,7 +44,7 @@ def register(sub) -> None:
 
 
 def cmd_check(args) -> int:
-    from ..assemble import cycle_figures
+    from ..scene.queries import cycle_figures
     from ..scene import load_scene
     from ..scene.read import SweepNotScene
 

@@ -12,9 +12,11 @@ made into machine code on its own (:func:`_linked_only`); ``kernel(inline=True)`
 LLVM inlines it at its call sites (:func:`_inlined_by_llvm`). What Python calls to run
 (the stepper) is ``compiled``. ``kernel`` is ``compiled`` without numba's reference counting
 (``_nrt=False``), because with it every call that passes arrays — the
-:data:`transient.core.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
+:data:`transient.core.model.layout.Model` tuple holds a dozen — increfs and decrefs each of them through
 an indirect call. Kernels under ``kernel`` must not allocate arrays (they work in buffers their
-caller allocated); the few that allocate (work arrays) are ``compiled``.
+caller allocated); the few that allocate (work arrays) are ``compiled``. A kernel passed to
+another as an argument (the model's derivative to the integrator) is a compile-time constant typed
+by its module and name (:class:`_KernelArgument`), so that what is compiled for it is cached.
 
 The replacements rely on numba internals, so they are on only under the numba release they were
 checked against (:data:`NUMBA_CHECKED`, pinned in pyproject.toml;
@@ -40,6 +42,9 @@ from numba.core.codegen import CPUCodeLibrary, JITCPUCodegen
 from numba.core.cpu import CPUContext
 from numba.core.itanium_mangler import mangle_identifier
 from numba.core.compiler_lock import global_compiler_lock
+from numba.core.datamodel import register_default
+from numba.core.datamodel.models import OpaqueModel
+from numba.core.imputils import lower_constant
 from numba.core.registry import CPUDispatcher
 from numba.core.runtime import rtsys
 
@@ -69,7 +74,7 @@ COMPILE_LOCK = "{}.compile.lock"
 
 class _SharedLocator(UserProvidedCacheLocator):
     """numba's locator of a function's cache files in ``numba.config.CACHE_DIR``, with their
-    folder named by the function's module (``transient.core.rhs``) where numba names it by a hash
+    folder named by the function's module (``transient.core.model.rhs``) where numba names it by a hash
     of the source file's absolute path: copies of the same sources at other paths (the nodes of a
     cluster, a clone and its worktrees, a fresh virtual environment) share one cache. numba's
     index keys each entry by a hash of the source's contents and by the CPU (its codegen's magic
@@ -136,7 +141,16 @@ def compiled(fn=None, *, _cache=_RegistryFreeCache, **options):
     return dispatcher
 
 
-class _CalledFromCompiledCode(CPUDispatcher):
+class _Kernel(CPUDispatcher):
+    """A kernel's dispatcher: as a value (an argument to another kernel), typed by name
+    (:class:`_KernelArgument`), under either numba release."""
+
+    @property
+    def _numba_type_(self):
+        return _KernelArgument(self)
+
+
+class _CalledFromCompiledCode(_Kernel):
     """A kernel compiled without numba's Python wrappers (``no_cpython_wrapper``,
     ``no_cfunc_wrapper``), for the calls from compiled code: each wrapper unboxes every field of
     its arguments — the Model's dozens — and was a large part of compiling a small kernel that
@@ -155,6 +169,69 @@ class _CalledFromCompiledCode(CPUDispatcher):
             entry = self.__dict__["_python_entry"] = compiled(
                 self.py_func, _cache=_PythonEntryCache, **options)
         return entry
+
+
+class _KernelArgument(types.Dispatcher):
+    """The numba type of a kernel as a value: a kernel passed to a function as an argument (the
+    model's derivative to the integrator, :mod:`transient.core.integrator`), which the callee is
+    compiled for as a constant, its call inlined where the kernel is.
+
+    numba's type of a function (``types.Dispatcher``) is named, compared and hashed by the
+    function object, its address in the name: in the cache's index a signature with it never
+    matches in another process, so a callee taking a kernel would be compiled anew in every
+    process and the compile helper's work (:mod:`transient.precompile`) never used. This type is
+    named, compared, hashed and pickled by the kernel's module and qualified name, which is what
+    the kernel is from one process to the next (the cache folder is named by a hash of every
+    source, so a changed kernel never meets an old index). Read back from an index, a type whose
+    kernel's module is not imported compares equal by name without importing it (an index lists
+    every signature its function was ever cached for)."""
+
+    def __init__(self, dispatcher=None, where=None):
+        if dispatcher is not None:
+            where = (dispatcher.py_func.__module__, dispatcher.py_func.__qualname__)
+            self._store_object(dispatcher)
+        else:
+            self._wr = _unresolved
+        self._where = tuple(where)
+        types.Type.__init__(self, f"kernel({self._where[0]}.{self._where[1]})")
+
+    @property
+    def key(self):
+        return self._where
+
+    def __eq__(self, other):
+        if type(self) is type(other):
+            return self._where == other._where
+        return NotImplemented
+
+    def __hash__(self):
+        return hash(self._where)
+
+    def __reduce__(self):
+        return _kernel_argument, self._where
+
+
+register_default(_KernelArgument)(OpaqueModel)  # (numba's data model of types.Dispatcher)
+
+
+@lower_constant(_KernelArgument)
+def _no_address(context, builder, ty, pyval):
+    """A kernel passed as a value carries nothing at run time: its calls are resolved by its type
+    when the callee is compiled. numba's constant of a function value is the function object's
+    address (``lower_constant(types.Dispatcher)``), a run-time address that numba then refuses
+    to cache in the calling function's machine code."""
+    return context.get_dummy_value()
+
+
+def _unresolved():
+    """The weak reference of a :class:`_KernelArgument` read back without its kernel: none."""
+    return None
+
+
+def _kernel_argument(module: str, qualname: str) -> "_KernelArgument":
+    """A :class:`_KernelArgument` read back from the cache's index: the kernel's own type where
+    its module is imported (numba interns types, and the two compare equal), else one by name."""
+    return _KernelArgument(None, (module, qualname))
 
 
 def _compile_once_across_processes(dispatcher):
@@ -254,7 +331,11 @@ def kernel(fn=None, *, inline=False, **options):
     if fn is None:
         return lambda f: kernel(f, inline=inline, **options)
     if not REPLACEMENTS_ON:  # (numba's inliner: the same machine code, a slower compile)
-        return compiled(fn, _nrt=False, **({"inline": "always"} if inline else {}), **options)
+        dispatcher = compiled(fn, _nrt=False, **({"inline": "always"} if inline else {}),
+                              **options)
+        if not config.DISABLE_JIT:
+            dispatcher.__class__ = _Kernel
+        return dispatcher
     if inline:
         _INLINED_BY_LLVM.add(_symbol_prefix(fn))
     _LINKED_ONLY.add(_symbol_prefix(fn))

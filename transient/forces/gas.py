@@ -3,7 +3,7 @@
 The gas force of a cylinder with a prescribed indicator diagram depends on the crank angle only,
 so it is tabulated once per scene (one idea: the periodic pressure table, built from points,
 from a function or from the mixed cycle) and evaluated in the compiled right-hand side by
-:func:`transient.core.tables.table_eval` (layout in :mod:`transient.core.tables`). This module
+:func:`transient.core.model.tables.table_eval` (layout in :mod:`transient.core.model.tables`). This module
 builds the tables:
 
 * :func:`table_from_points`: from user points (a measured or printed indicator diagram);
@@ -98,7 +98,7 @@ def gas_exchange_pressures(strokes: int, p_intake: float | None, p_exhaust: floa
 class PressureTable:
     """A periodic curve over one cycle, piecewise cubic between corners.
 
-    The four arrays are passed unchanged to the kernels of :mod:`transient.core.tables`;
+    The four arrays are passed unchanged to the kernels of :mod:`transient.core.model.tables`;
     treat them as read-only.
 
     Attributes
@@ -152,14 +152,14 @@ class PressureTable:
         return self.piece_knot.size - 1
 
     def wrap(self, x: ArrayLike) -> NDArray[np.float64]:
-        """Angles reduced into ``[0, period)`` (twin of :func:`~transient.core.tables.wrap_angle`)."""
+        """Angles reduced into ``[0, period)`` (twin of :func:`~transient.core.model.tables.wrap_angle`)."""
         x = np.asarray(x, dtype=np.float64)
         y = x - self.period * np.floor(x / self.period)
         y = np.where(y >= self.period, y - self.period, y)
         return np.where(y < 0.0, 0.0, y)
 
     def piece_of(self, x: ArrayLike) -> NDArray[np.int64]:
-        """Piece index of angles in ``[0, period)`` (twin of :func:`~transient.core.tables.find_piece`)."""
+        """Piece index of angles in ``[0, period)`` (twin of :func:`~transient.core.model.tables.find_piece`)."""
         j = np.searchsorted(self.corners, np.asarray(x, dtype=np.float64), side="right") - 1
         return np.clip(j, 0, self.n_pieces - 1)
 
@@ -173,7 +173,7 @@ class PressureTable:
             Angles [rad].
         piece : array_like of int, optional
             If given, `x` is not wrapped and each value uses the polynomials of its `piece`,
-            extrapolated outside it, as :func:`~transient.core.tables.table_eval` does.
+            extrapolated outside it, as :func:`~transient.core.model.tables.table_eval` does.
             If omitted, `x` is wrapped into the cycle and the piece is the one containing it
             (a corner belongs to the piece that starts there, i.e. the right limit of a jump).
 

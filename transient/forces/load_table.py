@@ -12,7 +12,7 @@ Practical Guide to Splines*, ch. II, (2.5) and ch. IV): linear ≤ h²/8·max|f�
 where the data are strictly monotone, O(h²) near an extremum, where its slope is set to zero.
 
 A load curve is held as the compiled model holds it
-(:func:`transient.core.tables.held_curve_value`): knots and a cubic per interval in ascending powers, its end values held outside the knots. A
+(:func:`transient.core.model.tables.held_curve_value`): knots and a cubic per interval in ascending powers, its end values held outside the knots. A
 curve over the cycle (abscissa ``"angle"``) is periodic: its knots run over one period from the
 last point shifted back by the period, so that the interval across the cycle's end is one piece.
 """
@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 #: Distinct corners of a load in time (a schedule's abscissae, a trace's knots) closer than
 #: this (relative to max(1, |t|)) are refused or taken as one: the event search could not tell
-#: them apart (``transient.core.events.ON_LEVEL`` is 1e-12).
+#: them apart (``transient.core.stepper.events.ON_LEVEL`` is 1e-12).
 SCHEDULE_MIN_GAP = 1e-9
 
 #: The interpolations a table may ask for.
@@ -64,7 +64,7 @@ class LoadCurve:
     period: float = 0.0
 
     def evaluate(self, x: ArrayLike) -> NDArray[np.float64]:
-        """T(x) in numpy, the twin of :func:`transient.core.forcing.table_load` (angles wrapped
+        """T(x) in numpy, the twin of :func:`transient.core.model.forcing.table_load` (angles wrapped
         into the period, values held beyond the ends)."""
         x = np.asarray(x, dtype=np.float64)
         k = self.knots

@@ -441,7 +441,7 @@ def wiebe_tables(volume: VolumeFunction, fuel_levels: Sequence[float], **cycle
     fuel_levels : sequence of float
         Fuel masses per cycle [kg], finite, ≥ 0 and strictly increasing; 0 is the motored cycle.
         Not a scene key: a scene (``[gas.wiebe]``) has the levels 0 and ``fuel_mass``
-        (:func:`transient.assemble.wiebe_levels`), always valid ones.
+        (:func:`transient.scene.queries.wiebe_levels`), always valid ones.
     **cycle
         Every other keyword of :func:`wiebe_cycle` (not `fuel_mass`).
 

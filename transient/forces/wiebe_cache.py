@@ -1,7 +1,7 @@
 """Wiebe cycles kept on disk between processes: a warm start does not integrate them again.
 
 A scene with ``model = "wiebe"`` needs its motored and full-load cycles
-(:func:`transient.assemble.wiebe_levels`). Integrating them with scipy's DOP853, and importing
+(:func:`transient.scene.queries.wiebe_levels`). Integrating them with scipy's DOP853, and importing
 scipy's integrators for it, is a large part of such a scene's warm start. The cycles depend only
 on their arguments and on the code, so they are stored in
 ``$XDG_CACHE_HOME/transient/tables/`` (default ``~/.cache``), one ``.npz`` per set of cycles,

@@ -9,8 +9,8 @@ for the stepper, in plain Python for the reference path.
 Adding a mechanism takes
 
 1. its compiled kernel, ``transient/core/<name>.py``: ``<name>_terms(mp, φ, u, du) -> (J, dJ/dφ)``
-   filling u_k and u′_k, a kind code in :mod:`transient.core.layout` and its branch in
-   ``transient.core.forcing.mechanism_terms`` (the stepper and the kinematics tables reach it
+   filling u_k and u′_k, a kind code in :mod:`transient.core.model.layout` and its branch in
+   ``transient.core.model.forcing.mechanism_terms`` (the stepper and the kinematics tables reach it
    there);
 2. its mechanism file, ``transient/mechanisms/<name>.py``: a frozen dataclass in SI with the
    members of :class:`Mechanism` (read from its ``[mechanism]`` table, validated, packed for
@@ -49,7 +49,7 @@ class Mechanism(Protocol):
     #: Its ``type`` in the ``[mechanism]`` table and its key in :data:`MECHANISMS`; the resolved
     #: scene writes it back (:meth:`toml_lines`) and errors name it.
     name: ClassVar[str]
-    #: ``Model.kind`` of its kernel in the compiled core (:mod:`transient.core.layout`), for
+    #: ``Model.kind`` of its kernel in the compiled core (:mod:`transient.core.model.layout`), for
     #: ``transient.assemble`` and the kinematics tables.
     kind: ClassVar[int]
     #: The links of its serial chain, shaft first: a friction pair joins two neighbours
@@ -57,12 +57,12 @@ class Mechanism(Protocol):
     #: The first carries the shaft's inertia and the load, the last the gas forces (the
     #: cylinders: their gas does its work on the pistons through the pair between them).
     links: ClassVar[tuple[str, ...]]
-    #: How each link's reduced inertia follows φ (``transient.core.layout.LINK_*``): constant
+    #: How each link's reduced inertia follows φ (``transient.core.model.layout.LINK_*``): constant
     #: (:meth:`link_inertias`), the pistons' (:attr:`piston_link_mass`), the swash plate's
     #: link 9, or the rest of J(φ) (exactly one link).
     link_laws: ClassVar[tuple[int, ...]]
     #: Whether a scene may give it wall heat transfer (``[gas.woschni]``): the cylinder ODE of
-    #: ``transient.core.cylinder`` is built for the crank-slider's volume.
+    #: ``transient.core.model.cylinder`` is built for the crank-slider's volume.
     wall_heat_transfer: ClassVar[bool]
     #: The keys its :attr:`n_cylinders` follows from, as the bounds of per-cylinder keys
     #: (``[[gas.cylinders]] cylinder``) name them.

@@ -1,7 +1,7 @@
 """Radial and V engines with a master rod and articulated (slave) rods (Semenov §§1, 3, 4): one
 idea, the articulated mechanism, as each mechanism has its one module.
 
-The compiled kinematics and the frame are described in :mod:`transient.core.articulated`; this
+The compiled kinematics and the frame are described in :mod:`transient.core.model.articulated`; this
 module holds the scene-side description (SI units), packs it for the kernel, and gives the numpy
 geometry of every body (:func:`positions`), the slave dimensions of Semenov (6)–(7)
 (:func:`slave_dimensions`), the exact dead centres and strokes that (55)–(58) approximate
@@ -34,8 +34,8 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core import articulated as core
-from ..core.layout import ARTICULATED, LINK_FIXED, LINK_PISTONS, LINK_REST
+from ..core.model import articulated as core
+from ..core.model.layout import ARTICULATED, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -168,7 +168,7 @@ class Articulated:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "articulated"
-    #: Model.kind of the compiled kernel (transient.core.layout.ARTICULATED).
+    #: Model.kind of the compiled kernel (transient.core.model.layout.ARTICULATED).
     kind = ARTICULATED
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
@@ -184,7 +184,7 @@ class Articulated:
     #: How each link's reduced inertia follows φ (``core.layout.LINK_*``), as the crank-slider's.
     link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions
-    #: (:mod:`transient.core.articulated_friction`).
+    #: (:mod:`transient.core.model.articulated_friction`).
     reaction_links = ("shaft", "crank", "master rod", "slave rod", "piston", "cylinder")
     #: The joints such a pair may name, in the order of ``articulated_friction.J_*``: the main
     #: bearings, the master crankpins, the link pins, the master piston pins, the slave piston
@@ -192,7 +192,7 @@ class Articulated:
     reaction_joints = (("shaft", "crank"), ("crank", "master rod"), ("master rod", "slave rod"),
                        ("master rod", "piston"), ("slave rod", "piston"), ("piston", "cylinder"))
     #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
-    #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.reactions`).
+    #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.model.reactions`).
     shaft_coupling = ("shaft", "crank")
 
     # -- sizes and constants ---------------------------------------------------------------------
@@ -382,7 +382,7 @@ class Articulated:
                                      f"{degrees(self.cycle):g}°")
 
     def pack(self) -> NDArray[np.float64]:
-        """Parameter array for :func:`transient.core.articulated.articulated_terms`."""
+        """Parameter array for :func:`transient.core.model.articulated.articulated_terms`."""
         ns = self.n_slaves
         mp = np.zeros(core.SLAVE0 + core.SLAVE_STRIDE * ns + self.rows)
         mp[:core.N_ROWS] = self.master().pack()[:core.N_ROWS]  # the crank-slider header
@@ -436,7 +436,7 @@ class Articulated:
 
     def reaction_reversals(self) -> NDArray[np.float64]:
         """Local angles α [rad] in [0, 2π) of a row where a joint's relative rate changes sign
-        (:mod:`transient.core.articulated_friction`, *Directions*): the master piston's dead
+        (:mod:`transient.core.model.articulated_friction`, *Directions*): the master piston's dead
         centres 0, π and the master rod's β′ = 0 at π/2, 3π/2 exactly; per slave the roots of
         its piston's X_i′, of its rod's β_i′ and of its link pin's β_i′ + β′, bracketed on a
         grid and refined by bisection to the last bit. The crankpin's −β′ − 1 never vanishes."""
@@ -613,7 +613,7 @@ def positions(mech: Articulated, alpha: ArrayLike) -> dict[str, NDArray[np.float
 
 def _slave_rates(mech: Articulated, alpha: float) -> NDArray[np.float64]:
     """(3, z′): per slave its piston's X_i′, its rod's β_i′ and its link pin's relative rate
-    β_i′ + β′ at local angle α (the kernel's :func:`transient.core.articulated.slave`)."""
+    β_i′ + β′ at local angle α (the kernel's :func:`transient.core.model.articulated.slave`)."""
     r, l = mech.crank_radius, mech.rod_length
     mp = mech.pack()
     ca, sa, cb, sb, db, ddb = core.master_rod(alpha, r, l)

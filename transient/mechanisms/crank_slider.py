@@ -1,6 +1,6 @@
 """Crank-slider engines (in-line, V, offset): geometry, masses, validation and the kinematics table.
 
-The compiled kinematics live in :mod:`transient.core.crank_slider`; this module holds the scene-side
+The compiled kinematics live in :mod:`transient.core.model.crank_slider`; this module holds the scene-side
 description (SI units) and packs it for the kernel; :mod:`.throws` reads how the cylinders sit
 on the crank.
 
@@ -23,8 +23,8 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core import crank_slider as core
-from ..core.layout import CRANK_SLIDER, LINK_FIXED, LINK_PISTONS, LINK_REST
+from ..core.model import crank_slider as core
+from ..core.model.layout import CRANK_SLIDER, LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..tomlout import toml_value
 from ..units import Named
@@ -132,7 +132,7 @@ class CrankSlider:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "crank-slider"
-    #: Model.kind of the compiled kernel (transient.core.layout.CRANK_SLIDER).
+    #: Model.kind of the compiled kernel (transient.core.model.layout.CRANK_SLIDER).
     kind = CRANK_SLIDER
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
     wall_heat_transfer = True
@@ -148,12 +148,12 @@ class CrankSlider:
     #: How each link's reduced inertia follows φ (``core.layout.LINK_*``): the crank's is
     #: constant, the rods' what J(φ) holds beyond the others, the pistons' m_p·Σ u_k².
     link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
-    #: Links for pairs with friction on their reactions (:mod:`transient.core.joint_friction`):
+    #: Links for pairs with friction on their reactions (:mod:`transient.core.model.joint_friction`):
     #: the piston is a link of its own and the cylinder (the frame) the last, so the pairs are
     #: the main bearings, the crankpins, the piston pins and the pistons in their cylinders.
     reaction_links = ("shaft", "crank", "rod", "piston", "cylinder")
     #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
-    #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.reactions`).
+    #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.model.reactions`).
     shaft_coupling = ("shaft", "crank")
 
     @property
@@ -359,7 +359,7 @@ class CrankSlider:
                              f"ends run between the throw's journals")
 
     def pack(self) -> NDArray[np.float64]:
-        """Parameter array for :func:`transient.core.crank_slider.crank_slider_terms`."""
+        """Parameter array for :func:`transient.core.model.crank_slider.crank_slider_terms`."""
         l = self.rod_length
         n = self.n_cylinders
         mp = np.zeros(core.SIN0 + 2 * n)

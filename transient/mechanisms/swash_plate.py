@@ -1,6 +1,6 @@
 """Swash-plate engines (Antonyuk et al., Fig. 1): geometry, masses, validation, positions, tables.
 
-The compiled kinematics and the frame are described in :mod:`transient.core.swash_plate`; this module
+The compiled kinematics and the frame are described in :mod:`transient.core.model.swash_plate`; this module
 holds the scene-side description (SI units), packs it for the kernel and gives numpy-level positions
 of every body for plots and checks.
 
@@ -50,8 +50,8 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..core import swash_plate as core
-from ..core.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH, SWASH_PLATE
+from ..core.model import swash_plate as core
+from ..core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH, SWASH_PLATE
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -62,7 +62,7 @@ if TYPE_CHECKING:
     from ..scene.reader import Section
 
 #: Housing hinge of cross 13 → (phase φ_h of the Hooke relation, hinge axis a = R_x(−φ_h) e_z);
-#: see transient.core.swash_plate.
+#: see transient.core.model.swash_plate.
 HINGES = {"normal": (0.0, (0.0, 0.0, 1.0)), "in-plane": (pi / 2.0, (0.0, 1.0, 0.0))}
 
 #: Cylinders at most (a scene check: every per-cylinder array is sized by it).
@@ -167,7 +167,7 @@ class SwashPlate:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "swash-plate"
-    #: Model.kind of the compiled kernel (transient.core.layout.SWASH_PLATE).
+    #: Model.kind of the compiled kernel (transient.core.model.layout.SWASH_PLATE).
     kind = SWASH_PLATE
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
@@ -189,7 +189,7 @@ class SwashPlate:
     #: crosses' by (15)–(17), the rods' what J(φ) holds beyond the others, the pistons'
     #: m_p·Σ_k u_k²/halves.
     link_laws = (LINK_FIXED, LINK_SWASH, LINK_REST, LINK_PISTONS, LINK_FIXED)
-    #: Links for pairs with friction on their reactions (:mod:`transient.core.swash_friction`),
+    #: Links for pairs with friction on their reactions (:mod:`transient.core.model.swash_friction`),
     #: the shaft side first: the shaft with flywheel and load, the plate on it, link 9, the rods,
     #: the pistons and the cylinders (the frame). So [shaft, plate] is the main bearing (the
     #: plate carries the mechanism's forces into it), [plate, link] the plate bearing 11,
@@ -219,7 +219,7 @@ class SwashPlate:
     def joint_reversals(self) -> tuple[float, ...]:
         """Shaft angles [rad] at which a joint with reaction friction reverses its relative
         motion: every piston's dead centres (the main and plate bearings turn one way while ω
-        keeps its sign; ``transient.core.swash_friction``)."""
+        keeps its sign; ``transient.core.model.swash_friction``)."""
         inner, outer = dead_centres(self)
         return tuple(self.firing_angles) + tuple(
             _snapped(a, 2.0 * pi * k / self.cylinders + pi) for k, a in enumerate(outer))
@@ -386,7 +386,7 @@ class SwashPlate:
                 raise SceneError(f"mechanism.{key}", f"must be ≥ 0, got {value:g}")
 
     def pack(self) -> NDArray[np.float64]:
-        """Parameter array for the kernels of :mod:`transient.core.swash_plate` (validates first)."""
+        """Parameter array for the kernels of :mod:`transient.core.model.swash_plate` (validates first)."""
         self.validate()
         return self._pack()
 

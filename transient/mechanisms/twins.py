@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import crank_slider as cs
+from ..core.model import crank_slider as cs
 
 
 class CrankSliderNumpy:

@@ -63,7 +63,7 @@ def angle_spacing(scene: Scene) -> float:
 
 def estimate(scene: Scene) -> Work:
     """The work of a run of ``scene`` (:class:`Work`)."""
-    from ..outputs import output_columns
+    from .outputs import output_columns
 
     run = scene.run
     turns = _revolutions(scene)

@@ -130,7 +130,7 @@ def _torques(scene: Scene, lever: float, gas_table) -> dict[str, tuple[float, st
     if load.table is not None:
         out["load.table.torque"] = (scale * max(map(abs, load.table.torque)), "")
     if gas_table is not None:
-        from ..assemble import gas_is_force
+        from .queries import gas_is_force
 
         is_force = gas_is_force(scene)
         offset = 0.0 if is_force else scene.gas.p0
@@ -156,8 +156,8 @@ def _torques(scene: Scene, lever: float, gas_table) -> dict[str, tuple[float, st
 def check_part_load(scene: Scene) -> None:
     """What would burn less than full-load fuel (a ``[[gas.cylinders]]`` entry that changes the
     combustion, a governor) needs a gas model that can: a motored curve to scale the combustion
-    above (:func:`transient.assemble.part_load_refusal`)."""
-    from ..assemble import part_load_refusal
+    above (:func:`transient.scene.queries.part_load_refusal`)."""
+    from .queries import part_load_refusal
 
     why = part_load_refusal(scene)
     if why is None:
@@ -194,7 +194,7 @@ def check_woschni(scene: Scene) -> None:
 def check_gas_table(scene: Scene, section: Section):
     """Build (and so validate) the pressure table; report under the key the user wrote.
     Returns the table (None without gas forces)."""
-    from ..assemble import gas_table
+    from .queries import gas_table
 
     try:
         table = gas_table(scene)
@@ -212,7 +212,7 @@ def check_offsets_in_closed_part(scene: Scene) -> None:
     """With wall heat transfer a cylinder's combustion is integrated inside its closed part:
     shifted by its combustion offset, it must still lie between intake closing and exhaust
     opening."""
-    from ..assemble import wiebe_levels
+    from .queries import wiebe_levels
 
     mech, gas = scene.mechanism, scene.gas
     cycle = wiebe_levels(mech, gas)[-1]
@@ -231,7 +231,7 @@ def check_offsets_in_closed_part(scene: Scene) -> None:
 
 def check_analysis(scene: Scene) -> None:
     """The [analysis] signals exist in this scene's trajectory and the orders fit the grid."""
-    from ..outputs import output_columns
+    from .outputs import output_columns
 
     a, mech = scene.analysis, scene.mechanism
     columns = list(output_columns(scene))
@@ -241,7 +241,7 @@ def check_analysis(scene: Scene) -> None:
         if name not in columns + derived:
             raise SceneError("analysis.orders", f"unknown signal {show_value(name)}; allowed: "
                                                 f"{', '.join(columns + derived)}")
-    from ..assemble import gas_is_force
+    from .queries import gas_is_force
 
     if a.thermodynamics and (scene.gas.model == "none" or gas_is_force(scene)):
         raise SceneError("analysis.thermodynamics",

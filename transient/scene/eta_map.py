@@ -1,6 +1,6 @@
 """A pair's efficiency map (``model = "table"``): the grid from a CSV file's rows or from inline
 arrays, and the checks that make the chain's solve with it exist and be unique
-(:mod:`transient.core.eta_table`).
+(:mod:`transient.core.model.eta_table`).
 
 Every refusal is a :class:`~transient.errors.SceneError` naming the key, what is wrong and what is
 allowed; speeds are quoted in rpm, as a map is usually written.
@@ -53,7 +53,7 @@ def check_map(key, speed, torque, fwd, bwd) -> None:
     per speed of one value per torque; and the transmitted moment increasing in the moment taken,
     η_fwd + x ∂η_fwd/∂x > 0 and η_bwd − x ∂η_bwd/∂x > 0 (x = |S|, the map bilinear, so checked
     at both ends of every cell of every speed row; module docstring of
-    :mod:`transient.core.eta_table`). |x ∂η/∂x| < η is sufficient for both.
+    :mod:`transient.core.model.eta_table`). |x ∂η/∂x| < η is sufficient for both.
     """
     for name, axis in (("speed", speed), ("torque", torque)):
         if not axis:

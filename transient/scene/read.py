@@ -628,7 +628,7 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
 
 def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
     """Among reaction pairs, a pair of another model only where the mechanism's solver takes it
-    (``transient.core.reactions``, *A constant-η or mapped pair at the main bearings*): at the
+    (``transient.core.model.reactions``, *A constant-η or mapped pair at the main bearings*): at the
     joint that couples the shaft to the mechanism, under the power-flow policy."""
     coupling = getattr(mech, "shaft_coupling", None)
     for i, p in enumerate(pairs):
@@ -764,7 +764,7 @@ def _rows(ps: Section, name: str) -> tuple[tuple[float, ...], ...]:
 def _check_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
     """Friction must not wedge the crank-slider: the rod's equation in the side force N has a
     slope of at least l cos β (1 − q), q = μ_s tan β + (μ r of crankpin and pin)(1 + μ_s)/(l cos β)
-    at the largest rod angle (:mod:`transient.core.joint_friction`); q < 1 keeps it increasing,
+    at the largest rod angle (:mod:`transient.core.model.joint_friction`); q < 1 keeps it increasing,
     hence one solution at every state."""
     r, l, e = mech.crank_radius, mech.rod_length, mech.offset
     sin_b = (r + abs(e)) / l
@@ -788,7 +788,7 @@ def _check_wedging_articulated(s: Section, mech, pairs: list[Pair], raw: list) -
     least c (1 − q), q = μ_slider tan β_max + (μ r of its two pins)(1 + μ_slider)/c with
     c = l cos β_max at its largest angle to its cylinder (the master rod: sin β_max = λ; slave
     rod i: its link pin's largest offset from its axis over l_i, ``slave_reach``); q < 1 for
-    every rod keeps the row's equations solvable (``transient.core.articulated_friction``)."""
+    every rod keeps the row's equations solvable (``transient.core.model.articulated_friction``)."""
     by_joint = {p.between: p for p in pairs}
     joints = mech.reaction_joints
 
@@ -817,7 +817,7 @@ def _check_wedging_articulated(s: Section, mech, pairs: list[Pair], raw: list) -
 def _check_piston_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
     """Friction must not wedge a swash plate's pistons: each piston's friction equation has a
     slope of at least 1 − μ tan γ in its friction force, γ the largest rod tilt to the cylinder
-    axis (:mod:`transient.core.swash_friction`); μ tan γ < 1 keeps it increasing, hence one
+    axis (:mod:`transient.core.model.swash_friction`); μ tan γ < 1 keeps it increasing, hence one
     solution at every state."""
     piston = next((p for p in pairs if p.between[0] == "piston"), None)
     if piston is None:

@@ -63,7 +63,7 @@ class Woschni:
     """Wall heat transfer of the closed part, Woschni's correlation: the ``[gas.woschni]`` table
     of ``model = "wiebe"`` (equations in :mod:`transient.forces.woschni`). With it the cylinder
     pressure depends on the shaft speed and on its own history, so the closed part of each
-    cylinder is a state of the ODE instead of a table (``transient.core.cylinder``).
+    cylinder is a state of the ODE instead of a table (``transient.core.model.cylinder``).
 
     ``c1`` [1] multiplies the mean piston speed, ``c2`` [m/(s K)] the pressure rise combustion
     causes (from the combustion start on; Woschni's direct-injection value by default);
@@ -112,7 +112,7 @@ class Cylinder:
     angle. ``misfire_cycles``: the cycles that misfire (each ≥ 1); ``misfire_every`` n [1]:
     cycles n, 2n, 3n, … misfire (0: none); ``misfire_rate`` [1] in [0, 1]: each cycle misfires
     with this probability, drawn from ``misfire_seed`` (a counter-based generator,
-    :func:`transient.core.variation.misfire_draw`, the same draws for the same seed, cylinder
+    :func:`transient.core.model.variation.misfire_draw`, the same draws for the same seed, cylinder
     and cycle in every run and on every machine). A cycle misfires if any of the three says
     so.
     """
@@ -311,7 +311,7 @@ class Starter:
 @dataclass(frozen=True)
 class Governor:
     """Speed governor, setting the fuel command f (see :class:`Gas`); equations in
-    :mod:`transient.core.governor`.
+    :mod:`transient.core.model.governor`.
 
     ``droop``: the static characteristic of the swash-plate paper (§4): f = 1 below
     ``speed_full`` (ω_a), linearly down to 0 at ``speed_zero`` (ω_1c), 0 above [rad/s].
@@ -476,7 +476,7 @@ MIN_WIEBE_STEP = 1e-5
 #: 0.8 GB per column and second before compression.
 MIN_OUTPUT_DT = 1e-8
 
-#: The compiled methods (transient.core.tableaus) and the reference path's (scipy-*).
+#: The compiled methods (transient.core.integrator.tableaus) and the reference path's (scipy-*).
 COMPILED_METHODS = ("dop853", "dopri5")
 #: Every ``[solver] method``: the compiled ones, then the reference path's.
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
@@ -510,7 +510,7 @@ class Pair:
     eta_backward: float
     name: str = ""
     #: ``"constant-eta"`` (the efficiencies above) or ``"reaction"``: friction on the joint's
-    #: reaction (every mechanism, :mod:`transient.core.reactions`; then η is
+    #: reaction (every mechanism, :mod:`transient.core.model.reactions`; then η is
     #: unused, 1). Among reaction pairs, a constant-eta or table pair only at the main bearings
     #: (``["shaft", "crank"]``, crank-slider and articulated), under the power-flow policy.
     model: str = "constant-eta"
@@ -527,7 +527,7 @@ class Pair:
     #: Reaction model, slider: friction from the gas pressure behind the rings as a share of
     #: the gas force on the piston, c_p = 4 μ_ring h/D for a top ring of height h [1].
     ring_pressure: float = 0.0
-    #: Table model (:mod:`transient.core.eta_table`; then the scalar η are unused, 1): the maps'
+    #: Table model (:mod:`transient.core.model.eta_table`; then the scalar η are unused, 1): the maps'
     #: speed axis |ω| [rad/s] and moment axis |S| [N m], each increasing and ≥ 0.
     speed: tuple[float, ...] = ()
     torque: tuple[float, ...] = ()
@@ -541,7 +541,7 @@ class Pair:
 
 @dataclass(frozen=True)
 class Friction:
-    """Non-ideal pairs and how their modes are chosen (``transient.core.chain``).
+    """Non-ideal pairs and how their modes are chosen (``transient.core.model.chain``).
 
     ``policy``: ``"power-flow"`` (each pair's mode agrees with the power it transmits) or
     ``"paper"`` (criterion (25), the sign of the shaft-side moments' power).

@@ -41,7 +41,7 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
     """
     from ..analysis.summary import summarize
     from ..run import integrate
-    from ..outputs import output_columns
+    from ..scene.outputs import output_columns
 
     t0 = time.perf_counter()
     out: dict[str, Any] = {"status": "failed", "complete": False, "message": "",

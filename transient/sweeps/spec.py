@@ -410,7 +410,7 @@ def _resolve(sweep: Sweep, base: dict, changes: dict, params: dict, i: int, base
 
 def _check_columns(sweep: Sweep, runs: tuple[RunSpec, ...]) -> None:
     """Collected short names must be measurable, stored columns must exist, in every scene."""
-    from ..outputs import output_columns
+    from ..scene.outputs import output_columns
 
     for spec in runs:
         for q in sweep.collect:

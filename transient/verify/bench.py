@@ -234,7 +234,7 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     from CyRK import nbsolve2_ivp
 
     from ..assemble import build_model
-    from ..core import layout
+    from ..core.model import layout, work
     from .cyrk_rhs import make_rhs
 
     model, _, _ = build_model(base)
@@ -244,7 +244,7 @@ def _cyrk(name, base, ref, rtol, revolutions, repeat, rhs_cache):
     rhs = rhs_cache[name]
     y0 = np.zeros(layout.n_state(model))
     y0[layout.PHI], y0[layout.OMEGA] = base.initial.phi, base.initial.omega
-    args = layout.work_array(model).ravel()  # (as allocated: no gas table piece selected yet)
+    args = work.work_array(model).ravel()  # (as allocated: no gas table piece selected yet)
     span = (0.0, ref.t_end)
 
     def solve(dense=False):

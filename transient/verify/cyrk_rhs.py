@@ -11,10 +11,11 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from ..core.forcing import governor_branch
-from ..core.layout import (N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, extras_of, n_state,
-                          work_array)
-from ..core.rhs import choose_modes, derivative
+from ..core.model.forcing import governor_branch
+from ..core.model.layout import (N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, extras_of,
+                                 n_state)
+from ..core.model.work import work_array
+from ..core.model.rhs import choose_modes, derivative
 
 # CyRK's callback signature: dy (double*), t, y (double*), args (double*).
 SIGNATURE = nb.types.void(nb.types.CPointer(nb.types.float64), nb.types.float64,

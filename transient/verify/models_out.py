@@ -1,7 +1,7 @@
 """What the friction models cost the scenes that do not use them, measured against a build
 without them: a copy of this package whose compiled core has every test of a reaction pair
 (``m.reaction``), an efficiency map (``m.eta_table``) and the stuck mode (``st.STUCK``,
-``stepper._stick``, the release) made a constant False, so that LLVM drops the code behind it.
+``loop._stick``, the release) made a constant False, so that LLVM drops the code behind it.
 A scene without those models runs the same steps and right-hand sides in both builds, so the
 difference in wall time is what the models' presence costs it.
 
@@ -23,19 +23,19 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1]
 
-#: (file of ``transient/core``, pattern, replacement, matches): the models' tests, made False.
+#: (file under ``transient/core``, pattern, replacement, matches): the models' tests, made False.
 LEFT_OUT = [
     *((f, r"\bm\.reaction\b", "(False and m.reaction)", n) for f, n in (
-        ("forcing.py", 3), ("inverse.py", 2), ("outputs.py", 2), ("rhs.py", 8),
-        ("stepper.py", 1), ("stuck.py", 2))),
+        ("model/forcing.py", 3), ("model/inverse.py", 2), ("model/outputs.py", 2),
+        ("model/rhs.py", 9), ("model/stuck.py", 2))),
     *((f, r"\bm\.eta_table\b", "(False and m.eta_table)", n) for f, n in (
-        ("inverse.py", 1), ("rhs.py", 3), ("stuck.py", 1))),
-    ("rhs.py", r"sw\[SW_DIRECTION\] == st\.STUCK", "False", 1),
-    ("rhs.py", r"sigma == st\.STUCK", "False", 1),
-    ("stepper.py", r"ist\[I_DIRECTION\] == st\.STUCK", "False", 1),
-    ("stepper.py", r"sw\[SW_DIRECTION\] == st\.STUCK and", "False and", 1),
-    ("stepper.py", r"and not _stick\(m, extras, cfg, y, evbuf, ist, wk\)", "and True", 2),
-    ("stepper.py", r"ev_code == EV_RELEASED:", "ev_code == EV_RELEASED and False:", 1),
+        ("model/inverse.py", 1), ("model/rhs.py", 3), ("model/stuck.py", 1))),
+    ("model/rhs.py", r"sw\[SW_DIRECTION\] == st\.STUCK", "False", 1),
+    ("model/rhs.py", r"sigma == st\.STUCK", "False", 1),
+    ("stepper/loop.py", r"ist\[I_DIRECTION\] == st\.STUCK", "False", 1),
+    ("stepper/loop.py", r"sw\[SW_DIRECTION\] == st\.STUCK and", "False and", 1),
+    ("stepper/loop.py", r"and not _stick\(m, extras, cfg, y, evbuf, ist, wk\)", "and True", 2),
+    ("stepper/loop.py", r"ev_code == EV_RELEASED:", "ev_code == EV_RELEASED and False:", 1),
 ]
 
 #: The scenes timed, by name (in ``cases/``): without friction, the plain variant of the kernels

@@ -40,12 +40,12 @@ from numba import njit
 
 from ..assemble import build_model
 from ..core import CACHE_DIR_VARIABLE
-from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS,
-                    SAMPLES_PER_REV, TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight,
-                    on_plateau, order_slope, read_record)
-from ..core import layout
+from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS, SAMPLES_PER_REV,
+                    TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight, on_plateau,
+                    order_slope, read_record)
+from ..core.model import layout, work
 from ..core.jit import kernel
-from ..core.rhs import derivative
+from ..core.model.rhs import derivative
 from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
@@ -88,7 +88,7 @@ def rhs_loop(m, states, y, out, sw, wk, chained, extras):
     the next's. Independent calls read the row itself: copying it into ``y`` costs a measurable
     part of a call on the bare cylinder, and the hand-written loop (:func:`make_hand_loop`) copies
     nothing. ``extras``: the kernels' variant for ``m``
-    (:func:`transient.core.layout.extras_of`)."""
+    (:func:`transient.core.model.layout.extras_of`)."""
     acc = 0.0
     for i in range(states.shape[0]):
         state = states[i]
@@ -128,7 +128,7 @@ def rhs_arguments(scene, n_states=2000):
     states[:, layout.PHI], states[:, layout.T] = phi, np.interp(phi, tr["phi"], tr["t"])
     states[:, layout.KINETIC] = np.interp(phi, tr["phi"], 0.5 * tr["J"] * tr["omega"] ** 2)
     n = layout.n_state(model)
-    return model, states, np.empty(n), np.zeros(n), _switches(), layout.work_array(model)
+    return model, states, np.empty(n), np.zeros(n), _switches(), work.work_array(model)
 
 
 def _switches():
@@ -262,7 +262,7 @@ def make_hand_loop(rhs):
 def hand_parameters(base) -> np.ndarray:
     """The bare single cylinder's parameters for :func:`make_hand_rhs`, in its order (the last
     seven are what ``loads`` reads, all idle in the bare scene)."""
-    from ..core import crank_slider as cs
+    from ..core.model import crank_slider as cs
 
     mech = base.mechanism
     if not (mech.rod_model == "rigid" and mech.offset == 0.0 and mech.n_cylinders == 1):
@@ -292,7 +292,7 @@ def hand_against_transient(base, rows, **flags) -> tuple[np.ndarray, np.ndarray]
     theirs = np.zeros(6)
     hand, transient = [], []
     for i in rows:
-        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), layout.work_array(m), False,
+        rhs_loop(m, states[i:i + 1], np.empty(6), theirs, _switches(), work.work_array(m), False,
                  layout.extras_of(m))
         rhs(p, states[i], out, rec)
         hand.append((out[layout.T], out[layout.KINETIC]))
@@ -321,7 +321,7 @@ def bare_kernel(rounds=7) -> dict:
     for kin in ("exact", "tabulated"):
         m, _, _ = build_model(dc.replace(base, solver=dc.replace(base.solver, kinematics=kin)))
         costs[kin] = per_call(rhs_loop, m, states, np.empty(6), np.zeros(6), _switches(),
-                              layout.work_array(m), False, layout.extras_of(m), rounds=rounds)
+                              work.work_array(m), False, layout.extras_of(m), rounds=rounds)
     return {"hand_written_s": hand, "exact_s": costs["exact"], "tabulated_s": costs["tabulated"]}
 
 

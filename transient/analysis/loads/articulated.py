@@ -5,14 +5,14 @@ The crank-slider counterpart is
 :mod:`transient.analysis.loads.crank_slider` (Gots §2.3–§2.6); its conventions are
 kept, and what differs is that the master rod carries the slave rods' link pins, so it is not a
 two-force member. The kinematics are the mechanism's own exact ones
-(:mod:`transient.core.articulated`, Semenov (8), (31), (40)–(41) solved exactly), evaluated by the
+(:mod:`transient.core.model.articulated`, Semenov (8), (31), (40)–(41) solved exactly), evaluated by the
 compiled kernels sample by sample; Semenov's text is pure kinematics at constant ω (Semenov §1,
 (17) and p. 22): the forces below follow from d'Alembert's principle on that geometry with the
 actual ω and ε.
 
 Frame and signs
 ---------------
-One row, as :mod:`transient.core.articulated`: origin O on the crank axis, ``x`` along the master
+One row, as :mod:`transient.core.model.articulated`: origin O on the crank axis, ``x`` along the master
 cylinder toward its piston, ``y`` a quarter-turn on in the direction of rotation; 2-D vectors are
 complex numbers x + iy here. Local crank angle α = φ − the row's phase; crankpin A = r e^{iα},
 unit vectors ĉ = e^{iα} (crank, outward) and t̂ = i e^{iα} (direction of rotation). Cylinder k of
@@ -60,7 +60,7 @@ Virtual work (the independent checks, ``tests/unit/test_loads_radial_swash.py``)
   master rod, W_links = 0 and T r ω = Σ P_k ṡ_k exactly as for the crank-slider.
 * Whole engine, against the kernel's reduced inertia (Antonyuk (18)–(21)):
   Σ_rows r (R_T + T_rk) = Σ_k P_g,k u_k − J ε − ½ J′ ω², with J, J′ of
-  :func:`transient.core.articulated.articulated_terms` — every inertia force above is checked
+  :func:`transient.core.model.articulated.articulated_terms` — every inertia force above is checked
   against the kinetic energy the simulation integrates.
 * The cylinder's share of the shaft torque is P_k u_k
   (:attr:`~transient.analysis.loads.common.PistonLoads.torque`): the
@@ -81,7 +81,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...core import articulated as core
+from ...core.model import articulated as core
 from ...mechanisms.articulated import Articulated, positions
 from .common import (
     Array,
@@ -135,7 +135,7 @@ def row_kinematics(mech: Articulated, alpha: ArrayLike) -> RowKinematics:
     """:class:`RowKinematics` at the local angles ``alpha`` [rad].
 
     The master comes from :func:`.crank_slider.slider_arrays` (Semenov (31), exact); the
-    slaves' derivatives from the compiled :func:`transient.core.articulated.slave`, one sample at a
+    slaves' derivatives from the compiled :func:`transient.core.model.articulated.slave`, one sample at a
     time (cheap enough: analyses run once per result), and their positions from the plain-numpy
     :func:`transient.mechanisms.articulated.positions`.
     """

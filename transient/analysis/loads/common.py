@@ -143,7 +143,7 @@ def gas_forces(scene, phi: ArrayLike, fuel: ArrayLike = 1.0) -> Array:
     (``trapezoid``) gives the force directly.
     """
     # (lazily: the table builders import scipy)
-    from ...assemble import gas_is_force, gas_phases, gas_tables
+    from ...scene.queries import gas_is_force, gas_phases, gas_tables
 
     mech = scene.mechanism
     phi = np.atleast_1d(np.asarray(phi, dtype=np.float64))
@@ -171,7 +171,7 @@ def trajectory_gas_force(scene, traj) -> Array | None:
     absent). A prescribed-speed run with ``fuel`` ≠ 1 (:func:`transient.run.prescribed`)
     scales the force without recording it in ``p_<k>``, so its loads are those at full fuel.
     """
-    from ...assemble import gas_is_force
+    from ...scene.queries import gas_is_force
 
     mech = scene.mechanism
     names = [f"p_{k + 1}" for k in range(mech.n_cylinders)]

@@ -4,12 +4,12 @@ big-end bearing, main journals and the running torques (Gots §2.3–§2.8).
 The textbook assumes a constant speed; here ω and ε are arbitrary, so every inertia force has a
 term in ε besides the one in ω². Everything is plain numpy over arrays of samples (this is the
 user-facing analysis layer, above the compiled core); the kinematics are the exact crank-slider of
-:func:`transient.core.crank_slider.slider`, of which :func:`slider_arrays` is the vectorised twin
+:func:`transient.core.model.crank_slider.slider`, of which :func:`slider_arrays` is the vectorised twin
 (``tests/unit/test_loads.py`` checks them against each other to 1e-13).
 
 Frame and signs (Gots §1, Fig. 27)
 ----------------------------------
-One cylinder, as :mod:`transient.core.crank_slider`: origin on the crank axis, ``y`` along the
+One cylinder, as :mod:`transient.core.model.crank_slider`: origin on the crank axis, ``y`` along the
 cylinder axis toward the head, ``x`` to the side the crankpin moves at the top. Crankpin
 A = r(sin α, cos α) at the local crank angle α (from the cylinder axis, in the direction of
 rotation); piston pin B = (e, y_B); sin β = (r sin α − e)/l, β > 0 when the rod leans in the
@@ -63,7 +63,7 @@ rotation), û = (A − B)/l = (sin β, −cos β) (along the rod, from the pin t
 Multi-cylinder engines
 ----------------------
 Cylinder k sits at local angle α_k = φ − ``firing_angles[k]`` (its crank is at the cylinder axis
-at ``firing_angles[k]``). Its gas table is read at φ − :func:`transient.assemble.gas_phases`
+at ``firing_angles[k]``). Its gas table is read at φ − :func:`transient.scene.queries.gas_phases`
 (local 0 = gas-exchange TDC of a 4-stroke). Its crankpin stands θ_k = δ_k − ``firing_angles[k]``
 ahead of the shaft's reference line (δ_k its bank; ``CrankSlider.pin_angles``), so crankpin k
 leads crankpin 1 by γ_k = θ_k − θ_1 (mod 2π) in the direction of rotation (Gots §2.7.1:
@@ -130,7 +130,7 @@ __all__ = [
 def slider_arrays(alpha: ArrayLike, r: float, l: float, e: float = 0.0
                   ) -> tuple[Array, Array, Array, Array, Array, Array]:
     """Exact crank-slider kinematics, vectorised: the numpy twin of
-    :func:`transient.core.crank_slider.slider`.
+    :func:`transient.core.model.crank_slider.slider`.
 
     Returns ``(s, ds, dds, beta, dbeta, ddbeta)`` at the local angles ``alpha`` [rad]: piston
     travel from the true TDC [m] and its derivatives in α [m/rad, m/rad²] (positive toward the

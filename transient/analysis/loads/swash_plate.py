@@ -2,11 +2,11 @@
 joints on link 9 and the torque each cylinder puts on the shaft.
 
 The counterpart of :mod:`transient.analysis.loads.crank_slider` for the mechanism of Antonyuk et
-al. (§2, exact kinematics of :mod:`transient.core.swash_plate`).
+al. (§2, exact kinematics of :mod:`transient.core.model.swash_plate`).
 The paper gives the reduced equation (18) with M_П = Σ P_q u_q1 (19)–(20) and no piston or rod
 forces: they follow here from d'Alembert's principle on the same geometry with the actual ω and ε.
 
-Frame and signs (as :mod:`transient.core.swash_plate`)
+Frame and signs (as :mod:`transient.core.model.swash_plate`)
 ------------------------------------------------------
 Fixed frame: ``Ox`` along the shaft toward the plate, the shaft turning from ``Oy`` toward ``Oz``.
 Piston k's joint D_k = (x_D, r₁ cos ψ_Dk, r₁ sin ψ_Dk) slides along ``x``; the gas pushes it toward
@@ -42,7 +42,7 @@ Virtual work (the independent checks, ``tests/unit/test_loads_radial_swash.py``)
   Σ torque = Σ_k P_k u_k — the mechanism's generalized force M_П of (19) with the inertia forces
   in P, computed with the kernel's u_k.
 * Whole engine: shaft_torque = Σ_k P_g,k u_k − J ε − ½ J′ ω² with J, J′ of
-  :func:`transient.core.swash_plate.swash_terms` (eq. (18)): every inertia force above is checked
+  :func:`transient.core.model.swash_plate.swash_terms` (eq. (18)): every inertia force above is checked
   against the kinetic energy the simulation integrates.
 
 What does not apply
@@ -61,7 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...core import swash_plate as core
+from ...core.model import swash_plate as core
 from ...mechanisms.swash_plate import SwashPlate
 from .common import (
     Array,
@@ -110,9 +110,9 @@ class SwashKinematics:
 def swash_kinematics(mech: SwashPlate, phi: ArrayLike) -> SwashKinematics:
     """:class:`SwashKinematics` at the shaft angles ``phi`` [rad].
 
-    Positions from the compiled :func:`transient.core.swash_plate.swash_points`, the Hooke joint
-    from :func:`transient.core.swash_plate.hooke` (one sample at a time); the derivatives as the
-    kernel :func:`~transient.core.swash_plate.swash_terms` forms them — B′ = w × B,
+    Positions from the compiled :func:`transient.core.model.swash_plate.swash_points`, the Hooke joint
+    from :func:`transient.core.model.swash_plate.hooke` (one sample at a time); the derivatives as the
+    kernel :func:`~transient.core.model.swash_plate.swash_terms` forms them — B′ = w × B,
     B″ = w′ × B + w × B′ with w = i + θ′n (eq. (8)) and eq. (10) differentiated twice — here on
     arrays, because the kernel keeps B′, B″ to itself.
     """

@@ -1,0 +1,116 @@
+"""The declared layouts of the compiled arrays (:mod:`transient.core.declare`): offsets derived
+from the declarations, the compiled index kernels against the declaration's offsets on every case,
+and each checked against something counted another way: the state's and the output row's lengths
+against the trajectory's columns that ``transient.scene.outputs`` names from the scene, the
+reaction solvers' rows against the rows they share, the event tables against each other."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from transient.assemble import build_model
+from transient.core.declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED, Block, Layout, Sized
+from transient.core.model import articulated_friction as af
+from transient.core.model import governor as gv
+from transient.core.model import joint_friction as jf
+from transient.core.model import layout
+from transient.core.model import swash_friction as sf
+from transient.core.model.work import N_WK, work_array
+from transient.core.stepper import events
+from transient.core.stepper import io as sio
+from transient.scene.outputs import output_columns
+from transient.scene import load_scene
+
+CASES = sorted((Path(__file__).resolve().parents[2] / "cases").glob("*.toml"))
+
+
+def test_offsets_follow_the_declared_sizes():
+    lay = Layout("l", "a", ("b", 3), Block("c", 2, "two"), start=5)
+    assert list(lay) == [5, 6, 9]
+    assert lay.end == lay.size == 11 and len(lay) == 3
+    assert lay.size_of("b") == 3 and lay.index("c") == 2
+    assert lay.table() == [("a", "5", ""), ("b", "6…8", ""), ("c", "9…10", "two")]
+
+
+def test_a_sized_block_is_laid_per_scene():
+    lay = Layout("l", "a", ("n", Sized(lambda o: o.k, "k of them")), "z")
+    assert lay.fixed_offset("n") == 1
+    with pytest.raises(TypeError, match="known per scene"):
+        lay.fixed_offset("z")
+    with pytest.raises(TypeError):
+        list(lay)  # (the unpacking of constants needs every offset known at import)
+
+    class Obj:
+        k = 4
+
+    assert lay.offsets_for(Obj) == [0, 1, 5, 6]
+
+
+def test_bad_declarations_are_refused():
+    with pytest.raises(ValueError, match="named twice"):
+        Layout("l", "a", "a")
+    with pytest.raises(ValueError, match="size -1"):
+        Layout("l", ("a", -1))
+    with pytest.raises(KeyError, match="no block 'x'"):
+        Layout("l", "a").index("x")
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.stem for c in CASES])
+def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
+    """The compiled index kernels (the chain the kernels index by) and the declaration's offsets
+    (what the Python side lays out) agree, and both with what the scene counts otherwise."""
+    scene = load_scene(case)
+    model, _, _ = build_model(scene)
+    at = layout.STATE.offsets_for(model)
+    assert [layout.gov_index(model), layout.latch_index(model), layout.cyl_index(model),
+            layout.n_state(model)] == at[layout.B_GOVERNOR:]
+    # the state: its length counted from the scene
+    expected = (6 + len(scene.friction.pairs) + len(gv.STATE_NAMES[model.gov_dyn])
+                + scene.mechanism.n_cylinders * (int(model.latch) + int(model.woschni)))
+    control = layout.state_control(model)
+    assert at[-1] == expected == control.size and np.all(np.diff(at) >= 0)
+    assert list(control[:3]) == [BY_INCREMENT, BY_INCREMENT, BY_SIZE]
+    assert np.all(control[3:layout.W_LOSS0 + model.n_pairs] == NOT_CONTROLLED)
+    assert np.all(control[at[layout.B_GOVERNOR]:at[layout.B_GOVERNOR + 1]] == BY_SIZE)
+    assert np.all(control[at[layout.B_PRESSURE]:] == BY_SIZE)
+    # the output row: as long as the trajectory's columns that the scene names
+    out = layout.OUTPUT.offsets_for(model)
+    assert [layout.pair_col(model), layout.governor_col(model), layout.cylinder_loss_col(model),
+            layout.n_outputs(model)] == [out[layout.O_PAIRS], out[layout.O_GOVERNOR],
+                                         out[layout.O_CYL_LOSS], out[-1]]
+    if scene.run.mode != "prescribed-speed":
+        names = list(output_columns(scene))
+        assert out[-1] == len(names) and names[out[layout.O_GAS]] == "p_1"
+        if model.n_pairs:
+            assert names[out[layout.O_PAIRS]] == "S_1"
+    assert work_array(model).shape[0] == N_WK
+    assert sio.fst_size(model) == sio.N_FST + at[-1] + max(model.n_pairs, 1)
+
+
+@pytest.mark.parametrize("solver", [jf, sf, af], ids=["crank-slider", "swash plate", "articulated"])
+def test_each_reaction_solver_lays_its_rows_after_the_shared_ones(solver):
+    shared = set(jf.SHARED)
+    own = set(solver.ROWS)
+    assert not shared & own and min(own) == jf.SHARED.end
+    assert N_WK >= layout.WK_RX + solver.ROWS.end
+    # every row constant of the module is one of its declared rows or a shared one
+    prefix = {jf: "R_", sf: "S_", af: "A_"}[solver]
+    constants = {getattr(solver, k) for k in dir(solver) if k.startswith(prefix) and k.isupper()
+                 and isinstance(getattr(solver, k), int)}
+    assert constants <= own | shared
+
+
+def test_the_switches_lead_the_stepper_integer_state():
+    assert sio.I_SWITCHES == 0 and sio.INTS.size_of("switches") == layout.N_SWITCHES
+    assert [sio.I_STARTER_ON, sio.I_LOAD_TABLE] == [layout.SW_STARTER, layout.SW_LOAD_TABLE]
+    assert sio.N_IST == layout.N_SWITCHES + len(sio.INTS) - 1
+
+
+def test_events_are_named_once_and_watched_in_slots():
+    assert len(set(sio.EVENT_NAMES)) == len(sio.EVENT_NAMES) == len(sio.EVENTS)
+    assert sio.EVENT_NAMES[sio.EV_RELEASED] == "released"
+    assert sio.EVENT_NAMES[sio.EV_PAIR_MODE] == "pair_mode"
+    assert events.N_EVENT_KINDS == events.WATCHED.size
+    assert events.FIRST_PAIR_EVENT + events.MAX_PAIRS == events.N_EVENT_KINDS

@@ -1,0 +1,26 @@
+"""The right-hand side's work array (``wk``): the rows :data:`.layout.WORK` declares, then, from
+``layout.WK_RX`` on, the rows of the reaction solver that needs most (each solver declares its own,
+after the rows they share, and a scene has one mechanism: they lie over one another).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..jit import compiled
+
+from . import articulated_friction as af
+from . import joint_friction as jf
+from . import swash_friction as sf
+from .layout import WK_RX, WK_SEL
+
+#: Rows of the work array: enough for any mechanism's reaction solver.
+N_WK = WK_RX + max(jf.ROWS.end, sf.ROWS.end, af.ROWS.end)
+
+
+@compiled
+def work_array(m):
+    """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
+    wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2)))
+    wk[WK_SEL, 0] = np.nan  # no pieces selected yet
+    wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
+    return wk

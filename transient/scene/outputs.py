@@ -1,0 +1,96 @@
+"""The trajectory columns a scene's run writes, with their units (the result file's layout:
+docs/guide/results.md).
+
+A query on the scene, with it: the scene's checks ask which columns a run will have (an
+``[analysis]`` request must name one), and the layers above (the run, the results, the analyses)
+name the columns through it. It reads a scene's records without importing their module.
+"""
+from __future__ import annotations
+
+import re
+
+from .queries import gas_is_force, governor_kind, reaction_friction
+from ..core.model import governor as gv
+from ..core.model.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
+
+
+def output_columns(scene) -> dict[str, str]:
+    """Trajectory datasets of a run and their units."""
+    cols = dict(zip(OUTPUTS, OUTPUT_UNITS))
+    for k in range(scene.mechanism.n_cylinders):
+        # p_k: cylinder pressure, or the force per piston for force-pulse models
+        cols[f"p_{k + 1}"] = "N" if gas_is_force(scene) else "Pa"
+    for k in range(len(scene.friction.pairs)):
+        for name, unit in zip(PAIR_OUTPUTS, PAIR_OUTPUT_UNITS):
+            cols[f"{name}_{k + 1}"] = unit
+    kind = governor_kind(scene.governor)
+    cols.update(zip(gv.STATE_NAMES[kind], gv.STATE_UNITS[kind]))
+    if scene.gas.injection is not None:  # the fuel each cylinder latched at its last injection
+        cols.update({f"fuel_{k + 1}": "1" for k in range(scene.mechanism.n_cylinders)})
+    if reaction_friction(scene):  # each reaction pair's loss split over the cylinders
+        cols.update({cylinder_loss_column(k, c): "W" for k in range(len(scene.friction.pairs))
+                     for c in range(scene.mechanism.n_cylinders)})
+    if scene.run.mode == "prescribed-speed":
+        cols["M_drive"] = "N m"
+        cols["W_drive"] = "J"
+    return cols
+
+
+def cylinder_loss_column(pair: int, cylinder: int) -> str:
+    """The column of the power that reaction pair ``pair`` loses in ``cylinder`` (both from 0)."""
+    return f"P_loss_{pair + 1}_cyl{cylinder + 1}"
+
+
+#: What each trajectory column holds, with its sign convention (torques and speeds positive in
+#: the direction of rotation, forces toward the crank axis, after Gots §1). ``{k}`` is
+#: a cylinder's or a pair's number.
+DESCRIPTIONS = {
+    "t": "time since the start of the run",
+    "phi": "crank angle, unwrapped: it grows with forward rotation and is not reduced to a cycle",
+    "omega": "shaft speed dφ/dt, positive in the direction of rotation",
+    "epsilon": "shaft acceleration dω/dt, positive when speeding up in the direction of rotation",
+    "J": "reduced moment of inertia J(φ) of the whole machine about the shaft, the [inertia] "
+         "constants included",
+    "dJ_dphi": "dJ/dφ, the rate of change of the reduced inertia with the crank angle",
+    "M_gas": "moment of the gas forces on the shaft, positive driving the shaft forward",
+    "M_load": "moment of the load on the shaft, positive driving it forward (a brake is negative)",
+    "M_starter": "moment of the starter on the shaft, positive driving it forward",
+    "fuel": "fuel command between the motored (0) and the full-load (1) pressure curve",
+    "W_gas": "work of M_gas on the shaft since the start, ∫M_gas ω dt",
+    "W_load": "work of M_load on the shaft since the start (negative: taken by the load)",
+    "W_starter": "work of M_starter on the shaft since the start",
+    "p_{k}": "pressure in cylinder {k} (for force-pulse models the force on piston {k}), pushing "
+             "the piston toward the crank axis",
+    "S_{k}": "moment that non-ideal pair {k} takes from its shaft side, reduced to φ; the far "
+             "side receives eta_{k}·S_{k}",
+    "eta_{k}": "efficiency in use in pair {k}: η_forward (< 1) when power flows forward, "
+               "1/η_backward (> 1) when it flows back",
+    "P_loss_{k}": "power lost in pair {k}, (1 − eta_{k})·S_{k}·ω",
+    "W_loss_{k}": "energy lost in pair {k} since the start, ∫P_loss_{k} dt",
+    "P_loss_{k}_cyl{c}": "power lost in reaction pair {k} at the joints of cylinder {c}; over "
+                         "the cylinders it sums to P_loss_{k}",
+    "gov_integral": "the PI(D) governor's integral state",
+    "gov_rack": "the PI(D) governor's rack (actuator) position",
+    "gov_filter": "the PID governor's filtered speed",
+    "sleeve_lift": "the flyweight governor's sleeve lift",
+    "sleeve_speed": "the flyweight governor's sleeve speed, d(sleeve_lift)/dt",
+    "fuel_{k}": "fuel command latched by cylinder {k} at its last injection",
+    "M_drive": "drive moment the prescribed speed needs on the shaft, positive driving it forward",
+    "W_drive": "work of M_drive on the shaft since the start, ∫M_drive ω dt (to the solver's "
+               "tolerance, at any output spacing)",
+}
+
+
+def describe(column: str) -> str:
+    """The description of a trajectory column (:data:`DESCRIPTIONS`), for numbered ones too."""
+    if column in DESCRIPTIONS:
+        return DESCRIPTIONS[column]
+    split = re.fullmatch(r"P_loss_(\d+)_cyl(\d+)", column)
+    if split:
+        k, c = split.groups()
+        return DESCRIPTIONS["P_loss_{k}_cyl{c}"].replace("{k}", k).replace("{c}", c)
+    head, _, k = column.rpartition("_")
+    pattern = f"{head}_{{k}}"
+    if k.isdigit() and pattern in DESCRIPTIONS:
+        return DESCRIPTIONS[pattern].replace("{k}", k)
+    raise KeyError(f"{column}: no description; add one to transient.scene.outputs.DESCRIPTIONS")
