@@ -121,3 +121,6 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 # The guide's pictures and a first run's output, made in the build from the model's own code
 # (_ext/guide_figures.py), and the landing page's cards.
 extensions += ["sphinx_design", "guide_figures"]
+# The developer guide's layer diagram and layout tables, made from the import contracts and the
+# declarations they show (_ext/developer_pages.py).
+extensions += ["developer_pages"]

@@ -192,7 +192,8 @@ def build_model(scene, part_load: bool = False
     """The compiled model, its breakpoints and the (full-load) pressure table of a scene.
 
     The motored curve is paired where the scene can burn less than full-load fuel
-    (:func:`burns_part_load`) or ``part_load`` asks for it (a study at a fixed fuel)."""
+    (:func:`~transient.scene.queries.burns_part_load`) or ``part_load`` asks for it (a study at
+    a fixed fuel)."""
     mech = scene.mechanism
     table, motored = gas_tables(scene)
     if not (part_load or burns_part_load(scene)):

@@ -1,8 +1,8 @@
 """Compile the stepper's callees in a helper process while this process compiles the stepper.
 
-On a cold cache, compiling the stepper (:func:`transient.core.stepper.advance`) is the bulk of
-a first run, on one core: while numba types the stepper it compiles, one after another, each
-of its callees (every kernel is a compile unit of its own, which LLVM inlines afterwards:
+On a cold cache, compiling the stepper (:func:`~transient.core.stepper.loop.advance`) is the
+bulk of a first run, on one core: while numba types the stepper it compiles, one after another,
+each of its callees (every kernel is a compile unit of its own, which LLVM inlines afterwards:
 :func:`transient.core.jit.kernel`). A helper process started at the same time compiles those
 callees in the reverse order, each under its compile lock
 (:func:`transient.core.jit._compile_once_across_processes`), so that the two use two cores. The
@@ -79,7 +79,7 @@ def _types_by_parameter(model, tab) -> dict:
                                   "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
              types.int64[::1]: ("ist", "sw", "control")}
-    # (``extras`` is None or True: the plain or the full variant, :func:`.core.layout.extras_of`)
+    # (``extras`` is None or True: the plain or the full variant, ``core.model.layout.extras_of``)
     extras = typeof(layout.extras_of(model))
     by_name = {"m": typeof(model), "tab": typeof(tab), "extras": extras,
                # the model's derivative in the integrator's form, and its context
@@ -126,8 +126,8 @@ STEPPER = loop.advance
 
 def stepper_is_cached(model, tab) -> bool:
     """Whether the stepper, in the kernels' variant for ``model``
-    (:func:`.core.layout.extras_of`), is compiled in this process or saved in numba's cache: a
-    cache that holds only the other variant leaves this one to compile."""
+    (:func:`~transient.core.model.layout.extras_of`), is compiled in this process or saved in
+    numba's cache: a cache that holds only the other variant leaves this one to compile."""
     return is_cached(STEPPER, signature(STEPPER, model, tab))
 
 

@@ -1,5 +1,6 @@
 """Result files (HDF5, format 1; docs/guide/results.md): the layout, a streaming writer and a
-reader.
+reader (one idea, the result file: what writes it and what reads it back kept together, so that
+the format has one definition).
 
 The layout of a run — header attributes, ``scene/toml``, ``trajectory/<column>``,
 ``events/<name>/{t,phi}``, ``solver`` attributes, ``analysis/<name>`` — is written by the

@@ -379,7 +379,7 @@ def eta_map():
     """The efficiency map of cases/gots_diesel_eta_map.toml: η_forward and η_backward against
     the moment |S| at each of its speeds, bilinear between the grid points as the kernel's
     ``lookup`` reads it (dots: the grid)."""
-    from transient.core.eta_table import BACKWARD, FORWARD, lookup
+    from transient.core.model.eta_table import BACKWARD, FORWARD, lookup
 
     scene = _case("gots_diesel_eta_map.toml")
     pair = next(p for p in scene.friction.pairs if p.model == "table")

@@ -1,4 +1,5 @@
-"""Swash-plate engines (Antonyuk et al., Fig. 1): geometry, masses, validation, positions, tables.
+"""Swash-plate engines (Antonyuk et al., Fig. 1): geometry, masses, validation, positions, tables
+(one idea, the swash-plate mechanism on the scene's side, as each mechanism has its one module).
 
 The compiled kinematics and the frame are described in :mod:`transient.core.model.swash_plate`; this module
 holds the scene-side description (SI units), packs it for the kernel and gives numpy-level positions

@@ -1,9 +1,10 @@
-"""The reference path's run: the model in plain numpy (:class:`ReferenceModel`, with the parts of
-:mod:`.twins`), integrated by ``scipy.integrate.solve_ivp`` in time (the state is (φ, ω) and the
-work integrals, (18) written out again; the mechanism's J(φ), dJ/dφ and transfer functions come
-from its plain-Python twin, ``reference_terms``, :mod:`transient.mechanisms.twins`).
-Breakpoints, the starter's cut-out and the switches' corners are terminal events of solve_ivp,
-so every segment between them is smooth.
+"""The reference path's run: the model in plain numpy
+(:class:`~transient.reference.integrate.ReferenceModel`, with the parts of
+:mod:`transient.reference.twins`), integrated by ``scipy.integrate.solve_ivp`` in time (the state is
+(φ, ω) and the work integrals, (18) written out again; the mechanism's J(φ), dJ/dφ and transfer
+functions come from its plain-Python twin, ``reference_terms``, :mod:`transient.mechanisms.twins`).
+Breakpoints, the starter's cut-out and the switches' corners are terminal events of solve_ivp, so
+every segment between them is smooth.
 
 What it shares with the compiled path, and so does not check: the scene's assembly
 (:func:`transient.assemble.build_model`: the gas tables, the breakpoints, the load schedule, the

@@ -1,8 +1,10 @@
 """The model's parts in plain numpy, for the reference path (:mod:`.integrate`): the serial chain
-with constant-η pairs (:class:`ChainNumpy`, equations (22)–(29) solved again), the pairs' friction
-on the joints' reactions by the Newton–Euler oracles of :mod:`.joints` (:class:`ReactionNumpy`
-and its subclasses), the cylinders' closed-part pressures with wall heat
-(:class:`CylindersNumpy`) and the dynamic governors (:class:`GovernorNumpy`).
+with constant-η pairs (:class:`~transient.reference.twins.ChainNumpy`, equations (22)–(29) solved
+again), the pairs' friction on the joints' reactions by the Newton–Euler oracles of
+:mod:`transient.reference.joints` (:class:`~transient.reference.twins.ReactionNumpy` and its
+subclasses), the cylinders' closed-part pressures with wall heat
+(:class:`~transient.reference.twins.CylindersNumpy`) and the dynamic governors
+(:class:`~transient.reference.twins.GovernorNumpy`).
 
 What they share with the compiled path: the Model's arrays that the scene's assembly fills (the
 chain's links and their sub-chains, the joints' coefficients, the governor's parameters), the
@@ -125,8 +127,8 @@ class ChainNumpy:
 
 class ReactionNumpy(ChainNumpy):
     """Friction on the crank-slider's joint reactions, solved as the compiled kernel does not:
-    the joint forces by Newton–Euler (:func:`crank_slider_joint_forces`, eight linear equations
-    per cylinder) with the friction laws applied to them (:func:`crank_slider_friction_laws`),
+    the joint forces by Newton–Euler (:func:`~transient.reference.joints.crank_slider_joint_forces`, eight linear equations
+    per cylinder) with the friction laws applied to them (:func:`~transient.reference.joints.crank_slider_friction_laws`),
     iterated to a fixed point. For given friction moments and forces every joint force is affine
     in φ̈, so each turn takes φ̈ exactly from the shaft's equation J₀ φ̈ = M_shaft + Σ T(φ̈) with
     the forces at φ̈ = 0 and 1; the friction is a small share of the forces (μ·r/l), so the
@@ -232,7 +234,7 @@ class ReactionNumpy(ChainNumpy):
 
 class ArticulatedReactionNumpy(ReactionNumpy):
     """Friction on the articulated mechanism's joint reactions for the reference path: φ̈ and the
-    joints' forces by its own Newton–Euler (:func:`articulated_joint_forces`, the shaft's equation
+    joints' forces by its own Newton–Euler (:func:`~transient.reference.joints.articulated_joint_forces`, the shaft's equation
     closing the linear system, the friction a fixed point on its forces), not by the kernels'
     Newton solve; directions at the segment's angle ``sel``, as the compiled path holds them."""
 
@@ -254,7 +256,7 @@ class ArticulatedReactionNumpy(ReactionNumpy):
 class SwashReactionNumpy(ReactionNumpy):
     """Friction on the swash plate's joint reactions for the reference path: φ̈ and the reactions
     by its Newton–Euler of every body as one linear system, the friction laws closed on them by
-    ``scipy.optimize.fsolve`` (:func:`swash_plate_friction`), not by the kernels' Newton solve;
+    ``scipy.optimize.fsolve`` (:func:`~transient.reference.joints.swash_plate_friction`), not by the kernels' Newton solve;
     the pistons' directions at the segment's angle ``sel``, as the compiled path holds them. The
     bearings' losses are the engine's, no cylinder's: their columns per cylinder are NaN."""
 

@@ -2,6 +2,10 @@
 describe (inertia, gas, load, starter, governor, initial state, run, solver, output, friction,
 analysis), with the limits the reader checks them against. The mechanisms' records are the
 classes of :mod:`transient.mechanisms`.
+
+One idea, what a scene is as data: a record per table, each field with its unit, default and
+limits in one place (the user guide's key tables are generated from them); reading the TOML
+into them is :mod:`.read`, the checks across tables :mod:`.checks`.
 """
 from __future__ import annotations
 

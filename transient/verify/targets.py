@@ -1,6 +1,8 @@
 """The performance targets, measured by ``transient bench`` beside the work-precision record and
 written to ``targets.md`` and ``targets.json`` in the record's folder: each target with what was
-measured, how, and whether it is met or by how much it is missed.
+measured, how, and whether it is met or by how much it is missed. One idea: the targets'
+report, each target's measurement beside its verdict, so that what is measured and what it is
+held to cannot drift apart.
 
 * speed at equal accuracy (≥ 300× solve_ivp RK45, ≥ 2× CyRK at a final phase error ≤ 1e-6 rad)
   and the error's fall with the tolerance: read from the record's rows (:mod:`transient.verify.bench`);

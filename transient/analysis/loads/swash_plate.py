@@ -7,7 +7,7 @@ The paper gives the reduced equation (18) with M_П = Σ P_q u_q1 (19)–(20) an
 forces: they follow here from d'Alembert's principle on the same geometry with the actual ω and ε.
 
 Frame and signs (as :mod:`transient.core.model.swash_plate`)
-------------------------------------------------------
+------------------------------------------------------------
 Fixed frame: ``Ox`` along the shaft toward the plate, the shaft turning from ``Oy`` toward ``Oz``.
 Piston k's joint D_k = (x_D, r₁ cos ψ_Dk, r₁ sin ψ_Dk) slides along ``x``; the gas pushes it toward
 +x (toward the plate), so u_k = dx_D/dφ (times ``halves``: the kernel sums both pistons of a

@@ -1,6 +1,6 @@
 """A plain adaptive driver of the integrator's kernels for an ODE y′ = f(y): steps of an embedded
 pair (:mod:`.rk`) under its error norm and PI step-size control, the dense output at requested
-abscissae, and one optional terminal event located on it (:mod:`.roots`).
+abscissae, and one optional terminal event located on it (:mod:`~transient.core.integrator.roots`).
 
 It is the integrator on its own, with nothing of the engine: the tests run it on closed-form
 problems (a harmonic oscillator, SciPy's rational test problem), so that the numerics the

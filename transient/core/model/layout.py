@@ -194,7 +194,7 @@ OUTPUT = Layout(
 )
 O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS = range(len(OUTPUT))
 
-#: Rows of the work array ``wk`` (see :func:`work_array`), one column per cylinder, pair or link:
+#: Rows of the work array ``wk`` (:func:`.work.work_array`), one column per cylinder, pair or link:
 #: transfer functions u, u′ per cylinder; per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the
 #: mode margins g_k, their least value over the right-hand sides evaluated since the stepper
 #: reset it, and η*, S of a trial mode vector; the least and largest speed ω over those

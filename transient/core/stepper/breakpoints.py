@@ -35,7 +35,8 @@ def _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst):
     θ = 1; one closer than ``tol_end`` is left to the event search, which finds it at once in the
     next step). ``up``, ``down``: the breakpoints above and below the shaft. ``tol_end``: a step
     that would end within rounding of ``x_end`` ends on it exactly, so that no later step of a
-    few ulp is needed (:func:`next_breakpoint` treats such a point as reached).
+    few ulp is needed (:func:`~transient.core.integrator.breakpoints.next_breakpoint` treats
+    such a point as reached).
     """
     here = y[PHI]
     if not angle_mode and abs(here - fst[F_PASSED_BP]) <= BP_LANDING:

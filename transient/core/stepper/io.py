@@ -1,4 +1,4 @@
-"""What the stepper (:func:`~transient.core.stepper.advance`) and its Python caller exchange: the settings
+"""What the stepper (:func:`~.loop.advance`) and its Python caller exchange: the settings
 ``cfg``, the stepper's state kept between chunks (``fst``, ``ist``), the return codes, the event
 codes and their names, and the writing of output rows and events into the caller's buffers.
 

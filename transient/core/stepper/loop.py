@@ -7,8 +7,9 @@ fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for period
 While ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint,
 so the right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal)
 it integrates in time, and a step that would cross a breakpoint is retaken so that it ends on it
-(:mod:`.breakpoints`). The events (:mod:`.events`) truncate the step they fall in; acting on one
-changes the switches, the state or the independent variable (:func:`_switch_at_event`).
+(:mod:`~transient.core.stepper.breakpoints`). The events (:mod:`.events`) truncate the step
+they fall in; acting on one changes the switches, the state or the independent variable
+(:func:`_switch_at_event`).
 
 Each turn of the loop in :func:`advance` is: the segment's end
 (:func:`.breakpoints._segment_end`) and the step size (:func:`_step_size`), a step attempt
@@ -23,6 +24,10 @@ samples inside the step (:func:`_emit_step_samples`), and either the step taken 
 :func:`advance` runs until the run ends, an output buffer fills or a step budget is used, so that
 the Python caller can stream results, show progress and react to Ctrl-C between chunks
 (:mod:`~transient.core.stepper.io`).
+
+One idea, the loop of a run: the steps, their retakes and the events acted on, in one module
+because LLVM inlines its pieces into :func:`advance` and they share its bookkeeping; the
+numerics of a step are the integrator's, locating an event is :mod:`.events`.
 
 Every function here is a compile unit of its own (:func:`transient.core.jit.kernel`). The pieces of the loop,
 and the helpers called once per step or per root-finding iteration that take the Model, are
