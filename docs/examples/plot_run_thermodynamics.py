@@ -18,8 +18,8 @@ import matplotlib.pyplot as plt
 
 import transient
 from transient import plots
-from transient.scene.queries import gas_table
 from transient.scene import scene_from_dict
+from transient.scene.queries import gas_table
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"
 

@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from transient.scene.queries import cycle_figures
 from transient.cli import main
 from transient.core.model import crank_slider as cs_core
 from transient.mechanisms import articulated as art
 from transient.mechanisms import swash_plate as sp
 from transient.mechanisms.crank_slider import CrankSlider
 from transient.scene import load_scene
+from transient.scene.queries import cycle_figures
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"

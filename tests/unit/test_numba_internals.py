@@ -19,7 +19,7 @@ from pathlib import Path
 
 import llvmlite.binding as ll
 import numba
-from numba.core import (caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes, types)
+from numba.core import caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes, types
 from numba.core.base import BaseContext
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys

@@ -12,7 +12,7 @@ import pytest
 
 from transient.assemble import build_model
 from transient.cli import main
-from transient.core.model.variation import (FUEL, PRESSURE, SHIFT, START, cycle_fuel, misfire_draw)
+from transient.core.model.variation import FUEL, PRESSURE, SHIFT, START, cycle_fuel, misfire_draw
 from transient.errors import SceneError
 from transient.scene import load_scene, scene_from_dict
 

@@ -23,8 +23,8 @@ import pytest
 from scipy.integrate import quad
 
 from transient.core.model.crank_slider import crank_slider_terms
-from transient.scene import Gas, Initial, Load, Output, Run, Solver, load_scene
 from transient.run import integrate
+from transient.scene import Gas, Initial, Load, Output, Run, Solver, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

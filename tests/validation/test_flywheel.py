@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from transient.study.flywheel import flywheel_for_delta
 from transient.analysis.irregularity import cycle_means, fluctuation, steady_state_time
-from transient.scene import Load, Output, Run, load_scene
 from transient.run import integrate, prescribed
+from transient.scene import Load, Output, Run, load_scene
+from transient.study.flywheel import flywheel_for_delta
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

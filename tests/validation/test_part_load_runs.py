@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 
 from transient import simulate
-from transient.scene.queries import gas_tables
 from transient.scene import Friction, Governor, load_scene, scene_from_dict
+from transient.scene.queries import gas_tables
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
@@ -78,8 +78,8 @@ def test_woschni_cut_out_is_the_motored_cycle_with_wall_heat():
     governor) with cylinder 2 cut out: over the closed part of its second cycle its pressure is
     transient.forces.woschni's closed cycle without fuel at that speed, to 1e-6 (the solvers'
     tolerances: rtol 1e-11 here, 1e-12 there), peaking where it does on the same samples."""
-    from transient.scene.queries import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
+    from transient.scene.queries import clearance_volume
 
     base = load_scene(CASES / "gots_diesel_woschni.toml")
     scene = replace(base.replace(gas={"cylinders": [{"cylinder": 2, "cut_out": True}]},

@@ -43,8 +43,16 @@ from numpy.typing import NDArray
 
 from ..errors import SceneError
 from ..roots import bisect_root
-from .gas import (ANGLE_TOL, DEFAULT_STEP, IndicatedCycle, VolumeFunction, deg_text,
-                  table_from_function, volume_at, wrapped_pieces)
+from .gas import (
+    ANGLE_TOL,
+    DEFAULT_STEP,
+    IndicatedCycle,
+    VolumeFunction,
+    deg_text,
+    table_from_function,
+    volume_at,
+    wrapped_pieces,
+)
 
 __all__ = ["CompressorCycle", "compressor_cycle", "ideal_compressor_work"]
 

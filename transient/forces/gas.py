@@ -18,8 +18,9 @@ caller, not here.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence, Union
+from typing import Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

@@ -26,10 +26,11 @@ How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from math import cos, degrees, hypot, pi, sin, sqrt
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

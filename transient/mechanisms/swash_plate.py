@@ -42,10 +42,11 @@ How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from math import asin, cos, degrees, inf, pi, sin
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray

@@ -16,13 +16,27 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from ..core.model.layout import (LINK_PISTONS, LINK_REST, LINK_SWASH, RX_MU, RX_RADIUS,
-                                 RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS)
+from ..core.model.layout import (
+    LINK_PISTONS,
+    LINK_REST,
+    LINK_SWASH,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+)
 from ..core.model.swash_plate import link_terms as swash_link_terms
 from ..mechanisms import reaction_joints
-from .joints import (_at_acceleration, articulated_joint_forces, crank_slider_friction_laws,
-                     crank_slider_joint_forces, crank_slider_joint_powers, crank_slider_joint_signs,
-                     swash_plate_friction)
+from .joints import (
+    _at_acceleration,
+    articulated_joint_forces,
+    crank_slider_friction_laws,
+    crank_slider_joint_forces,
+    crank_slider_joint_powers,
+    crank_slider_joint_signs,
+    swash_plate_friction,
+)
 
 
 class ChainNumpy:
@@ -300,8 +314,8 @@ class CylindersNumpy:
 
     def __init__(self, scene, phases: np.ndarray, period: float, c: int,
                  offsets: np.ndarray) -> None:
-        from ..scene.queries import clearance_volume, wiebe_levels
         from ..forces import closed_cycle, woschni
+        from ..scene.queries import clearance_volume, wiebe_levels
 
         gas, mech = scene.gas, scene.mechanism
         self.fn, self.w, self.c, self.period, self.phases = woschni, gas.wiebe, c, period, phases

@@ -23,8 +23,8 @@ import math
 from ..analysis.efficiency import mechanical_efficiency
 from ..analysis.summary import nan_reason
 from ..plots import friction_budget, sweep_heatmap
-from ..scene import Friction, Governor, Initial, Output, Run
 from ..run import prescribed
+from ..scene import Friction, Governor, Initial, Output, Run
 
 #: Columns of a study row besides the per-pair ones.
 STUDY_COLUMNS = ("policy", "fuel", "rpm", "eta_mech_work", "eta_mech_printed",

@@ -249,7 +249,7 @@ class SweepStore:
     def summary(self) -> tuple[list[dict[str, Any]], dict[str, str]]:
         """The summary rows (run order) and the units of their columns, from the stored runs."""
         units = {"run": "", "status": "", **{a.key: _suffix_unit(a.key) for a in self.sweep.axes},
-                 **{q: "" for q in self.sweep.collect}}
+                 **dict.fromkeys(self.sweep.collect, "")}
         rows = []
         for spec in self.sweep.runs:
             g = self.f["runs"].get(self.group_name(spec.index))

@@ -40,15 +40,27 @@ from numba import njit
 
 from ..assemble import build_model
 from ..core import CACHE_DIR_VARIABLE
-from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS, SAMPLES_PER_REV,
-                    TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight, on_plateau,
-                    order_slope, read_record)
-from ..core.model import layout, work
 from ..core.jit import kernel
+from ..core.model import layout, work
 from ..core.model.rhs import derivative
 from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
+from .bench import (
+    ADAPTIVE,
+    BASELINE_BUDGET_S,
+    BENCH_SCENES,
+    DEFAULT,
+    SAME_STEPS,
+    SAMPLES_PER_REV,
+    TARGET_PHASE,
+    at_target,
+    fastest_as_accurate,
+    loose_to_tight,
+    on_plateau,
+    order_slope,
+    read_record,
+)
 from .models_out import WITHOUT_FRICTION, friction_models_cost
 
 #: Right-hand sides per DOP853 step. The stepper picks each cylinder's gas table piece once per

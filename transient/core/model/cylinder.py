@@ -28,8 +28,8 @@ from __future__ import annotations
 
 import math
 
-from .crank_slider import E, L, R, slider
 from ..jit import kernel
+from .crank_slider import E, L, R, slider
 
 #: Layout of ``Model.cyl_par`` (filled by ``transient.assemble.cylinder_fields``): intake
 #: closing (local angle), length of the closed part, combustion start after IVC and duration

@@ -40,12 +40,11 @@ the moments (:func:`can_change`); elsewhere nothing could release it and the run
 from __future__ import annotations
 
 from ..jit import kernel
-
-from .chain import _best_candidate
 from . import eta_table as et
 from . import governor as gv
 from . import reactions as rx
-from .layout import (LT_TIME, SW_LOAD, T, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S, WK_SCRATCH)
+from .chain import _best_candidate
+from .layout import LT_TIME, SW_LOAD, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S, WK_SCRATCH, T
 
 #: ``sw[SW_DIRECTION]`` while the machine is stuck (±1 while it moves).
 STUCK = 0
