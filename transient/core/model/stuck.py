@@ -23,7 +23,8 @@ is continuous and strictly decreasing in a (``chain``, the proof of uniqueness, 
 (``eta_table``); for reaction pairs it is the solution of the joints' equations
 (``reactions.acceleration``) at ω = 0, where every friction term is a magnitude that varies
 continuously with the forces. So g falls through zero at the instant the drive exceeds the
-holding moment in one direction, and the stepper locates that instant as it locates a pair's mode switch (a margin falling to zero, to the
+holding moment in one direction, and the stepper locates that instant as it locates a pair's
+mode switch (a margin falling to zero, to the
 root finder's accuracy on the dense output); the pair margins' slot 0 carries g, the others a
 constant 1 that never falls. At the release the direction is the one whose margin crossed (the
 lower of −a₊, a₋) and the modes are chosen afresh for it.

@@ -2,7 +2,8 @@
 between breakpoints, with state events located on the dense output (docs/theory.md, Steppers;
 Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
 
-One loop for every pair in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
+One loop for every pair in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5), passed
+as data; adaptive, or with
 fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).
 While ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint,
 so the right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal)
@@ -243,7 +244,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         fired).
     """
     io = Chunk(cfg, bp, fst, ist, outbuf, evbuf)
-    K, F, f, y_new, tmp, wk, gs = work.K, work.F, work.f, work.y_new, work.tmp, work.wk, work.gs
+    K, f, y_new, tmp, wk, gs = work.K, work.f, work.y_new, work.tmp, work.wk, work.gs
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     # rows kept free: a step spans at most 256 intervals of its grid (in time, of each grid)
