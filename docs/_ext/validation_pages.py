@@ -455,7 +455,7 @@ def figure_overview():
     groups = {"gots": "Gots", "antonyuk": "Antonyuk et al.", "semenov": "Semenov",
               "closed_forms": "closed forms"}
     fig, ax = plt.subplots(figsize=(8, 3.0), layout="constrained")
-    for k, (module, label) in enumerate(groups.items()):
+    for k, module in enumerate(groups):
         ratios = [c.ratio for n in names if n.startswith(module + ".")
                   for c in comparisons(n) if c.tolerance.on_deviation]
         ratios = np.maximum(np.array(ratios), 1e-12)

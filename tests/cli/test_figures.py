@@ -340,7 +340,7 @@ def test_piston_orders_draw_nothing_below_their_noise_floor(misfire):
     assert floors["constant ω̄"] == pytest.approx(720 * np.finfo(float).eps)
     rel = ro.piston.relative_constant[-1]
     assert np.any((rel > 0) & (rel < 1e-14))  # (what the floor keeps out)
-    containers = [c for c in ax.containers]
+    containers = list(ax.containers)
     for container, floor in zip(containers, (floors["run"], floors["constant ω̄"])):
         heights = [bar.get_height() for bar in container]
         assert heights and min(heights) >= floor

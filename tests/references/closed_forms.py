@@ -172,7 +172,7 @@ def mixed_cycle_work():
     for rho in (1.671, 1.699):
         mc = gots.cycle(rho)
         ends = mc.corners
-        w_quad = sum(quad(lambda x: float(gots.exact_pressure(mc, x)) * float(gots.dvolume(x)),
+        w_quad = sum(quad(lambda x, mc=mc: float(gots.exact_pressure(mc, x)) * float(gots.dvolume(x)),
                           a, b, epsabs=1e-12, epsrel=1e-13, limit=200)[0]
                      for a, b in zip(ends[:-1], ends[1:]))
         out += [

@@ -1,6 +1,7 @@
 """Friction on the swash plate's joint reactions (:mod:`transient.core.model.swash_friction`) against
 the Newton–Euler model written separately in numpy
-(:func:`transient.reference.swash_plate_reactions`: every body's equations one linear system, the kinematics from positions and rotation matrices;
+(:func:`transient.reference.swash_plate_reactions`: every body's equations one linear system,
+the kinematics from positions and rotation matrices;
 :func:`transient.reference.swash_plate_friction` closes the friction laws, written out again
 there, by ``scipy.optimize.fsolve``).
 

@@ -151,8 +151,8 @@ def test_table_misfire_follows_the_users_motored_curve():
     tdc = np.radians([0.0, 540.0, 180.0, 360.0])  # gas-exchange TDCs
     P = 4 * math.pi
     points = np.radians(TABLE_PHI)
-    full = lambda x: np.interp(x, points, np.array(TABLE_P) * 1e5)  # noqa: E731
-    motored = lambda x: np.interp(x, points, np.array(TABLE_MOTORED) * 1e5)  # noqa: E731
+    full = lambda x: np.interp(x, points, np.array(TABLE_P) * 1e5)
+    motored = lambda x: np.interp(x, points, np.array(TABLE_MOTORED) * 1e5)
     misfires = 0
     for k in range(4):
         x = np.mod(phi - tdc[k], P)

@@ -727,7 +727,7 @@ def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.floa
     x = _points(mp, grid)[2][..., 0]
     inner, outer = np.empty(z), np.empty(z)
     for k in range(z):
-        inner[k], outer[k] = (bisect_root(lambda p: rate(p, k), grid[j] - h, grid[j] + h)
+        inner[k], outer[k] = (bisect_root(lambda p, k=k: rate(p, k), grid[j] - h, grid[j] + h)
                               for j in (np.argmin(x[:, k]), np.argmax(x[:, k])))
     return inner, outer
 

@@ -88,7 +88,8 @@ class SweepStore:
     ``solver`` attributes; ``analysis/<name>``, the run's summary, with ``unit``), with the
     sweep's attributes ``index``, ``params`` (JSON), ``scene_toml`` (the resolved scene, by which
     a run is reused), ``worker``, ``wall_s`` and ``status`` (the run's, as a result's:
-    ``finished``, ``stalled``, …, ``failed``; written last: a group without it is unfinished); ``/unused/scene_<hash>`` finished runs the sweep no longer
+    ``finished``, ``stalled``, …, ``failed``; written last: a group without it is unfinished);
+    ``/unused/scene_<hash>`` finished runs the sweep no longer
     holds, in the same form (kept, so that no computed run is lost, and reused if the sweep
     holds their scene again); ``/analysis/summary`` the table of collected quantities
     (attribute ``units``, JSON).

@@ -591,7 +591,7 @@ def tolerance_ladder(quick: bool, ctx: Context) -> Outcome:
     o = Outcome()
     rtols = [10.0 ** -k for k in range(3, 10 if quick else 13)]
     for domain in ("auto", "time"):
-        def build(rtol, **solver):
+        def build(rtol, domain=domain, **solver):
             d = put(spinup(10 if quick else 40), "output", dt=1e-4)  # the time-domain grid
             return put(d, "solver", rtol=rtol, atol=rtol * 1e-2, domain=domain, **solver)
 

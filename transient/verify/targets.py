@@ -215,7 +215,7 @@ def make_hand_rhs(layout=False, loads=False, records=False):
         if layout:
             sp, cp = math.sin(y[0]), math.cos(y[0])
             m_slide, m_rot = p[10] + p[11], p[12] + p[13]
-            for k in range(int(p[16])):
+            for _ in range(int(p[16])):
                 sa, ca = sp * p[15] - cp * p[14], cp * p[15] + sp * p[14]
                 sb = (r * sa - p[9]) / l
                 cb = math.sqrt(1.0 - sb * sb)
