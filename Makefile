@@ -5,7 +5,7 @@ STAMP := $(VENV)/.installed
 DEFAULT_SCENE := cases/swash_plate_4cyl.toml
 DEFAULT_RESULT := results/$(basename $(notdir $(DEFAULT_SCENE))).h5
 
-.PHONY: run test test-stress test-cpu bench docs install clean
+.PHONY: run test test-fast lint test-stress test-cpu bench docs install clean
 
 # Bytecode is written at install: where PYTHONDONTWRITEBYTECODE is set, each run would otherwise
 # compile transient's sources again, a noticeable part of a warm start.
@@ -25,18 +25,28 @@ run: $(STAMP)
 	$(VENV)/bin/transient run $(DEFAULT_SCENE) -o results --force
 	$(VENV)/bin/transient plot $(DEFAULT_RESULT) -o results --force
 
-# The suite's tiers (docs/developer/testing.md): `make test` the import contracts
-# (pyproject.toml, [tool.importlinter]) and every test but the long stress; `make test-stress`
-# that stress (marker `stress`); `make test-cpu` the runs again with the code built for another
-# CPU. A fast loop: $(PY) -m pytest -m "not slow" -n 2 tests/unit (or any folder).
+# The suite's tiers (docs/developer/testing.md): `make test` the checks of `make lint`, then
+# every test but the long stress; `make test-fast` the unit tests but the slow ones (the loop
+# while changing the code); `make test-stress` that stress (marker `stress`); `make test-cpu` the
+# runs again with the code built for another CPU.
 # One pytest worker per core, at most 4 (a process compiling the stepper holds about a gigabyte);
 # worksteal moves queued tests from a busy worker to an idle one (the first runs compile for
 # minutes).
 PYTEST := $(PY) -m pytest -q -n auto --maxprocesses 4 --dist worksteal
 
-test: $(STAMP)
+# The import contracts (pyproject.toml, [tool.importlinter]), ruff and mypy ([tool.ruff],
+# [tool.mypy]): seconds, so they go first.
+lint: $(STAMP)
 	$(VENV)/bin/lint-imports
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
+
+test: lint
 	$(PYTEST) -m "not stress"
+
+# Under two minutes once the kernels are cached: every test over about ten seconds is `slow`.
+test-fast: $(STAMP)
+	$(PYTEST) -m "not slow and not stress" tests/unit
 
 # Kill-and-resume, random scenes of every mechanism, `transient stress --quick`.
 test-stress: $(STAMP)

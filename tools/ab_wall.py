@@ -23,8 +23,8 @@ import numpy as np
 
 import transient
 import transient.run
-from transient.scene import load_scene
 from transient.run import integrate
+from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 

@@ -19,10 +19,10 @@ from numba import njit
 import transient.core.model.forcing as forcing
 import transient.core.model.layout as layout
 import transient.core.model.rhs as rhs
-from transient.verify.targets import (BARE_SCENE, CALLS_PER_STEP, per_call, rhs_arguments, rhs_loop)
 from transient.core.model import governor as gv
 from transient.core.model.crank_slider import crank_slider_terms
 from transient.scene import load_scene
+from transient.verify.targets import BARE_SCENE, CALLS_PER_STEP, per_call, rhs_arguments, rhs_loop
 
 
 def derivative_without(kind=True, gas=True, generator=True, others=True):

@@ -16,10 +16,10 @@ from pathlib import Path
 
 os.environ["NUMBA_DISABLE_JIT"] = "1"
 
-import transient.core.stepper.events as events  # noqa: E402
-import transient.core.model.rhs as rhs  # noqa: E402
-from transient.scene import load_scene  # noqa: E402
-from transient.run import integrate  # noqa: E402
+import transient.core.model.rhs as rhs
+import transient.core.stepper.events as events
+from transient.run import integrate
+from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 margins = collections.Counter()  # caller → margin evaluations

@@ -9,8 +9,8 @@ from pathlib import Path
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.analysis.irregularity import cycle_means
-from transient.scene import Friction, load_scene
 from transient.run import integrate
+from transient.scene import Friction, load_scene
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 print("| engine | policy | steady rpm | η work ratio | η (30) printed | per pair: loss, circulated "

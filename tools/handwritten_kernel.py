@@ -8,8 +8,8 @@ scene carrying unused options (a droop governor, a zero-torque starter, never ac
 15 alternating runs). Rerun: ``.venv/bin/python tools/handwritten_kernel.py``.
 ``tools/bare_gap.py`` looks at the same difference from transient's side.
 """
-from transient.verify.targets import BARE_SCENE, bare_kernel, hand_written_cost, unused_options
 from transient.scene import load_scene
+from transient.verify.targets import BARE_SCENE, bare_kernel, hand_written_cost, unused_options
 
 base = load_scene(BARE_SCENE)
 rungs = {"hand-written (18)": {}, "+ offset, masses, cylinder loop": dict(layout=True),

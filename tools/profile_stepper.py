@@ -53,8 +53,8 @@ def run(name: str, repeats: int = 20, samples_per_rev: int = 1) -> None:
         return original(self, value)
 
     codegen.CPUCodeLibrary._set_compiled_object = keep
-    from transient.scene import load_scene
     from transient.run import integrate
+    from transient.scene import load_scene
 
     scene = load_scene(CASES / f"{name}.toml")
     scene = dc.replace(scene, output=dc.replace(scene.output, samples_per_rev=samples_per_rev),

@@ -19,8 +19,8 @@ import sys
 import time
 from pathlib import Path
 
-from transient.verify import bench
 from transient.scene import load_scene
+from transient.verify import bench
 
 NAME = "gots_diesel_governed"
 RK45 = "solve_ivp RK45 (numpy RHS)"

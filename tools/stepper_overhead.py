@@ -11,13 +11,17 @@ Rerun: ``.venv/bin/python tools/stepper_overhead.py``.
 """
 from pathlib import Path
 
-from transient.verify.bench import BENCH_SCENES
-from transient.verify.targets import (CALLS_PER_STEP, per_call, rhs_arguments, stepper_overhead,
-                                      timed_scene)
-from transient.core.model import layout
-from transient.core.model import rhs
 from transient.core.jit import kernel
+from transient.core.model import layout, rhs
 from transient.scene import load_scene
+from transient.verify.bench import BENCH_SCENES
+from transient.verify.targets import (
+    CALLS_PER_STEP,
+    per_call,
+    rhs_arguments,
+    stepper_overhead,
+    timed_scene,
+)
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 SCENES = dict(BENCH_SCENES, gots_spinup=CASES / "gots_diesel_spinup.toml",

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from transient.analysis.irregularity import cycle_means, fluctuation
-from transient.scene import load_scene
 from transient.run import integrate
+from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 phi = np.linspace(0, 2 * np.pi, 721)

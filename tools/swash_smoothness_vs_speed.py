@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from transient.analysis.irregularity import fluctuation
-from transient.scene import load_scene
 from transient.run import integrate
+from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 MEAN_TORQUE = {"swash_plate_1cyl": 119.91, "swash_plate_4cyl": 482.52}

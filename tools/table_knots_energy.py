@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-import transient.scene.queries as queries
 import transient.forces.gas as gas
+import transient.scene.queries as queries
 from transient.run import integrate
 from transient.scene import load_scene
 

@@ -14,21 +14,50 @@ from numpy.typing import NDArray
 
 from .core.model import cylinder as cyl
 from .core.model import governor as gv
-from .core.model.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
 from .core.model import variation as var
+from .core.model.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core.model.layout import (
+    LINK_FIXED,
+    LINK_PISTONS,
+    LINK_REST,
+    LINK_SWASH,
+    LT_ANGLE,
+    LT_NONE,
+    LT_SPEED,
+    LT_TIME,
+    N_JOINTS,
+    N_RX_PAR,
+    PAPER,
+    PHI,
+    POWER_FLOW,
+    RX_ETA_BWD,
+    RX_ETA_FWD,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    TABULATED,
+    Model,
+    T,
+    extras_of,
+)
 from .core.model.variation import cycle_fuel
-from .core.model.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_JOINTS, N_RX_PAR, PAPER,
-                                PHI, POWER_FLOW, RX_ETA_BWD, RX_ETA_FWD, RX_MU, RX_RADIUS,
-                                RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, TABULATED, Model, T,
-                                extras_of)
-from .core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
 from .core.model.work import work_array
 from .forces.gas import PressureTable, shift_cubic
-from .mechanisms import reaction_joints
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
-from .scene.queries import (burns_part_load, clearance_volume, cycle_begin, gas_is_force,
-                            gas_phases, gas_tables, governor_kind, reaction_friction,
-                            wiebe_levels)
+from .mechanisms import reaction_joints
+from .scene.queries import (
+    burns_part_load,
+    clearance_volume,
+    cycle_begin,
+    gas_is_force,
+    gas_phases,
+    gas_tables,
+    governor_kind,
+    reaction_friction,
+    wiebe_levels,
+)
 
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,

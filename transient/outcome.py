@@ -20,7 +20,6 @@ import numpy as np
 from .errors import SimulationError
 from .scene.records import RUNAWAY_SPEED
 
-
 #: Every status a run ends with, and what it means (user guide, Result files: Statuses); a run
 #: the stepper ends as ``stiff`` is run again by an implicit method and ends with one of these.
 STATUSES = {

@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 
-
 #: rpm per rad/s.
 RPM = 30.0 / math.pi
 

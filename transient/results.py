@@ -159,7 +159,7 @@ def reopen_file(path: Path) -> h5py.File:
 
 def now() -> str:
     """The time of writing as it is stored (``created``): UTC, ISO 8601, whole seconds."""
-    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    return _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
 
 
 def write_header(node: h5py.Group, **attrs: Any) -> None:
@@ -464,7 +464,7 @@ class ResultWriter:
         """Close what can be closed of a file whose writes failed, and remove it."""
         try:
             self.f.close()
-        except Exception:  # noqa: BLE001 — the file is broken already
+        except Exception:
             pass
         Path(name).unlink(missing_ok=True)
 

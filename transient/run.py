@@ -9,27 +9,27 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
 from .assemble import build_model, initial_governor
-from .scene.queries import part_load_refusal
-from .core.model import forcing, layout, work
 from .core import stepper
-from .core.stepper import loop
-from .core.stepper import io as sio
+from .core.integrator.tableaus import TABLEAUS
+from .core.model import forcing, layout, work
 from .core.model.inverse import inverse_dynamics
 from .core.model.layout import n_outputs, n_state
-from .core.integrator.tableaus import TABLEAUS
+from .core.stepper import io as sio
+from .core.stepper import loop
 from .errors import SceneError, SimulationError
-from .outcome import (FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of)
-from .scene.outputs import output_columns
+from .outcome import FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of
 from .precompile import start_helper, stop_helper
 from .prescribed_work import Motion, work_columns
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
+from .scene.outputs import output_columns
+from .scene.queries import part_load_refusal
 from .scene.records import COMPILED_METHODS, runs_compiled
 from .stopping import deferred
 
@@ -420,7 +420,7 @@ class _WriteBehind:
         and the writer remembers a broken write)."""
         try:
             self.wait()
-        except Exception:  # noqa: BLE001 — reported by the exception being handled
+        except Exception:
             pass
 
     def shutdown(self) -> None:

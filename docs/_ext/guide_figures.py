@@ -328,9 +328,9 @@ def eta_law():
     a1.axvline(0, color="0.6", lw=0.6)
     a1.set_xlabel("power taken from the shaft side S·ω [kW]")
     a1.set_ylabel("power lost [kW]")
-    a1.text(0.97, 0.9, f"shaft side drives:\n(1 − η_forward) S·ω", transform=a1.transAxes,
+    a1.text(0.97, 0.9, "shaft side drives:\n(1 − η_forward) S·ω", transform=a1.transAxes,
             ha="right", va="top", fontsize=8)
-    a1.text(0.03, 0.9, f"far side drives:\n(1/η_backward − 1) |S·ω|", transform=a1.transAxes,
+    a1.text(0.03, 0.9, "far side drives:\n(1/η_backward − 1) |S·ω|", transform=a1.transAxes,
             ha="left", va="top", fontsize=8)
     a2.plot(power / 1e3, eta, color="C1", lw=1.6, drawstyle="steps-mid")
     a2.axhline(1.0, color="0.6", lw=0.6)
@@ -358,7 +358,7 @@ def reaction_law():
         a1.plot(R / 1e3, main.mu * main.radius * R + main.viscous * q, ls=style, color="C0",
                 label=f"q = {q:g} rad/s")
     a1.set_xlabel("journal load |R| [kN]")
-    a1.set_ylabel(f"friction moment [N m]")
+    a1.set_ylabel("friction moment [N m]")
     a1.set_title(f"{main.name}: μ·r·|R| + c·q (μ = {main.mu:g}, r = {main.radius * 1e3:g} mm)",
                  fontsize=9)
     N = np.linspace(0.0, 5e3, 200)

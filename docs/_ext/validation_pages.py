@@ -231,7 +231,6 @@ def _save(fig, srcdir: Path, name: str) -> str:
 def figure_gots_forces():
     """П4.1 N, S, K, T of cylinder 1: printed, model (the book's inertia), misprinted cells."""
     import matplotlib.pyplot as plt
-
     from references import gots
 
     by = {c.quantity: c for c in comparisons("gots.p41_forces")}
@@ -305,7 +304,6 @@ def figure_gots_torques():
 def figure_gots_indicator():
     """П2.1: printed pressures and temperatures against the ideal mixed cycle."""
     import matplotlib.pyplot as plt
-
     from references import gots
 
     by = {c.quantity: c for c in comparisons("gots.p21_indicator")}
@@ -382,7 +380,6 @@ def per_turn(t, phi, omega):
 def figure_antonyuk():
     """The example's spin-up with one and four cylinders, turn by turn, and the last turn."""
     import matplotlib.pyplot as plt
-
     from references import antonyuk
 
     comparisons("antonyuk.four_cylinders_smoother")
@@ -417,8 +414,8 @@ def figure_semenov():
     """λᵢ against the bank angle, exact and by (61), with the printed points; the slave's
     acceleration at 180° against the master's."""
     import matplotlib.pyplot as plt
-
     from references import semenov
+
     from transient.mechanisms import articulated as art
 
     by = {c.quantity: c for c in comparisons("semenov.slave_dynamic_parameter")}
@@ -458,7 +455,7 @@ def figure_overview():
     groups = {"gots": "Gots", "antonyuk": "Antonyuk et al.", "semenov": "Semenov",
               "closed_forms": "closed forms"}
     fig, ax = plt.subplots(figsize=(8, 3.0), layout="constrained")
-    for k, (module, label) in enumerate(groups.items()):
+    for k, module in enumerate(groups):
         ratios = [c.ratio for n in names if n.startswith(module + ".")
                   for c in comparisons(n) if c.tolerance.on_deviation]
         ratios = np.maximum(np.array(ratios), 1e-12)

@@ -24,8 +24,8 @@ from matplotlib.ticker import MaxNLocator
 import transient
 from transient.analysis.orders import order_spectrum, to_angle_grid
 from transient.analysis.thermo import own_cycles
-from transient.scene.queries import gas_tables
 from transient.plots import run_indicator_phi
+from transient.scene.queries import gas_tables
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"
 scene = transient.load_scene(CASES / "diesel_4cyl_misfire.toml")

@@ -5,7 +5,8 @@ IMEP, BMEP, FMEP and the indicator diagram of a run
 The Gots diesel with Wiebe combustion, friction pairs and a droop governor, at half the case's
 fan load: the governor settles it on its droop line at part fuel.
 ``[analysis] thermodynamics = true`` makes the run store, per cylinder and cycle, the indicated
-work ∮p dV of the pressure it applied with the exact cylinder volume, and per cycle the brake and friction mean effective pressures from the
+work ∮p dV of the pressure it applied with the exact cylinder volume, and per cycle the brake and
+friction mean effective pressures from the
 load's work and the pairs' losses; over a cycle IMEP − BMEP − FMEP is the change of the kinetic
 energy over the swept volume. The indicator diagram is drawn from the run's pressure: at part
 fuel it lies well below the input table's full-load curve.
@@ -18,8 +19,8 @@ import matplotlib.pyplot as plt
 
 import transient
 from transient import plots
-from transient.scene.queries import gas_table
 from transient.scene import scene_from_dict
+from transient.scene.queries import gas_table
 
 CASES = Path(transient.__file__).resolve().parents[1] / "cases"
 

@@ -20,17 +20,15 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from scene_texts import SMALL
+from terminal import terminal_run
 
 import transient
 import transient.core.stepper as stepper
 import transient.core.stepper.io as sio
+import transient.run as sim
 from transient.cli import KERNELS_NOTICE, main
 from transient.scene import to_toml
-
-from scene_texts import SMALL
-from terminal import terminal_run
-
-import transient.run as sim
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"

@@ -22,24 +22,22 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-from matplotlib.collections import PolyCollection, QuadMesh  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.collections import PolyCollection, QuadMesh
 
-import transient  # noqa: E402
-from transient import plots  # noqa: E402
-from transient.analysis.irregularity import cycle_boundaries  # noqa: E402
-from transient.analysis.loads.diagrams import (articulated_diagrams,  # noqa: E402
-                                               crank_slider_diagrams)
-from transient.analysis.loads.crank_slider import loads_from_trajectory  # noqa: E402
-from transient.analysis.orders import run_orders  # noqa: E402
-from transient.cli import loads as cli_loads  # noqa: E402
-from transient.cli import main  # noqa: E402
-from transient.cli import orders as cli_orders  # noqa: E402
-from transient.cli import plot as cli_plot  # noqa: E402
-from transient.results import open_result  # noqa: E402
+import transient
+from transient import plots
+from transient.analysis.irregularity import cycle_boundaries
+from transient.analysis.loads.crank_slider import loads_from_trajectory
+from transient.analysis.loads.diagrams import articulated_diagrams, crank_slider_diagrams
+from transient.analysis.orders import run_orders
+from transient.cli import loads as cli_loads
+from transient.cli import main
+from transient.cli import orders as cli_orders
+from transient.cli import plot as cli_plot
+from transient.results import open_result
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 UNIT = re.compile(r"\[[^\]]+\]")
@@ -342,7 +340,7 @@ def test_piston_orders_draw_nothing_below_their_noise_floor(misfire):
     assert floors["constant ω̄"] == pytest.approx(720 * np.finfo(float).eps)
     rel = ro.piston.relative_constant[-1]
     assert np.any((rel > 0) & (rel < 1e-14))  # (what the floor keeps out)
-    containers = [c for c in ax.containers]
+    containers = list(ax.containers)
     for container, floor in zip(containers, (floors["run"], floors["constant ω̄"])):
         heights = [bar.get_height() for bar in container]
         assert heights and min(heights) >= floor

@@ -9,7 +9,6 @@ import json
 import math
 
 import pytest
-
 from golden import GOLDEN, capture, compare, run, scenes, tolerances, with_errors
 from own_error import MOVE
 

@@ -12,14 +12,13 @@ from importlib import metadata
 from pathlib import Path
 
 import pytest
+from scene_texts import MIXED_CYCLE, SMALL
 
 import transient
 from transient.cli import main
+from transient.errors import SceneError
 from transient.results import RECORDED_PACKAGES, open_result
 from transient.scene import load_scene, scene_from_dict
-from transient.errors import SceneError
-
-from scene_texts import MIXED_CYCLE, SMALL
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = REPO / "cases"

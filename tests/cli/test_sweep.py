@@ -16,14 +16,13 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from terminal import terminal_run
 
 from transient.analysis.summary import summarize
 from transient.cli import KERNELS_NOTICE, main
-from transient.scene import load_scene
 from transient.run import integrate
+from transient.scene import load_scene
 from transient.sweeps import kernel_loads, load_sweep, open_run, run_sweep
-
-from terminal import terminal_run
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -21,17 +21,17 @@ from pathlib import Path
 
 import numpy as np
 from balances import closure
-from scene_texts import COMPRESSOR_GAS, SMALL
 from sample_integrals import sample_integral_impl
+from scene_texts import COMPRESSOR_GAS, SMALL
 from scipy.integrate import quad
 
 from transient.analysis.summary import summarize
 from transient.assemble import build_model
-from transient.scene.queries import gas_table
 from transient.core.model.forcing import inertia
 from transient.core.model.work import work_array
 from transient.run import integrate
 from transient.scene import load_scene
+from transient.scene.queries import gas_table
 from transient.scene.read import scene_from_dict
 
 from . import Comparison, Tolerance, case, gots
@@ -172,7 +172,7 @@ def mixed_cycle_work():
     for rho in (1.671, 1.699):
         mc = gots.cycle(rho)
         ends = mc.corners
-        w_quad = sum(quad(lambda x: float(gots.exact_pressure(mc, x)) * float(gots.dvolume(x)),
+        w_quad = sum(quad(lambda x, mc=mc: float(gots.exact_pressure(mc, x)) * float(gots.dvolume(x)),
                           a, b, epsabs=1e-12, epsrel=1e-13, limit=200)[0]
                      for a, b in zip(ends[:-1], ends[1:]))
         out += [

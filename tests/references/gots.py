@@ -37,10 +37,10 @@ import numpy as np
 
 from transient.analysis.loads import crank_slider as L
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.scene.queries import gas_phases, gas_table
 from transient.forces.gas import mixed_cycle
 from transient.run import integrate
 from transient.scene import load_scene
+from transient.scene.queries import gas_phases, gas_table
 
 from . import Comparison, Tolerance, case, read_table
 

@@ -118,7 +118,8 @@ SCENE_CASES = [
      "friction.pairs[1].name: '" + "x" * 36 + "... names friction.pairs[0] too; give each pair "
      "its own name (it labels the pair's result columns and reports)"),
     ("long-order-signal", SMALL + f'\n[analysis]\norders = ["{LONG}"]\n',
-     "analysis.orders: unknown signal '" + "x" * 36 + "...; allowed: t, phi, omega, epsilon, J, dJ_dphi, M_gas, M_load, M_starter, "
+     "analysis.orders: unknown signal '" + "x" * 36 + "...; allowed: t, phi, omega, epsilon, J, dJ_dphi, "
+     "M_gas, M_load, M_starter, "
      "fuel, W_gas, W_load, W_starter, p_1, W_1"),
 ]
 

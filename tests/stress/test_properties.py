@@ -31,9 +31,15 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, reject, settings
 from hypothesis import strategies as st
 
-from transient.verify.stress import (balance_residual, balance_tolerance, base, nonfinite, put,
-                                     scene_of)
 from transient.run import integrate
+from transient.verify.stress import (
+    balance_residual,
+    balance_tolerance,
+    base,
+    nonfinite,
+    put,
+    scene_of,
+)
 
 FULL = os.environ.get("TRANSIENT_STRESS_FULL", "") not in ("", "0")
 EXAMPLES_CI, EXAMPLES_FULL = 30, 500

@@ -59,7 +59,7 @@ def test_transfer_functions_and_inertia_against_numpy_geometry():
     for phi in ANGLES:
         J, _, u, _ = kernel(mech, phi)
         P = art.positions(mech, np.array([phi - h, phi + h]))
-        d = lambda key: (P[key][1] - P[key][0]) / (2 * h)  # noqa: E731
+        d = lambda key, P=P: (P[key][1] - P[key][0]) / (2 * h)
         axes = np.exp(1j * np.asarray(mech.slave_banks))
         np.testing.assert_allclose(u[0], -d("B").real, rtol=1e-8, atol=1e-10)
         np.testing.assert_allclose(u[1:], -(d("Bi") / axes).real, rtol=1e-8, atol=1e-10)

@@ -29,8 +29,18 @@ from transient.assemble import build_model
 from transient.core.model import articulated as core
 from transient.core.model import articulated_friction as af
 from transient.core.model.joint_friction import R_LOSS, R_P
-from transient.core.model.layout import (N_JOINTS, N_RX_PAR, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                                         RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model.layout import (
+    N_JOINTS,
+    N_RX_PAR,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    WK_ETA,
+    WK_RX,
+    WK_S,
+)
 from transient.core.model.work import N_WK
 from transient.mechanisms.articulated import _slave_rates
 from transient.reference import articulated_joint_forces

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from transient.scene import load_scene
 from transient.verify import targets as bt
 from transient.verify.bench import ADAPTIVE
-from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 FLAGS = ({}, {"layout": True}, {"layout": True, "loads": True},

@@ -9,9 +9,9 @@ import pytest
 from scene_texts import SMALL
 
 from transient.cli import main
-from transient.scene.outputs import output_columns
 from transient.scene import load_scene
 from transient.scene.budget import RTOL_MIN, estimate
+from transient.scene.outputs import output_columns
 
 
 def text(old: str | tuple, new: str | tuple) -> str:

@@ -295,7 +295,7 @@ def test_one_pair_power_flow_mode_is_unique():
         J, dJ, M, w, f, b = random_chain(rng, 1, eta_low=0.05)
         R = M - 0.5 * dJ * w * w
         D = J[1] * R[0] - J[0] * R[1]
-        for es, (a, S0) in zip((f[0], 1 / b[0]), both_one_pair_modes(J, dJ, M, w, f[0], b[0])):
+        for es, (_, S0) in zip((f[0], 1 / b[0]), both_one_pair_modes(J, dJ, M, w, f[0], b[0])):
             assert abs(S0 - D / (es * J[0] + J[1])) <= RTOL * np.sum(np.abs(R)) * np.sum(J) / (es * J[0] + J[1])
             assert np.sign(S0) == np.sign(D)
         es_out, S = np.empty(1), np.empty(1)

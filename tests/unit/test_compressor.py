@@ -16,11 +16,11 @@ import pytest
 from scene_texts import COMPRESSOR_GAS, SMALL, check_text
 from scipy.integrate import quad
 
-from transient.scene.queries import cycle_figures, gas_is_force, gas_tables
 from transient.errors import SceneError
 from transient.forces.compressor import compressor_cycle, ideal_compressor_work
-from transient.scene.outputs import output_columns
 from transient.scene import load_scene
+from transient.scene.outputs import output_columns
+from transient.scene.queries import cycle_figures, gas_is_force, gas_tables
 from transient.scene.read import scene_from_dict
 from transient.scene.write import to_toml
 

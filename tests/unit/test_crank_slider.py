@@ -284,7 +284,7 @@ def test_dJ_u_du_are_the_finite_differences(geom, layout):
     assert rel_err(fd(lambda p: terms(mp, p)[2], ALPHA), du) <= FD_RTOL
     for k, phase in enumerate(mech.firing_angles):
         # u_k = ds_k/dφ of cylinder k's own piston travel at local angle φ − phase_k.
-        s_k = lambda p: core.slider(p - phase, r, l, e)[0]  # noqa: E731
+        s_k = lambda p, phase=phase: core.slider(p - phase, r, l, e)[0]
         assert rel_err(fd(s_k, ALPHA)[:, 0], u[:, k]) <= FD_RTOL
     assert np.all(J > 0)
 

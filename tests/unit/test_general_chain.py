@@ -229,6 +229,7 @@ def test_rhs_agrees_with_27_to_29_written_apart(pairs):
             assert S[-1] == -Mk[-1] / eta[-1]
 
 
+@pytest.mark.slow  # (solve_ivp of the model written apart, a Python right-hand side)
 def test_four_pair_run_agrees_with_solve_ivp_of_the_model_written_apart():
     """Four revolutions of the four-pair engine from 1000 rpm (compression and firing, every
     pair switching modes): the compiled run at rtol = 1e-10 against the model above integrated

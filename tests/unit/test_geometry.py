@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from transient.scene.queries import cycle_figures
 from transient.cli import main
 from transient.core.model import crank_slider as cs_core
 from transient.mechanisms import articulated as art
 from transient.mechanisms import swash_plate as sp
 from transient.mechanisms.crank_slider import CrankSlider
 from transient.scene import load_scene
+from transient.scene.queries import cycle_figures
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = ROOT / "cases"
@@ -31,7 +31,7 @@ def extremes(f, lo: float, hi: float, h: float, n: int = 20_001) -> tuple[float,
     f′ by central differences of step ``h`` (f is only evaluated, never differentiated)."""
     x = np.linspace(lo, hi, n, endpoint=False)
     v = np.array([f(a) for a in x])
-    rate = lambda a: (f(a + h) - f(a - h)) / (2.0 * h)  # noqa: E731
+    rate = lambda a: (f(a + h) - f(a - h)) / (2.0 * h)
     step = x[1] - x[0]
     return tuple(brentq(rate, x[j] - step, x[j] + step, xtol=1e-14)
                  for j in (int(np.argmin(v)), int(np.argmax(v))))
@@ -63,7 +63,7 @@ def test_crank_slider_geometry_against_a_search_of_the_piston_travel(r, l, e):
     the angles found (with offset) and the acceleration at TDC r(1 + λ) of §2.3 (without)."""
     mech = crank_slider(r, l, e)
     g = mech.geometry()
-    travel = lambda a: cs_core.slider(a, r, l, e)[0]  # noqa: E731
+    travel = lambda a: cs_core.slider(a, r, l, e)[0]
     tdc, bdc = extremes(travel, -math.pi / 2, 3 * math.pi / 2, 1e-5)
     assert g["tdc"] == (pytest.approx(tdc, abs=1e-9), "rad")
     assert g["bdc"] == (pytest.approx(bdc, abs=1e-9), "rad")
@@ -118,7 +118,7 @@ def test_articulated_geometry_against_a_search_of_the_piston_positions(name):
     total = 0.0
     for i in range(1 + mech.n_slaves):
         c = f"cyl_{i + 1}_"
-        X = lambda a: float(axial(mech, a, i)[0])  # noqa: E731
+        X = lambda a, i=i: float(axial(mech, a, i)[0])
         bdc, tdc = extremes(X, -0.5, 2.0 * math.pi - 0.5, 1e-6)
         assert abs(wrapped(g[c + "tdc"][0], tdc)) <= 1e-8, c
         assert abs(wrapped(g[c + "bdc"][0], bdc)) <= 1e-8, c
@@ -175,7 +175,7 @@ def test_swash_plate_geometry_against_a_search_of_the_piston_joints(name):
     total = 0.0
     for k in range(geom.cylinders):
         c = f"cyl_{k + 1}_"
-        x = lambda p: float(sp.positions(geom, p)["D"][0, k, 0])  # noqa: E731
+        x = lambda p, k=k: float(sp.positions(geom, p)["D"][0, k, 0])
         inner, outer = extremes(x, -0.5, 2.0 * math.pi - 0.5, 1e-6, n=4001)
         assert abs(wrapped(g[c + "tdc"][0], inner)) <= 1e-8, c
         assert abs(wrapped(g[c + "bdc"][0], outer)) <= 1e-8, c
@@ -240,7 +240,7 @@ def test_a_slave_whose_tdc_is_across_0_deg_from_its_bank_lags_it_by_a_small_angl
                        link_angles=(math.radians(psi),), link_radii=radial.link_radii[:1],
                        slave_lengths=radial.slave_lengths[:1], firing=())
         g = mech.geometry()
-        X = lambda a: float(axial(mech, a, 1)[0])  # noqa: E731
+        X = lambda a, mech=mech: float(axial(mech, a, 1)[0])
         _, tdc = extremes(X, -0.5, 2.0 * math.pi - 0.5, 1e-6)
         assert abs(g["cyl_2_tdc"][0] - math.radians(bank)) > math.pi  # wrapped across 0°
         lag = g["cyl_2_tdc_after_bank"][0]

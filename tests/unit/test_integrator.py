@@ -19,9 +19,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
-
 import plain_odes as po
+import pytest
 
 TESTS = Path(__file__).resolve().parents[1]
 METHODS = ("dop853", "dopri5")

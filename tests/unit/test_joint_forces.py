@@ -20,12 +20,11 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from engines import MECHS
 
 from transient.analysis.loads import crank_slider as L
 from transient.core.model import crank_slider as core
 from transient.reference import crank_slider_joint_forces
-
-from engines import MECHS
 
 RTOL = 1e-13
 

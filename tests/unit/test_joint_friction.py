@@ -28,18 +28,30 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from engines import MECHS
 
 from transient.assemble import build_model
 from transient.core.model import crank_slider as core
 from transient.core.model import joint_friction as jf
-from transient.core.model.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER,
-                                         N_JOINTS, N_RX_PAR, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                                         RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model.layout import (
+    JOINT_CRANKPIN,
+    JOINT_MAIN,
+    JOINT_PIN,
+    JOINT_SLIDER,
+    N_JOINTS,
+    N_RX_PAR,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    WK_ETA,
+    WK_RX,
+    WK_S,
+)
 from transient.core.model.work import N_WK
 from transient.reference import crank_slider_friction, crank_slider_joint_signs
 from transient.scene import load_scene, to_toml
-
-from engines import MECHS
 
 RTOL = 1e-12
 

@@ -20,8 +20,8 @@ from transient.core.model import swash_friction as sf
 from transient.core.model.work import N_WK, work_array
 from transient.core.stepper import events
 from transient.core.stepper import io as sio
-from transient.scene.outputs import output_columns
 from transient.scene import load_scene
+from transient.scene.outputs import output_columns
 
 CASES = sorted((Path(__file__).resolve().parents[2] / "cases").glob("*.toml"))
 

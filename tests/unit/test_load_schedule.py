@@ -22,9 +22,7 @@ import pytest
 from scene_texts import SMALL, check_text
 
 from transient.assemble import build_model
-from transient.core.model import forcing
-from transient.core.model import layout
-from transient.core.model import work
+from transient.core.model import forcing, layout, work
 from transient.scene import Load, load_scene, scene_from_dict, to_toml
 
 # the small scene from 30°, with the default output

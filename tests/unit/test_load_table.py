@@ -24,8 +24,17 @@ from scene_texts import SMALL, check_text
 
 from transient.assemble import build_model, load_table_curve
 from transient.core.model import forcing
-from transient.core.model.layout import (LT_ANGLE, LT_NONE, LT_SPEED, LT_TIME, N_SWITCHES, PHI,
-                                         SW_LOAD_TABLE, T, extras_of)
+from transient.core.model.layout import (
+    LT_ANGLE,
+    LT_NONE,
+    LT_SPEED,
+    LT_TIME,
+    N_SWITCHES,
+    PHI,
+    SW_LOAD_TABLE,
+    T,
+    extras_of,
+)
 from transient.core.model.work import work_array
 from transient.forces.load_table import interpolant, load_curve
 from transient.scene import LoadTable, load_scene, to_toml

@@ -24,12 +24,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from engines import MECHS, gots_mech
 
 from transient.analysis.loads import crank_slider as L
 from transient.analysis.loads.common import gas_forces, rod_split
 from transient.core.model import crank_slider as core
-
-from engines import MECHS, gots_mech
 
 RTOL = 1e-12  # exact identities: round-off of a few dozen operations
 FD_RTOL = 1e-8  # see module docstring
@@ -301,8 +300,8 @@ def test_running_torques():
 
 def test_gas_forces_and_trajectory():
     """Gas forces read from the scene's tables at φ − gas_phases, and from a trajectory's p_k."""
-    from transient.scene.queries import gas_phases, gas_table, gas_tables
     from transient.scene import load_scene
+    from transient.scene.queries import gas_phases, gas_table, gas_tables
 
     scene = load_scene(Path(__file__).resolve().parents[2] / "cases" / "gots_diesel_4400.toml")
     mech = scene.mechanism

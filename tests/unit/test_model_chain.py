@@ -11,11 +11,7 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.core.model import forcing
-from transient.core.model import inverse
-from transient.core.model import layout
-from transient.core.model import rhs
-from transient.core.model import work
+from transient.core.model import forcing, inverse, layout, rhs, work
 from transient.core.model.chain import LOCKED, UNIQUE
 from transient.scene import Friction, Pair, load_scene
 

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import llvmlite.binding as ll
 import numba
-from numba.core import (caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes, types)
+import pytest
+from numba.core import caching, codegen, compiler, cpu, dispatcher, sigutils, typed_passes, types
 from numba.core.base import BaseContext
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.runtime import rtsys
@@ -280,6 +281,7 @@ def hash_new(s):
 """
 
 
+@pytest.mark.slow  # (kernels compiled cold in processes of their own, in a fresh cache)
 def test_registry_free_cache_loads_code_that_allocates_and_hashes(tmp_path):
     """Compiled in one process, loaded in another (with another hash seed) without the
     registries: once the first function is loaded the hash secrets are there (before any of
@@ -550,6 +552,7 @@ else:
 """
 
 
+@pytest.mark.slow  # (kernels compiled cold in processes of their own, in a fresh cache)
 def test_a_kernel_marked_inline_is_inlined_by_llvm_also_when_loaded_from_the_cache(tmp_path):
     """``kernel(inline=True)``: no call to it is left in a caller's optimized code, whether the
     callee was compiled with the caller or loaded from numba's cache (where the compile helper

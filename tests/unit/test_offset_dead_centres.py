@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from scene_texts import MIXED_CYCLE, SMALL
 
-from transient.scene.queries import clearance_volume, gas_table
 from transient.cli import main
 from transient.forces.gas import mixed_cycle
 from transient.scene import load_scene
+from transient.scene.queries import clearance_volume, gas_table
 
 MIXED = MIXED_CYCLE.format(cr=18)
 

@@ -26,9 +26,16 @@ from references import check_all, semenov
 from scipy.integrate import quad
 
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.analysis.orders import (cycle_spectra, odd_harmonic_report, order_spectrum,
-                                       piston_acceleration, piston_inertia_force,
-                                       resample_angle, rod_angular_acceleration, to_angle_grid)
+from transient.analysis.orders import (
+    cycle_spectra,
+    odd_harmonic_report,
+    order_spectrum,
+    piston_acceleration,
+    piston_inertia_force,
+    resample_angle,
+    rod_angular_acceleration,
+    to_angle_grid,
+)
 
 R, L = 0.047, 0.148  # cases/gots_diesel_4400.toml (Gots App. 1)
 LAM = R / L

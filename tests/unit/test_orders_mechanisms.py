@@ -24,8 +24,8 @@ import pytest
 
 from transient.analysis.orders import report_for_scene
 from transient.analysis.pistons import piston_kinematics
-from transient.scene import Initial, Output, Run, load_scene
 from transient.run import integrate
+from transient.scene import Initial, Output, Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 N = 1440  # grid points per cycle

@@ -11,8 +11,16 @@ import numpy as np
 import pytest
 
 from transient.errors import SimulationError
-from transient.outcome import (IDLE_CHUNKS, STATUSES, RunStopped, Watch, code_status, failure_cause,
-                               status_in, status_of)
+from transient.outcome import (
+    IDLE_CHUNKS,
+    STATUSES,
+    RunStopped,
+    Watch,
+    code_status,
+    failure_cause,
+    status_in,
+    status_of,
+)
 
 
 def scene(omega0=100.0, budget=4e9, policy="power-flow", pairs=(), revolutions=math.inf,

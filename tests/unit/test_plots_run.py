@@ -12,13 +12,13 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
 
-from transient import plots, simulate  # noqa: E402
-from transient.analysis.irregularity import cycle_boundaries, fluctuation  # noqa: E402
-from transient.scene import Initial, Output, Run, load_scene  # noqa: E402
+from transient import plots, simulate
+from transient.analysis.irregularity import cycle_boundaries, fluctuation
+from transient.scene import Initial, Output, Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

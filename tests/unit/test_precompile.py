@@ -12,9 +12,9 @@ from numba import config, types
 
 from transient import precompile
 from transient.assemble import build_model
-from transient.core.stepper import breakpoints
 from transient.core import jit
 from transient.core.integrator.tableaus import TABLEAUS
+from transient.core.stepper import breakpoints
 from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"

@@ -65,21 +65,21 @@ def test_tighter_tolerance_takes_more_pieces():
 
 def test_atol_alone_bounds_the_error():
     """With rtol = 0 the sum of the errors stays below atol (a function near zero)."""
-    f = lambda x: 1e-3 * np.exp(x)[None, :]  # noqa: E731
+    f = lambda x: 1e-3 * np.exp(x)[None, :]
     edges = np.array([0.0, 0.3, 1.7, 3.0])
     q = integrals(f, edges[:-1], edges[1:], 0.0, 1e-12)
     assert np.abs(q.value[0] - 1e-3 * np.diff(np.exp(edges))).sum() <= 1e-12
 
 
 def test_non_finite_integrand_is_reported_not_halved_forever():
-    f = lambda x: np.where(x > 0.25, np.nan, 1.0)[None, :]  # noqa: E731
+    f = lambda x: np.where(x > 0.25, np.nan, 1.0)[None, :]
     q = integrals(f, [0.0, 0.5], [0.5, 1.0], 1e-10, 0.0)
     assert q.unresolved >= 1 and q.pieces < 4 * MAX_HALVINGS
     assert np.all(np.isnan(q.value))
 
 
 def test_empty_intervals_and_refusals():
-    f = lambda x: np.vstack([x, x * x])  # noqa: E731
+    f = lambda x: np.vstack([x, x * x])
     q = integrals(f, [0.0, 1.0, 1.0], [1.0, 1.0, 2.0], 1e-10, 0.0)
     assert q.value.shape == (2, 3)
     np.testing.assert_allclose(q.value, [[0.5, 0.0, 1.5], [1 / 3, 0.0, 7 / 3]], rtol=1e-14)

@@ -378,7 +378,8 @@ CASES = [
      "must be an array of tables"),
     ("unknown-policy", pair(policy="coulomb"), "friction.policy",
      "unknown value 'coulomb'; allowed: 'power-flow', 'paper'"),
-    ("paper-policy-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"') + '\n[friction]\npolicy = "paper"\n\n[[friction.pairs]]\n'
+    ("paper-policy-on-reference-path", add_after("rtol = 1e-6", 'method = "scipy-RK45"')
+     + '\n[friction]\npolicy = "paper"\n\n[[friction.pairs]]\n'
                             'between = ["shaft", "crank"]\neta_forward = 0.9\neta_backward = 0.9\n',
      "solver.method", "the reference path (scipy-*) follows the power-flow policy only"),
     # [analysis] (issue 7): what to store under /analysis after the run.

@@ -1,6 +1,7 @@
 """Friction on the swash plate's joint reactions (:mod:`transient.core.model.swash_friction`) against
 the Newton–Euler model written separately in numpy
-(:func:`transient.reference.swash_plate_reactions`: every body's equations one linear system, the kinematics from positions and rotation matrices;
+(:func:`transient.reference.swash_plate_reactions`: every body's equations one linear system,
+the kinematics from positions and rotation matrices;
 :func:`transient.reference.swash_plate_friction` closes the friction laws, written out again
 there, by ``scipy.optimize.fsolve``).
 
@@ -26,8 +27,18 @@ import pytest
 from transient.assemble import build_model
 from transient.core.model import swash_friction as sf
 from transient.core.model import swash_plate as core
-from transient.core.model.layout import (N_JOINTS, N_RX_PAR, RX_MU, RX_RADIUS, RX_RING_FORCE,
-                                         RX_RING_PRESSURE, RX_VISCOUS, WK_ETA, WK_RX, WK_S)
+from transient.core.model.layout import (
+    N_JOINTS,
+    N_RX_PAR,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    WK_ETA,
+    WK_RX,
+    WK_S,
+)
 from transient.core.model.work import N_WK
 from transient.mechanisms.swash_plate import antonyuk_example, dead_centres
 from transient.reference import swash_plate_friction, swash_plate_motion, swash_plate_reactions

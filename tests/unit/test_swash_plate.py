@@ -156,9 +156,9 @@ def test_J_is_twice_the_kinetic_energy_of_all_bodies(case):
     g = sp.antonyuk_example(**CASES[case])
     h = 1e-3
     pos = sp.positions(g, PHI)
-    v = {key: derivative(lambda p: sp.positions(g, p)[key], PHI, h) for key in ("B", "D", "G")}
+    v = {key: derivative(lambda p, key=key: sp.positions(g, p)[key], PHI, h) for key in ("B", "D", "G")}
     e_dot = (v["B"] - v["D"]) / g.rod_length
-    sq = lambda x: np.sum(x * x, axis=-1)  # noqa: E731
+    sq = lambda x: np.sum(x * x, axis=-1)
     ell, c, m = g.rod_length, g.rod_cg_from_pin, g.rod_mass
     if g.rod_model == "two-mass":
         rods = m * (ell - c) / ell * sq(v["D"]) + m * c / ell * sq(v["B"])
@@ -207,8 +207,8 @@ def test_the_table_u_is_the_derivative_of_its_x(halves):
     g = sp.antonyuk_example(halves=halves)
     table = sp.kinematics_table(g, PHI)
     for k in range(1, g.cylinders + 1):
-        x = lambda p: sp.kinematics_table(g, p)[f"x_{k}"]  # noqa: E731
-        u = lambda p: sp.kinematics_table(g, p)[f"u_{k}"]  # noqa: E731
+        x = lambda p, k=k: sp.kinematics_table(g, p)[f"x_{k}"]
+        u = lambda p, k=k: sp.kinematics_table(g, p)[f"u_{k}"]
         np.testing.assert_allclose(table[f"u_{k}"], derivative(x, PHI, 1e-2, D6), atol=1e-10)
         np.testing.assert_allclose(table[f"du_{k}"], derivative(u, PHI, 1e-2, D6), atol=1e-9)
 

@@ -276,8 +276,8 @@ def test_bisect_root_is_the_root_to_the_last_bit(sign):
     from scipy.optimize import brentq
 
     from transient.roots import bisect_root
-    g = lambda x: sign * (math.expm1(x) - 0.3)  # noqa: E731 (root log(1.3))
-    positive = lambda x: g(x) >= 0.0  # noqa: E731
+    g = lambda x: sign * (math.expm1(x) - 0.3)
+    positive = lambda x: g(x) >= 0.0
     x = bisect_root(g, 0.0, 2.0)
     assert positive(x) == positive(2.0) != positive(np.nextafter(x, -np.inf))
     assert abs(x - brentq(g, 0.0, 2.0, xtol=1e-15, rtol=4 * np.finfo(float).eps)) <= 4 * np.spacing(x)

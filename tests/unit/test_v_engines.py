@@ -34,6 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scene_texts import SMALL, check_text
 
 from transient.analysis.loads import crank_slider as L
 from transient.core.model import crank_slider as core
@@ -41,8 +42,6 @@ from transient.mechanisms.crank_slider import CrankSlider
 from transient.mechanisms.twins import CrankSliderNumpy
 from transient.reference import crank_slider_joint_forces
 from transient.scene import load_scene
-
-from scene_texts import SMALL, check_text
 
 RTOL = 1e-12
 FD_RTOL = 1e-7

@@ -12,7 +12,7 @@ import pytest
 
 from transient.assemble import build_model
 from transient.cli import main
-from transient.core.model.variation import (FUEL, PRESSURE, SHIFT, START, cycle_fuel, misfire_draw)
+from transient.core.model.variation import FUEL, PRESSURE, SHIFT, START, cycle_fuel, misfire_draw
 from transient.errors import SceneError
 from transient.scene import load_scene, scene_from_dict
 
@@ -229,7 +229,8 @@ def table_data(motored: bool = False, cylinders=(), governor: bool = False) -> d
 
 @pytest.mark.parametrize("entry, key", [
     ({"fuel": 0.8}, "fuel"), ({"cut_out": True}, "cut_out"),
-    ({"misfire_every": 3}, "misfire_every"), ({"misfire_cycles": [2]}, "misfire_cycles"), ({"misfire_rate": 0.1}, "misfire_rate"),
+    ({"misfire_every": 3}, "misfire_every"), ({"misfire_cycles": [2]}, "misfire_cycles"),
+    ({"misfire_rate": 0.1}, "misfire_rate"),
     ({"combustion_offset_deg": 2}, "combustion_offset")])
 def test_table_without_motored_curve_refuses_what_burns_less(entry, key):
     with pytest.raises(SceneError) as err:

@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.scene.queries import wiebe_levels
 from transient.core import CACHE_DIR_VARIABLE, source_hash
 from transient.errors import SceneError
 from transient.forces import wiebe_cache
 from transient.forces.wiebe import WiebeCycle, wiebe_tables
 from transient.mechanisms.crank_slider import CrankSlider
 from transient.scene import load_scene
+from transient.scene.queries import wiebe_levels
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

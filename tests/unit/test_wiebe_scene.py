@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.scene.queries import gas_tables, wiebe_levels
 from transient.cli import main
 from transient.errors import SceneError
 from transient.forces.wiebe import WiebeCycle, wiebe_cycle
 from transient.scene import Wiebe, load_scene, to_toml
+from transient.scene.queries import gas_tables, wiebe_levels
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 WIEBE = CASES / "gots_diesel_wiebe.toml"

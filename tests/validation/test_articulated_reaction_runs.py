@@ -24,15 +24,21 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import (
+    check_release_at_holds,
+    check_zero_friction_is_ideal,
+    closure,
+    dense_spin_up,
+    gas_forces_at_rest,
+    loss_is_share_of_transmitted,
+    losses_nonnegative,
+)
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
-from transient.run import integrate, prescribed
 from transient.reference import articulated_joint_forces
+from transient.run import integrate, prescribed
 from transient.scene import Gas, Initial, Output, Run, Starter, load_scene
-
-from balances import (check_release_at_holds, check_zero_friction_is_ideal, closure, dense_spin_up,
-                      gas_forces_at_rest, loss_is_share_of_transmitted, losses_nonnegative)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 CASE = CASES / "radial_5cyl_reaction_friction.toml"

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from transient.cli import main
-from transient.scene import Gas, Initial, Load, Run, load_scene
 from transient.run import integrate
+from transient.scene import Gas, Initial, Load, Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 SCENES = ("radial_5cyl", "radial_9cyl", "v_twin_fork_blade")

@@ -9,15 +9,15 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from conftest import CASES
+
 from transient.assemble import build_model
+from transient.core.integrator.tableaus import TABLEAUS
 from transient.core.jit import _KernelArgument
 from transient.core.model.layout import extras_of
-from transient.core.integrator.tableaus import TABLEAUS
 from transient.precompile import CALLEES, compile_callees, signature
-from transient.scene import load_scene
 from transient.run import integrate
-
-from conftest import CASES
+from transient.scene import load_scene
 
 
 def test_helper_compiles_the_signatures_the_stepper_calls():

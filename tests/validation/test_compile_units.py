@@ -9,15 +9,14 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from conftest import CASES
 
 from transient.assemble import build_model
 from transient.core import jit, stepper
-from transient.core.model import layout
 from transient.core.integrator import rk
+from transient.core.model import layout
 from transient.run import simulate
 from transient.scene import load_scene
-
-from conftest import CASES
 
 
 def _functions_in_stepper() -> list[str]:

@@ -26,10 +26,10 @@ import pytest
 from references import check_all, closed_forms
 
 from transient.analysis.summary import summarize
-from transient.scene.queries import gas_phases, gas_table
 from transient.mechanisms import swash_plate as sp
 from transient.run import integrate
 from transient.scene import Load
+from transient.scene.queries import gas_phases, gas_table
 
 RPM = math.pi / 30.0
 

@@ -25,9 +25,9 @@ import pytest
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.scene.outputs import cylinder_loss_column
 from transient.run import integrate
 from transient.scene import Cylinder, Friction, Output, Pair, Run, load_scene
+from transient.scene.outputs import cylinder_loss_column
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 CASE = CASES / "gots_diesel_reaction_friction.toml"

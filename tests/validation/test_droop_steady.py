@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from transient.scene import Run, load_scene
 from transient.run import integrate
+from transient.scene import Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -23,8 +23,8 @@ import pytest
 from scipy.integrate import quad
 
 from transient.core.model.crank_slider import crank_slider_terms
-from transient.scene import Gas, Initial, Load, Output, Run, Solver, load_scene
 from transient.run import integrate
+from transient.scene import Gas, Initial, Load, Output, Run, Solver, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -190,7 +190,8 @@ def work_balance(data, scene, sample_integral, table_end_events, domain):
     load. Every M here is smooth between the gas table's ends (its other knots, breakpoints too,
     are C²), so a degree-6
     local-polynomial rule on 0.25–0.5° samples between the breakpoint events (and the run's ends)
-    is accurate to ~1e-11 of the work (see :func:`test_work_quadrature_is_converged`). In crank angle the integral is ∫M dφ over φ-samples; in time ∫M ω dt over t-samples.
+    is accurate to ~1e-11 of the work (see :func:`test_work_quadrature_is_converged`). In crank angle the integral
+    is ∫M dφ over φ-samples; in time ∫M ω dt over t-samples.
     """
     tr = data.trajectory
     bp = table_end_events(data, scene)

@@ -11,13 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import closure, losses_nonnegative
 from scipy.interpolate import RegularGridInterpolator
 
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study
-
-from balances import closure, losses_nonnegative
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0

@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from transient.study.flywheel import flywheel_for_delta
 from transient.analysis.irregularity import cycle_means, fluctuation, steady_state_time
-from transient.scene import Load, Output, Run, load_scene
 from transient.run import integrate, prescribed
+from transient.scene import Load, Output, Run, load_scene
+from transient.study.flywheel import flywheel_for_delta
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -57,7 +57,8 @@ def test_flywheel_gives_target_delta_in_fresh_run(delta_target):
     assert res.iterations[-1].delta_change < 1e-5  # the helper's runs ended in steady state
     delta, mean_speed, t_steady = fresh_delta(SCENE, res.flywheel)
     print(f"δ_target {delta_target}: estimate {res.estimate:.5f}, "
-          f"flywheel {res.flywheel:.5f} kg m² after {len(res.iterations)} run(s); helper δ {res.delta:.6f}, fresh run δ {delta:.6f} "
+          f"flywheel {res.flywheel:.5f} kg m² after {len(res.iterations)} run(s); "
+          f"helper δ {res.delta:.6f}, fresh run δ {delta:.6f} "
           f"({delta / delta_target - 1:+.2%}), steady from t = {t_steady:.2f} s")
     assert math.isfinite(t_steady)
     assert mean_speed == pytest.approx(res.speed, rel=1e-3)

@@ -31,16 +31,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import dense_spin_up
 
-from transient.analysis.efficiency import (chen_flynn_fmep, displacement, mean_piston_speed,
-                                           mechanical_efficiency)
+from transient.analysis.efficiency import (
+    chen_flynn_fmep,
+    displacement,
+    mean_piston_speed,
+    mechanical_efficiency,
+)
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.scene.queries import gas_table
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, load_scene
+from transient.scene.queries import gas_table
 from transient.study.efficiency import point_scene
-
-from balances import dense_spin_up
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0

@@ -17,18 +17,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import closure, losses_nonnegative
 
 from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
 from transient.core.model.chain import LOCKED, modes_power_flow
 from transient.core.model.forcing import moments
 from transient.core.model.layout import WK_DJ, WK_J, WK_M, extras_of
-from transient.core.model.work import work_array
 from transient.core.model.rhs import split_subchains
-from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
+from transient.core.model.work import work_array
 from transient.run import integrate, prescribed
-
-from balances import closure, losses_nonnegative
+from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -27,9 +27,9 @@ import numpy as np
 import pytest
 from references import check_all, closed_forms, gots, read_table
 
-from transient.scene.queries import gas_phases
 from transient.core.model import crank_slider as core
 from transient.scene import load_scene
+from transient.scene.queries import gas_phases
 
 
 def test_scene_is_the_books_engine():

@@ -15,12 +15,11 @@ import tomllib
 
 import numpy as np
 import pytest
+from conftest import CASES
 from scipy.interpolate import CubicHermiteSpline
 
-from transient.scene import scene_from_dict
 from transient.run import integrate
-
-from conftest import CASES
+from transient.scene import scene_from_dict
 
 RPM = math.pi / 30.0
 

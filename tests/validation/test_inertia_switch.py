@@ -15,11 +15,10 @@ import math
 import tomllib
 
 import numpy as np
-
-from transient.scene import scene_from_dict
-from transient.run import integrate
-
 from conftest import CASES
+
+from transient.run import integrate
+from transient.scene import scene_from_dict
 
 
 def scene(case: str, **sections):

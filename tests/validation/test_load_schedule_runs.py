@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from transient.scene import Gas, Initial, Load, Output, Run, Solver, Starter, load_scene
 from transient.run import integrate
+from transient.scene import Gas, Initial, Load, Output, Run, Solver, Starter, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 W0 = 2000.0 * math.pi / 30.0

@@ -17,9 +17,9 @@ from references import check_all, gots, read_table
 
 from transient.analysis.loads import crank_slider as L
 from transient.analysis.loads.common import rod_split
-from transient.scene.queries import gas_phases
-from transient.scene import load_scene
 from transient.run import integrate
+from transient.scene import load_scene
+from transient.scene.queries import gas_phases
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -27,8 +27,8 @@ from transient.analysis.loads.common import rod_split
 from transient.analysis.loads.swash_plate import swash_loads_from_trajectory
 from transient.cli import main
 from transient.results import open_result
-from transient.scene import Analysis, load_scene
 from transient.run import simulate
+from transient.scene import Analysis, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -30,15 +30,21 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import (
+    check_release_at_holds,
+    closure,
+    constant_main_bearings,
+    dense_spin_up,
+    loss_is_share_of_transmitted,
+    losses_nonnegative,
+    with_main_bearings,
+    without_friction,
+)
+from own_error import assert_agree
 
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Initial, Load, Output, Pair, Run, Starter, load_scene
 from transient.study.efficiency import efficiency_study, point_scene
-
-from balances import (check_release_at_holds, closure, constant_main_bearings, dense_spin_up,
-                      loss_is_share_of_transmitted, losses_nonnegative, with_main_bearings,
-                      without_friction)
-from own_error import assert_agree
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = np.pi / 30.0

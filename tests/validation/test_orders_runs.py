@@ -26,10 +26,9 @@ import numpy as np
 import pytest
 
 from transient.analysis.irregularity import fluctuation
-from transient.analysis.orders import (order_spectrum, report_for_scene, run_orders,
-                                       to_angle_grid)
-from transient.scene import load_scene
+from transient.analysis.orders import order_spectrum, report_for_scene, run_orders, to_angle_grid
 from transient.run import integrate
+from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 REVS = 20

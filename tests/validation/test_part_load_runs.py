@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 
 from transient import simulate
-from transient.scene.queries import gas_tables
 from transient.scene import Friction, Governor, load_scene, scene_from_dict
+from transient.scene.queries import gas_tables
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
@@ -78,8 +78,8 @@ def test_woschni_cut_out_is_the_motored_cycle_with_wall_heat():
     governor) with cylinder 2 cut out: over the closed part of its second cycle its pressure is
     transient.forces.woschni's closed cycle without fuel at that speed, to 1e-6 (the solvers'
     tolerances: rtol 1e-11 here, 1e-12 there), peaking where it does on the same samples."""
-    from transient.scene.queries import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
+    from transient.scene.queries import clearance_volume
 
     base = load_scene(CASES / "gots_diesel_woschni.toml")
     scene = replace(base.replace(gas={"cylinders": [{"cylinder": 2, "cut_out": True}]},
@@ -151,8 +151,8 @@ def test_table_misfire_follows_the_users_motored_curve():
     tdc = np.radians([0.0, 540.0, 180.0, 360.0])  # gas-exchange TDCs
     P = 4 * math.pi
     points = np.radians(TABLE_PHI)
-    full = lambda x: np.interp(x, points, np.array(TABLE_P) * 1e5)  # noqa: E731
-    motored = lambda x: np.interp(x, points, np.array(TABLE_MOTORED) * 1e5)  # noqa: E731
+    full = lambda x: np.interp(x, points, np.array(TABLE_P) * 1e5)
+    motored = lambda x: np.interp(x, points, np.array(TABLE_MOTORED) * 1e5)
     misfires = 0
     for k in range(4):
         x = np.mod(phi - tdc[k], P)

@@ -27,9 +27,9 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from transient.scene.queries import gas_table
 from transient.run import prescribed
 from transient.scene import load_scene
+from transient.scene.queries import gas_table
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0

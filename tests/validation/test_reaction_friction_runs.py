@@ -32,16 +32,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import (
+    check_zero_friction_is_ideal,
+    closure,
+    dense_spin_up,
+    loss_is_share_of_transmitted,
+)
 
 from transient.analysis.efficiency import chen_flynn_fmep, mean_piston_speed, mechanical_efficiency
 from transient.analysis.loads.crank_slider import slider_arrays
-from transient.scene.queries import gas_table
 from transient.run import integrate, prescribed
 from transient.scene import Friction, Gas, Initial, Output, Pair, Run, Starter, load_scene
+from transient.scene.queries import gas_table
 from transient.study.efficiency import efficiency_study, point_scene
-
-from balances import (check_zero_friction_is_ideal, closure, dense_spin_up,
-                      loss_is_share_of_transmitted)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0

@@ -44,13 +44,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import constant_main_bearings
 from scipy.interpolate import CubicHermiteSpline
 
 import transient.reference.integrate as reference
-from transient.scene import load_scene
 from transient.run import integrate
-
-from balances import constant_main_bearings
+from transient.scene import load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RTOL = ATOL = 1e-10

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from transient.cli import main
-from transient.scene import load_scene
 from transient.run import integrate
+from transient.scene import load_scene
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "coasting_single.toml"
 

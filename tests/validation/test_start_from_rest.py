@@ -33,8 +33,8 @@ import numpy as np
 import pytest
 from numpy.polynomial import Polynomial
 
-from transient.scene import Initial, Output, Run, Starter, load_scene
 from transient.run import integrate
+from transient.scene import Initial, Output, Run, Starter, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RTOL = ATOL = 1e-10

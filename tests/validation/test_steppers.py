@@ -14,8 +14,8 @@ import pytest
 from scipy.integrate import quad
 
 from transient.core.model.crank_slider import crank_slider_terms
-from transient.scene import Load, Run, load_scene
 from transient.run import integrate
+from transient.scene import Load, Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 REVS = 10

@@ -16,11 +16,10 @@ import tomllib
 import h5py
 import numpy as np
 import pytest
-
-from transient.scene import scene_from_dict
-from transient.run import integrate, run_compiled, simulate
-
 from conftest import CASES
+
+from transient.run import integrate, run_compiled, simulate
+from transient.scene import scene_from_dict
 
 
 def stiff_scene(**solver):

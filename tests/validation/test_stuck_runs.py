@@ -30,14 +30,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import check_release_at_holds, closure, drive, gas_forces_at_rest, losses_nonnegative
 
 from transient.analysis.loads.crank_slider import slider_arrays
 from transient.analysis.summary import stuck_phases
 from transient.run import integrate
 from transient.scene import Friction, Gas, Initial, Load, Output, Run, Starter, load_scene
-
-from balances import (check_release_at_holds, closure, drive, gas_forces_at_rest,
-                      losses_nonnegative)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 TOL_T = 1e-9  # s

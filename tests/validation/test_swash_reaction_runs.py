@@ -25,14 +25,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balances import (
+    check_zero_friction_is_ideal,
+    closure,
+    dense_spin_up,
+    loss_is_share_of_transmitted,
+    losses_nonnegative,
+)
 
 from transient.mechanisms.swash_plate import stroke
 from transient.reference import swash_plate_motion
 from transient.run import integrate
 from transient.scene import Friction, Gas, Governor, Initial, Load, Output, Run, Starter, load_scene
-
-from balances import (check_zero_friction_is_ideal, closure, dense_spin_up,
-                      loss_is_share_of_transmitted, losses_nonnegative)
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "swash_plate_4cyl_reaction_friction.toml"
 

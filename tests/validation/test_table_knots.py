@@ -23,7 +23,7 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from transient.assemble import build_model
 from transient.run import integrate
-from transient.scene import Gas, Initial, Inertia, Run, load_scene
+from transient.scene import Gas, Initial, Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 CYCLE = 4.0 * math.pi

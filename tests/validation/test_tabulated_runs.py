@@ -12,8 +12,8 @@ import pytest
 
 from transient.assemble import build_model, kinematics_table
 from transient.core.model.layout import TABULATED
-from transient.scene import Run, load_scene
 from transient.run import integrate
+from transient.scene import Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -31,8 +31,8 @@ import pytest
 
 from transient.analysis.summary import summarize
 from transient.analysis.thermo import cycle_thermodynamics
-from transient.scene import Analysis, Friction, Governor, Initial, Output, Run, load_scene
 from transient.run import integrate
+from transient.scene import Analysis, Friction, Governor, Initial, Output, Run, load_scene
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0
@@ -244,9 +244,9 @@ def test_woschni_state_pressure_work_and_net_heat():
     rtol 1e-12) plus the pumping loop, to 1e-6; the apparent heat release of the run's pressure
     is the fuel's heat less the wall's, Q_b − Q_w of that integration, to 1e-4 (measured 3.5e-5;
     the heat release is a trapezoid over 0.25° samples, and dp/dφ a spline of them)."""
-    from transient.scene.queries import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
-    from transient.scene import Inertia, Load
+    from transient.scene import Load
+    from transient.scene.queries import clearance_volume
 
     base = load_scene(CASES / "gots_diesel_woschni.toml")
     omega = 4400 * RPM

@@ -214,7 +214,8 @@ def test_first_law_constant_gamma(fired):
     assert mc.closed_work / q < eta_otto
     print(f"\nfired (γ = {GAMMA}): Q = {q:.3f} J, ∮p dV = {mc.closed_work:.6f} J; rel. to "
           f"Q − ΔU {mc.closed_work / w_balance - 1:.1e} (own p_end), "
-          f"{mc.closed_work / w_indep - 1:.1e} (quadrature p_end), {mc.closed_work / w_elem - 1:.1e} (heat elements); p_end rel "
+          f"{mc.closed_work / w_indep - 1:.1e} (quadrature p_end), "
+          f"{mc.closed_work / w_elem - 1:.1e} (heat elements); p_end rel "
           f"{mc.p_end / p_end - 1:.1e}; η = {mc.closed_work / q:.4f} (Otto {eta_otto:.4f}); "
           f"p_max {mc.p_max / 1e6:.3f} MPa at {mc.angle_max / DEG:.3f}°, T_max {mc.t_max:.0f} K")
 

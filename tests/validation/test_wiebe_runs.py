@@ -28,11 +28,10 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model
-from transient.scene.queries import gas_tables, wiebe_levels
 from transient.forces.wiebe import wiebe_tables
-from transient.scene import Friction, Governor, Initial, Output, Run, load_scene
 from transient.run import integrate
-
+from transient.scene import Friction, Governor, Initial, Output, Run, load_scene
+from transient.scene.queries import gas_tables, wiebe_levels
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 RPM = math.pi / 30.0

@@ -20,7 +20,6 @@ import pytest
 from conftest import CASES
 from scipy.integrate import quad
 
-from transient.scene.queries import clearance_volume, wiebe_levels
 from transient.errors import SceneError
 from transient.forces.wiebe import wiebe_cycle
 from transient.forces.woschni import (
@@ -35,6 +34,7 @@ from transient.forces.woschni import (
     woschni_coefficient,
 )
 from transient.scene import load_scene
+from transient.scene.queries import clearance_volume, wiebe_levels
 
 DEG = math.pi / 180
 RPM = math.pi / 30

@@ -100,8 +100,8 @@ def constant_speed_scene(rpm: float, revolutions: float = 6.0, **woschni) -> dic
 
 def numpy_closed_cycle(scene, omega):
     """The closed part of cylinder 1 by transient.forces.woschni (solve_ivp, rtol 1e-12)."""
-    from transient.scene.queries import clearance_volume
     from transient.forces.woschni import WoschniParameters, closed_cycle
+    from transient.scene.queries import clearance_volume
 
     mech, gas = scene.mechanism, scene.gas
     w, h = gas.wiebe, gas.woschni

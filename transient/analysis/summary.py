@@ -7,8 +7,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .efficiency import EFFICIENCY_VALUES, mechanical_efficiency
-from .irregularity import (cycle_boundaries, cycle_means, fluctuation, last_cycle_ranges,
-                           steady_state_time)
+from .irregularity import (
+    cycle_boundaries,
+    cycle_means,
+    fluctuation,
+    last_cycle_ranges,
+    steady_state_time,
+)
 from .orders import resample_angle
 from .requested import requested_analyses
 from .transient_response import load_step_times, run_response

@@ -517,8 +517,8 @@ def own_cycle_numbers(scene, cylinder: int, starts: ArrayLike) -> NDArray[np.int
     ``starts`` (:func:`own_cycles`), as ``[[gas.cylinders]]`` counts them for its misfires: 1
     the cycle in progress at the initial angle (:func:`transient.assemble.variation_fields`)."""
     from ..assemble import variation_fields
-    from ..scene.queries import gas_phases
     from ..core.model.variation import START
+    from ..scene.queries import gas_phases
 
     first = variation_fields(scene, gas_phases(scene))["var_par"][cylinder - 1, START]
     return np.rint((np.asarray(starts, dtype=float) - first) / scene.mechanism.cycle

@@ -7,8 +7,19 @@ import math
 from pathlib import Path
 
 from ..errors import SceneError, show_value
-from .common import (EXIT_OK, MAX_POINTS, MAX_RPM, add_force, check_output_file, number_list,
-                     output_file, output_folder, pyplot, save, whole)
+from .common import (
+    EXIT_OK,
+    MAX_POINTS,
+    MAX_RPM,
+    add_force,
+    check_output_file,
+    number_list,
+    output_file,
+    output_folder,
+    pyplot,
+    save,
+    whole,
+)
 
 
 def register(sub) -> None:
@@ -28,10 +39,9 @@ def register(sub) -> None:
 
 
 def cmd_efficiency(args) -> int:
-    from ..scene.queries import part_load_refusal
     from ..scene import POLICIES, load_scene
-    from ..study.efficiency import (efficiency_study, plot_budget, plot_map, plot_study,
-                                    write_csv)
+    from ..scene.queries import part_load_refusal
+    from ..study.efficiency import efficiency_study, plot_budget, plot_map, plot_study, write_csv
 
     scene = load_scene(args.scene)
     rpm = number_list(args.rpm, "--rpm", 0.0, MAX_RPM)

@@ -6,8 +6,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import (EXIT_OK, MAX_POINTS, add_force, check_output_file, output_file, pyplot,
-                     save, whole)
+from .common import (
+    EXIT_OK,
+    MAX_POINTS,
+    add_force,
+    check_output_file,
+    output_file,
+    pyplot,
+    save,
+    whole,
+)
 
 
 def register(sub) -> None:

@@ -6,9 +6,17 @@ import numpy as np
 
 from ..errors import SceneError
 from ..mechanisms.crank_slider import MAX_CYLINDERS
-from .common import (EXIT_OK, add_force, output_folder, pyplot, read_result, result_stem, save,
-                     whole, write_columns)
-
+from .common import (
+    EXIT_OK,
+    add_force,
+    output_folder,
+    pyplot,
+    read_result,
+    result_stem,
+    save,
+    whole,
+    write_columns,
+)
 
 #: The loads' names in the CSV where Gots' letter means something else in a result: Gots' S,
 #: the force along the rod, is ``S_rod`` (a result's ``S_k`` is the moment pair k transmits).

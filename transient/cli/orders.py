@@ -7,8 +7,19 @@ import math
 import numpy as np
 
 from ..errors import SceneError
-from .common import (EXIT_OK, MAX_POINTS, add_force, output_folder, pyplot, read_result, real,
-                     result_stem, save, whole, write_columns)
+from .common import (
+    EXIT_OK,
+    MAX_POINTS,
+    add_force,
+    output_folder,
+    pyplot,
+    read_result,
+    real,
+    result_stem,
+    save,
+    whole,
+    write_columns,
+)
 
 
 def register(sub) -> None:

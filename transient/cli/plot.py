@@ -41,9 +41,9 @@ def figures(res, cylinders=None, cycles=None, held=None):
     of their own those cylinders hold (as ``_check_choices`` counts them; None: counted here)."""
     plt = pyplot()
 
-    from .. import plots
     import numpy as np
 
+    from .. import plots
     from ..scene.queries import gas_is_force, gas_tables
 
     scene = res.scene()

@@ -44,8 +44,8 @@ def register(sub) -> None:
 
 
 def cmd_check(args) -> int:
-    from ..scene.queries import cycle_figures
     from ..scene import load_scene
+    from ..scene.queries import cycle_figures
     from ..scene.read import SweepNotScene
 
     try:
@@ -94,8 +94,8 @@ def _print_figures(figures: dict) -> None:
 
 def cmd_run(args) -> int:
     from ..results import check_writable
-    from ..scene import load_scene, runs_compiled
     from ..run import simulate
+    from ..scene import load_scene, runs_compiled
 
     scene = load_scene(args.scene)
     path = Path(args.output) / f"{Path(args.scene).stem}.h5"

@@ -3,13 +3,22 @@ summaries (:mod:`transient.sweeps`)."""
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import SceneError, show_value
-from .common import (EXIT_FAILED, EXIT_OK, KERNELS_NOTICE, MAX_WORKERS, add_force,
-                     check_result_path, output_folder, pyplot, save, whole)
+from .common import (
+    EXIT_FAILED,
+    EXIT_OK,
+    KERNELS_NOTICE,
+    MAX_WORKERS,
+    add_force,
+    check_result_path,
+    output_folder,
+    pyplot,
+    save,
+    whole,
+)
 
 
 def register(sub) -> None:

@@ -7,7 +7,6 @@ from pathlib import Path
 from ..errors import SceneError, show_value
 from .common import EXIT_FAILED, EXIT_OK, add_force, real, whole
 
-
 #: Bounds of the benchmark's options: a record of 10⁶ revolutions per run, or of 100 runs per
 #: point, would take days on the benchmark scenes.
 MAX_BENCH_REVOLUTIONS = 1e6
@@ -74,9 +73,9 @@ def cmd_stress(args) -> int:
 
 
 def cmd_bench(args) -> int:
+    from ..scene import load_scene
     from ..verify.bench import BASELINE_BUDGET_S, BENCH_SCENES, rewrite_report, run_bench
     from ..verify.targets import rewrite_targets, run_targets
-    from ..scene import load_scene
 
     if args.report or args.targets:
         if not (Path(args.output) / "work_precision.csv").is_file():

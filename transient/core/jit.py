@@ -39,12 +39,12 @@ from numba import _dynfunc, config, njit, types
 from numba.core import sigutils
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, UserProvidedCacheLocator
 from numba.core.codegen import CPUCodeLibrary, JITCPUCodegen
-from numba.core.cpu import CPUContext
-from numba.core.itanium_mangler import mangle_identifier
 from numba.core.compiler_lock import global_compiler_lock
+from numba.core.cpu import CPUContext
 from numba.core.datamodel import register_default
 from numba.core.datamodel.models import OpaqueModel
 from numba.core.imputils import lower_constant
+from numba.core.itanium_mangler import mangle_identifier
 from numba.core.registry import CPUDispatcher
 from numba.core.runtime import rtsys
 
@@ -228,7 +228,7 @@ def _unresolved():
     return None
 
 
-def _kernel_argument(module: str, qualname: str) -> "_KernelArgument":
+def _kernel_argument(module: str, qualname: str) -> _KernelArgument:
     """A :class:`_KernelArgument` read back from the cache's index: the kernel's own type where
     its module is imported (numba interns types, and the two compare equal), else one by name."""
     return _KernelArgument(None, (module, qualname))

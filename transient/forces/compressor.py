@@ -3,7 +3,8 @@ of a compressor or pump whose piston works against its gas, as a periodic pressu
 
 The textbook's ideal indicator diagram of a reciprocating compressor with clearance (Rogers &
 Mayhew, *Engineering Thermodynamics: Work and Heat Transfer*, the chapter on reciprocating
-compressors; derived below piece by piece, so the closed forms stand on their own), with self-acting valves that open as soon as the pressure reaches the line's
+compressors; derived below piece by piece, so the closed forms stand on their own), with self-acting
+valves that open as soon as the pressure reaches the line's
 pressure (no valve losses, no leakage) and the constant suction and discharge pressures p_s,
 p_d. Over one turn, from the top dead centre t (least volume V_c, the clearance):
 
@@ -43,8 +44,16 @@ from numpy.typing import NDArray
 
 from ..errors import SceneError
 from ..roots import bisect_root
-from .gas import (ANGLE_TOL, DEFAULT_STEP, IndicatedCycle, VolumeFunction, deg_text,
-                  table_from_function, volume_at, wrapped_pieces)
+from .gas import (
+    ANGLE_TOL,
+    DEFAULT_STEP,
+    IndicatedCycle,
+    VolumeFunction,
+    deg_text,
+    table_from_function,
+    volume_at,
+    wrapped_pieces,
+)
 
 __all__ = ["CompressorCycle", "compressor_cycle", "ideal_compressor_work"]
 

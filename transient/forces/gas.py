@@ -18,8 +18,8 @@ caller, not here.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -63,7 +63,7 @@ INTERPOLATIONS = ("linear", "pchip", "spline")
 #: a few ulp; anything closer than this (relative to the period) is snapped onto it.
 ANGLE_TOL = 1e-9
 
-PieceFunction = Union[Callable[[NDArray[np.float64]], ArrayLike], float]
+PieceFunction = Callable[[NDArray[np.float64]], ArrayLike] | float
 
 #: A cylinder volume V(x) [m³], vectorised over local crank angles x [rad].
 VolumeFunction = Callable[[NDArray[np.float64]], ArrayLike]

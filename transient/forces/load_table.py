@@ -12,7 +12,8 @@ Practical Guide to Splines*, ch. II, (2.5) and ch. IV): linear ≤ h²/8·max|f�
 where the data are strictly monotone, O(h²) near an extremum, where its slope is set to zero.
 
 A load curve is held as the compiled model holds it
-(:func:`transient.core.model.tables.held_curve_value`): knots and a cubic per interval in ascending powers, its end values held outside the knots. A
+(:func:`transient.core.model.tables.held_curve_value`): knots and a cubic per
+interval in ascending powers, its end values held outside the knots. A
 curve over the cycle (abscissa ``"angle"``) is periodic: its knots run over one period from the
 last point shifted back by the period, so that the interval across the cycle's end is one piece.
 """

@@ -26,10 +26,11 @@ How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 from math import cos, degrees, hypot, pi, sin, sqrt
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -450,7 +451,7 @@ class Articulated:
                     if f[j] == 0.0:
                         out.append(float(grid[j]))
                     elif f[j + 1] != 0.0:
-                        root = bisect_root(lambda a: _slave_rates(self, a)[which, i], grid[j],
+                        root = bisect_root(lambda a, which=which, i=i: _slave_rates(self, a)[which, i], grid[j],
                                            grid[j + 1])
                         out.append(float(root))
         return np.unique(np.mod(np.array(out), 2.0 * pi))
@@ -654,7 +655,7 @@ def dead_centres(mech: Articulated) -> tuple[NDArray[np.float64], NDArray[np.flo
     tdc, bdc = np.zeros(1 + mech.n_slaves), np.full(1 + mech.n_slaves, pi)
     for i in range(1, 1 + mech.n_slaves):
         for out, j in ((tdc, np.argmax(x[:, i])), (bdc, np.argmin(x[:, i]))):
-            out[i] = bisect_root(lambda a: rate(a, i), grid[j] - h, grid[j] + h) % (2.0 * pi)
+            out[i] = bisect_root(lambda a, i=i: rate(a, i), grid[j] - h, grid[j] + h) % (2.0 * pi)
     return tdc, bdc
 
 

@@ -43,10 +43,11 @@ How it fills the mechanism interface (:class:`transient.mechanisms.Mechanism`):
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from math import asin, cos, degrees, inf, pi, sin
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -727,7 +728,7 @@ def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.floa
     x = _points(mp, grid)[2][..., 0]
     inner, outer = np.empty(z), np.empty(z)
     for k in range(z):
-        inner[k], outer[k] = (bisect_root(lambda p: rate(p, k), grid[j] - h, grid[j] + h)
+        inner[k], outer[k] = (bisect_root(lambda p, k=k: rate(p, k), grid[j] - h, grid[j] + h)
                               for j in (np.argmin(x[:, k]), np.argmax(x[:, k])))
     return inner, outer
 

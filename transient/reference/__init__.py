@@ -9,9 +9,15 @@ saying what it shares with the compiled path:
   compiled reaction-friction solvers and of the analyses' forces.
 """
 from .integrate import run_reference
-from .joints import (articulated_joint_forces, crank_slider_friction, crank_slider_joint_forces,
-                     crank_slider_joint_signs, swash_plate_friction, swash_plate_motion,
-                     swash_plate_reactions)
+from .joints import (
+                     articulated_joint_forces,
+                     crank_slider_friction,
+                     crank_slider_joint_forces,
+                     crank_slider_joint_signs,
+                     swash_plate_friction,
+                     swash_plate_motion,
+                     swash_plate_reactions,
+)
 
 __all__ = ["run_reference", "articulated_joint_forces", "crank_slider_friction",
            "crank_slider_joint_forces", "crank_slider_joint_signs", "swash_plate_friction",

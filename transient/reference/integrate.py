@@ -31,8 +31,14 @@ from ..core.model.layout import T
 from ..core.model.variation import PRESSURE, SHIFT, cycle_fuel
 from ..errors import SimulationError
 from ..scene.queries import gas_tables
-from .twins import (ArticulatedReactionNumpy, ChainNumpy, CylindersNumpy, GovernorNumpy,
-                    ReactionNumpy, SwashReactionNumpy)
+from .twins import (
+    ArticulatedReactionNumpy,
+    ChainNumpy,
+    CylindersNumpy,
+    GovernorNumpy,
+    ReactionNumpy,
+    SwashReactionNumpy,
+)
 
 
 class ReferenceModel:

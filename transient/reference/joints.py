@@ -27,10 +27,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..core.model.layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU,
-                                 RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS)
+from ..core.model.layout import (
+    JOINT_CRANKPIN,
+    JOINT_MAIN,
+    JOINT_PIN,
+    JOINT_SLIDER,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+)
 from ..mechanisms.articulated import positions
-
 
 # ------------------------------------------------------------------------------------------------
 # The crank-slider
@@ -517,7 +525,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
             t0 = kin[j]["t0"][0]
             s0 = at_sel[j]["t0"][0]
             M_O[j] = -sigma * mu[0] * np.hypot(*main[:, j]) - jp[0, 2] * omega
-            M_A[j] = (-np.sign((s0 - 1.0)) * sigma * mu[1] * np.hypot(*big[:, k])
+            M_A[j] = (-np.sign(s0 - 1.0) * sigma * mu[1] * np.hypot(*big[:, k])
                       - jp[1, 2] * (t0 - 1.0) * omega)
             M_B0[j] = -np.sign(s0) * sigma * mu[3] * np.hypot(*pin[:, k]) - jp[3, 2] * t0 * omega
             x0 = kin[j]["B"][1].real

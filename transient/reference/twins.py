@@ -18,13 +18,27 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from ..core.model.layout import (LINK_PISTONS, LINK_REST, LINK_SWASH, RX_MU, RX_RADIUS,
-                                 RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS)
+from ..core.model.layout import (
+    LINK_PISTONS,
+    LINK_REST,
+    LINK_SWASH,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+)
 from ..core.model.swash_plate import link_terms as swash_link_terms
 from ..mechanisms import reaction_joints
-from .joints import (_at_acceleration, articulated_joint_forces, crank_slider_friction_laws,
-                     crank_slider_joint_forces, crank_slider_joint_powers, crank_slider_joint_signs,
-                     swash_plate_friction)
+from .joints import (
+    _at_acceleration,
+    articulated_joint_forces,
+    crank_slider_friction_laws,
+    crank_slider_joint_forces,
+    crank_slider_joint_powers,
+    crank_slider_joint_signs,
+    swash_plate_friction,
+)
 
 
 class ChainNumpy:
@@ -127,11 +141,13 @@ class ChainNumpy:
 
 class ReactionNumpy(ChainNumpy):
     """Friction on the crank-slider's joint reactions, solved as the compiled kernel does not:
-    the joint forces by Newton–Euler (:func:`~transient.reference.joints.crank_slider_joint_forces`, eight linear equations
-    per cylinder) with the friction laws applied to them (:func:`~transient.reference.joints.crank_slider_friction_laws`),
-    iterated to a fixed point. For given friction moments and forces every joint force is affine
-    in φ̈, so each turn takes φ̈ exactly from the shaft's equation J₀ φ̈ = M_shaft + Σ T(φ̈) with
-    the forces at φ̈ = 0 and 1; the friction is a small share of the forces (μ·r/l), so the
+    the joint forces by Newton–Euler
+    (:func:`~transient.reference.joints.crank_slider_joint_forces`, eight linear equations per
+    cylinder) with the friction laws applied to them
+    (:func:`~transient.reference.joints.crank_slider_friction_laws`), iterated to a fixed point.
+    For given friction moments and forces every joint force is affine in φ̈, so each turn takes
+    φ̈ exactly from the shaft's equation J₀ φ̈ = M_shaft + Σ T(φ̈) with the forces at φ̈ = 0
+    and 1; the friction is a small share of the forces (μ·r/l), so the
     turns contract to rounding within a few dozen. The joints' directions are those at the
     segment's angle ``sel``, as the compiled path holds them between breakpoints."""
 
@@ -234,9 +250,9 @@ class ReactionNumpy(ChainNumpy):
 
 class ArticulatedReactionNumpy(ReactionNumpy):
     """Friction on the articulated mechanism's joint reactions for the reference path: φ̈ and the
-    joints' forces by its own Newton–Euler (:func:`~transient.reference.joints.articulated_joint_forces`, the shaft's equation
-    closing the linear system, the friction a fixed point on its forces), not by the kernels'
-    Newton solve; directions at the segment's angle ``sel``, as the compiled path holds them."""
+    joints' forces by its own Newton–Euler
+    (:func:`~transient.reference.joints.articulated_joint_forces`, the shaft's equation closing
+    the linear system, the friction a fixed point on its forces), not by the kernels' Newton solve; directions at the segment's angle ``sel``, as the compiled path holds them."""
 
     def solve_mode(self, inputs, w, sigma, eta):
         """:meth:`ReactionNumpy.solve_mode`: the shaft's equation, which closes the linear
@@ -256,7 +272,8 @@ class ArticulatedReactionNumpy(ReactionNumpy):
 class SwashReactionNumpy(ReactionNumpy):
     """Friction on the swash plate's joint reactions for the reference path: φ̈ and the reactions
     by its Newton–Euler of every body as one linear system, the friction laws closed on them by
-    ``scipy.optimize.fsolve`` (:func:`~transient.reference.joints.swash_plate_friction`), not by the kernels' Newton solve;
+    ``scipy.optimize.fsolve`` (:func:`~transient.reference.joints.swash_plate_friction`), not by
+    the kernels' Newton solve;
     the pistons' directions at the segment's angle ``sel``, as the compiled path holds them. The
     bearings' losses are the engine's, no cylinder's: their columns per cylinder are NaN."""
 
@@ -302,8 +319,8 @@ class CylindersNumpy:
 
     def __init__(self, scene, phases: np.ndarray, period: float, c: int,
                  offsets: np.ndarray) -> None:
-        from ..scene.queries import clearance_volume, wiebe_levels
         from ..forces import closed_cycle, woschni
+        from ..scene.queries import clearance_volume, wiebe_levels
 
         gas, mech = scene.gas, scene.mechanism
         self.fn, self.w, self.c, self.period, self.phases = woschni, gas.wiebe, c, period, phases

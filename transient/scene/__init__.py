@@ -14,9 +14,27 @@ Every key may be written in SI (``crank_radius = 0.047``) or with one unit suffi
 - :mod:`.write`    :func:`~.write.to_toml`, the resolved scene back to TOML
 """
 from .read import load_scene, replace_scene, scene_from_dict
-from .records import (POLICIES, Analysis, Cylinder, Friction, Gas, Governor, Inertia, Initial,
-                      Load, LoadTable, Output, Pair, Run, Scene, Solver, Starter, Wiebe, Woschni,
-                      runs_compiled)
+from .records import (
+                      POLICIES,
+                      Analysis,
+                      Cylinder,
+                      Friction,
+                      Gas,
+                      Governor,
+                      Inertia,
+                      Initial,
+                      Load,
+                      LoadTable,
+                      Output,
+                      Pair,
+                      Run,
+                      Scene,
+                      Solver,
+                      Starter,
+                      Wiebe,
+                      Woschni,
+                      runs_compiled,
+)
 from .write import to_toml
 
 # Scenes from code: the records cannot import their reader (it imports them), so the methods

@@ -33,8 +33,8 @@ def check_consistency(scene: Scene) -> tuple[float, float]:
     except OverflowError:
         area = math.inf
     if not math.isfinite(area):
-        raise SceneError("mechanism.bore", f"the piston area overflows; check the bore and its "
-                                           f"unit (mm: 'bore_mm')")
+        raise SceneError("mechanism.bore", "the piston area overflows; check the bore and its "
+                                           "unit (mm: 'bore_mm')")
     if J.min() <= 0.0:
         at = math.degrees(phi[int(np.argmin(J))])
         raise SceneError("inertia", f"the reduced inertia J(φ) falls to {J.min():.3g} kg m² at "

@@ -109,7 +109,7 @@ def parse_toml(text: str, file: str) -> dict:
 LONG_ARRAY_CHARS = 2000
 #: An array holding numbers, separators and TOML's whitespace only (no comment, no string, no
 #: nested array): its content between the brackets.
-_NUMBER_ARRAY = re.compile(r"\[([0-9eE+\-., \t\r\n]{%d,})\]" % LONG_ARRAY_CHARS)
+_NUMBER_ARRAY = re.compile(rf"\[([0-9eE+\-., \t\r\n]{{{LONG_ARRAY_CHARS},}})\]")
 def _numbers_apart(text: str) -> dict | None:
     """``text`` parsed as tomllib parses it, its long arrays of plain numbers read apart: each
     is replaced by a placeholder string, the numbers are converted as tomllib converts them

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import re
 
-from .queries import gas_is_force, governor_kind, reaction_friction
 from ..core.model import governor as gv
 from ..core.model.layout import OUTPUT_UNITS, OUTPUTS, PAIR_OUTPUT_UNITS, PAIR_OUTPUTS
+from .queries import gas_is_force, governor_kind, reaction_friction
 
 
 def output_columns(scene) -> dict[str, str]:

@@ -13,20 +13,47 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..errors import SceneError
+from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
 from ..mechanisms import MECHANISMS, reaction_joints
 from ..mechanisms.articulated import slave_reach
 from ..units import ALL_SUFFIXES
 from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table, check_magnitudes
-from .files import parse_toml, read_text, table_number, table_rows
 from .eta_map import check_map, grid_from_points
+from .files import parse_toml, read_text, table_number, table_rows
 from .reader import MISSING, Named, Section, finite_number, show_value
-from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
-from .records import (DEFAULT_MAX_OUTPUT_BYTES, DEFAULT_MAX_STEPS, DETREND, GOVERNOR_KEYS,
-                      MAX_COMBUSTION_OFFSET, MAX_CYLINDER_FACTOR, MAX_GAMMA, MAX_SAMPLES_PER_REV,
-                      METHODS, MIN_OUTPUT_DT, MIN_WIEBE_STEP, PAIR_MODELS, POLICIES, Analysis,
-                      Cylinder, Friction, Gas, Governor, Inertia, Initial, Load, LoadTable, Output,
-                      Pair, Run, Scene, Solver, Starter, Wiebe, Woschni)
+from .records import (
+    DEFAULT_MAX_OUTPUT_BYTES,
+    DEFAULT_MAX_STEPS,
+    DETREND,
+    GOVERNOR_KEYS,
+    MAX_COMBUSTION_OFFSET,
+    MAX_CYLINDER_FACTOR,
+    MAX_GAMMA,
+    MAX_SAMPLES_PER_REV,
+    METHODS,
+    MIN_OUTPUT_DT,
+    MIN_WIEBE_STEP,
+    PAIR_MODELS,
+    POLICIES,
+    Analysis,
+    Cylinder,
+    Friction,
+    Gas,
+    Governor,
+    Inertia,
+    Initial,
+    Load,
+    LoadTable,
+    Output,
+    Pair,
+    Run,
+    Scene,
+    Solver,
+    Starter,
+    Wiebe,
+    Woschni,
+)
 from .write import to_toml
 
 

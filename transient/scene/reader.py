@@ -9,10 +9,11 @@ is allowed.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
-from typing import Any, Callable, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -43,12 +44,12 @@ class Key:
     or_zero: bool = False
 
 
-_LISTENER: ContextVar[Callable[["Section", Key], None] | None] = ContextVar("scene_key_listener",
+_LISTENER: ContextVar[Callable[[Section, Key], None] | None] = ContextVar("scene_key_listener",
                                                                            default=None)
 
 
 @contextmanager
-def listening(callback: Callable[["Section", Key], None]) -> Iterator[None]:
+def listening(callback: Callable[[Section, Key], None]) -> Iterator[None]:
     """Within the block, ``callback(section, key)`` hears every key any :class:`Section` asks
     for, before it is read (the key reference is built from this: :mod:`.keyref`)."""
     token = _LISTENER.set(callback)
@@ -269,7 +270,7 @@ class Section:
                                                 f"{show_value(value)}")
         return tuple(value)
 
-    def sub(self, name: str, required: bool = False) -> "Section":
+    def sub(self, name: str, required: bool = False) -> Section:
         self._ask("table", name, default=MISSING if required else None)
         self.known.append(name)
         if name not in self.data:
@@ -281,7 +282,7 @@ class Section:
         self.subs[name] = child
         return child
 
-    def tables(self, name: str) -> list["Section"]:
+    def tables(self, name: str) -> list[Section]:
         """The array of tables ``[[name]]`` under this table, a :class:`Section` each ([] if
         absent)."""
         self._ask("tables", name, default=())

@@ -23,8 +23,8 @@ import math
 from ..analysis.efficiency import mechanical_efficiency
 from ..analysis.summary import nan_reason
 from ..plots import friction_budget, sweep_heatmap
-from ..scene import Friction, Governor, Initial, Output, Run
 from ..run import prescribed
+from ..scene import Friction, Governor, Initial, Output, Run
 
 #: Columns of a study row besides the per-pair ones.
 STUDY_COLUMNS = ("policy", "fuel", "rpm", "eta_mech_work", "eta_mech_printed",
@@ -85,7 +85,7 @@ def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
     their markers) on ``ax_eta``; for the first policy at its largest fuel, each pair's loss [% of
     W_in] on ``ax_loss`` and the energy it circulates [× W_in] on a twin axis. Returns the artists."""
     keys = sorted({(r["policy"], r["fuel"]) for r in rows}, key=lambda k: (k[0], -k[1]))
-    styles = {p: s for p, s in zip(sorted({k[0] for k in keys}), (("o", "-"), ("x", "--")))}
+    styles = dict(zip(sorted({k[0] for k in keys}), (("o", "-"), ("x", "--"))))
     artists = []
     for policy, fuel in keys:
         sel = [r for r in rows if r["policy"] == policy and r["fuel"] == fuel]

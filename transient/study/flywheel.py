@@ -106,8 +106,8 @@ class FlywheelResult:
 def _constant_speed(scene, speed: float, samples: int):
     """Inverse dynamics over one engine cycle at constant ``speed``: (φ, M_e, J) with
     M_e = −M_drive the engine torque on the constant-inertia part (module docstring)."""
-    from ..scene import Run
     from ..run import prescribed
+    from ..scene import Run
 
     cycle = scene.mechanism.cycle
     s = replace(scene, run=Run(mode="prescribed-speed", speed=speed,
@@ -154,8 +154,8 @@ def _steady_run(scene, flywheel: float, speed: float, phi, E, J_scene, revolutio
                 ) -> FlywheelIteration:
     """Run ``scene`` with ``flywheel`` from the closed-form speed at its initial angle; δ of the
     last two cycles."""
-    from ..scene import Initial, Run
     from ..run import integrate
+    from ..scene import Initial, Run
 
     cycle, phi0 = scene.mechanism.cycle, scene.initial.phi
     J = J_scene + (flywheel - scene.inertia.flywheel)

@@ -9,8 +9,17 @@
   run again, it mends the file, reusing every stored run whose resolved scene is unchanged.
 """
 from .execute import Outcome, kernel_loads, run_one, run_sweep, worker_info
-from .spec import (DEFAULT_COLLECT, METHODS, QUANTITIES, SPACINGS, Axis, RunSpec, Sweep,
-                   load_sweep, set_key)
+from .spec import (
+                   DEFAULT_COLLECT,
+                   METHODS,
+                   QUANTITIES,
+                   SPACINGS,
+                   Axis,
+                   RunSpec,
+                   Sweep,
+                   load_sweep,
+                   set_key,
+)
 from .store import SweepStore, SweepTable, open_run, read_summary
 
 __all__ = [

@@ -26,7 +26,6 @@ from ..version import __version__
 from .spec import RunSpec, Sweep
 from .store import SweepStore
 
-
 # ------------------------------------------------------------------------------------------------
 # A worker's part: one run, arrays back to the client
 
@@ -59,7 +58,7 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
             out["summary"] = {**summarize(scene, data.trajectory, data.events), **data.summary}
         out["status"] = data.status
         out["message"] = data.message
-    except Exception as exc:  # noqa: BLE001 (this run failed: say so, the sweep goes on)
+    except Exception as exc:
         out["message"] = f"{type(exc).__name__}: {exc}"
     out["wall_s"] = time.perf_counter() - t0
     return out
@@ -175,7 +174,7 @@ def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int |
                 spec = futures.pop(fut)
                 try:
                     res = fut.result()
-                except Exception as exc:  # noqa: BLE001 (a lost worker or task: this run only)
+                except Exception as exc:
                     res = _lost(exc)
                 fut.release()
                 yield spec, res
@@ -301,7 +300,7 @@ class _client:
                                                 f"scheduler") from None
         try:
             info = self.client.run(worker_info)
-        except Exception as exc:  # noqa: BLE001 (whatever the workers raise, said in one line)
+        except Exception as exc:
             self.__exit__(None, None, None)
             raise SceneError("--scheduler", f"the workers cannot import transient ({exc}); "
                                             f"install it in the workers' environment") from None

@@ -88,7 +88,8 @@ class SweepStore:
     ``solver`` attributes; ``analysis/<name>``, the run's summary, with ``unit``), with the
     sweep's attributes ``index``, ``params`` (JSON), ``scene_toml`` (the resolved scene, by which
     a run is reused), ``worker``, ``wall_s`` and ``status`` (the run's, as a result's:
-    ``finished``, ``stalled``, …, ``failed``; written last: a group without it is unfinished); ``/unused/scene_<hash>`` finished runs the sweep no longer
+    ``finished``, ``stalled``, …, ``failed``; written last: a group without it is unfinished);
+    ``/unused/scene_<hash>`` finished runs the sweep no longer
     holds, in the same form (kept, so that no computed run is lost, and reused if the sweep
     holds their scene again); ``/analysis/summary`` the table of collected quantities
     (attribute ``units``, JSON).
@@ -249,7 +250,7 @@ class SweepStore:
     def summary(self) -> tuple[list[dict[str, Any]], dict[str, str]]:
         """The summary rows (run order) and the units of their columns, from the stored runs."""
         units = {"run": "", "status": "", **{a.key: _suffix_unit(a.key) for a in self.sweep.axes},
-                 **{q: "" for q in self.sweep.collect}}
+                 **dict.fromkeys(self.sweep.collect, "")}
         rows = []
         for spec in self.sweep.runs:
             g = self.f["runs"].get(self.group_name(spec.index))

@@ -40,8 +40,8 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ..errors import SimulationError
-from ..scene import load_scene
 from ..run import integrate
+from ..scene import load_scene
 
 _CASES = Path(__file__).resolve().parents[2] / "cases"
 #: Benchmark scenes: the single-cylinder crank (equation (18) alone), the Gots diesel with

@@ -12,10 +12,17 @@ import numba as nb
 import numpy as np
 
 from ..core.model.forcing import governor_branch
-from ..core.model.layout import (N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_GOVERNOR, extras_of,
-                                 n_state)
-from ..core.model.work import work_array
+from ..core.model.layout import (
+    N_SWITCHES,
+    OMEGA,
+    PHI,
+    SW_DIRECTION,
+    SW_GOVERNOR,
+    extras_of,
+    n_state,
+)
 from ..core.model.rhs import choose_modes, derivative
+from ..core.model.work import work_array
 
 # CyRK's callback signature: dy (double*), t, y (double*), args (double*).
 SIGNATURE = nb.types.void(nb.types.CPointer(nb.types.float64), nb.types.float64,

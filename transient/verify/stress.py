@@ -36,9 +36,9 @@ import resource
 import time
 import tomllib
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -145,7 +145,7 @@ class Case:
 
     name: str
     probes: str
-    run: Callable[[bool, "Context"], Outcome]
+    run: Callable[[bool, Context], Outcome]
     quick: bool = True
     time_limit: float = 60.0  # [s], quick and full alike unless full_time_limit is set
     full_time_limit: float | None = None
@@ -591,7 +591,7 @@ def tolerance_ladder(quick: bool, ctx: Context) -> Outcome:
     o = Outcome()
     rtols = [10.0 ** -k for k in range(3, 10 if quick else 13)]
     for domain in ("auto", "time"):
-        def build(rtol, **solver):
+        def build(rtol, domain=domain, **solver):
             d = put(spinup(10 if quick else 40), "output", dt=1e-4)  # the time-domain grid
             return put(d, "solver", rtol=rtol, atol=rtol * 1e-2, domain=domain, **solver)
 
@@ -1105,7 +1105,7 @@ def catalogue() -> list[Case]:
 def _child(case: Case, quick: bool, out: str, soft: float, conn) -> None:
     try:
         o = case.run(quick, Context(Path(out), time.monotonic() + soft))
-    except BaseException as exc:  # noqa: BLE001 — a crash is a result to report
+    except BaseException as exc:
         o = Outcome(ok=False, status="error", notes=[f"{type(exc).__name__}: {exc}".splitlines()[0],
                                            traceback.format_exc().splitlines()[-1]])
     conn.send(o)

@@ -42,15 +42,27 @@ from numba import njit
 
 from ..assemble import build_model
 from ..core import CACHE_DIR_VARIABLE
-from .bench import (ADAPTIVE, BASELINE_BUDGET_S, BENCH_SCENES, DEFAULT, SAME_STEPS, SAMPLES_PER_REV,
-                    TARGET_PHASE, at_target, fastest_as_accurate, loose_to_tight, on_plateau,
-                    order_slope, read_record)
-from ..core.model import layout, work
 from ..core.jit import kernel
+from ..core.model import layout, work
 from ..core.model.rhs import derivative
 from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
+from .bench import (
+    ADAPTIVE,
+    BASELINE_BUDGET_S,
+    BENCH_SCENES,
+    DEFAULT,
+    SAME_STEPS,
+    SAMPLES_PER_REV,
+    TARGET_PHASE,
+    at_target,
+    fastest_as_accurate,
+    loose_to_tight,
+    on_plateau,
+    order_slope,
+    read_record,
+)
 from .models_out import WITHOUT_FRICTION, friction_models_cost
 
 #: Right-hand sides per DOP853 step. The stepper picks each cylinder's gas table piece once per
@@ -205,7 +217,7 @@ def make_hand_rhs(layout=False, loads=False, records=False):
         if layout:
             sp, cp = math.sin(y[0]), math.cos(y[0])
             m_slide, m_rot = p[10] + p[11], p[12] + p[13]
-            for k in range(int(p[16])):
+            for _ in range(int(p[16])):
                 sa, ca = sp * p[15] - cp * p[14], cp * p[15] + sp * p[14]
                 sb = (r * sa - p[9]) / l
                 cb = math.sqrt(1.0 - sb * sb)

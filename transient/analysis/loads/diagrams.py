@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..irregularity import last_cycle_window
+from ..wear import angle_weights, wear_rays
 from .articulated import ArticulatedLoads, articulated_loads_from_trajectory
 from .crank_slider import (
     CylinderLoads,
@@ -25,7 +26,6 @@ from .crank_slider import (
     main_journal_loads,
     running_torques,
 )
-from ..wear import angle_weights, wear_rays
 
 Array = NDArray[np.float64]
 

@@ -9,7 +9,6 @@ The event function is passed as a kernel, ``g(ctx, y)``, the value at the state 
 from __future__ import annotations
 
 from ..jit import kernel
-
 from .rk import dense_eval, dense_state
 
 #: Iterations of the Illinois method at most, and the bracket's width in θ that ends them.

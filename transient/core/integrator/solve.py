@@ -13,7 +13,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import compiled
-
 from .rk import accepted_size, dense, dense_state, error_norm, shrink, step
 from .roots import crosses, root
 

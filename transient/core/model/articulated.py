@@ -26,8 +26,8 @@ from __future__ import annotations
 
 from math import cos, sin, sqrt
 
-from .crank_slider import L, R, cylinder_terms, slider
 from ..jit import kernel
+from .crank_slider import L, R, cylinder_terms, slider
 
 #: Layout of ``mp`` (filled by ``transient.mechanisms.articulated.Articulated.pack``). Slots 0–9
 #: are the crank-slider header of the master cylinder (``transient.core.model.crank_slider``: R, L,

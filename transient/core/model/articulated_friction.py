@@ -83,14 +83,47 @@ import numpy as np
 
 from ..declare import Layout
 from ..jit import kernel
-
-from .articulated import (COS_D, LINK_A, LINK_Q, N_ROWS, N_SLAVES, SIN_D, SLAVE0, SLAVE_CG, SLAVE_I,
-                          SLAVE_L, SLAVE_PISTON, SLAVE_ROD, SLAVE_STRIDE, master_rod, row0, slave)
-from .crank_slider import I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, R, ROD_CG
-from .joint_friction import (MAX_ITER, R_LOSS, R_P, SHARED, TOL, _norm, _slope, clear_pairs, newton_step,
-                             pair_efficiencies)
-from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS,
-                     WK_CYL_LOSS, WK_RX, WK_S)
+from .articulated import (
+    COS_D,
+    LINK_A,
+    LINK_Q,
+    N_ROWS,
+    N_SLAVES,
+    SIN_D,
+    SLAVE0,
+    SLAVE_CG,
+    SLAVE_I,
+    SLAVE_L,
+    SLAVE_PISTON,
+    SLAVE_ROD,
+    SLAVE_STRIDE,
+    master_rod,
+    row0,
+    slave,
+)
+from .crank_slider import I_ROD, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, ROD_CG, L, R
+from .joint_friction import (
+    MAX_ITER,
+    R_LOSS,
+    R_P,
+    SHARED,
+    TOL,
+    _norm,
+    _slope,
+    clear_pairs,
+    newton_step,
+    pair_efficiencies,
+)
+from .layout import (
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    WK_CYL_LOSS,
+    WK_RX,
+    WK_S,
+)
 
 #: The joints (rows of ``Model.rx_par``): main bearing, master crankpin, link pins, master piston
 #: pin, slave piston pins, pistons in their cylinders.

@@ -21,15 +21,16 @@ rest cools). The equations and their sources are those of :mod:`transient.forces
 
 Outside the closed part the pressure is the gas-exchange table's (the same for every fuel) and
 the state is held. A shaft that turns backwards is not modelled for these states (no valve runs
-backwards): the closed part restarts at p_a whenever the shaft is on an intake closing. Crank-slider only: V = V_c + F_p·s(x) from the exact kinematics, and
+backwards): the closed part restarts at p_a whenever the shaft is on an intake closing.
+Crank-slider only: V = V_c + F_p·s(x) from the exact kinematics, and
 dV/dφ = F_p·u_k, the transfer function the mechanism kernel has already computed.
 """
 from __future__ import annotations
 
 import math
 
-from .crank_slider import E, L, R, slider
 from ..jit import kernel
+from .crank_slider import E, L, R, slider
 
 #: Layout of ``Model.cyl_par`` (filled by ``transient.assemble.cylinder_fields``): intake
 #: closing (local angle), length of the closed part, combustion start after IVC and duration

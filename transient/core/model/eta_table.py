@@ -47,7 +47,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-
 from .chain import chain_solve
 
 #: Newton's stopping level, in units of |a| + B (module docstring): a few ulps.

@@ -15,19 +15,44 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-
 from . import cylinder as cyl
 from . import governor as gv
+from . import reactions as rx
 from .articulated import articulated_terms
 from .crank_slider import crank_slider_terms
-from . import reactions as rx
-from .layout import (ARTICULATED, CRANK_SLIDER, KINETIC, LT_ANGLE, LT_NONE, LT_SPEED, OMEGA, PHI,
-                     SW_GENERATOR, SW_GOVERNOR, SW_LOAD, SW_SLEEVE, SW_STARTER, T, TABULATED,
-                     WK_DEMAND, WK_DU, WK_FUEL, WK_LOCAL, WK_LOCAL_SHIFT, WK_PIECE, WK_PIECE_SHIFT,
-                     WK_RX, WK_SEL, WK_U, cyl_index, gov_index, latch_index)
+from .layout import (
+    ARTICULATED,
+    CRANK_SLIDER,
+    KINETIC,
+    LT_ANGLE,
+    LT_NONE,
+    LT_SPEED,
+    OMEGA,
+    PHI,
+    SW_GENERATOR,
+    SW_GOVERNOR,
+    SW_LOAD,
+    SW_SLEEVE,
+    SW_STARTER,
+    TABULATED,
+    WK_DEMAND,
+    WK_DU,
+    WK_FUEL,
+    WK_LOCAL,
+    WK_LOCAL_SHIFT,
+    WK_PIECE,
+    WK_PIECE_SHIFT,
+    WK_RX,
+    WK_SEL,
+    WK_U,
+    T,
+    cyl_index,
+    gov_index,
+    latch_index,
+)
 from .swash_plate import swash_terms
-from .tabulated import tabulated_terms
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
+from .tabulated import tabulated_terms
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
 

@@ -10,18 +10,43 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import compiled, kernel
-
-from .forcing import (fuel, generator_branch, governor_branch, load_segment, moments,
-                      speed_knot_segment)
-from .layout import (COL_EPS, N_SWITCHES, OMEGA, PHI, POWER_FLOW, SW_GENERATOR,
-                     SW_GOVERNOR, SW_LOAD, SW_LOAD_TABLE, T, W_LOSS0, WK_DJ, WK_ETA, WK_ETA_TRY,
-                     WK_J, WK_M, WK_S, WK_S_TRY, cylinder_loss_col, latch_index, n_state,
-                     pair_col)
-from .work import work_array
 from .eta_table import invert
-from .reactions import inverse_drive
+from .forcing import (
+    fuel,
+    generator_branch,
+    governor_branch,
+    load_segment,
+    moments,
+    speed_knot_segment,
+)
+from .layout import (
+    COL_EPS,
+    N_SWITCHES,
+    OMEGA,
+    PHI,
+    POWER_FLOW,
+    SW_GENERATOR,
+    SW_GOVERNOR,
+    SW_LOAD,
+    SW_LOAD_TABLE,
+    W_LOSS0,
+    WK_DJ,
+    WK_ETA,
+    WK_ETA_TRY,
+    WK_J,
+    WK_M,
+    WK_S,
+    WK_S_TRY,
+    T,
+    cylinder_loss_col,
+    latch_index,
+    n_state,
+    pair_col,
+)
 from .outputs import cylinder_loss_rows, output_row, pair_rows
+from .reactions import inverse_drive
 from .rhs import pair_etas, split_subchains
+from .work import work_array
 
 
 @kernel

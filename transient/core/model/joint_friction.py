@@ -88,11 +88,37 @@ import numpy as np
 
 from ..declare import Layout
 from ..jit import kernel
-
-from .crank_slider import (E, I_ROD, L, M_CRANK, M_CRANKPIN, M_PIN, M_PISTON, M_ROD, N_CYL, R,
-                           ROD_CG, SIN0, rod_and_piston, rod_and_piston_second)
-from .layout import (JOINT_CRANKPIN, JOINT_MAIN, JOINT_PIN, JOINT_SLIDER, RX_MU, RX_RADIUS,
-                     RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS, WK_ETA, WK_RX, WK_S)
+from .crank_slider import (
+    I_ROD,
+    M_CRANK,
+    M_CRANKPIN,
+    M_PIN,
+    M_PISTON,
+    M_ROD,
+    N_CYL,
+    ROD_CG,
+    SIN0,
+    E,
+    L,
+    R,
+    rod_and_piston,
+    rod_and_piston_second,
+)
+from .layout import (
+    JOINT_CRANKPIN,
+    JOINT_MAIN,
+    JOINT_PIN,
+    JOINT_SLIDER,
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    WK_CYL_LOSS,
+    WK_ETA,
+    WK_RX,
+    WK_S,
+)
 
 #: The rows from ``layout.WK_RX`` that every reaction solver shares, so that its callers fill
 #: and read them alike: each piston's gas force P (filled by :func:`.forcing.moments`), the step's

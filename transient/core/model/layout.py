@@ -20,8 +20,8 @@ import numpy as np
 
 from ..declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED, Block, Layout, Sized
 from ..jit import kernel
-
 from . import governor as gv
+
 
 @kernel(inline=True)
 def n_losses(m):

@@ -9,12 +9,28 @@ stepper's grid samples and as a call for the rows written at events.
 from __future__ import annotations
 
 from ..jit import kernel
-
-from .reactions import loss_moment
 from .forcing import command, cylinder_value, moments
-from .layout import (N_OUT_FIXED, PAIR_OUTPUTS, PHI, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER,
-                     WK_CYL_LOSS, WK_ETA, WK_FUEL, WK_S, cyl_index, cylinder_loss_col, gov_index,
-                     governor_col, latch_index, pair_col)
+from .layout import (
+    N_OUT_FIXED,
+    PAIR_OUTPUTS,
+    PHI,
+    W_GAS,
+    W_LOAD,
+    W_LOSS0,
+    W_STARTER,
+    WK_CYL_LOSS,
+    WK_ETA,
+    WK_FUEL,
+    WK_S,
+    T,
+    cyl_index,
+    cylinder_loss_col,
+    gov_index,
+    governor_col,
+    latch_index,
+    pair_col,
+)
+from .reactions import loss_moment
 from .rhs import acceleration
 from .variation import PRESSURE
 

@@ -50,14 +50,21 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-
-from .chain import LOCKED, UNIQUE
 from . import articulated_friction as af
 from . import eta_table as et
 from . import joint_friction as jf
 from . import swash_friction as sf
-from .layout import (ARTICULATED, RX_ETA_BWD, RX_ETA_FWD, SWASH_PLATE, WK_CYL_LOSS, WK_ETA, WK_RX,
-                     WK_S)
+from .chain import LOCKED, UNIQUE
+from .layout import (
+    ARTICULATED,
+    RX_ETA_BWD,
+    RX_ETA_FWD,
+    SWASH_PLATE,
+    WK_CYL_LOSS,
+    WK_ETA,
+    WK_RX,
+    WK_S,
+)
 
 #: Rows (offsets from ``layout.WK_RX``) every mechanism's solver shares: the gas force on each
 #: piston, the pairs' loss moments (``joint_friction.SHARED``).

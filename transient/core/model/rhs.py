@@ -11,18 +11,41 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-
-from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
-from . import governor as gv
 from . import eta_table as et
+from . import governor as gv
 from . import joint_friction as jf
 from . import reactions as rx
 from . import stuck as st
-from .swash_plate import link_terms as swash_link_terms
+from .chain import LOCKED, UNIQUE, chain_solve, eta_star, modes_power_flow_into
 from .forcing import command, cylinder_rates, governor_rates, moments
-from .layout import (KINETIC, LINK_FIXED, LINK_PISTONS, OMEGA, PHI, POWER_FLOW, SW_DIRECTION,
-                     SW_MODES, T, W_GAS, W_LOAD, W_LOSS0, W_STARTER, WK_DJ, WK_DU, WK_ETA, WK_G,
-                     WK_G_MIN, WK_J, WK_M, WK_S, WK_SCRATCH, WK_SPEED, WK_U, N_SCRATCH)
+from .layout import (
+    KINETIC,
+    LINK_FIXED,
+    LINK_PISTONS,
+    N_SCRATCH,
+    OMEGA,
+    PHI,
+    POWER_FLOW,
+    SW_DIRECTION,
+    SW_MODES,
+    W_GAS,
+    W_LOAD,
+    W_LOSS0,
+    W_STARTER,
+    WK_DJ,
+    WK_DU,
+    WK_ETA,
+    WK_G,
+    WK_G_MIN,
+    WK_J,
+    WK_M,
+    WK_S,
+    WK_SCRATCH,
+    WK_SPEED,
+    WK_U,
+    T,
+)
+from .swash_plate import link_terms as swash_link_terms
 
 
 @kernel(inline=True)

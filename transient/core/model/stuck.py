@@ -23,7 +23,8 @@ is continuous and strictly decreasing in a (``chain``, the proof of uniqueness, 
 (``eta_table``); for reaction pairs it is the solution of the joints' equations
 (``reactions.acceleration``) at ω = 0, where every friction term is a magnitude that varies
 continuously with the forces. So g falls through zero at the instant the drive exceeds the
-holding moment in one direction, and the stepper locates that instant as it locates a pair's mode switch (a margin falling to zero, to the
+holding moment in one direction, and the stepper locates that instant as it locates a pair's
+mode switch (a margin falling to zero, to the
 root finder's accuracy on the dense output); the pair margins' slot 0 carries g, the others a
 constant 1 that never falls. At the release the direction is the one whose margin crossed (the
 lower of −a₊, a₋) and the modes are chosen afresh for it.
@@ -40,12 +41,11 @@ the moments (:func:`can_change`); elsewhere nothing could release it and the run
 from __future__ import annotations
 
 from ..jit import kernel
-
-from .chain import _best_candidate
 from . import eta_table as et
 from . import governor as gv
 from . import reactions as rx
-from .layout import (LT_TIME, SW_LOAD, T, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S, WK_SCRATCH)
+from .chain import _best_candidate
+from .layout import LT_TIME, SW_LOAD, WK_DJ, WK_ETA, WK_G, WK_J, WK_M, WK_RX, WK_S, WK_SCRATCH, T
 
 #: ``sw[SW_DIRECTION]`` while the machine is stuck (±1 while it moves).
 STUCK = 0

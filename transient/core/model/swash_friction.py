@@ -106,13 +106,46 @@ import numpy as np
 
 from ..declare import Layout
 from ..jit import kernel
-
-from .joint_friction import (MAX_ITER, R_LOSS, R_P, R_SEL, SHARED, TOL, _norm, _slope, clear_pairs,
-                             newton_step, pair_efficiencies)
-from .layout import (RX_MU, RX_RADIUS, RX_RING_FORCE, RX_RING_PRESSURE, RX_VISCOUS, WK_CYL_LOSS,
-                     WK_RX, WK_S)
-from .swash_plate import (COS_A, HALVES, HINGE_PHASE, I_CROSS, I_ROD, J_DIAM, J_POLAR, M_PISTON,
-                          M_ROD, N_CYL, ROD_CG, ROD_L, SIN_A, link_motion, rod_motion)
+from .joint_friction import (
+    MAX_ITER,
+    R_LOSS,
+    R_P,
+    R_SEL,
+    SHARED,
+    TOL,
+    _norm,
+    _slope,
+    clear_pairs,
+    newton_step,
+    pair_efficiencies,
+)
+from .layout import (
+    RX_MU,
+    RX_RADIUS,
+    RX_RING_FORCE,
+    RX_RING_PRESSURE,
+    RX_VISCOUS,
+    WK_CYL_LOSS,
+    WK_RX,
+    WK_S,
+)
+from .swash_plate import (
+    COS_A,
+    HALVES,
+    HINGE_PHASE,
+    I_CROSS,
+    I_ROD,
+    J_DIAM,
+    J_POLAR,
+    M_PISTON,
+    M_ROD,
+    N_CYL,
+    ROD_CG,
+    ROD_L,
+    SIN_A,
+    link_motion,
+    rod_motion,
+)
 
 #: The swash plate's joints (rows of ``Model.rx_par``), in the order of its ``reaction_links``:
 #: the main bearing (frame – shaft), the plate bearing (plate – link 9), the ball joints B_k

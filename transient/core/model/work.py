@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import compiled
-
 from . import articulated_friction as af
 from . import joint_friction as jf
 from . import swash_friction as sf

@@ -7,18 +7,29 @@ and the derivative carried over from the last step may be stale (:func:`_at_brea
 """
 from __future__ import annotations
 
-import numpy as np
-
-from ..jit import kernel
-
 from ..integrator.breakpoints import count_below, next_breakpoint
+from ..jit import kernel
 from ..model import cylinder as cyl
-from .events import _crossing, _dense_once, _load_corner
 from ..model.forcing import command, inertia, speed
 from ..model.layout import OMEGA, PHI, cyl_index, latch_index
-from .io import (C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI, C_MAX_STEP_T, C_PHI_END, C_T_END,
-                 EV_INJECTION, F_PASSED_BP, F_REDO_LEVEL, I_ANGLE_MODE, I_NREDO,
-                 MAX_OUTPUT_INTERVALS, Segment, _emit_event, _retake)
+from .events import _crossing, _dense_once, _load_corner
+from .io import (
+    C_DPHI_OUT,
+    C_DT_OUT,
+    C_MAX_STEP_PHI,
+    C_MAX_STEP_T,
+    C_PHI_END,
+    C_T_END,
+    EV_INJECTION,
+    F_PASSED_BP,
+    F_REDO_LEVEL,
+    I_ANGLE_MODE,
+    I_NREDO,
+    MAX_OUTPUT_INTERVALS,
+    Segment,
+    _emit_event,
+    _retake,
+)
 
 # In time, a breakpoint counts as passed once a step has ended within this angle of it [rad]
 # (a retaken step lands on it only to the accuracy of the dense output).

@@ -15,19 +15,47 @@ from __future__ import annotations
 import numpy as np
 
 from ..declare import Layout
-from ..jit import kernel
-
-from ..model.chain import MAX_PAIRS
-from ..model import governor as gv
-from ..model.forcing import demand, inertia, is_pi, speed
-from ..model.layout import (LT_SPEED, OMEGA, PHI, SW_LOAD, SW_LOAD_TABLE, SW_SLEEVE, SW_STARTER, T,
-                            WK_DEMAND, WK_G, WK_G_MIN, gov_index)
 from ..integrator.rk import dense, dense_state
 from ..integrator.roots import crosses, crossing_inside, fall_after_rise, root
+from ..jit import kernel
+from ..model import governor as gv
+from ..model.chain import MAX_PAIRS
+from ..model.forcing import demand, inertia, is_pi, speed
+from ..model.layout import (
+    LT_SPEED,
+    OMEGA,
+    PHI,
+    SW_LOAD,
+    SW_LOAD_TABLE,
+    SW_SLEEVE,
+    SW_STARTER,
+    WK_DEMAND,
+    WK_G,
+    WK_G_MIN,
+    T,
+    gov_index,
+)
 from ..model.rhs import margins_at, margins_inline, model_rhs
-from .io import (C_PHI_END, C_T_END, C_W_HI, C_W_LO, EV_END, EV_GENERATOR, EV_GOVERNOR, EV_LOAD,
-                 EV_LOAD_KNOT, EV_PAIR_MODE, EV_REVERSAL, EV_SLEEVE_FREE, EV_SLEEVE_STOP,
-                 EV_STARTER_CUTOUT, EV_TO_ANGLE, EV_TO_TIME, I_AT_EVENT, I_NFEV)
+from .io import (
+    C_PHI_END,
+    C_T_END,
+    C_W_HI,
+    C_W_LO,
+    EV_END,
+    EV_GENERATOR,
+    EV_GOVERNOR,
+    EV_LOAD,
+    EV_LOAD_KNOT,
+    EV_PAIR_MODE,
+    EV_REVERSAL,
+    EV_SLEEVE_FREE,
+    EV_SLEEVE_STOP,
+    EV_STARTER_CUTOUT,
+    EV_TO_ANGLE,
+    EV_TO_TIME,
+    I_AT_EVENT,
+    I_NFEV,
+)
 
 # Event "components" at and above PAIR_COMP are the mode margins of the pairs (rhs.mode_margins);
 # DEMAND_COMP is the PI governor's demand u (forcing.demand).

@@ -14,14 +14,25 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..jit import kernel
-
-from ..model.forcing import inertia, speed
 from ..declare import Block, Layout, Sized
-from ..model.layout import (N_SWITCHES, PHI, SW_DIRECTION, SW_GENERATOR, SW_GOVERNOR, SW_LOAD,
-                            SW_LOAD_TABLE, SW_MODES, SW_SLEEVE, SW_STARTER, STATE, T)
-from ..model.outputs import output_row, output_row_inline
 from ..integrator.rk import dense_eval
+from ..jit import kernel
+from ..model.forcing import inertia, speed
+from ..model.layout import (
+    N_SWITCHES,
+    PHI,
+    STATE,
+    SW_DIRECTION,
+    SW_GENERATOR,
+    SW_GOVERNOR,
+    SW_LOAD,
+    SW_LOAD_TABLE,
+    SW_MODES,
+    SW_SLEEVE,
+    SW_STARTER,
+    T,
+)
+from ..model.outputs import output_row, output_row_inline
 
 #: ``cfg``, the run's settings (float64, filled by ``transient.run``): the tolerances, the ends of
 #: the run in time and in angle, the switch speeds from crank angle to time and back, the output

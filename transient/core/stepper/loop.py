@@ -2,7 +2,8 @@
 between breakpoints, with state events located on the dense output (docs/theory.md, Steppers;
 Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
 
-One loop for every pair in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5), passed as data; adaptive, or with
+One loop for every pair in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5), passed
+as data; adaptive, or with
 fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).
 While ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint,
 so the right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal)
@@ -48,36 +49,142 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..integrator.rk import accepted_size, dense_eval, error_norm, shrink, step, stiffness
 from ..jit import compiled, kernel
-
-from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
+from ..model import governor as gv
+from ..model import stuck as st
 from ..model.chain import AMBIGUOUS, NONE_CONSISTENT
 from ..model.chain import LOCKED as LOCKED_STATUS
-from .events import (DEMAND_COMP, MAX_UNSEEN, N_MARGIN_SAMPLES, PAIR_COMP, _dense_once, _event_g,
-                     _locate_events, _root, _sleeve_stops)
-from ..model import governor as gv
-from ..model.forcing import (generator_branch, governor_branch, inertia, load_segment, moments,
-                             speed, speed_knot_segment, start_branch)
-from ..model.layout import (KINETIC, N_SWITCHES, OMEGA, PHI, SW_DIRECTION, SW_MODES, T, WK_DEMAND,
-                            WK_G, WK_G_MIN, WK_SPEED, gov_index, n_state,
-                            state_control)
+from ..model.forcing import (
+    generator_branch,
+    governor_branch,
+    inertia,
+    load_segment,
+    moments,
+    speed,
+    speed_knot_segment,
+    start_branch,
+)
+from ..model.layout import (
+    KINETIC,
+    N_SWITCHES,
+    OMEGA,
+    PHI,
+    SW_DIRECTION,
+    SW_MODES,
+    WK_DEMAND,
+    WK_G,
+    WK_G_MIN,
+    WK_SPEED,
+    T,
+    gov_index,
+    state_control,
+)
+from ..model.rhs import (
+    choose_modes,
+    derivative,
+    kink_in_attempt,
+    margins_at,
+    model_rhs,
+    release,
+    reset_kinks,
+    watches_kinks,
+)
 from ..model.work import work_array
-from ..model.rhs import (choose_modes, derivative, kink_in_attempt, margins_at, model_rhs,
-                         release, reset_kinks, watches_kinks)
-from ..model import stuck as st
-from ..integrator.rk import accepted_size, dense_eval, error_norm, shrink, step, stiffness
-from .io import (C_ATOL, C_CHUNK_STEPS, C_DPHI_OUT, C_FIXED_STEP, C_DT_OUT, C_PHI_END, C_RTOL,
-                 C_T_END, C_W_HI, CHATTERING, EV_BREAKPOINT, EV_END, EV_GENERATOR, EV_GOVERNOR,
-                 EV_LOAD, EV_LOAD_KNOT, EV_PAIR_MODE, EV_RELEASED, EV_REVERSAL, EV_SLEEVE_FREE,
-                 EV_SLEEVE_STOP, EV_STARTER_CUTOUT, EV_STUCK, EV_TO_ANGLE, EV_TO_TIME, F_ERR_OLD,
-                 F_H, F_LAST_PHI, F_LAST_SWITCH, F_LAST_T, F_NEXT_OUT, F_PASSED_BP, F_REDO_LEVEL,
-                 F_SEL, FAIL_NONFINITE, FAIL_STEP, I_ANGLE_MODE, I_AT_EVENT, I_CHATTER_CODE,
-                 I_DIRECTION, I_F_VALID, I_FLIPPED, I_GEN_LOW, I_GOV_BRANCH, I_LOAD_SEG,
-                 I_LOAD_TABLE, I_MODES, I_NBAD, I_NCHATTER, I_NEV, I_NFEV, I_NONSTIFF, I_NOUT,
-                 I_NREDO, I_NREJECT, I_NSTEPS, I_NSWITCH, I_NTIES, I_NUNSEEN, I_REJECTED, I_SLEEVE,
-                 I_STARTED, I_STARTER_ON, I_STIFF, RUNNING, STALLED, STIFF, _carry, _emit_event,
-                 MAX_OUTPUT_INTERVALS, At, Chunk, Work, _emit_new_row, _emit_row, _emit_samples,
-                 _finish, _locked, _reset_output_grid, _retake)
+from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
+from .events import (
+    DEMAND_COMP,
+    MAX_UNSEEN,
+    N_MARGIN_SAMPLES,
+    PAIR_COMP,
+    _dense_once,
+    _event_g,
+    _locate_events,
+    _root,
+    _sleeve_stops,
+)
+from .io import (
+    C_ATOL,
+    C_CHUNK_STEPS,
+    C_DPHI_OUT,
+    C_DT_OUT,
+    C_FIXED_STEP,
+    C_PHI_END,
+    C_RTOL,
+    C_T_END,
+    C_W_HI,
+    CHATTERING,
+    EV_BREAKPOINT,
+    EV_END,
+    EV_GENERATOR,
+    EV_GOVERNOR,
+    EV_LOAD,
+    EV_LOAD_KNOT,
+    EV_PAIR_MODE,
+    EV_RELEASED,
+    EV_REVERSAL,
+    EV_SLEEVE_FREE,
+    EV_SLEEVE_STOP,
+    EV_STARTER_CUTOUT,
+    EV_STUCK,
+    EV_TO_ANGLE,
+    EV_TO_TIME,
+    F_ERR_OLD,
+    F_H,
+    F_LAST_PHI,
+    F_LAST_SWITCH,
+    F_LAST_T,
+    F_NEXT_OUT,
+    F_PASSED_BP,
+    F_REDO_LEVEL,
+    F_SEL,
+    FAIL_NONFINITE,
+    FAIL_STEP,
+    I_ANGLE_MODE,
+    I_AT_EVENT,
+    I_CHATTER_CODE,
+    I_DIRECTION,
+    I_F_VALID,
+    I_FLIPPED,
+    I_GEN_LOW,
+    I_GOV_BRANCH,
+    I_LOAD_SEG,
+    I_LOAD_TABLE,
+    I_MODES,
+    I_NBAD,
+    I_NCHATTER,
+    I_NEV,
+    I_NFEV,
+    I_NONSTIFF,
+    I_NOUT,
+    I_NREDO,
+    I_NREJECT,
+    I_NSTEPS,
+    I_NSWITCH,
+    I_NTIES,
+    I_NUNSEEN,
+    I_REJECTED,
+    I_SLEEVE,
+    I_STARTED,
+    I_STARTER_ON,
+    I_STIFF,
+    MAX_OUTPUT_INTERVALS,
+    RUNNING,
+    STALLED,
+    STIFF,
+    At,
+    Chunk,
+    Work,
+    _carry,
+    _emit_event,
+    _emit_new_row,
+    _emit_row,
+    _emit_samples,
+    _finish,
+    _locked,
+    _reset_output_grid,
+    _retake,
+)
 
 # Hairer's stiffness test (dop853.f, dopri5.f): this many accepted steps with hλ beyond the
 # tableau's bound, not interrupted by as many as NONSTIFF_RESET within it, mean that stability,
@@ -142,7 +249,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         fired).
     """
     io = Chunk(cfg, bp, fst, ist, outbuf, evbuf)
-    K, F, f, y_new, tmp, wk, gs = work.K, work.F, work.f, work.y_new, work.tmp, work.wk, work.gs
+    K, f, y_new, tmp, wk, gs = work.K, work.f, work.y_new, work.tmp, work.wk, work.gs
     rtol = cfg[C_RTOL]
     atol = cfg[C_ATOL]
     # rows kept free: a step spans at most 256 intervals of its grid (in time, of each grid)
