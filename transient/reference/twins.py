@@ -252,7 +252,8 @@ class ArticulatedReactionNumpy(ReactionNumpy):
     """Friction on the articulated mechanism's joint reactions for the reference path: φ̈ and the
     joints' forces by its own Newton–Euler
     (:func:`~transient.reference.joints.articulated_joint_forces`, the shaft's equation closing
-    the linear system, the friction a fixed point on its forces), not by the kernels' Newton solve; directions at the segment's angle ``sel``, as the compiled path holds them."""
+    the linear system, the friction a fixed point on its forces), not by the kernels' Newton solve;
+    directions at the segment's angle ``sel``, as the compiled path holds them."""
 
     def solve_mode(self, inputs, w, sigma, eta):
         """:meth:`ReactionNumpy.solve_mode`: the shaft's equation, which closes the linear
