@@ -59,7 +59,10 @@ def _scene():
     return replace(scene, run=replace(scene.run, revolutions=REVOLUTIONS))
 
 
-@pytest.mark.slow  # (the fallback compiles the whole stepper with plain njit, in its own cache)
+# the long tier: the fallback compiles the whole stepper again with plain njit, in its own cache,
+# close to ten minutes of one worker on a cold cache
+@pytest.mark.slow
+@pytest.mark.stress
 def test_the_stepper_under_the_fallback_agrees_with_the_normal_build(tmp_path):
     # numba's own cache for the fallback's kernels, beside (not among) the replacements' cache
     env = {**os.environ, "NUMBA_CACHE_DIR": str(cache_root() / "numba-fallback"),
