@@ -166,9 +166,10 @@ def mark_events(axes, events, cycles: int):
     with its rate. Returns the handles for a legend."""
     from matplotlib.lines import Line2D
 
-    styles: list[dict[str, Any]] = [{"color": "C3", "ls": "-", "lw": 0.8}, {"color": "k", "ls": ":", "lw": 1.0},
-              {"color": "C4", "ls": "--", "lw": 0.8}, {"color": "C2", "ls": "-.", "lw": 0.8},
-              {"color": "0.4", "ls": (0, (1, 3)), "lw": 1.0}]
+    styles: list[dict[str, Any]] = [
+        {"color": "C3", "ls": "-", "lw": 0.8}, {"color": "k", "ls": ":", "lw": 1.0},
+        {"color": "C4", "ls": "--", "lw": 0.8}, {"color": "C2", "ls": "-.", "lw": 0.8},
+        {"color": "0.4", "ls": (0, (1, 3)), "lw": 1.0}]
     handles = []
     for j, (kind, words, times) in enumerate(events):
         if cycles and times.size > max(3.0, MARKED_PER_CYCLE * cycles):

@@ -245,8 +245,9 @@ def _axis_list(root: _Table, file: str) -> list:
 
 def _check_key(key: str, err: SceneError) -> list[tuple[str, int | None]]:
     """The parts of a dotted scene key, name and optional [index] each; err if malformed."""
-    parts = [m for m in map(_KEY_PART.match, key.split(".")) if m is not None]
-    if not key or len(parts) != key.count(".") + 1:
+    texts = key.split(".")
+    parts = [m for m in map(_KEY_PART.match, texts) if m is not None]
+    if not key or len(parts) < len(texts):
         err.message = (f"{show_value(key)} is not a scene key; give dotted TOML keys such as "
                        f"'load.torque' or 'friction.pairs[0].eta_forward'")
         err.args = (err.line(),)
