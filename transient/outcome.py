@@ -265,14 +265,15 @@ class Watch:
     def _stops_said(self, lead: str) -> str:
         """The speed's passages through zero after ``lead``, for a message: how many, the first
         and the last ("" if none)."""
-        if not self.stops:
+        first, last = self.first_stop, self.last_stop
+        if first is None or last is None:  # (no passage: the first sets both)
             return (f"{lead}it turned backwards from the start"
                     if self.last.get("omega", 0.0) < 0.0 else "")
-        t, phi = self.first_stop
+        t, phi = first
         text = (f"{lead}the speed went through zero {self.stops} time{'s' * (self.stops > 1)}, "
                 f"first at t = {t:.9g} s, φ = {phi:.9g} rad ({math.degrees(phi):.6g}°)")
         if self.stops > 1:
-            t, phi = self.last_stop
+            t, phi = last
             text += f", last at t = {t:.9g} s, φ = {phi:.9g} rad ({math.degrees(phi):.6g}°)"
         return text
 
@@ -309,7 +310,7 @@ class Watch:
         """The speed's passages through zero over the whole run, for the end-of-run summary:
         ``speed_reversals`` [1] and the first one's ``speed_reversal_first_t`` [s] and
         ``speed_reversal_first_phi`` [rad]; nothing if the speed never went through zero."""
-        if not self.stops:
+        if self.first_stop is None:  # (set at the first passage)
             return {}
         return {"speed_reversals": (float(self.stops), "1"),
                 "speed_reversal_first_t": (self.first_stop[0], "s"),

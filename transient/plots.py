@@ -5,6 +5,7 @@ Where a helper plots a run, ``traj`` is a :class:`~transient.results.Result` or 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -165,9 +166,10 @@ def mark_events(axes, events, cycles: int):
     with its rate. Returns the handles for a legend."""
     from matplotlib.lines import Line2D
 
-    styles = [{"color": "C3", "ls": "-", "lw": 0.8}, {"color": "k", "ls": ":", "lw": 1.0},
-              {"color": "C4", "ls": "--", "lw": 0.8}, {"color": "C2", "ls": "-.", "lw": 0.8},
-              {"color": "0.4", "ls": (0, (1, 3)), "lw": 1.0}]
+    styles: list[dict[str, Any]] = [
+        {"color": "C3", "ls": "-", "lw": 0.8}, {"color": "k", "ls": ":", "lw": 1.0},
+        {"color": "C4", "ls": "--", "lw": 0.8}, {"color": "C2", "ls": "-.", "lw": 0.8},
+        {"color": "0.4", "ls": (0, (1, 3)), "lw": 1.0}]
     handles = []
     for j, (kind, words, times) in enumerate(events):
         if cycles and times.size > max(3.0, MARKED_PER_CYCLE * cycles):
@@ -669,7 +671,7 @@ def polar_load(ax, x, y, label=None, scale=1e-3, angle_deg=None, dead_centres=No
     return artists
 
 
-def _angle_marks(ax, angle, x, y, colour, dead_centres):
+def _angle_marks(ax, angle, x, y, colour, dead_centres) -> list:
     """Dots every 30° of ``angle`` along the curve (x, y), labelled every 90° (120° over a 720°
     cycle; marks that fall on one spot share a label), and a star at each dead centre."""
     every = 120.0 if angle[-1] - angle[0] > 400.0 else 90.0

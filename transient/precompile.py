@@ -27,15 +27,20 @@ import os
 import pickle
 import subprocess
 import sys
+from typing import IO, Any, cast
 
 import numpy as np
-from numba import config, typeof, types
+from numba import config as numba_config
+from numba import typeof, types
 
 from .core import jit
 from .core.integrator import rk
 from .core.model import layout, rhs
 from .core.stepper import breakpoints, events, loop
 from .core.stepper import io as sio
+
+#: numba's settings, which it sets at import from the environment, out of a type checker's sight.
+config: Any = numba_config
 
 #: The stepper's callees, each compiled apart with its own callees (:func:`.core.jit.kernel`), in
 #: the reverse of the order in which the stepper's compile first calls for them (recorded with
@@ -79,6 +84,7 @@ def _types_by_parameter(model, tab) -> dict:
                                   "y_evt"),
              types.float64[:, ::1]: ("K", "F", "outbuf", "evbuf", "wk", "gs"),
              types.int64[::1]: ("ist", "sw", "control")}
+    vector, matrix, ints = np.zeros(1), np.zeros((1, 1)), np.zeros(1, np.int64)
     # (``extras`` is None or True: the plain or the full variant, ``core.model.layout.extras_of``)
     extras = typeof(layout.extras_of(model))
     by_name = {"m": typeof(model), "tab": typeof(tab), "extras": extras,
@@ -87,10 +93,11 @@ def _types_by_parameter(model, tab) -> dict:
                "ctx": types.Tuple((typeof(model), extras, types.boolean, types.float64,
                                    types.int64[::1], types.float64[:, ::1])),
                # the loop's records (stepper.io)
-               "io": typeof(sio.Chunk(*_vectors(3), np.zeros(1, np.int64), *_matrices(2))),
-               "work": typeof(sio.Work(*_matrices(2), *_vectors(4), *_matrices(2),
-                                       np.zeros(1, np.int64))),
-               "at": typeof(sio.At(True, 0, 0.0, 0.0, 0.0, np.zeros(1, np.int64))),
+               "io": typeof(sio.Chunk(cfg=vector, bp=vector, fst=vector, ist=ints,
+                                      outbuf=matrix, evbuf=matrix)),
+               "work": typeof(sio.Work(K=matrix, F=matrix, f=vector, y_new=vector, y_evt=vector,
+                                       tmp=vector, wk=matrix, gs=matrix, control=ints)),
+               "at": typeof(sio.At(True, 0, 0.0, 0.0, 0.0, ints)),
                "seg": typeof(sio.Segment(*(6 * [0.0]))),
                "seen": types.Tuple((types.boolean, types.float64, types.float64)),
                "crossing": types.Tuple((types.float64, types.int64, types.float64)),
@@ -98,14 +105,6 @@ def _types_by_parameter(model, tab) -> dict:
     for numba_type, names in (scalar | array).items():
         by_name.update(dict.fromkeys(names, numba_type))
     return by_name
-
-
-def _vectors(n: int) -> list:
-    return [np.zeros(1) for _ in range(n)]
-
-
-def _matrices(n: int) -> list:
-    return [np.zeros((1, 1)) for _ in range(n)]
 
 
 def signature(fn, model, tab) -> tuple:
@@ -163,9 +162,8 @@ def start_helper(model, tab, callees=CALLEES) -> subprocess.Popen | None:
             [sys.executable, "-c", f"import {__name__} as p; p.helper_main()"],
             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             env=helper_environment())
-        with helper.stdin:
-            pickle.dump((model, tab, [(fn.__module__, fn.__name__) for fn in callees]),
-                        helper.stdin)
+        with cast(IO[bytes], helper.stdin) as pipe:  # (stdin=PIPE: never None)
+            pickle.dump((model, tab, [(fn.__module__, fn.__name__) for fn in callees]), pipe)
     except OSError:  # (no process to be had, or it died at once: the compile goes on alone)
         stop_helper(helper)
         return None

@@ -19,6 +19,7 @@ to within rtol·Σ∫|P_x| dt + atol per column, whatever the output spacing.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,6 +29,9 @@ from .core.model.inverse import inverse_dynamics
 from .core.model.layout import n_outputs
 from .forces.load_table import interpolant
 from .quadrature import integrals
+
+if TYPE_CHECKING:
+    from scipy.interpolate import PPoly
 
 #: The torque columns whose power M·ω is a work column, by that column's name.
 TORQUE_WORK = {"W_gas": "M_gas", "W_load": "M_load", "W_starter": "M_starter"}
@@ -41,8 +45,8 @@ class Motion:
     t0: float
     phi0: float
     omega: float = 0.0
-    speed: object = None  # ω(t) and its antiderivative, with a table
-    angle: object = None
+    speed: PPoly | None = None  # ω(t) and its antiderivative, with a table
+    angle: PPoly | None = None
 
     @classmethod
     def of(cls, scene) -> Motion:
@@ -57,7 +61,7 @@ class Motion:
            ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         """(φ, ω, ε) at the times ``t``; at a point of a linear table ε is the slope after it."""
         t = np.asarray(t, dtype=np.float64)
-        if self.speed is None:
+        if self.speed is None or self.angle is None:  # (both are given, or neither)
             return (self.phi0 + self.omega * (t - self.t0), np.full_like(t, self.omega),
                     np.zeros_like(t))
         return self.phi0 + self.angle(t) - self.angle(self.t0), self.speed(t), self.speed(t, 1)

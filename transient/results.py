@@ -527,11 +527,11 @@ class ResultWriter:
 
     def _events(self, events: dict[str, np.ndarray]) -> None:
         """A block's events into the log, in time order (the log is, block after block)."""
-        rows = [np.column_stack([np.full(len(v), self.event_names.index(name), float),
-                                 np.asarray(v, dtype=float).reshape(-1, 2)])
-                for name, v in events.items() if len(v)]
-        if rows:
-            rows = np.concatenate(rows)
+        named = [np.column_stack([np.full(len(v), self.event_names.index(name), float),
+                                  np.asarray(v, dtype=float).reshape(-1, 2)])
+                 for name, v in events.items() if len(v)]
+        if named:
+            rows = np.concatenate(named)
             _extend(self.checkpoints["events"], rows[np.argsort(rows[:, 1], kind="stable")])
 
     def restart(self) -> None:

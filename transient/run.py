@@ -22,7 +22,7 @@ from .core.model import forcing, layout, work
 from .core.model.inverse import inverse_dynamics
 from .core.model.layout import n_outputs, n_state
 from .core.stepper import io as sio
-from .core.stepper import loop
+from .core.stepper.loop import CHATTER_COUNT, STIFF_COUNT
 from .errors import SceneError, SimulationError
 from .outcome import FINISHED, RunStopped, Watch, code_status, failure_cause, judge, status_of
 from .precompile import start_helper, stop_helper
@@ -142,7 +142,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     y, fst, ist = _initial_state(scene, model)
     outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
     evbuf = np.empty((EVENT_ROWS, 4))
-    blocks, events = [], {name: [] for name in sio.EVENT_NAMES}  # events kept only with keep
+    blocks: list[dict[str, np.ndarray]] = []
+    events: dict[str, list[np.ndarray]] = {name: [] for name in sio.EVENT_NAMES}  # kept with keep
     status, message = sio.RUNNING, ""
     # An inertia switched in: the run stops at that time (as at its end), the shaft's inertia and
     # speed jump (switch_inertia), and the run goes on.
@@ -203,13 +204,13 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
                    f"applied moments in both directions ({why})")
     if status == sio.CHATTERING:
         event = sio.EVENT_NAMES[int(ist[sio.I_CHATTER_CODE])]
-        message = (f"chattering: {loop.CHATTER_COUNT} state events in a row ({event}) without "
+        message = (f"chattering: {CHATTER_COUNT} state events in a row ({event}) without "
                    f"progress at {at} (last sample {where})"
                    + (f"; the {scene.friction.policy!r} criterion has no consistent mode here (a "
                       f"sliding mode), the power-flow policy has one at every state"
                       if event == "pair_mode" and scene.friction.policy != "power-flow" else ""))
     if status == sio.STIFF:
-        message = (f"stiff at {at}: in {loop.STIFF_COUNT} steps the estimate h·λ of the "
+        message = (f"stiff at {at}: in {STIFF_COUNT} steps the estimate h·λ of the "
                    f"dominant eigenvalue exceeded the stability bound {tab.stiff_bound:g} of "
                    f"{scene.solver.method} (Hairer's test), so stability, not accuracy, sets "
                    f"the step (a governor or actuator far faster than the engine?)")
@@ -500,7 +501,7 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
     return res
 
 
-def _with_result(exc: SimulationError, res: Result, path: Path) -> SimulationError:
+def _with_result(exc: SimulationError, res: Result, path: str | Path) -> SimulationError:
     """``exc`` carrying the result ``res``, its message saying where the result is."""
     exc.args = (f"{exc}; result in {path} (status = {res.status})" if res.complete else
                 f"{exc}; partial result kept in {path} (complete = false)",)

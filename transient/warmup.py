@@ -22,6 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
+from typing import Any
 
 from numba.core import event
 
@@ -31,7 +32,7 @@ from .scene import Scene
 
 #: The scene :func:`warm_up` runs: the Gots diesel (Gots, Table 1) with friction pairs and a
 #: mixed cycle, which reaches every kind of kernel the stepper calls.
-WARMUP_SCENE = {
+WARMUP_SCENE: dict[str, dict[str, Any]] = {
     "scene": {"name": "warmup", "description": "compiles the kernels (transient warmup)"},
     "mechanism": {"type": "crank-slider", "crank_radius_mm": 47, "rod_length_mm": 148,
                   "bore_mm": 88, "piston_mass": 1.52, "crank_mass": 0.912, "strokes": 4,
@@ -52,7 +53,7 @@ WARMUP_SCENE = {
 }
 
 #: How long :func:`warm_up` runs each scene [revolutions].
-WARMUP_REVOLUTIONS = WARMUP_SCENE["run"]["revolutions"]
+WARMUP_REVOLUTIONS: float = WARMUP_SCENE["run"]["revolutions"]
 #: The same engine without friction pairs: a plain scene (the kernels' plain variant).
 PLAIN_SCENE = {key: value for key, value in WARMUP_SCENE.items() if key != "friction"}
 #: A prescribed speed (the inverse dynamics are kernels of their own).

@@ -124,7 +124,8 @@ def _pieces(x: NDArray[np.float64], cuts: NDArray[np.float64], tol: float
     next starts at the first after it. Returns (start, stop, left boundary) per run; a grid point
     belongs to the last run whose left boundary is ≤ it (see :func:`_run_of`).
     """
-    breaks = [(float(x[i + 1]), i + 1, i + 1) for i in np.nonzero(np.diff(x) == 0.0)[0]]
+    breaks = [(float(x[i + 1]), int(i) + 1, int(i) + 1)
+              for i in np.nonzero(np.diff(x) == 0.0)[0]]
     for c in cuts:
         lo = int(np.searchsorted(x, c - tol, side="left"))  # first sample on or after the cut
         hi = int(np.searchsorted(x, c + tol, side="right"))  # first sample after it
@@ -132,7 +133,8 @@ def _pieces(x: NDArray[np.float64], cuts: NDArray[np.float64], tol: float
             continue  # nothing on one side of it: the data end there
         breaks.append((float(c), lo + 1 if hi > lo else lo, max(lo, hi - 1)))
     breaks.sort()
-    out, start, left = [], 0, -math.inf
+    out: list[tuple[int, int, float]] = []
+    start, left = 0, -math.inf
     for bound, stop, nxt in breaks:
         if stop > start:
             out.append((start, stop, left))

@@ -234,9 +234,9 @@ def _corner_cuts(scene, phi_lo: float, phi_hi: float, events) -> list[NDArray[np
     tables = [t for t in gas_tables(scene) if t is not None]
     corners = np.unique(np.concatenate([[0.0], *[np.asarray(t.corners) for t in tables]]))
     corners = corners[corners < cycle]
-    other = [np.asarray(v)[:, 1] for k, v in (events or {}).items() if k in FUEL_CORNERS
-             and np.size(v)]
-    other = np.concatenate(other) if other else np.zeros(0)
+    fuel = [np.asarray(v)[:, 1] for k, v in (events or {}).items() if k in FUEL_CORNERS
+            and np.size(v)]
+    other = np.concatenate(fuel) if fuel else np.zeros(0)
     out = []
     for phase in gas_phases(scene):
         j0 = math.floor((phi_lo - phase) / cycle) - 1

@@ -72,7 +72,7 @@ def wear_rays(direction: ArrayLike, magnitude: ArrayLike, weight: ArrayLike, n_r
     sums : (n_rays,) array
         Sums [unit of ``magnitude``].
     """
-    rays = np.arange(n_rays) * (360.0 / n_rays)
+    rays = np.arange(n_rays, dtype=np.float64) * (360.0 / n_rays)
     d = np.degrees(np.asarray(direction, dtype=float))[None, :] - rays[:, None]
     d = (d + 180.0) % 360.0 - 180.0
     # (the tolerance keeps a load exactly on the arc's end, up to rounding, inside)

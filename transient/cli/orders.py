@@ -208,12 +208,12 @@ def cmd_orders(args) -> int:
             cols_csv[f"M_cylinder_{k + 1}_amplitude_Nm"] = per_cyl.amplitude[k]
             cols_csv[f"M_cylinder_{k + 1}_phase_rad"] = per_cyl.phase[k]
     if rep is not None:  # W_k: cylinder k's piston acceleration, as [analysis] orders names it
-        w = f"W_{args.cylinder}"
-        cols_csv[f"{w}_amplitude_m_s2"] = rep.amplitude[-1]
-        cols_csv[f"{w}_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
-        cols_csv[f"{w}_relative"] = rep.relative[-1]
-        cols_csv[f"{w}_relative_constant"] = rep.relative_constant[-1]
-        cols_csv[f"{w}_relative_added"] = rep.relative_added[-1]
+        col = f"W_{args.cylinder}"
+        cols_csv[f"{col}_amplitude_m_s2"] = rep.amplitude[-1]
+        cols_csv[f"{col}_amplitude_constant_m_s2"] = rep.amplitude_constant[-1]
+        cols_csv[f"{col}_relative"] = rep.relative[-1]
+        cols_csv[f"{col}_relative_constant"] = rep.relative_constant[-1]
+        cols_csv[f"{col}_relative_added"] = rep.relative_added[-1]
     csv = out / f"{stem}_orders.csv"
     write_columns(csv, cols_csv, args.force)
     written.append(csv)

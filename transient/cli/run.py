@@ -355,7 +355,8 @@ def cmd_warmup(args) -> int:
     def report(kernel) -> None:
         print(f"{'  ' * kernel.depth}compiled {kernel.name} in {kernel.wall_s:.2f} s", flush=True)
 
-    print(f"kernels in {config.CACHE_DIR}", flush=True)
+    cache = config.CACHE_DIR  # type: ignore[attr-defined]  # (numba sets it at import)
+    print(f"kernels in {cache}", flush=True)
     compiled = warm_up(scenes, report)
     print(f"{len(compiled)} kernel(s) compiled" if compiled else "all kernels were cached")
     return EXIT_OK

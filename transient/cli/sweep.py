@@ -3,6 +3,7 @@ summaries (:mod:`transient.sweeps`)."""
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -133,7 +134,7 @@ def cmd_sweep_plot(args) -> int:
                                            f"{', '.join(tab.collect)}", file=str(args.result))
     out = output_folder(args.output, tab.path.parent)
     plt = pyplot()
-    dims = []  # one coordinate per grid dimension: the first axis of each group
+    dims: list[dict[str, Any]] = []  # one coordinate per grid dimension: each group's first axis
     for a in tab.axes:
         if all(d["group"] != a["group"] for d in dims):
             dims.append(a)

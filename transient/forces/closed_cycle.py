@@ -32,6 +32,7 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -45,6 +46,9 @@ from transient.forces.gas import (
     gas_exchange_pressures,
     volume_at,
 )
+
+if TYPE_CHECKING:
+    from scipy.integrate import OdeSolution
 
 __all__ = [
     "DEFAULT_A",
@@ -396,7 +400,7 @@ class Segment:
     lo: float
     hi: float
     power: float | None  # m + 1 when integrated in u, else None
-    sol: object          # scipy OdeSolution with the components (p, W[, Q_w])
+    sol: OdeSolution     # with the components (p, W[, Q_w])
     size: int            # number of components
 
     def u_of_x(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -557,11 +561,11 @@ def integrate_closed(st: CycleSetup, fuel_mass: float, volume: VolumeFunction,
     scale = 1e-3 * st.rtol
     atol = np.array([scale * st.p_a] + [scale * st.p_a * v_a] * (size - 1))
     y0 = np.array([st.p_a] + [0.0] * (size - 1))
-    breaks = [st.ivc]
+    ends = [st.ivc]
     for b in (st.start, end, st.evo):
-        if b > breaks[-1]:
-            breaks.append(b)
-    breaks = np.array(breaks)
+        if b > ends[-1]:
+            ends.append(b)
+    breaks = np.array(ends)
     segments = []
     for lo, hi in itertools.pairwise(breaks):
         burning = q_total > 0.0 and lo >= st.start and hi <= end

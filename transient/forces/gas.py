@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -88,10 +89,13 @@ def gas_exchange_pressures(strokes: int, p_intake: float | None, p_exhaust: floa
     NaN for a 2-stroke, which has no gas-exchange strokes."""
     if strokes != 4:
         return float("nan"), float("nan")
-    for key, value in (("gas.p_intake", p_intake), ("gas.p_exhaust", p_exhaust)):
+
+    def absolute(key: str, value: float | None) -> float:
         if value is None or not (np.isfinite(value) and value >= 0.0):
             raise SceneError(key, f"{value!r} Pa; a 4-stroke needs an absolute pressure ≥ 0")
-    return float(p_intake), float(p_exhaust)
+        return float(value)
+
+    return absolute("gas.p_intake", p_intake), absolute("gas.p_exhaust", p_exhaust)
 
 
 @dataclass(frozen=True, eq=False)
@@ -506,14 +510,14 @@ def every_knot_a_corner(table: PressureTable) -> PressureTable:
                          piece_knot=np.arange(n + 1, dtype=np.int64), period=table.period)
 
 
-def table_from_function(f: PieceFunction | Sequence[PieceFunction], period: float,
-                        corners: ArrayLike = (), step: float = DEFAULT_STEP
+def table_from_function(f: PieceFunction | list[PieceFunction] | tuple[PieceFunction, ...],
+                        period: float, corners: ArrayLike = (), step: float = DEFAULT_STEP
                         ) -> tuple[PressureTable, float]:
     """Tabulate closed forms piece by piece with a not-a-knot cubic spline.
 
     Parameters
     ----------
-    f : callable, float, or sequence of them
+    f : callable, float, or list or tuple of them
         Either one vectorised ``f(x)`` for the whole cycle (continuous at the corners, which
         may be kinks), or one entry per piece. An entry may be a float: a constant piece is
         stored as a single interval. Each callable must be smooth on its closed piece: it is
@@ -599,6 +603,11 @@ class IndicatedCycle(PressureTable):
     """
 
     work: float
+
+    if TYPE_CHECKING:  # (a field of some subclasses: a property here would refuse their value)
+        @property
+        def v_h(self) -> float:
+            """Swept volume [m³]."""
 
     @property
     def mean_torque(self) -> float:

@@ -29,11 +29,15 @@ import tempfile
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from transient.core import cache_root, source_hash
 from transient.forces.wiebe import WiebeCycle
+
+if TYPE_CHECKING:
+    from transient.forces.closed_cycle import ClosedPart
 
 #: Files the folder keeps: writing one more deletes the least recently used beyond it (a file of
 #: the Gots engine's two cycles is 0.26 MB).
@@ -95,7 +99,7 @@ def _write(path: Path, cycles: tuple[WiebeCycle, ...]) -> None:
     temporary = Path(f.name)
     try:
         with f:
-            np.savez(f, **arrays)
+            np.savez(f, **arrays)  # type: ignore[arg-type]  # (no key is numpy's allow_pickle)
         os.replace(temporary, path)
     finally:
         temporary.unlink(missing_ok=True)  # (gone once renamed; a failed write's remains)
@@ -122,7 +126,8 @@ def _read(path: Path, compute: Callable[[], tuple]) -> tuple[WiebeCycle, ...]:
             closed = _ClosedPartOnDemand(data[f"{i}.closed.start"].item(),
                                          data[f"{i}.closed.end"].item(),
                                          lambda i=i: again()[i].closed)
-            cycles.append(WiebeCycle(closed=closed, **values))
+            # (the stand-in answers as the ClosedPart it stands for)
+            cycles.append(WiebeCycle(closed=cast("ClosedPart", closed), **values))
     return tuple(cycles)
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import SceneError, show_value
 from .reader import Section
-from .records import COMPILED_METHODS, RUNAWAY_SPEED, Scene
+from .records import COMPILED_METHODS, RUNAWAY_SPEED, Scene, Wiebe
 
 
 def check_consistency(scene: Scene) -> tuple[float, float]:
@@ -182,13 +182,23 @@ def check_woschni(scene: Scene) -> None:
                                         "states of the ODE, which a prescribed-speed run does not "
                                         "integrate; run it dynamic (a large flywheel holds the "
                                         "speed) or leave [gas.woschni] out")
-    if scene.gas.wiebe.m < 0.0:
-        raise SceneError("gas.wiebe.m", f"m = {scene.gas.wiebe.m:g}: with wall heat transfer the "
+    m = combustion(scene).m
+    if m < 0.0:
+        raise SceneError("gas.wiebe.m", f"m = {m:g}: with wall heat transfer the "
                                         f"heat-release rate enters the ODE, and for m < 0 it is "
                                         f"infinite at the combustion start; give m ≥ 0")
     if scene.solver.kinematics == "tabulated":
         raise SceneError("solver.kinematics", "the cylinder volumes of wall heat transfer use the "
                                               "exact kinematics; use kinematics = \"exact\"")
+
+
+def combustion(scene: Scene) -> Wiebe:
+    """The Wiebe combustion that wall heat transfer integrates (the reader reads
+    ``[gas.woschni]`` only with it)."""
+    if scene.gas.wiebe is None:
+        raise SceneError("gas.woschni", 'wall heat transfer is built for model = "wiebe"; leave '
+                                        '[gas.woschni] out')
+    return scene.gas.wiebe
 
 
 def check_gas_table(scene: Scene, section: Section):
@@ -214,14 +224,15 @@ def check_offsets_in_closed_part(scene: Scene) -> None:
     opening."""
     from .queries import wiebe_levels
 
-    mech, gas = scene.mechanism, scene.gas
-    cycle = wiebe_levels(mech, gas)[-1]
+    mech, gas, duration = scene.mechanism, scene.gas, combustion(scene).duration
+    # (mypy sees no __hash__ on a Protocol-typed value; each mechanism is a frozen dataclass)
+    cycle = wiebe_levels(mech, gas)[-1]  # type: ignore[arg-type]
     closed = (cycle.closed.end - cycle.closed.start) % mech.cycle or mech.cycle
     start = (cycle.combustion_start - cycle.closed.start) % mech.cycle
     for i, c in enumerate(gas.cylinders):
-        a, b = start + c.combustion_offset, start + gas.wiebe.duration + c.combustion_offset
+        a, b = start + c.combustion_offset, start + duration + c.combustion_offset
         if a < 0.0 or b > closed:
-            lo, hi = -start, closed - start - gas.wiebe.duration
+            lo, hi = -start, closed - start - duration
             raise SceneError(f"gas.cylinders[{i}].combustion_offset",
                              f"{math.degrees(c.combustion_offset):g}° moves the combustion out "
                              f"of the closed part (intake closing to exhaust opening), which "

@@ -181,8 +181,10 @@ class Recorder:
             row = Row(key.name, key)
             table.rows.append(row)
         row.contexts.add((self._family, variant))
-        if key.kind not in row.kinds:
+        if key.kind is not None and key.kind not in row.kinds:  # (a number's: others have none)
             row.kinds.append(key.kind)
+        if self._read is None:
+            raise RuntimeError("a key heard outside Recorder.read")
         case, data, base_dir, varied = self._read
         bounds = tuple((w, value_of(b) if isinstance(value_of(b), int) else float(value_of(b)))
                        for w, b in key.bounds)

@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 
 from ..core.model import governor as gv
 from ..errors import SceneError
-from ..forces.compressor import compressor_cycle
-from ..forces.gas import PressureTable, mixed_cycle, table_from_points
+from ..forces.compressor import CompressorCycle, compressor_cycle
+from ..forces.gas import IndicatedCycle, PressureTable, mixed_cycle, table_from_points
 from ..forces.trapezoid import trapezoid_table
 
 
@@ -183,14 +183,13 @@ def cycle_figures(scene) -> dict[str, tuple[float, str]]:
     done on the gas, the volumetric efficiency, the volume drawn in and the local angles where
     the valves open; at a constant prescribed speed the indicated power, and the mean drive
     moment that speed needs without friction. Empty for the other models."""
-    from ..forces.gas import IndicatedCycle
 
     table = gas_table(scene)
     if not isinstance(table, IndicatedCycle):
         return {}
     n = scene.mechanism.n_cylinders
     out = {"cycle_work": (table.work, "J"), "mean_gas_torque": (n * table.mean_torque, "N m")}
-    if scene.gas.model == "compressor":
+    if isinstance(table, CompressorCycle):  # (the table of gas.model "compressor")
         out.update(indicated_work=(table.indicated_work, "J"),
                    volumetric_efficiency=(table.volumetric_efficiency, "1"),
                    suction_volume=(table.suction_volume, "m^3"),

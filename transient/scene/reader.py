@@ -329,7 +329,7 @@ class Section:
 
     @staticmethod
     def _unit_hint(name: str, kind: str | None) -> str:
-        suffixes = SUFFIXES.get(kind, {})
+        suffixes = SUFFIXES.get(kind, {}) if kind else {}
         if not suffixes:  # (one unit: name it, unless the number has none)
             return f"give {name!r}" + (f" [{UNITS[kind]}]" if kind and kind != "1" else "")
         options = [name] + [f"{name}_{s}" for s in suffixes]

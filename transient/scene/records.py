@@ -11,8 +11,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from ..mechanisms import Mechanism
+
+if TYPE_CHECKING:
+    from .read import replace_scene, scene_from_dict
+    from .write import to_toml
 
 
 @dataclass(frozen=True)
@@ -649,6 +654,11 @@ class Scene:
     analysis: Analysis = field(default_factory=Analysis)
     source_file: str = field(default="", compare=False, repr=False)
     source_text: str = field(default="", compare=False, repr=False)
+
+    if TYPE_CHECKING:  # (bound in transient.scene, where the reader, which imports this, is known)
+        from_dict = staticmethod(scene_from_dict)
+        replace = replace_scene
+        to_toml = to_toml
 
     def geometry(self) -> dict[str, tuple[float, str]]:
         """What the mechanism's geometry implies, without a run, name → (value, unit) in SI

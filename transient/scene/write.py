@@ -24,7 +24,7 @@ def to_toml(scene: Scene) -> str:
     lines += ["", "[governor]"] + [f"{k} = {toml_value(getattr(scene.governor, k))}"
                                    for k in GOVERNOR_KEYS[scene.governor.model]]
     lines += _section("initial", scene.initial)
-    run = {"mode": scene.run.mode}
+    run: dict[str, Any] = {"mode": scene.run.mode}
     for k in ("t_end", "revolutions"):
         if math.isfinite(getattr(scene.run, k)):
             run[k] = getattr(scene.run, k)
@@ -77,7 +77,8 @@ def _gas_section(gas: Gas, strokes: int) -> list[str]:
     if gas.injection is not None:
         names = (*names, "injection")
     lines = ["", "[gas]"] + [f"{k} = {toml_value(getattr(gas, k))}" for k in names]
-    if gas.model == "wiebe":  # unset optional angles (None) are left out: they read back as None
+    # Model "wiebe"'s table: unset optional angles (None) are left out, they read back as None.
+    if gas.wiebe is not None:
         lines += ["", "[gas.wiebe]"] + [f"{f.name} = {toml_value(getattr(gas.wiebe, f.name))}"
                                         for f in fields(gas.wiebe)
                                         if getattr(gas.wiebe, f.name) is not None]

@@ -255,7 +255,7 @@ def flywheel_for_delta(scene, delta_target: float, speed: float | None = None, l
 
     cycle_time = base.mechanism.cycle / speed
     iterations: list[FlywheelIteration] = []
-    x_prev = y_prev = None
+    prev: tuple[float, float] | None = None  # (x, y) of the previous iteration
     fly = estimate
     for _ in range(max_iter):
         tau = (J_rest + fly) / -slope
@@ -271,10 +271,10 @@ def flywheel_for_delta(scene, delta_target: float, speed: float | None = None, l
             return FlywheelResult(delta_target, fly, estimate, speed, dE, J_rest, base.load,
                                   tuple(iterations), True)
         x, y = math.log(J_rest + fly), math.log(it.delta)
-        k = -1.0 if x_prev is None or x == x_prev else (y - y_prev) / (x - x_prev)
+        k = -1.0 if prev is None or x == prev[0] else (y - prev[1]) / (x - prev[0])
         if not k < 0.0:
             k = -1.0
-        x_prev, y_prev = x, y
+        prev = x, y
         x_new = x + (math.log(delta_target) - y) / k
         fly = max(math.exp(x_new) - J_rest, 0.5 * fly)  # J_fly stays positive
     return FlywheelResult(delta_target, iterations[-1].flywheel, estimate, speed, dE, J_rest,

@@ -118,8 +118,11 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
     if not isinstance(axes, dict) or not axes:
         raise SceneError("axes", "give a dict of dotted scene keys and their values, e.g. "
                                  "{'load.torque': [50, 100]}")
-    tmp = None if output is not None else tempfile.TemporaryDirectory(prefix="transient-sweep-")
-    folder = Path(output if output is not None else tmp.name)
+    tmp = None
+    if output is None:
+        tmp = tempfile.TemporaryDirectory(prefix="transient-sweep-")
+        output = tmp.name
+    folder = Path(output)
     folder.mkdir(parents=True, exist_ok=True)
     name = name or base.name
     spec_file = folder / f"{name}.sweep.toml"  # (the sweep's own definition: rewritten each time)

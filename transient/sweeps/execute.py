@@ -15,9 +15,10 @@ import socket
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator
 from dataclasses import dataclass
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 from ..errors import SceneError
@@ -155,7 +156,7 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
 
 
 def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int | None
-             ) -> Iterator[tuple[RunSpec, dict]]:
+             ) -> Generator[tuple[RunSpec, dict], None, None]:
     """(spec, result) of each run as it finishes."""
     if not todo:
         return
@@ -220,7 +221,7 @@ def check_main_guarded() -> None:
     if main is None or not rerun or dask.config.get(
             "distributed.worker.multiprocessing-method", "spawn") == "fork":
         return
-    frame = sys._getframe()
+    frame: FrameType | None = sys._getframe()
     while frame is not None and not (frame.f_globals is vars(main)
                                      and frame.f_code.co_name == "<module>"):
         frame = frame.f_back

@@ -134,7 +134,8 @@ class _Table:
     def __init__(self, data: Any, where: str, file: str) -> None:
         if not isinstance(data, dict):
             raise SceneError(where, f"must be a table, got {type(data).__name__}", file=file)
-        self.data, self.where, self.file, self.known = dict(data), where, file, []
+        self.data, self.where, self.file = dict(data), where, file
+        self.known: list[str] = []
 
     def error(self, key: str, message: str) -> SceneError:
         return SceneError(f"{self.where}.{key}" if self.where else key, message, file=self.file)
@@ -193,7 +194,8 @@ def load_sweep(source: str | Path) -> Sweep:
     changes = _flatten(root.get("set", (dict,), {}, "a table of dotted scene keys and values"))
     for key in changes:
         _check_key(key, SceneError(f"set.{key}", "", file=file))
-    axes = tuple(_axis(_Table(a, f"axis[{i}]", file), method, samples, seed, i)
+    draws = None if samples is None or seed is None else (samples, seed)  # (method "random")
+    axes = tuple(_axis(_Table(a, f"axis[{i}]", file), draws, i)
                  for i, a in enumerate(_axis_list(root, file)))
     root.finish()
     _check_distinct(axes, file)
@@ -243,8 +245,9 @@ def _axis_list(root: _Table, file: str) -> list:
 
 def _check_key(key: str, err: SceneError) -> list[tuple[str, int | None]]:
     """The parts of a dotted scene key, name and optional [index] each; err if malformed."""
-    parts = [_KEY_PART.match(p) for p in key.split(".")]
-    if not key or not all(parts):
+    texts = key.split(".")
+    parts = [m for m in map(_KEY_PART.match, texts) if m is not None]
+    if not key or len(parts) < len(texts):
         err.message = (f"{show_value(key)} is not a scene key; give dotted TOML keys such as "
                        f"'load.torque' or 'friction.pairs[0].eta_forward'")
         err.args = (err.line(),)
@@ -269,7 +272,9 @@ def _check_distinct(axes: tuple[Axis, ...], file: str) -> None:
                                                f"give each quantity one axis", file=file)
 
 
-def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int) -> Axis:
+def _axis(t: _Table, draws: tuple[int, int] | None, i: int) -> Axis:
+    """Axis ``i`` of the table ``t``; ``draws``, (samples, seed) of method ``"random"``, else
+    None."""
     key = t.get("key", (str,), None, "a dotted scene key (string)")
     if key is None:
         raise t.error("key", "is missing; give the dotted scene key this axis sets, e.g. "
@@ -278,8 +283,8 @@ def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int)
     group = t.get("group", (str,), f"#{i}", "a string")
     values = t.get("values", (list,), None, "a list of values")
     lo_hi = {k: t.get(k, (int, float), None, "a number")
-             for k in (("low", "high") if method == "random" else ("from", "to"))}
-    num = t.get("num", (int,), None, "a whole number ≥ 2") if method != "random" else None
+             for k in (("low", "high") if draws is not None else ("from", "to"))}
+    num = t.get("num", (int,), None, "a whole number ≥ 2") if draws is None else None
     spacing = t.get("spacing", (str,), "linear", "a string")
     t.finish()
     for k, v in lo_hi.items():
@@ -296,22 +301,23 @@ def _axis(t: _Table, method: str, samples: int | None, seed: int | None, i: int)
         if not values or not all(isinstance(v, (int, float, str, bool)) for v in values):
             raise t.error("values", f"must be a non-empty list of numbers, strings or booleans, "
                                     f"got {show_value(values)}")
-        if method == "random":  # draw from the list
+        if draws is not None:  # draw from the list
+            samples, seed = draws
             picks = np.random.default_rng([seed, i]).integers(0, len(values), samples)
             values = [values[k] for k in picks]
         return Axis(key, tuple(values), group)
-    need = list(lo_hi) + ([] if method == "random" else ["num"])
+    need = list(lo_hi) + ([] if draws is not None else ["num"])
     missing = [k for k in need if k not in given]
     if missing:
         raise t.error(missing[0], f"is missing; give 'values' = [...] or {', '.join(need)}")
     a, b = lo_hi.values()
     if spacing == "log" and not (a > 0 and b > 0):
         raise t.error(need[0], f"spacing = \"log\" needs positive bounds, got {a:g} and {b:g}")
-    if method == "random":
+    if draws is not None:
         if not a < b:
             raise t.error("high", f"must be > low ({a:g}), got {b:g}")
-        return Axis(key, _draw(a, b, spacing, samples, seed, i), group)
-    if not 2 <= num <= MAX_RUNS:
+        return Axis(key, _draw(a, b, spacing, *draws, i), group)
+    if num is None or not 2 <= num <= MAX_RUNS:  # (None: refused as missing above)
         raise t.error("num", f"must be 2 … {MAX_RUNS} (runs of one sweep), got {num}")
     grid = np.geomspace(a, b, num) if spacing == "log" else np.linspace(a, b, num)
     return Axis(key, tuple(float(v) for v in grid), group)

@@ -70,7 +70,7 @@ SAMPLES_PER_REV = 72
 TIMED_SAMPLES_PER_REV = 1
 
 #: transient's compiled paths in the sweep: label → solver settings. Adaptive ones sweep rtol.
-ADAPTIVE = {
+ADAPTIVE: dict[str, dict[str, str | float]] = {
     "transient DOP853 (crank angle)": {"method": "dop853"},
     "transient DOP853 (time)": {"method": "dop853", "domain": "time"},
     "transient DOPRI5 (crank angle)": {"method": "dopri5"},
@@ -79,8 +79,9 @@ ADAPTIVE = {
 }
 #: The fixed-step path sweeps the step instead: 2π/N for these N (steps per revolution); its
 #: tables are made to 1e-12 (``table_tolerance``), near the splines' floor.
-FIXED = {"transient DOP853 fixed step, tabulated (crank angle)":
-         {"method": "dop853", "kinematics": "tabulated", "table_tolerance": 1e-12}}
+FIXED: dict[str, dict[str, str | float]] = {
+    "transient DOP853 fixed step, tabulated (crank angle)":
+        {"method": "dop853", "kinematics": "tabulated", "table_tolerance": 1e-12}}
 #: The fixed-step path's steps per revolution N (a step of 2π/N).
 STEPS_PER_REV = (16, 32, 64, 128, 256, 512, 1024)
 #: The label of the default path, against which the others' speed is stated.
@@ -284,7 +285,8 @@ def run_bench(scenes=None, revolutions=1000.0, tolerances=TOLERANCES, repeat=5,
     """Measure every (scene, method, rtol); write ``work_precision.csv``, one figure per scene
     and ``work_precision.md`` into ``out``; return the rows."""
     scenes = scenes or BENCH_SCENES
-    rows, refs, rhs_cache = [], {}, {}
+    rows, refs = [], {}
+    rhs_cache: dict[str, object] = {}  # each scene's right-hand side compiled for CyRK
     for name, path in scenes.items():
         base = load_scene(path)
         t0 = time.perf_counter()

@@ -97,7 +97,7 @@ def friction_models_cost(cases: Path, tmp: Path, scenes=tuple(SCENES), rounds=5,
     for name in scenes:
         what = SCENES[name]
         scene = cases / f"{name}.toml"
-        walls = {"this": [], "out": []}
+        walls: dict[str, list[float]] = {"this": [], "out": []}
         nfev = {}
         for _ in range(rounds):
             for side, path in (("this", None), ("out", copy)):

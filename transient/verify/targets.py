@@ -36,6 +36,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -566,8 +567,8 @@ def error_monotone(rows, floors: dict[str, float]) -> list[dict]:
 def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     """Every target's measurement (``quick``: the harness on short runs, one repeat)."""
     q = dict(repeat=1, revolutions=10.0, rounds=1) if quick else {}
-    res = {"speed": speed_at_equal_accuracy(rows), "monotone": error_monotone(rows, floors),
-           "overhead": []}
+    res: dict[str, Any] = {"speed": speed_at_equal_accuracy(rows),
+                           "monotone": error_monotone(rows, floors), "overhead": []}
     for name, path in BENCH_SCENES.items():
         res["overhead"] += stepper_overhead(name, path, **q)
         progress(f"targets: stepper overhead, {name}")
