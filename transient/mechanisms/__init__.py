@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .articulated import Articulated
 from .crank_slider import CrankSlider
+from .scotch_yoke import ScotchYoke
 from .swash_plate import SwashPlate
 
 if TYPE_CHECKING:
@@ -346,4 +347,5 @@ MECHANISMS: dict[str, type[Mechanism]] = {
     "crank-slider": CrankSlider,
     "swash-plate": SwashPlate,
     "articulated": Articulated,
+    "scotch-yoke": ScotchYoke,
 }
