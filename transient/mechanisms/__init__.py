@@ -68,8 +68,7 @@ class Mechanism(Protocol):
     key_meanings: ClassVar[dict[str, dict[str, str]]]
     #: Whether every piston follows the crank-slider law s(φ − φ_k) of ``crank_radius``,
     #: ``rod_length`` and ``offset`` (the odd-harmonic report then uses that closed form; other
-    #: pistons' s′, s″ come from ``transient.analysis.pistons``, which needs a line for a new
-    #: mechanism).
+    #: pistons' s′, s″ come from their capability ``"pistons"``).
     slider_law: ClassVar[bool]
     #: 2 or 4: the gas cycle's length, ``cycle`` = π·strokes.
     strokes: int
