@@ -34,7 +34,7 @@ print(len(log.compiled), *(c.name for c in log.compiled))
 FEATURE_KERNELS = {
     "friction pairs": ("chain.modes_power_flow_into", "chain._best_candidate", "rhs.margins_at",
                        "rhs.chain_acceleration", "events._pair_event", "events._sample_margins",
-                       "stepper._settle_modes", "outputs.pair_rows"),
+                       "loop._settle_modes", "outputs.pair_rows"),
     "governor states": ("forcing.governor_rates", "governor.pi_rates", "governor.flyweight_rates",
                         "forcing.demand", "events._sleeve_event", "events._sleeve_stops"),
     "latched fuel": ("breakpoints._inject",),
@@ -70,7 +70,7 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
     # the default scene: a static droop governor, no friction pairs, nothing else of the kind
     assert transient(mechanisms[0], code=PROBE)[0] != "0"
     plain = cached_kernels(tmp_path / "cache")
-    assert {"stepper.advance", "rhs.derivative", "forcing.moments"} <= plain
+    assert {"loop.advance", "rhs.derivative", "forcing.moments"} <= plain
     for feature, kernels in FEATURE_KERNELS.items():
         assert not plain & set(kernels), feature
     lines = transient("warmup", *mechanisms)
@@ -79,7 +79,7 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
     assert all(line.strip().startswith("compiled ") for line in lines[1:-1])
     # (the stepper's callees, such as rhs.derivative, may be the compile helper's, which this
     # process then loads: the cache below has them)
-    assert {"transient.core.stepper.advance",
+    assert {"transient.core.stepper.loop.advance",
             "transient.core.model.inverse.inverse_dynamics"} <= set(compiled)
     assert lines[-1] == f"{len(compiled)} kernel(s) compiled"
     full = cached_kernels(tmp_path / "cache")
