@@ -36,7 +36,7 @@ def derivative_without(kind=True, gas=True, generator=True, others=True):
         u = wk[layout.WK_U]
         with_dJ = m.n_pairs > 0
         if kind:
-            J, _ = forcing.mechanism_terms(m.kind, m.mech, m.kin_coef, y[layout.PHI], u,
+            J, _ = forcing.mechanism_terms(m, y[layout.PHI], u,
                                            wk[layout.WK_DU], with_dJ)
         else:
             J, _ = crank_slider_terms(m.mech, y[layout.PHI], u, wk[layout.WK_DU], with_dJ)

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 from .core.model import cylinder as cyl
 from .core.model import governor as gv
 from .core.model import variation as var
-from .core.model.forcing import applied_value, fuel, governor_branch, mechanism_terms, select_pieces
+from .core.model.forcing import applied_value, fuel, governor_branch, select_pieces
 from .core.model.layout import (
     LINK_FIXED,
     LINK_PISTONS,
@@ -37,16 +37,17 @@ from .core.model.layout import (
     RX_RING_FORCE,
     RX_RING_PRESSURE,
     RX_VISCOUS,
-    TABULATED,
     Model,
     T,
     extras_of,
 )
+from .core.model.reactions import NO_REACTIONS
+from .core.model.tabulated import terms as tabulated_kernel
 from .core.model.variation import cycle_fuel
 from .core.model.work import work_array
 from .forces.gas import PressureTable, shift_cubic
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
-from .mechanisms import reaction_joints
+from .mechanisms import provides, reaction_joints
 from .scene.queries import (
     burns_part_load,
     clearance_volume,
@@ -127,7 +128,7 @@ def _piston_moves(mech, k: int, angle: float) -> bool:
     """Whether piston k moves at the shaft angle (u_k above 1e-9 of the largest |u|, not a dead
     centre to rounding)."""
     u, du = np.empty(mech.n_cylinders), np.empty(mech.n_cylinders)
-    mechanism_terms(int(mech.kind), mech.pack(), np.zeros((1, 1, 6)), angle, u, du, False)
+    mech.kernel(mech.pack(), np.zeros((1, 1, 6)), angle, u, du, False)
     return bool(abs(u[k]) > 1e-9 * np.abs(u).max())
 
 
@@ -254,7 +255,7 @@ def build_model(scene, part_load: bool = False
     if reaction_friction(scene):
         bp = union_of_angles(bp, reaction_breakpoints(scene), period)
     model = Model(
-        kind=TABULATED if tabulated else int(mech.kind), mech=mech.pack(),
+        terms=tabulated_kernel if tabulated else mech.kernel, mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
         J0=float(scene.inertia.total),
         has_gas=table is not None, gas_phase=phases,
@@ -442,7 +443,7 @@ def kinematics_table(scene):
     from .tabulate import FRACTION_OF_RTOL, build_table
     mech = scene.mechanism
     target = sv.table_tolerance or FRACTION_OF_RTOL * sv.rtol
-    return build_table(int(mech.kind), mech.pack(), mech.n_cylinders, target)
+    return build_table(mech.kernel, mech.pack(), mech.n_cylinders, target)
 
 
 def chain_fields(scene) -> dict:
@@ -463,8 +464,19 @@ def chain_fields(scene) -> dict:
         policy=PAPER if friction.policy == "paper" else POWER_FLOW,
         **link_fields(mech, link_sub),
         reaction=False, rx_par=np.zeros((N_JOINTS, N_RX_PAR)),
-        rx_pair=np.full(N_JOINTS, -1, dtype=np.int64),
+        rx_pair=np.full(N_JOINTS, -1, dtype=np.int64), **reaction_kernel_fields(mech),
         **eta_table_fields(friction.pairs))
+
+
+def reaction_kernel_fields(mech) -> dict:
+    """The Model's reaction solver: the mechanism's own
+    (:class:`~transient.mechanisms.ReactionFriction`), else kernels that are never called
+    (``reactions.NO_REACTIONS``), so that the stepper holds no other mechanism's solver."""
+    if provides(mech, "reaction-friction"):
+        kernels, sides = mech.reaction_kernels, mech.tracks_sides
+    else:
+        kernels, sides = NO_REACTIONS, False
+    return dict(zip(("rx_prepare", "rx_solve", "rx_inverse"), kernels), rx_sides=sides)
 
 
 def link_fields(mech, link_sub: list[int]) -> dict:
@@ -543,26 +555,12 @@ def reaction_fields(scene) -> dict:
     return dict(n_pairs=n, eta_fwd=np.ones(n), eta_bwd=np.ones(n),
                 policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
                 **link_fields(mech, [0] * len(mech.links)),
-                reaction=True, rx_par=rx_par, rx_pair=rx_pair, **eta_table_fields(pairs))
+                reaction=True, rx_par=rx_par, rx_pair=rx_pair, **reaction_kernel_fields(mech),
+                **eta_table_fields(pairs))
 
 
 def reaction_breakpoints(scene) -> NDArray[np.float64]:
     """Shaft angles in [0, cycle) where a joint's relative speed changes sign (reaction friction),
-    so that no step straddles a reversal of a friction force: a mechanism's own
-    ``joint_reversals`` (the swash plate's: its pistons' dead centres); the local angles of a row
-    where any joint of the articulated mechanism reverses (``Articulated.reaction_reversals``),
-    repeated at each row's phase; else the crank-slider's, each piston's dead centres (its speed)
-    and its local 90° and 270° (the rod's rate β̇ ∝ cos α, ``transient.core.model.joint_friction``)."""
-    mech = scene.mechanism
-    own = getattr(mech, "joint_reversals", None)
-    if own is not None:
-        return np.unique(np.mod(np.asarray(own(), dtype=np.float64), mech.cycle))
-    turns = np.arange(0.0, mech.cycle - 1e-9, 2.0 * math.pi)
-    if hasattr(mech, "reaction_reversals"):
-        local, phases = mech.reaction_reversals(), np.asarray(mech.row_phases)
-    else:
-        tdc, bdc = mech.dead_centre_angles()
-        local = np.array([tdc, 0.5 * math.pi, bdc, 1.5 * math.pi])
-        phases = np.asarray(mech.firing_angles)
-    angles = np.add.outer(phases, np.add.outer(turns, local)).ravel()
-    return np.unique(np.mod(angles, mech.cycle))
+    so that no step straddles a reversal of a friction force: the mechanism's
+    ``reaction_reversals`` (:class:`~transient.mechanisms.ReactionFriction`)."""
+    return scene.mechanism.reaction_reversals()

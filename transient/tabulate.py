@@ -16,8 +16,6 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import PPoly, make_interp_spline
 
-from .core.model.forcing import mechanism_terms
-
 #: Table sizes tried: 64, 128, … intervals per revolution.
 MIN_INTERVALS, MAX_INTERVALS = 64, 1 << 15
 #: The tables' error bound as a fraction of the scene's rtol (``solver.table_tolerance`` = 0).
@@ -37,14 +35,15 @@ class KinematicsTable:
     target: float
 
 
-def exact_terms(kind: int, mech: NDArray[np.float64], ncyl: int, phi: NDArray[np.float64]
+def exact_terms(kernel, mech: NDArray[np.float64], ncyl: int, phi: NDArray[np.float64]
                 ) -> NDArray[np.float64]:
-    """Rows J, dJ, u_1 … u_n, u′_1 … u′_n of the exact kernel at the angles ``phi``."""
+    """Rows J, dJ, u_1 … u_n, u′_1 … u′_n of the exact kernel (a mechanism's ``kernel``, with its
+    packed parameters ``mech``) at the angles ``phi``."""
     out = np.empty((2 + 2 * ncyl, phi.size))
     u, du = np.empty(ncyl), np.empty(ncyl)
     no_table = np.zeros((1, 1, 6))
     for j, p in enumerate(phi):
-        out[0, j], out[1, j] = mechanism_terms(kind, mech, no_table, p, u, du, True)
+        out[0, j], out[1, j] = kernel(mech, no_table, p, u, du, True)
         out[2: 2 + ncyl, j] = u
         out[2 + ncyl:, j] = du
     return out
@@ -64,14 +63,14 @@ def _tables(terms: NDArray[np.float64], ncyl: int, n: int) -> NDArray[np.float64
     return np.stack([_fit(r, n) for r in rows])
 
 
-def _error(coef, kind, mech, ncyl, scale) -> float:
+def _error(coef, kernel, mech, ncyl, scale) -> float:
     """Largest relative deviation from the exact kernel at the quarter points of every interval."""
     from .core.model.tabulated import tabulated_terms
 
     n = coef.shape[1]
     h = 2.0 * math.pi / n
     phi = (np.arange(n)[:, None] * h + np.array([0.25, 0.5, 0.75]) * h).ravel()
-    exact = exact_terms(kind, mech, ncyl, phi)
+    exact = exact_terms(kernel, mech, ncyl, phi)
     u, du = np.empty(ncyl), np.empty(ncyl)
     worst = 0.0
     for j, p in enumerate(phi):
@@ -81,11 +80,11 @@ def _error(coef, kind, mech, ncyl, scale) -> float:
     return worst
 
 
-def build_table(kind: int, mech: NDArray[np.float64], ncyl: int, target: float) -> KinematicsTable:
+def build_table(kernel, mech: NDArray[np.float64], ncyl: int, target: float) -> KinematicsTable:
     """The smallest table (64 · 2^j intervals) whose estimated relative error ≤ ``target``; if
     refining stops paying (the error falls less than 2× per doubling: the spline fit's rounding,
     ~1e-13, is reached) or MAX_INTERVALS does not reach it, a table with ``coef = None``."""
-    probe = exact_terms(kind, mech, ncyl, np.linspace(0.0, 2.0 * math.pi, 4097))
+    probe = exact_terms(kernel, mech, ncyl, np.linspace(0.0, 2.0 * math.pi, 4097))
     if np.max(np.abs(probe[:, -1] - probe[:, 0])) > 1e-12 * np.max(np.abs(probe)):
         raise ValueError("the mechanism's kinematics is not 2π-periodic")
     # Relative to each function's largest magnitude (a function that vanishes: absolute).
@@ -95,8 +94,8 @@ def build_table(kind: int, mech: NDArray[np.float64], ncyl: int, target: float) 
     n, best, best_n = MIN_INTERVALS, math.inf, 0
     while n <= MAX_INTERVALS:
         x = np.linspace(0.0, 2.0 * math.pi, n + 1)
-        coef = _tables(exact_terms(kind, mech, ncyl, x), ncyl, n)
-        err = _error(coef, kind, mech, ncyl, scale)
+        coef = _tables(exact_terms(kernel, mech, ncyl, x), ncyl, n)
+        err = _error(coef, kernel, mech, ncyl, scale)
         if err <= target:
             return KinematicsTable(coef, n, err, target)
         if err > 0.5 * best:

@@ -26,9 +26,11 @@ from typing import Any
 
 from numba.core import event
 
+from .assemble import build_model
+from .core.model.layout import extras_of
 from .errors import SimulationError
 from .run import simulate
-from .scene import Scene
+from .scene import Friction, Pair, Scene
 
 #: The scene :func:`warm_up` runs: the Gots diesel (Gots, Table 1) with friction pairs and a
 #: mixed cycle, which reaches every kind of kernel the stepper calls.
@@ -127,13 +129,29 @@ class CompileLog(event.Listener):
         event.unregister("numba:compile", self)
 
 
+def both_variants(scene: Scene) -> tuple[Scene, ...]:
+    """``scene``, and where it runs the kernels' plain variant
+    (:func:`transient.core.model.layout.extras_of`) the same with a lossless constant-η pair
+    between its mechanism's first two links, which runs the full one: each mechanism's stepper
+    is a compile of its own (``Model.terms``), so the built-in scenes, all crank-sliders, do not
+    compile another mechanism's, and its scenes with friction pairs, governor states and the
+    like run the full variant."""
+    model, _, _ = build_model(scene)
+    if extras_of(model) is not None:
+        return (scene,)
+    first, second = scene.mechanism.links[:2]
+    lossless = Pair(between=(first, second), eta_forward=1.0, eta_backward=1.0, name="warmup")
+    return scene, replace(scene, friction=Friction("power-flow", (lossless,)))
+
+
 def warm_up(scenes: Iterable[Scene] = (),
             report: Callable[[Compiled], None] | None = None) -> list[Compiled]:
     """Compile (or load from the cache) the kernels that runs of the built-in scenes and of
     ``scenes`` need, running each for a fraction of a revolution in memory; returns the
     functions compiled (none where all were cached), each passed to ``report`` as it ends."""
     with CompileLog(report) as log:
-        for scene in (*map(Scene.from_dict, WARMUP_SCENES), *scenes):
+        for scene in (*map(Scene.from_dict, WARMUP_SCENES), *(v for s in scenes
+                                                               for v in both_variants(s))):
             try:
                 simulate(replace(scene, run=replace(scene.run, revolutions=WARMUP_REVOLUTIONS,
                                                     t_end=float("inf"))))

@@ -168,7 +168,7 @@ def test_no_joint_reverses_between_breakpoints():
     mech = scene.mechanism
     model, bp, _ = build_model(scene)
     reversal = set(np.round(np.mod(np.add.outer(np.asarray(mech.row_phases),
-                                                mech.reaction_reversals()), 2 * np.pi), 9).ravel())
+                                                mech.row_reversals()), 2 * np.pi), 9).ravel())
     ends = np.append(bp, bp[0] + mech.cycle)
     for a, b in zip(ends[:-1], ends[1:]):
         x = np.linspace(a, b, 42)[1:-1]

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from transient.core.model import swash_plate as core
-from transient.core.model.layout import SWASH_PLATE
+from transient.core.model.swash_plate import terms as swash_kernel
 from transient.errors import SceneError
 from transient.forces.gas import mixed_cycle
 from transient.mechanisms import swash_plate as sp
@@ -223,7 +223,7 @@ def test_validate_messages_survive_the_key_mapping():
 
 def test_interface_attributes():
     g = sp.antonyuk_example()
-    assert g.kind == SWASH_PLATE == 1
+    assert g.kernel is swash_kernel
     assert g.strokes == 2
     assert g.cycle == 2 * math.pi
     assert g.n_cylinders == 4

@@ -22,7 +22,7 @@ SCENES = ["coasting_single", "gots_diesel_governed", "swash_plate_4cyl"]
 def mechanism(stem):
     scene = load_scene(CASES / f"{stem}.toml")
     mech = scene.mechanism
-    return int(mech.kind), mech.pack(), mech.n_cylinders
+    return mech.kernel, mech.pack(), mech.n_cylinders
 
 
 def table_values(coef, ncyl, phi):

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from transient.assemble import build_model, kinematics_table
-from transient.core.model.layout import TABULATED
 from transient.run import integrate
 from transient.scene import Run, load_scene
 
@@ -64,7 +63,7 @@ def test_unreachable_tolerance_falls_back_to_exact():
                                          table_tolerance=1e-15))
     assert kinematics_table(scene).coef is None
     model, _, _ = build_model(scene)
-    assert model.kind != TABULATED
+    assert model.terms is scene.mechanism.kernel
     data, exact = integrate(scene), integrate(base)
     assert data.solver["kinematics"].startswith("exact (no table")
     assert data.solver["table_error"] > 1e-15

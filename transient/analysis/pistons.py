@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..mechanisms import PluginTable, needed
+
 
 @dataclass(frozen=True)
 class Pistons:
@@ -71,17 +73,19 @@ def _swash_plate(mech, phi):
     return s, ds, dds, np.full(n, mech.halves * mech.piston_area), stroke(mech)
 
 
-#: Per mechanism name: (mechanism, φ (m,)) → s, s′, s″ (n, m), area (n,), stroke (n,).
-KINEMATICS = {"crank-slider": _crank_slider, "articulated": _articulated,
-              "swash-plate": _swash_plate}
+#: Per mechanism name (capability ``"pistons"``): (mechanism, φ (m,)) → s, s′, s″ (n, m), area (n,), stroke (n,).
+#: A mechanism's own module of :mod:`transient.analysis.loads` may hold it as
+#: ``piston_travel``.
+KINEMATICS = PluginTable({"crank-slider": _crank_slider, "articulated": _articulated,
+                          "swash-plate": _swash_plate},
+                         "transient.analysis.loads.{}", "piston_travel")
 
 
 def piston_kinematics(mech, phi: ArrayLike) -> Pistons:
-    """:class:`Pistons` of ``mech`` at the shaft angles ``phi`` [rad]; ValueError for a
-    mechanism without an entry in :data:`KINEMATICS`."""
-    law = KINEMATICS.get(mech.name)
-    if law is None:
-        raise ValueError(f"no piston kinematics for {type(mech).__name__}")
+    """:class:`Pistons` of ``mech`` at the shaft angles ``phi`` [rad] (capability
+    ``"pistons"``, which every mechanism has: :class:`~transient.mechanisms.MissingCapability`
+    for one without it)."""
+    law = needed(mech, "pistons", KINEMATICS)
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     return Pistons(*law(mech, phi))
 

@@ -53,7 +53,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
+from ..mechanisms import PluginTable, provider
 from .irregularity import cycle_boundaries
+from .loads.common import stored_record
 from .orders import order_spectrum, resolve_detrend, to_angle_grid
 from .pistons import piston_kinematics
 from .thermo import cycle_thermodynamics
@@ -152,22 +154,11 @@ def stored_loads(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     names += [f"p_{k + 1}" for k in range(mech.n_cylinders) if f"p_{k + 1}" in traj]
     grid, cols = to_angle_grid(traj, names, n, mech.cycle, phi0=scene.initial.phi, cycles=1,
                                cuts=cuts)
-    store = LOADS.get(mech.name)
+    store = provider(mech, "loads", LOADS)
     if store is None:
         raise SceneError("analysis.loads", f"loads are not computed for {type(mech).__name__}; "
                                            f"allowed here: false")
     return store(scene, grid, {"phi": grid, **cols})
-
-
-def _stored_record(ld, grid, forces) -> dict[str, tuple[Any, str]]:
-    """What every mechanism stores: the grid, the forces named [N], the cylinders' torques and
-    the engine torque [N m]."""
-    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
-    for name in forces:
-        out[f"loads_{name}"] = (getattr(ld, name), "N")
-    out["loads_torque"] = (ld.torque, "N m")
-    out["loads_engine_torque"] = (ld.engine_torque, "N m")
-    return out
 
 
 def _stored_crank_slider_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
@@ -177,7 +168,7 @@ def _stored_crank_slider_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
 
     mech = scene.mechanism
     ld = loads_from_trajectory(scene, traj)
-    out = _stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R"))
+    out = stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R"))
     out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
     journals, pins = running_torques(mech, ld)
     mj = main_journal_loads(mech, ld, traj["omega"], traj["epsilon"])
@@ -195,7 +186,7 @@ def _stored_articulated_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
     from .loads.articulated import articulated_loads_from_trajectory
 
     ld = articulated_loads_from_trajectory(scene, traj)
-    out = _stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R", "link_x",
+    out = stored_record(ld, grid, ("P", "N", "S", "K", "T", "R_K", "R_T", "R", "link_x",
                                     "link_y"))
     out["loads_crankpin_R_max"] = (ld.R.max(axis=1), "N")
     out["loads_link_R_max"] = (ld.link_R.max(axis=1), "N")
@@ -208,12 +199,16 @@ def _stored_swash_loads(scene, grid, traj) -> dict[str, tuple[Any, str]]:
     from .loads.swash_plate import swash_loads_from_trajectory
 
     ld = swash_loads_from_trajectory(scene, traj)
-    out = _stored_record(ld, grid, ("P", "S", "N_radial", "N_tangential"))
+    out = stored_record(ld, grid, ("P", "S", "N_radial", "N_tangential"))
     out["loads_shaft_torque"] = (ld.shaft_torque, "N m")
     return out
 
 
-#: The storer of each mechanism's loads by its name in :data:`transient.mechanisms.MECHANISMS`:
+#: The storer of each mechanism's loads (capability ``"loads"``) by its name in
+#: :data:`transient.mechanisms.MECHANISMS`:
 #: (scene, angle grid, trajectory on it) → name → (value, unit).
-LOADS = {"crank-slider": _stored_crank_slider_loads, "articulated": _stored_articulated_loads,
-         "swash-plate": _stored_swash_loads}
+#: a mechanism's own module of :mod:`transient.analysis.loads` may hold it as ``stored_loads``.
+LOADS = PluginTable({"crank-slider": _stored_crank_slider_loads,
+                     "articulated": _stored_articulated_loads,
+                     "swash-plate": _stored_swash_loads},
+                    "transient.analysis.loads.{}", "stored_loads")

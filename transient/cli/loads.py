@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
+from ..mechanisms import MECHANISMS, PluginTable, provider, provides
 from ..mechanisms.crank_slider import MAX_CYLINDERS
 from .common import (
     EXIT_OK,
@@ -43,9 +44,10 @@ def _loads_scene(res):
     """The result's scene, or a one-line error (exit 2) if ``transient loads`` draws nothing for
     its mechanism (:data:`DRAWERS`)."""
     scene = res.scene()
-    if scene.mechanism.name not in DRAWERS:
-        raise SceneError("mechanism.type", f"load diagrams are drawn for crank-slider and "
-                                           f"articulated engines, not "
+    if provider(scene.mechanism, "drawers", DRAWERS) is None:
+        drawn = " and ".join(name for name, cls in MECHANISMS.items()
+                             if provides(cls, "drawers"))
+        raise SceneError("mechanism.type", f"load diagrams are drawn for {drawn} engines, not "
                                            f"{type(scene.mechanism).__name__} (its forces are "
                                            f"stored by [analysis] loads = true)",
                          file=str(res.path))
@@ -65,7 +67,7 @@ def _diagrams(compute, res, *args):
 def cmd_loads(args) -> int:
     res = read_result(args.result)
     scene = _loads_scene(res)
-    return DRAWERS[scene.mechanism.name](args, res, scene)
+    return provider(scene.mechanism, "drawers", DRAWERS)(args, res, scene)
 
 
 def _crank_slider_loads(args, res, scene) -> int:
@@ -284,7 +286,9 @@ def articulated_figures(scene, d):
     yield "loads_crankpin", fig
 
 
-#: What ``transient loads`` draws, by the mechanism's name in
+#: What ``transient loads`` draws (capability ``"drawers"``), by the mechanism's name in
 #: :data:`transient.mechanisms.MECHANISMS`; other mechanisms store their forces through
 #: ``[analysis] loads = true`` instead.
-DRAWERS = {"crank-slider": _crank_slider_loads, "articulated": _radial_loads}
+#: A mechanism's own module ``transient.cli.loads_<name>`` may hold it as ``draw``.
+DRAWERS = PluginTable({"crank-slider": _crank_slider_loads, "articulated": _radial_loads},
+                      "transient.cli.loads_{}", "draw")

@@ -149,6 +149,23 @@ class _Kernel(CPUDispatcher):
     def _numba_type_(self):
         return _KernelArgument(self)
 
+    def __reduce__(self):
+        """A kernel of a module pickles by its module and name, as its type does: a Model that
+        holds kernels (``Model.terms``) reaches another process (the compile helper,
+        :mod:`transient.precompile`) as the kernels that process imports, not as copies
+        compiled apart."""
+        module, name = self.py_func.__module__, self.py_func.__qualname__
+        if "<locals>" in name:
+            return super().__reduce__()
+        return _kernel_named, (module, name)
+
+
+def _kernel_named(module: str, name: str):
+    """The kernel ``name`` of ``module``, imported (:meth:`_Kernel.__reduce__`)."""
+    import importlib
+
+    return getattr(importlib.import_module(module), name)
+
 
 class _CalledFromCompiledCode(_Kernel):
     """A kernel compiled without numba's Python wrappers (``no_cpython_wrapper``,

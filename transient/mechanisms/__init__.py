@@ -6,34 +6,27 @@ A mechanism maps the shaft angle φ to the positions of its bodies and gives the
 J(φ), dJ/dφ and the piston transfer functions u_k(φ) = ds_k/dφ, u′_k(φ): in the compiled core
 for the stepper, in plain Python for the reference path.
 
-Adding a mechanism takes
-
-1. its compiled kernel, ``transient/core/<name>.py``: ``<name>_terms(mp, φ, u, du) -> (J, dJ/dφ)``
-   filling u_k and u′_k, a kind code in :mod:`transient.core.model.layout` and its branch in
-   ``transient.core.model.forcing.mechanism_terms`` (the stepper and the kinematics tables reach it
-   there);
-2. its mechanism file, ``transient/mechanisms/<name>.py``: a frozen dataclass in SI with the
-   members of :class:`Mechanism` (read from its ``[mechanism]`` table, validated, packed for
-   the kernel, written back to TOML);
-3. its loads analysis: a module of :mod:`transient.analysis` and its line in
-   ``transient.analysis.requested.LOADS`` (without one, ``[analysis] loads = true`` is refused
-   for it: the analyses sit above the mechanisms, so a mechanism cannot name them itself),
-   its pistons' travel in ``transient.analysis.pistons.KINEMATICS`` (cylinder volumes, piston
-   accelerations, each cylinder's torque),
-   and, if ``transient loads`` is to draw its diagrams, a line in
-   ``transient.cli.loads.DRAWERS``;
-4. one line in :data:`MECHANISMS` below.
+What a mechanism provides beyond :class:`Mechanism` it claims in its ``capabilities``, each
+named in :data:`CAPABILITIES`: the mechanism layer's are Protocols here (:class:`ReactionFriction`,
+:class:`NumpyTwin`), the analyses' (which sit above the mechanisms, so a mechanism cannot name
+them) are tables keyed by the mechanism's name in the layer that holds them. Every place that
+branches on the mechanism asks :func:`provider`, which errors for a mechanism that does not claim
+the capability and for one that claims it without a provider, never falls through to another
+mechanism's code; ``tests/unit/test_mechanism_registry.py`` holds every registered mechanism to
+its claims. Adding a mechanism is ``docs/developer/mechanisms.md``.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
+import dataclasses
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .articulated import Articulated
 from .crank_slider import CrankSlider
+from .scotch_yoke import ScotchYoke
 from .swash_plate import SwashPlate
 
 if TYPE_CHECKING:
@@ -50,9 +43,12 @@ class Mechanism(Protocol):
     #: Its ``type`` in the ``[mechanism]`` table and its key in :data:`MECHANISMS`; the resolved
     #: scene writes it back (:meth:`toml_lines`) and errors name it.
     name: ClassVar[str]
-    #: ``Model.kind`` of its kernel in the compiled core (:mod:`transient.core.model.layout`), for
-    #: ``transient.assemble`` and the kinematics tables.
-    kind: ClassVar[int]
+    #: Its compiled kernel's entry, ``terms(mp, kin_coef, φ, u, u′, with_dJ) -> (J, dJ/dφ)``
+    #: filling u_k, u′_k (``Model.terms``, :mod:`transient.core.model.layout`): the stepper is
+    #: compiled for it, and the kinematics tables sample it.
+    kernel: ClassVar[Any]
+    #: What it provides beyond this Protocol, names of :data:`CAPABILITIES`.
+    capabilities: ClassVar[frozenset[str]]
     #: The links of its serial chain, shaft first: a friction pair joins two neighbours
     #: (the scene's ``[friction]``, the chain of ``transient.assemble`` and the reference path).
     #: The first carries the shaft's inertia and the load, the last the gas forces (the
@@ -73,8 +69,7 @@ class Mechanism(Protocol):
     key_meanings: ClassVar[dict[str, dict[str, str]]]
     #: Whether every piston follows the crank-slider law s(φ − φ_k) of ``crank_radius``,
     #: ``rod_length`` and ``offset`` (the odd-harmonic report then uses that closed form; other
-    #: pistons' s′, s″ come from ``transient.analysis.pistons``, which needs a line for a new
-    #: mechanism).
+    #: pistons' s′, s″ come from their capability ``"pistons"``).
     slider_law: ClassVar[bool]
     #: 2 or 4: the gas cycle's length, ``cycle`` = π·strokes.
     strokes: int
@@ -160,13 +155,191 @@ class Mechanism(Protocol):
         {} if it has none."""
 
 
+@runtime_checkable
+class ReactionFriction(Protocol):
+    """Friction on the joints' reactions (``model = "reaction"`` pairs, capability
+    ``"reaction-friction"``): its joints, its compiled solver, where its joints reverse, and the
+    checks that its equations stay solvable (wedging)."""
+
+    #: Its links for reaction pairs, shaft side first (the frame last).
+    reaction_links: ClassVar[tuple[str, ...]]
+    #: The joints reaction pairs may name, (shaft-side link, far link), in the order of the rows
+    #: of ``Model.rx_par``.
+    reaction_joints: ClassVar[tuple[tuple[str, str], ...]]
+    #: The joint where a constant-η or mapped pair may sit among reaction pairs (the main
+    #: bearings, ``transient.core.model.reactions``), or None where none may.
+    shaft_coupling: ClassVar[tuple[str, str] | None]
+    #: Its compiled solver's kernels (prepare, solve, inverse_drive): ``Model.rx_prepare``,
+    #: ``rx_solve``, ``rx_inverse``.
+    reaction_kernels: ClassVar[tuple[Any, Any, Any]]
+    #: Whether its solve leaves each cylinder's side force for the stepper's side tracking
+    #: (``Model.rx_sides``).
+    tracks_sides: ClassVar[bool]
+
+    @property
+    def ideal_reaction_joints(self) -> dict[str, str]:
+        """Joints (by their shaft-side link) that cannot have friction on their reactions, each
+        with why, for the scene's error."""
+
+    def reaction_reversals(self) -> NDArray[np.float64]:
+        """Shaft angles [rad] in [0, cycle) where a joint's relative motion reverses while ω
+        keeps its sign: breakpoints, so that no step straddles a friction force's reversal."""
+
+    def check_wedging(self, s: Section, pairs, raw) -> None:
+        """Raise :class:`~transient.errors.SceneError` (naming the pair as the user wrote it,
+        ``raw`` the pairs' tables as written) where a reaction pair's friction could wedge the
+        mechanism: its equations must keep one solution over the whole cycle."""
+
+
+@runtime_checkable
+class NumpyTwin(Protocol):
+    """A plain-numpy twin of its kernel (capability ``"twin"``), written from the equations
+    again, for the reference path, which must not share the compiled code it checks; a mechanism
+    without one runs its kernel's Python code there (:class:`~.twins.KernelTwin`)."""
+
+    #: Built from the mechanism, its ``terms(φ)`` gives (J, dJ/dφ, u_k, u′_k).
+    twin: ClassVar[type]
+
+
+#: Every capability a mechanism may claim, and who provides it: a Protocol of this module (the
+#: mechanism itself), or the table that holds it keyed by the mechanism's name.
+CAPABILITIES: dict[str, type | str] = {
+    "reaction-friction": ReactionFriction,
+    "twin": NumpyTwin,
+    "reaction-twin": "transient.reference.integrate.REACTION_TWINS",
+    "pistons": "transient.analysis.pistons.KINEMATICS",
+    "loads": "transient.analysis.requested.LOADS",
+    "drawers": "transient.cli.loads.DRAWERS",
+}
+
+
+#: Capabilities that claim others: the reference path checks reaction friction by its twin.
+IMPLIES: dict[str, tuple[str, ...]] = {"reaction-friction": ("reaction-twin",)}
+
+
+class PluginTable(Mapping[str, Any]):
+    """A table of a layer above the mechanisms (an analysis's, keyed by mechanism name) whose
+    entries are its own or live in one module per mechanism of that layer: ``module`` with
+    ``{}`` for the mechanism's name in snake case (``"scotch-yoke"`` → ``scotch_yoke``) and
+    ``attr`` the entry's name there. A mechanism's plugin thus adds its analysis as a file of
+    its own, imported when first asked for; the layer names the module, so nothing imports
+    upward."""
+
+    def __init__(self, own: Mapping[str, Any], module: str, attr: str) -> None:
+        self.own, self.module, self.attr = dict(own), module, attr
+
+    def _found(self, name: str):
+        import importlib
+        import importlib.util
+
+        where = self.module.format(name.replace("-", "_"))
+        if name not in MECHANISMS or importlib.util.find_spec(where) is None:
+            return None
+        return getattr(importlib.import_module(where), self.attr, None)
+
+    def __getitem__(self, name: str):
+        if name in self.own:
+            return self.own[name]
+        found = self._found(name)
+        if found is None:
+            raise KeyError(name)
+        return found
+
+    def __iter__(self):
+        return iter([n for n in MECHANISMS if n in self])
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+    def __contains__(self, name: object) -> bool:
+        return isinstance(name, str) and (name in self.own or self._found(name) is not None)
+
+    def __repr__(self) -> str:
+        return f"{self.module}.{self.attr}"
+
+
+class MissingCapability(LookupError):
+    """A mechanism claims a capability that nothing provides for it (a defect of the mechanism's
+    plugin, not of the scene)."""
+
+
+def provides(mech, capability: str) -> bool:
+    """Whether ``mech`` (a mechanism or its class) claims ``capability``; an unknown name is an
+    error."""
+    if capability not in CAPABILITIES:
+        raise ValueError(f"unknown capability {capability!r}; known: {', '.join(CAPABILITIES)}")
+    return capability in mech.capabilities
+
+
+def provider(mech, capability: str, table: Mapping[str, Any]):
+    """``table[mech.name]``, the provider of ``capability`` for ``mech``; None if it does not
+    claim it (the caller refuses the request with its own message); :class:`MissingCapability`
+    if it claims it and ``table`` has no entry for it."""
+    if not provides(mech, capability):
+        return None
+    try:
+        return table[mech.name]
+    except KeyError:
+        raise MissingCapability(f"{mech.name!r} claims {capability!r}, which "
+                                f"{CAPABILITIES[capability]} does not provide for it") from None
+
+
+def needed(mech, capability: str, table: Mapping[str, Any]):
+    """:func:`provider` where the caller cannot go on without it: :class:`MissingCapability`
+    if ``mech`` does not claim ``capability`` either (:data:`IMPLIES` keeps it from happening)."""
+    found = provider(mech, capability, table)
+    if found is None:
+        raise MissingCapability(f"{mech.name!r} does not claim {capability!r}, which is needed "
+                                f"here")
+    return found
+
+
+def protocol_members(protocol: type) -> set[str]:
+    """The names a class must have to follow ``protocol``: its annotated attributes and its
+    methods and properties."""
+    names = set(getattr(protocol, "__annotations__", {}))
+    names |= {n for n, v in vars(protocol).items()
+              if not n.startswith("_") and (callable(v) or isinstance(v, (property,
+                                                                           classmethod)))}
+    return names
+
+
+def capability_gaps(cls: type, tables: Mapping[str, Mapping[str, Any]]) -> list[str]:
+    """What mechanism class ``cls`` lacks of :class:`Mechanism` and of what it claims, one line
+    each ([] if nothing): a claimed name not in :data:`CAPABILITIES`, a member of a claimed
+    Protocol it does not define, a claimed table capability with no entry in ``tables`` (its
+    table by capability name), an entry there it does not claim, a claim :data:`IMPLIES` that
+    it does not make."""
+    fields = {f.name for f in dataclasses.fields(cls)} if dataclasses.is_dataclass(cls) else set()
+
+    def lacks(name: str) -> bool:
+        return name not in fields and not any(name in vars(c) for c in cls.__mro__)
+
+    gaps = [f"{cls.__name__} lacks {name!r} of Mechanism"
+            for name in sorted(protocol_members(Mechanism)) if lacks(name)]
+    for cap in sorted(cls.capabilities):
+        what = CAPABILITIES.get(cap)
+        if what is None:
+            gaps.append(f"{cls.__name__} claims {cap!r}, not a capability")
+        elif isinstance(what, type):
+            gaps += [f"{cls.__name__} claims {cap!r} but lacks {name!r} of {what.__name__}"
+                     for name in sorted(protocol_members(what)) if lacks(name)]
+        gaps += [f"{cls.__name__} claims {cap!r} but not {also!r}, which it implies"
+                 for also in IMPLIES.get(cap, ()) if also not in cls.capabilities]
+    for cap, table in tables.items():
+        claimed, listed = cap in cls.capabilities, cls.name in table
+        if claimed and not listed:
+            gaps.append(f"{cls.__name__} claims {cap!r} but {CAPABILITIES[cap]} has no "
+                        f"{cls.name!r}")
+        if listed and not claimed:
+            gaps.append(f"{CAPABILITIES[cap]} has {cls.name!r}, which does not claim {cap!r}")
+    return gaps
+
+
 def reaction_joints(mech) -> tuple[tuple[str, str], ...]:
-    """The joints that pairs with friction on their reactions may name, (shaft-side link, far
-    link) in the order of the rows of ``Model.rx_par``: the mechanism's own
-    ``reaction_joints``, else the neighbours of its ``reaction_links`` (a chain, as the
-    crank-slider's); () if it has no reaction friction."""
-    links = getattr(mech, "reaction_links", ())
-    return getattr(mech, "reaction_joints", tuple(zip(links, links[1:])))
+    """The joints that pairs with friction on their reactions may name, in the order of the rows
+    of ``Model.rx_par``; () if it has no reaction friction."""
+    return mech.reaction_joints if provides(mech, "reaction-friction") else ()
 
 
 #: Every mechanism by its ``type`` in the ``[mechanism]`` table.
@@ -174,4 +347,5 @@ MECHANISMS: dict[str, type[Mechanism]] = {
     "crank-slider": CrankSlider,
     "swash-plate": SwashPlate,
     "articulated": Articulated,
+    "scotch-yoke": ScotchYoke,
 }

@@ -29,19 +29,21 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from math import cos, degrees, hypot, pi, sin, sqrt
-from typing import TYPE_CHECKING
+from math import cos, degrees, hypot, inf, pi, sin, sqrt
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..core.model import articulated as core
-from ..core.model.layout import ARTICULATED, LINK_FIXED, LINK_PISTONS, LINK_REST
+from ..core.model import articulated_friction
+from ..core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
 from ..units import Named
 from .crank_slider import CrankSlider
+from .throws import at_phases
 from .twins import KernelTwin
 
 if TYPE_CHECKING:
@@ -169,8 +171,12 @@ class Articulated:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "articulated"
-    #: Model.kind of the compiled kernel (transient.core.model.layout.ARTICULATED).
-    kind = ARTICULATED
+    #: Its compiled kernel (``Model.terms``).
+    kernel = staticmethod(core.terms)
+    #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`):
+    #: no numpy twin (the reference path runs the kernel's Python code).
+    capabilities = frozenset({"reaction-friction", "reaction-twin", "pistons", "loads",
+                              "drawers"})
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
     cylinder_count = "mechanism.rows × (1 + the slaves in mechanism.bank)"
@@ -195,6 +201,13 @@ class Articulated:
     #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
     #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.model.reactions`).
     shaft_coupling = ("shaft", "crank")
+    #: The solver of :mod:`transient.core.model.articulated_friction`, which keeps its side
+    #: forces apart from the crank-slider's side tracking.
+    reaction_kernels = (articulated_friction.prepare, articulated_friction.solve,
+                        articulated_friction.inverse_drive)
+    tracks_sides = False
+    #: No joint of it is kept ideal.
+    ideal_reaction_joints: ClassVar[dict[str, str]] = {}
 
     # -- sizes and constants ---------------------------------------------------------------------
     @property
@@ -436,6 +449,45 @@ class Articulated:
         return self.master().volume_function(clearance)
 
     def reaction_reversals(self) -> NDArray[np.float64]:
+        """Shaft angles [rad] in [0, cycle) where a joint's relative motion reverses: the row's
+        (:meth:`row_reversals`) at each row's phase."""
+        return at_phases(self.row_reversals(), self.row_phases, self.cycle)
+
+    def check_wedging(self, s: Section, pairs, raw) -> None:
+        """Friction must not wedge a rod: as for the crank-slider
+        (:meth:`CrankSlider.check_wedging`), each rod's equation in its piston's side force has a
+        slope of at least c (1 − q), q = μ_slider tan β_max + (μ r of its two pins)(1 +
+        μ_slider)/c with c = l cos β_max at its largest angle to its cylinder (the master rod:
+        sin β_max = λ; slave rod i: its link pin's largest offset from its axis over l_i,
+        :func:`slave_reach`); q < 1 for every rod keeps the row's equations solvable
+        (:mod:`transient.core.model.articulated_friction`)."""
+        by_joint = {p.between: p for p in pairs}
+        joints = self.reaction_joints
+
+        def mu_r(j: int) -> float:
+            p = by_joint.get(joints[j])
+            return p.mu * p.radius if p is not None else 0.0
+
+        slider = by_joint.get(joints[5])
+        mu_s = slider.mu if slider is not None else 0.0
+        rods = [(self.rod_length, self.crank_radius, mu_r(1) + mu_r(3), "master rod")]
+        rods += [(li, h, mu_r(2) + mu_r(4), f"slave rod {i + 1}")
+                 for i, (li, h) in enumerate(zip(self.slave_lengths, slave_reach(self)))]
+        for length, reach, mr, rod in rods:
+            sin_b = reach / length
+            cos_b = sqrt(max(1.0 - sin_b * sin_b, 0.0))
+            c = length * cos_b
+            q = (mu_s * sin_b / cos_b + mr * (1.0 + mu_s) / c) if cos_b > 0.0 else inf
+            if q >= 1.0:
+                i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
+                         and item.get("between", [None])[-1] in ("cylinder", "piston",
+                                                                  "slave rod", "master rod"))
+                raise SceneError(f"{s.key('pairs')}[{i}].mu",
+                                 f"the friction would wedge the {rod}: μ_slider·tan β_max + "
+                                 f"(μ·r of its pins)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; "
+                                 f"allowed below 1 (lubricated pairs are around 0.01)")
+
+    def row_reversals(self) -> NDArray[np.float64]:
         """Local angles α [rad] in [0, 2π) of a row where a joint's relative rate changes sign
         (:mod:`transient.core.model.articulated_friction`, *Directions*): the master piston's dead
         centres 0, π and the master rod's β′ = 0 at π/2, 3π/2 exactly; per slave the roots of
@@ -451,8 +503,9 @@ class Articulated:
                     if f[j] == 0.0:
                         out.append(float(grid[j]))
                     elif f[j + 1] != 0.0:
-                        root = bisect_root(lambda a, which=which, i=i: _slave_rates(self, a)[which, i], grid[j],
-                                           grid[j + 1])
+                        root = bisect_root(
+                            lambda a, which=which, i=i: _slave_rates(self, a)[which, i],
+                            grid[j], grid[j + 1])
                         out.append(float(root))
         return np.unique(np.mod(np.array(out), 2.0 * pi))
 

@@ -25,12 +25,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.model import crank_slider as core
-from ..core.model.layout import CRANK_SLIDER, LINK_FIXED, LINK_PISTONS, LINK_REST
+from ..core.model import joint_friction
+from ..core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST
 from ..errors import SceneError
 from ..tomlout import toml_value
 from ..units import Named
 from . import throws
-from .throws import ANGLE_TOL, SHARED, SINGLE, equal_angles, read_crank, wrap_angle
+from .throws import ANGLE_TOL, SHARED, SINGLE, at_phases, equal_angles, read_crank, wrap_angle
 from .twins import CrankSliderNumpy
 
 if TYPE_CHECKING:
@@ -133,8 +134,13 @@ class CrankSlider:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "crank-slider"
-    #: Model.kind of the compiled kernel (transient.core.model.layout.CRANK_SLIDER).
-    kind = CRANK_SLIDER
+    #: Its compiled kernel (``Model.terms``).
+    kernel = staticmethod(core.terms)
+    #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`).
+    capabilities = frozenset({"reaction-friction", "twin", "reaction-twin", "pistons", "loads",
+                              "drawers"})
+    #: Its numpy twin, for the reference path.
+    twin = CrankSliderNumpy
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
     wall_heat_transfer = True
     cylinder_count = "mechanism.cylinders"
@@ -153,6 +159,12 @@ class CrankSlider:
     #: the piston is a link of its own and the cylinder (the frame) the last, so the pairs are
     #: the main bearings, the crankpins, the piston pins and the pistons in their cylinders.
     reaction_links = ("shaft", "crank", "rod", "piston", "cylinder")
+    #: The joints reaction pairs may name: each link with its neighbour (a chain).
+    reaction_joints = tuple(zip(reaction_links, reaction_links[1:]))
+    #: The solver of :mod:`transient.core.model.joint_friction`, which leaves each cylinder's
+    #: side force for the stepper's side tracking.
+    reaction_kernels = (joint_friction.prepare, joint_friction.solve, joint_friction.inverse_drive)
+    tracks_sides = True
     #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
     #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.model.reactions`).
     shaft_coupling = ("shaft", "crank")
@@ -185,6 +197,33 @@ class CrankSlider:
             return {"crank": "the crankpin of fork-and-blade rods, where the blade turns on the "
                              "fork's big end, which carries both rods' forces"}
         return {}
+
+    def reaction_reversals(self) -> NDArray[np.float64]:
+        """Shaft angles in [0, cycle) where a joint's relative motion reverses: each piston's
+        dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α,
+        :mod:`transient.core.model.joint_friction`)."""
+        tdc, bdc = self.dead_centre_angles()
+        return at_phases([tdc, 0.5 * pi, bdc, 1.5 * pi], self.firing_angles, self.cycle)
+
+    def check_wedging(self, s: Section, pairs, raw) -> None:
+        """Friction must not wedge the crank-slider: the rod's equation in the side force N has a
+        slope of at least l cos β (1 − q), q = μ_s tan β + (μ r of crankpin and pin)(1 + μ_s)/(l
+        cos β) at the largest rod angle (:mod:`transient.core.model.joint_friction`); q < 1
+        keeps it increasing, hence one solution at every state."""
+        r, l, e = self.crank_radius, self.rod_length, self.offset
+        sin_b = (r + abs(e)) / l
+        cos_b = math.sqrt(max(1.0 - sin_b * sin_b, 0.0))
+        by_joint = {p.between[0]: p for p in pairs}
+        mu_s = by_joint["piston"].mu if "piston" in by_joint else 0.0
+        mr = sum(by_joint[j].mu * by_joint[j].radius for j in ("crank", "rod") if j in by_joint)
+        q = (mu_s * sin_b / cos_b + mr * (1.0 + mu_s) / (l * cos_b)) if cos_b > 0.0 else math.inf
+        if q >= 1.0:
+            i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
+                     and item.get("between", [None])[0] in ("piston", "crank", "rod"))
+            raise SceneError(f"{s.key('pairs')}[{i}].mu",
+                             f"the friction would wedge the mechanism: μ_slider·tan β_max + "
+                             f"(μ·r of crankpin and pin)(1 + μ_slider)/(l cos β_max) = {q:.3g} "
+                             f"≥ 1; allowed below 1 (lubricated pairs are around 0.01)")
 
     def throw_of_cylinder(self) -> NDArray[np.intp]:
         """The throw (0-based, from the nose) each cylinder rides on."""
@@ -480,7 +519,7 @@ class CrankSlider:
     def reference_terms(self) -> Callable[[float], tuple]:
         """φ ↦ (J, dJ/dφ, u_k, u′_k) for the reference path: the numpy twin written from the Gots
         relations (:class:`~.twins.CrankSliderNumpy`), independent of the kernel."""
-        return CrankSliderNumpy(self).terms
+        return self.twin(self).terms
 
     def analysis_summary(self) -> dict[str, tuple[float, str]]:
         """Figures of the mechanism itself for a result's ``/analysis``: none here."""

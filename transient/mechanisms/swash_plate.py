@@ -46,14 +46,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
-from math import asin, cos, degrees, inf, pi, sin
+from math import asin, atan, cos, degrees, inf, pi, sin, tan
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..core.model import swash_friction
 from ..core.model import swash_plate as core
-from ..core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH, SWASH_PLATE
+from ..core.model.layout import LINK_FIXED, LINK_PISTONS, LINK_REST, LINK_SWASH
 from ..errors import SceneError
 from ..roots import bisect_root
 from ..tomlout import toml_value
@@ -169,8 +170,11 @@ class SwashPlate:
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
     name = "swash-plate"
-    #: Model.kind of the compiled kernel (transient.core.model.layout.SWASH_PLATE).
-    kind = SWASH_PLATE
+    #: Its compiled kernel (``Model.terms``).
+    kernel = staticmethod(core.terms)
+    #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`):
+    #: no numpy twin (the reference path runs the kernel's Python code), no load diagrams.
+    capabilities = frozenset({"reaction-friction", "reaction-twin", "pistons", "loads"})
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
     wall_heat_transfer = False
     cylinder_count = "mechanism.cylinders"
@@ -202,6 +206,15 @@ class SwashPlate:
     #: whose rods' spin about their own axes the solver does not carry.
     ideal_reaction_joints = {"link": "the ball joints B_k of the rods on link 9",
                              "rod": "the ball joints D_k of the rods on the pistons"}
+    #: The joints reaction pairs may name: each link with its neighbour (a chain).
+    reaction_joints = tuple(zip(reaction_links, reaction_links[1:]))
+    #: No constant-η or mapped pair among reaction pairs: the main bearing sits in the shaft's
+    #: equation itself (:mod:`transient.core.model.reactions`).
+    shaft_coupling = None
+    #: The solver of :mod:`transient.core.model.swash_friction`, which keeps its side forces
+    #: apart from the crank-slider's side tracking.
+    reaction_kernels = (swash_friction.prepare, swash_friction.solve, swash_friction.inverse_drive)
+    tracks_sides = False
 
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia of each link besides the shaft's: none here [kg m²]."""
@@ -218,13 +231,32 @@ class SwashPlate:
         :func:`max_offset`): asin(lateral offset/ℓ)."""
         return asin(max_offset(self) / self.rod_length)
 
-    def joint_reversals(self) -> tuple[float, ...]:
-        """Shaft angles [rad] at which a joint with reaction friction reverses its relative
-        motion: every piston's dead centres (the main and plate bearings turn one way while ω
-        keeps its sign; ``transient.core.model.swash_friction``)."""
+    def reaction_reversals(self) -> NDArray[np.float64]:
+        """Shaft angles [rad] in [0, cycle) at which a joint with reaction friction reverses its
+        relative motion: every piston's dead centres (the main and plate bearings turn one way
+        while ω keeps its sign; ``transient.core.model.swash_friction``)."""
         inner, outer = dead_centres(self)
-        return tuple(self.firing_angles) + tuple(
+        angles = tuple(self.firing_angles) + tuple(
             _snapped(a, 2.0 * pi * k / self.cylinders + pi) for k, a in enumerate(outer))
+        return np.unique(np.mod(np.asarray(angles, dtype=np.float64), self.cycle))
+
+    def check_wedging(self, s: Section, pairs, raw) -> None:
+        """Friction must not wedge the pistons: each piston's friction equation has a slope of
+        at least 1 − μ tan γ in its friction force, γ the largest rod tilt to the cylinder axis
+        (:mod:`transient.core.model.swash_friction`); μ tan γ < 1 keeps it increasing, hence one
+        solution at every state."""
+        piston = next((p for p in pairs if p.between[0] == "piston"), None)
+        if piston is None:
+            return
+        tan_g = tan(self.max_rod_tilt())
+        if piston.mu * tan_g >= 1.0:
+            i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
+                     and item.get("between", [None])[0] == "piston")
+            raise SceneError(f"{s.key('pairs')}[{i}].mu",
+                             f"the friction would wedge the pistons: μ·tan γ_max = "
+                             f"{piston.mu * tan_g:.3g} ≥ 1 at the largest rod tilt "
+                             f"γ_max = {degrees(atan(tan_g)):.3g}°; allowed "
+                             f"μ < {1.0 / tan_g:.3g}")
 
     @property
     def n_cylinders(self) -> int:

@@ -19,6 +19,7 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import SceneError
 from ..units import SUFFIXES, Named
@@ -242,3 +243,13 @@ def wrap_angle(x, period: float = TWO_PI):
 
 def _degrees(angles, digits: int = 4) -> list[float]:
     return [round(math.degrees(a), digits) for a in angles]
+
+
+def at_phases(local, phases, cycle: float) -> NDArray[np.float64]:
+    """Shaft angles [rad] in [0, ``cycle``), sorted and unique, where a row (a cylinder, or a row
+    of cylinders) at each of ``phases`` passes the ``local`` angles of its turn, every turn of
+    the cycle: where a joint's motion reverses, as a breakpoint."""
+    turns = np.arange(0.0, cycle - 1e-9, TWO_PI)
+    angles = np.add.outer(np.asarray(phases, dtype=np.float64),
+                          np.add.outer(turns, np.asarray(local, dtype=np.float64))).ravel()
+    return np.unique(np.mod(angles, cycle))

@@ -30,6 +30,7 @@ from ..core.model.forcing import generator_branch, load_segment
 from ..core.model.layout import T
 from ..core.model.variation import PRESSURE, SHIFT, cycle_fuel
 from ..errors import SimulationError
+from ..mechanisms import PluginTable, needed
 from ..scene.queries import gas_tables
 from .twins import (
     ArticulatedReactionNumpy,
@@ -39,6 +40,15 @@ from .twins import (
     ReactionNumpy,
     SwashReactionNumpy,
 )
+
+#: The numpy twin of each mechanism's reaction solver, by its name in
+#: :data:`transient.mechanisms.MECHANISMS` (capability ``"reaction-twin"``).
+#: A mechanism's own module ``transient.reference.reaction_<name>`` may hold it as
+#: ``ReactionTwin``.
+REACTION_TWINS = PluginTable({"crank-slider": ReactionNumpy,
+                              "articulated": ArticulatedReactionNumpy,
+                              "swash-plate": SwashReactionNumpy},
+                             "transient.reference.reaction_{}", "ReactionTwin")
 
 
 class ReferenceModel:
@@ -62,9 +72,9 @@ class ReferenceModel:
         self.chain = None  # the non-ideal pairs: a serial chain, or the joints' reactions
         if scene.friction.pairs:
             reaction = any(p.model == "reaction" for p in scene.friction.pairs)
-            own = {"articulated": ArticulatedReactionNumpy, "swash-plate": SwashReactionNumpy}
             self.chain = (ChainNumpy(scene) if not reaction else
-                          own.get(scene.mechanism.name, ReactionNumpy)(scene, self.model))
+                          needed(scene.mechanism, "reaction-twin", REACTION_TWINS)(scene,
+                                                                                   self.model))
         self.sigma = 1.0 if w0 >= 0 else -1.0
         m = self.model
         # the load schedule's segment and the generator's branch, switched at terminal events

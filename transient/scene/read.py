@@ -14,8 +14,7 @@ from pathlib import Path
 
 from ..errors import SceneError
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
-from ..mechanisms import MECHANISMS, reaction_joints
-from ..mechanisms.articulated import slave_reach
+from ..mechanisms import MECHANISMS, provides, reaction_joints
 from ..units import ALL_SUFFIXES
 from .budget import check_work
 from .checks import check_analysis, check_consistency, check_gas_table, check_magnitudes
@@ -591,17 +590,18 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
     for i, ps in enumerate(sections):
         model = ps.string("model", "constant-eta", choices=PAIR_MODELS)
         links = mech.links
+        reacting = provides(mech, "reaction-friction")
         if model == "reaction":
-            links = getattr(mech, "reaction_links", ())
-            if not links:
+            if not reacting:
                 raise SceneError(ps.key("model"), f"friction on the reactions is not implemented "
                                                   f"for {mech.name!r}; use model = "
                                                   f"\"constant-eta\" here")
+            links = mech.reaction_links
         hint = ""
-        if model != "reaction" and getattr(mech, "reaction_links", links) != links:
+        if model != "reaction" and reacting and mech.reaction_links != links:
             hint = (f" (pairs with model = \"reaction\" join "
                     f"{' – '.join(mech.reaction_links)})")
-        if model == "reaction" and hasattr(mech, "reaction_joints"):
+        if model == "reaction" and mech.reaction_joints != tuple(zip(links, links[1:])):
             between = _joint(ps, mech)
         else:
             between = _between(ps, links, hint)
@@ -610,7 +610,7 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
                                                 f"work, and this scene has none (gas.model = "
                                                 f"\"none\"); give a gas model, or join other "
                                                 f"links of {' – '.join(links)}")
-        ideal = getattr(mech, "ideal_reaction_joints", {}) if model == "reaction" else {}
+        ideal = mech.ideal_reaction_joints if model == "reaction" else {}
         if between[0] in ideal:
             allowed = ", ".join(f"[{a!r}, {b!r}]" for a, b in zip(links, links[1:])
                                 if a not in ideal)
@@ -642,12 +642,7 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
         _check_mixed(s, mech, policy, pairs)
         joints = reaction_joints(mech)
         pairs.sort(key=lambda p: joints.index(p.between))
-        if hasattr(mech, "reaction_joints"):
-            _check_wedging_articulated(s, mech, pairs, raw)
-        elif hasattr(mech, "max_rod_tilt"):
-            _check_piston_wedging(s, mech, pairs, raw)
-        else:
-            _check_wedging(s, mech, pairs, raw)
+        mech.check_wedging(s, pairs, raw)
     else:
         pairs.sort(key=lambda p: mech.links.index(p.between[0]))
     return Friction(policy, tuple(pairs))
@@ -657,7 +652,7 @@ def _check_mixed(s: Section, mech, policy: str, pairs) -> None:
     """Among reaction pairs, a pair of another model only where the mechanism's solver takes it
     (``transient.core.model.reactions``, *A constant-η or mapped pair at the main bearings*): at the
     joint that couples the shaft to the mechanism, under the power-flow policy."""
-    coupling = getattr(mech, "shaft_coupling", None)
+    coupling = mech.shaft_coupling
     for i, p in enumerate(pairs):
         if p.model == "reaction":
             continue
@@ -786,78 +781,6 @@ def _rows(ps: Section, name: str) -> tuple[tuple[float, ...], ...]:
         raise SceneError(ps.key(name), f"must be a list of rows of finite numbers (one row per "
                                        f"speed), got {show_value(value)}")
     return tuple(tuple(float(v) for v in r) for r in value)
-
-
-def _check_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
-    """Friction must not wedge the crank-slider: the rod's equation in the side force N has a
-    slope of at least l cos β (1 − q), q = μ_s tan β + (μ r of crankpin and pin)(1 + μ_s)/(l cos β)
-    at the largest rod angle (:mod:`transient.core.model.joint_friction`); q < 1 keeps it increasing,
-    hence one solution at every state."""
-    r, l, e = mech.crank_radius, mech.rod_length, mech.offset
-    sin_b = (r + abs(e)) / l
-    cos_b = math.sqrt(max(1.0 - sin_b * sin_b, 0.0))
-    by_joint = {p.between[0]: p for p in pairs}
-    mu_s = by_joint["piston"].mu if "piston" in by_joint else 0.0
-    mr = sum(by_joint[j].mu * by_joint[j].radius for j in ("crank", "rod") if j in by_joint)
-    q = (mu_s * sin_b / cos_b + mr * (1.0 + mu_s) / (l * cos_b)) if cos_b > 0.0 else math.inf
-    if q >= 1.0:
-        i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
-                 and item.get("between", [None])[0] in ("piston", "crank", "rod"))
-        raise SceneError(f"{s.key('pairs')}[{i}].mu",
-                         f"the friction would wedge the mechanism: μ_slider·tan β_max + "
-                         f"(μ·r of crankpin and pin)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; "
-                         f"allowed below 1 (lubricated pairs are around 0.01)")
-
-
-def _check_wedging_articulated(s: Section, mech, pairs: list[Pair], raw: list) -> None:
-    """Friction must not wedge a rod of the articulated mechanism: as for the crank-slider
-    (:func:`_check_wedging`), each rod's equation in its piston's side force has a slope of at
-    least c (1 − q), q = μ_slider tan β_max + (μ r of its two pins)(1 + μ_slider)/c with
-    c = l cos β_max at its largest angle to its cylinder (the master rod: sin β_max = λ; slave
-    rod i: its link pin's largest offset from its axis over l_i, ``slave_reach``); q < 1 for
-    every rod keeps the row's equations solvable (``transient.core.model.articulated_friction``)."""
-    by_joint = {p.between: p for p in pairs}
-    joints = mech.reaction_joints
-
-    def mu_r(j: int) -> float:
-        p = by_joint.get(joints[j])
-        return p.mu * p.radius if p is not None else 0.0
-
-    slider = by_joint.get(joints[5])
-    mu_s = slider.mu if slider is not None else 0.0
-    rods = [(mech.rod_length, mech.crank_radius, mu_r(1) + mu_r(3), "master rod")]
-    rods += [(li, h, mu_r(2) + mu_r(4), f"slave rod {i + 1}")
-             for i, (li, h) in enumerate(zip(mech.slave_lengths, slave_reach(mech)))]
-    for length, reach, mr, rod in rods:
-        sin_b = reach / length
-        cos_b = math.sqrt(max(1.0 - sin_b * sin_b, 0.0))
-        c = length * cos_b
-        q = (mu_s * sin_b / cos_b + mr * (1.0 + mu_s) / c) if cos_b > 0.0 else math.inf
-        if q >= 1.0:
-            i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
-                     and item.get("between", [None])[-1] in ("cylinder", "piston", "slave rod",
-                                                              "master rod"))
-            raise SceneError(f"{s.key('pairs')}[{i}].mu",
-                             f"the friction would wedge the {rod}: μ_slider·tan β_max + (μ·r of "
-                             f"its pins)(1 + μ_slider)/(l cos β_max) = {q:.3g} ≥ 1; allowed "
-                             f"below 1 (lubricated pairs are around 0.01)")
-def _check_piston_wedging(s: Section, mech, pairs: list[Pair], raw: list) -> None:
-    """Friction must not wedge a swash plate's pistons: each piston's friction equation has a
-    slope of at least 1 − μ tan γ in its friction force, γ the largest rod tilt to the cylinder
-    axis (:mod:`transient.core.model.swash_friction`); μ tan γ < 1 keeps it increasing, hence one
-    solution at every state."""
-    piston = next((p for p in pairs if p.between[0] == "piston"), None)
-    if piston is None:
-        return
-    tan_g = math.tan(mech.max_rod_tilt())
-    if piston.mu * tan_g >= 1.0:
-        i = next(i for i, item in enumerate(raw) if isinstance(item, dict)
-                 and item.get("between", [None])[0] == "piston")
-        raise SceneError(f"{s.key('pairs')}[{i}].mu",
-                         f"the friction would wedge the pistons: μ·tan γ_max = "
-                         f"{piston.mu * tan_g:.3g} ≥ 1 at the largest rod tilt "
-                         f"γ_max = {math.degrees(math.atan(tan_g)):.3g}°; allowed "
-                         f"μ < {1.0 / tan_g:.3g}")
 
 
 def _efficiency(s: Section, name: str) -> float:

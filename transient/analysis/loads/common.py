@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -240,3 +241,14 @@ def rotating_inertia_rows(mass: float, radius: float, omega: ArrayLike, epsilon:
     record: (K, T) as writable arrays of ``shape``."""
     k, t = rotating_inertia_force(mass, radius, omega, epsilon)
     return np.broadcast_to(k, shape).copy(), np.broadcast_to(t, shape).copy()
+
+
+def stored_record(ld, grid, forces) -> dict[str, tuple[Any, str]]:
+    """What every mechanism stores: the grid, the forces named [N], the cylinders' torques and
+    the engine torque [N m]."""
+    out: dict[str, tuple[Any, str]] = {"loads_phi": (grid, "rad")}
+    for name in forces:
+        out[f"loads_{name}"] = (getattr(ld, name), "N")
+    out["loads_torque"] = (ld.torque, "N m")
+    out["loads_engine_torque"] = (ld.engine_torque, "N m")
+    return out

@@ -165,3 +165,10 @@ def axial_positions(mp, alpha, x, dx, ddx):
     for i in range(int(mp[N_SLAVES])):
         x[1 + i], dx[1 + i], ddx[1 + i], _, _, _, _, _, _ = slave(mp, i, r, ca, sa, cb, sb, db,
                                                                   ddb)
+
+
+@kernel(inline=True)
+def terms(mp, kin_coef, phi, u, du, with_dJ):
+    """``Model.terms`` of master and articulated rods: :func:`articulated_terms` (``kin_coef`` is the
+    tabulated kernel's)."""
+    return articulated_terms(mp, phi, u, du)

@@ -119,3 +119,10 @@ def crank_slider_terms(mp, phi, u, du, with_dJ=True):
         J += Jk
         dJ += dJk
     return J, dJ
+
+
+@kernel(inline=True)
+def terms(mp, kin_coef, phi, u, du, with_dJ):
+    """``Model.terms`` of the crank-slider: :func:`crank_slider_terms` (``kin_coef`` is the
+    tabulated kernel's)."""
+    return crank_slider_terms(mp, phi, u, du, with_dJ)

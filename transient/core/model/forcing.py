@@ -18,11 +18,7 @@ from ..jit import kernel
 from . import cylinder as cyl
 from . import governor as gv
 from . import reactions as rx
-from .articulated import articulated_terms
-from .crank_slider import crank_slider_terms
 from .layout import (
-    ARTICULATED,
-    CRANK_SLIDER,
     KINETIC,
     LT_ANGLE,
     LT_NONE,
@@ -34,7 +30,6 @@ from .layout import (
     SW_LOAD,
     SW_SLEEVE,
     SW_STARTER,
-    TABULATED,
     WK_DEMAND,
     WK_DU,
     WK_FUEL,
@@ -50,23 +45,16 @@ from .layout import (
     gov_index,
     latch_index,
 )
-from .swash_plate import swash_terms
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
-from .tabulated import tabulated_terms
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
-def mechanism_terms(kind, mech, kin_coef, phi, u, du, with_dJ):
+def mechanism_terms(m, phi, u, du, with_dJ):
     """J(φ) and dJ/dφ of the mechanism's moving parts; fills ``u[k]``, ``du[k]`` per cylinder.
-    Without ``with_dJ`` dJ and ``du`` may be left NaN (the exact crank-slider skips them)."""
-    if kind == TABULATED:
-        return tabulated_terms(kin_coef, phi, u, du)
-    if kind == CRANK_SLIDER:
-        return crank_slider_terms(mech, phi, u, du, with_dJ)
-    if kind == ARTICULATED:
-        return articulated_terms(mech, phi, u, du)
-    return swash_terms(mech, phi, u, du)
+    Without ``with_dJ`` dJ and ``du`` may be left NaN (the exact crank-slider skips them). The
+    Model's own kernel (``Model.terms``), chosen when the stepper is compiled: no dispatch."""
+    return m.terms(m.mech, m.kin_coef, phi, u, du, with_dJ)
 
 
 @kernel(inline=True)
@@ -193,7 +181,7 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
 @kernel(inline=True)
 def inertia(m, phi, wk):
     """Total reduced inertia J(φ), (19); fills the row u of ``wk``."""
-    J, _ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, wk[WK_U], wk[WK_DU], False)
+    J, _ = mechanism_terms(m, phi, wk[WK_U], wk[WK_DU], False)
     return J + m.J0
 
 
@@ -384,7 +372,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
     """
     phi = y[PHI]
     u = wk[WK_U]
-    J, dJ = mechanism_terms(m.kind, m.mech, m.kin_coef, phi, u, wk[WK_DU], with_dJ)
+    J, dJ = mechanism_terms(m, phi, u, wk[WK_DU], with_dJ)
     J += m.J0
     w = speed(J, angle_mode, y)
     M_gas = 0.0

@@ -126,9 +126,6 @@ SWITCHES = Layout("switches", "starter", "governor", "modes", "direction", "load
  SW_LOAD_TABLE) = SWITCHES
 N_SWITCHES = SWITCHES.size
 
-#: Mechanism kinds (``Model.kind``); TABULATED: any, from its tables (``Model.kin_coef``).
-CRANK_SLIDER, SWASH_PLATE, TABULATED, ARTICULATED = 0, 1, 2, 3
-
 #: How the reduced inertia of a link of the serial chain follows φ (a mechanism's ``link_laws``;
 #: ``Model.link_own`` holds the first two where a pair cuts such a link from the rest):
 #: LINK_FIXED a constant (``Model.link_J``), LINK_PISTONS the pistons' m·Σ_k u_k² (m
@@ -247,9 +244,12 @@ N_RX_PAR = 7
 Model = namedtuple(
     "Model",
     [
-        "kind",  # int: CRANK_SLIDER, SWASH_PLATE, ARTICULATED or TABULATED
+        # The mechanism's kernel, terms(mech, kin_coef, φ, u, u′, with_dJ) -> (J, dJ/dφ) filling
+        # u_k, u′_k: a compile-time constant (a kernel as a value, transient.core.jit), so that
+        # a scene's stepper holds its own mechanism's kernel alone, inlined, and no dispatch
+        "terms",
         "mech",  # float64[:]: the mechanism's packed parameters
-        "kin_coef",  # float64[1 + ncyl, n, 6]: the TABULATED kind's splines (transient.core.model.tabulated)
+        "kin_coef",  # float64[1 + ncyl, n, 6]: the tabulated kernel's splines (transient.core.model.tabulated)
         "ncyl",  # int: number of cylinders (gas force points)
         "J0",  # float: constant inertia of shaft, flywheel and load [kg m²]
         "has_gas",  # bool
@@ -308,6 +308,14 @@ Model = namedtuple(
         "reaction",  # bool: the pairs' losses follow from the joint reactions
         "rx_par",  # float64[N_JOINTS, N_RX_PAR]: each joint's coefficients (zeros: ideal)
         "rx_pair",  # int64[N_JOINTS]: the pair each joint reports as, −1 for an ideal joint
+        # the mechanism's reaction solver (compile-time constants as ``terms``; the kernels of
+        # transient.core.model.reactions.NO_REACTIONS for a mechanism without one): its
+        # prepare(mech, φ, ω, sel, wk), solve(mech, rx_par, rx_pair, J0, M_shaft, ε0, ω, σ,
+        # n_pairs, wk) and inverse_drive(m, ε, ω, σ, M_shaft, wk)
+        "rx_prepare",
+        "rx_solve",
+        "rx_inverse",
+        "rx_sides",  # bool: its solve leaves each cylinder's side force for track_sides
         # efficiencies mapped over speed and transmitted moment (transient.core.model.eta_table); the
         # arrays keep their types without maps (one row of zeros), so one compile serves all
         "eta_table",  # bool: the pairs' η come from the maps below (eta_fwd, eta_bwd unused)

@@ -1,13 +1,15 @@
-"""Friction on the joints' reactions, whichever the mechanism: the one place that picks the
-mechanism's solver by ``Model.kind`` (:mod:`.joint_friction` for the crank-slider,
-:mod:`.articulated_friction` for master and articulated rods, :mod:`.swash_friction` for the
-swash plate), for the right-hand side, the stuck mode, the inverse dynamics and the output rows.
+"""Friction on the joints' reactions, whichever the mechanism: the one place that calls the
+mechanism's solver (the Model's ``rx_prepare``, ``rx_solve``, ``rx_inverse``, chosen when the
+stepper is compiled: :mod:`.joint_friction` for the crank-slider, :mod:`.articulated_friction`
+for master and articulated rods, :mod:`.swash_friction` for the swash plate; :data:`NO_REACTIONS`
+for a mechanism without one), for the right-hand side, the stuck mode, the inverse dynamics and
+the output rows.
 Every solver fills the same rows of ``wk`` for its callers: each piston's gas force (``R_P``,
 filled by :func:`.forcing.moments`), the pairs' loss moments (``R_LOSS``), their η*, S
 (``WK_ETA``, ``WK_S``) and each cylinder's share of the losses (``WK_CYL_LOSS``).
 
-A scene with reaction pairs and tabulated kinematics keeps its mechanism's kind only if it is a
-crank-slider (``Model.kind`` is then TABULATED): the scene check refuses the others.
+A scene with reaction pairs and tabulated kinematics is a crank-slider's (its ``Model.terms`` is
+then the tables'): the scene check refuses the others.
 
 A constant-η or mapped pair at the main bearings among reaction pairs
 ---------------------------------------------------------------------
@@ -50,21 +52,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-from . import articulated_friction as af
 from . import eta_table as et
 from . import joint_friction as jf
-from . import swash_friction as sf
 from .chain import LOCKED, UNIQUE
-from .layout import (
-    ARTICULATED,
-    RX_ETA_BWD,
-    RX_ETA_FWD,
-    SWASH_PLATE,
-    WK_CYL_LOSS,
-    WK_ETA,
-    WK_RX,
-    WK_S,
-)
+from .layout import RX_ETA_BWD, RX_ETA_FWD, WK_CYL_LOSS, WK_ETA, WK_RX, WK_S
 
 #: Rows (offsets from ``layout.WK_RX``) every mechanism's solver shares: the gas force on each
 #: piston, the pairs' loss moments (``joint_friction.SHARED``).
@@ -74,12 +65,7 @@ R_P, R_LOSS = jf.R_P, jf.R_LOSS
 @kernel(inline=True)
 def prepare(m, phi, w, sel, wk):
     """The mechanism's rows of the state (φ, ω) and of the step's angle ``sel``."""
-    if m.kind == SWASH_PLATE:
-        sf.prepare(m.mech, phi, w, sel, wk)
-    elif m.kind == ARTICULATED:
-        af.prepare(m.mech, phi, w, sel, wk)
-    else:
-        jf.prepare(m.mech, phi, w, sel, wk)
+    m.rx_prepare(m.mech, phi, w, sel, wk)
 
 
 #: ``modes`` of :func:`acceleration`: the pair at the main bearings in its consistent mode, as at
@@ -112,11 +98,7 @@ def acceleration(m, J, dJ, w, M_gas, M_shaft, sigma, modes, wk):
 @kernel(inline=True)
 def _solve(m, J0, M_shaft, eps0, w, sigma, wk):
     """The mechanism's solver on the shaft's equation J₀ ε = M_shaft + T."""
-    if m.kind == SWASH_PLATE:
-        return sf.solve(m.mech, m.rx_par, m.rx_pair, J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
-    if m.kind == ARTICULATED:
-        return af.solve(m.mech, m.rx_par, m.rx_pair, J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
-    return jf.solve(m.mech, m.rx_par, m.rx_pair, J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
+    return m.rx_solve(m.mech, m.rx_par, m.rx_pair, J0, M_shaft, eps0, w, sigma, m.n_pairs, wk)
 
 
 @kernel
@@ -184,12 +166,7 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     """The drive torque on the shaft for a prescribed φ̈ = ``eps``, with the joints' friction;
     with a constant-η or mapped pair at the main bearings, S with h(S) = η*(|S|) S = −T, its
     mode from the sign of the power it passes (forward where −T σ ≥ 0; module docstring)."""
-    if m.kind == SWASH_PLATE:
-        drive = sf.inverse_drive(m, eps, w, sigma, M_shaft, wk)
-    elif m.kind == ARTICULATED:
-        drive = af.inverse_drive(m, eps, w, sigma, M_shaft, wk)
-    else:
-        drive = jf.inverse_drive(m, eps, w, sigma, M_shaft, wk)
+    drive = m.rx_inverse(m, eps, w, sigma, M_shaft, wk)
     if not coupled(m):
         return drive
     k = m.rx_pair[0]
@@ -233,4 +210,27 @@ def tracks_sides(m):
     """Whether the stepper puts step ends where a side force changes side
     (``joint_friction.track_sides``): the crank-slider's solve leaves each cylinder's N in the row
     the tracking reads; the other mechanisms' solvers keep their side forces elsewhere."""
-    return m.kind != SWASH_PLATE and m.kind != ARTICULATED
+    return m.rx_sides
+
+
+@kernel(inline=True)
+def no_prepare(mp, phi, w, sel, wk):
+    """``Model.rx_prepare`` of a mechanism without reaction friction: never called (the scene
+    check refuses reaction pairs for it, so ``Model.reaction`` is False)."""
+
+
+@kernel(inline=True)
+def no_solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
+    """``Model.rx_solve`` of a mechanism without reaction friction: never called; NaN, which
+    the stepper reports, were it ever."""
+    return np.nan
+
+
+@kernel(inline=True)
+def no_inverse(m, eps, w, sigma, M_shaft, wk):
+    """``Model.rx_inverse`` of a mechanism without reaction friction: never called; NaN."""
+    return np.nan
+
+
+#: The reaction kernels (prepare, solve, inverse_drive) of a mechanism without reaction friction.
+NO_REACTIONS = (no_prepare, no_solve, no_inverse)

@@ -232,3 +232,10 @@ def swash_terms(mp, phi, u, du):
         u[k] = halves * x1
         du[k] = halves * x2
     return halves * J, halves * dJ
+
+
+@kernel(inline=True)
+def terms(mp, kin_coef, phi, u, du, with_dJ):
+    """``Model.terms`` of the swash plate: :func:`swash_terms` (``kin_coef`` is the
+    tabulated kernel's)."""
+    return swash_terms(mp, phi, u, du)

@@ -52,3 +52,10 @@ def tabulated_terms(coef, phi, u, du):
     for k in range(coef.shape[0] - 1):
         u[k], du[k] = _poly5(coef[1 + k, i], x)
     return J, dJ
+
+
+@kernel(inline=True)
+def terms(mp, kin_coef, phi, u, du, with_dJ):
+    """``Model.terms`` of tabulated kinematics, any mechanism's: :func:`tabulated_terms` (``mp``
+    is the mechanism's own parameters, for its reaction solver)."""
+    return tabulated_terms(kin_coef, phi, u, du)
