@@ -161,7 +161,7 @@ class _Kernel(CPUDispatcher):
 
 
 def _kernel_named(module: str, name: str):
-    """The kernel ``name`` of ``module``, imported (:meth:`_Kernel.__reduce__`)."""
+    """The kernel ``name`` of ``module``, imported (``_Kernel.__reduce__``)."""
     import importlib
 
     return getattr(importlib.import_module(module), name)

@@ -455,11 +455,11 @@ class Articulated:
 
     def check_wedging(self, s: Section, pairs, raw) -> None:
         """Friction must not wedge a rod: as for the crank-slider
-        (:meth:`CrankSlider.check_wedging`), each rod's equation in its piston's side force has a
-        slope of at least c (1 − q), q = μ_slider tan β_max + (μ r of its two pins)(1 +
-        μ_slider)/c with c = l cos β_max at its largest angle to its cylinder (the master rod:
-        sin β_max = λ; slave rod i: its link pin's largest offset from its axis over l_i,
-        :func:`slave_reach`); q < 1 for every rod keeps the row's equations solvable
+        (:meth:`~transient.mechanisms.crank_slider.CrankSlider.check_wedging`), each rod's equation
+        in its piston's side force has a slope of at least c (1 − q), q = μ_slider tan β_max + (μ r
+        of its two pins)(1 + μ_slider)/c with c = l cos β_max at its largest angle to its cylinder
+        (the master rod: sin β_max = λ; slave rod i: its link pin's largest offset from its axis
+        over l_i, :func:`slave_reach`); q < 1 for every rod keeps the row's equations solvable
         (:mod:`transient.core.model.articulated_friction`)."""
         by_joint = {p.between: p for p in pairs}
         joints = self.reaction_joints

@@ -247,7 +247,7 @@ Model = namedtuple(
         # The mechanism's kernel, terms(mech, kin_coef, φ, u, u′, with_dJ) -> (J, dJ/dφ) filling
         # u_k, u′_k: a compile-time constant (a kernel as a value, transient.core.jit), so that
         # a scene's stepper holds its own mechanism's kernel alone, inlined, and no dispatch
-        "terms",
+        "terms",  # kernel: the mechanism's J(φ), dJ/dφ and transfer functions
         "mech",  # float64[:]: the mechanism's packed parameters
         "kin_coef",  # float64[1 + ncyl, n, 6]: the tabulated kernel's splines (transient.core.model.tabulated)
         "ncyl",  # int: number of cylinders (gas force points)
@@ -312,9 +312,9 @@ Model = namedtuple(
         # transient.core.model.reactions.NO_REACTIONS for a mechanism without one): its
         # prepare(mech, φ, ω, sel, wk), solve(mech, rx_par, rx_pair, J0, M_shaft, ε0, ω, σ,
         # n_pairs, wk) and inverse_drive(m, ε, ω, σ, M_shaft, wk)
-        "rx_prepare",
-        "rx_solve",
-        "rx_inverse",
+        "rx_prepare",  # kernel: the joints' geometry at φ, into the work array
+        "rx_solve",  # kernel: φ̈ and the joints' losses with friction on their reactions
+        "rx_inverse",  # kernel: the drive moment that gives a prescribed φ̈ (inverse dynamics)
         "rx_sides",  # bool: its solve leaves each cylinder's side force for track_sides
         # efficiencies mapped over speed and transmitted moment (transient.core.model.eta_table); the
         # arrays keep their types without maps (one row of zeros), so one compile serves all

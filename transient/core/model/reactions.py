@@ -1,7 +1,7 @@
 """Friction on the joints' reactions, whichever the mechanism: the one place that calls the
 mechanism's solver (the Model's ``rx_prepare``, ``rx_solve``, ``rx_inverse``, chosen when the
 stepper is compiled: :mod:`.joint_friction` for the crank-slider, :mod:`.articulated_friction`
-for master and articulated rods, :mod:`.swash_friction` for the swash plate; :data:`NO_REACTIONS`
+for master and articulated rods, :mod:`.swash_friction` for the swash plate; ``NO_REACTIONS``
 for a mechanism without one), for the right-hand side, the stuck mode, the inverse dynamics and
 the output rows.
 Every solver fills the same rows of ``wk`` for its callers: each piston's gas force (``R_P``,
