@@ -82,8 +82,9 @@ def test_compare_sees_a_change_beyond_the_tolerance_in_any_kept_value():
     plain = copy.deepcopy(base)
     plain.pop("error")
     assert compare(plain, base) == []
+    # (the residual is at rounding: a change of several times itself is within its floor)
     within = [("end", "omega", 5e-6), ("omega", 0, 2e-6), ("end", "t", 5e-9),
-              ("analysis", "energy_balance_residual", -2e-14),  # (the issue's: 7 times itself)
+              ("analysis", "energy_balance_residual", -2e-14),
               ("analysis", "overshoot_pct", 5e-11), ("analysis", "W_loss_1_per_cycle", 5e-5)]
     for where, key, by in within:
         assert compare(_changed(where, key, by), base) == [], (where, key)

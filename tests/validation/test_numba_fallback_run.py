@@ -59,8 +59,7 @@ def _scene():
     return replace(scene, run=replace(scene.run, revolutions=REVOLUTIONS))
 
 
-# the long tier: the fallback compiles the whole stepper again with plain njit, in its own cache,
-# close to ten minutes of one worker on a cold cache
+# the long tier: the fallback compiles the whole stepper again with plain njit, in its own cache
 @pytest.mark.slow
 @pytest.mark.stress
 def test_the_stepper_under_the_fallback_agrees_with_the_normal_build(tmp_path):
