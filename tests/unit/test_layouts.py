@@ -114,3 +114,31 @@ def test_events_are_named_once_and_watched_in_slots():
     assert sio.EVENT_NAMES[sio.EV_PAIR_MODE] == "pair_mode"
     assert events.N_EVENT_KINDS == events.WATCHED.size
     assert events.FIRST_PAIR_EVENT + events.MAX_PAIRS == events.N_EVENT_KINDS
+
+
+def _numbas_own_type(model):
+    """numba's type of ``model`` as it types any tuple, field by field (without the cache of
+    :func:`transient.core.jit.typed_by_fingerprint`)."""
+    from numba.core.typing.typeof import Purpose, _TypeofContext, typeof_impl
+
+    return typeof_impl.dispatch(tuple)(model, _TypeofContext(Purpose.argument))
+
+
+def test_the_models_type_from_its_fingerprint_is_numbas_own_on_every_case():
+    from numba import typeof
+
+    seen = {}
+    for path in CASES:
+        model, _, _ = build_model(load_scene(path))
+        assert typeof(model) == _numbas_own_type(model), path.name
+        seen.setdefault(typeof(model), path.name)
+    assert len(seen) > 3  # (the cases differ in their mechanisms' kernels and fields' types)
+
+
+def test_a_model_whose_field_changes_type_gets_its_own_type():
+    from numba import typeof
+
+    model, _, _ = build_model(load_scene(CASES[0]))
+    other = model._replace(mech=model.mech.astype(np.float32))
+    assert typeof(other) != typeof(model)
+    assert typeof(other) == _numbas_own_type(other)

@@ -629,3 +629,32 @@ def test_shared_locator_is_numbas_user_provided_locator_with_another_folder():
     assert "_locator_classes" in vars(caching.CompileResultCacheImpl) or hasattr(
         caching.CompileResultCacheImpl, "_locator_classes"), _relies(
         SHARED, "numba.core.caching._CacheImpl._locator_classes")
+
+
+# ----------------------------------------------------------------------------------------------
+# typed_by_fingerprint and _TypesKeptAlive
+
+FINGERPRINT = "transient.core.jit.typed_by_fingerprint"
+KEPT_ALIVE = "transient.core.jit._TypesKeptAlive"
+
+
+def test_fingerprint_covers_what_typed_by_fingerprint_leaves_to_it():
+    from numba._dispatcher import compute_fingerprint
+    from numba.core.typing.typeof import typeof_impl
+
+    kern = jit.kernel(lambda x: x)
+    with pytest.raises(NotImplementedError):  # (why the kernels are keyed apart)
+        compute_fingerprint((1.0, kern))
+    assert compute_fingerprint((1.0, (2, 3.0))) != compute_fingerprint((1.0, (2.0, 3))), _relies(
+        FINGERPRINT, "numba._dispatcher.compute_fingerprint telling apart the types of a tuple's "
+        "fields, nested tuples included")
+    assert typeof_impl.dispatch(tuple).__name__ == "_typeof_tuple", _relies(
+        FINGERPRINT, "numba typing a tuple by typeof_impl's registration for tuple")
+
+
+def test_types_kept_alive_stands_for_the_set_numba_only_adds_to_and_clears():
+    source = inspect.getsource(dispatcher)
+    uses = {line.strip() for line in source.splitlines() if "_types_active_call" in line}
+    assert uses == {"self._types_active_call = set()", "self._types_active_call.add(tp)",
+                    "self._types_active_call.clear()"}, _relies(
+        KEPT_ALIVE, f"numba's Dispatcher using _types_active_call by add and clear alone: {uses}")

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import fcntl
 import functools
+import operator
 import os
 import warnings
 from contextlib import contextmanager
@@ -136,9 +137,21 @@ def compiled(fn=None, *, _cache=_RegistryFreeCache, **options):
     dispatcher = njit(fn, **options)
     if not config.DISABLE_JIT:  # (then njit returns fn itself)
         dispatcher._cache = _cache(dispatcher.py_func)  # (what cache=True sets)
+        dispatcher._types_active_call = _TypesKeptAlive()
         _compile_per_type(dispatcher)
         _compile_once_across_processes(dispatcher)
     return dispatcher
+
+
+class _TypesKeptAlive(dict):
+    """numba's set of the types a dispatcher gave arguments it typed in Python
+    (``Dispatcher._types_active_call``, which keeps them alive while their codes are in use),
+    keyed by identity: a set hashes the type at every call, and numba hashes a type by hashing
+    its fields' types in turn, which for the Model (:func:`typed_by_fingerprint`) costs more
+    than the rest of the call."""
+
+    def add(self, tp):
+        self[id(tp)] = tp
 
 
 class _Kernel(CPUDispatcher):
@@ -249,6 +262,51 @@ def _kernel_argument(module: str, qualname: str) -> _KernelArgument:
     """A :class:`_KernelArgument` read back from the cache's index: the kernel's own type where
     its module is imported (numba interns types, and the two compare equal), else one by name."""
     return _KernelArgument(None, (module, qualname))
+
+
+def typed_by_fingerprint(cls):
+    """numba's type of a ``cls`` (a namedtuple holding kernels as values, the
+    :data:`transient.core.model.layout.Model`) as an argument from Python, found by the
+    fingerprint of its other fields.
+
+    numba's dispatcher types an argument from Python by a fingerprint computed in C (a string of
+    each field's kind, dtype and layout), which it has for numbers, arrays and tuples of them but
+    not for a kernel: a tuple holding one is typed in Python field by field, about a hundred
+    times slower than the rest of the call, at every call. This caches the type by the C
+    fingerprint of the fields that have one and the kernels themselves, which together are what
+    numba's type of the tuple is made of. The fields that hold kernels are found on the first
+    value; a value with a kernel elsewhere is typed as numba types it. Off under another numba
+    release (the fingerprint is an internal)."""
+    if not REPLACEMENTS_ON:
+        return cls
+    from numba._dispatcher import compute_fingerprint
+    from numba.core.typing.typeof import typeof_impl
+
+    as_tuple = typeof_impl.dispatch(tuple)
+    fields: list = []  # (the getters of the fields with a fingerprint and of the kernels)
+    types_seen: dict = {}
+
+    @typeof_impl.register(cls)
+    def _typeof(val, c):
+        if not fields:
+            kernels = [i for i, v in enumerate(val) if isinstance(v, _Kernel)]
+            rest = [i for i in range(len(val)) if i not in kernels]
+            fields.extend(operator.itemgetter(*f) if f else _nothing for f in (rest, kernels))
+        try:
+            key = (compute_fingerprint(fields[0](val)), fields[1](val))
+        except NotImplementedError:  # (no fingerprint: a kernel in another field)
+            return as_tuple(val, c)
+        found = types_seen.get(key)
+        if found is None:
+            found = types_seen[key] = as_tuple(val, c)
+        return found
+
+    return cls
+
+
+def _nothing(_val) -> tuple:
+    """The getter of no fields (:func:`typed_by_fingerprint`)."""
+    return ()
 
 
 def _compile_once_across_processes(dispatcher):

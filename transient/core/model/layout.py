@@ -19,7 +19,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED, Block, Layout, Sized
-from ..jit import kernel
+from ..jit import kernel, typed_by_fingerprint
 from . import governor as gv
 
 
@@ -326,6 +326,7 @@ Model = namedtuple(
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
     ],
 )
+typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)
 
 
 def extras_of(m):
