@@ -7,7 +7,7 @@
   equation (18) of the same engine, integrated apart in crank angle on the mechanism's twin
   J(φ) (:func:`~transient.reference.torsion.rigid_run`), the error falling as 1/k;
 * **Floquet**: the multipliers of the linearised two-mass model with J = J₀(1 + ε cos 2θ) at a
-  constant speed Ω, from a monodromy matrix integrated here (Hill's equation (T10)), locate the
+  constant speed Ω, from a monodromy matrix integrated here (Hill's equation (T8)), locate the
   principal parametric instability where Mathieu's chart puts it to first order in ε
   (the gap second order), and predict the growth or decay of a small twist about the periodic
   orbit of the nonlinear reference model.
@@ -25,8 +25,8 @@ from scipy.optimize import brentq
 from transient.mechanisms.twins import CrankSliderNumpy
 from transient.reference.torsion import (
     WORKS,
-    CrankSliderCylinders,
     Coupling,
+    CrankSliderCylinders,
     PressurePulse,
     Ring,
     ShaftLine,
@@ -132,7 +132,7 @@ W_N = math.sqrt(K / J0)
 
 
 def monodromy(eps: float, c: float, Om: float) -> np.ndarray:
-    """Hill's equation (T10) of the twist x = θ₁ − Ωt of a mass J₀(1 + ε cos 2θ₁) on a
+    """Hill's equation (T8) of the twist x = θ₁ − Ωt of a mass J₀(1 + ε cos 2θ₁) on a
     section (K, c) to a mass turning at Ω: J ẍ + (c + Ω J′) ẋ + (K + ½ Ω² J″) x = 0, its
     fundamental matrix over one period π/Ω of the parametric excitation."""
     def f(t, z):
@@ -154,7 +154,7 @@ def principal_region(eps: float) -> tuple[float, float]:
 
 
 def test_principal_region_against_mathieu():
-    """To first order in ε (T11) the twist obeys Mathieu's y″ + (a − 2q cos 2τ) y = 0 with
+    """To first order in ε (T9) the twist obeys Mathieu's y″ + (a − 2q cos 2τ) y = 0 with
     a = (ω_n/Ω)², q = aε/2, whose first region a = 1 ± q puts the edges at
     Ω/ω_n = √(1 ∓ ε/2); the Floquet edges differ by O(ε²): at most ε², and 4 × less
     (3 … 5) at half the ε."""
