@@ -25,3 +25,15 @@ OFFSET_RIGID = {"offset": 0.012, "rod_length": 0.11, "rod_model": "rigid",
 #: The Gots engine, with an offset and a shorter rod, and with a rigid rod besides.
 MECHS = {"two-mass": gots_mech(), "offset-two-mass": gots_mech(offset=0.012, rod_length=0.11),
          "offset-rigid": gots_mech(**OFFSET_RIGID)}
+
+
+def inline_six_mech(**changes) -> CrankSlider:
+    """An in-line six of a truck diesel's size (bore 102 mm, stroke 120 mm, rod 190 mm, two-mass
+    rod), firing 1-5-3-6-2-4 every 120°: the engine of the elastic shaft line's tests."""
+    firing = {1: 0.0, 5: 120.0, 3: 240.0, 6: 360.0, 2: 480.0, 4: 600.0}
+    base = CrankSlider(crank_radius=0.06, rod_length=0.19, offset=0.0, bore=0.102,
+                       piston_mass=1.6, crank_mass=1.2, rod_model="two-mass", rod_mass=2.2,
+                       rod_cg_from_pin=0.7 * 0.19, rod_inertia_cg=0.0, strokes=4,
+                       firing_angles=tuple(np.radians([firing[c] for c in range(1, 7)])),
+                       bank_angles=(0.0,) * 6)
+    return replace(base, **changes)

@@ -1,0 +1,459 @@
+"""The elastic shaft line in plain numpy, for the reference path: stations k = 0 … N−1 along the
+crankshaft, each with its own angle θ_k, speed ω_k and reduced inertia
+J_k(θ_k) = J_own,k + Σ_c J_c(θ_k) of the cylinders c it carries, joined by elastic sections;
+dampers' rings and an elastic coupling through a gear to a driven inertia as further degrees of
+freedom (the equations of the theory page, *The elastic shaft line*, (T1)–(T9)).
+
+Per station, Lagrange's equation (T2)
+
+    J_k θ̈_k + ½ J′_k ω_k² = M_gas,k + M_ext,k + T_k,
+
+T_k the torque of the sections, rings, coupling and absolute damping on station k; with a
+constant-η pair between a station's shaft and its throw's mechanism, (T7) in its place. The work
+of the applied moments and the energy every dissipative element takes are integrated as extra
+states, so that the balance (T4) holds at every sample to the solver's accuracy.
+
+What it shares with the compiled path: nothing of ``transient.core``. The crank-slider's
+per-cylinder terms (:class:`CrankSliderCylinders`) are written here from the mechanism's
+geometry and masses (the scene's :class:`~transient.mechanisms.crank_slider.CrankSlider`), apart
+from the twin :class:`~transient.mechanisms.twins.CrankSliderNumpy`, which gives their sum and so
+checks them; :func:`rigid_run` integrates the rigid reduced equation (18) on that twin for the
+rigid limit.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
+
+Array = NDArray[np.float64]
+
+
+class Cylinders(Protocol):
+    """The engine side of a shaft line: each cylinder's own reduced inertia and applied moment,
+    as functions of the angle of the station that carries it."""
+
+    def inertia(self, angles: Array) -> tuple[Array, Array]:
+        """(J_c, dJ_c/dθ) of each cylinder at its station's angle θ [kg m², kg m²/rad]."""
+        ...
+
+    def moments(self, angles: Array, speeds: Array, t: float) -> Array:
+        """Each cylinder's applied moment reduced to its station's angle [N m]."""
+        ...
+
+
+#: Applied moments on the stations, (θ, ω, t) ↦ M_ext per station [N m] (load, starter).
+StationMoments = Callable[[Array, Array, float], Array]
+#: The load on the driven inertia, (θ_d, ω_d, t) ↦ M_load [N m].
+DrivenMoment = Callable[[float, float, float], float]
+
+
+@dataclass(frozen=True)
+class Ring:
+    """A damper's ring on a station: inertia I_r, and between ring and station a damping c_r
+    (the silicone of a viscous damper) and a stiffness k_r (0 for a viscous damper, > 0 for a
+    tuned rubber damper)."""
+
+    station: int
+    inertia: float
+    damping: float
+    stiffness: float = 0.0
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """An elastic coupling from a station through an ideal gear to a driven inertia J_d: the
+    coupling's twist is δ = θ_station − i θ_d, with i = ω_station/ω_d the gear ratio and the
+    stiffness and damping referred to the station's side; the gear passes i times its torque
+    to the driven side."""
+
+    station: int
+    stiffness: float
+    damping: float
+    ratio: float
+    driven_inertia: float
+
+
+@dataclass(frozen=True)
+class ShaftLine:
+    """The shaft line's data, stations from the nose.
+
+    ``inertia`` J_own,k (N); ``stiffness`` k_i and ``damping`` c_i of section i between
+    stations i and i+1 (N−1); ``absolute`` d_k, a viscous drag −d_k ω_k on each station (N);
+    ``station_of_cylinder`` the station each cylinder rides on; ``eta``: per station the
+    (forward, backward) efficiency of a constant-η pair between its shaft and its throw's
+    mechanism (1, 1: none)."""
+
+    inertia: Array
+    stiffness: Array
+    damping: Array
+    absolute: Array
+    station_of_cylinder: NDArray[np.intp]
+    rings: tuple[Ring, ...] = ()
+    coupling: Coupling | None = None
+    eta: tuple[Array, Array] | None = None
+
+    def __post_init__(self) -> None:
+        n = len(self.inertia)
+        sizes = {"stiffness": (len(self.stiffness), n - 1), "damping": (len(self.damping), n - 1),
+                 "absolute": (len(self.absolute), n)}
+        for name, (got, want) in sizes.items():
+            if got != want:
+                raise ValueError(f"ShaftLine.{name}: {got} values for {n} stations; allowed "
+                                 f"{want}")
+        if n < 1 or np.any(np.asarray(self.inertia) <= 0.0):
+            raise ValueError("ShaftLine.inertia: every station needs an inertia > 0")
+        if np.any(np.asarray(self.stiffness) <= 0.0):
+            raise ValueError("ShaftLine.stiffness: every section needs a stiffness > 0")
+        stations = np.asarray(self.station_of_cylinder)
+        if stations.size and (stations.min() < 0 or stations.max() >= n):
+            raise ValueError(f"ShaftLine.station_of_cylinder: stations 0 … {n - 1} only")
+        for ring in self.rings:
+            if not 0 <= ring.station < n or ring.inertia <= 0.0:
+                raise ValueError(f"ShaftLine.rings: {ring} needs a station 0 … {n - 1} and an "
+                                 f"inertia > 0")
+        c = self.coupling
+        if c is not None and (not 0 <= c.station < n or c.ratio == 0.0 or c.stiffness <= 0.0
+                              or c.driven_inertia <= 0.0):
+            raise ValueError(f"ShaftLine.coupling: {c} needs a station 0 … {n - 1}, a ratio ≠ 0 "
+                             f"and a stiffness and driven inertia > 0")
+        if self.eta is not None:
+            f, b = (np.asarray(e, dtype=float) for e in self.eta)
+            if f.shape != (n,) or b.shape != (n,) or np.any((f <= 0) | (f > 1) | (b <= 0)
+                                                             | (b > 1)):
+                raise ValueError("ShaftLine.eta: per station 0 < η ≤ 1, forward and backward")
+
+    @property
+    def n(self) -> int:
+        return len(self.inertia)
+
+
+#: The work integrals at the end of the state, in this order: the applied moments' work (gas,
+#: on the stations, on the driven inertia), then the energy taken by the sections' damping, the
+#: absolute damping, the rings, the coupling and the pairs.
+WORKS = ("W_gas", "W_ext", "W_load", "L_sections", "L_absolute", "L_rings", "L_coupling",
+         "L_pairs")
+
+
+@dataclass
+class TorsionModel:
+    """Right-hand side in time of the shaft line (T2), with its rings and coupling, and the work
+    integrals. State: θ (N), ω (N), the rings' angles and speeds, the driven inertia's angle and
+    speed (with a coupling), then :data:`WORKS`."""
+
+    line: ShaftLine
+    cylinders: Cylinders
+    external: StationMoments | None = None
+    driven_load: DrivenMoment | None = None
+    nfev: int = field(default=0, init=False)
+
+    def __post_init__(self) -> None:
+        n, r = self.line.n, len(self.line.rings)
+        self.n_rings = r
+        self.i_ring = 2 * n
+        self.i_driven = 2 * n + 2 * r
+        self.i_works = self.i_driven + (2 if self.line.coupling is not None else 0)
+        self.size = self.i_works + len(WORKS)
+        self.carrier = np.asarray(self.line.station_of_cylinder, dtype=np.intp)
+
+    # -- state ------------------------------------------------------------------------------
+    def initial_state(self, theta: float, omega: float) -> Array:
+        """Every station, ring and the gear's input at angle θ and speed ω (no twist), the
+        works zero."""
+        y = np.zeros(self.size)
+        n, r = self.line.n, self.n_rings
+        y[:n], y[n:2 * n] = theta, omega
+        y[self.i_ring:self.i_ring + r], y[self.i_ring + r:self.i_driven] = theta, omega
+        c = self.line.coupling
+        if c is not None:
+            y[self.i_driven], y[self.i_driven + 1] = theta / c.ratio, omega / c.ratio
+        return y
+
+    def split(self, y: Array):
+        """(θ, ω, ring angles, ring speeds, driven angle, driven speed) of state y."""
+        n, r = self.line.n, self.n_rings
+        th, w = y[:n], y[n:2 * n]
+        rth, rw = y[self.i_ring:self.i_ring + r], y[self.i_ring + r:self.i_driven]
+        if self.line.coupling is None:
+            return th, w, rth, rw, 0.0, 0.0
+        return th, w, rth, rw, y[self.i_driven], y[self.i_driven + 1]
+
+    def station_inertia(self, theta: Array) -> tuple[Array, Array, Array]:
+        """(J_k, J′_k, the mechanism's part of J_k) per station at its angle, (T1)."""
+        Jc, dJc = self.cylinders.inertia(theta[self.carrier])
+        Jm = np.zeros(self.line.n)
+        dJ = np.zeros(self.line.n)
+        np.add.at(Jm, self.carrier, Jc)
+        np.add.at(dJ, self.carrier, dJc)
+        return self.line.inertia + Jm, dJ, Jm
+
+    def gas_moments(self, theta: Array, omega: Array, t: float) -> Array:
+        """M_gas,k: the moments of the cylinders each station carries."""
+        Mc = self.cylinders.moments(theta[self.carrier], omega[self.carrier], t)
+        M = np.zeros(self.line.n)
+        np.add.at(M, self.carrier, Mc)
+        return M
+
+    # -- the elastic and dissipative elements --------------------------------------------------
+    def section_torques(self, theta: Array, omega: Array) -> Array:
+        """The torque each section transmits from station i+1 to station i, k_i Δθ_i + c_i Δω_i
+        with Δθ_i = θ_{i+1} − θ_i [N m]."""
+        return self.line.stiffness * np.diff(theta) + self.line.damping * np.diff(omega)
+
+    def element_torques(self, y: Array):
+        """(T_k on each station, the torque on each ring, on the driven inertia, and the power
+        each kind of element dissipates: sections, absolute damping, rings, coupling)."""
+        line = self.line
+        th, w, rth, rw, thd, wd = self.split(y)
+        S = self.section_torques(th, w)
+        T = np.zeros(line.n)
+        T[:-1] += S
+        T[1:] -= S
+        T -= line.absolute * w
+        T_ring = np.zeros(self.n_rings)
+        p_rings = 0.0
+        for j, ring in enumerate(line.rings):
+            rel = w[ring.station] - rw[j]
+            tq = ring.stiffness * (th[ring.station] - rth[j]) + ring.damping * rel
+            T[ring.station] -= tq
+            T_ring[j] = tq
+            p_rings += ring.damping * rel * rel
+        T_driven, p_coupling = 0.0, 0.0
+        c = line.coupling
+        if c is not None:
+            rel = w[c.station] - c.ratio * wd
+            tq = c.stiffness * (th[c.station] - c.ratio * thd) + c.damping * rel
+            T[c.station] -= tq
+            T_driven = c.ratio * tq
+            p_coupling = c.damping * rel * rel
+        p_sections = float(np.sum(line.damping * np.diff(w) ** 2))
+        p_absolute = float(np.sum(line.absolute * w * w))
+        return T, T_ring, T_driven, (p_sections, p_absolute, p_rings, p_coupling)
+
+    def potential(self, y: Array) -> float:
+        """Σ ½ k Δθ² of the sections, the rings' springs and the coupling [J]."""
+        line = self.line
+        th, _, rth, _, thd, _ = self.split(y)
+        V = 0.5 * float(np.sum(line.stiffness * np.diff(th) ** 2))
+        for j, ring in enumerate(line.rings):
+            V += 0.5 * ring.stiffness * (th[ring.station] - rth[j]) ** 2
+        c = line.coupling
+        if c is not None:
+            V += 0.5 * c.stiffness * (th[c.station] - c.ratio * thd) ** 2
+        return V
+
+    def kinetic(self, y: Array) -> float:
+        """Σ ½ J_k(θ_k) ω_k² of the stations, rings and driven inertia [J]."""
+        th, w, _, rw, _, wd = self.split(y)
+        J = self.station_inertia(th)[0]
+        K = 0.5 * float(np.sum(J * w * w))
+        K += 0.5 * sum(ring.inertia * rw[j] ** 2 for j, ring in enumerate(self.line.rings))
+        if self.line.coupling is not None:
+            K += 0.5 * self.line.coupling.driven_inertia * wd * wd
+        return K
+
+    def balance(self, y: Array, y0: Array) -> float:
+        """(T4): energy now less energy at y0, less the applied work, plus the losses [J]; zero
+        in exact arithmetic."""
+        W = dict(zip(WORKS, y[self.i_works:]))
+        work_in = W["W_gas"] + W["W_ext"] + W["W_load"]
+        losses = sum(W[k] for k in WORKS if k.startswith("L_"))
+        return (self.kinetic(y) + self.potential(y) - self.kinetic(y0) - self.potential(y0)
+                - work_in + losses)
+
+    # -- the equations --------------------------------------------------------------------------
+    def accelerations(self, t: float, y: Array):
+        """(θ̈ per station, ring accelerations, driven acceleration, applied powers (gas, ext,
+        load), dissipated powers (sections, absolute, rings, coupling, pairs))."""
+        line = self.line
+        th, w, _, rw, thd, wd = self.split(y)
+        J, dJ, Jm = self.station_inertia(th)
+        M_gas = self.gas_moments(th, w, t)
+        M_ext = (np.asarray(self.external(th, w, t), dtype=float) if self.external is not None
+                 else np.zeros(line.n))
+        T, T_ring, T_driven, dissipated = self.element_torques(y)
+        if line.eta is None:
+            acc = (M_gas + M_ext + T - 0.5 * dJ * w * w) / J
+            p_pairs = 0.0
+        else:
+            acc, p_pairs = self.through_pairs(J - Jm, Jm, dJ, M_ext + T, M_gas, w)
+        ring_acc = np.array([T_ring[j] / ring.inertia for j, ring in enumerate(line.rings)])
+        M_load = 0.0
+        driven_acc = 0.0
+        if line.coupling is not None:
+            M_load = float(self.driven_load(thd, wd, t)) if self.driven_load is not None else 0.0
+            driven_acc = (T_driven + M_load) / line.coupling.driven_inertia
+        applied = (float(M_gas @ w), float(M_ext @ w), M_load * wd)
+        return acc, ring_acc, driven_acc, applied, (*dissipated, p_pairs)
+
+    def through_pairs(self, J0: Array, Jm: Array, dJm: Array, M0: Array, Mm: Array,
+                      w: Array) -> tuple[Array, float]:
+        """θ̈ per station with a constant-η pair between each station's shaft (J0, the moments
+        M0 of sections, elements and loads) and its throw's mechanism (Jm, J′m, the gas moment
+        Mm), (T7): (η* J0 + Jm) θ̈ = η* M0 + Mm − ½ J′m ω², with η* = η_fwd where the shaft's
+        moment into the pair S = M0 − J0 θ̈ has the sign of ω and 1/η_bwd where it has the
+        other (the power-flow policy, one station at a time); and the pairs' loss
+        Σ (1 − η*) S ω."""
+        assert self.line.eta is not None
+        fwd, bwd = (np.asarray(e, dtype=float) for e in self.line.eta)
+        sigma = np.where(w >= 0.0, 1.0, -1.0)
+        R = Mm - 0.5 * dJm * w * w
+
+        def solve(eta):
+            a = (eta * M0 + R) / (eta * J0 + Jm)
+            return a, M0 - J0 * a
+
+        a_f, S_f = solve(fwd)
+        a_b, S_b = solve(1.0 / bwd)
+        backward = (S_f * sigma < 0.0) & (S_b * sigma <= 0.0)
+        acc = np.where(backward, a_b, a_f)
+        S = np.where(backward, S_b, S_f)
+        eta = np.where(backward, 1.0 / bwd, fwd)
+        return acc, float(np.sum((1.0 - eta) * S * w))
+
+    def rhs(self, t: float, y: Array) -> Array:
+        self.nfev += 1
+        _, w, _, rw, _, wd = self.split(y)
+        acc, ring_acc, driven_acc, applied, dissipated = self.accelerations(t, y)
+        dy = np.empty(self.size)
+        n, r = self.line.n, self.n_rings
+        dy[:n], dy[n:2 * n] = w, acc
+        dy[self.i_ring:self.i_ring + r], dy[self.i_ring + r:self.i_driven] = rw, ring_acc
+        if self.line.coupling is not None:
+            dy[self.i_driven], dy[self.i_driven + 1] = wd, driven_acc
+        dy[self.i_works:] = (*applied, *dissipated)
+        return dy
+
+
+def integrate(model: TorsionModel, y0: Array, t_end: float, method: str = "DOP853",
+              rtol: float = 1e-10, atol: float = 1e-12, **options):
+    """``solve_ivp`` over [0, t_end] from y0; the work integrals are left out of the error
+    control (they do not feed back), as the rigid run leaves its own."""
+    scale = np.ones(model.size)
+    scale[model.i_works:] = np.inf  # (atol ∞: never limits the step)
+    sol = solve_ivp(model.rhs, (0.0, t_end), y0, method=method, rtol=rtol, atol=atol * scale,
+                    **options)
+    if sol.status == -1:
+        raise RuntimeError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
+    return sol
+
+
+# -- the engine's side: a crank-slider's cylinders, and a pressure pulse ------------------------
+
+class CrankSliderCylinders:
+    """Each cylinder of a crank-slider (:class:`~transient.mechanisms.crank_slider.CrankSlider`)
+    on its own: with a the local angle from the cylinder's TDC, the crankpin
+    A = (r sin a, r cos a), the piston pin B = (e, y_B) on the cylinder's axis,
+    y_B = r cos a + √(l² − q²), q = r sin a − e, the rod's angle sin β = q/l and its centre of
+    mass G = B + f (A − B), f = l₁/l:
+
+        J_c(a) = m_slide y_B′² + m_rot r² + m_rod |G′|² + I_rod β′²     (T1a)
+
+    (′ = d/da; two-mass rod: its shares at pin and crankpin in m_slide and m_rot, Gots (20)),
+    and J_c′ from the second derivatives. The gas moment is (p_c − p₀) A_p u_c with
+    u_c = −y_B′ the piston's speed over ω (positive down the stroke). ``pressure``: the gauge
+    pressure p − p₀ [Pa] of a cylinder at its local angle in its cycle, vectorised."""
+
+    def __init__(self, mech, pressure: Callable[[Array], Array] | None = None) -> None:
+        self.r, self.l, self.e = mech.crank_radius, mech.rod_length, mech.offset
+        l1 = mech.rod_cg_from_pin
+        two_mass = mech.rod_model == "two-mass"
+        self.m_slide = mech.piston_mass + (mech.rod_mass * (self.l - l1) / self.l if two_mass
+                                           else 0.0)
+        self.m_rot = mech.crank_mass_per_cylinder + (mech.rod_mass * l1 / self.l if two_mass
+                                                     else 0.0)
+        self.m_rod = 0.0 if two_mass else mech.rod_mass
+        self.I_rod = 0.0 if two_mass else mech.rod_inertia_cg
+        self.f = l1 / self.l
+        self.firing = np.asarray(mech.firing_angles, dtype=float)
+        self.cycle = mech.cycle
+        self.area = mech.piston_area
+        self.pressure = pressure
+
+    def local(self, angles: Array) -> Array:
+        """Each cylinder's angle from its firing TDC, in [0, cycle)."""
+        return np.mod(angles - self.firing, self.cycle)
+
+    def kinematics(self, angles: Array):
+        """(y_B′, y_B″, β′, β″, G′, G″) at the cylinders' local angles."""
+        a = angles - self.firing
+        r, l = self.r, self.l
+        s, c = np.sin(a), np.cos(a)
+        q, dq, ddq = r * s - self.e, r * c, -r * s
+        root = np.sqrt(l * l - q * q)
+        droot = -q * dq / root
+        dy = -r * s - q * dq / root
+        ddy = -r * c - (dq * dq + q * ddq) / root - (q * dq) ** 2 / root ** 3
+        db = dq / root
+        ddb = (ddq * root - dq * droot) / root ** 2
+        f = self.f
+        G1 = np.array([f * r * c, (1 - f) * dy - f * r * s])
+        G2 = np.array([-f * r * s, (1 - f) * ddy - f * r * c])
+        return dy, ddy, db, ddb, G1, G2
+
+    def inertia(self, angles: Array) -> tuple[Array, Array]:
+        dy, ddy, db, ddb, G1, G2 = self.kinematics(angles)
+        J = (self.m_slide * dy * dy + self.m_rot * self.r ** 2 + self.m_rod * np.sum(G1 * G1, 0)
+             + self.I_rod * db * db)
+        dJ = 2.0 * (self.m_slide * dy * ddy + self.m_rod * np.sum(G1 * G2, 0)
+                    + self.I_rod * db * ddb)
+        return J, dJ
+
+    def piston_speeds(self, angles: Array) -> Array:
+        """u_c = ds_c/dθ: the pistons' speeds over ω [m/rad]."""
+        return -self.kinematics(angles)[0]
+
+    def moments(self, angles: Array, speeds: Array, t: float) -> Array:
+        if self.pressure is None:
+            return np.zeros(angles.shape)
+        return self.pressure(self.local(angles)) * self.area * self.piston_speeds(angles)
+
+
+@dataclass(frozen=True)
+class PressurePulse:
+    """A smooth gauge pressure for tests: a Gaussian pulse of height ``peak`` [Pa] centred
+    ``at`` [rad] after firing TDC with standard width ``width`` [rad], periodic in the cycle
+    (its tails at half a cycle are below rounding)."""
+
+    peak: float
+    at: float
+    width: float
+    cycle: float = 4.0 * math.pi
+
+    def __call__(self, local: Array) -> Array:
+        d = np.mod(local + 0.5 * self.cycle, self.cycle) - 0.5 * self.cycle - self.at
+        return self.peak * np.exp(-0.5 * (d / self.width) ** 2)
+
+
+# -- the rigid limit ---------------------------------------------------------------------------
+
+def rigid_run(J_rest: float, terms, gas: Callable[[float], float],
+              moment: Callable[[float, float], float], phi_end: float, omega0: float,
+              rtol: float = 1e-12, atol: float = 1e-12, phi0: float = 0.0):
+    """The rigid reduced equation (18) in its crank-angle form, dK/dφ = M, dt/dφ = 1/ω,
+    K = ½ J(φ) ω², with J(φ) = J_rest + the mechanism's twin J (``terms``: φ ↦ (J, J′, u, u′),
+    :class:`~transient.mechanisms.twins.CrankSliderNumpy`), ``gas`` φ ↦ M_gas and ``moment``
+    (φ, ω) ↦ the other moments reduced to φ. Returns the solution in φ, y = (t, K), and
+    ω(φ) as a function of it."""
+    def total(phi):
+        return J_rest + terms(phi)[0]
+
+    def rhs(phi, y):
+        w = math.sqrt(2.0 * y[1] / total(phi))
+        return [1.0 / w, gas(phi) + moment(phi, w)]
+
+    sol = solve_ivp(rhs, (phi0, phi_end), [0.0, 0.5 * total(phi0) * omega0 ** 2],
+                    method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+    if sol.status != 0:
+        raise RuntimeError(f"rigid run failed at φ = {sol.t[-1]:.9g}: {sol.message}")
+
+    def omega(phi):
+        phi = np.asarray(phi, dtype=float)
+        K = sol.sol(phi)[1]
+        return np.sqrt(2.0 * K / np.vectorize(total)(phi))
+    return sol, omega
