@@ -173,6 +173,8 @@ class Articulated:
     name = "articulated"
     #: Its compiled kernel (``Model.terms``).
     kernel = staticmethod(core.terms)
+    #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
+    shares_kernel = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`):
     #: no numpy twin (the reference path runs the kernel's Python code).
     capabilities = frozenset({"reaction-friction", "reaction-twin", "pistons", "loads",

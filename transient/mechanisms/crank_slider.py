@@ -136,6 +136,8 @@ class CrankSlider:
     name = "crank-slider"
     #: Its compiled kernel (``Model.terms``).
     kernel = staticmethod(core.terms)
+    #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
+    shares_kernel = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`).
     capabilities = frozenset({"reaction-friction", "twin", "reaction-twin", "pistons", "loads",
                               "drawers"})

@@ -86,6 +86,8 @@ class ScotchYoke:
     name = "scotch-yoke"
     #: Its compiled kernel (``Model.terms``).
     kernel = staticmethod(core.terms)
+    #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
+    shares_kernel = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism`: its numpy twin, its pistons' travel and
     #: its loads (:mod:`transient.analysis.loads.scotch_yoke`); no reaction friction, no drawn
     #: diagrams.

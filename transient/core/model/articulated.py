@@ -127,28 +127,50 @@ def articulated_terms(mp, phi, u, du):
     ``u[k]`` = ds_k/dφ with s_k the travel from the outer dead centre toward the crank (so a gas
     force P, positive toward the crank, does P·u[k]), ``du[k]`` = d²s_k/dφ².
     """
-    r = mp[R]
-    l = mp[L]
-    ns = int(mp[N_SLAVES])
     j0 = row0(mp)
     J = 0.0
     dJ = 0.0
     for j in range(int(mp[N_ROWS])):
-        alpha = phi - mp[j0 + j]
-        base = j * (1 + ns)
-        # Master piston, master rod (as a body: its centre of mass and β′) and the crank throw.
-        Jm, dJm, u[base], du[base] = cylinder_terms(alpha, mp)
-        J += Jm
-        dJ += dJm
-        ca, sa, cb, sb, db, ddb = master_rod(alpha, r, l)
-        for i in range(ns):
-            X, X1, X2, A1x, A1y, A2x, A2y, t1, t2 = slave(mp, i, r, ca, sa, cb, sb, db, ddb)
-            Js, dJs = slave_inertia(mp, i, X1, X2, A1x, A1y, A2x, A2y, t1, t2)
-            J += Js
-            dJ += dJs
-            u[base + 1 + i] = -X1
-            du[base + 1 + i] = -X2
+        Jj, dJj = row_terms(mp, j, phi - mp[j0 + j], u, du)
+        J += Jj
+        dJ += dJj
     return J, dJ
+
+
+@kernel(inline=True)
+def row_terms(mp, j, alpha, u, du):
+    """J and dJ/dα of row j (its crank throw, master rod and piston, slaves) at its local angle
+    α; fills the row's u, u′ (:func:`articulated_terms`)."""
+    r = mp[R]
+    l = mp[L]
+    ns = int(mp[N_SLAVES])
+    base = j * (1 + ns)
+    # Master piston, master rod (as a body: its centre of mass and β′) and the crank throw.
+    J, dJ, u[base], du[base] = cylinder_terms(alpha, mp)
+    ca, sa, cb, sb, db, ddb = master_rod(alpha, r, l)
+    for i in range(ns):
+        X, X1, X2, A1x, A1y, A2x, A2y, t1, t2 = slave(mp, i, r, ca, sa, cb, sb, db, ddb)
+        Js, dJs = slave_inertia(mp, i, X1, X2, A1x, A1y, A2x, A2y, t1, t2)
+        J += Js
+        dJ += dJs
+        u[base + 1 + i] = -X1
+        du[base + 1 + i] = -X2
+    return J, dJ
+
+
+@kernel(inline=True)
+def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of master and articulated rods: a row's master and slaves move with its
+    crank throw, so they ride one station, whose angle is that of the row's master,
+    ``angles[j(1 + z′)]``; the master's share is the whole row's J, the slaves' nothing."""
+    ns = int(mp[N_SLAVES])
+    j0 = row0(mp)
+    for j in range(int(mp[N_ROWS])):
+        base = j * (1 + ns)
+        Jc[base], dJc[base] = row_terms(mp, j, angles[base] - mp[j0 + j], u, du)
+        for i in range(ns):
+            Jc[base + 1 + i] = 0.0
+            dJc[base + 1 + i] = 0.0
 
 
 @kernel

@@ -122,6 +122,22 @@ def crank_slider_terms(mp, phi, u, du, with_dJ=True):
 
 
 @kernel(inline=True)
+def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of the crank-slider: each cylinder's own reduced inertia J_c, J′_c and
+    transfer functions at ``angles[k]``, the angle of the station that carries it (theory (T1a)):
+    on an elastic shaft line each throw turns at its own angle, so each cylinder takes its own
+    sine and cosine."""
+    n = int(mp[N_CYL])
+    for k in range(n):
+        sp = sin(angles[k])
+        cp = cos(angles[k])
+        s0 = mp[SIN0 + k]
+        c0 = mp[SIN0 + n + k]
+        Jc[k], dJc[k], u[k], du[k] = cylinder_terms_sc(sp * c0 - cp * s0, cp * c0 + sp * s0, mp,
+                                                       True)
+
+
+@kernel(inline=True)
 def terms(mp, kin_coef, phi, u, du, with_dJ):
     """``Model.terms`` of the crank-slider: :func:`crank_slider_terms` (``kin_coef`` is the
     tabulated kernel's)."""

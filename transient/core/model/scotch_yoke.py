@@ -34,6 +34,12 @@ def scotch_yoke_terms(mp, phi, u, du):
 
 
 @kernel(inline=True)
+def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of the Scotch yoke: its one cylinder's J and J′ at its station's angle."""
+    Jc[0], dJc[0] = scotch_yoke_terms(mp, angles[0], u, du)
+
+
+@kernel(inline=True)
 def terms(mp, kin_coef, phi, u, du, with_dJ):
     """``Model.terms`` of the Scotch yoke: :func:`scotch_yoke_terms` (``kin_coef`` is the
     tabulated kernel's)."""

@@ -235,6 +235,17 @@ def swash_terms(mp, phi, u, du):
 
 
 @kernel(inline=True)
+def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of the swash plate: its plate, links, rods and pistons move together, so
+    they ride one station, whose angle is ``angles[0]``; the first cylinder's share is the whole
+    J, the others' nothing."""
+    Jc[0], dJc[0] = swash_terms(mp, angles[0], u, du)
+    for k in range(1, int(mp[N_CYL])):
+        Jc[k] = 0.0
+        dJc[k] = 0.0
+
+
+@kernel(inline=True)
 def terms(mp, kin_coef, phi, u, du, with_dJ):
     """``Model.terms`` of the swash plate: :func:`swash_terms` (``kin_coef`` is the
     tabulated kernel's)."""

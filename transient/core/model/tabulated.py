@@ -55,6 +55,17 @@ def tabulated_terms(coef, phi, u, du):
 
 
 @kernel(inline=True)
+def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of tabulated kinematics: the tables hold the mechanism's J(φ) whole, so
+    every cylinder rides one station, whose angle is ``angles[0]``; the first cylinder's share
+    is the whole J, the others' nothing."""
+    Jc[0], dJc[0] = tabulated_terms(kin_coef, angles[0], u, du)
+    for k in range(1, kin_coef.shape[0] - 1):
+        Jc[k] = 0.0
+        dJc[k] = 0.0
+
+
+@kernel(inline=True)
 def terms(mp, kin_coef, phi, u, du, with_dJ):
     """``Model.terms`` of tabulated kinematics, any mechanism's: :func:`tabulated_terms` (``mp``
     is the mechanism's own parameters, for its reaction solver)."""
