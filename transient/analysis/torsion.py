@@ -164,7 +164,7 @@ def _elements(line: ShaftLine) -> list[tuple[str, int, int]]:
     names, at = line.names, line.station_dof
     out = [(f"section {i + 1} ({names[at[i]]}–{names[at[i + 1]]})", at[i], at[i + 1])
            for i in range(len(at) - 1)]
-    out += [(f"damper spring at {names[hub]}", hub, ring) for d, ring, hub in line._rings()
+    out += [(f"damper spring at {names[hub]}", hub, ring) for d, ring, hub in line.rings()
             if d.model == "tuned"]
     if line.shaft.coupling is not None:
         out.append(("coupling", at[-1], line.n - 1))

@@ -7,6 +7,7 @@ Every key is read before the checks across entries, so that the key reference he
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from ..errors import SceneError, show_value
 from ..mechanisms import provides
@@ -61,16 +62,10 @@ def read_shaft(s: Section, mech, inertia: Inertia) -> Shaft:
                                     f"[shaft.coupling] driven_inertia); leave [inertia] out or 0")
     if not reference:
         own = [st.inertia for st in stations]
-        shaft = _with(shaft, reference=stations[own.index(max(own))].name)
+        shaft = replace(shaft, reference=stations[own.index(max(own))].name)
     if not load_at:
-        shaft = _with(shaft, load_at=DRIVEN if coupling else stations[-1].name)
+        shaft = replace(shaft, load_at=DRIVEN if coupling else stations[-1].name)
     return shaft
-
-
-def _with(shaft: Shaft, **changes) -> Shaft:
-    from dataclasses import replace
-
-    return replace(shaft, **changes)
 
 
 def _read_station(s: Section) -> Station:

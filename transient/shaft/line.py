@@ -84,7 +84,7 @@ class ShaftLine:
         spring ties to anything."""
         return 1 + sum(d.model == "viscous" for d in self.shaft.dampers)
 
-    def _rings(self):
+    def rings(self):
         """(damper, its ring's dof, its hub's dof) of each damper."""
         ring_of = iter(i for i, d in enumerate(self.dofs) if d.kind == "ring")
         by_station = sorted(self.shaft.dampers,
@@ -97,7 +97,7 @@ class ShaftLine:
         own = np.zeros(self.n)
         for st, i in zip(self.shaft.stations, self.station_dof):
             own[i] = st.inertia
-        for damper, ring, _ in self._rings():
+        for damper, ring, _ in self.rings():
             own[ring] = damper.inertia
         if self.shaft.coupling is not None:
             own[-1] = self.shaft.coupling.referred_inertia
@@ -113,7 +113,7 @@ class ShaftLine:
             relative = sec.loss_factor + 2.0 * sec.damping_ratio
             c = sec.damping + (relative * sec.stiffness / omega_1 if relative else 0.0)
             yield at[i], at[i + 1], sec.stiffness, c
-        for damper, ring, hub in self._rings():
+        for damper, ring, hub in self.rings():
             yield hub, ring, damper.stiffness, damper.damping
         if shaft.coupling is not None:
             cp = shaft.coupling
