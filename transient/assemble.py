@@ -59,6 +59,7 @@ from .scene.queries import (
     reaction_friction,
     wiebe_levels,
 )
+from .shaft import refuse_elastic_run
 
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
@@ -224,6 +225,7 @@ def build_model(scene, part_load: bool = False
     The motored curve is paired where the scene can burn less than full-load fuel
     (:func:`~transient.scene.queries.burns_part_load`) or ``part_load`` asks for it (a study at
     a fixed fuel)."""
+    refuse_elastic_run(scene)
     mech = scene.mechanism
     table, motored = gas_tables(scene)
     if not (part_load or burns_part_load(scene)):

@@ -960,3 +960,72 @@ def sweep_scatter(ax, x, y, c, xlabel, ylabel, clabel=None):
     ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
     return artists
+
+
+#: How the Campbell diagram draws an engine order of each kind
+#: (:data:`transient.analysis.torsion.ORDER_KINDS`): the major orders bold, the other integer
+#: orders dashed, the half orders dotted, so that a grey print tells them apart too.
+ORDER_STYLES = {"major": dict(color="C3", lw=1.5, ls="-"),
+                "integer": dict(color="0.3", lw=0.8, ls=(0, (5, 2))),
+                "half": dict(color="0.55", lw=0.8, ls=(0, (1.5, 1.5)))}
+
+
+def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None):
+    """The Campbell diagram of a shaft line: natural frequency [Hz] against shaft speed [rpm].
+
+    ``modal`` (:class:`transient.analysis.torsion.Modal`): each elastic mode below the highest
+    order's line as a line at its cycle-mean frequency, its frozen-angle band shaded; ``orders``
+    [1/rev] as lines f = q·n/60, styled by kind (:data:`ORDER_STYLES`) and labelled where they
+    leave the axes; ``criticals`` (:class:`transient.analysis.torsion.Critical`) marked, their
+    size growing with their relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
+    ``run_orders``: a run's order spectra per cycle as :func:`campbell` takes them,
+    (cycle-mean speeds [rpm], orders [1/rev], amplitudes (n_cycles, n_orders)), drawn on the
+    orders' lines as markers of area ∝ amplitude; None draws none. Returns the legend's
+    handles."""
+    from matplotlib.lines import Line2D
+
+    from .analysis.torsion import order_kind
+
+    lo, hi = speed_range
+    top = 1.05 * max(orders) * hi / 60.0
+    rpm = np.array([lo, hi])
+    handles = []
+    for mode in modal.modes:
+        if mode.band[0] > top:
+            continue
+        color = f"C{(mode.number - 1) % 10}"
+        ax.axhspan(*mode.band, color=color, alpha=0.18, lw=0)
+        handles.append(ax.axhline(mode.f, color=color, lw=1.2,
+                                  label=f"mode {mode.number}: {mode.f:.4g} Hz "
+                                        f"(band {mode.band[0]:.4g}–{mode.band[1]:.4g})"))
+    firing = modal.line.scene.mechanism.firing_angles
+    for q in orders:
+        kind = order_kind(q, firing)
+        ax.plot(rpm, q * rpm / 60.0, **ORDER_STYLES[kind])
+        x_end = min(hi, 60.0 * top / q)
+        ax.annotate(f"{q:g}", (x_end, q * x_end / 60.0), fontsize=6, ha="right", va="top",
+                    color=ORDER_STYLES[kind]["color"], xytext=(-2, -1),
+                    textcoords="offset points")
+    handles += [Line2D([], [], **ORDER_STYLES[k], label=f"{k} orders") for k in ORDER_STYLES]
+    if criticals:
+        x = [c.rpm for c in criticals]
+        y = [c.rpm * c.order / 60.0 for c in criticals]
+        size = [12.0 + 48.0 * c.excitation for c in criticals]
+        handles.append(ax.scatter(x, y, s=size, facecolor="none", edgecolor="k", lw=0.9,
+                                  zorder=3, label="critical speeds (size: relative excitation)"))
+    if run_orders is not None:
+        speeds, run_q, amp = (np.asarray(a, dtype=float) for a in run_orders)
+        amp = np.abs(amp)
+        largest = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
+        x = np.repeat(speeds[:, None], run_q.size, axis=1)
+        ax.scatter(x, x * run_q[None, :] / 60.0, s=80.0 * amp / largest, color="C0", alpha=0.5,
+                   lw=0, zorder=2)
+        handles.append(Line2D([], [], marker="o", ls="", color="C0", alpha=0.5,
+                              label="run's order amplitudes"))
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(0.0, top)
+    ax.set_xlabel("shaft speed [rpm]")
+    ax.set_ylabel("frequency [Hz]")
+    ax.grid(True, alpha=0.3)
+    legend_outside(ax, handles=handles)
+    return handles

@@ -31,6 +31,7 @@ from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memo
 from .scene.outputs import output_columns
 from .scene.queries import part_load_refusal
 from .scene.records import COMPILED_METHODS, runs_compiled
+from .shaft import refuse_elastic_run
 from .stopping import deferred
 
 BUFFER_ROWS = 8192
@@ -353,6 +354,7 @@ def integrate(scene, on_block=None, progress=None, keep=True, start=None, before
     ``start`` wrote before it. The run comes back judged (:func:`transient.outcome.judge`) over
     all of it; a run that outgrows its output budget or stops advancing raises
     :class:`~transient.outcome.RunStopped` after its blocks so far went to ``on_block``."""
+    refuse_elastic_run(scene)
     watch = Watch(scene, len(output_columns(scene)))
     for block, events in before:
         watch.take(block, events)
@@ -487,6 +489,7 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
     >>> math.isclose(omega0, 1000 * 2 * math.pi / 60)
     True
     """
+    refuse_elastic_run(scene)  # (before any file is made)
     if path is None:
         if force or resume:
             raise SceneError("path", "force and resume apply to a result file: give its path")

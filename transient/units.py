@@ -15,6 +15,7 @@ SUFFIXES: dict[str, dict[str, float]] = {
     "length": {"mm": 1e-3},
     "pressure": {"bar": 1e5, "MPa": 1e6},
     "force": {"kN": 1e3},
+    "modulus": {"GPa": 1e9},
 }
 ALL_SUFFIXES = sorted({s for kind in SUFFIXES.values() for s in kind})
 
@@ -41,6 +42,8 @@ UNITS: dict[str, str] = {
     "specific energy": "J/kg",
     "per kelvin": "1/K",
     "stiffness": "N/m",
+    "torsional stiffness": "N m/rad",
+    "modulus": "Pa",
     "linear damping": "N s/m",
     "rotary damping": "N m s/rad",
     "quadratic rotary damping": "N m s²/rad²",
@@ -55,6 +58,7 @@ SHOWN: dict[str, tuple[str, str]] = {
     "speed": ("rpm", "rpm"),
     "length": ("mm", "mm"),
     "pressure": ("bar", "bar"),
+    "modulus": ("GPa", "GPa"),
 }
 
 

@@ -22,6 +22,7 @@ from transient.core.stepper import events
 from transient.core.stepper import io as sio
 from transient.scene import load_scene
 from transient.scene.outputs import output_columns
+from transient.shaft import rigid_equivalent
 
 CASES = sorted((Path(__file__).resolve().parents[2] / "cases").glob("*.toml"))
 
@@ -60,8 +61,10 @@ def test_bad_declarations_are_refused():
 @pytest.mark.parametrize("case", CASES, ids=[c.stem for c in CASES])
 def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
     """The compiled index kernels (the chain the kernels index by) and the declaration's offsets
-    (what the Python side lays out) agree, and both with what the scene counts otherwise."""
-    scene = load_scene(case)
+    (what the Python side lays out) agree, and both with what the scene counts otherwise. A
+    scene with an elastic shaft line, whose compiled model is not built yet, is laid out as its
+    rigid equivalent."""
+    scene = rigid_equivalent(load_scene(case))
     model, _, _ = build_model(scene)
     at = layout.STATE.offsets_for(model)
     assert [layout.gov_index(model), layout.latch_index(model), layout.cyl_index(model),
@@ -128,8 +131,8 @@ def test_the_models_type_from_its_fingerprint_is_numbas_own_on_every_case():
     from numba import typeof
 
     seen = {}
-    for path in CASES:
-        model, _, _ = build_model(load_scene(path))
+    for path in CASES:  # (an elastic line's model is not built yet: its rigid equivalent's is)
+        model, _, _ = build_model(rigid_equivalent(load_scene(path)))
         assert typeof(model) == _numbas_own_type(model), path.name
         seen.setdefault(typeof(model), path.name)
     assert len(seen) > 3  # (the cases differ in their mechanisms' kernels and fields' types)

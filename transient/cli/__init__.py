@@ -5,7 +5,7 @@ Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulatio
 partial result is kept and marked incomplete).
 
 Each command group is a module that registers its subparsers and parses, calls the library,
-draws and prints: ``run`` (run, check, info), ``plot``, ``kinematics``, ``verify`` (bench,
+draws and prints: ``run`` (run, check, info), ``plot``, ``kinematics``, ``modes``, ``verify`` (bench,
 stress), ``efficiency``, ``loads``, ``orders``, ``sweep`` (sweep, sweep-plot); ``common`` holds
 what they share. Errors become exit codes here only, in :func:`main`.
 """
@@ -18,7 +18,7 @@ import sys
 
 from ..errors import SceneError, SimulationError, WriteFailed
 from ..stopping import interrupting
-from . import efficiency, kinematics, loads, orders, plot, run, sweep, verify
+from . import efficiency, kinematics, loads, modes, orders, plot, run, sweep, verify
 from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE, OptionParser
 
 __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", "main"]
@@ -27,7 +27,8 @@ __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", 
 _BROKEN_WRITE: WriteFailed | None = None
 
 #: The subcommands' registrations, in the order ``transient --help`` lists them.
-_COMMANDS = (run.register, plot.register, kinematics.register, verify.register_bench,
+_COMMANDS = (run.register, plot.register, kinematics.register, modes.register,
+             verify.register_bench,
              efficiency.register, loads.register, orders.register, verify.register_stress,
              sweep.register)
 
@@ -44,6 +45,7 @@ EXAMPLES = {
     "warmup": "transient warmup cases/radial_9cyl.toml",
     "plot": "transient plot results/swash_plate_4cyl.h5 -o results",
     "kinematics": "transient kinematics cases/radial_5cyl.toml --points 721 -o results",
+    "modes": "transient modes cases/inline6_damper.toml -o results",
     "bench": "transient bench --quick -o results/benchmarks",
     "efficiency": "transient efficiency cases/gots_diesel_friction.toml --rpm 1000,2000",
     "loads": "transient loads results/gots_diesel_4400.h5 --cylinder 2 -o results",

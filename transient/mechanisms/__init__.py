@@ -207,11 +207,30 @@ class NumpyTwin(Protocol):
     twin: ClassVar[type]
 
 
+@runtime_checkable
+class CylinderInertia(Protocol):
+    """Each cylinder's own share of J(φ) (capability ``"cylinder-inertia"``), so that an elastic
+    shaft line (:mod:`transient.shaft`) can put each crankpin's cylinders on a station of their
+    own, each at its station's angle. A mechanism without it keeps its cylinders together: its
+    whole J(φ) on one station."""
+
+    @property
+    def crankpins(self) -> tuple[tuple[int, ...], ...]:
+        """The cylinders (0-based) by the crankpin they ride on, from the nose: the cylinders
+        of one crankpin move together and stay on one station."""
+
+    def cylinder_inertia_terms(self) -> Callable[[float], tuple[NDArray[np.float64],
+                                                                NDArray[np.float64]]]:
+        """θ ↦ (J_k(θ), dJ_k/dθ) of every cylinder k at shaft angle θ (each at its own phase)
+        [kg m², kg m²/rad], whose sum over k is the mechanism's J(θ), dJ/dθ."""
+
+
 #: Every capability a mechanism may claim, and who provides it: a Protocol of this module (the
 #: mechanism itself), or the table that holds it keyed by the mechanism's name.
 CAPABILITIES: dict[str, type | str] = {
     "reaction-friction": ReactionFriction,
     "twin": NumpyTwin,
+    "cylinder-inertia": CylinderInertia,
     "reaction-twin": "transient.reference.integrate.REACTION_TWINS",
     "pistons": "transient.analysis.pistons.KINEMATICS",
     "loads": "transient.analysis.requested.LOADS",

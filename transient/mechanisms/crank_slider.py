@@ -140,7 +140,7 @@ class CrankSlider:
     shares_kernel = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`).
     capabilities = frozenset({"reaction-friction", "twin", "reaction-twin", "pistons", "loads",
-                              "drawers"})
+                              "drawers", "cylinder-inertia"})
     #: Its numpy twin, for the reference path.
     twin = CrankSliderNumpy
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
@@ -522,6 +522,20 @@ class CrankSlider:
         """φ ↦ (J, dJ/dφ, u_k, u′_k) for the reference path: the numpy twin written from the Gots
         relations (:class:`~.twins.CrankSliderNumpy`), independent of the kernel."""
         return self.twin(self).terms
+
+    @property
+    def crankpins(self) -> tuple[tuple[int, ...], ...]:
+        """The cylinders (0-based) of each throw, from the nose (capability
+        ``"cylinder-inertia"``)."""
+        throw = self.throw_of_cylinder()
+        return tuple(tuple(int(k) for k in np.flatnonzero(throw == t))
+                     for t in range(self.n_throws))
+
+    def cylinder_inertia_terms(self) -> Callable[[float], tuple[NDArray[np.float64],
+                                                                NDArray[np.float64]]]:
+        """θ ↦ (J_k, dJ_k/dθ) per cylinder, from the numpy twin's per-cylinder terms (each
+        cylinder's slider, rotating, rod and rod-rotation parts), whose sum is J(θ)."""
+        return self.twin(self).cylinder_terms
 
     def analysis_summary(self) -> dict[str, tuple[float, str]]:
         """Figures of the mechanism itself for a result's ``/analysis``: none here."""

@@ -25,6 +25,15 @@ class CrankSliderNumpy:
 
     def terms(self, phi: float):
         """(J, dJ, u[k], u′[k]) at shaft angle φ, all cylinders."""
+        J, dJ, u, du = self._per_cylinder(phi)
+        return np.sum(J), np.sum(dJ), u, du
+
+    def cylinder_terms(self, phi: float):
+        """(J_k, dJ_k/dφ) of each cylinder k at shaft angle φ: its share of J(φ)."""
+        J, dJ, _, _ = self._per_cylinder(phi)
+        return J, dJ
+
+    def _per_cylinder(self, phi: float):
         a = phi - self.phases
         r, l = self.r, self.l
         beta = np.arcsin((r * np.sin(a) - self.e) / l)
@@ -38,10 +47,10 @@ class CrankSliderNumpy:
         f = self.f_cg
         g1 = np.array([f * r * np.cos(a), -(1 - f) * u - f * r * np.sin(a)])
         g2 = np.array([-f * r * np.sin(a), -(1 - f) * du - f * r * np.cos(a)])
-        J = np.sum(self.m_slide * u**2 + self.m_rot * r**2 + self.m_rod * np.sum(g1**2, axis=0)
-                   + self.I_rod * db**2)
-        dJ = 2 * np.sum(self.m_slide * u * du + self.m_rod * np.sum(g1 * g2, axis=0)
-                        + self.I_rod * db * ddb)
+        J = (self.m_slide * u**2 + self.m_rot * r**2 + self.m_rod * np.sum(g1**2, axis=0)
+             + self.I_rod * db**2)
+        dJ = 2 * (self.m_slide * u * du + self.m_rod * np.sum(g1 * g2, axis=0)
+                  + self.I_rod * db * ddb)
         return J, dJ, u, du
 
 

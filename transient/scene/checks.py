@@ -23,6 +23,8 @@ def check_consistency(scene: Scene) -> tuple[float, float]:
     with np.errstate(over="ignore", invalid="ignore"):
         kinematics = scene.mechanism.kinematics_table(phi)
         J = kinematics["J"] + scene.inertia.total
+        if scene.shaft is not None:  # (its rigid equivalent's: the line turning as one body)
+            J = J + scene.shaft.constant_inertia
         lever = sum(float(np.max(np.abs(kinematics[f"u_{k + 1}"])))
                     for k in range(scene.mechanism.n_cylinders))
     if not np.all(np.isfinite(J)):

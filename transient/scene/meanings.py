@@ -21,6 +21,57 @@ MEANINGS: dict[str, dict[str, str]] = {
         "output": "How densely the trajectory is sampled.",
         "friction": "Non-ideal kinematic pairs and how their modes are chosen.",
         "analysis": "Results derived after the run, stored only when asked for.",
+        "shaft": "The elastic shaft line: stations, sections, dampers and the coupling to a "
+                 "driven inertia (absent: a rigid shaft).",
+    },
+    "shaft": {
+        "stations": "The stations of the line, in order from the front end "
+                    "(``[[shaft.stations]]``).",
+        "sections": "The shaft sections between consecutive stations, one fewer than the "
+                    "stations (``[[shaft.sections]]``).",
+        "dampers": "Torsional vibration dampers, each a ring on a station's hub "
+                   "(``[[shaft.dampers]]``).",
+        "coupling": "An elastic coupling, a gear and the driven inertia beyond the last station "
+                    "(``[shaft.coupling]``).",
+        "reference": "The station whose angle is the run's crank angle.",
+        "load_at": "Where the load acts: a station's name, or ``driven`` (the driven inertia).",
+        "speed_range": "Lowest and highest speed whose critical speeds ``transient modes`` "
+                       "lists.",
+    },
+    "shaft.stations[]": {
+        "name": "Names the station (unique): the modes table and the dampers refer to it.",
+        "inertia": "The station's own constant inertia (pulley, hub, webs and counterweights, "
+                   "flywheel); its cylinders' reduced inertia comes on top.",
+        "damping": "Absolute damping of the station to the frame.",
+        "cylinders": "The cylinders (1-based) whose crankpin the station carries; empty for a "
+                     "pulley or flywheel.",
+    },
+    "shaft.sections[]": {
+        "stiffness": "Torsional stiffness of the section.",
+        "length": "Length of a round shaft section (without ``stiffness``).",
+        "diameter": "Outer diameter of a round shaft section.",
+        "bore": "Inner diameter of a hollow section; k = Gπ(d⁴ − d_i⁴)/(32 L).",
+        "shear_modulus": "Shear modulus G of the section's material.",
+        "damping": "Relative (section) damping coefficient between its two stations.",
+        "loss_factor": "Loss factor η: viscous c = η·k/ω₁ at the line's first natural "
+                       "frequency.",
+        "damping_ratio": "Damping ratio ζ: viscous c = 2ζ·k/ω₁ at the line's first natural "
+                         "frequency.",
+    },
+    "shaft.dampers[]": {
+        "station": "The station whose hub carries the damper.",
+        "model": "``viscous`` (a ring in silicone: inertia and damping) or ``tuned`` (a "
+                 "rubber-sprung ring: also a stiffness).",
+        "inertia": "Moment of inertia of the damper's ring.",
+        "damping": "Damping coefficient between ring and hub.",
+        "stiffness": "Stiffness between ring and hub (``tuned``).",
+    },
+    "shaft.coupling": {
+        "stiffness": "Torsional stiffness of the elastic coupling, at shaft speed.",
+        "damping": "Damping coefficient of the coupling.",
+        "gear_ratio": "Gear ratio i = n_driven / n_shaft beyond the coupling; the driven "
+                      "inertia is i²·J_d at the shaft.",
+        "driven_inertia": "Moment of inertia J_d of the driven machine, at its own speed.",
     },
     "scene": {
         "name": "Names the result: labels its file, figures and terminal lines.",

@@ -53,6 +53,7 @@ from .records import (
     Wiebe,
     Woschni,
 )
+from .shaft import read_shaft
 from .write import to_toml
 
 
@@ -272,6 +273,11 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         sa = root.sub("analysis")
         sections["analysis"] = _read_analysis(sa)
         sa.finish()
+        root.known.append("shaft")
+        if root.has("shaft"):  # (absent: the rigid shaft, nothing read or checked)
+            sh = root.sub("shaft")
+            sections["shaft"] = read_shaft(sh, mech, sections["inertia"])
+            sh.finish()
         root.finish()
         scene = Scene(name=name, description=description, mechanism=mech, **sections)
         least_inertia, lever = check_consistency(scene)

@@ -601,6 +601,126 @@ class Analysis:
 DETREND = ("auto", "ramp", "none")
 
 
+#: Shear modulus of steel [Pa], the default of a shaft section given by its geometry.
+STEEL_SHEAR_MODULUS = 80e9
+#: The damper models of ``[[shaft.dampers]]``: a ring coupled to its hub by a viscous film
+#: only, or by a spring (rubber) with its damping.
+DAMPER_MODELS = ("viscous", "tuned")
+
+
+@dataclass(frozen=True)
+class Station:
+    """A station of the shaft line, a ``[[shaft.stations]]`` entry (in order from the front
+    end): a rigid disc where the line carries inertia.
+
+    ``name`` labels it (unique). ``inertia`` [kg m²]: its own constant inertia (pulley, damper
+    hub, webs and counterweights, flywheel), to which the reduced inertia of the cylinders it
+    carries is added at its own angle. ``damping`` [N m s/rad]: absolute damping to the frame
+    (≥ 0). ``cylinders``: the numbers (1-based) of the cylinders whose crankpin it carries
+    (in-line: one; V: the two of a throw; radial and swash plate: all); empty for a pulley or a
+    flywheel.
+    """
+
+    name: str
+    inertia: float = 0.0
+    damping: float = 0.0
+    cylinders: tuple[int, ...] = ()
+
+
+@dataclass(frozen=True)
+class ShaftSection:
+    """A shaft section between two consecutive stations, a ``[[shaft.sections]]`` entry
+    (section i joins stations i and i + 1).
+
+    ``stiffness`` k [N m/rad], given, or from the geometry of a round shaft: ``length`` L,
+    ``diameter`` d, ``bore`` d_i (hollow; default 0) and ``shear_modulus`` G (default steel,
+    80 GPa): k = G·π(d⁴ − d_i⁴)/(32 L). Its relative damping (between its two stations), at most
+    one of: ``damping`` c [N m s/rad]; ``loss_factor`` η [1]; ``damping_ratio`` ζ [1]. A loss
+    factor (hysteretic damping) and a damping ratio become a viscous coefficient at the line's
+    first natural frequency ω₁ (of the undamped line at cycle-mean inertias,
+    :mod:`transient.shaft`): c = η·k/ω₁ = 2ζ·k/ω₁, so that the section dissipates per cycle of
+    the first mode what the hysteretic law does (η = 2ζ).
+    """
+
+    stiffness: float
+    damping: float = 0.0
+    loss_factor: float = 0.0
+    damping_ratio: float = 0.0
+
+
+@dataclass(frozen=True)
+class Damper:
+    """A torsional vibration damper, a ``[[shaft.dampers]]`` entry: a ring of its own degree of
+    freedom on the hub of ``station``. ``model``: ``"viscous"`` (a ring in silicone, coupled to
+    the hub by ``damping`` c [N m s/rad] only) or ``"tuned"`` (a rubber-sprung ring: also
+    ``stiffness`` k [N m/rad]). ``inertia`` [kg m²]: the ring's (> 0); the hub's is the
+    station's.
+    """
+
+    station: str
+    model: str
+    inertia: float
+    damping: float
+    stiffness: float = 0.0
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """What the shaft line drives beyond its last station, the ``[shaft.coupling]`` table: an
+    elastic coupling of ``stiffness`` [N m/rad] and ``damping`` [N m s/rad] at shaft speed (on
+    the flywheel side of the gear), then a rigid gear without inertia of ``gear_ratio`` i =
+    n_driven / n_shaft [1], then the driven machine's ``driven_inertia`` J_d [kg m²]. Referred
+    to the shaft, the driven inertia is i²·J_d (the same kinetic energy ½J_d(iθ̇)²) and a torque
+    T on the driven shaft is i·T (the same power).
+    """
+
+    stiffness: float
+    driven_inertia: float
+    damping: float = 0.0
+    gear_ratio: float = 1.0
+
+    @property
+    def referred_inertia(self) -> float:
+        """i²·J_d [kg m²]: the driven inertia seen at the shaft's speed."""
+        return self.gear_ratio ** 2 * self.driven_inertia
+
+
+@dataclass(frozen=True)
+class Shaft:
+    """The elastic shaft line, the ``[shaft]`` table (absent: the rigid shaft of J(φ) and
+    ``[inertia]``): its ``stations`` in order from the front end, the ``sections`` between them
+    (one fewer), the ``dampers`` on them, the ``coupling`` to a driven inertia (or None).
+
+    ``reference``: the station whose angle is the run's crank angle (default: the station with
+    the largest own inertia, the flywheel's, the first of equals). ``load_at``: where the load
+    acts, a station's name or ``"driven"`` (default: the driven inertia with a coupling, else
+    the last station). ``speed_range`` [rad/s]: the speeds whose critical speeds ``transient
+    modes`` lists (default: 0 to 1.2 times the highest speed the scene names). ``[inertia]`` is
+    zero or absent with a shaft line: the stations hold its inertias.
+    """
+
+    stations: tuple[Station, ...]
+    sections: tuple[ShaftSection, ...]
+    dampers: tuple[Damper, ...] = ()
+    coupling: Coupling | None = None
+    reference: str = ""
+    load_at: str = ""
+    speed_range: tuple[float, ...] = ()
+
+    @property
+    def constant_inertia(self) -> float:
+        """The line's constant inertias as one rigid body [kg m²]: the stations' own, the damper
+        rings' and the driven inertia referred to the shaft (the rigid equivalent's
+        ``[inertia]``; the cylinders' J(φ) comes on top)."""
+        driven = self.coupling.referred_inertia if self.coupling else 0.0
+        return (sum(s.inertia for s in self.stations) + sum(d.inertia for d in self.dampers)
+                + driven)
+
+    def station_index(self, name: str) -> int:
+        """The position (0-based) of the station called ``name``."""
+        return [s.name for s in self.stations].index(name)
+
+
 @dataclass(frozen=True)
 class Scene:
     """A validated scene: what :func:`transient.load_scene` returns, one record per TOML
@@ -652,6 +772,7 @@ class Scene:
     output: Output = field(default_factory=Output)
     friction: Friction = field(default_factory=Friction)
     analysis: Analysis = field(default_factory=Analysis)
+    shaft: Shaft | None = None
     source_file: str = field(default="", compare=False, repr=False)
     source_text: str = field(default="", compare=False, repr=False)
 

@@ -9,7 +9,7 @@ from dataclasses import fields, is_dataclass
 from typing import Any
 
 from ..tomlout import toml_value
-from .records import GOVERNOR_KEYS, Gas, Load, Scene
+from .records import GOVERNOR_KEYS, Gas, Load, Scene, Shaft
 
 
 def to_toml(scene: Scene) -> str:
@@ -57,7 +57,33 @@ def to_toml(scene: Scene) -> str:
         else:
             lines += [f"eta_forward = {toml_value(pair.eta_forward)}",
                       f"eta_backward = {toml_value(pair.eta_backward)}"]
+    if scene.shaft is not None:
+        lines += _shaft_section(scene.shaft)
     return "\n".join(lines) + "\n"
+
+
+def _shaft_section(shaft: Shaft) -> list[str]:
+    """[shaft] and its arrays: sections by their stiffness (the geometry resolved), a damper's
+    stiffness only for a tuned one."""
+    lines = ["", "[shaft]", f"reference = {toml_value(shaft.reference)}",
+             f"load_at = {toml_value(shaft.load_at)}"]
+    if shaft.speed_range:
+        lines.append(f"speed_range = {toml_value(list(shaft.speed_range))}")
+    for station in shaft.stations:
+        lines += ["", "[[shaft.stations]]"] + [
+            f"{f.name} = {toml_value(list(v) if isinstance(v, tuple) else v)}"
+            for f in fields(station) for v in [getattr(station, f.name)]]
+    for section in shaft.sections:
+        lines += ["", "[[shaft.sections]]", f"stiffness = {toml_value(section.stiffness)}"]
+        lines += [f"{k} = {toml_value(getattr(section, k))}"
+                  for k in ("damping", "loss_factor", "damping_ratio") if getattr(section, k)]
+    for damper in shaft.dampers:
+        lines += ["", "[[shaft.dampers]]"] + [
+            f"{f.name} = {toml_value(getattr(damper, f.name))}" for f in fields(damper)
+            if f.name != "stiffness" or damper.model == "tuned"]
+    if shaft.coupling is not None:
+        lines += _section("shaft.coupling", shaft.coupling)
+    return lines
 
 
 def _gas_section(gas: Gas, strokes: int) -> list[str]:

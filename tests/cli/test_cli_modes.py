@@ -1,0 +1,100 @@
+"""``transient modes``: the modes table and critical speeds on standard output, the Campbell
+diagram (and with --csv the tables) written, nothing overwritten without --force, and every
+mistake one line with exit 2."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from transient.cli import main
+
+CASE = Path(__file__).resolve().parents[2] / "cases" / "inline6_damper.toml"
+
+
+def test_modes_prints_the_table_and_writes_the_figure_and_tables(tmp_path, capsys):
+    assert main(["modes", str(CASE), "-o", str(tmp_path), "--csv"]) == 0
+    out = capsys.readouterr().out
+    assert "2 rigid mode(s) at 0 Hz" in out and "critical speeds from 800 to 4400 rpm" in out
+    names = {p.name for p in tmp_path.iterdir()}
+    assert names == {"inline6_damper_campbell.png", "inline6_damper_modes.csv",
+                     "inline6_damper_criticals.csv"}
+    assert (tmp_path / "inline6_damper_campbell.png").read_bytes()[:4] == b"\x89PNG"
+    with open(tmp_path / "inline6_damper_criticals.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert rows and all(800 <= float(r["rpm"]) <= 4400 for r in rows)
+    # each critical is its mode's frequency over its order (the modes table's f)
+    with open(tmp_path / "inline6_damper_modes.csv", encoding="utf-8") as fh:
+        f = {int(float(r["mode"])): float(r["f_Hz"]) for r in csv.DictReader(fh)}
+    for r in rows:
+        assert float(r["rpm"]) == pytest.approx(60 * f[int(float(r["mode"]))]
+                                                / float(r["order"]), rel=1e-10)
+
+
+def test_nothing_is_overwritten_without_force(tmp_path, capsys):
+    figure = tmp_path / "inline6_damper_campbell.png"
+    figure.write_bytes(b"mine")
+    assert main(["modes", str(CASE), "-o", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "exists; use --force" in err[0]
+    assert figure.read_bytes() == b"mine"
+    assert main(["modes", str(CASE), "-o", str(tmp_path), "--force"]) == 0
+    assert figure.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_speed_range_and_orders_from_the_options(tmp_path, capsys):
+    assert main(["modes", str(CASE), "-o", str(tmp_path), "--speed-range", "2600,2700",
+                 "--max-order", "6"]) == 0
+    out = capsys.readouterr().out
+    table = out[out.index("critical speeds"):].splitlines()[2:]
+    rows = [line.split() for line in table if line.strip() and not line.startswith("wrote")]
+    assert [(r[1], r[2], r[3]) for r in rows] == [("1", "6", "major")]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--speed-range", "3000,1000"], "--speed-range: give two speeds LO,HI"),
+    (["--speed-range", "x"], "--speed-range: must be comma-separated numbers"),
+    (["--max-order", "0"], "max-order"),
+])
+def test_bad_options_are_one_line(tmp_path, capsys, args, words):
+    assert main(["modes", str(CASE), "-o", str(tmp_path), *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and words in err[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_scene_without_a_shaft_line_is_refused(tmp_path, capsys):
+    rigid = CASE.parent / "gots_diesel_spinup.toml"
+    assert main(["modes", str(rigid), "-o", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "shaft: the scene has no [shaft] table" in err
+
+
+def test_the_campbell_diagram_takes_a_runs_order_spectra():
+    """The overlay draws one marker per cycle and order, on that order's line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from transient import plots
+    from transient.analysis.torsion import critical_speeds, engine_orders, modal_analysis
+    from transient.scene import load_scene
+    from transient.shaft import ShaftLine
+
+    scene = load_scene(CASE)
+    modal = modal_analysis(ShaftLine(scene), band_samples=8)
+    orders = engine_orders(scene.mechanism.cycle, 6)
+    fig, ax = plt.subplots()
+    speeds, run_q = np.array([1000.0, 2000.0]), np.array([3.0, 4.5])
+    before = len(ax.collections)
+    handles = plots.modal_campbell(ax, modal, orders, (800.0, 4400.0),
+                                   critical_speeds(modal, orders, (800.0, 4400.0)),
+                                   run_orders=(speeds, run_q, np.array([[1.0, 2.0], [3.0, 4.0]])))
+    dots = ax.collections[-1].get_offsets()
+    assert len(ax.collections) > before and len(dots) == 4
+    assert np.allclose(dots[:, 1], dots[:, 0] * np.array([3.0, 4.5, 3.0, 4.5]) / 60.0)
+    assert handles[-1].get_label() == "run's order amplitudes"
+    plt.close(fig)

@@ -1,0 +1,128 @@
+"""``transient modes``: the torsional modes and critical speeds of a scene's shaft line, without
+running it (:mod:`transient.analysis.torsion`), and its Campbell diagram."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from ..errors import SceneError
+from .common import (
+    EXIT_OK,
+    MAX_RPM,
+    add_force,
+    check_output_file,
+    number_list,
+    output_folder,
+    pyplot,
+    real,
+    save,
+    write_columns,
+)
+
+
+def register(sub) -> None:
+    m = sub.add_parser("modes", help="torsional modes, critical speeds and the Campbell diagram "
+                                     "of a scene's shaft line")
+    m.add_argument("scene")
+    m.add_argument("-o", "--output", default="results", help="output folder (default results/)")
+    m.add_argument("--speed-range", default=None, metavar="LO,HI",
+                   help="speeds [rpm] whose critical speeds are listed (default: the scene's "
+                        "[shaft] speed_range, else 0 to 1.2 × its highest speed)")
+    m.add_argument("--max-order", type=real(gt=0.0, le=1000.0), default=12.0,
+                   help="highest engine order [1/rev] (default 12)")
+    m.add_argument("--csv", action="store_true",
+                   help="also write the modes and the critical speeds as CSV")
+    add_force(m)
+    m.set_defaults(func=cmd_modes)
+
+
+def cmd_modes(args) -> int:
+    import numpy as np
+
+    from .. import plots
+    from ..analysis.torsion import critical_speeds, engine_orders, modal_analysis, speed_range
+    from ..scene import load_scene
+    from ..shaft import ShaftLine
+
+    scene = load_scene(args.scene)
+    if scene.shaft is None:
+        raise SceneError("shaft", "the scene has no [shaft] table: its shaft is rigid and has no "
+                                  "torsional modes; describe the shaft line (docs: Torsion)",
+                         file=args.scene)
+    rpm_range = _speed_range(args.speed_range) if args.speed_range else speed_range(scene)
+    out = output_folder(args.output, Path("results"))
+    stem = Path(args.scene).stem
+    paths = {"figure": out / f"{stem}_campbell.png"}
+    if args.csv:
+        paths.update(modes=out / f"{stem}_modes.csv", criticals=out / f"{stem}_criticals.csv")
+    for path in paths.values():  # (before any work: nothing is overwritten without --force)
+        check_output_file(path, args.force)
+
+    line = ShaftLine(scene)
+    modal = modal_analysis(line)
+    orders = engine_orders(scene.mechanism.cycle, args.max_order)
+    criticals = critical_speeds(modal, orders, rpm_range)
+    _print_modes(scene, modal)
+    _print_criticals(criticals, rpm_range)
+
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(10, 6))
+    plots.modal_campbell(ax, modal, orders, rpm_range, criticals)
+    ax.set_title(f"{scene.name}: Campbell diagram of the shaft line")
+    written = [save(fig, paths["figure"], args.force)]
+    if args.csv:
+        cols = {"mode": np.array([m.number for m in modal.modes]),
+                "f_Hz": np.array([m.f for m in modal.modes]),
+                "band_low_Hz": np.array([m.band[0] for m in modal.modes]),
+                "band_high_Hz": np.array([m.band[1] for m in modal.modes])}
+        cols.update({f"shape_{name}": np.array([m.shape[i] for m in modal.modes])
+                     for i, name in enumerate(line.names)})
+        write_columns(paths["modes"], cols, args.force)
+        written.append(paths["modes"])
+        kinds = {"major": 0, "integer": 1, "half": 2}
+        write_columns(paths["criticals"], {
+            "mode": np.array([c.mode for c in criticals]),
+            "order": np.array([c.order for c in criticals]),
+            "kind_major0_integer1_half2": np.array([kinds[c.kind] for c in criticals]),
+            "rpm": np.array([c.rpm for c in criticals]),
+            "relative_excitation": np.array([c.excitation for c in criticals])}, args.force)
+        written.append(paths["criticals"])
+    for path in written:
+        print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _speed_range(text: str) -> tuple[float, float]:
+    values = number_list(text, "--speed-range", -1e-300, MAX_RPM)
+    if len(values) != 2 or not values[0] < values[1]:
+        raise SceneError("--speed-range", f"give two speeds LO,HI [rpm] with LO < HI, got "
+                                          f"{text!r}")
+    return values[0], values[1]
+
+
+def _print_modes(scene, modal) -> None:
+    line = modal.line
+    print(f"{scene.name}: shaft line of {len(line.shaft.stations)} stations, {line.n} degrees of "
+          f"freedom, at cycle-mean inertias; {modal.rigid} rigid mode(s) at 0 Hz")
+    print(f"{'mode':>4} {'f [Hz]':>10} {'frozen band [Hz]':>21}  largest amplitude / twist")
+    for m in modal.modes:
+        print(f"{m.number:4d} {m.f:10.4g} {m.band[0]:10.4g} – {m.band[1]:<8.4g}  {m.largest_at} / "
+              f"{m.twist_at}")
+    if modal.damped:
+        print(f"damped: {'f_n [Hz]':>10} {'ζ':>8} {'f_d [Hz]':>10}"
+              + (f"  ({modal.creeping} real eigenvalue(s): rigid or creeping motions)"
+                 if modal.creeping else ""))
+        for d in modal.damped:
+            print(f"        {d.omega_n / (2 * math.pi):10.4g} {d.zeta:8.4f} "
+                  f"{d.omega_d / (2 * math.pi):10.4g}")
+
+
+def _print_criticals(criticals, rpm_range) -> None:
+    lo, hi = rpm_range
+    print(f"critical speeds from {lo:g} to {hi:g} rpm (relative excitation: the vector sum of "
+          f"the mode's amplitudes at the cylinders, 0 … 1):")
+    if not criticals:
+        print("  none")
+    print(f"  {'rpm':>9} {'mode':>4} {'order':>6} {'kind':>8} {'excitation':>10}")
+    for c in criticals:
+        print(f"  {c.rpm:9.1f} {c.mode:4d} {c.order:6g} {c.kind:>8} {c.excitation:10.3f}")

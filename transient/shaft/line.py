@@ -1,0 +1,212 @@
+"""A scene's shaft line as matrices: the degrees of freedom, their constant stiffness K and
+damping C, and the angle-dependent inertia of each station.
+
+**Degrees of freedom**, in order along the line: each station, each followed by the rings of
+the dampers on it, then the driven inertia of a coupling. Each ring couples to its hub only, so
+K and C stay banded (the stations' chain tridiagonal, a ring one place off it).
+
+**Inertia.** Station s carries its own constant inertia and the cylinders of its crankpins:
+J_s(θ) = J_own,s + Σ_{k on s} J_k(θ) and J′_s(θ) = Σ_{k on s} dJ_k/dθ, each cylinder's share of
+the mechanism's J at the station's own angle θ, with the cylinder's own phase (capability
+``"cylinder-inertia"``). A mechanism without it carries all its cylinders on one station, whose
+J is then the mechanism's whole J(θ). With every station at one angle, Σ_s J_s(φ) plus the rings'
+and the driven side's inertias is the rigid model's J(φ) (:func:`rigid_equivalent`).
+
+**Damping.** Absolute per station (to the frame), relative per section, a damper's between
+its ring and hub, a coupling's across it. A section given by a loss factor η or a damping ratio
+ζ gets the viscous c = η·k/ω₁ = 2ζ·k/ω₁ at ω₁, the lowest natural frequency of the undamped
+line at cycle-mean inertias (hysteretic damping's equivalent at the mode that matters most:
+per cycle of that mode it dissipates πηkΘ², as the hysteretic law does).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import cast
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from ..errors import SceneError
+from ..mechanisms import CylinderInertia, provides
+from ..scene.records import Inertia, Scene, Shaft
+
+#: Angles per revolution at which the cycle-mean inertias are sampled: J(θ) is periodic and
+#: smooth, so the mean of equally spaced samples converges geometrically.
+MEAN_SAMPLES = 720
+
+
+@dataclass(frozen=True)
+class Dof:
+    """A degree of freedom of the line: its ``name`` (a station's, ``"<station> damper"``,
+    ``"driven"``), its ``kind`` (``"station"``, ``"ring"``, ``"driven"``) and the station it
+    belongs to (for a ring its hub's; -1 for the driven inertia)."""
+
+    name: str
+    kind: str
+    station: int
+
+
+class ShaftLine:
+    """The shaft line of ``scene`` (which has a ``[shaft]`` table)."""
+
+    def __init__(self, scene: Scene) -> None:
+        if scene.shaft is None:
+            raise ValueError(f"scene {scene.name!r} has no [shaft] table")
+        shaft: Shaft = scene.shaft
+        self.scene, self.shaft = scene, shaft
+        dofs: list[Dof] = []
+        self.station_dof: list[int] = []
+        for i, st in enumerate(shaft.stations):
+            self.station_dof.append(len(dofs))
+            dofs.append(Dof(st.name, "station", i))
+            dofs += [Dof(f"{st.name} damper", "ring", i) for d in shaft.dampers
+                     if d.station == st.name]
+        if shaft.coupling is not None:
+            dofs.append(Dof("driven", "driven", -1))
+        self.dofs = tuple(dofs)
+        self.n = len(dofs)
+        self._own = self._own_inertia()
+        self._cylinder_terms = _cylinder_terms(scene)
+        self.K = self._stiffness()
+        mean = self.mean_inertia()
+        self.omega_1 = float(np.sqrt(_lowest_elastic(self.K, mean, self.rigid_modes)))
+        self.C = self._damping()
+
+    # -- the degrees of freedom ---------------------------------------------------------------
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(d.name for d in self.dofs)
+
+    @property
+    def rigid_modes(self) -> int:
+        """Modes of zero frequency: the free line's one, and one per viscous ring, which no
+        spring ties to anything."""
+        return 1 + sum(d.model == "viscous" for d in self.shaft.dampers)
+
+    def rings(self):
+        """(damper, its ring's dof, its hub's dof) of each damper."""
+        ring_of = iter(i for i, d in enumerate(self.dofs) if d.kind == "ring")
+        by_station = sorted(self.shaft.dampers,
+                            key=lambda d: self.shaft.station_index(d.station))
+        # (rings follow their stations in order; dampers of one station keep the scene's order)
+        for damper in by_station:
+            yield damper, next(ring_of), self.station_dof[self.shaft.station_index(damper.station)]
+
+    def _own_inertia(self) -> NDArray[np.float64]:
+        own = np.zeros(self.n)
+        for st, i in zip(self.shaft.stations, self.station_dof):
+            own[i] = st.inertia
+        for damper, ring, _ in self.rings():
+            own[ring] = damper.inertia
+        if self.shaft.coupling is not None:
+            own[-1] = self.shaft.coupling.referred_inertia
+        return own
+
+    # -- matrices ------------------------------------------------------------------------------
+    def _pairs(self, omega_1: float = np.nan):
+        """(dof a, dof b, stiffness, damping) of every element joining two dofs; a section's
+        loss factor or damping ratio as the viscous c at ``omega_1`` (one of the three is
+        given, the others are 0)."""
+        shaft, at = self.shaft, self.station_dof
+        for i, sec in enumerate(shaft.sections):
+            relative = sec.loss_factor + 2.0 * sec.damping_ratio
+            c = sec.damping + (relative * sec.stiffness / omega_1 if relative else 0.0)
+            yield at[i], at[i + 1], sec.stiffness, c
+        for damper, ring, hub in self.rings():
+            yield hub, ring, damper.stiffness, damper.damping
+        if shaft.coupling is not None:
+            cp = shaft.coupling
+            yield at[-1], self.n - 1, cp.stiffness, cp.damping
+
+    @staticmethod
+    def _assemble(n: int, pairs) -> NDArray[np.float64]:
+        out = np.zeros((n, n))
+        for a, b, value in pairs:
+            out[a, a] += value
+            out[b, b] += value
+            out[a, b] -= value
+            out[b, a] -= value
+        return out
+
+    def _stiffness(self) -> NDArray[np.float64]:
+        return self._assemble(self.n, ((a, b, k) for a, b, k, _ in self._pairs()))
+
+    def _damping(self) -> NDArray[np.float64]:
+        C = self._assemble(self.n, ((a, b, c) for a, b, _, c in self._pairs(self.omega_1)))
+        for st, i in zip(self.shaft.stations, self.station_dof):
+            C[i, i] += st.damping
+        return C
+
+    # -- inertia ---------------------------------------------------------------------------
+    def station_inertia(self, theta) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(J_s, J′_s) of every station at its angle ``theta`` [rad] (one per station, or one
+        for all): own inertia plus its cylinders' reduced inertia, and its derivative."""
+        stations = self.shaft.stations
+        theta = np.broadcast_to(np.asarray(theta, dtype=float), (len(stations),))
+        J = np.array([st.inertia for st in stations], dtype=float)
+        dJ = np.zeros(len(stations))
+        for s, st in enumerate(stations):
+            if st.cylinders:
+                Jk, dJk = self._cylinder_terms(float(theta[s]))
+                cyl = np.asarray(st.cylinders) - 1
+                J[s] += float(np.sum(np.asarray(Jk)[cyl]))
+                dJ[s] = float(np.sum(np.asarray(dJk)[cyl]))
+        return J, dJ
+
+    def mass_diagonal(self, phi: float) -> NDArray[np.float64]:
+        """The inertia of every dof with every station frozen at the angle ``phi`` [rad]."""
+        diag = self._own.copy()
+        diag[self.station_dof] = self.station_inertia(phi)[0]
+        return diag
+
+    def mean_inertia(self, samples: int = MEAN_SAMPLES) -> NDArray[np.float64]:
+        """Every dof's inertia averaged over one revolution (the linearised line's)."""
+        phi = 2.0 * np.pi * np.arange(samples) / samples
+        return np.mean([self.mass_diagonal(p) for p in phi], axis=0)
+
+
+def _cylinder_terms(scene: Scene):
+    """θ ↦ (J_k, dJ_k/dθ) per cylinder: the mechanism's own split where it has one, else its
+    whole J(θ) given to each cylinder's share as J/n (all of them sit on one station)."""
+    mech = scene.mechanism
+    if provides(mech, "cylinder-inertia"):
+        return cast(CylinderInertia, mech).cylinder_inertia_terms()
+    whole = mech.reference_terms()
+    n = mech.n_cylinders
+
+    def shares(theta: float):
+        J, dJ, _, _ = whole(theta)
+        return np.full(n, J / n), np.full(n, dJ / n)
+    return shares
+
+
+def _lowest_elastic(K, M_diag, rigid: int) -> float:
+    """ω₁² of the undamped line: its lowest eigenvalue past the ``rigid`` zero ones."""
+    values = scipy.linalg.eigh(K, np.diag(M_diag), eigvals_only=True)
+    return float(values[rigid]) if values.size > rigid else np.nan
+
+
+def refuse_elastic_run(scene: Scene) -> None:
+    """Raise :class:`~transient.errors.SceneError` for a scene with ``[shaft]``: its elastic
+    time-domain run is not available yet, and running it rigid instead would not do what it
+    asks."""
+    if scene.shaft is not None:
+        raise SceneError("shaft", "the elastic time-domain run of a [shaft] scene is not "
+                                  "available yet; `transient modes` gives its modes and critical "
+                                  "speeds, and the rigid model runs the scene without [shaft] "
+                                  "(transient.shaft.rigid_equivalent)", file=scene.source_file)
+
+
+def rigid_equivalent(scene: Scene) -> Scene:
+    """``scene`` with a rigid shaft: no ``[shaft]``, and ``[inertia]`` holding the line's
+    constant inertias as one body, the stations' own and the damper rings' as ``shaft`` and
+    the driven inertia referred to the shaft (i²·J_d) as ``load``. Its J(φ) is the line's at
+    one angle everywhere. A scene without ``[shaft]`` comes back as it is."""
+    shaft = scene.shaft
+    if shaft is None:
+        return scene
+    driven = shaft.coupling.referred_inertia if shaft.coupling else 0.0
+    own = shaft.constant_inertia - driven
+    return replace(scene, shaft=None, inertia=Inertia(shaft=own, load=driven),
+                   source_file="", source_text="")
