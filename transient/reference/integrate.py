@@ -88,8 +88,10 @@ class ReferenceModel:
         self.load_curve = load_table_curve(scene)  # the tabulated load, in numpy
         self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
         self.n_gov = gv.n_states(m.gov_dyn)
-        self.latched: NDArray[np.float64] | None = None  # fuel per cylinder, with latching (set by run_reference)
-        self.factors: float | NDArray[np.float64] = 1.0  # each cylinder's fuel factor in its cycle (set by select)
+        # fuel per cylinder, with latching (set by run_reference)
+        self.latched: NDArray[np.float64] | None = None
+        # each cylinder's fuel factor in its cycle (set by select)
+        self.factors: float | NDArray[np.float64] = 1.0
         self.shift = None  # combustion offsets the tables are read with (set by select)
         self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov,
                                          m.var_par[:, SHIFT])
