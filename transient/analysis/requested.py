@@ -119,11 +119,12 @@ def stored_orders(scene, traj, cuts) -> dict[str, tuple[Any, str]]:
     names = tuple(dict.fromkeys(["t", *columns]))
     grid, cols = to_angle_grid(traj, names, n, cycle, phi0=scene.initial.phi, cuts=cuts,
                                closed=True)
-    pk = piston_kinematics(mech, grid) if derived else None
-    for s, k in derived.items():
-        # W = ω²s″ + εs′ (Semenov §4), exact kinematics of any mechanism's piston
-        cols[s] = cols["omega"] ** 2 * pk.dds[k - 1] + cols["epsilon"] * pk.ds[k - 1]
-        units[s] = "m/s^2"
+    if derived:
+        pk = piston_kinematics(mech, grid)
+        for s, k in derived.items():
+            # W = ω²s″ + εs′ (Semenov §4), exact kinematics of any mechanism's piston
+            cols[s] = cols["omega"] ** 2 * pk.dds[k - 1] + cols["epsilon"] * pk.ds[k - 1]
+            units[s] = "m/s^2"
     mode = resolve_detrend(req.detrend, scene.initial.omega, float(traj["omega"][-1]))
     t_marks = cols["t"][::n]  # every cycle's start and the last one's end (closed grid)
     out: dict[str, tuple[Any, str]] = {"orders_cycle_start": (grid[:-1:n], "rad"),

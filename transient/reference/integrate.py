@@ -19,8 +19,11 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from ..assemble import build_model, initial_governor, load_table_curve
@@ -66,7 +69,7 @@ class ReferenceModel:
         self.motored = gas_tables(scene)[1]
         self.mechanism_terms = scene.mechanism.reference_terms()
         self.starter_on = scene.starter.torque > 0 and scene.initial.omega < scene.starter.cutout_speed
-        self.pieces = None
+        self.pieces: NDArray[np.int64] | None = None
         w0 = scene.initial.omega
         self.branch = self.droop_branch(w0)
         self.chain = None  # the non-ideal pairs: a serial chain, or the joints' reactions
@@ -85,8 +88,10 @@ class ReferenceModel:
         self.load_curve = load_table_curve(scene)  # the tabulated load, in numpy
         self.governor = GovernorNumpy(scene, 5 + len(scene.friction.pairs))
         self.n_gov = gv.n_states(m.gov_dyn)
-        self.latched = None  # fuel per cylinder, with latching (set by run_reference)
-        self.factors = 1.0  # each cylinder's fuel factor in its cycle (set by select)
+        # fuel per cylinder, with latching (set by run_reference)
+        self.latched: NDArray[np.float64] | None = None
+        # each cylinder's fuel factor in its cycle (set by select)
+        self.factors: float | NDArray[np.float64] = 1.0
         self.shift = None  # combustion offsets the tables are read with (set by select)
         self.cylinders = (CylindersNumpy(scene, m.gas_phase, m.period, self.governor.g + self.n_gov,
                                          m.var_par[:, SHIFT])
@@ -236,7 +241,20 @@ class ReferenceModel:
         return np.asarray(out)
 
 
-def _speed_crossing(ref, t, y, level):
+@dataclass(frozen=True)
+class _Event:
+    """An event function of solve_ivp, g(t, y), with the attributes solve_ivp reads: whether
+    reaching g = 0 ends the integration, and the direction of the crossing (0 either way)."""
+
+    g: Callable[[float, NDArray[np.float64]], float]
+    terminal: bool
+    direction: float
+
+    def __call__(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.g(t, y)
+
+
+def _speed_crossing(ref, t, y, level) -> _Event:
     """Terminal event ω = level in the direction ω must go to reach it; starting on the level
     (just after stopping there), the direction away from where the speed is heading now, so
     that solve_ivp does not stop again at once (and :func:`_leaving_start`)."""
@@ -248,11 +266,10 @@ def _speed_crossing(ref, t, y, level):
 
     def g(t, yy):
         return yy[1] - level
-    g.terminal, g.direction = True, direction
-    return g
+    return _Event(g, True, direction)
 
 
-def _leaving_start(g, t_start):
+def _leaving_start(g: _Event, t_start: float) -> _Event:
     """The terminal event ``g`` of a segment starting at ``t_start``, except that where the
     state starts exactly on its level, g there takes the sign of the side its direction leaves
     from: the event then fires only when the state comes back across the level later.
@@ -266,16 +283,14 @@ def _leaving_start(g, t_start):
         if v == 0.0 and t == t_start:
             return -g.direction * 1e-300
         return v
-    h.terminal, h.direction = g.terminal, g.direction
-    return h
+    return _Event(h, g.terminal, g.direction)
 
 
-def _level_crossing(in_time: bool, level: float, direction: int):
+def _level_crossing(in_time: bool, level: float, direction: int) -> _Event:
     """Terminal event: t (``in_time``) or φ reaching ``level`` in ``direction``."""
     def g(t, yy):
         return (t if in_time else yy[0]) - level
-    g.terminal, g.direction = True, direction
-    return g
+    return _Event(g, True, direction)
 
 
 def _segment(ref, phi, omega):
@@ -289,7 +304,7 @@ def _segment(ref, phi, omega):
     return down, up
 
 
-def _sleeve_events(gov: GovernorNumpy, y) -> list:
+def _sleeve_events(gov: GovernorNumpy, y) -> list[tuple[str, _Event]]:
     """Terminal events of the flyweight governor: a moving sleeve reaching a stop; on a stop, the
     net force turning away from it (the balance of centrifugal force and spring, ω free)."""
     if gov.gov.model != "flyweight":
@@ -301,15 +316,12 @@ def _sleeve_events(gov: GovernorNumpy, y) -> list:
 
         def high(t, yy):
             return yy[g] - travel
-        low.terminal, low.direction = True, -1
-        high.terminal, high.direction = True, 1
-        return [("sleeve_stop", low), ("sleeve_stop", high)]
+        return [("sleeve_stop", _Event(low, True, -1)), ("sleeve_stop", _Event(high, True, 1))]
     z = 0.0 if gov.sleeve == 1 else travel
 
     def away(t, yy):
         return gov.force(yy[1], z, 0.0)
-    away.terminal, away.direction = True, 1 if gov.sleeve == 1 else -1
-    return [("sleeve_free", away)]
+    return [("sleeve_free", _Event(away, True, 1 if gov.sleeve == 1 else -1))]
 
 
 def _with_dense_tail(sol, ts, phi_from):
@@ -343,24 +355,25 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
     n_gov, n_cyl = ref.n_gov, ref.model.ncyl
     if ref.model.latch:
         ref.latched = start[n_gov:n_gov + n_cyl].copy()
-    cylinders = start[start.size - n_cyl:] if ref.cylinders is not None else []
+    cylinders = start[start.size - n_cyl:] if ref.cylinders is not None else np.empty(0)
     t, y = 0.0, np.concatenate([[scene.initial.phi, scene.initial.omega], np.zeros(3 + n_pairs),
                                 start[:n_gov], cylinders])
     message = ""
-    blocks, events, nfev, nsteps = [], {"breakpoint": [], "starter_cutout": [],
-                                         "governor_corner": []}, 0, 0
+    blocks: list[NDArray[np.float64]] = []
+    events: dict[str, list[tuple[float, float]]] = {"breakpoint": [], "starter_cutout": [],
+                                                    "governor_corner": []}
+    nfev, nsteps = 0, 0
     t0 = time.perf_counter()
     max_step = sv.max_step / max(sv.switch_speed, abs(scene.initial.omega), 1e-9)
     while True:
         down, up = _segment(ref, y[0], y[1])
         ref.select(down, up)
-        evs = []
+        evs: list[tuple[str, _Event]] = []
 
-        def crossing(level, direction):
+        def crossing(level: float, direction: int) -> _Event:
             def g(t, yy):
                 return yy[0] - level
-            g.terminal, g.direction = True, direction
-            return g
+            return _Event(g, True, direction)
 
         if math.isfinite(up):
             evs.append(("breakpoint", crossing(up, 1)))
@@ -374,8 +387,7 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
         if not math.isfinite(run.t_end):  # a stall would never reach the end: stop there
             def stop(t, yy):
                 return yy[1]
-            stop.terminal, stop.direction = True, -1
-            evs.append(("stall", stop))
+            evs.append(("stall", _Event(stop, True, -1)))
         if ref.chain is not None and y[1] == 0.0:  # at rest: the pairs may hold the chain
             J, dJ, Mg, Ml, Ms, pc = ref.moments(y[0], 0.0, y)
             ref.sigma = ref.chain.start_direction(ref.friction_inputs(y[0], J, dJ, Mg, Ml + Ms, pc))
@@ -392,13 +404,11 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
         if ref.chain is not None and math.isfinite(run.t_end):
             def rest(t, yy):  # friction turns with the motion: stop where the shaft stops
                 return yy[1]
-            rest.terminal, rest.direction = True, -np.sign(y[1]) or -ref.sigma
-            evs.append(("rest", rest))
+            evs.append(("rest", _Event(rest, True, -np.sign(y[1]) or -ref.sigma)))
         elif math.isfinite(run.t_end):  # (recorded as it passes, as the compiled path does)
             def through_zero(t, yy):
                 return yy[1]
-            through_zero.terminal, through_zero.direction = False, 0
-            evs.append(("through_zero", through_zero))
+            evs.append(("through_zero", _Event(through_zero, False, 0)))
         m = ref.model
         if ref.seg < m.load_x.size:  # the next corner of the load schedule, and the one behind
             evs.append(("load_up", _level_crossing(m.load_comp == T, m.load_x[ref.seg], 1)))
@@ -412,8 +422,7 @@ def run_reference(scene, on_block=None, progress=None, state_only: bool = False,
         if ref.starter_on:
             def cut(t, yy):
                 return yy[1] - scene.starter.cutout_speed
-            cut.terminal, cut.direction = True, 1
-            evs.append(("starter_cutout", cut))
+            evs.append(("starter_cutout", _Event(cut, True, 1)))
         dense = dense_tail > 0 and not up < phi_end - dense_tail  # may reach the tail
         sol = solve_ivp(ref.rhs, (t, t_end), y, method=method, rtol=sv.rtol, atol=sv.atol,
                         events=[_leaving_start(e, t) for _, e in evs] or None,

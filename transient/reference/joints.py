@@ -500,7 +500,7 @@ def articulated_joint_forces(mech, phi: float, omega: float, gas_force, coeffici
             Amat[ie, ie] = J0
             rhs[ie] = M_shaft
         x = np.linalg.solve(Amat, rhs)
-        eps = x[ie] if unknown_eps else epsilon
+        eps = x[ie] if epsilon is None else epsilon
         # the friction of these forces
         N = np.empty(nc)
         pin, big, main = np.empty((2, nc)), np.empty((2, nc)), np.empty((2, rows))

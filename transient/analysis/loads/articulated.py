@@ -164,8 +164,11 @@ def row_kinematics(mech: Articulated, alpha: ArrayLike) -> RowKinematics:
     s = np.empty(shape)
     s[0] = s0
     s[1:] = r + l - (pos["Bi"] / axis[None, 1:]).real.T
+    # The points are complex (x + iy) though positions() annotates its dict as float.
+    crankpin = np.asarray(pos["A"], dtype=np.complex128)
+    link_pins = np.asarray(pos["Ai"].T, dtype=np.complex128)
     return RowKinematics(alpha=alpha, s=s, ds=ds, dds=dds, beta=beta, dbeta=dbeta, ddbeta=ddbeta,
-                         A=pos["A"], A_link=pos["Ai"].T, dA_link=dA, ddA_link=ddA, axis=axis)
+                         A=crankpin, A_link=link_pins, dA_link=dA, ddA_link=ddA, axis=axis)
 
 
 def pin_forces(P: ArrayLike, beta: ArrayLike, couple: ArrayLike, length: float
@@ -176,9 +179,10 @@ def pin_forces(P: ArrayLike, beta: ArrayLike, couple: ArrayLike, length: float
     on the rod about its big end, in the sense of rotation [N m], ``length`` the rod [m]. Returns
     ``(N, S)``: N = P tan β + H, S = P/cos β + H sin β, H = −C/(l cos β).
     """
-    cb = np.cos(beta)
-    h = -np.asarray(couple) / (length * cb)
-    return P * np.tan(beta) + h, P / cb + h * np.sin(beta)
+    p, b = np.asarray(P, dtype=np.float64), np.asarray(beta, dtype=np.float64)
+    cb = np.cos(b)
+    h = -np.asarray(couple, dtype=np.float64) / (length * cb)
+    return p * np.tan(b) + h, p / cb + h * np.sin(b)
 
 
 def _cross(a, b):

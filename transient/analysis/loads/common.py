@@ -118,9 +118,10 @@ def trajectory_arrays(phi: ArrayLike, omega: ArrayLike, epsilon: ArrayLike
                       ) -> tuple[Array, Array, Array]:
     """φ [rad], ω [rad/s] and ε [rad/s²] as float arrays broadcast together, at least 1-D (a
     constant speed is a scalar ω and ε = 0)."""
-    return tuple(np.broadcast_arrays(np.atleast_1d(np.asarray(phi, dtype=np.float64)),
-                                     np.asarray(omega, dtype=np.float64),
-                                     np.asarray(epsilon, dtype=np.float64)))
+    phi_b, omega_b, epsilon_b = np.broadcast_arrays(
+        np.atleast_1d(np.asarray(phi, dtype=np.float64)),
+        np.asarray(omega, dtype=np.float64), np.asarray(epsilon, dtype=np.float64))
+    return phi_b, omega_b, epsilon_b
 
 
 def gas_force_array(gas_force: ArrayLike | None, shape: tuple[int, int]) -> Array:
