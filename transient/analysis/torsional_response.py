@@ -20,7 +20,7 @@ has T̂_c,q = T̂_1,q e^{−i q φ_c}. The mean T̄ twists the line statically a
 it is left out.
 
 **Response.** With M the cycle-mean inertias, K and C the line's stiffness and damping
-(:class:`~transient.shaft.ShaftLine`), each order is a harmonic at ω = qΩ and the steady
+(:class:`~transient.shaft.line.ShaftLine`), each order is a harmonic at ω = qΩ and the steady
 angles are ϑ(t) = Σ_q Re(X_q e^{i q Ω t}) with (K − ω² M + i ω C) X_q = F_q, solved banded.
 An element joining dofs a and b (a the nearer the front end) of stiffness k and damping c
 carries T_e = (k + i ω c)(X_a − X_b) and dissipates ½ ω² c |X_a − X_b|² on average; as the
@@ -197,7 +197,7 @@ class ForcedResponse:
     ``orders`` [1/rev] (n_q,) of its excitation (module docs for the conventions).
 
     Complex amplitudes, each signal Σ_q Re(A_q e^{i q φ}): ``force`` [N m] (n_s, n_q, n_dofs)
-    on the dofs (:attr:`ShaftLine.names`), ``angle`` [rad] (n_s, n_q, n_dofs) of the dofs,
+    on the dofs (:attr:`~transient.shaft.line.ShaftLine.names`), ``angle`` [rad] (n_s, n_q, n_dofs) of the dofs,
     ``torque`` [N m] (n_s, n_q, n_elements) of the ``elements`` (labels; dof a − dof b, a the
     nearer the front end). ``power`` [W] (n_s, n_q, n_elements): the mean power each element
     dissipates by order. Over all the orders: ``torque_pp`` [N m] (n_s, n_elements), the
