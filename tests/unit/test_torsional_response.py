@@ -213,6 +213,9 @@ def fourier(f, cycle: float, order: float, corners, epsabs: float) -> complex:
 
 
 def test_each_cylinders_orders_against_quadrature_of_the_fourier_integral():
+    """Cylinders 1 and 4 of the six and the inertia torque of throw 1, several orders, against
+    scipy's quad on the reference crank-slider (its moments positive in the sense of
+    rotation): the amplitudes, their phases and their sign."""
     scene = INLINE6
     mech = scene.mechanism
     orders = np.array([0.5, 1.0, 3.0, 4.5, 6.0, 11.5])
@@ -235,20 +238,18 @@ def test_each_cylinders_orders_against_quadrature_of_the_fourier_integral():
 
 
 def test_the_phase_convention_each_cylinder_at_its_firing_angle():
-    """Identical cylinders: T_c(φ) = T_1(φ − (φ_c − φ_1)), so T̂_c,q = T̂_1,q e^{−iq(φ_c − φ_1)}.
-    And the sign: the gas torque of the order ½ is mostly the expansion stroke's push, in the
-    sense of rotation (the cycle's mean, positive, is its half at q → 0)."""
+    """Identical cylinders: T_c(φ) = T_1(φ − (φ_c − φ_1)), so T̂_c,q = T̂_1,q e^{−iq(φ_c − φ_1)};
+    the major orders of the six add in phase. (The sign, positive in the sense of rotation,
+    is the reference path's, which the quadrature test holds the amplitudes to.)"""
     exc = excitation(ShaftLine(INLINE6))
     firing = np.asarray(INLINE6.mechanism.firing_angles)
     for c in range(1, 6):
         shift = np.exp(-1j * exc.orders * (firing[c] - firing[0]))
         assert exc.gas[c] == pytest.approx(exc.gas[0] * shift, rel=1e-9, abs=1e-9)
-    phases = np.exp(1j * np.outer(exc.orders, firing))
     # the major orders (3, 6, 9, 12) add in phase: Σ_c T̂_c = 6 T̂_1 e^{−iqφ_1}
     major = [j for j, q in enumerate(exc.orders) if q % 3 == 0]
     total = exc.gas[:, major].sum(axis=0)
     assert total == pytest.approx(6 * exc.gas[0, major], rel=1e-9)
-    assert np.all(np.abs(phases) > 0)
 
 
 def test_per_cylinder_factors_and_refusals():

@@ -28,7 +28,8 @@ orders are distinct harmonics, these powers add.
 
 **Synthesis.** The vibratory torque of an element over the cycle is the sum of its orders'
 harmonics, T_e(φ) = Σ_q Re(T_e,q e^{i q φ}); its peak-to-peak is max − min of that signal
-(located on a fine grid, then refined by Newton's method on dT/dφ = 0). The sum of the orders'
+(located on a grid of 16 points per period of the highest harmonic, then refined by
+Newton's method on dT/dφ = 0). The sum of the orders'
 amplitudes Σ_q |T_e,q| is the bound the classical tables use: half the peak-to-peak never
 exceeds it, and it is reached only if every order peaks at one angle.
 """
@@ -202,7 +203,9 @@ class ForcedResponse:
     nearer the front end). ``power`` [W] (n_s, n_q, n_elements): the mean power each element
     dissipates by order. Over all the orders: ``torque_pp`` [N m] (n_s, n_elements), the
     peak-to-peak of the synthesised torque over the cycle, ``torque_sum`` [N m] the sum of the
-    orders' amplitudes, ``angle_pp`` [rad] (n_s, n_dofs) the peak-to-peak of each dof's angle."""
+    orders' amplitudes, ``angle_pp`` [rad] (n_s, n_dofs) the peak-to-peak of each dof's angle
+    about the steady rotation (the line's swing as one body, the speed's irregularity,
+    included)."""
 
     line: ShaftLine
     omega: Array
@@ -288,7 +291,8 @@ def synthesise(amplitudes, harmonics, psi) -> Array:
 def peak_to_peak(amplitudes: Complex, harmonics) -> Array:
     """max − min over the cycle of Σ_m Re(A_m e^{i m ψ}) for ``amplitudes`` (n_s, n_m, n) by
     harmonic ``harmonics`` m; (n_s, n). Each extreme is found on a grid of 16 points per
-    harmonic and refined by Newton's method on the signal's derivative."""
+    period of the highest harmonic and refined by Newton's method on the signal's
+    derivative."""
     A = np.moveaxis(np.asarray(amplitudes, dtype=np.complex128), 1, -1)  # (n_s, n, n_m)
     m = np.asarray(harmonics, dtype=float)
     size = int(GRID_PER_HARMONIC * max(1.0, float(np.max(m))))
