@@ -56,6 +56,8 @@ def test_speed_range_and_orders_from_the_options(tmp_path, capsys):
     (["--speed-range", "3000,1000"], "--speed-range: give two speeds LO,HI"),
     (["--speed-range", "x"], "--speed-range: must be comma-separated numbers"),
     (["--max-order", "0"], "max-order"),
+    (["--speeds", "50"], "--speeds: sets the speeds of the forced response; add --response"),
+    (["--response", "--speeds", "1"], "speeds"),
 ])
 def test_bad_options_are_one_line(tmp_path, capsys, args, words):
     assert main(["modes", str(CASE), "-o", str(tmp_path), *args]) == 2
