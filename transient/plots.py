@@ -1029,3 +1029,51 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None):
     ax.grid(True, alpha=0.3)
     legend_outside(ax, handles=handles)
     return handles
+
+
+def torsional_response(axes, res, criticals, leading: int = 6):
+    """The steady forced response of a shaft line against mean speed [rpm], on two axes.
+
+    ``res`` (:class:`transient.analysis.torsional_response.ForcedResponse`). Top: each
+    element's vibratory torque over all the orders, half the synthesised peak-to-peak (an
+    amplitude, comparable with one order's). Bottom: the most loaded element's, with the sum of
+    its orders' amplitudes (the classical bound) and its ``leading`` largest orders, styled by
+    kind (:data:`ORDER_STYLES`' colours cycled within a kind). ``criticals``
+    (:class:`transient.analysis.torsion.Critical`) marked on both as vertical lines, labelled
+    order/mode on the top axes. Returns the index of the most loaded element."""
+    from .analysis.torsion import order_kind
+    from .analysis.torsional_response import leading_orders
+
+    top, bottom = axes
+    rpm = res.rpm
+    half = 0.5 * res.torque_pp
+    for e, label in enumerate(res.elements):
+        top.plot(rpm, half[:, e], lw=1.1, label=label)
+    worst = int(np.argmax(half.max(axis=0)))
+    bottom.plot(rpm, half[:, worst], color="k", lw=1.6, label="all orders (½ peak-to-peak)")
+    bottom.plot(rpm, res.torque_sum[:, worst], color="k", lw=0.9, ls="--",
+                label="sum of the orders' amplitudes")
+    firing = res.line.scene.mechanism.firing_angles
+    for n, j in enumerate(leading_orders(res, worst, leading)):
+        q = float(res.orders[j])
+        kind = order_kind(q, firing)
+        bottom.plot(rpm, np.abs(res.torque[:, j, worst]), color=f"C{n}", lw=1.0,
+                    ls=ORDER_STYLES[kind]["ls"] if kind != "major" else "-",
+                    label=f"order {q:g} ({kind})")
+    for ax in axes:
+        for c in criticals:
+            ax.axvline(c.rpm, color="0.6", lw=0.6, ls=":", zorder=0)
+        ax.set_xlim(float(rpm[0]), float(rpm[-1]))
+        ax.set_ylim(bottom=0.0)
+        ax.set_ylabel("vibratory torque [N m]")
+        ax.grid(True, alpha=0.3)
+    for c in criticals:
+        top.annotate(f"{c.order:g}/{c.mode}", (c.rpm, 1.0), xycoords=("data", "axes fraction"),
+                     fontsize=6, rotation=90, ha="right", va="top", color="0.4")
+    top.set_title("vibratory torque amplitude of each element, all orders (½ peak-to-peak); "
+                  "critical speeds dotted, labelled order/mode", fontsize=9)
+    bottom.set_title(f"{res.elements[worst]}: all orders and the leading orders", fontsize=9)
+    bottom.set_xlabel("mean shaft speed [rpm]")
+    legend_outside(top)
+    legend_outside(bottom)
+    return worst

@@ -56,6 +56,8 @@ def test_speed_range_and_orders_from_the_options(tmp_path, capsys):
     (["--speed-range", "3000,1000"], "--speed-range: give two speeds LO,HI"),
     (["--speed-range", "x"], "--speed-range: must be comma-separated numbers"),
     (["--max-order", "0"], "max-order"),
+    (["--speeds", "50"], "--speeds: sets the speeds of the forced response; add --response"),
+    (["--response", "--speeds", "1"], "speeds"),
 ])
 def test_bad_options_are_one_line(tmp_path, capsys, args, words):
     assert main(["modes", str(CASE), "-o", str(tmp_path), *args]) == 2
@@ -98,3 +100,39 @@ def test_the_campbell_diagram_takes_a_runs_order_spectra():
     assert np.allclose(dots[:, 1], dots[:, 0] * np.array([3.0, 4.5, 3.0, 4.5]) / 60.0)
     assert handles[-1].get_label() == "run's order amplitudes"
     plt.close(fig)
+
+
+def test_the_response_writes_its_table_and_figure(tmp_path, capsys):
+    """--response: the table's peak-to-peak per element is the synthesised signal's, at most
+    twice the sum of the orders' amplitudes; a second run without --force overwrites
+    nothing."""
+    args = ["modes", str(CASE), "-o", str(tmp_path), "--response", "--speeds", "41",
+            "--max-order", "6"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "steady forced response at" in out and "dissipates at most" in out
+    table = tmp_path / "inline6_damper_response.csv"
+    figure = tmp_path / "inline6_damper_response.png"
+    assert figure.read_bytes()[:4] == b"\x89PNG"
+    with open(table, encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) >= 41 and float(rows[0]["rpm"]) == 800.0
+    name = "section 4 (throw 3–throw 4)"
+    for r in rows:
+        assert 0.0 < float(r[f"{name} peak-to-peak [N m]"]) <= 2.0 * float(
+            r[f"{name} sum of orders [N m]"]) * (1 + 1e-12)
+        assert float(r["damper silicone at pulley power [W]"]) > 0.0
+    before = table.read_bytes()
+    assert main(args) == 2
+    assert "exists; use --force" in capsys.readouterr().err
+    assert table.read_bytes() == before
+
+
+def test_the_response_refuses_a_misfiring_scene_before_writing(tmp_path, capsys):
+    scene = tmp_path / "misfire.toml"
+    scene.write_text(CASE.read_text() + "\n[[gas.cylinders]]\ncylinder = 2\nmisfire_every = 5\n")
+    out = tmp_path / "out"
+    assert main(["modes", str(scene), "-o", str(out), "--response"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "gas.cylinders[0].misfire_every" in err[0]
+    assert list(out.iterdir()) == []

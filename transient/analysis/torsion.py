@@ -105,7 +105,8 @@ class Mode:
 @dataclass(frozen=True)
 class Critical:
     """Engine order ``order`` [1/rev] of kind ``kind`` meeting mode ``mode`` at ``rpm``, with
-    the mode's relative excitation by that order (:mod:`module docs <.torsion>`)."""
+    the mode's relative excitation by that order
+    (:mod:`module docs <transient.analysis.torsion>`)."""
 
     mode: int
     order: float
@@ -132,7 +133,7 @@ def modal_analysis(line: ShaftLine, band_samples: int = BAND_SAMPLES) -> Modal:
     mean = line.mean_inertia()
     omega, shapes = natural_modes(line.K, mean, line.rigid_modes)
     bands = frozen_bands(line, band_samples)
-    elements = _elements(line)
+    elements = shaft_elements(line)
     modes = []
     for j in range(line.rigid_modes, line.n):
         shape = shapes[:, j]
@@ -158,14 +159,15 @@ def frozen_bands(line: ShaftLine, samples: int = BAND_SAMPLES) -> NDArray[np.flo
     return np.vstack([freqs.min(axis=0), freqs.max(axis=0)]).astype(np.float64)
 
 
-def _elements(line: ShaftLine) -> list[tuple[str, int, int]]:
+def shaft_elements(line: ShaftLine, viscous: bool = False) -> list[tuple[str, int, int]]:
     """(label, dof a, dof b) of each elastic element: the sections, the tuned dampers' springs
-    and the coupling."""
+    and the coupling; with ``viscous`` the viscous dampers' silicone too (an element of
+    damping only). dof a is the one nearer the front end (a damper's: its hub)."""
     names, at = line.names, line.station_dof
     out = [(f"section {i + 1} ({names[at[i]]}–{names[at[i + 1]]})", at[i], at[i + 1])
            for i in range(len(at) - 1)]
-    out += [(f"damper spring at {names[hub]}", hub, ring) for d, ring, hub in line.rings()
-            if d.model == "tuned"]
+    out += [(f"damper {'spring' if d.model == 'tuned' else 'silicone'} at {names[hub]}", hub,
+             ring) for d, ring, hub in line.rings() if viscous or d.model == "tuned"]
     if line.shaft.coupling is not None:
         out.append(("coupling", at[-1], line.n - 1))
     return out

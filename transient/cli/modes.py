@@ -1,5 +1,7 @@
 """``transient modes``: the torsional modes and critical speeds of a scene's shaft line, without
-running it (:mod:`transient.analysis.torsion`), and its Campbell diagram."""
+running it (:mod:`transient.analysis.torsion`), and its Campbell diagram; with ``--response``
+its steady forced response to the engine's orders over the speed range
+(:mod:`transient.analysis.torsional_response`)."""
 from __future__ import annotations
 
 import math
@@ -16,8 +18,13 @@ from .common import (
     pyplot,
     real,
     save,
+    whole,
     write_columns,
 )
+
+#: Speeds of ``--response`` by default: 5 rpm apart over the case's 800–4400 rpm, fine enough
+#: for a resonance of a few per cent damping.
+RESPONSE_SPEEDS = 721
 
 
 def register(sub) -> None:
@@ -32,6 +39,12 @@ def register(sub) -> None:
                    help="highest engine order [1/rev] (default 12)")
     m.add_argument("--csv", action="store_true",
                    help="also write the modes and the critical speeds as CSV")
+    m.add_argument("--response", action="store_true",
+                   help="also the steady forced response at constant inertia over the speed "
+                        "range: a table (CSV) and a figure of each element's vibratory torque")
+    m.add_argument("--speeds", type=whole(2, 100_000), default=None, metavar="N",
+                   help=f"speeds of the response, evenly over the range, the critical speeds "
+                        f"added (default {RESPONSE_SPEEDS})")
     add_force(m)
     m.set_defaults(func=cmd_modes)
 
@@ -41,6 +54,7 @@ def cmd_modes(args) -> int:
 
     from .. import plots
     from ..analysis.torsion import critical_speeds, engine_orders, modal_analysis, speed_range
+    from ..analysis.torsional_response import check_steady
     from ..scene import load_scene
     from ..shaft import ShaftLine
 
@@ -55,6 +69,13 @@ def cmd_modes(args) -> int:
     paths = {"figure": out / f"{stem}_campbell.png"}
     if args.csv:
         paths.update(modes=out / f"{stem}_modes.csv", criticals=out / f"{stem}_criticals.csv")
+    if args.speeds is not None and not args.response:
+        raise SceneError("--speeds", "sets the speeds of the forced response; add --response or "
+                                     "leave --speeds out")
+    if args.response:
+        check_steady(scene)
+        paths.update(response=out / f"{stem}_response.csv",
+                     response_figure=out / f"{stem}_response.png")
     for path in paths.values():  # (before any work: nothing is overwritten without --force)
         check_output_file(path, args.force)
 
@@ -87,6 +108,8 @@ def cmd_modes(args) -> int:
             "rpm": np.array([c.rpm for c in criticals]),
             "relative_excitation": np.array([c.excitation for c in criticals])}, args.force)
         written.append(paths["criticals"])
+    if args.response:
+        written += _response(line, orders, rpm_range, criticals, args, paths)
     for path in written:
         print(f"wrote {path}")
     return EXIT_OK
@@ -126,3 +149,51 @@ def _print_criticals(criticals, rpm_range) -> None:
     print(f"  {'rpm':>9} {'mode':>4} {'order':>6} {'kind':>8} {'excitation':>10}")
     for c in criticals:
         print(f"  {c.rpm:9.1f} {c.mode:4d} {c.order:6g} {c.kind:>8} {c.excitation:10.3f}")
+
+
+def _response(line, orders, rpm_range, criticals, args, paths) -> list[Path]:
+    """The forced response over ``rpm_range``: its summary printed, its table and figure
+    written; returns their paths."""
+    import numpy as np
+
+    from .. import plots
+    from ..analysis.torsional_response import forced_response, speed_grid
+
+    points = args.speeds or RESPONSE_SPEEDS
+    res = forced_response(line, speed_grid(rpm_range, points, criticals), orders)
+    _print_response(res)
+    cols = {"rpm": res.rpm}
+    for e, label in enumerate(res.elements):
+        name = label.replace(",", ";")
+        cols[f"{name} peak-to-peak [N m]"] = res.torque_pp[:, e]
+        cols[f"{name} sum of orders [N m]"] = res.torque_sum[:, e]
+        if np.any(res.power[:, :, e]):
+            cols[f"{name} power [W]"] = res.power[:, :, e].sum(axis=1)
+    for e, label in enumerate(res.elements):
+        for j, q in enumerate(res.orders):
+            cols[f"{label.replace(',', ';')} order {q:g} [N m]"] = np.abs(res.torque[:, j, e])
+    write_columns(paths["response"], cols, args.force)
+    plt = pyplot()
+    fig, axes = plt.subplots(2, 1, figsize=(11, 8), sharex=True)
+    plots.torsional_response(axes, res, criticals)
+    fig.suptitle(f"{line.scene.name}: steady forced response at constant inertia (full load)")
+    return [paths["response"], save(fig, paths["response_figure"], args.force)]
+
+
+def _print_response(res) -> None:
+    import numpy as np
+
+    print(f"steady forced response at {res.rpm.size} speeds from {res.rpm[0]:.6g} to "
+          f"{res.rpm[-1]:.6g} rpm, orders {res.orders[0]:g} … {res.orders[-1]:g}, full load, "
+          f"cycle-mean inertias:")
+    print(f"  {'element':<34} {'peak-to-peak [N m]':>18} {'at [rpm]':>9} {'leading order':>13}"
+          f" {'its amplitude [N m]':>19}")
+    for e, label in enumerate(res.elements):
+        i = int(np.argmax(res.torque_pp[:, e]))
+        j = int(np.argmax(np.abs(res.torque[i, :, e])))
+        print(f"  {label:<34} {res.torque_pp[i, e]:18.5g} {res.rpm[i]:9.1f} "
+              f"{res.orders[j]:13g} {abs(res.torque[i, j, e]):19.5g}")
+        total = res.power[:, :, e].sum(axis=1)
+        if label.startswith("damper") and np.any(total):
+            k = int(np.argmax(total))
+            print(f"  {'':<34} dissipates at most {total[k]:.5g} W, at {res.rpm[k]:.1f} rpm")
