@@ -28,8 +28,7 @@ RESPONSE_SPEEDS = 721
 
 
 def register(sub) -> None:
-    m = sub.add_parser("modes", help="torsional modes, critical speeds and the Campbell diagram "
-                                     "of a scene's shaft line")
+    m = sub.add_parser("modes", help="a shaft line's torsional modes, criticals and response")
     m.add_argument("scene")
     m.add_argument("-o", "--output", default="results", help="output folder (default results/)")
     m.add_argument("--speed-range", default=None, metavar="LO,HI",
