@@ -59,7 +59,10 @@ from .scene.queries import (
     reaction_friction,
     wiebe_levels,
 )
-from .shaft import refuse_elastic_run
+from .core.model import elastic
+from .core.model import shaft as line_kernels
+from .core.model import tabulated
+from .shaft import ShaftLine, refuse_elastic_run
 
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
@@ -273,7 +276,8 @@ def build_model(scene, part_load: bool = False
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation)
+        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation,
+        **line_fields(scene, tabulated))
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
         if moved.size:  # the combustion's start and end, δ_k later
@@ -284,6 +288,33 @@ def build_model(scene, part_load: bool = False
         gap = np.abs(bp[:, None] - reaction_breakpoints(scene)[None, :])
         model.bp_jump[:] |= np.any(np.minimum(gap, period - gap) <= 1e-12 * period, axis=1)
     return model, model.breakpoints, table
+
+
+def line_fields(scene, tabulated_kinematics: bool) -> dict:
+    """The elastic shaft line's part of the Model (:class:`~transient.shaft.ShaftLine`: its
+    dofs, inertias, elements and absolute damping; the kernels of
+    :mod:`transient.core.model.elastic`), or size-1 zeros and the no-op kernels of
+    :mod:`transient.core.model.shaft` on a rigid shaft."""
+    if scene.shaft is None:
+        return dict(line_n=0, line_ref=0, line_load=0, line_J=np.zeros(1),
+                    line_weight=np.ones(1), line_abs=np.zeros(1),
+                    line_el=np.zeros((1, line_kernels.N_ELEMENT)),
+                    line_carrier=np.zeros(1, dtype=np.int64), shares=line_kernels.no_shares,
+                    line_rates=line_kernels.no_line_rates, line_row=line_kernels.no_line_row,
+                    line_mode=line_kernels.no_line_mode,
+                    line_ref_inertia=line_kernels.no_line_inertia)
+    line = ShaftLine(scene)
+    shaft = scene.shaft
+    carrier = np.zeros(scene.mechanism.n_cylinders, dtype=np.int64)
+    for i, st in enumerate(shaft.stations):
+        carrier[np.asarray(st.cylinders, dtype=np.int64) - 1] = line.station_dof[i]
+    load = line.names.index(shaft.load_at)
+    shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
+    return dict(line_n=line.n, line_ref=line.station_dof[shaft.station_index(shaft.reference)],
+                line_load=load, line_J=line.own_inertia, line_weight=line.weights, line_abs=line.absolute,
+                line_el=np.ascontiguousarray(line.element_rows()), line_carrier=carrier,
+                shares=shares, line_rates=elastic.elastic_rates, line_row=elastic.elastic_row,
+                line_mode=elastic.elastic_mode, line_ref_inertia=elastic.elastic_ref_inertia)
 
 
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:

@@ -720,6 +720,32 @@ class Shaft:
         """The position (0-based) of the station called ``name``."""
         return [s.name for s in self.stations].index(name)
 
+    def line_dofs(self) -> tuple[tuple[str, str, int], ...]:
+        """(name, kind, station) of the line's degrees of freedom in order: each station
+        (``"station"``), then the rings of the dampers on it (``"ring"``, named ``"<station>
+        damper"``, numbered from the second on one station), then with a coupling the driven
+        inertia (``"driven"``, station −1)."""
+        out = []
+        for i, st in enumerate(self.stations):
+            out.append((st.name, "station", i))
+            rings = sum(d.station == st.name for d in self.dampers)
+            out += [(f"{st.name} damper" + (f" {k + 1}" if k else ""), "ring", i)
+                    for k in range(rings)]
+        if self.coupling is not None:
+            out.append(("driven", "driven", -1))
+        return tuple(out)
+
+    def line_elements(self) -> tuple[tuple[str, str], ...]:
+        """The names of the two dofs each element of the line joins, in order: the sections,
+        each damper (hub, ring) by station, the coupling (last station, driven)."""
+        names = [s.name for s in self.stations]
+        out = list(zip(names[:-1], names[1:]))
+        out += [(hub, ring) for ring, kind, i in self.line_dofs() if kind == "ring"
+                for hub in [names[i]]]
+        if self.coupling is not None:
+            out.append((names[-1], "driven"))
+        return tuple(out)
+
 
 @dataclass(frozen=True)
 class Scene:

@@ -35,13 +35,29 @@ def line_inertia(carrier, J_own, Jc, dJc, J, dJ):
 
 
 @kernel(inline=True)
-def line_torques(elements, absolute, theta, omega, T):
-    """T_d: the torques of the elements and of the absolute damping −a_d ω_d on each degree of
-    freedom, (T3); returns the power they take [W] (Σ c δ̇² + Σ a ω²)."""
+def line_torques(elements, absolute, weights, theta, omega, T):
+    """T_d: the torques of the elements and of the absolute damping on each degree of freedom,
+    (T3); returns the power they take [W] (Σ c δ̇² + Σ a_d (ω_d − ω̄)²).
+
+    The absolute damping a_d acts on each dof's motion relative to the line's rigid-body motion
+    ω̄ = Σ w_d ω_d / Σ w_d (``weights`` w_d the cycle-mean inertias): r_d = a_d (ω_d − ω̄) and
+    τ_d = −r_d + (w_d/Σw) Σ_e r_e, the torque −Pᵀ A P ω with P = I − 1 wᵀ/Σw. It has no net
+    torque, so it never brakes the rotation as a whole, and takes Σ a_d (ω_d − ω̄)²."""
+    total = 0.0
+    moment = 0.0
+    for d in range(T.shape[0]):
+        total += weights[d]
+        moment += weights[d] * omega[d]
+    mean = moment / total
+    resultant = 0.0
     taken = 0.0
     for d in range(T.shape[0]):
-        T[d] = -absolute[d] * omega[d]
-        taken += absolute[d] * omega[d] * omega[d]
+        r = absolute[d] * (omega[d] - mean)
+        T[d] = -r
+        resultant += r
+        taken += r * (omega[d] - mean)
+    for d in range(T.shape[0]):
+        T[d] += weights[d] / total * resultant
     for e in range(elements.shape[0]):
         i = int(elements[e, EL_I])
         j = int(elements[e, EL_J])
@@ -71,3 +87,33 @@ def line_angle_rates(ref, gear, M, T, omega, d_twist, d_energy):
     for d in range(omega.shape[0]):
         d_twist[d] = gear[d] * omega[d] * inv - 1.0
         d_energy[d] = (M[d] + T[d]) * omega[d] * inv
+
+
+# -- the rigid shaft's kernels in the Model's line fields: the stepper calls them only where
+# ``Model.line_n`` > 0, so that a rigid scene's stepper holds none of the line's code
+
+
+@kernel(inline=True)
+def no_shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of a rigid shaft: never called."""
+
+
+@kernel(inline=True)
+def no_line_rates(m, extras, angle_mode, y, sel, sw, wk, out):
+    """``Model.line_rates`` of a rigid shaft: never called."""
+
+
+@kernel(inline=True)
+def no_line_row(m, angle_mode, y, sw, wk, row):
+    """``Model.line_row`` of a rigid shaft: never called."""
+
+
+@kernel(inline=True)
+def no_line_mode(m, y, to_angle, wk):
+    """``Model.line_mode`` of a rigid shaft: never called."""
+
+
+@kernel(inline=True)
+def no_line_inertia(m, phi, wk):
+    """``Model.line_ref_inertia`` of a rigid shaft: never called."""
+    return 0.0

@@ -351,7 +351,9 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         h_next, fst[F_ERR_OLD] = accepted_size(tab, err, fst[F_ERR_OLD], h, h_planned, cut,
                                                rejected)
         rejected = False
-        if not fixed and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist):
+        # (an elastic shaft line's stiff sections bound the explicit step by stability: the
+        # run goes on at that step, there being no implicit path for it to hand over to)
+        if not fixed and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist) and m.line_n == 0:
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
@@ -766,17 +768,23 @@ def _switch_at_event(m, extras, io, angle_mode, event, h_next, y, wk):
 
 @kernel
 def _to_angle_mode(m, y, ist, wk):
-    """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
+    """Crank angle becomes the independent variable; the third state becomes K = ½ J ω², and
+    on an elastic shaft line each dof's speed its K_d (``Model.line_mode``)."""
     J = inertia(m, y[PHI], wk)
     y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
+    if m.line_n > 0:  # the shaft line's other dofs alike
+        m.line_mode(m, y, True, wk)
     ist[I_ANGLE_MODE] = 1
 
 
 @kernel
 def _to_time_mode(m, y, ist, wk):
-    """Time becomes the independent variable; the third state becomes ω."""
+    """Time becomes the independent variable; the third state becomes ω, and each shaft-line
+    dof's K_d its ω_d."""
     J = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
+    if m.line_n > 0:
+        m.line_mode(m, y, False, wk)
     ist[I_ANGLE_MODE] = 0
 
 
