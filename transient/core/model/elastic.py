@@ -135,8 +135,8 @@ def line_forces(m, y, sw, wk):
     wk[WK_LINE_M, m.line_load] += M_load
     M_starter = starter_moment(m, w_ref, sw)
     wk[WK_LINE_M, m.line_ref] += M_starter
-    taken = line_torques(m.line_el, m.line_abs, m.line_weight, wk[WK_LINE_THETA, :n],
-                         wk[WK_LINE_OMEGA, :n], wk[WK_LINE_T, :n])
+    taken = line_torques(m.line_el, m.line_abs, m.line_weight, wk[WK_LINE_GEAR, :n],
+                         wk[WK_LINE_THETA, :n], wk[WK_LINE_OMEGA, :n], wk[WK_LINE_T, :n])
     return M_gas, P_gas, M_load, M_starter, taken
 
 

@@ -35,29 +35,32 @@ def line_inertia(carrier, J_own, Jc, dJc, J, dJ):
 
 
 @kernel(inline=True)
-def line_torques(elements, absolute, weights, theta, omega, T):
+def line_torques(elements, absolute, weights, gear, theta, omega, T):
     """T_d: the torques of the elements and of the absolute damping on each degree of freedom,
-    (T3); returns the power they take [W] (Σ c δ̇² + Σ a_d (ω_d − ω̄)²).
+    (T3); returns the power they take [W] (Σ c δ̇² + Σ a_d (g_d ω_d − ω̄)²).
 
     The absolute damping a_d acts on each dof's motion relative to the line's rigid-body motion
-    ω̄ = Σ w_d ω_d / Σ w_d (``weights`` w_d the cycle-mean inertias): r_d = a_d (ω_d − ω̄) and
-    τ_d = −r_d + (w_d/Σw) Σ_e r_e, the torque −Pᵀ A P ω with P = I − 1 wᵀ/Σw. It has no net
-    torque, so it never brakes the rotation as a whole, and takes Σ a_d (ω_d − ω̄)²."""
+    ω̄ = Σ w_d g_d ω_d / Σ w_d (``weights`` w_d the cycle-mean inertias at the reference's
+    speed, ``gear`` g_d each dof's ratio to it, as in :func:`line_angle_rates`): with
+    r_d = a_d (g_d ω_d − ω̄), τ_d = g_d (−r_d + (w_d/Σw) Σ_e r_e), the torque −Pᵀ A P ω of
+    P = I − 1 wᵀ/Σw on the speeds g_d ω_d. It has no net torque, so it never brakes the
+    rotation as a whole, and takes Σ a_d (g_d ω_d − ω̄)²."""
     total = 0.0
     moment = 0.0
     for d in range(T.shape[0]):
         total += weights[d]
-        moment += weights[d] * omega[d]
+        moment += weights[d] * gear[d] * omega[d]
     mean = moment / total
     resultant = 0.0
     taken = 0.0
     for d in range(T.shape[0]):
-        r = absolute[d] * (omega[d] - mean)
-        T[d] = -r
+        slip = gear[d] * omega[d] - mean
+        r = absolute[d] * slip
+        T[d] = -gear[d] * r
         resultant += r
-        taken += r * (omega[d] - mean)
+        taken += r * slip
     for d in range(T.shape[0]):
-        T[d] += weights[d] / total * resultant
+        T[d] += gear[d] * weights[d] / total * resultant
     for e in range(elements.shape[0]):
         i = int(elements[e, EL_I])
         j = int(elements[e, EL_J])
