@@ -13,7 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .core.model import cylinder as cyl
+from .core.model import elastic, tabulated
 from .core.model import governor as gv
+from .core.model import shaft as line_kernels
 from .core.model import variation as var
 from .core.model.forcing import applied_value, fuel, governor_branch, select_pieces
 from .core.model.layout import (
@@ -59,9 +61,6 @@ from .scene.queries import (
     reaction_friction,
     wiebe_levels,
 )
-from .core.model import elastic
-from .core.model import shaft as line_kernels
-from .core.model import tabulated
 from .shaft import ShaftLine, refuse_elastic_run
 
 

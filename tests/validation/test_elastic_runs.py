@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import transient
+from transient.analysis.efficiency import mechanical_efficiency
 from transient.reference.torsion import from_scene, integrate
 from transient.scene import load_scene
 from transient.scene.outputs import column_name
@@ -65,7 +66,8 @@ def test_the_run_is_the_reference_lines(two_cycles):
 def test_the_energy_balance_holds_to_the_solvers_tolerance(two_cycles):
     """Σ ½J_d(θ_d)ω_d² + Σ ½kδ² − (K + V)₀ = W_gas + W_load + W_starter − W_line_loss at every
     sample, the kinetic energy from the columns' angles and speeds with ShaftLine's station
-    inertias, the potential from its element table: within 1e2·rtol of the gas work."""
+    inertias, the potential from its element table: within 1e2·rtol of the gas work; the
+    column ``E_line`` is that energy, and the efficiency analysis closes its balance with it."""
     scene, res = two_cycles
     tr = res.trajectory
     line = ShaftLine(scene)
@@ -80,6 +82,8 @@ def test_the_energy_balance_holds_to_the_solvers_tolerance(two_cycles):
     a, b = rows[:, 0].astype(int), rows[:, 1].astype(int)
     potential = 0.5 * np.sum(rows[:, 2, None] * (theta[a] - theta[b]) ** 2, axis=0)
     energy = kinetic + potential
+    # the kernels' own sum of it (J_d from the mechanism's compiled shares)
+    np.testing.assert_allclose(tr["E_line"], energy, rtol=1e-12)
     balance = (energy - energy[0] - tr["W_gas"] - tr["W_load"] - tr["W_starter"]
                + tr["W_line_loss"])
     assert tr["W_line_loss"][-1] > 0.0 and np.all(np.diff(tr["W_line_loss"]) >= 0.0)
@@ -88,6 +92,8 @@ def test_the_energy_balance_holds_to_the_solvers_tolerance(two_cycles):
     ref = line.station_dof[line.shaft.station_index(line.shaft.reference)]
     np.testing.assert_array_equal(tr["omega"], omega[ref])
     assert np.all(tr[f"twist_{names[ref]}"] == 0.0)
+    budget = mechanical_efficiency(scene, tr, window=(tr["phi"][0], tr["phi"][-1], 2))
+    assert abs(budget["energy_balance_residual"][0]) <= 1e2 * scene.solver.rtol
 
 
 def test_the_rigid_limit():

@@ -39,6 +39,7 @@ def output_columns(scene) -> dict[str, str]:
             cols[f"omega_{column_name(name)}"] = "rad/s"
         for a, b in scene.shaft.line_elements():
             cols[f"torque_{column_name(a)}_{column_name(b)}"] = "N m"
+        cols["E_line"] = "J"
         cols["W_line_loss"] = "J"
     return cols
 
@@ -93,6 +94,8 @@ DESCRIPTIONS = {
     "omega_{d}": "speed of shaft-line dof {d}, dθ/dt (elastic [shaft])",
     "torque_{a}_{b}": "torque of the shaft-line element between dofs {a} and {b}, k·(θ_a − θ_b) "
                       "+ c·(ω_a − ω_b): positive where {a} leads {b}",
+    "E_line": "energy of the shaft line: its dofs' kinetic energies Σ ½J_d ω_d² and its "
+              "elements' elastic energies Σ ½k δ²",
     "W_line_loss": "energy the shaft line's damping took since the start (sections, dampers, "
                    "coupling, absolute damping)",
     "W_drive": "work of M_drive on the shaft since the start, ∫M_drive ω dt (to the solver's "

@@ -43,8 +43,9 @@ MEAN_SAMPLES = 720
 @dataclass(frozen=True)
 class Dof:
     """A degree of freedom of the line (:meth:`~transient.scene.records.Shaft.line_dofs`): its
-    ``name`` (a station's, ``"<station> damper"``, ``"driven"``), its ``kind`` (``"station"``, ``"ring"``, ``"driven"``) and the station it
-    belongs to (for a ring its hub's; -1 for the driven inertia)."""
+    ``name`` (a station's, ``"<station> damper"``, ``"driven"``), its ``kind``
+    (``"station"``, ``"ring"``, ``"driven"``) and the station it belongs to (for a ring its
+    hub's; -1 for the driven inertia)."""
 
     name: str
     kind: str

@@ -189,7 +189,8 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
     """``Model.line_row``: an elastic scene's output row: the fixed columns of the reference
     dof (ω, ε, J, J′ its own; M_gas all cylinders', M_load at its dof), each cylinder's
     pressure at its own angle, then per dof its twist θ_d − φ and speed, per element its torque
-    k δ + c δ̇ (δ = θ_a − r θ_b) and the energy the line's damping took."""
+    k δ + c δ̇ (δ = θ_a − r θ_b), the line's energy Σ ½J_d ω_d² + Σ ½k δ² and the energy its
+    damping took."""
     n = m.line_n
     ref = m.line_ref
     line_inertias(m, y, wk)
@@ -217,9 +218,11 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
         row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, wk[WK_CYL_ANGLE, c], f, wk)
                                 if m.has_gas else 0.0)
     k = line_col(m)
+    energy = 0.0
     for d in range(n):
         row[k] = wk[WK_LINE_THETA, d] - y[PHI]
         row[k + 1] = wk[WK_LINE_OMEGA, d]
+        energy += 0.5 * wk[WK_LINE_J, d] * row[k + 1] * row[k + 1]
         k += 2
     th = wk[WK_LINE_THETA]
     w = wk[WK_LINE_OMEGA]
@@ -227,9 +230,12 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
         i = int(m.line_el[e, EL_I])
         j = int(m.line_el[e, EL_J])
         r = m.line_el[e, EL_R]
-        row[k] = m.line_el[e, EL_K] * (th[i] - r * th[j]) + m.line_el[e, EL_C] * (w[i] - r * w[j])
+        twist = th[i] - r * th[j]
+        row[k] = m.line_el[e, EL_K] * twist + m.line_el[e, EL_C] * (w[i] - r * w[j])
+        energy += 0.5 * m.line_el[e, EL_K] * twist * twist
         k += 1
-    row[k] = y[line_loss_index(m)]
+    row[k] = energy
+    row[k + 1] = y[line_loss_index(m)]
 
 
 @kernel

@@ -198,8 +198,8 @@ def n_cylinder_loss_columns(m):
 @kernel(inline=True)
 def n_line_columns(m):
     """The output row's shaft-line columns: per dof its twist and speed, per element its
-    torque, and the energy the line's damping took; none on a rigid shaft."""
-    return 2 * m.line_n + m.line_el.shape[0] + 1 if m.line_n > 0 else 0
+    torque, the line's energy and the energy its damping took; none on a rigid shaft."""
+    return 2 * m.line_n + m.line_el.shape[0] + 2 if m.line_n > 0 else 0
 
 
 #: The output row's blocks (``transient.scene.outputs.output_columns`` names the columns in this
@@ -218,9 +218,9 @@ OUTPUT = Layout(
           "the fuel each cylinder latched"),
     Block("cyl_loss", Sized(n_cylinder_loss_columns, "one per reaction pair and cylinder"),
           "the power each reaction pair loses in each cylinder (pair 1 in cylinders 1 … n, …)"),
-    Block("line", Sized(n_line_columns, "2 per dof, 1 per element, 1"),
+    Block("line", Sized(n_line_columns, "2 per dof, 1 per element, 2"),
           "each shaft-line dof's twist [rad] and speed [rad/s], each element's torque [N m], "
-          "the energy the line's damping took [J]"),
+          "the line's kinetic and elastic energy and the energy its damping took [J]"),
 )
 O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS, O_LINE = range(len(OUTPUT))
 
