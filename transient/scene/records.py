@@ -615,10 +615,11 @@ class Station:
 
     ``name`` labels it (unique). ``inertia`` [kg m²]: its own constant inertia (pulley, damper
     hub, webs and counterweights, flywheel), to which the reduced inertia of the cylinders it
-    carries is added at its own angle. ``damping`` [N m s/rad]: absolute damping to the frame
-    (≥ 0). ``cylinders``: the numbers (1-based) of the cylinders whose crankpin it carries
-    (in-line: one; V: the two of a throw; radial and swash plate: all); empty for a pulley or a
-    flywheel.
+    carries is added at its own angle. ``damping`` [N m s/rad]: absolute damping (≥ 0), acting
+    on the station's motion relative to the line's rigid-body motion (its speed less the line's
+    mean speed weighted by the cycle-mean inertias), never as a drag on the whole rotation.
+    ``cylinders``: the numbers (1-based) of the cylinders whose crankpin it carries (in-line:
+    one; V: the two of a throw; radial and swash plate: all); empty for a pulley or a flywheel.
     """
 
     name: str

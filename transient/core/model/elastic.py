@@ -64,18 +64,18 @@ from .tables import find_piece
 
 
 @kernel(inline=True)
+def twist_index(m, d):
+    """Index in the state of dof d's twist q_d (d not the reference); its K_d (ω_d) follows."""
+    return line_index(m) + 2 * (d if d < m.line_ref else d - 1)
+
+
+@kernel(inline=True)
 def line_inertias(m, y, wk):
     """Each dof's angle θ_d (WK_LINE_THETA), J_d and J′_d (WK_LINE_J, WK_LINE_DJ) at state
     ``y``; each cylinder's transfer functions at its dof's angle in the rows u, u′."""
     n = m.line_n
-    L = line_index(m)
-    j = 0
     for d in range(n):
-        if d == m.line_ref:
-            wk[WK_LINE_THETA, d] = y[PHI]
-        else:
-            wk[WK_LINE_THETA, d] = y[PHI] + y[L + 2 * j]
-            j += 1
+        wk[WK_LINE_THETA, d] = y[PHI] if d == m.line_ref else y[PHI] + y[twist_index(m, d)]
     for c in range(m.ncyl):
         wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, m.line_carrier[c]]
     m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
@@ -89,14 +89,8 @@ def line_speeds(m, angle_mode, y, wk):
     """Each dof's speed ω_d (WK_LINE_OMEGA): √(2K_d/J_d) in crank angle (NaN where K_d < 0,
     which the stepper reports as a non-finite state), the state itself in time; after
     :func:`line_inertias`."""
-    L = line_index(m)
-    j = 0
     for d in range(m.line_n):
-        if d == m.line_ref:
-            v = y[KINETIC]
-        else:
-            v = y[L + 2 * j + 1]
-            j += 1
+        v = y[KINETIC] if d == m.line_ref else y[twist_index(m, d) + 1]
         wk[WK_LINE_OMEGA, d] = np.sqrt(2.0 * v / wk[WK_LINE_J, d]) if angle_mode else v
 
 
@@ -153,7 +147,6 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
     wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w_ref)
-    L = line_index(m)
     first = wk[WK_LINE_RATE, :n]
     second = wk[WK_LINE_RATE + 1, :n]
     if angle_mode:
@@ -172,12 +165,10 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
         out[PHI] = w_ref
         out[T] = 1.0
         out[OMEGA] = second[ref]
-    j = 0
     for d in range(n):
         if d != ref:
-            out[L + 2 * j] = first[d]
-            out[L + 2 * j + 1] = second[d]
-            j += 1
+            out[twist_index(m, d)] = first[d]
+            out[twist_index(m, d) + 1] = second[d]
     out[W_GAS] = P_gas * q
     out[W_LOAD] = M_load * w[m.line_load] * q
     out[W_STARTER] = M_starter * w_ref * q
@@ -244,14 +235,11 @@ def elastic_mode(m, y, to_angle, wk):
     (``to_angle``) or back, where the independent variable changes (the reference's own third
     state is converted by the stepper, with :func:`elastic_ref_inertia`)."""
     line_inertias(m, y, wk)
-    L = line_index(m)
-    j = 0
     for d in range(m.line_n):
         if d != m.line_ref:
-            i = L + 2 * j + 1
+            i = twist_index(m, d) + 1
             J = wk[WK_LINE_J, d]
             y[i] = 0.5 * J * y[i] * y[i] if to_angle else np.sqrt(2.0 * y[i] / J)
-            j += 1
 
 
 @kernel
