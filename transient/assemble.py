@@ -291,29 +291,24 @@ def build_model(scene, part_load: bool = False
 
 def line_fields(scene, tabulated_kinematics: bool) -> dict:
     """The elastic shaft line's part of the Model (:class:`~transient.shaft.ShaftLine`: its
-    dofs, inertias, elements and absolute damping; the kernels of
-    :mod:`transient.core.model.elastic`), or size-1 zeros and the no-op kernels of
+    dofs, inertias, elements and absolute damping packed by
+    :func:`~transient.core.model.shaft.pack_line`; the mechanism's shares and
+    :func:`transient.core.model.elastic.elastic_model`), or no dofs and the no-op kernels of
     :mod:`transient.core.model.shaft` on a rigid shaft."""
     if scene.shaft is None:
-        return dict(line_n=0, line_ref=0, line_load=0, line_J=np.zeros(1),
-                    line_weight=np.ones(1), line_abs=np.zeros(1),
-                    line_el=np.zeros((1, line_kernels.N_ELEMENT)),
-                    line_carrier=np.zeros(1, dtype=np.int64), shares=line_kernels.no_shares,
-                    line_rates=line_kernels.no_line_rates, line_row=line_kernels.no_line_row,
-                    line_mode=line_kernels.no_line_mode,
-                    line_ref_inertia=line_kernels.no_line_inertia)
+        return dict(line=line_kernels.RIGID_LINE, shares=line_kernels.no_shares,
+                    line_model=line_kernels.no_line_model)
     line = ShaftLine(scene)
     shaft = scene.shaft
     carrier = np.zeros(scene.mechanism.n_cylinders, dtype=np.int64)
     for i, st in enumerate(shaft.stations):
         carrier[np.asarray(st.cylinders, dtype=np.int64) - 1] = line.station_dof[i]
-    load = line.names.index(shaft.load_at)
+    dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n)])
+    packed = line_kernels.pack_line(line.station_dof[shaft.station_index(shaft.reference)],
+                                    line.names.index(shaft.load_at), carrier, dofs,
+                                    line.element_rows())
     shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
-    return dict(line_n=line.n, line_ref=line.station_dof[shaft.station_index(shaft.reference)],
-                line_load=load, line_J=line.own_inertia, line_weight=line.weights, line_abs=line.absolute,
-                line_el=np.ascontiguousarray(line.element_rows()), line_carrier=carrier,
-                shares=shares, line_rates=elastic.elastic_rates, line_row=elastic.elastic_row,
-                line_mode=elastic.elastic_mode, line_ref_inertia=elastic.elastic_ref_inertia)
+    return dict(line=packed, shares=shares, line_model=elastic.elastic_model)
 
 
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:

@@ -70,7 +70,7 @@ def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
             layout.n_state(model)] == at[layout.B_GOVERNOR:]
     # the state: its length counted from the scene
     dofs = len(scene.shaft.line_dofs()) if scene.shaft is not None else 0
-    assert model.line_n == dofs
+    assert layout.line_dofs(model) == dofs
     expected = (6 + len(scene.friction.pairs) + len(gv.STATE_NAMES[model.gov_dyn])
                 + scene.mechanism.n_cylinders * (int(model.latch) + int(model.woschni))
                 + (2 * dofs - 1 if dofs else 0))

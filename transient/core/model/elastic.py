@@ -1,6 +1,6 @@
-"""The elastic shaft line's derivative, output row and mode switch: the kernels an elastic
-scene's Model carries in its ``line_*`` fields (a rigid scene's carry the no-ops of
-:mod:`.shaft`), so that only elastic scenes' steppers compile them.
+"""The elastic shaft line's derivative and output row: the kernel an elastic scene's Model
+carries as ``line_model`` (a rigid scene's the no-op of :mod:`.shaft`), so that only elastic
+scenes' steppers compile them.
 
 The state (:data:`.layout.STATE`): φ, t and the third state are the reference dof's (θ_ref = φ;
 K_ref = ½J_ref ω_ref² in crank angle, ω_ref in time), the works W_gas (all cylinders'), W_load
@@ -20,7 +20,17 @@ import numpy as np
 from ..jit import kernel
 from .forcing import applied_value, fuel, load_moment, starter_moment
 from .layout import (
+    EL_C,
+    EL_I,
+    EL_J,
+    EL_K,
+    EL_R,
     KINETIC,
+    LD_ABS,
+    LD_GEAR,
+    LD_WEIGHT,
+    LM_LOAD,
+    LM_REF,
     N_OUT_FIXED,
     OMEGA,
     PHI,
@@ -29,11 +39,7 @@ from .layout import (
     W_LOAD,
     W_STARTER,
     WK_CYL_ANGLE,
-    WK_CYL_DJ,
-    WK_CYL_J,
-    WK_DU,
     WK_LINE_DJ,
-    WK_LINE_GEAR,
     WK_LINE_J,
     WK_LINE_M,
     WK_LINE_OMEGA,
@@ -46,42 +52,28 @@ from .layout import (
     WK_U,
     T,
     line_col,
-    line_index,
+    line_dofs,
     line_loss_index,
 )
 from .shaft import (
-    EL_C,
-    EL_I,
-    EL_J,
-    EL_K,
-    EL_R,
     line_accelerations,
     line_angle_rates,
-    line_inertia,
+    line_inertias,
+    line_parts,
     line_torques,
+    twist_index,
 )
 from .tables import find_piece
 
 
 @kernel(inline=True)
-def twist_index(m, d):
-    """Index in the state of dof d's twist q_d (d not the reference); its K_d (ω_d) follows."""
-    return line_index(m) + 2 * (d if d < m.line_ref else d - 1)
-
-
-@kernel(inline=True)
-def line_inertias(m, y, wk):
-    """Each dof's angle θ_d (WK_LINE_THETA), J_d and J′_d (WK_LINE_J, WK_LINE_DJ) at state
-    ``y``; each cylinder's transfer functions at its dof's angle in the rows u, u′."""
-    n = m.line_n
-    for d in range(n):
-        wk[WK_LINE_THETA, d] = y[PHI] if d == m.line_ref else y[PHI] + y[twist_index(m, d)]
-    for c in range(m.ncyl):
-        wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, m.line_carrier[c]]
-    m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
-             wk[WK_U], wk[WK_DU])
-    line_inertia(m.line_carrier, m.line_J, wk[WK_CYL_J, :m.ncyl], wk[WK_CYL_DJ, :m.ncyl],
-                 wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n])
+def elastic_model(m, row, angle_mode, y, sw, wk, out):
+    """``Model.line_model``: the output row at ``y`` into ``out`` (``row``) or the derivative
+    (:func:`elastic_rates`)."""
+    if row:
+        elastic_row(m, angle_mode, y, sw, wk, out)
+    else:
+        elastic_rates(m, angle_mode, y, sw, wk, out)
 
 
 @kernel(inline=True)
@@ -89,8 +81,9 @@ def line_speeds(m, angle_mode, y, wk):
     """Each dof's speed ω_d (WK_LINE_OMEGA): √(2K_d/J_d) in crank angle (NaN where K_d < 0,
     which the stepper reports as a non-finite state), the state itself in time; after
     :func:`line_inertias`."""
-    for d in range(m.line_n):
-        v = y[KINETIC] if d == m.line_ref else y[twist_index(m, d) + 1]
+    ref = int(m.line[0, LM_REF])
+    for d in range(line_dofs(m)):
+        v = y[KINETIC] if d == ref else y[twist_index(m, d) + 1]
         wk[WK_LINE_OMEGA, d] = np.sqrt(2.0 * v / wk[WK_LINE_J, d]) if angle_mode else v
 
 
@@ -110,36 +103,39 @@ def line_forces(m, y, sw, wk):
     """The applied moments on each dof (WK_LINE_M) and the line's torques (WK_LINE_T), after
     :func:`line_speeds`. Returns (M_gas, its power, M_load, M_starter, the power the line's
     damping takes)."""
-    n = m.line_n
+    carrier, dofs, elements = line_parts(m.line)
+    n = line_dofs(m)
     for d in range(n):
         wk[WK_LINE_M, d] = 0.0
-    w_ref = wk[WK_LINE_OMEGA, m.line_ref]
+    ref = int(m.line[0, LM_REF])
+    load = int(m.line[0, LM_LOAD])
+    w_ref = wk[WK_LINE_OMEGA, ref]
     M_gas = 0.0
     P_gas = 0.0
     if m.has_gas:
         f = fuel(m, w_ref, sw[SW_GOVERNOR])
         for c in range(m.ncyl):
-            d = m.line_carrier[c]
+            d = int(carrier[c])
             p = cylinder_pressure(m, c, wk[WK_LINE_THETA, d], f, wk)
             M_c = m.gas_scale[c] * (p - m.gas_offset) * wk[WK_U, c]
             wk[WK_LINE_M, d] += M_c
             M_gas += M_c
             P_gas += M_c * wk[WK_LINE_OMEGA, d]
-    M_load = load_moment(m, None, wk[WK_LINE_OMEGA, m.line_load], y, sw)
-    wk[WK_LINE_M, m.line_load] += M_load
+    M_load = load_moment(m, None, wk[WK_LINE_OMEGA, load], y, sw)
+    wk[WK_LINE_M, load] += M_load
     M_starter = starter_moment(m, w_ref, sw)
-    wk[WK_LINE_M, m.line_ref] += M_starter
-    taken = line_torques(m.line_el, m.line_abs, m.line_weight, wk[WK_LINE_GEAR, :n],
+    wk[WK_LINE_M, ref] += M_starter
+    taken = line_torques(elements, dofs[:, LD_ABS], dofs[:, LD_WEIGHT], dofs[:, LD_GEAR],
                          wk[WK_LINE_THETA, :n], wk[WK_LINE_OMEGA, :n], wk[WK_LINE_T, :n])
     return M_gas, P_gas, M_load, M_starter, taken
 
 
 @kernel(inline=True)
-def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
-    """``Model.line_rates``: dy/dt, or dy/dφ in the reference's crank angle (T5), of an
-    elastic scene's state, in the form of :func:`.rhs.derivative`."""
-    n = m.line_n
-    ref = m.line_ref
+def elastic_rates(m, angle_mode, y, sw, wk, out):
+    """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
+    form of :func:`.rhs.derivative`."""
+    n = line_dofs(m)
+    ref = int(m.line[0, LM_REF])
     line_inertias(m, y, wk)
     line_speeds(m, angle_mode, y, wk)
     M_gas, P_gas, M_load, M_starter, taken = line_forces(m, y, sw, wk)
@@ -150,8 +146,8 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
     first = wk[WK_LINE_RATE, :n]
     second = wk[WK_LINE_RATE + 1, :n]
     if angle_mode:
-        line_angle_rates(ref, wk[WK_LINE_GEAR, :n], wk[WK_LINE_M, :n], wk[WK_LINE_T, :n], w,
-                         first, second)
+        line_angle_rates(ref, line_parts(m.line)[1][:, LD_GEAR], wk[WK_LINE_M, :n],
+                         wk[WK_LINE_T, :n], w, first, second)
         q = 1.0 / w_ref
         out[PHI] = 1.0
         out[T] = q
@@ -170,20 +166,20 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
             out[twist_index(m, d)] = first[d]
             out[twist_index(m, d) + 1] = second[d]
     out[W_GAS] = P_gas * q
-    out[W_LOAD] = M_load * w[m.line_load] * q
+    out[W_LOAD] = M_load * w[int(m.line[0, LM_LOAD])] * q
     out[W_STARTER] = M_starter * w_ref * q
     out[line_loss_index(m)] = taken * q
 
 
 @kernel
 def elastic_row(m, angle_mode, y, sw, wk, row):
-    """``Model.line_row``: an elastic scene's output row: the fixed columns of the reference
+    """An elastic scene's output row: the fixed columns of the reference
     dof (ω, ε, J, J′ its own; M_gas all cylinders', M_load at its dof), each cylinder's
     pressure at its own angle, then per dof its twist θ_d − φ and speed, per element its torque
     k δ + c δ̇ (δ = θ_a − r θ_b), the line's energy Σ ½J_d ω_d² + Σ ½k δ² and the energy its
     damping took."""
-    n = m.line_n
-    ref = m.line_ref
+    n = line_dofs(m)
+    ref = int(m.line[0, LM_REF])
     line_inertias(m, y, wk)
     line_speeds(m, angle_mode, y, wk)
     M_gas, _, M_load, M_starter, _ = line_forces(m, y, sw, wk)
@@ -217,42 +213,14 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
         k += 2
     th = wk[WK_LINE_THETA]
     w = wk[WK_LINE_OMEGA]
-    for e in range(m.line_el.shape[0]):
-        i = int(m.line_el[e, EL_I])
-        j = int(m.line_el[e, EL_J])
-        r = m.line_el[e, EL_R]
+    elements = line_parts(m.line)[2]
+    for e in range(elements.shape[0]):
+        i = int(elements[e, EL_I])
+        j = int(elements[e, EL_J])
+        r = elements[e, EL_R]
         twist = th[i] - r * th[j]
-        row[k] = m.line_el[e, EL_K] * twist + m.line_el[e, EL_C] * (w[i] - r * w[j])
-        energy += 0.5 * m.line_el[e, EL_K] * twist * twist
+        row[k] = elements[e, EL_K] * twist + elements[e, EL_C] * (w[i] - r * w[j])
+        energy += 0.5 * elements[e, EL_K] * twist * twist
         k += 1
     row[k] = energy
     row[k + 1] = y[line_loss_index(m)]
-
-
-@kernel
-def elastic_mode(m, y, to_angle, wk):
-    """``Model.line_mode``: each dof but the reference from ω_d to K_d = ½J_d(θ_d)ω_d²
-    (``to_angle``) or back, where the independent variable changes (the reference's own third
-    state is converted by the stepper, with :func:`elastic_ref_inertia`)."""
-    line_inertias(m, y, wk)
-    for d in range(m.line_n):
-        if d != m.line_ref:
-            i = twist_index(m, d) + 1
-            J = wk[WK_LINE_J, d]
-            y[i] = 0.5 * J * y[i] * y[i] if to_angle else np.sqrt(2.0 * y[i] / J)
-
-
-@kernel
-def elastic_ref_inertia(m, phi, wk):
-    """``Model.line_ref_inertia``: J_ref(φ), the reference dof's own inertia and its cylinders'
-    shares at φ, summed as :func:`.shaft.line_inertia` sums them (so that K_ref = ½J_ref ω_ref²
-    converts both ways to the same bits); fills the rows u, u′ at φ."""
-    for c in range(m.ncyl):
-        wk[WK_CYL_ANGLE, c] = phi
-    m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
-             wk[WK_U], wk[WK_DU])
-    J = m.line_J[m.line_ref]
-    for c in range(m.ncyl):
-        if m.line_carrier[c] == m.line_ref:
-            J += wk[WK_CYL_J, c]
-    return J

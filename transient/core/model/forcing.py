@@ -44,7 +44,9 @@ from .layout import (
     cyl_index,
     gov_index,
     latch_index,
+    line_dofs,
 )
+from .shaft import ref_inertia
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
@@ -181,10 +183,10 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
 @kernel(inline=True)
 def inertia(m, phi, wk):
     """Total reduced inertia J(φ), (19); fills the row u of ``wk``. On an elastic shaft line
-    the reference dof's J_ref(φ) (its own and its cylinders', ``Model.line_ref_inertia``), the
-    inertia of the third state's K = ½Jω²."""
-    if m.line_n > 0:
-        return m.line_ref_inertia(m, phi, wk)
+    the reference dof's J_ref(φ) (its own and its cylinders'), the
+    inertia of the third state's K = ½Jω² (:func:`.shaft.ref_inertia`)."""
+    if line_dofs(m) > 0:
+        return ref_inertia(m, phi, wk)
     J, _ = mechanism_terms(m, phi, wk[WK_U], wk[WK_DU], False)
     return J + m.J0
 

@@ -47,17 +47,42 @@ def n_pressures(m):
     return m.ncyl if m.woschni else 0
 
 
+#: A row of the element table of an elastic shaft line (:mod:`.shaft`): the two degrees of
+#: freedom it joins, its stiffness [N m/rad], damping [N m s/rad] and gear ratio r = ω_i/ω_j [1].
+ELEMENT = Layout("element", "i", "j", "stiffness", "damping", "ratio")
+EL_I, EL_J, EL_K, EL_C, EL_R = ELEMENT
+N_ELEMENT = ELEMENT.size
+#: The Model's ``line``, the elastic shaft line packed in one array of N_ELEMENT columns: row 0
+#: these counts and indices; then a row per cylinder, the dof that carries it in column 0; a
+#: row per dof (:data:`LINE_DOF`); a row per element (:data:`ELEMENT`). A rigid shaft's is one
+#: row of zeros: no dofs.
+LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylinders")
+LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS = LINE_META
+#: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
+#: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad]
+#: and its gear ratio to the reference [1].
+LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear")
+LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR = LINE_DOF
+
+
+@kernel(inline=True)
+def line_dofs(m):
+    """The elastic shaft line's degrees of freedom; 0 on a rigid shaft."""
+    return int(m.line[0, LM_DOFS])
+
+
 @kernel(inline=True)
 def n_line_states(m):
     """The elastic shaft line's states: a twist and an energy (or speed) per degree of freedom
     other than the reference; none on a rigid shaft."""
-    return 2 * (m.line_n - 1) if m.line_n > 0 else 0
+    n = line_dofs(m)
+    return 2 * (n - 1) if n > 0 else 0
 
 
 @kernel(inline=True)
 def n_line_loss(m):
     """The energy the shaft line's damping took: one on an elastic line."""
-    return 1 if m.line_n > 0 else 0
+    return 1 if line_dofs(m) > 0 else 0
 
 
 #: The state vector's blocks, in order (a :class:`~transient.core.declare.Layout`). The first
@@ -70,7 +95,7 @@ def n_line_loss(m):
 #: injection (held constant between injections: their derivative is zero and the stepper sets
 #: them), then, with wall heat transfer, each cylinder's pressure in its closed part
 #: (:mod:`.cylinder`; the ``p_<k>`` columns show it there). On an elastic shaft line
-#: (``Model.line_n`` > 0; theory, (T5)) φ, the third state and the works are the reference
+#: (:func:`line_dofs` > 0; theory, (T5)) φ, the third state and the works are the reference
 #: degree of freedom's (the gas work all cylinders', the load's at its own dof), then per other
 #: dof in order its twist q_d = θ_d − φ and its K_d = ½J_d(θ_d)ω_d² in crank angle, ω_d in
 #: time (:mod:`.elastic`), and the energy the line's damping took.
@@ -199,7 +224,8 @@ def n_cylinder_loss_columns(m):
 def n_line_columns(m):
     """The output row's shaft-line columns: per dof its twist and speed, per element its
     torque, the line's energy and the energy its damping took; none on a rigid shaft."""
-    return 2 * m.line_n + m.line_el.shape[0] + 2 if m.line_n > 0 else 0
+    n = line_dofs(m)
+    return 2 * n + int(m.line[0, LM_ELEMENTS]) + 2 if n > 0 else 0
 
 
 #: The output row's blocks (``transient.scene.outputs.output_columns`` names the columns in this
@@ -256,7 +282,6 @@ WORK = Layout(
     ("line_M", 1, "the applied moments on each dof"),
     ("line_T", 1, "the line's torques on each dof"),
     ("line_rate", 2, "each dof's two rates (dq/dφ, dK/dφ; or ε in time)"),
-    ("line_gear", 1, "each dof's gear ratio to the reference (1)"),
     ("cyl_angle", 1, "each cylinder's angle, its station's"),
     ("cyl_J", 1, "each cylinder's share of J at its angle"),
     ("cyl_dJ", 1, "its derivative"),
@@ -264,7 +289,7 @@ WORK = Layout(
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
  WK_SCRATCH, WK_CYL_LOSS, WK_LINE_THETA, WK_LINE_OMEGA, WK_LINE_J, WK_LINE_DJ, WK_LINE_M,
- WK_LINE_T, WK_LINE_RATE, WK_LINE_GEAR, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ) = WORK
+ WK_LINE_T, WK_LINE_RATE, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ) = WORK
 N_SCRATCH = WORK.size_of("scratch")
 WK_RX = WORK.end
 
@@ -369,23 +394,12 @@ Model = namedtuple(
         "et_size",  # int64[n_pairs, 2]: the lengths of pair k's two axes
         "et_eta",  # float64[n_pairs, 2, nw_max, ns_max]: η_fwd, η_bwd on pair k's grid [1]
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
-        # the elastic shaft line (transient.shaft.ShaftLine; theory, The elastic shaft line):
-        # its degrees of freedom (stations, damper rings, the driven inertia referred to the
-        # shaft), size-1 zeros and no-op kernels (transient.core.model.shaft) on a rigid shaft,
-        # so that one compile serves every rigid scene and only elastic ones compile its code
-        "line_n",  # int: degrees of freedom of the line (0: the rigid shaft)
-        "line_ref",  # int: the reference dof, whose angle is φ
-        "line_load",  # int: the dof the load acts on
-        "line_J",  # float64[line_n]: each dof's own constant inertia [kg m²]
-        "line_weight",  # float64[line_n]: each dof's cycle-mean inertia [kg m²]
-        "line_abs",  # float64[line_n]: each dof's absolute damping [N m s/rad]
-        "line_el",  # float64[n_elements, shaft.N_ELEMENT]: the element table
-        "line_carrier",  # int64[ncyl]: the dof that carries each cylinder
+        # the elastic shaft line (transient.shaft.ShaftLine; theory, The elastic shaft line),
+        # packed: every field of the Model costs a rigid scene's run time, so the line is one
+        # array and two kernels; a rigid shaft's is a row of zeros (no dofs) and no-ops
+        "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
         "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
-        "line_rates",  # kernel: the line's derivative (m, extras, angle_mode, y, sel, sw, wk, out)
-        "line_row",  # kernel: the line's output row (m, angle_mode, y, sw, wk, row)
-        "line_mode",  # kernel: each dof's K_d ↔ ω_d at a change of the independent variable
-        "line_ref_inertia",  # kernel: J of the reference dof at φ (m, phi, wk)
+        "line_model",  # kernel: the line's derivative or output row (.elastic.elastic_model)
     ],
 )
 typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)

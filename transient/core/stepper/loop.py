@@ -78,6 +78,7 @@ from ..model.layout import (
     WK_SPEED,
     T,
     gov_index,
+    line_dofs,
     state_control,
 )
 from ..model.rhs import (
@@ -90,6 +91,7 @@ from ..model.rhs import (
     reset_kinks,
     watches_kinks,
 )
+from ..model.shaft import line_mode
 from ..model.work import work_array
 from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .events import (
@@ -353,7 +355,8 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         rejected = False
         # (an elastic shaft line's stiff sections bound the explicit step by stability: the
         # run goes on at that step, there being no implicit path for it to hand over to)
-        if not fixed and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist) and m.line_n == 0:
+        if (not fixed and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist)
+                and line_dofs(m) == 0):
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
@@ -769,11 +772,11 @@ def _switch_at_event(m, extras, io, angle_mode, event, h_next, y, wk):
 @kernel
 def _to_angle_mode(m, y, ist, wk):
     """Crank angle becomes the independent variable; the third state becomes K = ½ J ω², and
-    on an elastic shaft line each dof's speed its K_d (``Model.line_mode``)."""
+    on an elastic shaft line each dof's speed its K_d (:func:`~.shaft.line_mode`)."""
     J = inertia(m, y[PHI], wk)
     y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
-    if m.line_n > 0:  # the shaft line's other dofs alike
-        m.line_mode(m, y, True, wk)
+    if line_dofs(m) > 0:  # the shaft line's other dofs alike
+        line_mode(m, y, True, wk)
     ist[I_ANGLE_MODE] = 1
 
 
@@ -783,8 +786,8 @@ def _to_time_mode(m, y, ist, wk):
     dof's K_d its ω_d."""
     J = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
-    if m.line_n > 0:
-        m.line_mode(m, y, False, wk)
+    if line_dofs(m) > 0:
+        line_mode(m, y, False, wk)
     ist[I_ANGLE_MODE] = 0
 
 
