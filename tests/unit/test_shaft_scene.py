@@ -208,6 +208,16 @@ def test_the_api_refuses_what_the_elastic_run_does_not_support(key, extra, tmp_p
     assert list(tmp_path.iterdir()) == []  # (refused before any file is made)
 
 
+def test_tabulated_kinematics_is_refused_with_cylinders_on_several_stations():
+    """Its tables hold the mechanism's J(φ) whole: the six's throws on six stations cannot
+    share it out."""
+    text = (CASES / "inline6_damper.toml").read_text(encoding="utf-8")
+    elastic = load_scene("six.toml", text=text + '\n[solver]\nkinematics = "tabulated"\n')
+    with pytest.raises(SceneError, match="put every cylinder on one station") as info:
+        simulate(elastic)
+    assert info.value.key == "solver.kinematics"
+
+
 def test_the_command_refuses_what_the_elastic_run_does_not_support(tmp_path, capsys):
     path = tmp_path / "elastic.toml"
     path.write_text(_unsupported("load.inertia", UNSUPPORTED[4][1]), encoding="utf-8")
