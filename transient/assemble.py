@@ -290,7 +290,7 @@ def build_model(scene, part_load: bool = False
 
 
 def line_fields(scene, tabulated_kinematics: bool) -> dict:
-    """The elastic shaft line's part of the Model (:class:`~transient.shaft.ShaftLine`: its
+    """The elastic shaft line's part of the Model (:class:`~transient.shaft.line.ShaftLine`: its
     dofs, inertias, elements and absolute damping packed by
     :func:`~transient.core.model.shaft.pack_line`; the mechanism's shares and
     :func:`transient.core.model.elastic.elastic_model`), or no dofs and the no-op kernels of

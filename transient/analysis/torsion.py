@@ -107,7 +107,7 @@ class Mode:
 @dataclass(frozen=True)
 class Critical:
     """Engine order ``order`` [1/rev] of kind ``kind`` meeting mode ``mode`` at ``rpm``, with
-    the mode's relative excitation by that order (:mod:`module docs <.torsion>`)."""
+    the mode's relative excitation by that order (:mod:`module docs <transient.analysis.torsion>`)."""
 
     mode: int
     order: float

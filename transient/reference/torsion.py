@@ -496,7 +496,7 @@ def from_scene(scene) -> tuple[TorsionModel, int]:
     records, the cylinders (:class:`CrankSliderCylinders`) burning the full-load table of its
     gas, and its load's torque, linear and fan terms acting where ``load_at`` says. What it
     shares with the compiled path: the scene's records, the pressure table and the sections'
-    viscous c of a loss factor or damping ratio (:class:`transient.shaft.ShaftLine`, which
+    viscous c of a loss factor or damping ratio (:class:`transient.shaft.line.ShaftLine`, which
     needs the line's ω₁). A starter, governor, generator, schedule or a mechanism other than
     the crank-slider is beyond it (ValueError)."""
     from ..scene.queries import gas_phases, gas_tables

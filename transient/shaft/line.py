@@ -126,7 +126,7 @@ class ShaftLine:
 
     def element_rows(self) -> NDArray[np.float64]:
         """The elements as the compiled model's element table
-        (:data:`transient.core.model.shaft.ELEMENT`): per row the two dofs, stiffness, damping
+        (:data:`transient.core.model.layout.ELEMENT`): per row the two dofs, stiffness, damping
         and gear ratio (1: the driven inertia is referred to the shaft); the same elements as
         K and C."""
         rows = [(a, b, k, c, 1.0) for a, b, k, c in self._pairs(self.omega_1)]

@@ -1,5 +1,5 @@
 """The elastic shaft line's derivative and output row: the kernel an elastic scene's Model
-carries as ``line_model`` (a rigid scene's the no-op of :mod:`.shaft`), so that only elastic
+carries as ``line_model`` (a rigid scene's the no-op of :mod:`transient.core.model.shaft`), so that only elastic
 scenes' steppers compile them.
 
 The state (:data:`.layout.STATE`): φ, t and the third state are the reference dof's (θ_ref = φ;
@@ -80,7 +80,7 @@ def elastic_model(m, row, angle_mode, y, sw, wk, out):
 def line_speeds(m, angle_mode, y, wk):
     """Each dof's speed ω_d (WK_LINE_OMEGA): √(2K_d/J_d) in crank angle (NaN where K_d < 0,
     which the stepper reports as a non-finite state), the state itself in time; after
-    :func:`line_inertias`."""
+    :func:`~transient.core.model.shaft.line_inertias`."""
     ref = int(m.line[0, LM_REF])
     for d in range(line_dofs(m)):
         v = y[KINETIC] if d == ref else y[twist_index(m, d) + 1]
@@ -145,9 +145,9 @@ def elastic_rates(m, angle_mode, y, sw, wk, out):
     wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w_ref)
     first = wk[WK_LINE_RATE, :n]
     second = wk[WK_LINE_RATE + 1, :n]
+    gear = line_parts(m.line)[1][:, LD_GEAR]
     if angle_mode:
-        line_angle_rates(ref, line_parts(m.line)[1][:, LD_GEAR], wk[WK_LINE_M, :n],
-                         wk[WK_LINE_T, :n], w, first, second)
+        line_angle_rates(ref, gear, wk[WK_LINE_M, :n], wk[WK_LINE_T, :n], w, first, second)
         q = 1.0 / w_ref
         out[PHI] = 1.0
         out[T] = q
@@ -156,7 +156,7 @@ def elastic_rates(m, angle_mode, y, sw, wk, out):
         line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                            wk[WK_LINE_T, :n], w, second)
         for d in range(n):
-            first[d] = w[d] - w_ref
+            first[d] = gear[d] * w[d] - w_ref
         q = 1.0
         out[PHI] = w_ref
         out[T] = 1.0

@@ -47,7 +47,7 @@ def n_pressures(m):
     return m.ncyl if m.woschni else 0
 
 
-#: A row of the element table of an elastic shaft line (:mod:`.shaft`): the two degrees of
+#: A row of the element table of an elastic shaft line (:mod:`transient.core.model.shaft`): the two degrees of
 #: freedom it joins, its stiffness [N m/rad], damping [N m s/rad] and gear ratio r = ω_i/ω_j [1].
 ELEMENT = Layout("element", "i", "j", "stiffness", "damping", "ratio")
 EL_I, EL_J, EL_K, EL_C, EL_R = ELEMENT
@@ -60,7 +60,9 @@ LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylind
 LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS = LINE_META
 #: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
 #: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad]
-#: and its gear ratio to the reference [1].
+#: and its gear ratio to the reference [1]: 1 for every dof of a scene's line, whose driven
+#: inertia is referred to the shaft (:class:`transient.shaft.ShaftLine`), so that its angle is
+#: φ + q_d.
 LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear")
 LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR = LINE_DOF
 
