@@ -61,7 +61,7 @@ LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS = LINE_META
 #: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
 #: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad]
 #: and its gear ratio to the reference [1]: 1 for every dof of a scene's line, whose driven
-#: inertia is referred to the shaft (:class:`transient.shaft.ShaftLine`), so that its angle is
+#: inertia is referred to the shaft (:class:`transient.shaft.line.ShaftLine`), so that its angle is
 #: φ + q_d.
 LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear")
 LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR = LINE_DOF
