@@ -13,7 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .core.model import cylinder as cyl
+from .core.model import elastic, tabulated
 from .core.model import governor as gv
+from .core.model import shaft as line_kernels
 from .core.model import variation as var
 from .core.model.forcing import applied_value, fuel, governor_branch, select_pieces
 from .core.model.layout import (
@@ -59,7 +61,7 @@ from .scene.queries import (
     reaction_friction,
     wiebe_levels,
 )
-from .shaft import refuse_elastic_run
+from .shaft import ShaftLine, refuse_elastic_run
 
 
 def breakpoints(table: PressureTable | None, phases: NDArray[np.float64], period: float,
@@ -273,7 +275,8 @@ def build_model(scene, part_load: bool = False
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation)
+        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation,
+        **line_fields(scene, tabulated))
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
         if moved.size:  # the combustion's start and end, δ_k later
@@ -284,6 +287,28 @@ def build_model(scene, part_load: bool = False
         gap = np.abs(bp[:, None] - reaction_breakpoints(scene)[None, :])
         model.bp_jump[:] |= np.any(np.minimum(gap, period - gap) <= 1e-12 * period, axis=1)
     return model, model.breakpoints, table
+
+
+def line_fields(scene, tabulated_kinematics: bool) -> dict:
+    """The elastic shaft line's part of the Model (:class:`~transient.shaft.line.ShaftLine`: its
+    dofs, inertias, elements and absolute damping packed by
+    :func:`~transient.core.model.shaft.pack_line`; the mechanism's shares and
+    :func:`transient.core.model.elastic.elastic_model`), or no dofs and the no-op kernels of
+    :mod:`transient.core.model.shaft` on a rigid shaft."""
+    if scene.shaft is None:
+        return dict(line=line_kernels.RIGID_LINE, shares=line_kernels.no_shares,
+                    line_model=line_kernels.no_line_model)
+    line = ShaftLine(scene)
+    shaft = scene.shaft
+    carrier = np.zeros(scene.mechanism.n_cylinders, dtype=np.int64)
+    for i, st in enumerate(shaft.stations):
+        carrier[np.asarray(st.cylinders, dtype=np.int64) - 1] = line.station_dof[i]
+    dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n)])
+    packed = line_kernels.pack_line(line.station_dof[shaft.station_index(shaft.reference)],
+                                    line.names.index(shaft.load_at), carrier, dofs,
+                                    line.element_rows())
+    shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
+    return dict(line=packed, shares=shares, line_model=elastic.elastic_model)
 
 
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:

@@ -66,7 +66,11 @@ def _initial_state(scene, model):
     y[0] = scene.initial.phi
     y[2] = scene.initial.omega
     governor, sleeve = initial_governor(scene, model)
-    y[y.size - governor.size:] = governor
+    at = layout.STATE.offsets_for(model)
+    y[at[layout.B_GOVERNOR]:at[layout.B_GOVERNOR] + governor.size] = governor
+    # the shaft line's dofs at φ₀ and ω₀, untwisted (its speeds are states in time, where a run
+    # starts; the stepper makes them energies where it turns to crank angle)
+    y[at[layout.B_LINE] + 1:at[layout.B_LINE + 1]:2] = scene.initial.omega
     fst = np.zeros(sio.fst_size(model))
     fst[sio.F_PASSED_BP] = np.nan
     ist = np.zeros(sio.N_IST, dtype=np.int64)
@@ -362,7 +366,8 @@ def integrate(scene, on_block=None, progress=None, keep=True, start=None, before
         data = prescribed(scene)
     elif scene.solver.method in COMPILED_METHODS:
         data = run_compiled(scene, watch.wrap(on_block), progress, keep, start)
-        if data.message.startswith("stiff"):
+        if data.message.startswith("stiff") and scene.shaft is None:  # (the implicit path
+            # has no elastic line: an elastic run found stiff stays failed, as it says)
             data = _implicit_rerun(scene, data, watch.wrap(on_block), progress)
     else:
         from .reference import run_reference

@@ -49,9 +49,9 @@ from own_error import MOVE, tightened  # noqa: E402
 
 
 def scenes() -> list[Path]:
-    """Every scene of ``cases/`` that runs (the sweeps' folder holds sweep files, not scenes; a
-    scene with an elastic shaft line, ``[shaft]``, has no run yet: ``transient run`` refuses
-    it)."""
+    """Every scene of ``cases/`` that runs (the sweeps' folder holds sweep files, not scenes),
+    but those with an elastic shaft line, ``[shaft]``: their run-ups are long, and their runs
+    are held against the reference line's in ``tests/validation/test_elastic_runs.py``."""
     return sorted(p for p in CASES.glob("*.toml")
                   if tomllib.loads(p.read_text(encoding="utf-8")).get("shaft") is None)
 

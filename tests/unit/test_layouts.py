@@ -22,7 +22,6 @@ from transient.core.stepper import events
 from transient.core.stepper import io as sio
 from transient.scene import load_scene
 from transient.scene.outputs import output_columns
-from transient.shaft import rigid_equivalent
 
 CASES = sorted((Path(__file__).resolve().parents[2] / "cases").glob("*.toml"))
 
@@ -61,33 +60,41 @@ def test_bad_declarations_are_refused():
 @pytest.mark.parametrize("case", CASES, ids=[c.stem for c in CASES])
 def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
     """The compiled index kernels (the chain the kernels index by) and the declaration's offsets
-    (what the Python side lays out) agree, and both with what the scene counts otherwise. A
-    scene with an elastic shaft line, whose compiled model is not built yet, is laid out as its
-    rigid equivalent."""
-    scene = rigid_equivalent(load_scene(case))
+    (what the Python side lays out) agree, and both with what the scene counts otherwise (an
+    elastic shaft line: two states per dof but the reference's, and its loss)."""
+    scene = load_scene(case)
     model, _, _ = build_model(scene)
     at = layout.STATE.offsets_for(model)
     assert [layout.gov_index(model), layout.latch_index(model), layout.cyl_index(model),
+            layout.line_index(model), layout.line_loss_index(model),
             layout.n_state(model)] == at[layout.B_GOVERNOR:]
     # the state: its length counted from the scene
+    dofs = len(scene.shaft.line_dofs()) if scene.shaft is not None else 0
+    assert layout.line_dofs(model) == dofs
     expected = (6 + len(scene.friction.pairs) + len(gv.STATE_NAMES[model.gov_dyn])
-                + scene.mechanism.n_cylinders * (int(model.latch) + int(model.woschni)))
+                + scene.mechanism.n_cylinders * (int(model.latch) + int(model.woschni))
+                + (2 * dofs - 1 if dofs else 0))
     control = layout.state_control(model)
     assert at[-1] == expected == control.size and np.all(np.diff(at) >= 0)
     assert list(control[:3]) == [BY_INCREMENT, BY_INCREMENT, BY_SIZE]
     assert np.all(control[3:layout.W_LOSS0 + model.n_pairs] == NOT_CONTROLLED)
     assert np.all(control[at[layout.B_GOVERNOR]:at[layout.B_GOVERNOR + 1]] == BY_SIZE)
-    assert np.all(control[at[layout.B_PRESSURE]:] == BY_SIZE)
+    assert np.all(control[at[layout.B_PRESSURE]:at[layout.B_LINE_LOSS]] == BY_SIZE)
+    assert np.all(control[at[layout.B_LINE_LOSS]:] == NOT_CONTROLLED)
     # the output row: as long as the trajectory's columns that the scene names
     out = layout.OUTPUT.offsets_for(model)
     assert [layout.pair_col(model), layout.governor_col(model), layout.cylinder_loss_col(model),
-            layout.n_outputs(model)] == [out[layout.O_PAIRS], out[layout.O_GOVERNOR],
-                                         out[layout.O_CYL_LOSS], out[-1]]
+            layout.line_col(model), layout.n_outputs(model)] == [
+        out[layout.O_PAIRS], out[layout.O_GOVERNOR], out[layout.O_CYL_LOSS], out[layout.O_LINE],
+        out[-1]]
     if scene.run.mode != "prescribed-speed":
         names = list(output_columns(scene))
         assert out[-1] == len(names) and names[out[layout.O_GAS]] == "p_1"
         if model.n_pairs:
             assert names[out[layout.O_PAIRS]] == "S_1"
+        if dofs:
+            assert names[out[layout.O_LINE]] == f"twist_{scene.shaft.stations[0].name}"
+            assert names[-1] == "W_line_loss"
     assert work_array(model).shape[0] == N_WK
     assert sio.fst_size(model) == sio.N_FST + at[-1] + max(model.n_pairs, 1)
 
@@ -131,8 +138,8 @@ def test_the_models_type_from_its_fingerprint_is_numbas_own_on_every_case():
     from numba import typeof
 
     seen = {}
-    for path in CASES:  # (an elastic line's model is not built yet: its rigid equivalent's is)
-        model, _, _ = build_model(rigid_equivalent(load_scene(path)))
+    for path in CASES:
+        model, _, _ = build_model(load_scene(path))
         assert typeof(model) == _numbas_own_type(model), path.name
         seen.setdefault(typeof(model), path.name)
     assert len(seen) > 3  # (the cases differ in their mechanisms' kernels and fields' types)

@@ -51,6 +51,13 @@ def _compiled_line(model):
     return J_own, np.array(rows, dtype=float), absolute, driven
 
 
+def _gear(driven, n_dof):
+    """Each dof's ratio to the stations' speed: the driven inertia turns 1/i as fast."""
+    gear = np.ones(n_dof)
+    gear[driven] = COUPLING.ratio  # (its twist q = i θ_d − φ)
+    return gear
+
+
 def test_the_lines_accelerations_and_losses_are_the_references():
     mech, model, load = _reference()
     J_own, elements, absolute, driven = _compiled_line(model)
@@ -76,7 +83,8 @@ def test_the_lines_accelerations_and_losses_are_the_references():
         M[: model.line.n] = model.gas_moments(th, w, t)
         M[driven] = load(thd, wd, t)
         T = np.zeros(n_dof)
-        taken = shaft.line_torques(elements, absolute, theta, omega, T)
+        taken = shaft.line_torques(elements, absolute, model.weights, _gear(driven, n_dof),
+                                   theta, omega, T)
         acc = np.zeros(n_dof)
         shaft.line_accelerations(J, dJ, M, T, omega, acc)
 
@@ -92,8 +100,7 @@ def test_the_crank_angle_rates_are_the_time_rates_over_the_references_speed():
     carrier = np.asarray(model.line.station_of_cylinder, dtype=np.int64)
     n_dof = J_own.size
     ref = 7  # the flywheel
-    gear = np.ones(n_dof)
-    gear[driven] = COUPLING.ratio  # (its twist q = i θ_d − φ)
+    gear = _gear(driven, n_dof)
     rng = np.random.default_rng(9)
     y = model.initial_state(1.3, 180.0)
     y[: model.i_works] += rng.normal(0.0, 1e-3, model.i_works)
@@ -115,8 +122,30 @@ def test_the_crank_angle_rates_are_the_time_rates_over_the_references_speed():
     M[: model.line.n] = model.gas_moments(th, w, 0.0)
     M[driven] = load(thd, wd, 0.0)
     T = np.zeros(n_dof)
-    shaft.line_torques(elements, absolute, theta, omega, T)
+    shaft.line_torques(elements, absolute, model.weights, gear, theta, omega, T)
     dq, dK = np.zeros(n_dof), np.zeros(n_dof)
     shaft.line_angle_rates(ref, gear, M, T, omega, dq, dK)
     np.testing.assert_allclose(dq, dq_want, rtol=0, atol=1e-15)
     np.testing.assert_allclose(dK, dK_want, rtol=0, atol=RTOL * np.abs(T).max())
+
+
+def test_absolute_damping_acts_on_the_motion_relative_to_the_rigid_rotation():
+    """The absolute damping's torques sum to zero (it never brakes the line as a whole), vanish
+    on a rigid rotation, and take Σ a_d (ω_d − ω̄)², ω̄ the inertia-weighted mean speed."""
+    rng = np.random.default_rng(3)
+    n = 9
+    weights = rng.uniform(0.01, 1.0, n)
+    absolute = rng.uniform(0.0, 2.0, n)
+    gear = np.ones(n)
+    no_elements = np.zeros((0, shaft.N_ELEMENT))
+    theta = rng.normal(0.0, 1e-3, n)
+    T = np.zeros(n)
+    assert shaft.line_torques(no_elements, absolute, weights, gear, theta, np.full(n, 300.0),
+                              T) == 0.0
+    np.testing.assert_allclose(T, 0.0, atol=1e-12)
+    omega = 300.0 + rng.normal(0.0, 5.0, n)
+    taken = shaft.line_torques(no_elements, absolute, weights, gear, theta, omega, T)
+    mean = weights @ omega / weights.sum()
+    assert abs(T.sum()) <= 1e-12 * np.abs(T).max()
+    assert taken == pytest.approx(np.sum(absolute * (omega - mean) ** 2), rel=1e-12)
+    assert -T @ omega == pytest.approx(taken, rel=1e-9)

@@ -1,13 +1,14 @@
 """The ``[shaft]`` table: read into SI, written back, every mistake refused in one line naming
-the key (exit 2), and a scene with it never run rigid in its place: ``transient run`` and the
-API refuse it until the elastic run exists, and ``transient modes`` writes its modes."""
+the key (exit 2), and a scene with it never run rigid or without what it asks in its place:
+``transient run`` and the API refuse what the elastic run does not support, and ``transient
+modes`` writes its modes."""
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
 import pytest
-from scene_texts import SMALL
+from scene_texts import MIXED_CYCLE, SMALL
 
 from transient.cli import main
 from transient.errors import SceneError
@@ -170,26 +171,60 @@ def _without_inertia(text: str) -> str:
     return "\n".join(out) + "\n"
 
 
-# -- never run rigid in its place -----------------------------------------------------------
+# -- what the elastic run does not support is refused, never run without it or rigid -------
 
-def test_the_api_refuses_to_run_a_shaft_scene(tmp_path):
-    elastic = scene()
-    with pytest.raises(SceneError, match="elastic time-domain run of a \\[shaft\\] scene is not "
-                                         "available yet") as info:
+GAS = MIXED_CYCLE.format(cr=18)
+#: (the key refused, what the scene adds to BASE + LINE): one of each of
+#: transient.shaft.line.UNSUPPORTED
+UNSUPPORTED = [
+    ("friction.pairs", '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
+                       "eta_backward = 0.9\n"),
+    ("governor.model", '\n[governor]\nmodel = "pi"\nspeed_rpm = 1000\ngain_p = 10\n'
+                       'gain_i = 30\n'),
+    ("gas.injection", GAS + "injection_deg = 340\n"),
+    ("gas.cylinders", GAS + "\n[[gas.cylinders]]\ncylinder = 1\nfuel = 0.9\n"),
+    ("load.inertia", "\n[load]\ninertia = 0.1\ninertia_time = 0.01\n"),
+    ("run.mode", None),
+    ("solver.method", None),
+]
+
+
+def _unsupported(key: str, extra: str | None) -> str:
+    text = BASE + LINE + (extra or "")
+    if key == "run.mode":
+        return text.replace("revolutions = 2", 'mode = "prescribed-speed"\nspeed_rpm = 600\n'
+                                                "t_end = 0.1")
+    if key == "solver.method":
+        return text.replace("[solver]\n", '[solver]\nmethod = "scipy-Radau"\n')
+    return text
+
+
+@pytest.mark.parametrize("key, extra", UNSUPPORTED, ids=[k for k, _ in UNSUPPORTED])
+def test_the_api_refuses_what_the_elastic_run_does_not_support(key, extra, tmp_path):
+    elastic = load_scene("s.toml", text=_unsupported(key, extra))
+    with pytest.raises(SceneError, match="is not supported with an elastic \\[shaft\\] line") as info:
         simulate(elastic, tmp_path / "r.h5")
-    assert info.value.key == "shaft"
+    assert info.value.key == key
     assert list(tmp_path.iterdir()) == []  # (refused before any file is made)
-    with pytest.raises(SceneError, match="not available yet"):
+
+
+def test_tabulated_kinematics_is_refused_with_cylinders_on_several_stations():
+    """Its tables hold the mechanism's J(φ) whole: the six's throws on six stations cannot
+    share it out."""
+    text = (CASES / "inline6_damper.toml").read_text(encoding="utf-8")
+    elastic = load_scene("six.toml", text=text + '\n[solver]\nkinematics = "tabulated"\n')
+    with pytest.raises(SceneError, match="put every cylinder on one station") as info:
         simulate(elastic)
+    assert info.value.key == "solver.kinematics"
 
 
-def test_the_command_refuses_to_run_a_shaft_scene(tmp_path, capsys):
+def test_the_command_refuses_what_the_elastic_run_does_not_support(tmp_path, capsys):
     path = tmp_path / "elastic.toml"
-    path.write_text(BASE + LINE, encoding="utf-8")
+    path.write_text(_unsupported("load.inertia", UNSUPPORTED[4][1]), encoding="utf-8")
     out = tmp_path / "out"
     assert main(["run", str(path), "-o", str(out), "-q"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "shaft: the elastic time-domain run" in err[0]
+    assert len(err) == 1 and "load.inertia: is not supported with an elastic [shaft]" in err[0]
     assert not out.exists() or list(out.iterdir()) == []
     assert main(["check", str(path)]) == 0  # (a valid scene: modes work on it)
 

@@ -243,6 +243,21 @@ def test_a_loss_factor_and_a_damping_ratio_are_c_at_the_first_mode():
     assert c == 3.5
 
 
+def test_absolute_damping_is_relative_to_the_rigid_rotation():
+    """C's absolute part takes no torque on a rigid rotation (C·1 = 0: the rigid mode stays
+    undamped) and takes ωᵀCω = Σ c δ̇² + Σ a_d (ω_d − ω̄)² of power, ω̄ the cycle-mean-inertia
+    weighted mean speed, the elements' part written out from the element table."""
+    line = ShaftLine(INLINE6)
+    assert np.any(line.absolute > 0.0)
+    np.testing.assert_allclose(line.C @ np.ones(line.n), 0.0, atol=1e-12 * np.abs(line.C).max())
+    omega = 300.0 + np.random.default_rng(2).normal(0.0, 3.0, line.n)
+    mean = line.weights @ omega / line.weights.sum()
+    rows = line.element_rows()
+    elements = sum(c * (omega[int(a)] - omega[int(b)]) ** 2 for a, b, _, c, _ in rows)
+    assert omega @ line.C @ omega == pytest.approx(
+        elements + np.sum(line.absolute * (omega - mean) ** 2), rel=1e-9)
+
+
 @pytest.mark.parametrize("ratio", [0.5, 1.0, 3.0])
 def test_the_gear_ratio_refers_the_driven_inertia_by_its_square(ratio):
     """Against the line written in the driven machine's own angle ψ = i·θ_gear: kinetic energy

@@ -69,7 +69,8 @@ def dynamic_scenes():
     reactions, whose reference (the Newton–Euler forces with the friction closed on them at
     every evaluation) is too slow for these runs:
     :func:`test_reaction_friction_agrees_with_reference` runs shorter ones; nor those with an
-    elastic shaft line, whose run is not available yet."""
+    elastic shaft line, which the reference path's plain runner does not model (its reference
+    is :mod:`transient.reference.torsion`, ``tests/validation/test_elastic_runs.py``)."""
     names = []
     for path in sorted(CASES.glob("*.toml")):
         scene = load_scene(path)

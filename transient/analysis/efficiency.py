@@ -42,7 +42,9 @@ Mean effective pressures refer the work per cycle to the engine's displacement V
 (:func:`displacement`): ``imep`` = W_in/V_d (gas and starter work), ``bmep`` = W_out/V_d (taken
 by load and drive), ``fmep_<k>`` = W_loss,k/V_d and ``fmep`` their sum. Over C whole cycles
 imep − fmep − bmep = ΔK/(C V_d), K = ½J(φ)ω², zero in steady state; the relative mismatch of
-this balance is ``energy_balance_residual``. η_mech = bmep/imep = 1 − fmep/imep. Every pair of
+this balance is ``energy_balance_residual``. On an elastic shaft line K is the line's energy
+(``E_line``: its dofs' kinetic and its elements' elastic energy) and the energy its damping took
+(``W_line_loss``) is a loss in ``fmep`` too. η_mech = bmep/imep = 1 − fmep/imep. Every pair of
 the chains the mechanisms have joins links that all cylinders share (the main bearings of every
 throw, the crankpins of every rod, the plate bearing of every piston), so a pair's FMEP is
 referred to the whole displacement; for an engine whose cylinders work alike it is also each
@@ -163,7 +165,12 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
     driven = W_gas < 0.0 and W_shaft < 0.0  # (the power flows from the load or drive to the gas)
     W_in, W_out = (-W_shaft, -W_gas) if driven else (W_gas, W_shaft)
     losses = [_delta(traj, f"W_loss_{k + 1}", a, b) for k in range(n_pairs)]
-    dK = _delta({"phi": traj["phi"], "K": 0.5 * traj["J"] * traj["omega"] ** 2}, "K", a, b)
+    # an elastic shaft line: its energy, and what its damping took (0 without one)
+    line_loss = _delta(traj, "W_line_loss", a, b)
+    if "E_line" in traj:
+        dK = _delta(traj, "E_line", a, b)
+    else:
+        dK = _delta({"phi": traj["phi"], "K": 0.5 * traj["J"] * traj["omega"] ** 2}, "K", a, b)
     v_d = displacement(scene.mechanism)
     out = {
         "steady_phi_start": (a, "rad"),
@@ -171,12 +178,12 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         "W_in_per_cycle": (W_in / n_cyc, "J"),
         "W_out_per_cycle": (W_out / n_cyc, "J"),
         "eta_mech_work": (W_out / W_in if W_in > 0 else math.nan, "1"),
-        "energy_balance_residual": ((dK - (W_in - W_out - sum(losses)))
-                                    / _throughput(W_in, W_out, dK, losses), "1"),
+        "energy_balance_residual": ((dK - (W_in - W_out - sum(losses) - line_loss))
+                                    / _throughput(W_in, W_out, dK, [*losses, line_loss]), "1"),
         "displacement": (v_d, "m^3"),
         "imep": (W_gas / n_cyc / v_d, "Pa"),
         "bmep": (W_shaft / n_cyc / v_d, "Pa"),
-        "fmep": (sum(losses) / n_cyc / v_d, "Pa"),
+        "fmep": ((sum(losses) + line_loss) / n_cyc / v_d, "Pa"),
     }
     if driven:
         out["driven"] = (1.0, "1")

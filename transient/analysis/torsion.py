@@ -81,7 +81,9 @@ def damped_modes(K, C, M_diag) -> tuple[list[DampedMode], int]:
     A[n:, n:] = -inv[:, None] * np.asarray(C)
     lam = scipy.linalg.eigvals(A)
     scale = max(float(np.max(np.abs(lam))), 1.0)
-    oscillating = lam[lam.imag > 1e-9 * scale]
+    # (a free line's rigid mode is a double zero eigenvalue without a second eigenvector, which
+    # rounding splits by about √ε·|A|: below 1e-6 of the largest it is taken as zero)
+    oscillating = lam[(lam.imag > 1e-9 * scale) & (np.abs(lam) > 1e-6 * scale)]
     modes = sorted((DampedMode(float(abs(v)), float(v.imag), float(-v.real / abs(v)))
                     for v in oscillating), key=lambda m: m.omega_n)
     return modes, 2 * n - 2 * len(modes)

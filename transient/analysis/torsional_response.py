@@ -242,7 +242,10 @@ def forced_response(line: ShaftLine, omega, orders=None) -> ForcedResponse:
     elements = shaft_elements(line, viscous=True)
     a = np.array([e[1] for e in elements])
     b = np.array([e[2] for e in elements])
-    k, c = -line.K[a, b], -line.C[a, b]
+    rows = line.element_rows()  # (the same elements, in the same order, with their k and c)
+    if not np.array_equal(rows[:, :2], np.column_stack([a, b])):
+        raise RuntimeError("the shaft line's element table and its labels disagree")
+    k, c = rows[:, 2], rows[:, 3]
     band, (Kb, Mb, Cb) = band_of(line.K, np.diag(line.mean_inertia()), line.C)
     n_s, n_q = omega.size, q.size
     F = np.empty((n_s, n_q, line.n), dtype=np.complex128)

@@ -84,7 +84,8 @@ class ShaftLine:
     """The shaft line's data, stations from the nose.
 
     ``inertia`` J_own,k (N); ``stiffness`` k_i and ``damping`` c_i of section i between
-    stations i and i+1 (N−1); ``absolute`` d_k, a viscous drag −d_k ω_k on each station (N);
+    stations i and i+1 (N−1); ``absolute`` d_k on each station (N), acting on its speed less
+    the line's mean speed (:meth:`TorsionModel.absolute_torques`);
     ``station_of_cylinder`` the station each cylinder rides on; ``eta``: per station the
     (forward, backward) efficiency of a constant-η pair between its shaft and its throw's
     mechanism (1, 1: none)."""
@@ -160,6 +161,18 @@ class TorsionModel:
         self.i_works = self.i_driven + (2 if self.line.coupling is not None else 0)
         self.size = self.i_works + len(WORKS)
         self.carrier = np.asarray(self.line.station_of_cylinder, dtype=np.intp)
+        self.weights = self.mean_inertias()
+
+    def mean_inertias(self, samples: int = 720) -> Array:
+        """The inertia of every degree of freedom averaged over a revolution, as seen at the
+        stations' speed: stations (their cylinders' J at every angle), rings, then the driven
+        inertia J_d/i² (its speed there is i ω_d)."""
+        angles = 2.0 * math.pi * np.arange(samples) / samples
+        J = np.mean([self.station_inertia(np.full(self.line.n, a))[0] for a in angles], axis=0)
+        rings = [ring.inertia for ring in self.line.rings]
+        c = self.line.coupling
+        driven = [c.driven_inertia / c.ratio ** 2] if c is not None else []
+        return np.concatenate([J, rings, driven])
 
     # -- state ------------------------------------------------------------------------------
     def initial_state(self, theta: float, omega: float) -> Array:
@@ -214,26 +227,42 @@ class TorsionModel:
         T = np.zeros(line.n)
         T[:-1] += S
         T[1:] -= S
-        T -= line.absolute * w
-        T_ring = np.zeros(self.n_rings)
+        on_stations, on_rings, on_driven, p_absolute = self.absolute_torques(w, rw, wd)
+        T += on_stations
+        T_ring = on_rings.copy()
         p_rings = 0.0
         for j, ring in enumerate(line.rings):
             rel = w[ring.station] - rw[j]
             tq = ring.stiffness * (th[ring.station] - rth[j]) + ring.damping * rel
             T[ring.station] -= tq
-            T_ring[j] = tq
+            T_ring[j] += tq
             p_rings += ring.damping * rel * rel
-        T_driven, p_coupling = 0.0, 0.0
+        T_driven, p_coupling = on_driven, 0.0
         c = line.coupling
         if c is not None:
             rel = w[c.station] - c.ratio * wd
             tq = c.stiffness * (th[c.station] - c.ratio * thd) + c.damping * rel
             T[c.station] -= tq
-            T_driven = c.ratio * tq
+            T_driven += c.ratio * tq
             p_coupling = c.damping * rel * rel
         p_sections = float(np.sum(line.damping * np.diff(w) ** 2))
-        p_absolute = float(np.sum(line.absolute * w * w))
         return T, T_ring, T_driven, (p_sections, p_absolute, p_rings, p_coupling)
+
+    def absolute_torques(self, w: Array, ring_speeds: Array, driven_speed: float):
+        """The absolute damping d_k of the stations, on each station's speed less the line's
+        mean speed ω̄ (every dof's speed at the stations' side weighted by its mean inertia
+        m_j): the drags d_k(ω_k − ω̄) and, so that they add no net torque, their sum given back
+        to every dof in proportion to m_j. Returns (on the stations, on the rings, on the driven
+        inertia's own angle, the power taken Σ d_k (ω_k − ω̄)²)."""
+        c = self.line.coupling
+        ratio = c.ratio if c is not None else 1.0
+        speeds = np.concatenate([w, ring_speeds, [ratio * driven_speed] if c else []])
+        mean = float(self.weights @ speeds) / float(self.weights.sum())
+        drag = np.asarray(self.line.absolute) * (w - mean)
+        back = self.weights / self.weights.sum() * float(drag.sum())
+        n, r = self.line.n, self.n_rings
+        on_driven = ratio * float(back[n + r]) if c is not None else 0.0
+        return (-drag + back[:n], back[n:n + r], on_driven, float(drag @ (w - mean)))
 
     def potential(self, y: Array) -> float:
         """Σ ½ k Δθ² of the sections, the rings' springs and the coupling [J]."""
@@ -457,3 +486,67 @@ def rigid_run(J_rest: float, terms, gas: Callable[[float], float],
         K = sol.sol(phi)[1]
         return np.sqrt(2.0 * K / np.vectorize(total)(phi))
     return sol, omega
+
+
+# -- a scene's line --------------------------------------------------------------------------
+
+def from_scene(scene) -> tuple[TorsionModel, int]:
+    """The reference model of a crank-slider scene's ``[shaft]`` line and the index of its
+    reference station: the stations', sections', dampers' and coupling's data from the scene's
+    records, the cylinders (:class:`CrankSliderCylinders`) burning the full-load table of its
+    gas, and its load's torque, linear and fan terms acting where ``load_at`` says. What it
+    shares with the compiled path: the scene's records, the pressure table and the sections'
+    viscous c of a loss factor or damping ratio (:class:`transient.shaft.line.ShaftLine`, which
+    needs the line's ω₁). A starter, governor, generator, schedule or a mechanism other than
+    the crank-slider is beyond it (ValueError)."""
+    from ..scene.queries import gas_phases, gas_tables
+    from ..shaft import ShaftLine as CompiledLine
+
+    shaft, mech, load = scene.shaft, scene.mechanism, scene.load
+    if (mech.name != "crank-slider" or scene.starter.torque > 0.0
+            or scene.governor.model != "none" or load.generator_power or load.schedule_scale):
+        raise ValueError("from_scene: a crank-slider scene with a fixed load only")
+    compiled = CompiledLine(scene)
+    names = [st.name for st in shaft.stations]
+    n = len(names)
+    carrier = np.zeros(mech.n_cylinders, dtype=np.intp)
+    for i, st in enumerate(shaft.stations):
+        carrier[np.asarray(st.cylinders, dtype=np.intp) - 1] = i
+    c_sections = compiled.element_rows()[:n - 1, 3]
+    rings = tuple(Ring(names.index(d.station), d.inertia, d.damping, d.stiffness)
+                  for d, _, _ in compiled.rings())
+    coupling = None
+    if shaft.coupling is not None:
+        cp = shaft.coupling
+        coupling = Coupling(n - 1, cp.stiffness, cp.damping, 1.0 / cp.gear_ratio,
+                            cp.driven_inertia)
+    line = ShaftLine(inertia=np.array([st.inertia for st in shaft.stations]),
+                     stiffness=np.array([s.stiffness for s in shaft.sections]),
+                     damping=c_sections, absolute=np.array([st.damping for st in shaft.stations]),
+                     station_of_cylinder=carrier, rings=rings, coupling=coupling)
+    table = gas_tables(scene)[0]
+    p0 = scene.gas.p0
+    # (the table's local angle is from the cylinder's gas phase, the cylinders' from its TDC)
+    shift = gas_phases(scene) - np.asarray(mech.firing_angles)
+
+    def pressure(local):
+        return table(np.mod(local - shift, mech.cycle)) - p0
+
+    def torque(w):
+        return -(load.torque + load.linear * w + load.fan * w * np.abs(w))
+
+    external = driven = None
+    if shaft.load_at == "driven":
+        ratio = coupling.ratio if coupling is not None else 1.0
+
+        def driven(th, w, t):  # the law at the speed seen at the shaft, its power kept
+            return ratio * torque(ratio * w)
+    else:
+        at = names.index(shaft.load_at)
+
+        def external(th, w, t):
+            M = np.zeros(n)
+            M[at] = torque(w[at])
+            return M
+    model = TorsionModel(line, CrankSliderCylinders(mech, pressure), external, driven)
+    return model, names.index(shaft.reference)

@@ -42,7 +42,8 @@ MEANINGS: dict[str, dict[str, str]] = {
         "name": "Names the station (unique): the modes table and the dampers refer to it.",
         "inertia": "The station's own constant inertia (pulley, hub, webs and counterweights, "
                    "flywheel); its cylinders' reduced inertia comes on top.",
-        "damping": "Absolute damping of the station to the frame.",
+        "damping": "Absolute damping of the station, on its motion relative to the line's "
+                   "rigid-body motion (never a drag on the whole rotation).",
         "cylinders": "The cylinders (1-based) whose crankpin the station carries; empty for a "
                      "pulley or flywheel.",
     },

@@ -33,7 +33,21 @@ def output_columns(scene) -> dict[str, str]:
     if scene.run.mode == "prescribed-speed":
         cols["M_drive"] = "N m"
         cols["W_drive"] = "J"
+    if scene.shaft is not None:  # the elastic line's (layout.OUTPUT, block "line")
+        for name, _, _ in scene.shaft.line_dofs():
+            cols[f"twist_{column_name(name)}"] = "rad"
+            cols[f"omega_{column_name(name)}"] = "rad/s"
+        for a, b in scene.shaft.line_elements():
+            cols[f"torque_{column_name(a)}_{column_name(b)}"] = "N m"
+        cols["E_line"] = "J"
+        cols["W_line_loss"] = "J"
     return cols
+
+
+def column_name(name: str) -> str:
+    """A shaft-line dof's name as part of a column's: each run of characters other than
+    letters, digits and ``_`` one ``_`` (``"throw 1"`` → ``throw_1``)."""
+    return re.sub(r"\W+", "_", name).strip("_")
 
 
 def cylinder_loss_column(pair: int, cylinder: int) -> str:
@@ -76,6 +90,14 @@ DESCRIPTIONS = {
     "sleeve_speed": "the flyweight governor's sleeve speed, d(sleeve_lift)/dt",
     "fuel_{k}": "fuel command latched by cylinder {k} at its last injection",
     "M_drive": "drive moment the prescribed speed needs on the shaft, positive driving it forward",
+    "twist_{d}": "twist of shaft-line dof {d} against the reference, θ − φ (elastic [shaft])",
+    "omega_{d}": "speed of shaft-line dof {d}, dθ/dt (elastic [shaft])",
+    "torque_{a}_{b}": "torque of the shaft-line element between dofs {a} and {b}, k·(θ_a − θ_b) "
+                      "+ c·(ω_a − ω_b): positive where {a} leads {b}",
+    "E_line": "energy of the shaft line: its dofs' kinetic energies Σ ½J_d ω_d² and its "
+              "elements' elastic energies Σ ½k δ²",
+    "W_line_loss": "energy the shaft line's damping took since the start (sections, dampers, "
+                   "coupling, absolute damping)",
     "W_drive": "work of M_drive on the shaft since the start, ∫M_drive ω dt (to the solver's "
                "tolerance, at any output spacing)",
 }
@@ -89,6 +111,13 @@ def describe(column: str) -> str:
     if split:
         k, c = split.groups()
         return DESCRIPTIONS["P_loss_{k}_cyl{c}"].replace("{k}", k).replace("{c}", c)
+    for prefix, pattern in (("twist_", "twist_{d}"), ("omega_", "omega_{d}")):
+        if column.startswith(prefix):
+            return DESCRIPTIONS[pattern].replace("{d}", column[len(prefix):])
+    if column.startswith("torque_"):
+        return DESCRIPTIONS["torque_{a}_{b}"].replace("{a} and {b}", column[len("torque_"):]
+                                                      ).replace("{a}", "the first").replace(
+                                                          "{b}", "the second")
     head, _, k = column.rpartition("_")
     pattern = f"{head}_{{k}}"
     if k.isdigit() and pattern in DESCRIPTIONS:

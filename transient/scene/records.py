@@ -615,10 +615,11 @@ class Station:
 
     ``name`` labels it (unique). ``inertia`` [kg m²]: its own constant inertia (pulley, damper
     hub, webs and counterweights, flywheel), to which the reduced inertia of the cylinders it
-    carries is added at its own angle. ``damping`` [N m s/rad]: absolute damping to the frame
-    (≥ 0). ``cylinders``: the numbers (1-based) of the cylinders whose crankpin it carries
-    (in-line: one; V: the two of a throw; radial and swash plate: all); empty for a pulley or a
-    flywheel.
+    carries is added at its own angle. ``damping`` [N m s/rad]: absolute damping (≥ 0), acting
+    on the station's motion relative to the line's rigid-body motion (its speed less the line's
+    mean speed weighted by the cycle-mean inertias), never as a drag on the whole rotation.
+    ``cylinders``: the numbers (1-based) of the cylinders whose crankpin it carries (in-line:
+    one; V: the two of a throw; radial and swash plate: all); empty for a pulley or a flywheel.
     """
 
     name: str
@@ -719,6 +720,32 @@ class Shaft:
     def station_index(self, name: str) -> int:
         """The position (0-based) of the station called ``name``."""
         return [s.name for s in self.stations].index(name)
+
+    def line_dofs(self) -> tuple[tuple[str, str, int], ...]:
+        """(name, kind, station) of the line's degrees of freedom in order: each station
+        (``"station"``), then the rings of the dampers on it (``"ring"``, named ``"<station>
+        damper"``, numbered from the second on one station), then with a coupling the driven
+        inertia (``"driven"``, station −1)."""
+        out = []
+        for i, st in enumerate(self.stations):
+            out.append((st.name, "station", i))
+            rings = sum(d.station == st.name for d in self.dampers)
+            out += [(f"{st.name} damper" + (f" {k + 1}" if k else ""), "ring", i)
+                    for k in range(rings)]
+        if self.coupling is not None:
+            out.append(("driven", "driven", -1))
+        return tuple(out)
+
+    def line_elements(self) -> tuple[tuple[str, str], ...]:
+        """The names of the two dofs each element of the line joins, in order: the sections,
+        each damper (hub, ring) by station, the coupling (last station, driven)."""
+        names = [s.name for s in self.stations]
+        out = list(zip(names[:-1], names[1:]))
+        out += [(hub, ring) for ring, kind, i in self.line_dofs() if kind == "ring"
+                for hub in [names[i]]]
+        if self.coupling is not None:
+            out.append((names[-1], "driven"))
+        return tuple(out)
 
 
 @dataclass(frozen=True)

@@ -12,8 +12,12 @@ the mechanism's J at the station's own angle θ, with the cylinder's own phase (
 J is then the mechanism's whole J(θ). With every station at one angle, Σ_s J_s(φ) plus the rings'
 and the driven side's inertias is the rigid model's J(φ) (:func:`rigid_equivalent`).
 
-**Damping.** Absolute per station (to the frame), relative per section, a damper's between
-its ring and hub, a coupling's across it. A section given by a loss factor η or a damping ratio
+**Damping.** Absolute per station, relative per section, a damper's between its ring and hub,
+a coupling's across it. A station's absolute damping a_s acts on its motion relative to the
+line's rigid-body motion ω̄ = Σ w_d ω_d / Σ w_d (w_d the cycle-mean inertias), never as a drag
+on the whole rotation, which at running speed would take a_s·Ω² (0.5 N m s/rad at 3000 rpm is
+49 kW): its damping matrix is Pᵀ A P with P = I − 1 wᵀ/Σw and A = diag(a), which has no net
+torque and takes Σ a_d (ω_d − ω̄)² of power (theory, (T3)). A section given by a loss factor η or a damping ratio
 ζ gets the viscous c = η·k/ω₁ = 2ζ·k/ω₁ at ω₁, the lowest natural frequency of the undamped
 line at cycle-mean inertias (hysteretic damping's equivalent at the mode that matters most:
 per cycle of that mode it dissipates πηkΘ², as the hysteretic law does).
@@ -29,7 +33,7 @@ from numpy.typing import NDArray
 
 from ..errors import SceneError
 from ..mechanisms import CylinderInertia, provides
-from ..scene.records import Inertia, Scene, Shaft
+from ..scene.records import COMPILED_METHODS, Inertia, Scene, Shaft
 
 #: Angles per revolution at which the cycle-mean inertias are sampled: J(θ) is periodic and
 #: smooth, so the mean of equally spaced samples converges geometrically.
@@ -38,9 +42,10 @@ MEAN_SAMPLES = 720
 
 @dataclass(frozen=True)
 class Dof:
-    """A degree of freedom of the line: its ``name`` (a station's, ``"<station> damper"``,
-    ``"driven"``), its ``kind`` (``"station"``, ``"ring"``, ``"driven"``) and the station it
-    belongs to (for a ring its hub's; -1 for the driven inertia)."""
+    """A degree of freedom of the line (:meth:`~transient.scene.records.Shaft.line_dofs`): its
+    ``name`` (a station's, ``"<station> damper"``, ``"driven"``), its ``kind``
+    (``"station"``, ``"ring"``, ``"driven"``) and the station it belongs to (for a ring its
+    hub's; -1 for the driven inertia)."""
 
     name: str
     kind: str
@@ -55,22 +60,16 @@ class ShaftLine:
             raise ValueError(f"scene {scene.name!r} has no [shaft] table")
         shaft: Shaft = scene.shaft
         self.scene, self.shaft = scene, shaft
-        dofs: list[Dof] = []
-        self.station_dof: list[int] = []
-        for i, st in enumerate(shaft.stations):
-            self.station_dof.append(len(dofs))
-            dofs.append(Dof(st.name, "station", i))
-            dofs += [Dof(f"{st.name} damper", "ring", i) for d in shaft.dampers
-                     if d.station == st.name]
-        if shaft.coupling is not None:
-            dofs.append(Dof("driven", "driven", -1))
-        self.dofs = tuple(dofs)
-        self.n = len(dofs)
+        self.dofs = tuple(Dof(*d) for d in shaft.line_dofs())
+        self.station_dof = [i for i, d in enumerate(self.dofs) if d.kind == "station"]
+        self.n = len(self.dofs)
         self._own = self._own_inertia()
         self._cylinder_terms = _cylinder_terms(scene)
         self.K = self._stiffness()
-        mean = self.mean_inertia()
-        self.omega_1 = float(np.sqrt(_lowest_elastic(self.K, mean, self.rigid_modes)))
+        #: the dofs' cycle-mean inertias: the weights of the rigid-body motion that the absolute
+        #: damping is relative to
+        self.weights = self.mean_inertia()
+        self.omega_1 = float(np.sqrt(_lowest_elastic(self.K, self.weights, self.rigid_modes)))
         self.C = self._damping()
 
     # -- the degrees of freedom ---------------------------------------------------------------
@@ -92,6 +91,12 @@ class ShaftLine:
         # (rings follow their stations in order; dampers of one station keep the scene's order)
         for damper in by_station:
             yield damper, next(ring_of), self.station_dof[self.shaft.station_index(damper.station)]
+
+    @property
+    def own_inertia(self) -> NDArray[np.float64]:
+        """Each dof's own constant inertia [kg m²]: a station's without its cylinders', a
+        ring's, the driven inertia referred to the shaft."""
+        return self._own.copy()
 
     def _own_inertia(self) -> NDArray[np.float64]:
         own = np.zeros(self.n)
@@ -119,6 +124,22 @@ class ShaftLine:
             cp = shaft.coupling
             yield at[-1], self.n - 1, cp.stiffness, cp.damping
 
+    def element_rows(self) -> NDArray[np.float64]:
+        """The elements as the compiled model's element table
+        (:data:`transient.core.model.layout.ELEMENT`): per row the two dofs, stiffness, damping
+        and gear ratio (1: the driven inertia is referred to the shaft); the same elements as
+        K and C."""
+        rows = [(a, b, k, c, 1.0) for a, b, k, c in self._pairs(self.omega_1)]
+        return np.array(rows, dtype=float).reshape(len(rows), 5)
+
+    @property
+    def absolute(self) -> NDArray[np.float64]:
+        """Each dof's absolute damping a_d [N m s/rad] (the stations'; 0 on rings and driven)."""
+        a = np.zeros(self.n)
+        for st, i in zip(self.shaft.stations, self.station_dof):
+            a[i] = st.damping
+        return a
+
     @staticmethod
     def _assemble(n: int, pairs) -> NDArray[np.float64]:
         out = np.zeros((n, n))
@@ -134,9 +155,8 @@ class ShaftLine:
 
     def _damping(self) -> NDArray[np.float64]:
         C = self._assemble(self.n, ((a, b, c) for a, b, _, c in self._pairs(self.omega_1)))
-        for st, i in zip(self.shaft.stations, self.station_dof):
-            C[i, i] += st.damping
-        return C
+        P = np.eye(self.n) - np.outer(np.ones(self.n), self.weights) / self.weights.sum()
+        return C + P.T @ np.diag(self.absolute) @ P
 
     # -- inertia ---------------------------------------------------------------------------
     def station_inertia(self, theta) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -187,15 +207,42 @@ def _lowest_elastic(K, M_diag, rigid: int) -> float:
     return float(values[rigid]) if values.size > rigid else np.nan
 
 
+#: What the elastic run does not support yet: (the scene's key, whether the scene uses it, what
+#: to do instead). Each is refused before any work (:func:`refuse_elastic_run`).
+UNSUPPORTED = (
+    ("friction.pairs", lambda s: bool(s.friction.pairs), "leave out [[friction.pairs]]"),
+    ("governor.model", lambda s: s.governor.model not in ("none", "droop"),
+     "use \"none\" or the static \"droop\""),
+    ("gas.injection", lambda s: s.gas.injection is not None, "leave out fuel latching"),
+    ("gas.woschni", lambda s: s.gas.woschni is not None,
+     "leave out [gas.woschni] (the cylinders' pressure states)"),
+    ("gas.cylinders", lambda s: bool(s.gas.cylinders),
+     "leave out [[gas.cylinders]] (per-cylinder variation)"),
+    ("load.table", lambda s: s.load.table is not None, "give the load by its coefficients"),
+    ("load.inertia", lambda s: s.load.inertia > 0.0,
+     "leave the inertia switched in out (the line's driven inertia is [shaft.coupling]'s)"),
+    ("run.mode", lambda s: s.run.mode != "dynamic", "use \"dynamic\""),
+    ("solver.method", lambda s: s.solver.method not in COMPILED_METHODS,
+     f"use one of {', '.join(map(repr, COMPILED_METHODS))} (the compiled stepper)"),
+    ("solver.kinematics", lambda s: s.solver.kinematics == "tabulated" and len(
+        {i for i, st in enumerate(s.shaft.stations) if st.cylinders}) > 1,
+     "use the exact kinematics, or put every cylinder on one station (the tables hold the "
+     "mechanism's J(φ) whole)"),
+)
+
+
 def refuse_elastic_run(scene: Scene) -> None:
-    """Raise :class:`~transient.errors.SceneError` for a scene with ``[shaft]``: its elastic
-    time-domain run is not available yet, and running it rigid instead would not do what it
-    asks."""
-    if scene.shaft is not None:
-        raise SceneError("shaft", "the elastic time-domain run of a [shaft] scene is not "
-                                  "available yet; `transient modes` gives its modes and critical "
-                                  "speeds, and the rigid model runs the scene without [shaft] "
-                                  "(transient.shaft.rigid_equivalent)", file=scene.source_file)
+    """Raise :class:`~transient.errors.SceneError` for a scene with ``[shaft]`` that uses what
+    the elastic time-domain run does not support (:data:`UNSUPPORTED`): running it without that
+    feature, or rigid, would not do what the scene asks."""
+    if scene.shaft is None:
+        return
+    for key, used, instead in UNSUPPORTED:
+        if used(scene):
+            raise SceneError(key, f"is not supported with an elastic [shaft] line in this "
+                                  f"version; {instead}, or run the rigid model without [shaft] "
+                                  f"(transient.shaft.rigid_equivalent)",
+                             file=scene.source_file)
 
 
 def rigid_equivalent(scene: Scene) -> Scene:

@@ -44,7 +44,9 @@ from .layout import (
     cyl_index,
     gov_index,
     latch_index,
+    line_dofs,
 )
+from .shaft import ref_inertia
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
@@ -180,7 +182,11 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
 
 @kernel(inline=True)
 def inertia(m, phi, wk):
-    """Total reduced inertia J(φ), (19); fills the row u of ``wk``."""
+    """Total reduced inertia J(φ), (19); fills the row u of ``wk``. On an elastic shaft line
+    the reference dof's J_ref(φ) (its own and its cylinders'), the
+    inertia of the third state's K = ½Jω² (:func:`.shaft.ref_inertia`)."""
+    if line_dofs(m) > 0:
+        return ref_inertia(m, phi, wk)
     J, _ = mechanism_terms(m, phi, wk[WK_U], wk[WK_DU], False)
     return J + m.J0
 
@@ -352,6 +358,32 @@ def generator_branch(m, w, rising):
 
 
 @kernel(inline=True)
+def load_moment(m, extras, w, y, sw):
+    """The load's moment at its speed ``w`` [N m]: −s·(torque + linear·ω + fan·ω|ω| +
+    P/max(ω, ω_min) + T(x)) (:func:`moments`)."""
+    # (with s = 1 exactly the formula without a schedule, to the last bit)
+    s = load_scale(m, y, sw[SW_LOAD])
+    M_load = -s * (m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
+    if m.gen_power != 0.0:
+        # An electrical load of power s·P: M ω = −s·P. Below ω_min (a start from rest) the
+        # torque is held at its value there, so that it stays finite; a state event switches
+        # the branch at ω_min, as at the governor's corners, keeping each step smooth.
+        w_gen = m.gen_min if sw[SW_GENERATOR] else w
+        M_load -= s * m.gen_power / w_gen
+    if extras is not None and m.lt_kind != LT_NONE:
+        M_load -= s * table_load(m, w, y)
+    return M_load
+
+
+@kernel(inline=True)
+def starter_moment(m, w, sw):
+    """The starter's moment at speed ``w`` while it is engaged [N m]."""
+    if sw[SW_STARTER]:
+        return m.starter_torque * (1.0 - w / m.starter_noload)
+    return 0.0
+
+
+@kernel(inline=True)
 def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
     """Reduced inertia, speed and moments at state ``y``.
 
@@ -406,20 +438,8 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                                              * (wk[WK_FUEL, k] * m.var_par[k, PRESSURE]
                                                 if m.var_on else 1.0))
             M_gas *= f
-    # (with s = 1 exactly the formula without a schedule, to the last bit)
-    s = load_scale(m, y, sw[SW_LOAD])
-    M_load = -s * (m.load_const + m.load_linear * w + m.load_fan * w * abs(w))
-    if m.gen_power != 0.0:
-        # An electrical load of power s·P: M ω = −s·P. Below ω_min (a start from rest) the
-        # torque is held at its value there, so that it stays finite; a state event switches
-        # the branch at ω_min, as at the governor's corners, keeping each step smooth.
-        w_gen = m.gen_min if sw[SW_GENERATOR] else w
-        M_load -= s * m.gen_power / w_gen
-    if extras is not None and m.lt_kind != LT_NONE:
-        M_load -= s * table_load(m, w, y)
-    M_starter = 0.0
-    if sw[SW_STARTER]:
-        M_starter = m.starter_torque * (1.0 - w / m.starter_noload)
+    M_load = load_moment(m, extras, w, y, sw)
+    M_starter = starter_moment(m, w, sw)
     if extras is not None and m.reaction:
         if not m.has_gas:
             for k in range(m.ncyl):

@@ -47,6 +47,46 @@ def n_pressures(m):
     return m.ncyl if m.woschni else 0
 
 
+#: A row of the element table of an elastic shaft line (:mod:`transient.core.model.shaft`): the two degrees of
+#: freedom it joins, its stiffness [N m/rad], damping [N m s/rad] and gear ratio r = ω_i/ω_j [1].
+ELEMENT = Layout("element", "i", "j", "stiffness", "damping", "ratio")
+EL_I, EL_J, EL_K, EL_C, EL_R = ELEMENT
+N_ELEMENT = ELEMENT.size
+#: The Model's ``line``, the elastic shaft line packed in one array of N_ELEMENT columns: row 0
+#: these counts and indices; then a row per cylinder, the dof that carries it in column 0; a
+#: row per dof (:data:`LINE_DOF`); a row per element (:data:`ELEMENT`). A rigid shaft's is one
+#: row of zeros: no dofs.
+LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylinders")
+LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS = LINE_META
+#: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
+#: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad]
+#: and its gear ratio to the reference [1]: 1 for every dof of a scene's line, whose driven
+#: inertia is referred to the shaft (:class:`transient.shaft.line.ShaftLine`), so that its angle is
+#: φ + q_d.
+LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear")
+LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR = LINE_DOF
+
+
+@kernel(inline=True)
+def line_dofs(m):
+    """The elastic shaft line's degrees of freedom; 0 on a rigid shaft."""
+    return int(m.line[0, LM_DOFS])
+
+
+@kernel(inline=True)
+def n_line_states(m):
+    """The elastic shaft line's states: a twist and an energy (or speed) per degree of freedom
+    other than the reference; none on a rigid shaft."""
+    n = line_dofs(m)
+    return 2 * (n - 1) if n > 0 else 0
+
+
+@kernel(inline=True)
+def n_line_loss(m):
+    """The energy the shaft line's damping took: one on an elastic line."""
+    return 1 if line_dofs(m) > 0 else 0
+
+
 #: The state vector's blocks, in order (a :class:`~transient.core.declare.Layout`). The first
 #: three are the dynamics, φ, t and the third, ω in time or K = ½Jω² in crank angle; then work
 #: integrals, quadratures that do not feed back: the work of the gas forces, of the load and of
@@ -56,7 +96,11 @@ def n_pressures(m):
 #: states (:mod:`.governor`), then, with fuel latching, the fuel each cylinder took at its last
 #: injection (held constant between injections: their derivative is zero and the stepper sets
 #: them), then, with wall heat transfer, each cylinder's pressure in its closed part
-#: (:mod:`.cylinder`; the ``p_<k>`` columns show it there).
+#: (:mod:`.cylinder`; the ``p_<k>`` columns show it there). On an elastic shaft line
+#: (:func:`line_dofs` > 0; theory, (T5)) φ, the third state and the works are the reference
+#: degree of freedom's (the gas work all cylinders', the load's at its own dof), then per other
+#: dof in order its twist q_d = θ_d − φ and its K_d = ½J_d(θ_d)ω_d² in crank angle, ω_d in
+#: time (:mod:`.elastic`), and the energy the line's damping took.
 #:
 #: A block whose length depends on the scene is :class:`~transient.core.declare.Sized` by a
 #: kernel of the Model (:func:`n_losses` …). The kernels index the state through
@@ -83,9 +127,15 @@ STATE = Layout(
           "the fuel each cylinder latched at its last injection [1]"),
     Block("pressure", Sized(n_pressures, "one per cylinder with wall heat"),
           "each cylinder's pressure in its closed part [Pa]"),
+    Block("line", Sized(n_line_states, "two per shaft-line dof but the reference"),
+          "each dof's twist q_d = θ_d − φ [rad], then its K_d = ½J_dω_d² [J] in crank angle or "
+          "ω_d [rad/s] in time"),
+    Block("line_loss", Sized(n_line_loss, "one on an elastic shaft line"),
+          "energy the shaft line's damping took [J]"),
 )
 #: The blocks' numbers (places in :data:`STATE`).
-B_PHI, B_T, B_OMEGA, B_WORK, B_LOSS, B_GOVERNOR, B_LATCHED, B_PRESSURE = range(len(STATE))
+(B_PHI, B_T, B_OMEGA, B_WORK, B_LOSS, B_GOVERNOR, B_LATCHED, B_PRESSURE, B_LINE,
+ B_LINE_LOSS) = range(len(STATE))
 #: The components at offsets known at import (every block before them has a fixed size).
 PHI, T, OMEGA = STATE.fixed_offset("phi"), STATE.fixed_offset("t"), STATE.fixed_offset("omega")
 KINETIC = OMEGA
@@ -101,7 +151,7 @@ STATE_NAMES = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
 #: held constant between injections).
 CONTROL = {"phi": BY_INCREMENT, "t": BY_INCREMENT, "omega": BY_SIZE, "work": NOT_CONTROLLED,
            "loss": NOT_CONTROLLED, "governor": BY_SIZE, "latched": NOT_CONTROLLED,
-           "pressure": BY_SIZE}
+           "pressure": BY_SIZE, "line": BY_SIZE, "line_loss": NOT_CONTROLLED}
 
 
 def state_control(m) -> np.ndarray:
@@ -172,6 +222,14 @@ def n_cylinder_loss_columns(m):
     return m.n_pairs * m.ncyl if m.reaction else 0
 
 
+@kernel(inline=True)
+def n_line_columns(m):
+    """The output row's shaft-line columns: per dof its twist and speed, per element its
+    torque, the line's energy and the energy its damping took; none on a rigid shaft."""
+    n = line_dofs(m)
+    return 2 * n + int(m.line[0, LM_ELEMENTS]) + 2 if n > 0 else 0
+
+
 #: The output row's blocks (``transient.scene.outputs.output_columns`` names the columns in this
 #: order), sized per scene as the state's and indexed through the chained kernels
 #: :func:`pair_col`, :func:`governor_col`, :func:`cylinder_loss_col` and :func:`n_outputs`.
@@ -188,8 +246,11 @@ OUTPUT = Layout(
           "the fuel each cylinder latched"),
     Block("cyl_loss", Sized(n_cylinder_loss_columns, "one per reaction pair and cylinder"),
           "the power each reaction pair loses in each cylinder (pair 1 in cylinders 1 … n, …)"),
+    Block("line", Sized(n_line_columns, "2 per dof, 1 per element, 2"),
+          "each shaft-line dof's twist [rad] and speed [rad/s], each element's torque [N m], "
+          "the line's kinetic and elastic energy and the energy its damping took [J]"),
 )
-O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS = range(len(OUTPUT))
+O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS, O_LINE = range(len(OUTPUT))
 
 #: Rows of the work array ``wk`` (:func:`.work.work_array`), one column per cylinder, pair or link:
 #: transfer functions u, u′ per cylinder; per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the
@@ -216,10 +277,21 @@ WORK = Layout(
     "local", "piece", "sel", "fuel", "local_shift", "piece_shift",
     ("scratch", 4, "scratch of chain.modes_power_flow_into"),
     ("cyl_loss", 6, "each reaction pair's loss moment in each cylinder"),
+    ("line_theta", 1, "each shaft-line dof's angle θ_d"),
+    ("line_omega", 1, "each dof's speed ω_d"),
+    ("line_J", 1, "each dof's inertia J_d(θ_d)"),
+    ("line_dJ", 1, "each dof's J′_d(θ_d)"),
+    ("line_M", 1, "the applied moments on each dof"),
+    ("line_T", 1, "the line's torques on each dof"),
+    ("line_rate", 2, "each dof's two rates (dq/dφ, dK/dφ; or ε in time)"),
+    ("cyl_angle", 1, "each cylinder's angle, its station's"),
+    ("cyl_J", 1, "each cylinder's share of J at its angle"),
+    ("cyl_dJ", 1, "its derivative"),
 )
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
- WK_SCRATCH, WK_CYL_LOSS) = WORK
+ WK_SCRATCH, WK_CYL_LOSS, WK_LINE_THETA, WK_LINE_OMEGA, WK_LINE_J, WK_LINE_DJ, WK_LINE_M,
+ WK_LINE_T, WK_LINE_RATE, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ) = WORK
 N_SCRATCH = WORK.size_of("scratch")
 WK_RX = WORK.end
 
@@ -324,6 +396,12 @@ Model = namedtuple(
         "et_size",  # int64[n_pairs, 2]: the lengths of pair k's two axes
         "et_eta",  # float64[n_pairs, 2, nw_max, ns_max]: η_fwd, η_bwd on pair k's grid [1]
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
+        # the elastic shaft line (transient.shaft.ShaftLine; theory, The elastic shaft line),
+        # packed: every field of the Model costs a rigid scene's run time, so the line is one
+        # array and two kernels; a rigid shaft's is a row of zeros (no dofs) and no-ops
+        "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
+        "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
+        "line_model",  # kernel: the line's derivative or output row (.elastic.elastic_model)
     ],
 )
 typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)
@@ -364,10 +442,22 @@ def cyl_index(m):
     return latch_index(m) + n_latched(m)
 
 
+@kernel(inline=True)
+def line_index(m):
+    """Index of the shaft line's first state (on an elastic line), after the pressures."""
+    return cyl_index(m) + n_pressures(m)
+
+
+@kernel(inline=True)
+def line_loss_index(m):
+    """Index of the energy the shaft line's damping took (on an elastic line)."""
+    return line_index(m) + n_line_states(m)
+
+
 @kernel
 def n_state(m):
-    """Length of the state vector of model ``m``: after the pressures."""
-    return cyl_index(m) + n_pressures(m)
+    """Length of the state vector of model ``m``: after the line's loss."""
+    return line_loss_index(m) + n_line_loss(m)
 
 
 @kernel(inline=True)
@@ -389,7 +479,13 @@ def cylinder_loss_col(m):
     return governor_col(m) + n_governor_states(m) + n_latched(m)
 
 
+@kernel(inline=True)
+def line_col(m):
+    """Column of an output row where the shaft line's columns start (on an elastic line)."""
+    return cylinder_loss_col(m) + n_cylinder_loss_columns(m)
+
+
 @kernel
 def n_outputs(m):
     """Columns of an output row of model ``m``."""
-    return cylinder_loss_col(m) + n_cylinder_loss_columns(m)
+    return line_col(m) + n_line_columns(m)

@@ -44,6 +44,7 @@ from .layout import (
     WK_SPEED,
     WK_U,
     T,
+    line_dofs,
 )
 from .swash_plate import link_terms as swash_link_terms
 
@@ -150,8 +151,12 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     In crank angle dK/dφ = Σ M − Σ (1 − η*_k) S_k, the work–energy law of the chain
     (``transient.core.model.chain``), so that the energy lost is exactly what the pairs account for.
     ``extras``: the kernels' variant for ``m`` (:func:`.layout.extras_of`), as for every kernel
-    that reaches a feature only some scenes use.
+    that reaches a feature only some scenes use. An elastic shaft line's state has its own
+    derivative (``Model.line_model``, :mod:`.elastic`; a no-op in a rigid scene's Model).
     """
+    if line_dofs(m) > 0:
+        m.line_model(m, False, angle_mode, y, sw, wk, out)
+        return
     # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
     with_dJ = not angle_mode or (extras is not None and m.n_pairs > 0)
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ)

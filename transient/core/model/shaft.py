@@ -4,21 +4,74 @@ J_d(θ_d)), the rings of its dampers and the driven inertia beyond a coupling, a
 
 Every elastic or viscous link between two degrees of freedom — a section of the shaft, a damper's
 rubber or silicone, a coupling through a gear — is one row of an element table
-(:data:`ELEMENT`): it twists by δ = θ_i − r θ_j (r the gear ratio ω_i/ω_j, 1 on one shaft), its
+(:data:`.layout.ELEMENT`): it twists by δ = θ_i − r θ_j (r the gear ratio ω_i/ω_j, 1 on one shaft), its
 torque k δ + c δ̇ holds i back and drives j by r times it (a gear passes r times the torque to
 the slower side), and it takes c δ̇² of power. One loop over the rows serves sections, rings and
 couplings alike, O(N) in the line's length.
+
+The Model holds the line packed in one array (``Model.line``, :data:`.layout.LINE_META`,
+:func:`pack_line`), and the kernels that need no gas or load (the dofs' angles and inertias, the
+change of the independent variable, the reference's inertia) are here; the derivative and the
+output row are :mod:`.elastic`'s.
 """
 from __future__ import annotations
 
-from ..declare import Layout
-from ..jit import kernel
+import numpy as np
 
-#: A row of the element table: the two degrees of freedom it joins, its stiffness [N m/rad],
-#: damping [N m s/rad] and gear ratio r = ω_i/ω_j [1].
-ELEMENT = Layout("element", "i", "j", "stiffness", "damping", "ratio")
-EL_I, EL_J, EL_K, EL_C, EL_R = ELEMENT
-N_ELEMENT = ELEMENT.size
+from ..jit import kernel
+from .layout import (
+    EL_C,
+    EL_I,
+    EL_J,
+    EL_K,
+    EL_R,
+    LD_OWN,
+    LM_CYLINDERS,
+    LM_DOFS,
+    LM_ELEMENTS,
+    LM_REF,
+    N_ELEMENT,
+    PHI,
+    WK_CYL_ANGLE,
+    WK_CYL_DJ,
+    WK_CYL_J,
+    WK_DU,
+    WK_LINE_DJ,
+    WK_LINE_J,
+    WK_LINE_THETA,
+    WK_U,
+    line_dofs,
+    line_index,
+)
+
+
+def pack_line(ref: int, load: int, carrier, dofs, elements) -> np.ndarray:
+    """The Model's ``line`` (:data:`.layout.LINE_META`): the reference's and the load's dof, the
+    dof of each cylinder (``carrier``), the rows of the dofs (``dofs``, :data:`.layout.LINE_DOF`)
+    and of the elements (:data:`.layout.ELEMENT`)."""
+    carrier = np.asarray(carrier, dtype=float)
+    dofs = np.asarray(dofs, dtype=float)
+    elements = np.asarray(elements, dtype=float).reshape(-1, N_ELEMENT)
+    out = np.zeros((1 + carrier.size + len(dofs) + len(elements), N_ELEMENT))
+    out[0, :] = (len(dofs), ref, load, len(elements), carrier.size)
+    out[1:1 + carrier.size, 0] = carrier
+    out[1 + carrier.size:1 + carrier.size + len(dofs), :dofs.shape[1]] = dofs
+    out[1 + carrier.size + len(dofs):, :] = elements
+    return out
+
+
+#: The ``line`` of a rigid shaft's Model: no dofs.
+RIGID_LINE = np.zeros((1, N_ELEMENT))
+
+
+@kernel(inline=True)
+def line_parts(line):
+    """Views of the Model's packed ``line``: each cylinder's dof (a column of floats), the
+    dofs' rows and the element table."""
+    n = int(line[0, LM_DOFS])
+    d0 = 1 + int(line[0, LM_CYLINDERS])
+    e0 = d0 + n
+    return line[1:d0, 0], line[d0:e0, :], line[e0:e0 + int(line[0, LM_ELEMENTS]), :]
 
 
 @kernel(inline=True)
@@ -30,18 +83,37 @@ def line_inertia(carrier, J_own, Jc, dJc, J, dJ):
         J[d] = J_own[d]
         dJ[d] = 0.0
     for c in range(carrier.shape[0]):
-        J[carrier[c]] += Jc[c]
-        dJ[carrier[c]] += dJc[c]
+        J[int(carrier[c])] += Jc[c]
+        dJ[int(carrier[c])] += dJc[c]
 
 
 @kernel(inline=True)
-def line_torques(elements, absolute, theta, omega, T):
-    """T_d: the torques of the elements and of the absolute damping −a_d ω_d on each degree of
-    freedom, (T3); returns the power they take [W] (Σ c δ̇² + Σ a ω²)."""
+def line_torques(elements, absolute, weights, gear, theta, omega, T):
+    """T_d: the torques of the elements and of the absolute damping on each degree of freedom,
+    (T3); returns the power they take [W] (Σ c δ̇² + Σ a_d (g_d ω_d − ω̄)²).
+
+    The absolute damping a_d acts on each dof's motion relative to the line's rigid-body motion
+    ω̄ = Σ w_d g_d ω_d / Σ w_d (``weights`` w_d the cycle-mean inertias at the reference's
+    speed, ``gear`` g_d each dof's ratio to it, as in :func:`line_angle_rates`): with
+    r_d = a_d (g_d ω_d − ω̄), τ_d = g_d (−r_d + (w_d/Σw) Σ_e r_e), the torque −Pᵀ A P ω of
+    P = I − 1 wᵀ/Σw on the speeds g_d ω_d. It has no net torque, so it never brakes the
+    rotation as a whole, and takes Σ a_d (g_d ω_d − ω̄)²."""
+    total = 0.0
+    moment = 0.0
+    for d in range(T.shape[0]):
+        total += weights[d]
+        moment += weights[d] * gear[d] * omega[d]
+    mean = moment / total
+    resultant = 0.0
     taken = 0.0
     for d in range(T.shape[0]):
-        T[d] = -absolute[d] * omega[d]
-        taken += absolute[d] * omega[d] * omega[d]
+        slip = gear[d] * omega[d] - mean
+        r = absolute[d] * slip
+        T[d] = -gear[d] * r
+        resultant += r
+        taken += r * slip
+    for d in range(T.shape[0]):
+        T[d] += gear[d] * weights[d] / total * resultant
     for e in range(elements.shape[0]):
         i = int(elements[e, EL_I])
         j = int(elements[e, EL_J])
@@ -71,3 +143,74 @@ def line_angle_rates(ref, gear, M, T, omega, d_twist, d_energy):
     for d in range(omega.shape[0]):
         d_twist[d] = gear[d] * omega[d] * inv - 1.0
         d_energy[d] = (M[d] + T[d]) * omega[d] * inv
+
+
+# -- the line's state (layout.STATE, block "line")
+
+
+@kernel(inline=True)
+def twist_index(m, d):
+    """Index in the state of dof d's twist q_d (d not the reference); its K_d (ω_d) follows."""
+    return line_index(m) + 2 * (d if d < int(m.line[0, LM_REF]) else d - 1)
+
+
+@kernel(inline=True)
+def line_inertias(m, y, wk):
+    """Each dof's angle θ_d (WK_LINE_THETA), J_d and J′_d (WK_LINE_J, WK_LINE_DJ) at state
+    ``y``, (T1); each cylinder's transfer functions at its dof's angle in the rows u, u′."""
+    carrier, dofs, _ = line_parts(m.line)
+    n = line_dofs(m)
+    ref = int(m.line[0, LM_REF])
+    for d in range(n):
+        wk[WK_LINE_THETA, d] = y[PHI] if d == ref else y[PHI] + y[twist_index(m, d)]
+    for c in range(m.ncyl):
+        wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, int(carrier[c])]
+    m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
+             wk[WK_U], wk[WK_DU])
+    line_inertia(carrier, dofs[:, LD_OWN], wk[WK_CYL_J, :m.ncyl], wk[WK_CYL_DJ, :m.ncyl],
+                 wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n])
+
+
+@kernel
+def line_mode(m, y, to_angle, wk):
+    """Each dof but the reference from ω_d to K_d = ½J_d(θ_d)ω_d² (``to_angle``) or back, where
+    the independent variable changes (the stepper converts the reference's own with
+    :func:`ref_inertia`, through ``forcing.inertia``)."""
+    line_inertias(m, y, wk)
+    ref = int(m.line[0, LM_REF])
+    for d in range(line_dofs(m)):
+        if d != ref:
+            i = twist_index(m, d) + 1
+            J = wk[WK_LINE_J, d]
+            y[i] = 0.5 * J * y[i] * y[i] if to_angle else np.sqrt(2.0 * y[i] / J)
+
+
+@kernel
+def ref_inertia(m, phi, wk):
+    """J_ref(φ), the reference dof's own inertia and its cylinders' shares at φ, summed as
+    :func:`line_inertia` sums them (so that K_ref = ½J_ref ω_ref² converts both ways to the same
+    bits); fills the rows u, u′ at φ."""
+    carrier, dofs, _ = line_parts(m.line)
+    ref = int(m.line[0, LM_REF])
+    for c in range(m.ncyl):
+        wk[WK_CYL_ANGLE, c] = phi
+    m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
+             wk[WK_U], wk[WK_DU])
+    J = dofs[ref, LD_OWN]
+    for c in range(m.ncyl):
+        if int(carrier[c]) == ref:
+            J += wk[WK_CYL_J, c]
+    return J
+
+
+# -- a rigid shaft's kernels in the Model's line fields (never called: there are no dofs)
+
+
+@kernel(inline=True)
+def no_shares(mp, kin_coef, angles, Jc, dJc, u, du):
+    """``Model.shares`` of a rigid shaft."""
+
+
+@kernel(inline=True)
+def no_line_model(m, row, angle_mode, y, sw, wk, out):
+    """``Model.line_model`` of a rigid shaft."""

@@ -78,6 +78,7 @@ from ..model.layout import (
     WK_SPEED,
     T,
     gov_index,
+    line_dofs,
     state_control,
 )
 from ..model.rhs import (
@@ -90,6 +91,7 @@ from ..model.rhs import (
     reset_kinks,
     watches_kinks,
 )
+from ..model.shaft import line_mode
 from ..model.work import work_array
 from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .events import (
@@ -351,7 +353,10 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         h_next, fst[F_ERR_OLD] = accepted_size(tab, err, fst[F_ERR_OLD], h, h_planned, cut,
                                                rejected)
         rejected = False
-        if not fixed and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist):
+        # (an elastic shaft line's stiff sections bound the explicit step by stability: the
+        # run goes on at that step, there being no implicit path for it to hand over to)
+        if (not fixed and line_dofs(m) == 0
+                and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist)):
             # the run so far is kept; the state is the accepted step's start
             if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
                 _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
@@ -766,17 +771,23 @@ def _switch_at_event(m, extras, io, angle_mode, event, h_next, y, wk):
 
 @kernel
 def _to_angle_mode(m, y, ist, wk):
-    """Crank angle becomes the independent variable; the third state becomes K = ½ J ω²."""
+    """Crank angle becomes the independent variable; the third state becomes K = ½ J ω², and
+    on an elastic shaft line each dof's speed its K_d (:func:`~.shaft.line_mode`)."""
     J = inertia(m, y[PHI], wk)
     y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
+    if line_dofs(m) > 0:  # the shaft line's other dofs alike
+        line_mode(m, y, True, wk)
     ist[I_ANGLE_MODE] = 1
 
 
 @kernel
 def _to_time_mode(m, y, ist, wk):
-    """Time becomes the independent variable; the third state becomes ω."""
+    """Time becomes the independent variable; the third state becomes ω, and each shaft-line
+    dof's K_d its ω_d."""
     J = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
+    if line_dofs(m) > 0:
+        line_mode(m, y, False, wk)
     ist[I_ANGLE_MODE] = 0
 
 

@@ -1,0 +1,226 @@
+"""The elastic shaft line's derivative and output row: the kernel an elastic scene's Model
+carries as ``line_model`` (a rigid scene's the no-op of :mod:`transient.core.model.shaft`), so that only elastic
+scenes' steppers compile them.
+
+The state (:data:`.layout.STATE`): φ, t and the third state are the reference dof's (θ_ref = φ;
+K_ref = ½J_ref ω_ref² in crank angle, ω_ref in time), the works W_gas (all cylinders'), W_load
+(at the load's dof) and W_starter (at the reference); then per other dof d in order its twist
+q_d = θ_d − φ and K_d (ω_d in time), and the energy the line's damping took. Each cylinder's
+share of J, its transfer function and its gas pressure are taken at the angle of the dof that
+carries it (theory, (T1)–(T5)); the gas table's piece is found at that angle at every
+evaluation, since the stepper's piece selection (``sel``) and its breakpoints are the
+reference's: a corner of a cylinder's table crossed inside a step is a kink the step's error
+control handles. The droop governor reads the reference's speed, the load acts at its own dof's
+speed (the generator's low-speed branch is switched on the reference's, as every speed event).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..jit import kernel
+from .forcing import applied_value, fuel, load_moment, starter_moment
+from .layout import (
+    EL_C,
+    EL_I,
+    EL_J,
+    EL_K,
+    EL_R,
+    KINETIC,
+    LD_ABS,
+    LD_GEAR,
+    LD_WEIGHT,
+    LM_LOAD,
+    LM_REF,
+    N_OUT_FIXED,
+    OMEGA,
+    PHI,
+    SW_GOVERNOR,
+    W_GAS,
+    W_LOAD,
+    W_STARTER,
+    WK_CYL_ANGLE,
+    WK_LINE_DJ,
+    WK_LINE_J,
+    WK_LINE_M,
+    WK_LINE_OMEGA,
+    WK_LINE_RATE,
+    WK_LINE_T,
+    WK_LINE_THETA,
+    WK_LOCAL,
+    WK_PIECE,
+    WK_SPEED,
+    WK_U,
+    T,
+    line_col,
+    line_dofs,
+    line_loss_index,
+)
+from .shaft import (
+    line_accelerations,
+    line_angle_rates,
+    line_inertias,
+    line_parts,
+    line_torques,
+    twist_index,
+)
+from .tables import find_piece
+
+
+@kernel(inline=True)
+def elastic_model(m, row, angle_mode, y, sw, wk, out):
+    """``Model.line_model``: the output row at ``y`` into ``out`` (``row``) or the derivative
+    (:func:`elastic_rates`)."""
+    if row:
+        elastic_row(m, angle_mode, y, sw, wk, out)
+    else:
+        elastic_rates(m, angle_mode, y, sw, wk, out)
+
+
+@kernel(inline=True)
+def line_speeds(m, angle_mode, y, wk):
+    """Each dof's speed ω_d (WK_LINE_OMEGA): √(2K_d/J_d) in crank angle (NaN where K_d < 0,
+    which the stepper reports as a non-finite state), the state itself in time; after
+    :func:`~transient.core.model.shaft.line_inertias`."""
+    ref = int(m.line[0, LM_REF])
+    for d in range(line_dofs(m)):
+        v = y[KINETIC] if d == ref else y[twist_index(m, d) + 1]
+        wk[WK_LINE_OMEGA, d] = np.sqrt(2.0 * v / wk[WK_LINE_J, d]) if angle_mode else v
+
+
+@kernel(inline=True)
+def cylinder_pressure(m, c, theta, f, wk):
+    """The pressure (force) on cylinder c at its dof's angle ``theta`` and fuel f: the table's
+    piece found at its own angle in its cycle (WK_LOCAL, WK_PIECE), then the rigid model's
+    :func:`~.forcing.applied_value` there."""
+    local = (theta - m.gas_phase[c]) % m.period
+    wk[WK_LOCAL, c] = local
+    wk[WK_PIECE, c] = find_piece(m.knots, m.piece_knot, local)
+    return applied_value(m, None, c, theta, theta, f, wk)
+
+
+@kernel(inline=True)
+def line_forces(m, y, sw, wk):
+    """The applied moments on each dof (WK_LINE_M) and the line's torques (WK_LINE_T), after
+    :func:`line_speeds`. Returns (M_gas, its power, M_load, M_starter, the power the line's
+    damping takes)."""
+    carrier, dofs, elements = line_parts(m.line)
+    n = line_dofs(m)
+    for d in range(n):
+        wk[WK_LINE_M, d] = 0.0
+    ref = int(m.line[0, LM_REF])
+    load = int(m.line[0, LM_LOAD])
+    w_ref = wk[WK_LINE_OMEGA, ref]
+    M_gas = 0.0
+    P_gas = 0.0
+    if m.has_gas:
+        f = fuel(m, w_ref, sw[SW_GOVERNOR])
+        for c in range(m.ncyl):
+            d = int(carrier[c])
+            p = cylinder_pressure(m, c, wk[WK_LINE_THETA, d], f, wk)
+            M_c = m.gas_scale[c] * (p - m.gas_offset) * wk[WK_U, c]
+            wk[WK_LINE_M, d] += M_c
+            M_gas += M_c
+            P_gas += M_c * wk[WK_LINE_OMEGA, d]
+    M_load = load_moment(m, None, wk[WK_LINE_OMEGA, load], y, sw)
+    wk[WK_LINE_M, load] += M_load
+    M_starter = starter_moment(m, w_ref, sw)
+    wk[WK_LINE_M, ref] += M_starter
+    taken = line_torques(elements, dofs[:, LD_ABS], dofs[:, LD_WEIGHT], dofs[:, LD_GEAR],
+                         wk[WK_LINE_THETA, :n], wk[WK_LINE_OMEGA, :n], wk[WK_LINE_T, :n])
+    return M_gas, P_gas, M_load, M_starter, taken
+
+
+@kernel(inline=True)
+def elastic_rates(m, angle_mode, y, sw, wk, out):
+    """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
+    form of :func:`.rhs.derivative`."""
+    n = line_dofs(m)
+    ref = int(m.line[0, LM_REF])
+    line_inertias(m, y, wk)
+    line_speeds(m, angle_mode, y, wk)
+    M_gas, P_gas, M_load, M_starter, taken = line_forces(m, y, sw, wk)
+    w = wk[WK_LINE_OMEGA, :n]
+    w_ref = w[ref]
+    wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
+    wk[WK_SPEED, 1] = max(wk[WK_SPEED, 1], w_ref)
+    first = wk[WK_LINE_RATE, :n]
+    second = wk[WK_LINE_RATE + 1, :n]
+    gear = line_parts(m.line)[1][:, LD_GEAR]
+    if angle_mode:
+        line_angle_rates(ref, gear, wk[WK_LINE_M, :n], wk[WK_LINE_T, :n], w, first, second)
+        q = 1.0 / w_ref
+        out[PHI] = 1.0
+        out[T] = q
+        out[KINETIC] = second[ref]
+    else:
+        line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
+                           wk[WK_LINE_T, :n], w, second)
+        for d in range(n):
+            first[d] = gear[d] * w[d] - w_ref
+        q = 1.0
+        out[PHI] = w_ref
+        out[T] = 1.0
+        out[OMEGA] = second[ref]
+    for d in range(n):
+        if d != ref:
+            out[twist_index(m, d)] = first[d]
+            out[twist_index(m, d) + 1] = second[d]
+    out[W_GAS] = P_gas * q
+    out[W_LOAD] = M_load * w[int(m.line[0, LM_LOAD])] * q
+    out[W_STARTER] = M_starter * w_ref * q
+    out[line_loss_index(m)] = taken * q
+
+
+@kernel
+def elastic_row(m, angle_mode, y, sw, wk, row):
+    """An elastic scene's output row: the fixed columns of the reference
+    dof (ω, ε, J, J′ its own; M_gas all cylinders', M_load at its dof), each cylinder's
+    pressure at its own angle, then per dof its twist θ_d − φ and speed, per element its torque
+    k δ + c δ̇ (δ = θ_a − r θ_b), the line's energy Σ ½J_d ω_d² + Σ ½k δ² and the energy its
+    damping took."""
+    n = line_dofs(m)
+    ref = int(m.line[0, LM_REF])
+    line_inertias(m, y, wk)
+    line_speeds(m, angle_mode, y, wk)
+    M_gas, _, M_load, M_starter, _ = line_forces(m, y, sw, wk)
+    acc = wk[WK_LINE_RATE, :n]
+    line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
+                       wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)
+    w_ref = wk[WK_LINE_OMEGA, ref]
+    row[0] = y[T]
+    row[1] = y[PHI]
+    row[2] = w_ref
+    row[3] = acc[ref]
+    row[4] = wk[WK_LINE_J, ref]
+    row[5] = wk[WK_LINE_DJ, ref]
+    row[6] = M_gas
+    row[7] = M_load
+    row[8] = M_starter
+    f = fuel(m, w_ref, sw[SW_GOVERNOR])
+    row[9] = f
+    row[10] = y[W_GAS]
+    row[11] = y[W_LOAD]
+    row[12] = y[W_STARTER]
+    for c in range(m.ncyl):
+        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, wk[WK_CYL_ANGLE, c], f, wk)
+                                if m.has_gas else 0.0)
+    k = line_col(m)
+    energy = 0.0
+    for d in range(n):
+        row[k] = wk[WK_LINE_THETA, d] - y[PHI]
+        row[k + 1] = wk[WK_LINE_OMEGA, d]
+        energy += 0.5 * wk[WK_LINE_J, d] * row[k + 1] * row[k + 1]
+        k += 2
+    th = wk[WK_LINE_THETA]
+    w = wk[WK_LINE_OMEGA]
+    elements = line_parts(m.line)[2]
+    for e in range(elements.shape[0]):
+        i = int(elements[e, EL_I])
+        j = int(elements[e, EL_J])
+        r = elements[e, EL_R]
+        twist = th[i] - r * th[j]
+        row[k] = elements[e, EL_K] * twist + elements[e, EL_C] * (w[i] - r * w[j])
+        energy += 0.5 * elements[e, EL_K] * twist * twist
+        k += 1
+    row[k] = energy
+    row[k + 1] = y[line_loss_index(m)]
