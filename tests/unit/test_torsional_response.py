@@ -157,9 +157,10 @@ def test_friswell_line_against_opentorsions_vibratory_torque():
 
 
 def test_the_cases_line_against_opentorsions_harmonic_response():
-    """The inline six (damper ring, section damping by loss factor and damping ratio) through openTorsion's elements and ss_response; the
-    sections' torques (k + iωc)·twist from its own S and D matrices. Its chain is numbered
-    ring, pulley, throws, flywheel: a ring hanging off a station is a chain there."""
+    """The inline six (damper ring, section damping by loss factor and damping ratio)
+    through openTorsion's elements and ss_response; the sections' torques (k + iωc)·twist
+    from its own S and D matrices. Its chain is numbered ring, pulley, throws, flywheel: a
+    ring hanging off a station is a chain there."""
     ot = pytest.importorskip("opentorsion")
     # (without the throws' absolute damping: openTorsion's acts against the frame)
     line = ShaftLine(load_scene("inline6.toml", text=INLINE6.source_text.replace(
