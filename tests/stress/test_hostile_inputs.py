@@ -73,7 +73,7 @@ SCENE_CASES = [
      "inertia." + "x" * 149 + "...: unknown key; allowed here: flywheel, load, shaft"),
     ("long-table-name", SMALL + f"\n[{LONG}]\n",
      "x" * 157 + "...: unknown key; allowed here: analysis, friction, gas, governor, inertia, "
-     "initial, load, mechanism, output, run, scene, solver, starter"),
+     "initial, load, mechanism, output, run, scene, shaft, solver, starter"),
     ("newline-in-a-key", insert("shaft = 0.02", '"a\\nb" = 1'),
      "inertia.a\\nb: unknown key; allowed here: flywheel, load, shaft"),
     ("escape-in-a-key", insert("shaft = 0.02", '"\\u001b[2J" = 1'),
@@ -343,8 +343,8 @@ SPC = "--samples-per-cycle: must be 16 … 1000000, got"
 MAX_ORDER = "--max-order: must be finite and > 0, got"
 REVS = "--revolutions: must be finite and > 0 and ≤ 1e+06, got"
 BUDGET = "--baseline-budget: must be finite and > 0, got"
-COMMANDS = ("'run', 'check', 'info', 'warmup', 'plot', 'kinematics', 'bench', 'efficiency', 'loads', "
-            "'orders', 'stress', 'sweep', 'sweep-plot'")
+COMMANDS = ("'run', 'check', 'info', 'warmup', 'plot', 'kinematics', 'modes', 'bench', "
+            "'efficiency', 'loads', 'orders', 'stress', 'sweep', 'sweep-plot'")
 
 OPTION_CASES = [
     # kinematics --points: a count of grid points

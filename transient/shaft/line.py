@@ -28,7 +28,6 @@ from dataclasses import dataclass, replace
 from typing import cast
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from ..errors import SceneError
@@ -203,7 +202,10 @@ def _cylinder_terms(scene: Scene):
 
 def _lowest_elastic(K, M_diag, rigid: int) -> float:
     """ω₁² of the undamped line: its lowest eigenvalue past the ``rigid`` zero ones."""
-    values = scipy.linalg.eigh(K, np.diag(M_diag), eigvals_only=True)
+    # (M is diagonal: K x = ω² M x is the symmetric D K D y = ω² y with D = M^(-1/2), which
+    # numpy solves; a run builds the line, and a warm run loads no scipy.linalg)
+    scale = 1.0 / np.sqrt(M_diag)
+    values = np.linalg.eigvalsh(scale[:, None] * K * scale[None, :])
     return float(values[rigid]) if values.size > rigid else np.nan
 
 
