@@ -20,10 +20,10 @@ from transient.precompile import CALLEES, compile_callees, signature
 from transient.run import integrate
 from transient.scene import load_scene
 
-#: The mechanism kernel a signature's Model carries (each mechanism's stepper is a compile of its
-#: own, so the shared cache also holds the other mechanisms' signatures: not this scene's).
-MECHANISM_KERNEL = re.compile(r"transient\.core\.model\.(\w+)\.terms")
-OURS = {"crank_slider"}
+#: The kernels a signature carries as values (the Model's: its mechanism's, a rigid or an elastic
+#: shaft line's; the derivative): each such choice is a stepper compiled on its own, so the
+#: shared cache also holds other mechanisms' and elastic lines' signatures, not this scene's.
+MODEL_KERNEL = re.compile(r"kernel\((transient\.[\w.]+)\)")
 
 
 def test_helper_compiles_the_signatures_the_stepper_calls():
@@ -36,9 +36,10 @@ def test_helper_compiles_the_signatures_the_stepper_calls():
     compile_callees(model, tab)
     assert integrate(scene).complete  # (the stepper compiled, or loaded from the cache)
     for fn in CALLEES:
+        ours = set(MODEL_KERNEL.findall(f"{signature(fn, model, tab)}{signature(fn, full, tab)}"))
         saved = [key[0] for key in fn._cache._cache_file._load_index()
                  if not any(isinstance(a, _KernelArgument) and not a.key[0].startswith("transient.")
-                            for a in key[0]) and set(MECHANISM_KERNEL.findall(str(key[0]))) <= OURS]
+                            for a in key[0]) and set(MODEL_KERNEL.findall(str(key[0]))) <= ours]
         assert signature(fn, model, tab) in saved, (fn.__name__, saved)
         assert set(saved) <= {signature(fn, model, tab), signature(fn, full, tab)}, (
             fn.__name__, saved)
