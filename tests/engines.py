@@ -1,4 +1,4 @@
-"""Mechanisms the tests share (on ``pythonpath``, pyproject): one copy of each."""
+"""Mechanisms and shaft lines the tests share (on ``pythonpath``, pyproject): one copy of each."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -6,6 +6,7 @@ from dataclasses import replace
 import numpy as np
 
 from transient.mechanisms.crank_slider import CrankSlider
+from transient.reference.torsion import Coupling, Ring, ShaftLine
 
 
 def gots_mech(**changes) -> CrankSlider:
@@ -36,4 +37,22 @@ def inline_six_mech(**changes) -> CrankSlider:
                        rod_cg_from_pin=0.7 * 0.19, rod_inertia_cg=0.0, strokes=4,
                        firing_angles=tuple(np.radians([firing[c] for c in range(1, 7)])),
                        bank_angles=(0.0,) * 6)
+    return replace(base, **changes)
+
+
+#: The six's shaft line's own inertias: damper hub, six throws, flywheel [kg m²].
+SIX_OWN = np.array([0.03] + [0.05] * 6 + [1.2])
+
+
+def inline_six_line(**changes) -> ShaftLine:
+    """The in-line six's shaft line in the reference path's form: damper hub, six throws (one
+    cylinder each), flywheel; sections of 0.6–1.5 MN m/rad with some damping, a little absolute
+    damping at the throws, a viscous ring on the hub and a tuned one on the flywheel, and a
+    coupling through a 2:1 gear to a driven inertia."""
+    base = ShaftLine(inertia=SIX_OWN, stiffness=np.array([6e5] + [1.2e6] * 5 + [1.5e6]),
+                     damping=np.array([5.0] + [10.0] * 6),
+                     absolute=np.array([0.0] + [0.005] * 6 + [0.0]),
+                     station_of_cylinder=np.arange(1, 7),
+                     rings=(Ring(0, 0.04, 30.0), Ring(7, 0.02, 2.0, 2e4)),
+                     coupling=Coupling(7, 3e4, 20.0, 2.0, 0.5))
     return replace(base, **changes)

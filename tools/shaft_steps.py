@@ -24,20 +24,19 @@ import numpy as np
 from scipy.linalg import eigh
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from engines import inline_six_mech
+from engines import SIX_OWN as OWN
+from engines import inline_six_line, inline_six_mech
 
 from transient.reference.torsion import (
     Coupling,
     CrankSliderCylinders,
     PressurePulse,
-    Ring,
     ShaftLine,
     TorsionModel,
     integrate,
 )
 
 SPEED, MEAN_TORQUE, RATIO, JD = 200.0, 356.0, 2.0, 0.5
-OWN = np.array([0.03] + [0.05] * 6 + [1.2])
 K = np.array([6e5] + [1.2e6] * 5 + [1.5e6])
 KC, CC = 3e4, 20.0
 CYCLE = 4 * math.pi
@@ -65,10 +64,8 @@ def main():
         K[0] = float(sys.argv[1])
     mech = inline_six_mech()
     cyl = CrankSliderCylinders(mech, PressurePulse(9e6, math.radians(12), math.radians(15)))
-    line = ShaftLine(inertia=OWN, stiffness=K, damping=np.array([5.0] + [10.0] * 6),
-                     absolute=np.array([0.0] + [0.005] * 6 + [0.0]),
-                     station_of_cylinder=np.arange(1, 7), rings=(Ring(0, 0.04, 30.0),),
-                     coupling=Coupling(7, KC, CC, RATIO, JD))
+    line = inline_six_line(stiffness=K, rings=inline_six_line().rings[:1],
+                           coupling=Coupling(7, KC, CC, RATIO, JD))
     rigid = ShaftLine(inertia=np.array([OWN.sum() + JD / RATIO ** 2]), stiffness=np.zeros(0),
                       damping=np.zeros(0), absolute=np.array([0.03]),
                       station_of_cylinder=np.zeros(6, dtype=np.intp))

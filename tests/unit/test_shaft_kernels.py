@@ -7,31 +7,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from engines import inline_six_mech
+from engines import inline_six_line, inline_six_mech
 
 from transient.core.model import shaft
-from transient.reference.torsion import (
-    Coupling,
-    CrankSliderCylinders,
-    PressurePulse,
-    Ring,
-    ShaftLine,
-    TorsionModel,
-)
+from transient.reference.torsion import CrankSliderCylinders, PressurePulse, TorsionModel
 
-OWN = np.array([0.03] + [0.05] * 6 + [1.2])
-RINGS = (Ring(0, 0.04, 30.0), Ring(7, 0.02, 2.0, 2e4))
-COUPLING = Coupling(7, 3e4, 20.0, 2.0, 0.5)
+LINE = inline_six_line()
+RINGS, COUPLING = LINE.rings, LINE.coupling
 #: Rounding of sums of torques of the stiffness's size times twists.
 RTOL = 1e-12
 
 
 def _reference():
     mech = inline_six_mech()
-    line = ShaftLine(inertia=OWN, stiffness=np.array([6e5] + [1.2e6] * 5 + [1.5e6]),
-                     damping=np.array([5.0] + [10.0] * 6),
-                     absolute=np.array([0.0] + [0.005] * 6 + [0.0]),
-                     station_of_cylinder=np.arange(1, 7), rings=RINGS, coupling=COUPLING)
+    line = LINE
     load = lambda th, w, t: -40.0 - 0.01 * w * w
     pulse = PressurePulse(peak=8e6, at=np.radians(10.0), width=np.radians(30.0), cycle=4 * np.pi)
     return mech, TorsionModel(line, CrankSliderCylinders(mech, pulse), driven_load=load), load

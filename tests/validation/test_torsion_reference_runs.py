@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 import pytest
-from engines import inline_six_mech
+from engines import SIX_OWN, inline_six_line, inline_six_mech
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
@@ -28,7 +28,6 @@ from transient.reference.torsion import (
     Coupling,
     CrankSliderCylinders,
     PressurePulse,
-    Ring,
     ShaftLine,
     TorsionModel,
     integrate,
@@ -36,8 +35,6 @@ from transient.reference.torsion import (
 )
 
 PULSE = PressurePulse(9e6, math.radians(12.0), math.radians(15.0))
-#: The six's own inertias: damper hub, six throws, flywheel [kg m²].
-OWN = np.array([0.03] + [0.05] * 6 + [1.2])
 CYCLE = 4.0 * math.pi
 SPEED = 200.0  # [rad/s]
 MEAN_TORQUE = 356.0  # the pulse's mean moment over a cycle, six cylinders [N m]
@@ -53,14 +50,9 @@ def test_energy_balance_every_element():
     would show thousands of times above the tolerance), and the residual stays within
     rtol × the energy turned over, at rtol 1e-8 and 1e-10, falling with rtol."""
     mech = inline_six_mech()
-    line = ShaftLine(inertia=OWN, stiffness=np.array([6e5] + [1.2e6] * 5 + [1.5e6]),
-                     damping=np.array([5.0] + [10.0] * 6),
-                     # (on the motion relative to the line's only: enough to take a share)
-                     absolute=np.array([0.0] + [0.5] * 6 + [0.0]),
-                     station_of_cylinder=np.arange(1, 7),
-                     rings=(Ring(0, 0.04, 30.0), Ring(7, 0.02, 2.0, 2e4)),
-                     coupling=Coupling(7, 3e4, 20.0, 2.0, 0.5),
-                     eta=(np.full(8, 0.98), np.full(8, 0.97)))
+    # (absolute damping on the motion relative to the line's only: more, to take a share)
+    line = inline_six_line(absolute=np.array([0.0] + [0.5] * 6 + [0.0]),
+                           eta=(np.full(8, 0.98), np.full(8, 0.97)))
     model = TorsionModel(line, CrankSliderCylinders(mech, PULSE), driven_load=fan(2.0),
                          external=lambda th, w, t: np.where(np.arange(8) == 0, -5.0, 0.0))
     y0 = model.initial_state(0.0, SPEED)
@@ -81,11 +73,11 @@ def six_line(k: float, ratio: float, zeta: float = 0.3) -> ShaftLine:
     """The six with every section (and the coupling, 3 % of it) of stiffness k, damped at the
     ratio ζ of each section's two neighbours (heavily: the start's free vibration, excited by
     starting without twist, is gone within the first cycle), no rings."""
-    J = OWN + 0.014  # (with the mean of each throw's cylinder)
+    J = SIX_OWN + 0.014  # (with the mean of each throw's cylinder)
     ks = np.full(7, k)
     c = 2 * zeta * np.sqrt(ks * np.minimum(J[:-1], J[1:]) / 2)
     kc, Jd = 0.03 * k, 0.5
-    return ShaftLine(inertia=OWN, stiffness=ks, damping=c,
+    return ShaftLine(inertia=SIX_OWN, stiffness=ks, damping=c,
                      absolute=np.array([0.0] + [0.005] * 6 + [0.0]),
                      station_of_cylinder=np.arange(1, 7),
                      coupling=Coupling(7, kc, 2 * zeta * math.sqrt(kc * Jd / ratio ** 2), ratio,
@@ -109,7 +101,7 @@ def test_rigid_limit():
         return float(PULSE(local) @ twin.terms(phi)[2] * mech.piston_area)
 
     cycles = 3
-    rigid, omega = rigid_run(OWN.sum() + Jd / ratio ** 2, twin.terms, gas,
+    rigid, omega = rigid_run(SIX_OWN.sum() + Jd / ratio ** 2, twin.terms, gas,
                              lambda phi, w: load(phi / ratio, w / ratio, 0) / ratio,
                              cycles * CYCLE + 1.0, SPEED)
     t_end = rigid.sol(cycles * CYCLE)[0]
