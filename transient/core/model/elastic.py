@@ -69,11 +69,12 @@ from .tables import find_piece
 @kernel(inline=True)
 def elastic_model(m, row, angle_mode, y, sw, wk, out):
     """``Model.line_model``: the output row at ``y`` into ``out`` (``row``) or the derivative
-    (:func:`elastic_rates`)."""
+    (:func:`elastic_rates`); True, the rigid model's own left undone."""
     if row:
         elastic_row(m, angle_mode, y, sw, wk, out)
     else:
         elastic_rates(m, angle_mode, y, sw, wk, out)
+    return True
 
 
 @kernel(inline=True)
@@ -131,14 +132,21 @@ def line_forces(m, y, sw, wk):
 
 
 @kernel(inline=True)
+def line_at(m, angle_mode, y, sw, wk):
+    """Every dof's inertia, speed, applied moments and the line's torques at ``y`` into ``wk``
+    (what the derivative and the output row both start from); returns :func:`line_forces`'."""
+    line_inertias(m, y, wk)
+    line_speeds(m, angle_mode, y, wk)
+    return line_forces(m, y, sw, wk)
+
+
+@kernel(inline=True)
 def elastic_rates(m, angle_mode, y, sw, wk, out):
     """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
     form of :func:`.rhs.derivative`."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    line_inertias(m, y, wk)
-    line_speeds(m, angle_mode, y, wk)
-    M_gas, P_gas, M_load, M_starter, taken = line_forces(m, y, sw, wk)
+    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sw, wk)
     w = wk[WK_LINE_OMEGA, :n]
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
@@ -180,9 +188,7 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
     damping took."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    line_inertias(m, y, wk)
-    line_speeds(m, angle_mode, y, wk)
-    M_gas, _, M_load, M_starter, _ = line_forces(m, y, sw, wk)
+    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk)
     acc = wk[WK_LINE_RATE, :n]
     line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                        wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)

@@ -401,7 +401,7 @@ Model = namedtuple(
         # array and two kernels; a rigid shaft's is a row of zeros (no dofs) and no-ops
         "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
         "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
-        "line_model",  # kernel: the line's derivative or output row (.elastic.elastic_model)
+        "line_model",  # kernel: the line's derivative or output row; True if it did them
     ],
 )
 typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)

@@ -44,7 +44,6 @@ from .layout import (
     WK_SPEED,
     WK_U,
     T,
-    line_dofs,
 )
 from .swash_plate import link_terms as swash_link_terms
 
@@ -152,10 +151,10 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     (``transient.core.model.chain``), so that the energy lost is exactly what the pairs account for.
     ``extras``: the kernels' variant for ``m`` (:func:`.layout.extras_of`), as for every kernel
     that reaches a feature only some scenes use. An elastic shaft line's state has its own
-    derivative (``Model.line_model``, :mod:`.elastic`; a no-op in a rigid scene's Model).
+    derivative (``Model.line_model``, :mod:`.elastic`; in a rigid scene's Model a kernel that
+    returns False, a constant the compiler folds: the rigid path tests nothing at run time).
     """
-    if line_dofs(m) > 0:
-        m.line_model(m, False, angle_mode, y, sw, wk, out)
+    if m.line_model(m, False, angle_mode, y, sw, wk, out):
         return
     # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
     with_dJ = not angle_mode or (extras is not None and m.n_pairs > 0)

@@ -213,4 +213,5 @@ def no_shares(mp, kin_coef, angles, Jc, dJc, u, du):
 
 @kernel(inline=True)
 def no_line_model(m, row, angle_mode, y, sw, wk, out):
-    """``Model.line_model`` of a rigid shaft."""
+    """``Model.line_model`` of a rigid shaft: nothing done, as its False says."""
+    return False
