@@ -77,11 +77,12 @@ class Mechanism(Protocol):
     #: ``rod_length`` and ``offset`` (the odd-harmonic report then uses that closed form; other
     #: pistons' s′, s″ come from their capability ``"pistons"``).
     slider_law: ClassVar[bool]
-    #: 2 or 4: the gas cycle's length, ``cycle`` = π·strokes.
-    strokes: int
+    @property
+    def strokes(self) -> int:
+        """2 or 4: the gas cycle's length, ``cycle`` = π·strokes."""
 
     @classmethod
-    def read(cls, section: Section) -> Mechanism:
+    def read(cls, section: Section, /) -> Mechanism:
         """The mechanism from its ``[mechanism]`` table (the scene reader has taken ``type`` and
         finishes the table); validated, errors naming the keys as the user wrote them."""
 
@@ -335,29 +336,33 @@ def capability_gaps(cls: type, tables: Mapping[str, Mapping[str, Any]]) -> list[
     Protocol it does not define, a claimed table capability with no entry in ``tables`` (its
     table by capability name), an entry there it does not claim, a claim :data:`IMPLIES` that
     it does not make."""
-    fields = {f.name for f in dataclasses.fields(cls)} if dataclasses.is_dataclass(cls) else set()
+    fields = ({f.name for f in dataclasses.fields(cls)} if dataclasses.is_dataclass(cls)
+              else set[str]())
+    # a class that lacks them is reported below, as lacking members of Mechanism
+    claims: frozenset[str] = getattr(cls, "capabilities", frozenset())
+    name: str = getattr(cls, "name", cls.__name__)
 
-    def lacks(name: str) -> bool:
-        return name not in fields and not any(name in vars(c) for c in cls.__mro__)
+    def lacks(member: str) -> bool:
+        return member not in fields and not any(member in vars(c) for c in cls.__mro__)
 
-    gaps = [f"{cls.__name__} lacks {name!r} of Mechanism"
-            for name in sorted(protocol_members(Mechanism)) if lacks(name)]
-    for cap in sorted(cls.capabilities):
+    gaps = [f"{cls.__name__} lacks {member!r} of Mechanism"
+            for member in sorted(protocol_members(Mechanism)) if lacks(member)]
+    for cap in sorted(claims):
         what = CAPABILITIES.get(cap)
         if what is None:
             gaps.append(f"{cls.__name__} claims {cap!r}, not a capability")
         elif isinstance(what, type):
-            gaps += [f"{cls.__name__} claims {cap!r} but lacks {name!r} of {what.__name__}"
-                     for name in sorted(protocol_members(what)) if lacks(name)]
+            gaps += [f"{cls.__name__} claims {cap!r} but lacks {member!r} of {what.__name__}"
+                     for member in sorted(protocol_members(what)) if lacks(member)]
         gaps += [f"{cls.__name__} claims {cap!r} but not {also!r}, which it implies"
-                 for also in IMPLIES.get(cap, ()) if also not in cls.capabilities]
+                 for also in IMPLIES.get(cap, ()) if also not in claims]
     for cap, table in tables.items():
-        claimed, listed = cap in cls.capabilities, cls.name in table
+        claimed, listed = cap in claims, name in table
         if claimed and not listed:
             gaps.append(f"{cls.__name__} claims {cap!r} but {CAPABILITIES[cap]} has no "
-                        f"{cls.name!r}")
+                        f"{name!r}")
         if listed and not claimed:
-            gaps.append(f"{CAPABILITIES[cap]} has {cls.name!r}, which does not claim {cap!r}")
+            gaps.append(f"{CAPABILITIES[cap]} has {name!r}, which does not claim {cap!r}")
     return gaps
 
 

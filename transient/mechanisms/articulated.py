@@ -28,9 +28,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 from math import cos, degrees, hypot, inf, pi, sin, sqrt
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -170,44 +170,46 @@ class Articulated:
     firing: tuple[float, ...] = ()
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
-    name = "articulated"
+    name: ClassVar[str] = "articulated"
     #: Its compiled kernel (``Model.terms``).
-    kernel = staticmethod(core.terms)
+    kernel: ClassVar[Any] = staticmethod(core.terms)
     #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
-    shares_kernel = staticmethod(core.shares)
+    shares_kernel: ClassVar[Any] = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`):
     #: no numpy twin (the reference path runs the kernel's Python code).
-    capabilities = frozenset({"reaction-friction", "reaction-twin", "pistons", "loads",
-                              "drawers"})
+    capabilities: ClassVar[frozenset[str]] = frozenset(
+        {"reaction-friction", "reaction-twin", "pistons", "loads", "drawers"})
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
-    wall_heat_transfer = False
-    cylinder_count = "mechanism.rows × (1 + the slaves in mechanism.bank)"
-    key_meanings = KEY_MEANINGS
+    wall_heat_transfer: ClassVar[bool] = False
+    cylinder_count: ClassVar[str] = "mechanism.rows × (1 + the slaves in mechanism.bank)"
+    key_meanings: ClassVar[dict[str, dict[str, str]]] = KEY_MEANINGS
     #: The slave pistons do not follow the crank-slider's law, from which the analyses derive W_k.
-    slider_law = False
+    slider_law: ClassVar[bool] = False
     #: Links of the serial chain, shaft first, as the crank-slider's: the crank throws, the rods
     #: (each row's master rod with its slave rods: the link pins join them inside the link, the
     #: master piston hanging on the master rod beside the slaves, not beyond them), the pistons
     #: and the cylinders, whose gas does its work on the pistons.
-    links = ("shaft", "crank", "rod", "piston", "cylinder")
+    links: ClassVar[tuple[str, ...]] = ("shaft", "crank", "rod", "piston", "cylinder")
     #: How each link's reduced inertia follows φ (``core.layout.LINK_*``), as the crank-slider's.
-    link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
+    link_laws: ClassVar[tuple[int, ...]] = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions
     #: (:mod:`transient.core.model.articulated_friction`).
-    reaction_links = ("shaft", "crank", "master rod", "slave rod", "piston", "cylinder")
+    reaction_links: ClassVar[tuple[str, ...]] = (
+        "shaft", "crank", "master rod", "slave rod", "piston", "cylinder")
     #: The joints such a pair may name, in the order of ``articulated_friction.J_*``: the main
     #: bearings, the master crankpins, the link pins, the master piston pins, the slave piston
     #: pins and the pistons in their cylinders (every cylinder of every row that the joint has).
-    reaction_joints = (("shaft", "crank"), ("crank", "master rod"), ("master rod", "slave rod"),
-                       ("master rod", "piston"), ("slave rod", "piston"), ("piston", "cylinder"))
+    reaction_joints: ClassVar[tuple[tuple[str, str], ...]] = (
+        ("shaft", "crank"), ("crank", "master rod"), ("master rod", "slave rod"), ("master rod", "piston"),
+        ("slave rod", "piston"), ("piston", "cylinder"))
     #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
     #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.model.reactions`).
-    shaft_coupling = ("shaft", "crank")
+    shaft_coupling: ClassVar[tuple[str, str] | None] = ("shaft", "crank")
     #: The solver of :mod:`transient.core.model.articulated_friction`, which keeps its side
     #: forces apart from the crank-slider's side tracking.
-    reaction_kernels = (articulated_friction.prepare, articulated_friction.solve,
-                        articulated_friction.inverse_drive)
-    tracks_sides = False
+    reaction_kernels: ClassVar[tuple[Any, Any, Any]] = (
+        articulated_friction.prepare, articulated_friction.solve, articulated_friction.inverse_drive)
+    tracks_sides: ClassVar[bool] = False
     #: No joint of it is kept ideal.
     ideal_reaction_joints: ClassVar[dict[str, str]] = {}
 
@@ -312,14 +314,16 @@ class Articulated:
         if len(row_bank) != rows:
             raise s.rename(SceneError(s.key("row_bank"), f"has {len(row_bank)} entries; must have "
                                                          f"one per row ({rows})"))
-        rods = {}
+        rods: dict[str, dict[str, Any]] = {}
         # (the master rod carries the master piston: a mass; a slave rod may be massless)
-        for table, mass, length in (("rod", {"gt": 0.0}, Named(l, "rod_length")),
-                                    ("slave_rod", {"ge": 0.0},
-                                     Named(min(li), "the shortest slave_rod_length"))):
+        for table, massless, length in (("rod", False, Named(l, "rod_length")),
+                                        ("slave_rod", True,
+                                         Named(min(li), "the shortest slave_rod_length"))):
             rod = s.sub(table, required=True)
             model = rod.string("model", "two-mass", choices=("two-mass", "rigid"))
-            rods[table] = dict(model=model, mass=rod.number("mass", "mass", **mass),
+            mass = (rod.number("mass", "mass", ge=0.0) if massless
+                    else rod.number("mass", "mass", gt=0.0))
+            rods[table] = dict(model=model, mass=mass,
                                cg_from_pin=rod.number("cg_from_pin", "length", ge=0.0,
                                                       le=length),
                                inertia_cg=(rod.number("inertia_cg", "inertia", 0.0, ge=0.0)
@@ -505,11 +509,14 @@ class Articulated:
                     if f[j] == 0.0:
                         out.append(float(grid[j]))
                     elif f[j + 1] != 0.0:
-                        root = bisect_root(
-                            lambda a, which=which, i=i: _slave_rates(self, a)[which, i],
-                            grid[j], grid[j + 1])
+                        root = bisect_root(partial(self._slave_rate, which=which, i=i),
+                                           grid[j], grid[j + 1])
                         out.append(float(root))
         return np.unique(np.mod(np.array(out), 2.0 * pi))
+
+    def _slave_rate(self, a: float, which: int, i: int) -> float:
+        """One of slave i's rates at crank angle ``a``: u (``which`` 0), u′ (1) or u″ (2)."""
+        return float(_slave_rates(self, a)[which, i])
 
     def dead_centre_angles(self) -> tuple[float, float]:
         """Dead centres [rad] of the master cylinder, a centred crank-slider: 0 and π."""
@@ -624,11 +631,11 @@ def slave_dimensions(r: float, l: float, delta: float, link_radius: float | None
     ``link_radius`` (then l_i by (6)) or ``slave_length`` (then r_i by (7)). The relation takes
     cos β_i ≈ 1 at that position; the exact dead centres are :func:`dead_centres`'s."""
     root = sqrt(1.0 - (r / l * sin(delta)) ** 2)
-    if (link_radius is None) == (slave_length is None):
-        raise ValueError("give exactly one of link_radius and slave_length")
-    if link_radius is not None:
+    if link_radius is not None and slave_length is None:
         return link_radius, l - link_radius * root  # (6)
-    return (l - slave_length) / root, slave_length  # (7)
+    if slave_length is not None and link_radius is None:
+        return (l - slave_length) / root, slave_length  # (7)
+    raise ValueError("give exactly one of link_radius and slave_length")
 
 
 def axial_positions(mech: Articulated, alpha: ArrayLike
@@ -710,7 +717,7 @@ def dead_centres(mech: Articulated) -> tuple[NDArray[np.float64], NDArray[np.flo
     tdc, bdc = np.zeros(1 + mech.n_slaves), np.full(1 + mech.n_slaves, pi)
     for i in range(1, 1 + mech.n_slaves):
         for out, j in ((tdc, np.argmax(x[:, i])), (bdc, np.argmin(x[:, i]))):
-            out[i] = bisect_root(lambda a, i=i: rate(a, i), grid[j] - h, grid[j] + h) % (2.0 * pi)
+            out[i] = bisect_root(partial(rate, i=i), grid[j] - h, grid[j] + h) % (2.0 * pi)
     return tdc, bdc
 
 
@@ -881,8 +888,8 @@ def harmonics(mech: Articulated, orders: int = 6) -> list[SlaveHarmonics]:
         series[: min(5, orders + 1)] = coef[: orders + 1]
         ex = np.stack([exact[:, :, d, 1 + i] for d in range(3)])
         se = np.stack([series, _derive(series, 1), _derive(series, 2)])
-        err = tuple(float(np.max(np.abs(X[d][:, 1 + i] - series_values(se[d], alpha))))
-                    for d in range(3))
+        e = [float(np.max(np.abs(X[d][:, 1 + i] - series_values(se[d], alpha)))) for d in range(3)]
+        err = (e[0], e[1], e[2])
         out.append(SlaveHarmonics(
             cylinder=i + 2, bank=mech.slave_banks[i], link_angle=mech.link_angles[i], exact=ex,
             series=se, source=source, error=err, lam=float(lam[1 + i]),

@@ -19,7 +19,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from math import asin, degrees, pi
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -133,43 +133,44 @@ class CrankSlider:
     journal_spacing: float = 0.0
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
-    name = "crank-slider"
+    name: ClassVar[str] = "crank-slider"
     #: Its compiled kernel (``Model.terms``).
-    kernel = staticmethod(core.terms)
+    kernel: ClassVar[Any] = staticmethod(core.terms)
     #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
-    shares_kernel = staticmethod(core.shares)
+    shares_kernel: ClassVar[Any] = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`).
-    capabilities = frozenset({"reaction-friction", "twin", "reaction-twin", "pistons", "loads",
-                              "drawers", "cylinder-inertia"})
+    capabilities: ClassVar[frozenset[str]] = frozenset(
+        {"reaction-friction", "twin", "reaction-twin", "pistons", "loads", "drawers", "cylinder-inertia"})
     #: Its numpy twin, for the reference path.
-    twin = CrankSliderNumpy
+    twin: ClassVar[type] = CrankSliderNumpy
     #: Wall heat transfer may be given: the cylinder ODE is built for this volume.
-    wall_heat_transfer = True
-    cylinder_count = "mechanism.cylinders"
-    key_meanings = KEY_MEANINGS
+    wall_heat_transfer: ClassVar[bool] = True
+    cylinder_count: ClassVar[str] = "mechanism.cylinders"
+    key_meanings: ClassVar[dict[str, dict[str, str]]] = KEY_MEANINGS
     #: Its pistons follow the slider law the analyses derive piston accelerations W_k from.
-    slider_law = True
+    slider_law: ClassVar[bool] = True
     #: Links of the serial chain, shaft first (friction pairs join neighbours): the shaft with
     #: flywheel and load, the crank throws, the rods, the pistons, and the cylinders, whose gas
     #: does its work on the pistons (so [shaft, crank] are the main bearings, [crank, rod] the
     #: crankpins, [rod, piston] the piston pins, [piston, cylinder] the pistons in their bores).
-    links = ("shaft", "crank", "rod", "piston", "cylinder")
+    links: ClassVar[tuple[str, ...]] = ("shaft", "crank", "rod", "piston", "cylinder")
     #: How each link's reduced inertia follows φ (``core.layout.LINK_*``): the crank's is
     #: constant, the rods' what J(φ) holds beyond the others, the pistons' m_p·Σ u_k².
-    link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
+    link_laws: ClassVar[tuple[int, ...]] = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions (:mod:`transient.core.model.joint_friction`):
     #: the piston is a link of its own and the cylinder (the frame) the last, so the pairs are
     #: the main bearings, the crankpins, the piston pins and the pistons in their cylinders.
-    reaction_links = ("shaft", "crank", "rod", "piston", "cylinder")
+    reaction_links: ClassVar[tuple[str, ...]] = ("shaft", "crank", "rod", "piston", "cylinder")
     #: The joints reaction pairs may name: each link with its neighbour (a chain).
-    reaction_joints = tuple(zip(reaction_links, reaction_links[1:]))
+    reaction_joints: ClassVar[tuple[tuple[str, str], ...]] = tuple(zip(reaction_links, reaction_links[1:]))
     #: The solver of :mod:`transient.core.model.joint_friction`, which leaves each cylinder's
     #: side force for the stepper's side tracking.
-    reaction_kernels = (joint_friction.prepare, joint_friction.solve, joint_friction.inverse_drive)
-    tracks_sides = True
+    reaction_kernels: ClassVar[tuple[Any, Any, Any]] = (
+        joint_friction.prepare, joint_friction.solve, joint_friction.inverse_drive)
+    tracks_sides: ClassVar[bool] = True
     #: The reaction joint that may have a constant-η or mapped pair among reaction pairs: the
     #: main bearings, which couple the shaft to the mechanism (:mod:`transient.core.model.reactions`).
-    shaft_coupling = ("shaft", "crank")
+    shaft_coupling: ClassVar[tuple[str, str] | None] = ("shaft", "crank")
 
     @property
     def n_cylinders(self) -> int:
@@ -444,7 +445,7 @@ class CrankSlider:
         if self.rod_arrangement == SINGLE and equal_angles(self.bank_angles):
             return {}
         throws, split = self.throw_angles()
-        keys = {"throws": list(throws)}
+        keys: dict[str, object] = {"throws": list(throws)}
         if self.rod_arrangement != SINGLE:
             keys["rod_arrangement"] = self.rod_arrangement
         if self.rod_arrangement == "side-by-side":
@@ -489,7 +490,7 @@ class CrankSlider:
         mp = self.pack()
         n = self.n_cylinders
         cols: dict[str, list[float]] = {"phi_deg": list(np.degrees(phi)), "J": [], "dJ_dphi": []}
-        per = {f"{name}_{k + 1}": [] for k in range(n) for name in ("s", "u", "du", "beta_deg")}
+        per: dict[str, list[float]] = {f"{name}_{k + 1}": [] for k in range(n) for name in ("s", "u", "du", "beta_deg")}
         u = np.empty(n)
         du = np.empty(n)
         for p in phi:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from math import pi
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -83,27 +83,27 @@ class ScotchYoke:
     strokes: int = 2
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
-    name = "scotch-yoke"
+    name: ClassVar[str] = "scotch-yoke"
     #: Its compiled kernel (``Model.terms``).
-    kernel = staticmethod(core.terms)
+    kernel: ClassVar[Any] = staticmethod(core.terms)
     #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
-    shares_kernel = staticmethod(core.shares)
+    shares_kernel: ClassVar[Any] = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism`: its numpy twin, its pistons' travel and
     #: its loads (:mod:`transient.analysis.loads.scotch_yoke`); no reaction friction, no drawn
     #: diagrams.
-    capabilities = frozenset({"twin", "pistons", "loads"})
-    twin = ScotchYokeNumpy
+    capabilities: ClassVar[frozenset[str]] = frozenset({"twin", "pistons", "loads"})
+    twin: ClassVar[type] = ScotchYokeNumpy
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
-    wall_heat_transfer = False
-    cylinder_count = "1 (one cylinder on the yoke)"
-    key_meanings = KEY_MEANINGS
+    wall_heat_transfer: ClassVar[bool] = False
+    cylinder_count: ClassVar[str] = "1 (one cylinder on the yoke)"
+    key_meanings: ClassVar[dict[str, dict[str, str]]] = KEY_MEANINGS
     #: Not the crank-slider's law (its λ = 0 limit): the analyses take s′, s″ from its own.
-    slider_law = False
+    slider_law: ClassVar[bool] = False
     #: Links of the serial chain, shaft first: the crank (with the slider block), the yoke (with
     #: the piston), and the cylinder, whose gas does its work on the piston.
-    links = ("shaft", "crank", "yoke", "cylinder")
+    links: ClassVar[tuple[str, ...]] = ("shaft", "crank", "yoke", "cylinder")
     #: The crank's and block's reduced inertia is constant, the yoke's the rest of J(φ).
-    link_laws = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_FIXED)
+    link_laws: ClassVar[tuple[int, ...]] = (LINK_FIXED, LINK_FIXED, LINK_REST, LINK_FIXED)
     firing_angles = (0.0,)
     bank_angles = (0.0,)
 

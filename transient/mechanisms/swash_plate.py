@@ -45,9 +45,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import cached_property, lru_cache, partial
 from math import asin, atan, cos, degrees, inf, pi, sin, tan
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -169,20 +169,21 @@ class SwashPlate:
     cross_inertia: float
 
     #: Its ``type`` in the ``[mechanism]`` table (:data:`transient.mechanisms.MECHANISMS`).
-    name = "swash-plate"
+    name: ClassVar[str] = "swash-plate"
     #: Its compiled kernel (``Model.terms``).
-    kernel = staticmethod(core.terms)
+    kernel: ClassVar[Any] = staticmethod(core.terms)
     #: Its compiled kernel of each cylinder's share of J at its station's angle (``shares``).
-    shares_kernel = staticmethod(core.shares)
+    shares_kernel: ClassVar[Any] = staticmethod(core.shares)
     #: Beyond :class:`~transient.mechanisms.Mechanism` (:data:`~transient.mechanisms.CAPABILITIES`):
     #: no numpy twin (the reference path runs the kernel's Python code), no load diagrams.
-    capabilities = frozenset({"reaction-friction", "reaction-twin", "pistons", "loads"})
+    capabilities: ClassVar[frozenset[str]] = frozenset(
+        {"reaction-friction", "reaction-twin", "pistons", "loads"})
     #: No wall heat transfer: the cylinder ODE is built for the crank-slider's volume.
-    wall_heat_transfer = False
-    cylinder_count = "mechanism.cylinders"
-    key_meanings = KEY_MEANINGS
+    wall_heat_transfer: ClassVar[bool] = False
+    cylinder_count: ClassVar[str] = "mechanism.cylinders"
+    key_meanings: ClassVar[dict[str, dict[str, str]]] = KEY_MEANINGS
     #: Its pistons do not follow the crank-slider's law, from which the analyses derive W_k.
-    slider_law = False
+    slider_law: ClassVar[bool] = False
     #: Two-stroke: one gas pulse per cylinder and turn.
     strokes = 2
     #: Cycle length in shaft angle [rad].
@@ -192,31 +193,32 @@ class SwashPlate:
     #: with it), the rods, the pistons, and the cylinders, whose gas does its work on the pistons.
     #: So [shaft, link] is plate bearing 11, [link, rod] the ball joints B_k, [rod, piston] the
     #: ball joints D_k and [piston, cylinder] the pistons in their bores.
-    links = ("shaft", "link", "rod", "piston", "cylinder")
+    links: ClassVar[tuple[str, ...]] = ("shaft", "link", "rod", "piston", "cylinder")
     #: How each link's reduced inertia follows φ (``core.layout.LINK_*``): link 9's and the
     #: crosses' by (15)–(17), the rods' what J(φ) holds beyond the others, the pistons'
     #: m_p·Σ_k u_k²/halves.
-    link_laws = (LINK_FIXED, LINK_SWASH, LINK_REST, LINK_PISTONS, LINK_FIXED)
+    link_laws: ClassVar[tuple[int, ...]] = (LINK_FIXED, LINK_SWASH, LINK_REST, LINK_PISTONS, LINK_FIXED)
     #: Links for pairs with friction on their reactions (:mod:`transient.core.model.swash_friction`),
     #: the shaft side first: the shaft with flywheel and load, the plate on it, link 9, the rods,
     #: the pistons and the cylinders (the frame). So [shaft, plate] is the main bearing (the
     #: plate carries the mechanism's forces into it), [plate, link] the plate bearing 11,
     #: [link, rod] the ball joints B_k, [rod, piston] the ball joints D_k and [piston, cylinder]
     #: the pistons in their cylinders.
-    reaction_links = ("shaft", "plate", "link", "rod", "piston", "cylinder")
+    reaction_links: ClassVar[tuple[str, ...]] = ("shaft", "plate", "link", "rod", "piston", "cylinder")
     #: The joints among them that stay ideal (named by their shaft-side link): the ball joints,
     #: whose rods' spin about their own axes the solver does not carry.
     ideal_reaction_joints = {"link": "the ball joints B_k of the rods on link 9",
                              "rod": "the ball joints D_k of the rods on the pistons"}
     #: The joints reaction pairs may name: each link with its neighbour (a chain).
-    reaction_joints = tuple(zip(reaction_links, reaction_links[1:]))
+    reaction_joints: ClassVar[tuple[tuple[str, str], ...]] = tuple(zip(reaction_links, reaction_links[1:]))
     #: No constant-η or mapped pair among reaction pairs: the main bearing sits in the shaft's
     #: equation itself (:mod:`transient.core.model.reactions`).
-    shaft_coupling = None
+    shaft_coupling: ClassVar[tuple[str, str] | None] = None
     #: The solver of :mod:`transient.core.model.swash_friction`, which keeps its side forces
     #: apart from the crank-slider's side tracking.
-    reaction_kernels = (swash_friction.prepare, swash_friction.solve, swash_friction.inverse_drive)
-    tracks_sides = False
+    reaction_kernels: ClassVar[tuple[Any, Any, Any]] = (
+        swash_friction.prepare, swash_friction.solve, swash_friction.inverse_drive)
+    tracks_sides: ClassVar[bool] = False
 
     def link_inertias(self) -> tuple[float, ...]:
         """Constant reduced inertia of each link besides the shaft's: none here [kg m²]."""
@@ -762,7 +764,7 @@ def dead_centres(geom: SwashPlate) -> tuple[NDArray[np.float64], NDArray[np.floa
     x = _points(mp, grid)[2][..., 0]
     inner, outer = np.empty(z), np.empty(z)
     for k in range(z):
-        inner[k], outer[k] = (bisect_root(lambda p, k=k: rate(p, k), grid[j] - h, grid[j] + h)
+        inner[k], outer[k] = (bisect_root(partial(rate, k=k), grid[j] - h, grid[j] + h)
                               for j in (np.argmin(x[:, k]), np.argmax(x[:, k])))
     return inner, outer
 

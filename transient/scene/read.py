@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from ..errors import SceneError
 from ..forces.load_table import INTERPOLATIONS, SCHEDULE_MIN_GAP
@@ -219,7 +220,7 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
         kind = ms.string("type", choices=tuple(MECHANISMS))
         mech = MECHANISMS[kind].read(ms)
         ms.finish()
-        sections = {}
+        sections: dict[str, Any] = {}
         si = root.sub("inertia")
         sections["inertia"] = Inertia(si.number("shaft", "inertia", 0.0, ge=0.0),
                                       si.number("flywheel", "inertia", 0.0, ge=0.0),
@@ -337,7 +338,8 @@ def _read_cylinders(s: Section, n_cylinders: Named, burns: bool = True) -> tuple
     """The [[gas.cylinders]] entries: per cylinder its fuel and pressure factors, cut-out and
     misfires (:class:`~.records.Cylinder`), sorted by cylinder. A model that ``burns`` no fuel
     (a compressor) takes the pressure factor only."""
-    out, seen = [], {}
+    out: list[Cylinder] = []
+    seen: dict[int, int] = {}
     top = MAX_CYLINDER_FACTOR
     for i, cs in enumerate(s.tables("cylinders")):
         other = [k for k in cs.data if k not in ("cylinder", "pressure")]
@@ -426,7 +428,7 @@ def _read_compressor(s: Section, p0: float) -> Gas:
                n_reexpansion=n_e, clearance_ratio=clearance)
 
 
-def _gas_exchange(s: Section, strokes: int, **bounds: float) -> tuple[float, float]:
+def _gas_exchange(s: Section, strokes: int, **bounds: Any) -> tuple[float, float]:
     """``p_intake`` and ``p_exhaust`` [Pa], the constant pressures of a 4-stroke's intake and
     exhaust strokes (required, within ``bounds``, :meth:`Section.number`'s). A 2-stroke has no
     such strokes: the cycle models scavenge it to p_a at bottom dead centre, so the keys would
@@ -592,7 +594,8 @@ def _read_friction(s: Section, mech, base_dir: Path, gas_model: str) -> Friction
     policy = s.string("policy", "power-flow", choices=POLICIES)
     sections = s.tables("pairs")
     raw = [dict(ps.data) for ps in sections]  # (as written, for the wedging checks' messages)
-    pairs, seen = [], {}
+    pairs: list[Pair] = []
+    seen: dict[tuple[str, ...], int] = {}
     for i, ps in enumerate(sections):
         model = ps.string("model", "constant-eta", choices=PAIR_MODELS)
         links = mech.links
@@ -771,7 +774,7 @@ def _table_pair(ps: Section, between: tuple[str, str], name: str, base_dir: Path
         torque = ps.numbers("torque", "torque")
         fwd = _rows(ps, "eta_forward")
         bwd = _rows(ps, "eta_backward")
-        check_map(lambda k: ps.key(ps.written.get(k, k)), speed, torque, fwd, bwd)
+        check_map(lambda k: ps.key(ps.written.get(str(k), str(k))), speed, torque, fwd, bwd)
     return Pair(between=between, eta_forward=1.0, eta_backward=1.0, name=name, model="table",
                 speed=speed, torque=torque, eta_forward_map=fwd, eta_backward_map=bwd)
 
@@ -986,7 +989,7 @@ def _read_run(s: Section) -> Run:
     revs = s.number("revolutions", "revolutions", math.inf, gt=0.0)
     if math.isinf(t_end) and math.isinf(revs):
         raise SceneError(s.key("t_end"), "the run needs an end: give t_end [s] and/or revolutions")
-    budgets = {"max_output_bytes": s.number("max_output_bytes", "bytes",
+    budgets: dict[str, Any] = {"max_output_bytes": s.number("max_output_bytes", "bytes",
                                             DEFAULT_MAX_OUTPUT_BYTES, gt=0.0),
                "max_steps": s.number("max_steps", "1", DEFAULT_MAX_STEPS, ge=1.0)}
     if mode == "dynamic":
