@@ -972,7 +972,8 @@ ORDER_STYLES = {"major": dict(color="C3", lw=1.5, ls="-"),
                 "half": dict(color="0.55", lw=0.8, ls=(0, (1.5, 1.5)))}
 
 
-def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, run_label=None):
+def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, run_label=None,
+                   run_largest=None):
     """The Campbell diagram of a shaft line: natural frequency [Hz] against shaft speed [rpm].
 
     ``modal`` (:class:`transient.analysis.torsion.Modal`): each elastic mode below the highest
@@ -982,9 +983,11 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, r
     size growing with their relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
     ``run_orders``: a run's order amplitudes per cycle, (cycle-mean speeds [rpm], orders
     [1/rev], amplitudes (n_cycles, n_orders); :func:`transient.analysis.torsion_run.campbell_overlay`),
-    drawn on the orders' lines at (n, q·n/60) as :func:`_run_overlay` draws them, ``run_label``
-    naming the amplitude and its unit on the colour bar; None draws none. Returns the legend's
-    handles."""
+    drawn on the orders' lines at (n, q·n/60), a marker per cycle and order, its area and colour
+    (logarithmic, a colour bar under the axes) the amplitude, ``run_label``
+    naming the amplitude and its unit on the colour bar, ``run_largest`` the amplitude of the
+    top of its scale (default: the largest drawn; give one for diagrams of several runs to
+    compare); None draws none. Returns the legend's handles."""
     from matplotlib.lines import Line2D
 
     from .analysis.torsion import order_kind
@@ -1018,7 +1021,7 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, r
         handles.append(ax.scatter(x, y, s=size, facecolor="none", edgecolor="k", lw=0.9,
                                   zorder=3, label="critical speeds (size: relative excitation)"))
     if run_orders is not None:
-        handles.append(_run_overlay(ax, *run_orders, label=run_label))
+        handles.append(_run_overlay(ax, *run_orders, label=run_label, largest=run_largest))
     ax.set_xlim(lo, hi)
     ax.set_ylim(0.0, top)
     ax.set_xlabel("shaft speed [rpm]")
@@ -1037,25 +1040,27 @@ ORDER_LABELS = 0.05
 OVERLAY_DECADES = 2.0
 
 
-def _run_overlay(ax, speeds, run_q, amplitude, label=None):
+def _run_overlay(ax, speeds, run_q, amplitude, label=None, largest=None):
     """A run's order amplitudes on a Campbell diagram: a marker at (cycle-mean speed [rpm],
     q·n/60 [Hz]) for each cycle and order, its area ∝ the amplitude and its colour the
-    amplitude on a logarithmic scale (a colour bar under the axes, ``label`` on it), the
-    largest drawn last (on top); amplitudes :data:`OVERLAY_DECADES` below the largest left out.
-    Returns a handle for the legend."""
+    amplitude on a logarithmic scale up to ``largest`` (default the largest amplitude; a colour
+    bar under the axes, ``label`` on it), the largest drawn last (on top); amplitudes
+    :data:`OVERLAY_DECADES` below the top left out. Returns a handle for the legend."""
     from matplotlib.colors import LogNorm
     from matplotlib.lines import Line2D
 
     speeds, run_q = np.asarray(speeds, dtype=float), np.asarray(run_q, dtype=float)
     amp = np.abs(np.asarray(amplitude, dtype=float)).reshape(speeds.size, run_q.size)
-    largest = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
+    if largest is None:
+        largest = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
     floor = largest * 10.0 ** -OVERLAY_DECADES
     x = np.repeat(speeds[:, None], run_q.size, axis=1)
     y = x * run_q[None, :] / 60.0
     keep = amp >= floor
     order = np.argsort(amp[keep], kind="stable")
-    dots = ax.scatter(x[keep][order], y[keep][order], s=2.0 + 50.0 * amp[keep][order] / largest,
-                      c=amp[keep][order], cmap="plasma", norm=LogNorm(floor, largest),
+    shown = np.minimum(amp[keep][order], largest)
+    dots = ax.scatter(x[keep][order], y[keep][order], s=2.0 + 50.0 * shown / largest,
+                      c=shown, cmap="plasma", norm=LogNorm(floor, largest),
                       lw=0, alpha=0.85, zorder=2.5)
     ax.figure.colorbar(dots, ax=ax, orientation="horizontal", location="bottom", fraction=0.05,
                        pad=0.08, aspect=40, label=label or "run's order amplitude")

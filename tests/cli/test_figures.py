@@ -384,8 +384,9 @@ def test_orders_cli_writes_the_figure_its_run_calls_for(misfire, spinup, tmp_pat
 def test_orders_of_an_elastic_run_up_draw_the_line(tmp_path_factory):
     """An elastic run-up (the six from 2300 rpm, 30 revolutions): the Campbell diagram with the
     run's orders, a marker per cycle and order at (n, q·n/60), the order labels outside the
-    axes, clear of its legend; the line cycle by cycle against the cycle-mean speed, the
-    dampers apart and the sections summed."""
+    axes, clear of its legend; the line cycle by cycle against the cycle-mean speed: the
+    elements' torques, the column's six strongest orders, the damping's power with the dampers
+    apart and the sections summed."""
     import argparse
 
     from transient.cli import line_orders
@@ -414,8 +415,11 @@ def test_orders_of_an_elastic_run_up_draw_the_line(tmp_path_factory):
     for t in labels:
         box = t.get_window_extent(renderer)
         assert box.x0 >= spine.x1 and box.x1 <= legend.x0
-    speed, power = figs["cycles_figure"].axes[:2]
-    assert speed.get_xlabel() == "" and power.get_xlabel() == "cycle-mean speed [rpm]"
+    torque, tracks, power = [ax for ax in figs["cycles_figure"].axes
+                             if ax.get_label() != "<colorbar>"]
+    assert torque.get_xlabel() == tracks.get_xlabel() == ""
+    assert power.get_xlabel() == "cycle-mean speed [rpm]"
+    assert len(_lines(tracks)) == 6 and tracks.get_yscale() == "log"
     assert [line.get_label() for line in _lines(power)] == [
         "damper silicone at pulley", "sections, all", "absolute damping, all stations"]
     _close(figs)

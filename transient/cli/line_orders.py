@@ -166,15 +166,19 @@ def figures(r: LineReport):
     yield "campbell", fig
     run_up = is_run_up(r.cycles.omega_mean)
     x = r.rpm if run_up else np.arange(1, r.rpm.size + 1)
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(11, 7.5), sharex=True, layout="constrained")
+    fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(11, 10), sharex=True, layout="constrained")
     plots.cycle_curves(a1, x, {e.label: 0.5 * pp for e, pp in
                                zip(r.elements, r.cycles.peak_to_peak, strict=True)
                                if e.kind != "damper" or e.k},
                        "vibratory torque, ½ peak-to-peak [N m]", xlabel="")
     a1.set_title("each element's vibratory torque, cycle by cycle", fontsize=9)
-    plots.cycle_curves(a2, x, _grouped(r.power), "mean power over the cycle [W]",
+    tracks = {f"order {p.order:g}": r.orders_of_run.track(r.column, p.order)
+              for p in sorted(_strongest(r), key=lambda p: p.order)}
+    plots.order_tracks(a2, x, tracks, f"order amplitude [{r.unit}]", xlabel="")
+    a2.set_title(f"{r.column}: its strongest orders, cycle by cycle", fontsize=9)
+    plots.cycle_curves(a3, x, _grouped(r.power), "mean power over the cycle [W]",
                        xlabel="cycle-mean speed [rpm]" if run_up else "cycle of the run")
-    a2.set_title("power the damping takes, cycle by cycle", fontsize=9)
+    a3.set_title("power the damping takes, cycle by cycle", fontsize=9)
     fig.suptitle(f"{r.scene.name}: the shaft line cycle by cycle")
     yield "cycles_figure", fig
 
@@ -191,9 +195,16 @@ def _grouped(power: dict) -> dict:
     return groups
 
 
-def _print_line(r: LineReport, top: float) -> None:
+def _strongest(r: LineReport, count: int = 6) -> list:
+    """The peaks (:func:`~transient.analysis.torsion_run.order_peaks`) of the ``count``
+    orders of the column that are largest over the run, largest first."""
     from ..analysis.torsion_run import order_peaks
 
+    peaks = order_peaks(r.orders_of_run, r.column, r.orders, r.criticals)
+    return sorted(peaks, key=lambda p: p.amplitude, reverse=True)[:count]
+
+
+def _print_line(r: LineReport, top: float) -> None:
     rpm = r.rpm
     print(f"  shaft line over {rpm.size} whole cycle(s), {rpm.min():.6g} … {rpm.max():.6g} rpm "
           f"(cycle means):")
@@ -211,8 +222,7 @@ def _print_line(r: LineReport, top: float) -> None:
     print(f"  heats of the damping parts: Σ = {losses.heat[:, -1].sum():.8g} J against the "
           f"run's W_line_loss {losses.total[-1] - losses.total[0]:.8g} J (relative "
           f"difference {losses.residual:.2e}: the sampling's quadrature error)")
-    peaks = order_peaks(r.orders_of_run, r.column, r.orders, r.criticals)
-    peaks = sorted(peaks, key=lambda p: p.amplitude, reverse=True)[:6]
+    peaks = _strongest(r)
     print(f"  {r.column}, strongest orders up to {top:g}: largest amplitude and where, against "
           f"the nearest critical speed of the order:")
     for p in sorted(peaks, key=lambda p: p.order):
