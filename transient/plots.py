@@ -978,8 +978,8 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, r
 
     ``modal`` (:class:`transient.analysis.torsion.Modal`): each elastic mode below the highest
     order's line as a line at its cycle-mean frequency, its frozen-angle band shaded; ``orders``
-    [1/rev] as lines f = q·n/60, styled by kind (:data:`ORDER_STYLES`) and labelled where they
-    leave the axes; ``criticals`` (:class:`transient.analysis.torsion.Critical`) marked, their
+    [1/rev] as lines f = q·n/60, styled by kind (:data:`ORDER_STYLES`) and labelled outside
+    the right edge, where they leave the axes; ``criticals`` (:class:`transient.analysis.torsion.Critical`) marked, their
     size growing with their relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
     ``run_orders``: a run's order amplitudes per cycle, (cycle-mean speeds [rpm], orders
     [1/rev], amplitudes (n_cycles, n_orders); :func:`transient.analysis.torsion_run.campbell_overlay`),

@@ -2,24 +2,23 @@
 Rigid or elastic: the orders of the speed of one engine
 =======================================================
 
-The in-line six of ``cases/inline6_damper.toml`` at 2600 rpm, near the speed at which its
-damped first torsional mode meets the sixth order, run twice for twelve cycles: on its elastic
-shaft line, each throw at its own angle, and as its rigid equivalent
-(:func:`transient.shaft.rigid_equivalent`: the same inertias as one body, J(φ) the line's with
-every station at one angle). A fan load holds both near that speed. The orders of the speed over
-the last cycle are taken with the order machinery of ``transient orders``
+The in-line six of ``cases/inline6_damper.toml`` at 2600 rpm, near the speed at which its damped
+first torsional mode meets the sixth order, run twice for twelve cycles: on its elastic shaft
+line, each throw at its own angle, and as its rigid equivalent
+(:func:`transient.shaft.line.rigid_equivalent`: the same inertias as one body, J(φ) the line's
+with every station at one angle). A fan load holds both near that speed. The orders of the speed
+over the last cycle are taken with the order machinery of ``transient orders``
 (:func:`transient.analysis.torsion_run.line_orders`, each cycle's ramp removed).
 
 On the rigid shaft every cylinder drives one body, and the six's excitations add up only in its
 major orders 3, 6, 9, 12: the speed holds those (what is left of the others is the run still
 settling to its speed, a thousandth of them). On the elastic line the throws drive the first
-mode each at its own place along the shaft, and the minor orders add up in it too (their relative
-excitation, ``transient modes``): the flywheel — the run's reference — carries the orders 1.5 and
-4.5 at a tenth of a radian per second and more, where the rigid shaft has next to nothing, and
-the pulley at the front end, where the mode swings most, carries the sixth order at twenty times
-the rigid model's. A rigid model gives the
-flywheel's mean speed and its major orders; the elastic one gives what the front end and the
-damper see.
+mode each at its own place along the shaft, and the minor orders add up in it too (their
+relative excitation, ``transient modes``): the flywheel — the run's reference — carries the
+orders 1.5 and 4.5 at a tenth of a radian per second and more, where the rigid shaft has next to
+nothing, and the pulley at the front end, where the mode swings most, carries the sixth order at
+twenty times the rigid model's. A rigid model gives the flywheel's mean speed and its major
+orders; the elastic one gives what the front end and the damper see.
 """
 import math
 from pathlib import Path
