@@ -979,15 +979,17 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, r
     ``modal`` (:class:`transient.analysis.torsion.Modal`): each elastic mode below the highest
     order's line as a line at its cycle-mean frequency, its frozen-angle band shaded; ``orders``
     [1/rev] as lines f = q·n/60, styled by kind (:data:`ORDER_STYLES`) and labelled outside
-    the right edge, where they leave the axes; ``criticals`` (:class:`transient.analysis.torsion.Critical`) marked, their
-    size growing with their relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
+    the right edge, where they leave the axes; ``criticals``
+    (:class:`transient.analysis.torsion.Critical`) marked, their size growing with their
+    relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
     ``run_orders``: a run's order amplitudes per cycle, (cycle-mean speeds [rpm], orders
-    [1/rev], amplitudes (n_cycles, n_orders); :func:`transient.analysis.torsion_run.campbell_overlay`),
-    drawn on the orders' lines at (n, q·n/60), a marker per cycle and order, its area and colour
-    (logarithmic, a colour bar under the axes) the amplitude, ``run_label``
-    naming the amplitude and its unit on the colour bar, ``run_largest`` the amplitude of the
-    top of its scale (default: the largest drawn; give one for diagrams of several runs to
-    compare); None draws none. Returns the legend's handles."""
+    [1/rev], amplitudes (n_cycles, n_orders)) as
+    :func:`transient.analysis.torsion_run.campbell_overlay` gives them, drawn on the orders'
+    lines at (n, q·n/60), a marker per cycle and order, its area and colour (logarithmic, a
+    colour bar under the axes) the amplitude; ``run_label`` names the amplitude and its unit on
+    the colour bar, ``run_largest`` is the top of its scale (default: the largest drawn; give
+    one to compare the diagrams of several runs); None draws none. Returns the legend's
+    handles."""
     from matplotlib.lines import Line2D
 
     from .analysis.torsion import order_kind
@@ -1082,7 +1084,8 @@ def cycle_curves(ax, x, curves, ylabel, xlabel="cycle-mean speed [rpm]"):
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
-    legend_outside(ax)
+    if artists:
+        legend_outside(ax)
     return artists
 
 

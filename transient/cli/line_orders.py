@@ -178,6 +178,8 @@ def figures(r: LineReport):
     a2.set_title(f"{r.column}: its strongest orders, cycle by cycle", fontsize=9)
     plots.cycle_curves(a3, x, _grouped(r.power), "mean power over the cycle [W]",
                        xlabel="cycle-mean speed [rpm]" if run_up else "cycle of the run")
+    if not r.power:
+        a3.text(0.5, 0.5, "the line has no damping", transform=a3.transAxes, ha="center")
     a3.set_title("power the damping takes, cycle by cycle", fontsize=9)
     fig.suptitle(f"{r.scene.name}: the shaft line cycle by cycle")
     yield "cycles_figure", fig
@@ -219,9 +221,10 @@ def _print_line(r: LineReport, top: float) -> None:
             print(f"  {part}: mean power at most {mean[k]:.5g} W, at {rpm[k]:.6g} rpm; "
                   f"{mean[-1]:.5g} W in the last cycle")
     losses = r.losses
-    print(f"  heats of the damping parts: Σ = {losses.heat[:, -1].sum():.8g} J against the "
-          f"run's W_line_loss {losses.total[-1] - losses.total[0]:.8g} J (relative "
-          f"difference {losses.residual:.2e}: the sampling's quadrature error)")
+    if losses.parts:
+        print(f"  heats of the damping parts: Σ = {losses.heat[:, -1].sum():.8g} J against "
+              f"the run's W_line_loss {losses.total[-1] - losses.total[0]:.8g} J (relative "
+              f"difference {losses.residual:.2e}: the sampling's quadrature error)")
     peaks = _strongest(r)
     print(f"  {r.column}, strongest orders up to {top:g}: largest amplitude and where, against "
           f"the nearest critical speed of the order:")
