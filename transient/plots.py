@@ -52,10 +52,11 @@ def _columns(traj):
     return getattr(traj, "trajectory", traj)
 
 
-def legend_outside(ax, handles=None, above=False, **kwargs):
+def legend_outside(ax, handles=None, above=False, gap=0.01, **kwargs):
     """A legend to the right of ``ax`` (or ``above`` it, in one row, for panels stacked on
     one x axis that should keep one width), off its data: a legend inside an axes hides the
-    curves it names wherever they pass under it. Returns the legend."""
+    curves it names wherever they pass under it; ``gap`` [axes width] between the axes and a
+    legend at the right. Returns the legend."""
     kwargs.setdefault("fontsize", 8)
     if handles is not None:
         kwargs["handles"] = handles
@@ -64,7 +65,8 @@ def legend_outside(ax, handles=None, above=False, **kwargs):
                                       ax.get_legend_handles_labels()[0]))
         return ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.01), borderaxespad=0.0,
                          **kwargs)
-    return ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, **kwargs)
+    return ax.legend(loc="upper left", bbox_to_anchor=(1.0 + gap, 1.0), borderaxespad=0.0,
+                     **kwargs)
 
 
 def cylinder_style(k: int, shift: int = 0) -> dict:
@@ -970,17 +972,23 @@ ORDER_STYLES = {"major": dict(color="C3", lw=1.5, ls="-"),
                 "half": dict(color="0.55", lw=0.8, ls=(0, (1.5, 1.5)))}
 
 
-def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None):
+def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None, run_label=None,
+                   run_largest=None):
     """The Campbell diagram of a shaft line: natural frequency [Hz] against shaft speed [rpm].
 
     ``modal`` (:class:`transient.analysis.torsion.Modal`): each elastic mode below the highest
     order's line as a line at its cycle-mean frequency, its frozen-angle band shaded; ``orders``
-    [1/rev] as lines f = q·n/60, styled by kind (:data:`ORDER_STYLES`) and labelled where they
-    leave the axes; ``criticals`` (:class:`transient.analysis.torsion.Critical`) marked, their
-    size growing with their relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
-    ``run_orders``: a run's order spectra per cycle as :func:`campbell` takes them,
-    (cycle-mean speeds [rpm], orders [1/rev], amplitudes (n_cycles, n_orders)), drawn on the
-    orders' lines as markers of area ∝ amplitude; None draws none. Returns the legend's
+    [1/rev] as lines f = q·n/60, styled by kind (:data:`ORDER_STYLES`) and labelled outside
+    the right edge, where they leave the axes; ``criticals``
+    (:class:`transient.analysis.torsion.Critical`) marked, their size growing with their
+    relative excitation; ``speed_range`` (lo, hi) [rpm] the x axis.
+    ``run_orders``: a run's order amplitudes per cycle, (cycle-mean speeds [rpm], orders
+    [1/rev], amplitudes (n_cycles, n_orders)) as
+    :func:`transient.analysis.torsion_run.campbell_overlay` gives them, drawn on the orders'
+    lines at (n, q·n/60), a marker per cycle and order, its area and colour (logarithmic, a
+    colour bar under the axes) the amplitude; ``run_label`` names the amplitude and its unit on
+    the colour bar, ``run_largest`` is the top of its scale (default: the largest drawn; give
+    one to compare the diagrams of several runs); None draws none. Returns the legend's
     handles."""
     from matplotlib.lines import Line2D
 
@@ -1002,10 +1010,11 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None):
     for q in orders:
         kind = order_kind(q, firing)
         ax.plot(rpm, q * rpm / 60.0, **ORDER_STYLES[kind])
-        x_end = min(hi, 60.0 * top / q)
-        ax.annotate(f"{q:g}", (x_end, q * x_end / 60.0), fontsize=6, ha="right", va="top",
-                    color=ORDER_STYLES[kind]["color"], xytext=(-2, -1),
-                    textcoords="offset points")
+        # (labelled outside the right spine, where the line leaves the axes: inside they
+        # would sit on the modes' bands and the critical speeds near that edge)
+        ax.annotate(f"{q:g}", (1.0, q * hi / 60.0), xycoords=("axes fraction", "data"),
+                    xytext=(2, 0), textcoords="offset points", fontsize=6, ha="left",
+                    va="center", color=ORDER_STYLES[kind]["color"], annotation_clip=False)
     handles += [Line2D([], [], **ORDER_STYLES[k], label=f"{k} orders") for k in ORDER_STYLES]
     if criticals:
         x = [c.rpm for c in criticals]
@@ -1014,21 +1023,70 @@ def modal_campbell(ax, modal, orders, speed_range, criticals, run_orders=None):
         handles.append(ax.scatter(x, y, s=size, facecolor="none", edgecolor="k", lw=0.9,
                                   zorder=3, label="critical speeds (size: relative excitation)"))
     if run_orders is not None:
-        speeds, run_q, amp = (np.asarray(a, dtype=float) for a in run_orders)
-        amp = np.abs(amp)
-        largest = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
-        x = np.repeat(speeds[:, None], run_q.size, axis=1)
-        ax.scatter(x, x * run_q[None, :] / 60.0, s=80.0 * amp / largest, color="C0", alpha=0.5,
-                   lw=0, zorder=2)
-        handles.append(Line2D([], [], marker="o", ls="", color="C0", alpha=0.5,
-                              label="run's order amplitudes"))
+        handles.append(_run_overlay(ax, *run_orders, label=run_label, largest=run_largest))
     ax.set_xlim(lo, hi)
     ax.set_ylim(0.0, top)
     ax.set_xlabel("shaft speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
     ax.grid(True, alpha=0.3)
-    legend_outside(ax, handles=handles)
+    legend_outside(ax, handles=handles, gap=ORDER_LABELS)
     return handles
+
+
+#: Room [axes width] right of a Campbell diagram for the orders' labels, between its spine
+#: and its legend.
+ORDER_LABELS = 0.05
+
+#: Decades of amplitude below the largest that a run's overlay on the Campbell diagram shows:
+#: weaker orders are the run's noise and the other orders' leakage, and would cover the lines.
+OVERLAY_DECADES = 2.0
+
+
+def _run_overlay(ax, speeds, run_q, amplitude, label=None, largest=None):
+    """A run's order amplitudes on a Campbell diagram: a marker at (cycle-mean speed [rpm],
+    q·n/60 [Hz]) for each cycle and order, its area ∝ the amplitude and its colour the
+    amplitude on a logarithmic scale up to ``largest`` (default the largest amplitude; a colour
+    bar under the axes, ``label`` on it), the largest drawn last (on top); amplitudes
+    :data:`OVERLAY_DECADES` below the top left out. Returns a handle for the legend."""
+    from matplotlib.colors import LogNorm
+    from matplotlib.lines import Line2D
+
+    speeds, run_q = np.asarray(speeds, dtype=float), np.asarray(run_q, dtype=float)
+    amp = np.abs(np.asarray(amplitude, dtype=float)).reshape(speeds.size, run_q.size)
+    if largest is None:
+        largest = float(amp.max()) if amp.size and amp.max() > 0 else 1.0
+    floor = largest * 10.0 ** -OVERLAY_DECADES
+    x = np.repeat(speeds[:, None], run_q.size, axis=1)
+    y = x * run_q[None, :] / 60.0
+    keep = amp >= floor
+    order = np.argsort(amp[keep], kind="stable")
+    shown = np.minimum(amp[keep][order], largest)
+    dots = ax.scatter(x[keep][order], y[keep][order], s=2.0 + 50.0 * shown / largest,
+                      c=shown, cmap="plasma", norm=LogNorm(floor, largest),
+                      lw=0, alpha=0.85, zorder=2.5)
+    ax.figure.colorbar(dots, ax=ax, orientation="horizontal", location="bottom", fraction=0.05,
+                       pad=0.08, aspect=40, label=label or "run's order amplitude")
+    return Line2D([], [], marker="o", ls="", color=dots.cmap(0.7),
+                  label="the run's order amplitudes (area, colour)")
+
+
+def cycle_curves(ax, x, curves, ylabel, xlabel="cycle-mean speed [rpm]"):
+    """Quantities of a run cycle by cycle (``curves``: label → one value per cycle) against
+    ``x`` (each cycle's mean speed [rpm], or its number), joined in the order of x, each in its
+    own dash pattern (:data:`DASHES`); the legend right of the axes. Returns the artists."""
+    x = np.asarray(x, dtype=float)
+    order = np.argsort(x, kind="stable")
+    artists = []
+    for k, (name, v) in enumerate(curves.items()):
+        artists += ax.plot(x[order], np.asarray(v, dtype=float)[order], lw=1.0,
+                           marker="." if x.size <= 60 else None, ms=3, label=name,
+                           ls=DASHES[k % len(DASHES)], color=f"C{k % 10}")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    if artists:
+        legend_outside(ax)
+    return artists
 
 
 def torsional_response(axes, res, criticals, leading: int = 6):

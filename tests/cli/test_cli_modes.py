@@ -98,7 +98,9 @@ def test_the_campbell_diagram_takes_a_runs_order_spectra():
     dots = ax.collections[-1].get_offsets()
     assert len(ax.collections) > before and len(dots) == 4
     assert np.allclose(dots[:, 1], dots[:, 0] * np.array([3.0, 4.5, 3.0, 4.5]) / 60.0)
-    assert handles[-1].get_label() == "run's order amplitudes"
+    assert handles[-1].get_label() == "the run's order amplitudes (area, colour)"
+    # the colour bar under the axes names the amplitude
+    assert fig.axes[-1].get_label() == "<colorbar>"
     plt.close(fig)
 
 

@@ -381,6 +381,50 @@ def test_orders_cli_writes_the_figure_its_run_calls_for(misfire, spinup, tmp_pat
     capsys.readouterr()
 
 
+def test_orders_of_an_elastic_run_up_draw_the_line(tmp_path_factory):
+    """An elastic run-up (the six from 2300 rpm, 30 revolutions): the Campbell diagram with the
+    run's orders, a marker per cycle and order at (n, q·n/60), the order labels outside the
+    axes, clear of its legend; the line cycle by cycle against the cycle-mean speed: the
+    elements' torques, the column's six strongest orders, the damping's power with the dampers
+    apart and the sections summed."""
+    import argparse
+
+    from transient.cli import line_orders
+
+    res = _run(tmp_path_factory, "inline6_damper.toml", "six", initial={"omega_rpm": 2300},
+               run={"revolutions": 30})
+    args = argparse.Namespace(line_column=None, samples_per_cycle=720, max_order=12.0,
+                              detrend="auto")
+    r = line_orders.report(res, res.scene(), args, res.events["breakpoint"]["phi"])
+    figs = _figures(line_orders.figures(r))
+    assert set(figs) == {"campbell", "cycles_figure"}
+    for fig in figs.values():
+        check_readable(fig)
+    campbell = figs["campbell"].axes[0]
+    dots = campbell.collections[-1].get_offsets()
+    rpm = r.rpm
+    assert np.all((dots[:, 0] >= rpm.min() - 1e-9) & (dots[:, 0] <= rpm.max() + 1e-9))
+    ratio = dots[:, 1] / dots[:, 0] * 60.0  # each marker on its order's line
+    assert np.allclose(ratio, np.round(2 * ratio) / 2, atol=1e-9)
+    fig = figs["campbell"]
+    renderer = fig.canvas.get_renderer()
+    labels = [t for t in campbell.texts if re.fullmatch(r"[0-9.]+", t.get_text())]
+    assert len(labels) == 24
+    spine = campbell.get_window_extent(renderer)
+    legend = campbell.get_legend().get_window_extent(renderer)
+    for t in labels:
+        box = t.get_window_extent(renderer)
+        assert box.x0 >= spine.x1 and box.x1 <= legend.x0
+    torque, tracks, power = [ax for ax in figs["cycles_figure"].axes
+                             if ax.get_label() != "<colorbar>"]
+    assert torque.get_xlabel() == tracks.get_xlabel() == ""
+    assert power.get_xlabel() == "cycle-mean speed [rpm]"
+    assert len(_lines(tracks)) == 6 and tracks.get_yscale() == "log"
+    assert [line.get_label() for line in _lines(power)] == [
+        "damper silicone at pulley", "sections, all", "absolute damping, all stations"]
+    _close(figs)
+
+
 # ------------------------------------------------------------------------------------------------
 # transient loads
 

@@ -16,13 +16,15 @@ from .irregularity import (
 )
 from .orders import resample_angle
 from .requested import requested_analyses
+from .torsion_run import damper_power_summary
 from .transient_response import load_step_times, run_response
 
 
 def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
               ) -> dict[str, tuple[float, str]]:
     """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``: speed, its
-    fluctuation, steady state, the mechanical efficiency over the steady cycles, and the
+    fluctuation, steady state, the mechanical efficiency over the steady cycles, an elastic
+    line's damper power over the last cycle, and the
     ISO 8528-5 measures of each load step and of a spin-up (``transient_response``), and what
     the scene's ``[analysis]`` table asks for (:mod:`.requested`). With load steps, the steady
     state and the efficiency are looked for after the last one."""
@@ -57,6 +59,8 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
         out["mean_drive_torque_last_cycle"] = (float(work[1] - work[0]) / cycle, "N m")
     if scene.gas.model != "none":
         out.update(mechanical_efficiency(scene, traj, events))
+    if scene.shaft is not None:  # the line's damping: what a damper is sized by
+        out.update(damper_power_summary(scene, traj))
     out.update(stuck)
     out.update(requested)
     # the mechanism's own figures (articulated rods: slave harmonics against Semenov's series)

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from ..errors import SceneError
+from . import line_orders
 from .common import (
     EXIT_OK,
     MAX_POINTS,
@@ -31,8 +32,12 @@ def register(sub) -> None:
                     "speed (odd-harmonic report); δ of the last cycle; with two or more whole "
                     "cycles, for a run-up a waterfall (a colour map), a Campbell chart and "
                     "order tracks of ω against the cycle-mean speed, for any other run the "
-                    "waterfall and order tracks cycle by cycle. Results are written as files "
-                    "into DIR, never into the HDF5 result (read only here).")
+                    "waterfall and order tracks cycle by cycle. Of an elastic run ([shaft]) "
+                    "also the shaft line cycle by cycle: each element's torque (mean and "
+                    "peak-to-peak), each damping part's mean power, the orders of a twist or "
+                    "torque (--line-column) over the line's Campbell diagram with its critical "
+                    "speeds. Results are written as files into DIR, never into the HDF5 "
+                    "result (read only here).")
     od.add_argument("result")
     od.add_argument("-o", "--output", default=None, help="folder (default: beside the result)")
     od.add_argument("--samples-per-cycle", type=whole(16, MAX_POINTS), default=720,
@@ -46,6 +51,7 @@ def register(sub) -> None:
     od.add_argument("--cylinder", type=int, default=1, metavar="K",
                     help="cylinder (1-based) of the odd-harmonic report of the piston "
                          "acceleration (default 1)")
+    line_orders.add_options(od)
     add_force(od)
     od.set_defaults(func=cmd_orders)
 
@@ -183,6 +189,10 @@ def cmd_orders(args) -> int:
     if not 1 <= args.cylinder <= mech.n_cylinders:
         raise SceneError("--cylinder", f"cylinder {args.cylinder} is out of range; allowed: "
                                        f"1 … {mech.n_cylinders}", file=str(res.path))
+    line_orders.check_column(res, scene, args)
+    out = output_folder(args.output, res.path.parent)
+    stem = result_stem(res.path)
+    line_paths = line_orders.plan(scene, args, out, stem)
     try:
         ro = run_orders(scene, traj, n, cuts=cuts, detrend=args.detrend,
                         piston_cylinder=args.cylinder)
@@ -194,9 +204,6 @@ def cmd_orders(args) -> int:
     rpm = 30.0 / math.pi
     orders = ro.orders
     top = args.max_order
-
-    out = output_folder(args.output, res.path.parent)
-    stem = result_stem(res.path)
     written = []
     cols_csv = {"order": orders, "omega_amplitude_rad_s": spec_w.amplitude[-1],
                 "omega_phase_rad": spec_w.phase[-1]}
@@ -260,6 +267,8 @@ def cmd_orders(args) -> int:
         if rep.drift[-1] and abs(rep.drift[-1]) > 1e-6 * rep.first[-1]:
             print(f"  (the cycle is not periodic: W drifts by {rep.drift[-1]:.3g} m/s² across "
                   f"it, which leaks into every order)")
+    if line_paths is not None:
+        written += line_orders.write(res, scene, args, line_paths, cuts)
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK
