@@ -216,8 +216,11 @@ class TorsionModel:
                     ) -> Array:
         """M_gas,k: the moments of the cylinders each station carries (with an engine, from
         its states in ``y`` too)."""
-        Mc = (self.engine.moments(theta, omega, y) if self.engine is not None
-              else self.cylinders.moments(theta[self.carrier], omega[self.carrier], t))
+        if self.engine is None:
+            Mc = self.cylinders.moments(theta[self.carrier], omega[self.carrier], t)
+        else:
+            assert y is not None, "an engine's moments need the state"
+            Mc = self.engine.moments(theta, omega, y)
         M = np.zeros(self.line.n)
         np.add.at(M, self.carrier, Mc)
         return M
@@ -408,17 +411,25 @@ class Segments:
         return out
 
 
+@dataclass(frozen=True)
+class _Rising:
+    """A terminal event of solve_ivp: the state's component ``index`` rising through ``level``."""
+
+    index: int
+    level: float
+    terminal: bool = True
+    direction: float = 1.0
+
+    def __call__(self, t: float, y: Array) -> float:
+        return y[self.index] - self.level
+
+
 def _integrate_segments(model, y0, t_end, method, rtol, atol, **options) -> Segments:
     t, y = 0.0, np.array(y0, dtype=float)
     ends, pieces = [0.0], []
     while True:
         triggers = model.engine.triggers(y)
-        events = []
-        for index, level, _ in triggers:
-            def g(t, yv, index=index, level=level):
-                return yv[index] - level
-            g.terminal, g.direction = True, 1.0
-            events.append(g)
+        events = [_Rising(index, level) for index, level, _ in triggers]
         sol = solve_ivp(model.rhs, (t, t_end), y, method=method, rtol=rtol, atol=atol,
                         events=events, **options)
         if sol.status == -1:
@@ -524,24 +535,6 @@ class PressurePulse:
 
 # -- a scene's engine: its gas with the cylinders' variation, governor, latching, wall heat ----
 
-_MASK64 = (1 << 64) - 1
-
-
-def _mix64(z: int) -> int:
-    """SplitMix64's output function (Steele, Lea & Flood 2014, Fig. 3), in Python integers."""
-    z = (z + 0x9E3779B97F4A7C15) & _MASK64
-    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK64
-    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK64
-    return z ^ (z >> 31)
-
-
-def misfire_draw(seed: int, k: int, n: int) -> float:
-    """The uniform draw in [0, 1) of cylinder k (from 0) in its cycle n under ``seed``, as
-    :class:`transient.scene.records.Cylinder` defines it: the top 53 bits of
-    mix64(mix64(mix64(seed) ^ k) ^ n)."""
-    return (_mix64(_mix64(_mix64(seed) ^ k) ^ n) >> 11) / float(1 << 53)
-
-
 class SceneEngine:
     """A crank-slider scene's cylinders as the elastic run drives them, written apart from the
     compiled kernels: each cylinder's pressure at its own station's angle θ, on its table read
@@ -549,8 +542,9 @@ class SceneEngine:
     p0 + β_c (p − p0), with f_c the governor's command (or the fuel it latched) times its fuel
     factor in the cycle its own angle is in, 0 in a misfiring one (the scene's
     ``[[gas.cylinders]]``, :class:`~transient.scene.records.Cylinder`, the draws from
-    :func:`misfire_draw`); the governor (droop, PI(D), flyweight: the rigid reference's
-    :class:`~transient.reference.twins.GovernorNumpy`) reading the reference station's speed;
+    :func:`~transient.reference.twins.misfire_draw`); the governor (droop, PI(D), flyweight:
+    the rigid reference's :class:`~transient.reference.twins.GovernorNumpy`) reading the
+    reference station's speed;
     each cylinder latching the command where the reference passes its injection angle
     (``gas.injection``); with ``[gas.woschni]`` each cylinder's closed part a pressure state
     (the rigid reference's :class:`~transient.reference.twins.CylindersNumpy`) at its own
@@ -561,12 +555,16 @@ class SceneEngine:
 
     def __init__(self, scene, cylinders: CrankSliderCylinders, carrier, ref: int) -> None:
         from ..scene.queries import cycle_begin, gas_phases, gas_tables
+        from .twins import misfire_draw
 
+        self.draw = misfire_draw
         mech, gas = scene.mechanism, scene.gas
         if gas.model in ("none", "trapezoid") or gas.force:
             raise ValueError("SceneEngine: a gas model of pressures only")
         self.scene, self.cyl, self.carrier, self.ref = scene, cylinders, carrier, ref
-        self.full, self.motored = gas_tables(scene)
+        full, self.motored = gas_tables(scene)
+        assert full is not None  # (a pressure model has its table)
+        self.full = full
         self.p0, self.period = gas.p0, mech.cycle
         self.phase = gas_phases(scene)
         n = mech.n_cylinders
@@ -583,7 +581,7 @@ class SceneEngine:
         first = np.mod(self.phase + cycle_begin(mech), self.period)
         phi0 = scene.initial.phi
         self.start = phi0 - np.mod(phi0 - first, self.period)
-        self.n, self.n_states = n, 0
+        self.n = n
         self.n_gov = {"pi": 2 + (scene.governor.gain_d > 0.0), "flyweight": 2}.get(
             scene.governor.model, 0)
         self.latch = gas.injection
@@ -620,7 +618,7 @@ class SceneEngine:
         if f == 0.0 or n < 1:
             return float(f)
         if ((self.every[k] and n % self.every[k] == 0) or n in self.cycles[k]
-                or (self.rate[k] > 0.0 and misfire_draw(int(self.seed[k]), k, n) < self.rate[k])):
+                or (self.rate[k] > 0.0 and self.draw(int(self.seed[k]), k, n) < self.rate[k])):
             return 0.0
         return float(f)
 

@@ -309,6 +309,25 @@ class SwashReactionNumpy(ReactionNumpy):
         return (r.epsilon, *self.pairs(S, L_cyl, L))
 
 
+_MASK64 = (1 << 64) - 1
+
+
+def mix64(z: int) -> int:
+    """SplitMix64's output function (Steele, Lea & Flood 2014, Fig. 3), in Python integers."""
+    z = (z + 0x9E3779B97F4A7C15) & _MASK64
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK64
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK64
+    return z ^ (z >> 31)
+
+
+def misfire_draw(seed: int, k: int, n: int) -> float:
+    """The uniform draw in [0, 1) of cylinder k (from 0) in its cycle n under ``seed``, as
+    :class:`transient.scene.records.Cylinder` defines it: the top 53 bits of
+    mix64(mix64(mix64(seed) ^ k) ^ n); the twin of
+    :func:`transient.core.model.variation.misfire_draw`."""
+    return (mix64(mix64(mix64(seed) ^ k) ^ n) >> 11) / float(1 << 53)
+
+
 class CylindersNumpy:
     """The cylinder pressures of the closed part with wall heat transfer (``[gas.woschni]``),
     from the scalar functions of :mod:`transient.forces.woschni` and
