@@ -258,6 +258,10 @@ def build_model(scene, part_load: bool = False
         bp = union_of_angles(bp, curve.corners, period)
     if reaction_friction(scene):
         bp = union_of_angles(bp, reaction_breakpoints(scene), period)
+    cylinders = cylinder_fields(scene)
+    if cylinders["woschni"] and scene.shaft is not None:  # where the pressure states restart
+        # (a rigid scene's at its intake closings, the tables' corners already)
+        bp = union_of_angles(bp, phases + cylinders["cyl_par"][cyl.RESTART], period)
     model = Model(
         terms=tabulated_kernel if tabulated else mech.kernel, mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -275,7 +279,7 @@ def build_model(scene, part_load: bool = False
         starter_torque=scene.starter.torque, starter_noload=scene.starter.noload_speed,
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
-        **governor_fields(scene), **chain_fields(scene), **cylinder_fields(scene), **variation,
+        **governor_fields(scene), **chain_fields(scene), **cylinders, **variation,
         **line_fields(scene, tabulated))
     if model.woschni:
         model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
@@ -371,6 +375,10 @@ def cylinder_fields(scene) -> dict:
         clearance_volume(scene), area, mech.bore, cycle.v_h / area, cycle.v_h)
     par[[cyl.C1, cyl.C2, cyl.T_WALL]] = h.c1, h.c2, h.wall_temperature
     par[cyl.GAMMA_A] = w.gamma + w.gamma_slope * (w.t_a - w.gamma_t_ref)
+    # restarted at p_a where its intake closes; on an elastic line, whose breakpoints are the
+    # reference's angles, half its open part away from either end, which no twist reaches
+    par[cyl.RESTART] = (closed.start if scene.shaft is None
+                        else closed.end + 0.5 * (mech.cycle - (closed.end - closed.start)))
     return dict(woschni=True, cyl_par=par)
 
 

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 
 import pytest
-from scene_texts import MIXED_CYCLE, SMALL
+from scene_texts import SMALL
 
 from transient.cli import main
 from transient.errors import SceneError
@@ -173,16 +173,13 @@ def _without_inertia(text: str) -> str:
 
 # -- what the elastic run does not support is refused, never run without it or rigid -------
 
-GAS = MIXED_CYCLE.format(cr=18)
 #: (the key refused, what the scene adds to BASE + LINE): one of each of
 #: transient.shaft.line.UNSUPPORTED
 UNSUPPORTED = [
     ("friction.pairs", '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
                        "eta_backward = 0.9\n"),
-    ("governor.model", '\n[governor]\nmodel = "pi"\nspeed_rpm = 1000\ngain_p = 10\n'
-                       'gain_i = 30\n'),
-    ("gas.injection", GAS + "injection_deg = 340\n"),
-    ("gas.cylinders", GAS + "\n[[gas.cylinders]]\ncylinder = 1\nfuel = 0.9\n"),
+    ("load.table", '[shaft]\nload_at = "front"\n[load.table]\nphi_deg = [0, 360, 720]\n'
+                   "torque = [1, -1, 1]\n"),
     ("load.inertia", "\n[load]\ninertia = 0.1\ninertia_time = 0.01\n"),
     ("run.mode", None),
     ("solver.method", None),
@@ -220,7 +217,7 @@ def test_tabulated_kinematics_is_refused_with_cylinders_on_several_stations():
 
 def test_the_command_refuses_what_the_elastic_run_does_not_support(tmp_path, capsys):
     path = tmp_path / "elastic.toml"
-    path.write_text(_unsupported("load.inertia", UNSUPPORTED[4][1]), encoding="utf-8")
+    path.write_text(_unsupported("load.inertia", dict(UNSUPPORTED)["load.inertia"]), encoding="utf-8")
     out = tmp_path / "out"
     assert main(["run", str(path), "-o", str(out), "-q"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

@@ -14,22 +14,11 @@ from transient.assemble import build_model
 from transient.cli import main
 from transient.core.model.variation import FUEL, PRESSURE, SHIFT, START, cycle_fuel, misfire_draw
 from transient.errors import SceneError
+from transient.reference.twins import misfire_draw as draw
+from transient.reference.twins import mix64
 from transient.scene import load_scene, scene_from_dict
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "diesel_4cyl_misfire.toml"
-MASK = (1 << 64) - 1
-
-
-def mix64(z: int) -> int:
-    """SplitMix64's output function (Steele, Lea & Flood 2014, Fig. 3), in Python integers."""
-    z = (z + 0x9E3779B97F4A7C15) & MASK
-    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK
-    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
-    return z ^ (z >> 31)
-
-
-def draw(seed: int, k: int, n: int) -> float:
-    return (mix64(mix64(mix64(seed) ^ k) ^ n) >> 11) / 2.0 ** 53
 
 
 @pytest.fixture(scope="module")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from elastic_checks import line_balance
 
 import transient
 from transient.analysis.efficiency import mechanical_efficiency
@@ -63,34 +64,12 @@ def test_the_run_is_the_reference_lines(two_cycles):
     assert np.max(np.abs(-S - torque)) <= 1000 * rtol * np.max(np.abs(torque))
 
 
-def _balance(scene, tr):
-    """(T4) at every sample: Σ ½J_d(θ_d)ω_d² + Σ ½kδ² − its start − (W_gas + W_load +
-    W_starter − W_line_loss), the kinetic energy from the columns' angles and speeds with
-    ShaftLine's station inertias (numpy, not the kernels), the potential from its element
-    table; and that energy, to hold the column ``E_line`` against."""
-    line = ShaftLine(scene)
-    names = [column_name(d.name) for d in line.dofs]
-    theta = np.array([tr["phi"] + tr[f"twist_{d}"] for d in names])
-    omega = np.array([tr[f"omega_{d}"] for d in names])
-    J = np.repeat(line.own_inertia[:, None], theta.shape[1], axis=1)
-    for i in range(theta.shape[1]):
-        J[line.station_dof, i] = line.station_inertia(theta[line.station_dof, i])[0]
-    kinetic = 0.5 * np.sum(J * omega ** 2, axis=0)
-    rows = line.element_rows()
-    a, b = rows[:, 0].astype(int), rows[:, 1].astype(int)
-    potential = 0.5 * np.sum(rows[:, 2, None] * (theta[a] - theta[b]) ** 2, axis=0)
-    energy = kinetic + potential
-    balance = (energy - energy[0] - tr["W_gas"] - tr["W_load"] - tr["W_starter"]
-               + tr["W_line_loss"])
-    return balance, energy
-
-
 def test_the_energy_balance_holds_to_the_solvers_tolerance(two_cycles):
     """(T4) within 1e2·rtol of the gas work at every sample; the column ``E_line`` is the
     line's energy written out here, and the efficiency analysis closes its balance with it."""
     scene, res = two_cycles
     tr = res.trajectory
-    balance, energy = _balance(scene, tr)
+    balance, energy = line_balance(scene, tr)
     # the kernels' own sum of it (J_d from the mechanism's compiled shares)
     np.testing.assert_allclose(tr["E_line"], energy, rtol=1e-12)
     assert tr["W_line_loss"][-1] > 0.0 and np.all(np.diff(tr["W_line_loss"]) >= 0.0)
@@ -119,7 +98,7 @@ def test_a_start_from_rest_switches_every_dof_to_crank_angle():
     tr = res.trajectory
     assert tr["omega"][0] == 0.0 and tr["omega"][-1] > 2.0 * scene.solver.switch_speed
     assert res.events["to_angle_domain"]["t"].size >= 1 and tr["W_starter"][-1] > 0.0
-    balance, _ = _balance(scene, tr)
+    balance, _ = line_balance(scene, tr)
     assert np.max(np.abs(balance)) <= 1e2 * scene.solver.rtol * np.max(np.abs(tr["W_gas"]))
 
 

@@ -151,6 +151,7 @@ class TorsionModel:
     cylinders: Cylinders
     external: StationMoments | None = None
     driven_load: DrivenMoment | None = None
+    engine: SceneEngine | None = None
     nfev: int = field(default=0, init=False)
 
     def __post_init__(self) -> None:
@@ -158,7 +159,11 @@ class TorsionModel:
         self.n_rings = r
         self.i_ring = 2 * n
         self.i_driven = 2 * n + 2 * r
-        self.i_works = self.i_driven + (2 if self.line.coupling is not None else 0)
+        self.i_engine = self.i_driven + (2 if self.line.coupling is not None else 0)
+        self.i_works = self.i_engine
+        if self.engine is not None:  # its states (governor, latched fuels, pressures) here
+            self.engine.place(self.i_engine, n)
+            self.i_works += self.engine.n_states
         self.size = self.i_works + len(WORKS)
         self.carrier = np.asarray(self.line.station_of_cylinder, dtype=np.intp)
         self.weights = self.mean_inertias()
@@ -185,6 +190,8 @@ class TorsionModel:
         c = self.line.coupling
         if c is not None:
             y[self.i_driven], y[self.i_driven + 1] = theta / c.ratio, omega / c.ratio
+        if self.engine is not None:
+            y[self.i_engine:self.i_works] = self.engine.initial(theta, omega)
         return y
 
     def split(self, y: Array):
@@ -205,9 +212,15 @@ class TorsionModel:
         np.add.at(dJ, self.carrier, dJc)
         return self.line.inertia + Jm, dJ, Jm
 
-    def gas_moments(self, theta: Array, omega: Array, t: float) -> Array:
-        """M_gas,k: the moments of the cylinders each station carries."""
-        Mc = self.cylinders.moments(theta[self.carrier], omega[self.carrier], t)
+    def gas_moments(self, theta: Array, omega: Array, t: float, y: Array | None = None
+                    ) -> Array:
+        """M_gas,k: the moments of the cylinders each station carries (with an engine, from
+        its states in ``y`` too)."""
+        if self.engine is None:
+            Mc = self.cylinders.moments(theta[self.carrier], omega[self.carrier], t)
+        else:
+            assert y is not None, "an engine's moments need the state"
+            Mc = self.engine.moments(theta, omega, y)
         M = np.zeros(self.line.n)
         np.add.at(M, self.carrier, Mc)
         return M
@@ -302,7 +315,7 @@ class TorsionModel:
         line = self.line
         th, w, _, rw, thd, wd = self.split(y)
         J, dJ, Jm = self.station_inertia(th)
-        M_gas = self.gas_moments(th, w, t)
+        M_gas = self.gas_moments(th, w, t, y)
         M_ext = (np.asarray(self.external(th, w, t), dtype=float) if self.external is not None
                  else np.zeros(line.n))
         T, T_ring, T_driven, dissipated = self.element_torques(y)
@@ -355,6 +368,8 @@ class TorsionModel:
         dy[self.i_ring:self.i_ring + r], dy[self.i_ring + r:self.i_driven] = rw, ring_acc
         if self.line.coupling is not None:
             dy[self.i_driven], dy[self.i_driven + 1] = wd, driven_acc
+        if self.engine is not None:
+            dy[self.i_engine:self.i_works] = self.engine.rates(y[:n], w, y)
         dy[self.i_works:] = (*applied, *dissipated)
         return dy
 
@@ -362,14 +377,73 @@ class TorsionModel:
 def integrate(model: TorsionModel, y0: Array, t_end: float, method: str = "DOP853",
               rtol: float = 1e-10, atol: float = 1e-12, **options):
     """``solve_ivp`` over [0, t_end] from y0; the work integrals are left out of the error
-    control (they do not feed back), as the rigid run leaves its own."""
+    control (they do not feed back), as the rigid run leaves its own. With an engine whose
+    states change where an angle passes a level (:meth:`SceneEngine.triggers`: a fuel
+    latched, a closed part started), segment by segment between those terminal events; the
+    result's ``sol`` (with ``dense_output``) then evaluates the segment each time lies in."""
     scale = np.ones(model.size)
     scale[model.i_works:] = np.inf  # (atol ∞: never limits the step)
-    sol = solve_ivp(model.rhs, (0.0, t_end), y0, method=method, rtol=rtol, atol=atol * scale,
-                    **options)
-    if sol.status == -1:
-        raise RuntimeError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
-    return sol
+    if model.engine is None or not model.engine.triggers(y0):
+        sol = solve_ivp(model.rhs, (0.0, t_end), y0, method=method, rtol=rtol,
+                        atol=atol * scale, **options)
+        if sol.status == -1:
+            raise RuntimeError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
+        return sol
+    return _integrate_segments(model, y0, t_end, method, rtol, atol * scale, **options)
+
+
+@dataclass
+class Segments:
+    """A run of :func:`integrate` in segments: their ends ``t`` (from 0), solutions and dense
+    outputs; ``sol(t)`` evaluates the segment each time lies in (at a segment's end the
+    next one's start, after its event acted)."""
+
+    t: Array
+    pieces: list
+    status: int = 0
+
+    def sol(self, t):
+        t = np.asarray(t, dtype=float)
+        j = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.pieces) - 1)
+        out = np.empty((self.pieces[0].sol(self.t[0]).size, t.size))
+        for i in np.unique(j):
+            out[:, j == i] = self.pieces[i].sol(t[j == i])
+        return out
+
+
+@dataclass(frozen=True)
+class _Rising:
+    """A terminal event of solve_ivp: the state's component ``index`` rising through ``level``."""
+
+    index: int
+    level: float
+    terminal: bool = True
+    direction: float = 1.0
+
+    def __call__(self, t: float, y: Array) -> float:
+        return y[self.index] - self.level
+
+
+def _integrate_segments(model, y0, t_end, method, rtol, atol, **options) -> Segments:
+    t, y = 0.0, np.array(y0, dtype=float)
+    ends, pieces = [0.0], []
+    while True:
+        triggers = model.engine.triggers(y)
+        events = [_Rising(index, level) for index, level, _ in triggers]
+        sol = solve_ivp(model.rhs, (t, t_end), y, method=method, rtol=rtol, atol=atol,
+                        events=events, **options)
+        if sol.status == -1:
+            raise RuntimeError(f"solve_ivp failed at t = {sol.t[-1]:.9g} s: {sol.message}")
+        pieces.append(sol)
+        if sol.status == 0:
+            ends.append(t_end)
+            return Segments(np.array(ends[:-1]), pieces)
+        j = next(i for i, te in enumerate(sol.t_events) if te.size)
+        t, y = float(sol.t_events[j][0]), np.array(sol.y_events[j][0])
+        for index, level, act in triggers:  # every trigger on this level acts
+            if abs(y[index] - level) <= 1e-9 * max(1.0, abs(level)):
+                act(y)
+        ends.append(t)
 
 
 # -- the engine's side: a crank-slider's cylinders, and a pressure pulse ------------------------
@@ -459,6 +533,186 @@ class PressurePulse:
         return self.peak * np.exp(-0.5 * (d / self.width) ** 2)
 
 
+# -- a scene's engine: its gas with the cylinders' variation, governor, latching, wall heat ----
+
+class SceneEngine:
+    """A crank-slider scene's cylinders as the elastic run drives them, written apart from the
+    compiled kernels: each cylinder's pressure at its own station's angle θ, on its table read
+    at its local angle x, p = p_mot(x) + f_c (p_full(x − δ_c) − p_mot(x − δ_c)) acting as
+    p0 + β_c (p − p0), with f_c the governor's command (or the fuel it latched) times its fuel
+    factor in the cycle its own angle is in, 0 in a misfiring one (the scene's
+    ``[[gas.cylinders]]``, :class:`~transient.scene.records.Cylinder`, the draws from
+    :func:`~transient.reference.twins.misfire_draw`); the governor (droop, PI(D), flyweight:
+    the rigid reference's :class:`~transient.reference.twins.GovernorNumpy`) reading the
+    reference station's speed;
+    each cylinder latching the command where the reference passes its injection angle
+    (``gas.injection``); with ``[gas.woschni]`` each cylinder's closed part a pressure state
+    (the rigid reference's :class:`~transient.reference.twins.CylindersNumpy`) at its own
+    station's angle and speed, set to p_a where its own angle closes the intake.
+
+    States (the block :class:`TorsionModel` gives it, :meth:`place`): the governor's, the
+    latched fuels, the pressures. A flyweight sleeve is taken free (no stops)."""
+
+    def __init__(self, scene, cylinders: CrankSliderCylinders, carrier, ref: int) -> None:
+        from ..scene.queries import cycle_begin, gas_phases, gas_tables
+        from .twins import misfire_draw
+
+        self.draw = misfire_draw
+        mech, gas = scene.mechanism, scene.gas
+        if gas.model in ("none", "trapezoid") or gas.force:
+            raise ValueError("SceneEngine: a gas model of pressures only")
+        self.scene, self.cyl, self.carrier, self.ref = scene, cylinders, carrier, ref
+        full, self.motored = gas_tables(scene)
+        assert full is not None  # (a pressure model has its table)
+        self.full = full
+        self.p0, self.period = gas.p0, mech.cycle
+        self.phase = gas_phases(scene)
+        n = mech.n_cylinders
+        self.factor, self.beta, self.delta = np.ones(n), np.ones(n), np.zeros(n)
+        self.every, self.rate = np.zeros(n, dtype=int), np.zeros(n)
+        self.seed, self.cycles = np.zeros(n, dtype=int), [()] * n
+        for c in gas.cylinders:
+            k = c.cylinder - 1
+            self.factor[k], self.beta[k], self.delta[k] = c.fuel, c.pressure, c.combustion_offset
+            self.every[k], self.rate[k] = c.misfire_every, c.misfire_rate
+            self.seed[k] = c.misfire_seed
+            self.cycles[k] = tuple(c.misfire_cycles)
+        # cycle 1 of a cylinder: the one in progress at the initial angle
+        first = np.mod(self.phase + cycle_begin(mech), self.period)
+        phi0 = scene.initial.phi
+        self.start = phi0 - np.mod(phi0 - first, self.period)
+        self.n = n
+        self.n_gov = {"pi": 2 + (scene.governor.gain_d > 0.0), "flyweight": 2}.get(
+            scene.governor.model, 0)
+        self.latch = gas.injection
+        self.woschni = gas.woschni is not None
+        self.n_states = self.n_gov + n * (self.latch is not None) + n * self.woschni
+
+    def place(self, i0: int, stations: int) -> None:
+        """Its states start at index ``i0`` of the model's state, whose speeds of the
+        ``stations`` follow their angles."""
+        from .twins import CylindersNumpy, GovernorNumpy
+
+        self.i_speed = stations
+        self.governor = GovernorNumpy(self.scene, i0)
+        self.i_latch = i0 + self.n_gov
+        self.i_p = self.i_latch + (self.n if self.latch is not None else 0)
+        self.closed = (CylindersNumpy(self.scene, self.phase, self.period, self.i_p, self.delta)
+                       if self.woschni else None)
+
+    # -- the fuel -------------------------------------------------------------------------
+    def droop(self, w: float) -> float:
+        g = self.scene.governor
+        if g.model != "droop":
+            return 1.0
+        return float(np.clip((g.speed_zero - w) / (g.speed_zero - g.speed_full), 0.0, 1.0))
+
+    def command(self, w_ref: float, y: Array) -> float:
+        """The governor's fuel command at the reference's speed."""
+        return self.governor.command(w_ref, y, self.droop)
+
+    def cycle_factor(self, k: int, theta: float) -> float:
+        """Cylinder k's fuel factor in the cycle its angle θ is in (0: misfiring)."""
+        f = self.factor[k]
+        n = math.floor((theta - self.start[k]) / self.period) + 1
+        if f == 0.0 or n < 1:
+            return float(f)
+        if ((self.every[k] and n % self.every[k] == 0) or n in self.cycles[k]
+                or (self.rate[k] > 0.0 and self.draw(int(self.seed[k]), k, n) < self.rate[k])):
+            return 0.0
+        return float(f)
+
+    def fuels(self, angles: Array, w_ref: float, y: Array) -> Array:
+        """Each cylinder's fuel at its angle."""
+        f = (y[self.i_latch:self.i_latch + self.n] if self.latch is not None
+             else np.full(self.n, self.command(w_ref, y)))
+        return f * np.array([self.cycle_factor(k, a) for k, a in enumerate(angles)])
+
+    # -- pressures and moments ------------------------------------------------------------------
+    def table_pressures(self, local: Array, f: Array) -> Array:
+        """p_mot(x) + f (p_full(x − δ) − p_mot(x − δ)) at the local angles x (the tables read
+        δ later only without wall heat, whose combustion is shifted in its rates)."""
+        mot = self.motored if self.motored is not None else (lambda x: np.full(x.shape, self.p0))
+        x = local - (self.delta if not self.woschni else 0.0)
+        return mot(local) + f * (self.full(x) - mot(x))
+
+    def pressures(self, theta: Array, omega: Array, y: Array) -> Array:
+        """Each cylinder's pressure as it acts on its piston, at its station's angle."""
+        angles = theta[self.carrier]
+        local = np.mod(angles - self.phase, self.period)
+        p = self.table_pressures(local, self.fuels(angles, omega[self.ref], y))
+        if self.closed is not None:
+            p = self.closed.pressures(p, local, y)
+        return self.p0 + self.beta * (p - self.p0)
+
+    def moments(self, theta: Array, omega: Array, y: Array) -> Array:
+        """Each cylinder's gas moment (p − p0) A_p u_c(θ) [N m]."""
+        angles = theta[self.carrier]
+        return ((self.pressures(theta, omega, y) - self.p0) * self.cyl.area
+                * self.cyl.piston_speeds(angles))
+
+    # -- the states --------------------------------------------------------------------------
+    def initial(self, theta: float, omega: float) -> Array:
+        """The governor at rest at ω (PI(D): its integrator and rack at ``fuel_initial``, its
+        filter at ω; the flyweight's sleeve in its balance, free), each cylinder latched at the
+        command, each pressure the table's at it in its closed part (else p_a)."""
+        g = self.scene.governor
+        if g.model == "pi":
+            states = [g.fuel_initial, g.fuel_initial] + ([omega] if g.gain_d > 0.0 else [])
+            f0 = g.fuel_initial
+        elif g.model == "flyweight":
+            c = self.governor.cent * omega ** 2
+            z = (c * g.radius - g.spring_preload) / (g.spring_rate - c * self.governor.arm)
+            states = [z, 0.0]
+            f0 = g.fuel_max + (g.fuel_min - g.fuel_max) * z / g.travel
+        else:
+            states, f0 = [], self.droop(omega)
+        out = list(states) + ([f0] * self.n if self.latch is not None else [])
+        if self.closed is not None:
+            local = np.mod(theta - self.phase, self.period)
+            f = f0 * np.array([self.cycle_factor(k, theta) for k in range(self.n)])
+            p = self.table_pressures(local, f)
+            out += list(np.where(np.isfinite(self.closed.past_intake(local)), p,
+                                 self.closed.p_a))
+        return np.array(out, dtype=float)
+
+    def rates(self, theta: Array, omega: Array, y: Array) -> Array:
+        """The governor's rates at the reference's speed, zero for the latched fuels, each
+        pressure's at its station's angle and speed."""
+        w_ref = omega[self.ref]
+        out = list(self.governor.rates(w_ref, y)) + [0.0] * (self.n if self.latch is not None
+                                                               else 0)
+        if self.closed is not None:
+            angles = theta[self.carrier]
+            local = np.mod(angles - self.phase, self.period)
+            out += self.closed.rates(local, 0.0, self.cyl.piston_speeds(angles),
+                                     omega[self.carrier], self.fuels(angles, w_ref, y), y)
+        return np.array(out, dtype=float)
+
+    def triggers(self, y: Array) -> list:
+        """The angle levels next passed where a state is set: (the index of the angle in the
+        state, the level, the action on the state)."""
+        out = []
+
+        def ahead(angle: float, level: float) -> float:
+            return level + self.period * (math.floor((angle - level) / self.period + 1e-9) + 1)
+
+        if self.latch is not None:
+            for k in range(self.n):
+                def latch(yv, k=k):
+                    w_ref = yv[self.i_speed + self.ref]
+                    yv[self.i_latch + k] = self.command(w_ref, yv)
+                level = ahead(y[self.ref], self.phase[k] + self.latch)
+                out.append((self.ref, level, latch))
+        if self.closed is not None:
+            for k in range(self.n):
+                def close(yv, k=k):
+                    yv[self.i_p + k] = self.closed.p_a
+                s = int(self.carrier[k])
+                out.append((s, ahead(y[s], self.phase[k] + self.closed.ivc), close))
+        return out
+
+
 # -- the rigid limit ---------------------------------------------------------------------------
 
 def rigid_run(J_rest: float, terms, gas: Callable[[float], float],
@@ -493,18 +747,22 @@ def rigid_run(J_rest: float, terms, gas: Callable[[float], float],
 def from_scene(scene) -> tuple[TorsionModel, int]:
     """The reference model of a crank-slider scene's ``[shaft]`` line and the index of its
     reference station: the stations', sections', dampers' and coupling's data from the scene's
-    records, the cylinders (:class:`CrankSliderCylinders`) burning the full-load table of its
-    gas, and its load's torque, linear and fan terms acting where ``load_at`` says. What it
-    shares with the compiled path: the scene's records, the pressure table and the sections'
-    viscous c of a loss factor or damping ratio (:class:`transient.shaft.line.ShaftLine`, which
-    needs the line's ω₁). A starter, governor, generator, schedule or a mechanism other than
-    the crank-slider is beyond it (ValueError)."""
-    from ..scene.queries import gas_phases, gas_tables
+    records, the cylinders (:class:`CrankSliderCylinders`) driven by its gas as the elastic run
+    drives them (:class:`SceneEngine`: the cylinders' variation and misfires, the governor,
+    fuel latching, the closed part with wall heat), and its load's torque, linear and fan terms
+    and table (:func:`transient.assemble.load_table_curve`, at its dof's speed, angle or the
+    time) acting where ``load_at`` says. What it shares with the compiled path: the scene's
+    records, the pressure tables, the load's curve and the sections' viscous c of a loss
+    factor or damping ratio (:class:`transient.shaft.line.ShaftLine`, which needs the line's
+    ω₁). A starter,
+    generator, schedule, a force model of the gas or a mechanism other than the crank-slider is
+    beyond it (ValueError)."""
+    from ..assemble import load_table_curve
     from ..shaft import ShaftLine as CompiledLine
 
     shaft, mech, load = scene.shaft, scene.mechanism, scene.load
     if (mech.name != "crank-slider" or scene.starter.torque > 0.0
-            or scene.governor.model != "none" or load.generator_power or load.schedule_scale):
+            or load.generator_power or load.schedule_scale):
         raise ValueError("from_scene: a crank-slider scene with a fixed load only")
     compiled = CompiledLine(scene)
     names = [st.name for st in shaft.stations]
@@ -524,29 +782,30 @@ def from_scene(scene) -> tuple[TorsionModel, int]:
                      stiffness=np.array([s.stiffness for s in shaft.sections]),
                      damping=c_sections, absolute=np.array([st.damping for st in shaft.stations]),
                      station_of_cylinder=carrier, rings=rings, coupling=coupling)
-    table = gas_tables(scene)[0]
-    p0 = scene.gas.p0
-    # (the table's local angle is from the cylinder's gas phase, the cylinders' from its TDC)
-    shift = gas_phases(scene) - np.asarray(mech.firing_angles)
+    ref = names.index(shaft.reference)
+    cylinders = CrankSliderCylinders(mech)
+    engine = SceneEngine(scene, cylinders, carrier, ref) if scene.gas.model != "none" else None
 
-    def pressure(local):
-        return table(np.mod(local - shift, mech.cycle)) - p0
+    curve = load_table_curve(scene)
 
-    def torque(w):
-        return -(load.torque + load.linear * w + load.fan * w * np.abs(w))
+    def torque(th, w, t):
+        resist = load.torque + load.linear * w + load.fan * w * np.abs(w)
+        if curve is not None:  # T(x) at its dof's speed, angle or the time
+            resist += curve.evaluate({"speed": w, "angle": th, "time": t}[curve.abscissa])
+        return -resist
 
     external = driven = None
     if shaft.load_at == "driven":
         ratio = coupling.ratio if coupling is not None else 1.0
 
         def driven(th, w, t):  # the law at the speed seen at the shaft, its power kept
-            return ratio * torque(ratio * w)
+            return ratio * torque(ratio * th, ratio * w, t)
     else:
         at = names.index(shaft.load_at)
 
         def external(th, w, t):
             M = np.zeros(n)
-            M[at] = torque(w[at])
+            M[at] = torque(th[at], w[at], t)
             return M
-    model = TorsionModel(line, CrankSliderCylinders(mech, pressure), external, driven)
-    return model, names.index(shaft.reference)
+    model = TorsionModel(line, cylinders, external, driven, engine)
+    return model, ref

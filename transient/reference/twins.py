@@ -309,6 +309,25 @@ class SwashReactionNumpy(ReactionNumpy):
         return (r.epsilon, *self.pairs(S, L_cyl, L))
 
 
+_MASK64 = (1 << 64) - 1
+
+
+def mix64(z: int) -> int:
+    """SplitMix64's output function (Steele, Lea & Flood 2014, Fig. 3), in Python integers."""
+    z = (z + 0x9E3779B97F4A7C15) & _MASK64
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK64
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK64
+    return z ^ (z >> 31)
+
+
+def misfire_draw(seed: int, k: int, n: int) -> float:
+    """The uniform draw in [0, 1) of cylinder k (from 0) in its cycle n under ``seed``, as
+    :class:`transient.scene.records.Cylinder` defines it: the top 53 bits of
+    mix64(mix64(mix64(seed) ^ k) ^ n); the twin of
+    :func:`transient.core.model.variation.misfire_draw`."""
+    return (mix64(mix64(mix64(seed) ^ k) ^ n) >> 11) / float(1 << 53)
+
+
 class CylindersNumpy:
     """The cylinder pressures of the closed part with wall heat transfer (``[gas.woschni]``),
     from the scalar functions of :mod:`transient.forces.woschni` and
@@ -350,9 +369,13 @@ class CylindersNumpy:
         return np.where(closed, y[self.c:self.c + p_table.size], p_table)
 
     def rates(self, local_mid, phi_shift, u, w, fuel, y):
+        """dp_k/dt per cylinder; ``w`` the shaft's speed, or each cylinder's (an elastic
+        line's stations)."""
         w_ = self.w
         out = []
+        speeds = np.broadcast_to(w, np.shape(local_mid))
         for k, x_mid in enumerate(self.past_intake(local_mid)):
+            w_k = float(speeds[k])
             if not np.isfinite(x_mid):
                 out.append(0.0)
                 continue
@@ -365,12 +388,13 @@ class CylindersNumpy:
             dq_b = (q * self.zone.wiebe_rate_y(min(max((x - self.start) / w_.duration, 0.0), 1.0),
                                                w_.a, w_.m) / w_.duration if burning else 0.0)
             h = self.heat
-            q_w = self.fn.wall_heat_flow(p, v, w, w_.t_a, self.p_a, self.v_a, self.gamma_a, h.c1,
+            q_w = self.fn.wall_heat_flow(p, v, w_k, w_.t_a, self.p_a, self.v_a, self.gamma_a, h.c1,
                                          h.c2 if burnt else 0.0, h.wall_temperature, h.bore,
                                          h.stroke)
             g = w_.gamma + w_.gamma_slope * (w_.t_a * p * v / (self.p_a * self.v_a)
                                              - w_.gamma_t_ref)
-            out.append(self.zone.first_law_rate(p, v, self.area * u[k] * w, dq_b * w, q_w, g))
+            out.append(self.zone.first_law_rate(p, v, self.area * u[k] * w_k, dq_b * w_k, q_w,
+                                                g))
         return out
 
     def close_intakes(self, phi, y) -> None:

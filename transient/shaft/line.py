@@ -213,16 +213,16 @@ def _lowest_elastic(K, M_diag, rigid: int) -> float:
 #: to do instead). Each is refused before any work (:func:`refuse_elastic_run`).
 UNSUPPORTED = (
     ("friction.pairs", lambda s: bool(s.friction.pairs), "leave out [[friction.pairs]]"),
-    ("governor.model", lambda s: s.governor.model not in ("none", "droop"),
-     "use \"none\" or the static \"droop\""),
-    ("gas.injection", lambda s: s.gas.injection is not None, "leave out fuel latching"),
-    ("gas.woschni", lambda s: s.gas.woschni is not None,
-     "leave out [gas.woschni] (the cylinders' pressure states)"),
-    ("gas.cylinders", lambda s: bool(s.gas.cylinders),
-     "leave out [[gas.cylinders]] (per-cylinder variation)"),
-    ("load.table", lambda s: s.load.table is not None, "give the load by its coefficients"),
+    ("load.table", lambda s: s.load.table is not None and s.load.table.abscissa == "angle"
+     and s.shaft.load_at != s.shaft.reference,
+     "a load tabulated against the angle acts at the reference station only (its angle is the "
+     "run's crank angle): let the load act there (load_at), or tabulate it against speed or "
+     "time"),
     ("load.inertia", lambda s: s.load.inertia > 0.0,
-     "leave the inertia switched in out (the line's driven inertia is [shaft.coupling]'s)"),
+     "switched in, it would change the load's degree of freedom's inertia in the middle of the "
+     "run, and with it the line's first natural frequency (which gives the sections' loss "
+     "factors and damping ratios their viscous c) and the absolute damping's weights; give "
+     "the driven inertia in [shaft.coupling] from the start"),
     ("run.mode", lambda s: s.run.mode != "dynamic", "use \"dynamic\""),
     ("solver.method", lambda s: s.solver.method not in COMPILED_METHODS,
      f"use one of {', '.join(map(repr, COMPILED_METHODS))} (the compiled stepper)"),

@@ -4,21 +4,29 @@ scenes' steppers compile them.
 
 The state (:data:`.layout.STATE`): φ, t and the third state are the reference dof's (θ_ref = φ;
 K_ref = ½J_ref ω_ref² in crank angle, ω_ref in time), the works W_gas (all cylinders'), W_load
-(at the load's dof) and W_starter (at the reference); then per other dof d in order its twist
-q_d = θ_d − φ and K_d (ω_d in time), and the energy the line's damping took. Each cylinder's
-share of J, its transfer function and its gas pressure are taken at the angle of the dof that
-carries it (theory, (T1)–(T5)); the gas table's piece is found at that angle at every
-evaluation, since the stepper's piece selection (``sel``) and its breakpoints are the
-reference's: a corner of a cylinder's table crossed inside a step is a kink the step's error
-control handles. The droop governor reads the reference's speed, the load acts at its own dof's
-speed (the generator's low-speed branch is switched on the reference's, as every speed event).
+(at the load's dof) and W_starter (at the reference); then the governor's states, the latched
+fuels and the cylinders' pressure states as in the rigid model; then per other dof d in order
+its twist q_d = θ_d − φ and K_d (ω_d in time), and the energy the line's damping took. Each
+cylinder's share of J, its transfer function and its gas pressure are taken at the angle of the
+dof that carries it (theory, (T1)–(T5)): its table's piece, its cycle (fuel factor, misfire),
+its combustion offset's curve and its closed part (pressure state with wall heat) are all found
+at that angle at every evaluation, since the stepper's piece selection (``sel``) and its
+breakpoints are the reference's: a corner of a cylinder's table crossed inside a step is a kink
+the step's error control handles. The governor (droop, PI(D), flyweight) reads the reference's
+speed, and a cylinder latches its fuel where the reference passes its injection angle (a
+breakpoint); the load acts at its own dof's speed, a tabulated one at that speed too (the
+generator's low-speed branch and the map's knots are switched on the reference's speed, as every
+speed event: a knot crossed at another dof is a kink inside a step, the value always the
+curve's); a cylinder's pressure state evolves at its own station's angle and speed.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..jit import kernel
-from .forcing import applied_value, fuel, load_moment, starter_moment
+from . import cylinder as cyl
+from . import governor as gv
+from .forcing import applied_value, command, governor_rates, load_moment, starter_moment
 from .layout import (
     EL_C,
     EL_I,
@@ -34,7 +42,6 @@ from .layout import (
     N_OUT_FIXED,
     OMEGA,
     PHI,
-    SW_GOVERNOR,
     W_GAS,
     W_LOAD,
     W_STARTER,
@@ -47,14 +54,19 @@ from .layout import (
     WK_LINE_T,
     WK_LINE_THETA,
     WK_LOCAL,
+    WK_LOCAL_SHIFT,
     WK_PIECE,
+    WK_PIECE_SHIFT,
     WK_SPEED,
     WK_U,
     T,
+    cyl_index,
+    latch_index,
     line_col,
     line_dofs,
     line_loss_index,
 )
+from .outputs import governor_rows
 from .shaft import (
     line_accelerations,
     line_angle_rates,
@@ -64,6 +76,7 @@ from .shaft import (
     twist_index,
 )
 from .tables import find_piece
+from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
@@ -89,14 +102,55 @@ def line_speeds(m, angle_mode, y, wk):
 
 
 @kernel(inline=True)
-def cylinder_pressure(m, c, theta, f, wk):
-    """The pressure (force) on cylinder c at its dof's angle ``theta`` and fuel f: the table's
-    piece found at its own angle in its cycle (WK_LOCAL, WK_PIECE), then the rigid model's
-    :func:`~.forcing.applied_value` there."""
+def cylinder_fuel(m, c, theta, y, f):
+    """Cylinder c's fuel at its dof's angle ``theta``: the fuel it latched at its last injection
+    (fuel latching) or the governor's command f, times its factor in the cycle its own angle is
+    in (per-cylinder variation: 0 in a misfiring cycle), as :func:`.forcing.moments` takes it."""
+    f_c = y[latch_index(m) + c] if m.latch else f
+    if m.var_on:
+        f_c *= cycle_fuel(m, c, theta)
+    return f_c
+
+
+@kernel(inline=True)
+def cylinder_pressure(m, c, theta, y, f, wk):
+    """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel f
+    (:func:`cylinder_fuel`): the table's piece found at its own angle in its cycle (WK_LOCAL,
+    WK_PIECE; with a combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT,
+    WK_PIECE_SHIFT), then the rigid model's :func:`~.forcing.applied_value` there; in its closed
+    part with wall heat its pressure state; with a pressure factor β_c, p0 + β_c(p − p0), as it
+    acts on the piston."""
     local = (theta - m.gas_phase[c]) % m.period
     wk[WK_LOCAL, c] = local
     wk[WK_PIECE, c] = find_piece(m.knots, m.piece_knot, local)
-    return applied_value(m, None, c, theta, theta, f, wk)
+    if m.woschni and cyl.closed_angle(m.cyl_par, local, m.period) >= 0.0:
+        p = y[cyl_index(m) + c]
+    else:
+        if m.var_shifted:
+            shifted = (local - m.var_par[c, SHIFT]) % m.period
+            wk[WK_LOCAL_SHIFT, c] = shifted
+            wk[WK_PIECE_SHIFT, c] = find_piece(m.knots, m.piece_knot, shifted)
+        p = applied_value(m, True, c, theta, theta, f, wk)
+    if m.var_on:
+        p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
+    return p
+
+
+@kernel(inline=True)
+def cylinder_pressure_rate(m, c, y, w, f_c, wk):
+    """dp_c/dt of cylinder c's pressure state (wall heat, ``m.woschni``) at its own angle in its
+    cycle (WK_LOCAL, left by :func:`cylinder_pressure`) and its station's speed w: the rigid
+    model's first law (:func:`.cylinder.pressure_rate`), the combustion on or off as its own
+    angle (less its combustion offset) says; 0 outside its closed part."""
+    local = wk[WK_LOCAL, c]
+    x = cyl.closed_angle(m.cyl_par, local, m.period)
+    if x < 0.0:
+        return 0.0
+    if m.var_on:
+        x -= m.var_par[c, SHIFT]
+    A, B = cyl.pressure_rate(m.mech, m.cyl_par, x, x, local, y[cyl_index(m) + c],
+                             m.gas_scale[c] * wk[WK_U, c], w, f_c)
+    return w * A - B
 
 
 @kernel(inline=True)
@@ -114,15 +168,16 @@ def line_forces(m, y, sw, wk):
     M_gas = 0.0
     P_gas = 0.0
     if m.has_gas:
-        f = fuel(m, w_ref, sw[SW_GOVERNOR])
+        f = command(m, True, w_ref, y, sw)
         for c in range(m.ncyl):
             d = int(carrier[c])
-            p = cylinder_pressure(m, c, wk[WK_LINE_THETA, d], f, wk)
+            theta = wk[WK_LINE_THETA, d]
+            p = cylinder_pressure(m, c, theta, y, cylinder_fuel(m, c, theta, y, f), wk)
             M_c = m.gas_scale[c] * (p - m.gas_offset) * wk[WK_U, c]
             wk[WK_LINE_M, d] += M_c
             M_gas += M_c
             P_gas += M_c * wk[WK_LINE_OMEGA, d]
-    M_load = load_moment(m, None, wk[WK_LINE_OMEGA, load], y, sw)
+    M_load = load_moment(m, True, wk[WK_LINE_OMEGA, load], y, sw)
     wk[WK_LINE_M, load] += M_load
     M_starter = starter_moment(m, w_ref, sw)
     wk[WK_LINE_M, ref] += M_starter
@@ -177,6 +232,22 @@ def elastic_rates(m, angle_mode, y, sw, wk, out):
     out[W_LOAD] = M_load * w[int(m.line[0, LM_LOAD])] * q
     out[W_STARTER] = M_starter * w_ref * q
     out[line_loss_index(m)] = taken * q
+    if m.gov_dyn != gv.NONE or m.latch:  # the reference's speed drives the governor
+        governor_rates(m, w_ref, y, q, sw, wk, out)
+    if m.woschni:
+        pressure_rates(m, y, sw, w, q, wk, out)
+
+
+@kernel(inline=True)
+def pressure_rates(m, y, sw, w, q, wk, out):
+    """The cylinders' pressure states' rates (× ``q``: 1/ω_ref in crank angle), each at its
+    station's angle and speed ``w[d]`` (after :func:`line_forces`)."""
+    carrier = line_parts(m.line)[0]
+    f = command(m, True, w[int(m.line[0, LM_REF])], y, sw)
+    for c in range(m.ncyl):
+        d = int(carrier[c])
+        f_c = cylinder_fuel(m, c, wk[WK_LINE_THETA, d], y, f)
+        out[cyl_index(m) + c] = q * cylinder_pressure_rate(m, c, y, w[d], f_c, wk)
 
 
 @kernel
@@ -202,14 +273,16 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
     row[6] = M_gas
     row[7] = M_load
     row[8] = M_starter
-    f = fuel(m, w_ref, sw[SW_GOVERNOR])
+    f = command(m, True, w_ref, y, sw)
     row[9] = f
     row[10] = y[W_GAS]
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
     for c in range(m.ncyl):
-        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, wk[WK_CYL_ANGLE, c], f, wk)
-                                if m.has_gas else 0.0)
+        theta = wk[WK_CYL_ANGLE, c]
+        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, theta, y, cylinder_fuel(m, c, theta, y, f),
+                                                  wk) if m.has_gas else 0.0)
+    governor_rows(m, y, row)
     k = line_col(m)
     energy = 0.0
     for d in range(n):

@@ -79,12 +79,18 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
         row[N_OUT_FIXED + k] = p_k
     if extras is not None:
         pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[pair_col(m):])
-    j = governor_col(m)
-    for i in range(gov_index(m), cyl_index(m)):  # governor states, latched fuels
-        row[j] = y[i]
-        j += 1
+    governor_rows(m, y, row)
     if extras is not None and m.reaction:
         cylinder_loss_rows(m, w, wk, row[cylinder_loss_col(m):])
+
+
+@kernel(inline=True)
+def governor_rows(m, y, row):
+    """The dynamic governor's states and the latched fuels, as they are in the state."""
+    j = governor_col(m)
+    for i in range(gov_index(m), cyl_index(m)):
+        row[j] = y[i]
+        j += 1
 
 
 @kernel(inline=True)

@@ -146,14 +146,15 @@ def _inject(m, extras, y, sw, evbuf, ist, wk):
 
 @kernel
 def _close_intake(m, y):
-    """At a breakpoint: each cylinder whose intake closes here starts its closed part at p_a
+    """At a breakpoint: each cylinder whose pressure state restarts here (its intake closing;
+    on an elastic line the middle of its open part, ``cylinder.RESTART``) is set to p_a
     (``m.woschni``, :mod:`~transient.core.model.cylinder`). Returns whether any did (the derivative at y changes)."""
     if not m.woschni:
         return False
     c = cyl_index(m)
     hit = False
     for k in range(m.ncyl):
-        if _on_angle(y[PHI], m.gas_phase[k] + m.cyl_par[cyl.IVC], m.period):
+        if _on_angle(y[PHI], m.gas_phase[k] + m.cyl_par[cyl.RESTART], m.period):
             y[c + k] = m.cyl_par[cyl.P_A]
             hit = True
     return hit
