@@ -242,6 +242,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
         solver["ran"] = auto.said
         solver["auto_trial_nfev"] = auto.trial_nfev
     held = int(ist[sio.I_NSTIFF_STEPS])
+    if model.line[0, layout.LM_DOFS] > 0:
+        solver["held_steps"] = held  # (by stability, after the stiffness test fired)
     if scene.solver.method != "auto" and held >= HINT_SHARE * ist[sio.I_NSTEPS] > 0:
         solver["stability_hint"] = stability_hint(scene, held, int(ist[sio.I_NSTEPS]))
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
@@ -252,7 +254,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
 
 #: The share of an elastic run's explicit steps held by stability from which the run says so.
 HINT_SHARE = 0.25
-#: The steps of the W-method's trial in an ``"auto"`` run (:class:`_AutoMethod`).
+#: The steps of each method's trial in an ``"auto"`` run on an elastic line.
 AUTO_TRIAL_STEPS = 400
 
 
