@@ -99,21 +99,30 @@ def line_jacobian(m, angle_mode, y, f0, wk, band):
     for r in range(band.shape[0]):
         for c in range(band.shape[1]):
             band[r, c] = 0.0
+    if line_dofs(m) > 0:
+        line_inertias(m, y, wk)
+        line_speeds(m, angle_mode, y, wk)
+        _own_terms(m, angle_mode, y, f0, wk, lo, band)
+        _element_terms(m, angle_mode, wk, lo, band)
+    return lo
+
+
+@kernel(inline=True)
+def _rate_factor(angle_mode, J, w, w_ref):
+    """The factor from a torque on a dof to its energy's rate in crank angle, ω_d/ω_ref, or to
+    its speed's in time, 1/J_d."""
+    return w / w_ref if angle_mode else 1.0 / J
+
+
+@kernel(inline=True)
+def _own_terms(m, angle_mode, y, f0, wk, lo, band):
+    """Each dof's own block: its twist's rate, the absolute damping's diagonal and the
+    dependence of the rate of its energy on its own speed (after :func:`line_speeds`)."""
     n = line_dofs(m)
-    if n == 0:
-        return lo
     kb = (band.shape[1] - 1) // 2
-    _, dofs, elements = line_parts(m.line)
+    dofs = line_parts(m.line)[1]
     ref = int(m.line[0, LM_REF])
-    line_inertias(m, y, wk)
-    line_speeds(m, angle_mode, y, wk)
-    J = wk[WK_LINE_J, :n]
-    dJ = wk[WK_LINE_DJ, :n]
-    w = wk[WK_LINE_OMEGA, :n]
-    w_ref = w[ref]
-    gear = dofs[:, LD_GEAR]
-    # the factor on ∂T_d/∂θ_e into the d's energy (speed) row, and the chain rule of ω_e
-    # through its state: ∂ω_e/∂K_e = 1/(J_e ω_e) in crank angle, 1 in time
+    J, dJ, w = wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_OMEGA, :n]
     total = 0.0
     absolute = 0.0
     for d in range(n):
@@ -123,20 +132,21 @@ def line_jacobian(m, angle_mode, y, f0, wk, band):
         if d == ref:
             continue
         r = twist_index(m, d) - lo
-        row = w[d] / w_ref if angle_mode else 1.0 / J[d]
+        g = dofs[d, LD_GEAR]
         dw, dwq = _speed_partials(angle_mode, J[d], dJ[d], w[d])
         # the twist's rate g_d ω_d/ω_ref − 1 (g_d ω_d − ω_ref in time)
         if angle_mode:
-            band[r, kb] = gear[d] * dwq / w_ref
-            band[r, kb + 1] = gear[d] * dw / w_ref
+            band[r, kb] = g * dwq / w[ref]
+            band[r, kb + 1] = g * dw / w[ref]
         else:
-            band[r, kb + 1] = gear[d]
+            band[r, kb + 1] = g
         # the absolute damping's diagonal (T3): ∂A_d/∂ω_d
         share = dofs[d, LD_WEIGHT] / total
         a = dofs[d, LD_ABS]
-        dA = gear[d] * gear[d] * (-a + 2.0 * a * share - share * share * absolute)
-        band[r + 1, kb - 1] = row * dA * dwq
-        band[r + 1, kb] = row * dA * dw
+        dA = g * g * (-a + 2.0 * a * share - share * share * absolute)
+        factor = _rate_factor(angle_mode, J[d], w[d], w[ref])
+        band[r + 1, kb - 1] = factor * dA * dwq
+        band[r + 1, kb] = factor * dA * dw
         if angle_mode:
             # (M_d + T_d)·∂(ω_d/ω_ref)/∂y = (dK_d/dφ)/ω_d · ∂ω_d/∂y
             rate = f0[lo + r + 1] / w[d]
@@ -145,21 +155,31 @@ def line_jacobian(m, angle_mode, y, f0, wk, band):
         else:
             # −½J′_d ω_d²/J_d, its ω_d-derivative
             band[r + 1, kb] -= dJ[d] * w[d] / J[d]
+
+
+@kernel(inline=True)
+def _element_terms(m, angle_mode, wk, lo, band):
+    """The elements' couplings: T_i −= τ and T_j += rτ with τ = k(θ_i − rθ_j) + c(ω_i − rω_j),
+    so ∂T_a/∂θ_b = −s_a s_b k and ∂T_a/∂ω_b = −s_a s_b c (s_i = 1, s_j = −r), into the energy
+    (speed) rows of a and b against the states of a and b (after :func:`line_speeds`)."""
+    n = line_dofs(m)
+    kb = (band.shape[1] - 1) // 2
+    elements = line_parts(m.line)[2]
+    ref = int(m.line[0, LM_REF])
+    J, dJ, w = wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_OMEGA, :n]
     for e in range(elements.shape[0]):
         i = int(elements[e, EL_I])
         j = int(elements[e, EL_J])
         ratio = elements[e, EL_R]
         k = elements[e, EL_K]
         c = elements[e, EL_C]
-        # T_i −= τ, T_j += r τ with τ = k(θ_i − r θ_j) + c(ω_i − r ω_j): ∂T_a/∂θ_b = −s_a s_b k
-        # with s_i = 1, s_j = −r (and c for the speeds)
         for side_a in range(2):
             a = i if side_a == 0 else j
             if a == ref:
                 continue
             sa = 1.0 if side_a == 0 else -ratio
             ra = twist_index(m, a) - lo + 1
-            row = w[a] / w_ref if angle_mode else 1.0 / J[a]
+            factor = _rate_factor(angle_mode, J[a], w[a], w[ref])
             for side_b in range(2):
                 b = i if side_b == 0 else j
                 if b == ref:
@@ -167,9 +187,8 @@ def line_jacobian(m, angle_mode, y, f0, wk, band):
                 sb = 1.0 if side_b == 0 else -ratio
                 cb = twist_index(m, b) - lo
                 dw, dwq = _speed_partials(angle_mode, J[b], dJ[b], w[b])
-                _add(band, kb, ra, cb, -row * sa * sb * (k + c * dwq))
-                _add(band, kb, ra, cb + 1, -row * sa * sb * c * dw)
-    return lo
+                _add(band, kb, ra, cb, -factor * sa * sb * (k + c * dwq))
+                _add(band, kb, ra, cb + 1, -factor * sa * sb * c * dw)
 
 
 @kernel(inline=True)
