@@ -34,8 +34,8 @@ from numba import config as numba_config
 from numba import typeof, types
 
 from .core import jit
-from .core.integrator import rk
-from .core.model import layout, rhs
+from .core.integrator import rk, rosenbrock
+from .core.model import layout, line_jacobian, rhs
 from .core.stepper import breakpoints, events, loop
 from .core.stepper import io as sio
 
@@ -96,7 +96,10 @@ def _types_by_parameter(model, tab) -> dict:
                "io": typeof(sio.Chunk(cfg=vector, bp=vector, fst=vector, ist=ints,
                                       outbuf=matrix, evbuf=matrix)),
                "work": typeof(sio.Work(K=matrix, F=matrix, f=vector, y_new=vector, y_evt=vector,
-                                       tmp=vector, wk=matrix, gs=matrix, control=ints)),
+                                       tmp=vector, wk=matrix, gs=matrix, control=ints,
+                                       band=matrix if rosenbrock.is_w_method(tab) else None)),
+               # a W-method's: the model's Jacobian and its band's storage
+               "jac": typeof(line_jacobian.model_jacobian), "band": types.float64[:, ::1],
                "at": typeof(sio.At(True, 0, 0.0, 0.0, 0.0, ints)),
                "seg": typeof(sio.Segment(*(6 * [0.0]))),
                "seen": types.Tuple((types.boolean, types.float64, types.float64)),
@@ -113,9 +116,17 @@ def signature(fn, model, tab) -> tuple:
     return tuple(by_name[p] for p in inspect.signature(fn.py_func).parameters)
 
 
+def callees_of(tab, callees=CALLEES) -> tuple:
+    """``callees`` as the stepper of the method ``tab`` calls them: a W-method's step in place
+    of the explicit pairs'."""
+    if not rosenbrock.is_w_method(tab):
+        return callees
+    return tuple(rosenbrock.w_step if fn is rk.step else fn for fn in callees)
+
+
 def compile_callees(model, tab, callees=CALLEES) -> None:
     """Compile (or load from the cache) each of ``callees``, in that order."""
-    for fn in callees:
+    for fn in callees_of(tab, callees):
         fn.compile(signature(fn, model, tab))
 
 

@@ -30,7 +30,7 @@ from .prescribed_work import Motion, work_columns
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
 from .scene.outputs import output_columns
 from .scene.queries import part_load_refusal
-from .scene.records import COMPILED_METHODS, runs_compiled
+from .scene.records import AUTO_METHODS, COMPILED_METHODS, runs_compiled
 from .shaft import refuse_elastic_run
 from .stopping import deferred
 
@@ -58,6 +58,7 @@ def _config(scene) -> np.ndarray:
         cfg[sio.C_MAX_STEP_T] = math.inf
     cfg[sio.C_CHUNK_STEPS] = 20000
     cfg[sio.C_FIXED_STEP] = sv.fixed_step
+    cfg[sio.C_STIFF_SWITCH] = float(sv.method == "auto")
     return cfg
 
 
@@ -141,7 +142,8 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     model, bp, _ = build_model(scene)
     cfg = _config(scene)
     names = list(output_columns(scene))
-    tab = TABLEAUS[scene.solver.method]
+    auto = _AutoMethod(scene, model)
+    tab = TABLEAUS[auto.method]
     extras = layout.extras_of(model)
     compile_s = _compile(model, tab, cfg, bp)
     y, fst, ist = _initial_state(scene, model)
@@ -164,8 +166,14 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     t0 = time.perf_counter()
     try:
         while status == sio.RUNNING:
+            auto.mark(y, ist)
             status = stepper.advance(model, extras, tab, run_cfg, bp, y, fst, ist, outbuf, evbuf,
                                      stepper.buffers(model, tab, y.shape[0]))
+            chosen = auto.after_chunk(status, run_cfg, y, fst, ist)
+            if chosen is not None:  # (the state is as a chunk's end leaves it)
+                tab, status = TABLEAUS[chosen], sio.RUNNING
+                seconds = _compile(model, tab, cfg, bp)
+                compile_s, t0 = compile_s + seconds, t0 + seconds  # (no compile in the wall time)
             switching = status == sio.FINISHED and y[layout.T] == switch_at
             block = {name: outbuf[: ist[sio.I_NOUT], j].copy() for j, name in enumerate(names)}
             ev = _events_by_name(evbuf[: ist[sio.I_NEV]], switching)
@@ -230,10 +238,102 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
               "nreject": int(ist[sio.I_NREJECT]), "wall_s": wall, "compile_s": compile_s,
               "mode_switches": int(ist[sio.I_NSWITCH]), "mode_ties": int(ist[sio.I_NTIES]),
               **_kinematics_attrs(scene)}
+    if auto.elastic_auto:  # (which methods ran, from where)
+        solver["ran"] = auto.said
+        solver["auto_trial_nfev"] = auto.trial_nfev
+    held = int(ist[sio.I_NSTIFF_STEPS])
+    if model.line[0, layout.LM_DOFS] > 0:
+        solver["held_steps"] = held  # (by stability, after the stiffness test fired)
+    if scene.solver.method != "auto" and held >= HINT_SHARE * ist[sio.I_NSTEPS] > 0:
+        solver["stability_hint"] = stability_hint(scene, held, int(ist[sio.I_NSTEPS]))
     traj = {n: np.concatenate([b[n] for b in blocks] or [np.zeros(0)]) for n in names}
     return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
                    solver, complete=status == sio.FINISHED, message=message,
                    status=code_status(status))
+
+
+#: The share of an elastic run's explicit steps held by stability from which the run says so.
+HINT_SHARE = 0.25
+#: The steps of each method's trial in an ``"auto"`` run on an elastic line.
+AUTO_TRIAL_STEPS = 400
+
+
+def stability_hint(scene, held: int, steps: int) -> str:
+    """What to do about an elastic run whose explicit steps the stiffness test found held by
+    stability (``held`` of its ``steps``): the line's stiff sections, not accuracy, set them."""
+    return (f"{held} of {steps} steps of {scene.solver.method} were held by stability, not "
+            f"accuracy (Hairer's stiffness test: the shaft line's stiffest sections); "
+            f"solver.method = \"auto\" tries ROS34PW2 from there and keeps the method that "
+            f"advances further per derivative evaluation (\"ros34pw2\" runs it throughout)")
+
+
+class _AutoMethod:
+    """The compiled method of a run, and ``solver.method = "auto"``'s choice on an elastic
+    line: DOP853 until Hairer's stiffness test finds its steps held by stability (the stepper
+    then returns STIFF, the state left as a chunk's end leaves it, state S); then, from S, a
+    trial of AUTO_TRIAL_STEPS steps of ROS34PW2, whose result is discarded (the stepper's state
+    put back to S), and as many of DOP853, which the run keeps; the method that advanced the
+    shaft further per evaluation of the derivative over its trial from S runs the rest, and
+    the test is not run again. ``said``: which ran, from where; ``trial_nfev``: the evaluations
+    of the discarded trial (not in the run's count)."""
+
+    def __init__(self, scene, model) -> None:
+        auto = scene.solver.method == "auto"
+        self.elastic_auto = auto and model.line[0, layout.LM_DOFS] > 0
+        self.choosing = self.elastic_auto
+        self.method = AUTO_METHODS[0] if auto else scene.solver.method
+        self.said = self.method
+        self.trial_nfev = 0
+        self.phase = ""  # "", then "implicit" and "explicit": the trials under way
+        self.saved: tuple = ()  # S: y, fst, ist, and the chunk's steps
+        self.implicit = 0.0  # the W-method's progress over its trial
+        self.at = (0.0, 0)
+
+    def mark(self, y, ist) -> None:
+        """A chunk starts at ``y``."""
+        self.at = (float(y[layout.PHI]), int(ist[sio.I_NFEV]))
+
+    def _progress(self, y, ist) -> float:
+        """The shaft's angle per derivative evaluation over the chunk [rad]."""
+        return (y[layout.PHI] - self.at[0]) / max(int(ist[sio.I_NFEV]) - self.at[1], 1)
+
+    def after_chunk(self, status: int, cfg, y, fst, ist) -> str | None:
+        """The method to go on with after a chunk that ended with ``status`` at ``y`` (the
+        stepper's state ``fst``, ``ist``, put back to S after the W-method's trial; the
+        settings ``cfg`` set for what follows), or None to go on as before."""
+        if not self.choosing:
+            return None
+        explicit, implicit = AUTO_METHODS
+        if not self.phase:
+            if status != sio.STIFF:
+                return None
+            kept = ist.copy()
+            kept[sio.I_NOUT] = kept[sio.I_NEV] = 0  # (what the chunk wrote is drained)
+            self.saved = (y.copy(), fst.copy(), kept, cfg[sio.C_CHUNK_STEPS])
+            cfg[sio.C_CHUNK_STEPS], cfg[sio.C_STIFF_SWITCH] = AUTO_TRIAL_STEPS, 0.0
+            self.phase, self.t = "implicit", f"t = {y[layout.T]:.9g} s"
+            return implicit
+        if status != sio.RUNNING:  # (the run ended in a trial: as it ran)
+            self.choosing = False
+            if self.phase == "implicit":
+                self.said = f"{explicit}, then {implicit} from {self.t}"
+            return None
+        if self.phase == "implicit":
+            self.implicit = self._progress(y, ist)
+            self.trial_nfev = int(ist[sio.I_NFEV]) - self.at[1]
+            y[:], fst[:], ist[:] = self.saved[0], self.saved[1], self.saved[2]
+            self.phase = "explicit"
+            return explicit
+        progress = self._progress(y, ist)
+        cfg[sio.C_CHUNK_STEPS], self.choosing = self.saved[3], False
+        rates = (f"{self.implicit:.3g} against {progress:.3g} rad per evaluation over "
+                 f"{AUTO_TRIAL_STEPS} steps from {self.t}")
+        if self.implicit > progress:
+            self.said = (f"{explicit}, then {implicit} from t = {y[layout.T]:.9g} s "
+                         f"({rates})")
+            return implicit
+        self.said = f"{explicit} ({implicit} tried: {rates})"
+        return None
 
 
 def _restore(start, y, fst, ist) -> tuple[int, bool]:

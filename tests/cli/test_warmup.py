@@ -48,6 +48,12 @@ FEATURE_KERNELS = {
 }
 
 
+#: The W-method's kernels (``solver.method = "ros34pw2"``): a scene an explicit pair runs
+#: compiles none of them (its step is a compile-time choice, ``rosenbrock.method_step``).
+W_KERNELS = ("rosenbrock.w_step", "rosenbrock.band_factor", "rosenbrock.band_solve",
+             "line_jacobian.line_jacobian", "line_jacobian.model_jacobian")
+
+
 def cached_kernels(cache: Path) -> set[str]:
     """The kernels with a compiled version in the numba cache under ``cache``, as module and
     name (``rhs.derivative``): numba names each index file after them (then ``-`` and the line)."""
@@ -73,6 +79,7 @@ def test_warmup_compiles_what_runs_then_load(tmp_path):
     assert {"loop.advance", "rhs.derivative", "forcing.moments"} <= plain
     for feature, kernels in FEATURE_KERNELS.items():
         assert not plain & set(kernels), feature
+    assert not plain & set(W_KERNELS)
     lines = transient("warmup", *mechanisms)
     assert lines[0].startswith(f"kernels in {tmp_path / 'cache' / 'numba'}")
     compiled = [line.strip().split()[1] for line in lines[1:-1]]

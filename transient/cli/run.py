@@ -177,11 +177,14 @@ def _print_summary(summary, solver, names=()) -> None:
     if asked:
         print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
               f"`transient info`)")
-    print(f"  solver {solver['method']}: {solver['nsteps']} steps, {solver['nreject']} rejected, "
+    print(f"  solver {solver.get('ran', solver['method'])}: {solver['nsteps']} steps, "
+          f"{solver['nreject']} rejected, "
           f"{solver['nfev']} RHS calls, {solver['wall_s']:.3g} s (+ {solver['compile_s']:.3g} s "
           f"compile/cache load)")
     if solver.get("stiff_rerun"):
         print(f"  {solver['stiff_rerun']}")
+    if solver.get("stability_hint"):
+        print(f"  {solver['stability_hint']}")
 
 
 def _print_stops(v: dict) -> None:
@@ -300,11 +303,13 @@ def cmd_info(args) -> int:
         print(f"  events {name}: {ev['t'].size}")
     s = res.solver
     if s:
-        print(f"  solver {s.get('method')}: rtol {s.get('rtol')}, atol {s.get('atol')}, "
+        print(f"  solver {s.get('ran', s.get('method'))}: rtol {s.get('rtol')}, "
+              f"atol {s.get('atol')}, "
               f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
               f"wall {s.get('wall_s', 0):.3g} s, compile {s.get('compile_s', 0):.3g} s")
-        if s.get("stiff_rerun"):
-            print(f"  {s['stiff_rerun']}")
+        for note in ("stiff_rerun", "stability_hint"):
+            if s.get(note):
+                print(f"  {s[note]}")
     _print_provenance(a)
     if text:
         print(f"  scene file: {escaped(file)} ({len(text.splitlines())} lines, comments "

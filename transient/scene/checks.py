@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import SceneError, show_value
 from .reader import Section
-from .records import COMPILED_METHODS, RUNAWAY_SPEED, Scene, Wiebe
+from .records import COMPILED_METHODS, RUNAWAY_SPEED, W_METHODS, Scene, Wiebe
 
 
 def check_consistency(scene: Scene) -> tuple[float, float]:
@@ -62,6 +62,10 @@ def check_consistency(scene: Scene) -> tuple[float, float]:
         raise SceneError("solver.kinematics", f"tables are for the compiled methods "
                                               f"({', '.join(COMPILED_METHODS)}); the reference path "
                                               f"{sv.method!r} is exact by design")
+    if sv.method in W_METHODS and scene.shaft is None:
+        raise SceneError("solver.method", f"{sv.method!r} takes the Jacobian of an elastic "
+                                          f"[shaft] line, which this scene has not; use "
+                                          f"\"dop853\" for a rigid shaft")
     if sv.fixed_step > 0.0 and sv.domain == "time":
         raise SceneError("solver.fixed_step", "fixed steps are crank-angle steps; use "
                                               "domain = \"auto\" or fixed_step = 0")

@@ -426,8 +426,15 @@ class Run:
 @dataclass(frozen=True)
 class Solver:
     """Integration settings. ``method``: one of
-    :data:`~transient.scene.records.METHODS`; ``rtol`` [1] and ``atol`` (in the
-    units of each state) as scipy's; ``max_step`` [rad] in crank angle.
+    :data:`~transient.scene.records.METHODS`: ``"dop853"`` (explicit, order 8, the default),
+    ``"dopri5"`` (explicit, order 5), ``"ros34pw2"`` (linearly implicit Rosenbrock–W, order 3,
+    L-stable, for an elastic ``[shaft]`` line whose stiff sections would hold an explicit
+    method's step by stability: one banded factorisation of the line's Jacobian a step;
+    only with ``[shaft]``), ``"auto"`` (DOP853; where Hairer's stiffness test finds an
+    elastic line's steps held by stability, ROS34PW2 and DOP853 are tried from there and the
+    one that advances further per evaluation runs on; a rigid scene's is DOP853's), or a
+    reference path's (``"scipy-*"``); ``rtol`` [1] and ``atol``
+    (in the units of each state) as scipy's; ``max_step`` [rad] in crank angle.
     ``switch_speed`` [rad/s]: below it time is the independent variable;
     ``domain``: ``"auto"`` (crank angle above the switch speed) or ``"time"`` (time throughout,
     for comparison; the maximum step is then bounded by the output spacing only).
@@ -486,7 +493,12 @@ MIN_WIEBE_STEP = 1e-5
 MIN_OUTPUT_DT = 1e-8
 
 #: The compiled methods (transient.core.integrator.tableaus) and the reference path's (scipy-*).
-COMPILED_METHODS = ("dop853", "dopri5")
+COMPILED_METHODS = ("dop853", "dopri5", "ros34pw2", "auto")
+#: The compiled methods that take the elastic shaft line's Jacobian (linearly implicit).
+W_METHODS = ("ros34pw2",)
+#: ``"auto"``: the explicit method a run starts with, and the W-method it tries where the
+#: stiffness test finds an elastic line's steps held by stability (``transient.run``).
+AUTO_METHODS = ("dop853", "ros34pw2")
 #: Every ``[solver] method``: the compiled ones, then the reference path's.
 METHODS = (*COMPILED_METHODS, "scipy-DOP853", "scipy-RK45", "scipy-Radau")
 

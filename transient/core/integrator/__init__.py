@@ -1,9 +1,10 @@
 """The numerics of an ODE, knowing nothing of engines: Runge–Kutta pairs and their tableaus
 (:mod:`.tableaus`), the step, its error norm, the step-size control and the dense output
-(:mod:`.rk`), the location of an event function's zero on the dense output
-(:mod:`~transient.core.integrator.roots`), the search of periodic breakpoints
-(:mod:`~transient.core.integrator.breakpoints`), and a plain adaptive driver of them all
-(:mod:`.solve`, what the tests run on closed-form problems).
+(:mod:`.rk`), a Rosenbrock–W method for stiff problems that reuses them, with a model's banded
+Jacobian passed as a kernel like the derivative (:mod:`.rosenbrock`), the location of an event
+function's zero on the dense output (:mod:`~transient.core.integrator.roots`), the search of
+periodic breakpoints (:mod:`~transient.core.integrator.breakpoints`), and a plain adaptive driver
+of them all (:mod:`.solve`, what the tests run on closed-form problems).
 
 The contract with a model is three things, passed as arguments, never imported:
 

@@ -1,5 +1,6 @@
 """A plain adaptive driver of the integrator's kernels for an ODE y′ = f(y): steps of an embedded
-pair (:mod:`.rk`) under its error norm and PI step-size control, the dense output at requested
+pair (:mod:`.rk`) or of the W-method (:mod:`.rosenbrock`) under its error norm and PI step-size
+control, the dense output at requested
 abscissae, and one optional terminal event located on it (:mod:`~transient.core.integrator.roots`).
 
 It is the integrator on its own, with nothing of the engine: the tests run it on closed-form
@@ -13,15 +14,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import compiled
-from .rk import accepted_size, dense, dense_state, error_norm, shrink, step
+from .rk import accepted_size, dense, dense_state, error_norm, shrink
 from .roots import crosses, root
+from .rosenbrock import method_step
 
 #: Consecutive step attempts with a non-finite result before the solve gives up.
 MAX_NONFINITE = 30
 
 
 @compiled
-def solve(tab, rhs, ctx, x0, y0, x_end, h0, rtol, atol, control, ix, x_out, g, direction):
+def solve(tab, rhs, ctx, x0, y0, x_end, h0, rtol, atol, control, ix, x_out, g, direction, jac,
+          band):
     """Integrate y′ = ``rhs(ctx, y)`` from (x0, y0) towards x_end > x0 with the pair ``tab``,
     starting with the step ``h0``; the error control of each component as ``control`` says
     (:data:`transient.core.declare.BY_SIZE` …), the independent variable component ``ix`` (−1:
@@ -29,7 +32,8 @@ def solve(tab, rhs, ctx, x0, y0, x_end, h0, rtol, atol, control, ix, x_out, g, d
 
     ``x_out``: increasing abscissae where the dense output is sampled. ``g``: an event function
     ``g(ctx, y)``, or None; the solve stops where it first crosses zero in ``direction`` (+1
-    rising, −1 falling, 0 either).
+    rising, −1 falling, 0 either). ``jac``, ``band``: a W-method's Jacobian kernel and the
+    storage of its band (:mod:`.rosenbrock`), None and None for an explicit pair.
 
     Returns ``(x, y, y_out, n_out, n_steps, n_rejected, n_rhs, status)``: where the solve
     stopped and the state there, the samples (rows of ``y_out``; the first ``n_out`` are
@@ -60,7 +64,7 @@ def solve(tab, rhs, ctx, x0, y0, x_end, h0, rtol, atol, control, ix, x_out, g, d
             h = x_end - x
         for i in range(n):
             K[0, i] = f[i]
-        step(tab, rhs, ctx, ix, x, y, f, h, K, y_new, tmp)
+        method_step(tab, rhs, jac, ctx, ix, x, y, f, h, K, y_new, tmp, band)
         n_rhs += ns
         err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, control)
         if not (np.isfinite(err) and np.all(np.isfinite(y_new))):

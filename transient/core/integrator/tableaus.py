@@ -34,6 +34,7 @@ from collections import namedtuple
 import numpy as np
 
 from . import dop853_coefficients as dc
+from .rosenbrock import WTableau, ros34pw2
 
 Tableau = namedtuple("Tableau", ["A", "B", "E5", "E3", "D", "n_stages", "n_ext", "exponent",
                                  "order", "stiff_bound"])
@@ -64,5 +65,7 @@ def _dopri5() -> Tableau:
                    n_ext=n_ext, exponent=1.0 / 5.0, order=5, stiff_bound=2.5)
 
 
-#: The compiled methods by name (``solver.method`` in a scene).
-TABLEAUS = {"dop853": _dop853(), "dopri5": _dopri5()}
+#: The compiled methods by name (``solver.method`` in a scene): the explicit pairs, and the
+#: Rosenbrock–W method for stiff shaft lines (:mod:`.rosenbrock`).
+TABLEAUS: dict[str, Tableau | WTableau] = {"dop853": _dop853(), "dopri5": _dopri5(),
+                                           "ros34pw2": ros34pw2()}

@@ -37,11 +37,14 @@ from ..model.outputs import output_row, output_row_inline
 #: ``cfg``, the run's settings (float64, filled by ``transient.run``): the tolerances, the ends of
 #: the run in time and in angle, the switch speeds from crank angle to time and back, the output
 #: spacings in angle and in time, the largest steps in angle and in time, the steps a chunk may
-#: take, and the fixed step in angle (0: adaptive).
+#: take, the fixed step in angle (0: adaptive), and whether an elastic line's steps held by
+#: stability end the chunk for the caller to go on with the W-method (1: ``solver.method =
+#: "auto"``).
 SETTINGS = Layout("settings", "rtol", "atol", "t_end", "phi_end", "w_lo", "w_hi", "dphi_out",
-                  "dt_out", "max_step_phi", "max_step_t", "chunk_steps", "fixed_step")
+                  "dt_out", "max_step_phi", "max_step_t", "chunk_steps", "fixed_step",
+                  "stiff_switch")
 (C_RTOL, C_ATOL, C_T_END, C_PHI_END, C_W_LO, C_W_HI, C_DPHI_OUT, C_DT_OUT, C_MAX_STEP_PHI,
- C_MAX_STEP_T, C_CHUNK_STEPS, C_FIXED_STEP) = SETTINGS
+ C_MAX_STEP_T, C_CHUNK_STEPS, C_FIXED_STEP, C_STIFF_SWITCH) = SETTINGS
 N_CFG = SETTINGS.size
 #: ``fst``, the float state the stepper keeps between chunks: the next step's size, the angle
 #: ``sel`` of the last step (it picks the table pieces), the next output sample on the grid, the
@@ -71,17 +74,18 @@ N_FST = F_DERIV
 #: retakes aimed at a breakpoint, the state events in a row without progress (chattering), the
 #: pair-mode switches, the rounding ties of a mode choice, the pair an event has just flipped
 #: (+1), the event that chattered, the event just acted on (+1), the stiffness test's counts;
-#: whether the last attempt was rejected by the error test, the consecutive non-finite attempts
-#: and the consecutive attempts retaken for a crossing that no sample found.
+#: whether the last attempt was rejected by the error test, the consecutive non-finite attempts,
+#: the consecutive attempts retaken for a crossing that no sample found, and the steps of an
+#: elastic line's run that the stiffness test found held by stability.
 INTS = Layout(
     "stepper ints", Block("switches", N_SWITCHES, "the model's switches (layout.SWITCHES)"),
     "angle_mode", "nfev", "nsteps", "nreject", "nout", "nev", "started", "f_valid", "nredo",
     "nchatter", "nswitch", "nties", "flipped", "chatter_code", "at_event", "stiff", "nonstiff",
-    "rejected", "nbad", "nunseen",
+    "rejected", "nbad", "nunseen", "nstiff_steps",
 )
 (I_SWITCHES, I_ANGLE_MODE, I_NFEV, I_NSTEPS, I_NREJECT, I_NOUT, I_NEV, I_STARTED, I_F_VALID,
  I_NREDO, I_NCHATTER, I_NSWITCH, I_NTIES, I_FLIPPED, I_CHATTER_CODE, I_AT_EVENT, I_STIFF,
- I_NONSTIFF, I_REJECTED, I_NBAD, I_NUNSEEN) = INTS
+ I_NONSTIFF, I_REJECTED, I_NBAD, I_NUNSEEN, I_NSTIFF_STEPS) = INTS
 N_IST = INTS.size
 #: The switches in ``ist``, by their names in the stepper.
 (I_STARTER_ON, I_GOV_BRANCH, I_MODES, I_DIRECTION, I_LOAD_SEG, I_GEN_LOW, I_SLEEVE,
@@ -97,13 +101,15 @@ if I_SWITCHES != 0:  # (the stepper passes ist[:N_SWITCHES] on as the switches)
 #: ``Work``: the work arrays of one call (:func:`~transient.core.stepper.loop.buffers`), the
 #: stages, the dense output's coefficients, the derivative at the state, the new state, the
 #: state at an event, a scratch state, the right-hand side's work array, the pairs' margins
-#: over a step and the error control of each state component (``layout.state_control``).
+#: over a step, the error control of each state component (``layout.state_control``) and the
+#: storage of a W-method's banded matrix (None for an explicit pair: its step compiles without).
 #: ``At``: the step attempt at hand, whether crank angle is the independent
 #: variable and its index in the state, the step's start and size, the angle ``sel`` that picks
 #: the tables' pieces for it, the switches. ``Segment``: where the segment ends and what bounds
 #: the step (:func:`~transient.core.stepper.breakpoints._segment_end`).
 Chunk = namedtuple("Chunk", ["cfg", "bp", "fst", "ist", "outbuf", "evbuf"])
-Work = namedtuple("Work", ["K", "F", "f", "y_new", "y_evt", "tmp", "wk", "gs", "control"])
+Work = namedtuple("Work", ["K", "F", "f", "y_new", "y_evt", "tmp", "wk", "gs", "control",
+                           "band"])
 At = namedtuple("At", ["angle_mode", "ix", "x", "h", "sel", "sw"])
 Segment = namedtuple("Segment", ["x_end", "up", "down", "h_max", "tol_end", "corner"])
 

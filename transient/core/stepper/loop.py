@@ -2,8 +2,9 @@
 between breakpoints, with state events located on the dense output (docs/theory.md, Steppers;
 Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.6 and §II.10).
 
-One loop for every pair in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5), passed
-as data; adaptive, or with
+One loop for every method in :mod:`~transient.core.integrator.tableaus` (DOP853, DOPRI5, and
+the Rosenbrock–W ROS34PW2 with the shaft line's Jacobian, a compile-time choice), passed as
+data; adaptive, or with
 fixed crank-angle steps (``cfg[C_FIXED_STEP] > 0``: no error control, for periodic steady runs).
 While ω ≥ ω_lo it integrates in crank angle (dt/dφ = 1/ω) and stops exactly on every breakpoint,
 so the right-hand side is smooth inside every step; below ω_lo (start from rest, stall, reversal)
@@ -49,7 +50,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..integrator.rk import accepted_size, dense_eval, error_norm, shrink, step, stiffness
+from ..integrator.rk import accepted_size, dense_eval, error_norm, shrink, stiffness
+from ..integrator.rosenbrock import is_w_method, method_step
 from ..jit import compiled, kernel
 from ..model import governor as gv
 from ..model import stuck as st
@@ -81,6 +83,7 @@ from ..model.layout import (
     line_dofs,
     state_control,
 )
+from ..model.line_jacobian import line_band, model_jacobian
 from ..model.rhs import (
     choose_modes,
     derivative,
@@ -113,6 +116,7 @@ from .io import (
     C_FIXED_STEP,
     C_PHI_END,
     C_RTOL,
+    C_STIFF_SWITCH,
     C_T_END,
     C_W_HI,
     CHATTERING,
@@ -162,6 +166,7 @@ from .io import (
     I_NREDO,
     I_NREJECT,
     I_NSTEPS,
+    I_NSTIFF_STEPS,
     I_NSWITCH,
     I_NTIES,
     I_NUNSEEN,
@@ -204,12 +209,17 @@ def buffers(m, tab, n: int) -> Work:
     """The work arrays of one call of :func:`advance`, its last argument (a ``Work``): the
     stages ``K``, the dense output ``F``, the derivative ``f``, three states, the right-hand
     side's scratch ``wk``, the pairs' margins over a step ``gs`` and the state's error control
-    ``control`` (:func:`~transient.core.model.layout.state_control`). Allocated by the caller,
-    so that the stepper is one compile unit of its own, without reference counting. ``n``: the
-    length of the state."""
+    ``control`` (:func:`~transient.core.model.layout.state_control`), and for a W-method the
+    storage of its band over the shaft line's states (:func:`.line_jacobian.line_band`).
+    Allocated by the caller, so that the stepper is one compile unit of its own, without
+    reference counting. ``n``: the length of the state."""
+    band = None
+    if is_w_method(tab):
+        rows, kb = line_band(m.line)
+        band = np.zeros((rows, 2 * kb + 1))
     return Work(np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
                 np.empty(n), np.empty(n), np.empty(n), work_array(m),
-                np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))), state_control(m))
+                np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))), state_control(m), band)
 
 
 @compiled(nogil=True, _nrt=False)  # (nogil: the previous block is written meanwhile, simulate)
@@ -222,8 +232,9 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
     extras : None or True
         The kernels' variant for ``m`` (:func:`~transient.core.model.layout.extras_of`): None
         compiles none of the features a plain scene does not use.
-    tab : tableaus.Tableau
-        The Runge–Kutta pair (DOP853, DOPRI5).
+    tab : tableaus.Tableau or rosenbrock.WTableau
+        The Runge–Kutta pair (DOP853, DOPRI5) or the W-method (ROS34PW2), whose step takes
+        ``work.band``.
     cfg : float64[N_CFG]
         Settings, indices ``C_*`` (:mod:`~transient.core.stepper.io`, as the other layouts and
         codes).
@@ -314,7 +325,8 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
             if retakes_at_kinks:
                 reset_kinks(m, extras, wk)
             _start_attempt(f, K, wk)
-            step(tab, model_rhs, (m, extras, angle_mode, sel, sw, wk), ix, x, y, f, h, K, y_new, tmp)
+            method_step(tab, model_rhs, model_jacobian, (m, extras, angle_mode, sel, sw, wk), ix,
+                        x, y, f, h, K, y_new, tmp, work.band)
             finite, err, seen = _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner,
                                                seg.corner)
             if attempt > 0 or not (retakes_at_kinks and finite and err > 1.0):
@@ -353,14 +365,22 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         h_next, fst[F_ERR_OLD] = accepted_size(tab, err, fst[F_ERR_OLD], h, h_planned, cut,
                                                rejected)
         rejected = False
-        # (an elastic shaft line's stiff sections bound the explicit step by stability: the
-        # run goes on at that step, there being no implicit path for it to hand over to)
-        if (not fixed and line_dofs(m) == 0
+        # (a W-method's tableau has no stability bound to test)
+        if (not fixed and tab.stiff_bound < np.inf
                 and _stiff(tab, K, h, y, ix, work.control, rtol, atol, ist)):
-            # the run so far is kept; the state is the accepted step's start
-            if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
-                _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
-            return STIFF
+            if line_dofs(m) == 0:
+                # the run so far is kept; the state is the accepted step's start
+                if fst[F_LAST_T] != y[T] or fst[F_LAST_PHI] != y[PHI]:
+                    _emit_row(m, extras, y, fst[F_SEL], sw, outbuf, ist, fst, wk)
+                return STIFF
+            # An elastic line's stiff sections hold the step by stability: counted for the hint
+            # to take the W-method, or (``solver.method = "auto"``) the caller goes on with it
+            # from this step's start, which is left as a chunk's end leaves it.
+            ist[I_NSTIFF_STEPS] += 1
+            if cfg[C_STIFF_SWITCH] > 0.0:
+                _carry(fst, f, gs, m.n_pairs, True)
+                ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
+                return STIFF
         if not angle_mode and abs(y_new[PHI] - y[PHI]) > MAX_OUTPUT_INTERVALS * cfg[C_DPHI_OUT]:
             # (a step in time writes a sample at each crossing of the angle grid: no more of
             # them than a step in crank angle writes)
