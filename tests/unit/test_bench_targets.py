@@ -222,8 +222,9 @@ def _torsion_results(rigid_ratio, r2, cost_ratio, scipy_ratios):
 
 
 def test_the_elastic_verdicts_say_met_or_missed():
-    """≤ 10× the rigid run per cycle; linear in N (R² ≥ 0.95 and at most N₃₀/N₃ = 10× the cost
-    at 3); ≥ 100× the fastest scipy method; the rigid scenes' cost left to the rigid rows."""
+    """≤ 10× the rigid run per cycle; linear in N (rising, and at most N₃₀/N₃ = 10× the cost
+    at 3, whatever the noise makes of R²); ≥ 100× the fastest scipy method; the rigid scenes'
+    cost left to the rigid rows."""
     from transient.verify import torsion as vt
 
     def verdicts(res):
@@ -233,8 +234,7 @@ def test_the_elastic_verdicts_say_met_or_missed():
         "met", "met", "met", "covered by the rigid targets"]
     assert verdicts(_torsion_results(12.0, 0.99, 12.0, {"RK45": 300.0, "LSODA": 50.0})) == [
         "**missed**", "**missed**", "**missed**", "covered by the rigid targets"]
-    assert verdicts(_torsion_results(8.0, 0.9, 5.0, {}))[1:3] == ["**missed**",
-                                                                  "**not measured**"]
+    assert verdicts(_torsion_results(8.0, 0.9, 5.0, {}))[1:3] == ["met", "**not measured**"]
     line = vt.verdicts(_torsion_results(8.0, 0.99, 9.0, {"RK45": 300.0, "LSODA": 150.0}),
                        bt._missed)[2][2]
     assert line.startswith("150× solve_ivp LSODA (numpy RHS)")  # (the fastest of them)
