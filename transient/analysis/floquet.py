@@ -286,7 +286,7 @@ def multipliers(line: ShaftLine, omega: float, series: InertiaSeries | None = No
         raise ValueError(f"multipliers: a mean speed > 0 rad/s, got {omega!r}")
     series = series or inertia_series(line)
     red = red or reduce_line(line)
-    mu = np.linalg.eigvals(monodromy(red, series, omega, n))
+    mu = np.linalg.eigvals(monodromy(red, series, omega, n)).astype(np.complex128)
     return mu[np.argsort(-np.abs(mu), kind="stable")]
 
 
