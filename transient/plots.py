@@ -1135,3 +1135,36 @@ def torsional_response(axes, res, criticals, leading: int = 6):
     legend_outside(top)
     legend_outside(bottom)
     return worst
+
+
+#: Line styles of the speeds where instability regions may open, by kind
+#: (:class:`transient.analysis.floquet.Resonance`).
+RESONANCE_STYLES = {"principal": dict(color="C3", ls="--"), "second": dict(color="C1", ls=":"),
+                    "combination": dict(color="C2", ls="-.")}
+
+
+def floquet_chart(ax, res, resonances=()):
+    """The parametric stability of a shaft line against mean speed [rpm]: the twist's largest
+    growth per revolution, g·ln|μ|max in e-folds (``res``,
+    :class:`transient.analysis.floquet.Floquet`), the unstable speeds shaded, and the speeds
+    where regions may open (``resonances``, :class:`~transient.analysis.floquet.Resonance`)
+    as vertical lines labelled with their condition (principal dashed, second dotted,
+    combination dash-dotted)."""
+    rpm, growth = res.rpm, res.growth_per_rev
+    ax.plot(rpm, growth, color="k", lw=1.2, label="growth per revolution, g·ln|μ|max")
+    ax.axhline(0.0, color="0.3", lw=0.6)
+    ax.fill_between(rpm, 0.0, 1.0, where=res.unstable, transform=ax.get_xaxis_transform(),
+                    color="C3", alpha=0.15, lw=0, label="parametrically unstable")
+    seen = set()
+    for r in resonances:
+        style = RESONANCE_STYLES[r.kind]
+        ax.axvline(r.rpm, lw=0.7, zorder=0, label=None if r.kind in seen else
+                   f"{r.kind} resonance, hΩ = (ω_i + ω_j)/k", **style)
+        seen.add(r.kind)
+        ax.annotate(r.label, (r.rpm, 1.0), xycoords=("data", "axes fraction"), fontsize=6,
+                    rotation=90, ha="right", va="top", color=style["color"])
+    ax.set_xlim(float(rpm[0]), float(rpm[-1]))
+    ax.set_xlabel("mean shaft speed [rpm]")
+    ax.set_ylabel("twist growth per revolution [e-folds]")
+    ax.grid(True, alpha=0.3)
+    legend_outside(ax)

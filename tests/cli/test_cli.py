@@ -978,7 +978,15 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert "(quick: caches warm)" in targets and "## Cold compile profile" in targets
     lines = verdicts(res)
     assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 1 + 1 + 2 \
-        + len(BENCH_SCENES) * len(ADAPTIVE) + 2
+        + len(BENCH_SCENES) * len(ADAPTIVE) + 2 + 4  # (the elastic line's four)
+    tors = res["torsion"]  # (quick: 4 revolutions, lines of 3 and 4 stations, RK45 only)
+    assert tors["rigid"]["elastic_s"] > 0 and tors["rigid"]["rigid_s"] > 0
+    assert tors["scaling"]["stations"] == [3, 4] and all(
+        w > 0 for w in tors["scaling"]["wall_per_cycle_s"])
+    assert {r["method"] for r in tors["rows"]} == {"transient DOP853 (crank angle)",
+                                                     "solve_ivp RK45 (numpy RHS)"}
+    assert all(np.isfinite(r["phase_err_rad"]) for r in tors["rows"])
+    assert "## Elastic shaft line" in targets
     assert res["reaction"]["constant_s"] > 0 and res["reaction"]["reaction_s"] > 0
     (models,) = res["models"]  # (quick: the plain scene only)
     assert models["this_s"] > 0 and models["left_out_s"] > 0
@@ -986,7 +994,7 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert "## Friction models left out" in targets
     for target, case, measured, verdict in lines:
         assert verdict in ("met", "met at the baseline's best error", "**missed**",
-                           "**not measured**")
+                           "**not measured**", "covered by the rigid targets")
         assert f"| {target} | {case} | {measured} | {verdict} |" in targets
         assert "|" not in target + case + measured  # (a cell's pipe would split the table)
     # --report rewrites both reports from the stored measurements, unchanged; only with --force

@@ -56,7 +56,9 @@ def test_speed_range_and_orders_from_the_options(tmp_path, capsys):
     (["--speed-range", "3000,1000"], "--speed-range: give two speeds LO,HI"),
     (["--speed-range", "x"], "--speed-range: must be comma-separated numbers"),
     (["--max-order", "0"], "max-order"),
-    (["--speeds", "50"], "--speeds: sets the speeds of the forced response; add --response"),
+    (["--speeds", "50"], "--speeds: sets the speeds of the forced response and the stability "
+                         "chart; add --response or --floquet"),
+    (["--floquet", "--speeds", "1"], "speeds"),
     (["--response", "--speeds", "1"], "speeds"),
 ])
 def test_bad_options_are_one_line(tmp_path, capsys, args, words):
@@ -138,3 +140,31 @@ def test_the_response_refuses_a_misfiring_scene_before_writing(tmp_path, capsys)
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "gas.cylinders[0].misfire_every" in err[0]
     assert list(out.iterdir()) == []
+
+
+def test_the_floquet_chart_writes_its_table_and_figure(tmp_path, capsys):
+    """--floquet: a row per speed with |μ|max the largest of the multipliers' moduli and the
+    growth per revolution ln|μ|max (a crank-slider's inertias repeat every revolution); the
+    six's damped line stable at every speed (its inertia varies by a few per cent); a second
+    run without --force overwrites nothing."""
+    import math
+
+    args = ["modes", str(CASE), "-o", str(tmp_path), "--floquet", "--speeds", "13"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "parametric stability at 13 speeds from" in out and "stable at every speed" in out
+    table = tmp_path / "inline6_damper_floquet.csv"
+    assert (tmp_path / "inline6_damper_floquet.png").read_bytes()[:4] == b"\x89PNG"
+    with open(table, encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 13 and float(rows[0]["rpm"]) == 800.0
+    for r in rows:
+        moduli = [float(v) for k, v in r.items() if k.startswith("mu_abs_")]
+        assert float(r["mu_max"]) == max(moduli) < 1.0
+        assert float(r["growth_per_rev"]) == pytest.approx(math.log(float(r["mu_max"])),
+                                                           rel=1e-9)
+        assert r["unstable"] == "0"
+    before = table.read_bytes()
+    assert main(args) == 2
+    assert "exists; use --force" in capsys.readouterr().err
+    assert table.read_bytes() == before

@@ -177,3 +177,77 @@ def test_the_models_left_out_copy_matches_the_sources(tmp_path):
     assert (copy / "core" / "model" / "chain.py").read_text(encoding="utf-8") == original.read_text(
         encoding="utf-8")
 
+
+
+# -- the elastic shaft line's targets (transient.verify.torsion)
+
+
+@pytest.mark.parametrize("n", [3, 10, 30])
+def test_the_generated_line_has_n_stations_and_a_spectrum_bounded_in_n(n):
+    """N stations (the six's cylinders each on one of the first N − 1, in order; the flywheel
+    last, the reference and where the load acts), N − 1 equal sections, no damper; its highest
+    natural frequency within Gershgorin's bound 2√(k/J_min), which does not grow with N, and
+    near it from N = 10 on (an explicit step's stability limit: the same along the lines)."""
+    from transient.analysis.torsion import natural_modes
+    from transient.shaft import ShaftLine
+    from transient.verify import torsion as vt
+
+    scene = vt.generated_line(load_scene(vt.ELASTIC_SCENE), n)
+    shaft = scene.shaft
+    assert len(shaft.stations) == n and len(shaft.sections) == n - 1 and not shaft.dampers
+    carried = [c for st in shaft.stations for c in st.cylinders]
+    assert carried == list(range(1, 7))
+    assert shaft.reference == shaft.load_at == shaft.stations[-1].name == "flywheel"
+    line = ShaftLine(scene)
+    omega, _ = natural_modes(line.K, line.mean_inertia(), line.rigid_modes)
+    bound = 2.0 * math.sqrt(vt.SECTION_K / vt.STATION_INERTIA)
+    assert omega[-1] <= bound
+    if n >= 10:
+        assert omega[-1] >= 0.8 * bound
+
+
+def _torsion_results(rigid_ratio, r2, cost_ratio, scipy_ratios):
+    each = [{"scene": "six", "baseline": f"solve_ivp {m} (numpy RHS)", "error_rad": 1e-6,
+             "how": "measured", "baseline_s": r, "transient_s": 1.0, "ratio": r, "target": 100.0}
+            for m, r in scipy_ratios.items()]
+    return {"rigid": {"scene": "six", "stations": 8, "dofs": 9, "cycles": 100.0,
+                      "elastic_s": rigid_ratio * 1e-3, "rigid_s": 1e-3, "ratio": rigid_ratio,
+                      "elastic_steps": 400.0, "rigid_steps": 50.0, "elastic_call_s": 2e-7,
+                      "rigid_call_s": 1e-7},
+            "scaling": {"stations": [3, 30], "wall_per_cycle_s": [1e-3, cost_ratio * 1e-3],
+                        "steps_per_cycle": [400.0, 400.0], "slope_s": 1e-5, "intercept_s": 0.0,
+                        "r2": r2, "ratio": cost_ratio, "span": 10.0},
+            "rows": [], "scipy": bt.elastic_against_scipy([]) if not each else
+            {"each": each, "best": min(each, key=lambda s: s["ratio"])}}
+
+
+def test_the_elastic_verdicts_say_met_or_missed():
+    """≤ 10× the rigid run per cycle; linear in N (rising, and at most N₃₀/N₃ = 10× the cost
+    at 3, whatever the noise makes of R²); ≥ 100× the fastest scipy method; the rigid scenes'
+    cost left to the rigid rows."""
+    from transient.verify import torsion as vt
+
+    def verdicts(res):
+        return [v for _, _, _, v in vt.verdicts(res, bt._missed)]
+
+    assert verdicts(_torsion_results(8.0, 0.99, 9.0, {"RK45": 300.0, "LSODA": 150.0})) == [
+        "met", "met", "met", "covered by the rigid targets"]
+    assert verdicts(_torsion_results(12.0, 0.99, 12.0, {"RK45": 300.0, "LSODA": 50.0})) == [
+        "**missed**", "**missed**", "**missed**", "covered by the rigid targets"]
+    assert verdicts(_torsion_results(8.0, 0.9, 5.0, {}))[1:3] == ["met", "**not measured**"]
+    line = vt.verdicts(_torsion_results(8.0, 0.99, 9.0, {"RK45": 300.0, "LSODA": 150.0}),
+                       bt._missed)[2][2]
+    assert line.startswith("150× solve_ivp LSODA (numpy RHS)")  # (the fastest of them)
+
+
+def test_the_scipy_comparison_takes_the_fastest_method_at_equal_error():
+    """The record's rows through the rigid scenes' comparison: each method at 1e-6 rad against
+    transient's default path there; the best of them the one of least ratio."""
+    rows = [_row("six", DEFAULT, 1e-8, 0.01, 1e-7), _row("six", DEFAULT, 1e-6, 0.005, 1e-5),
+            _row("six", "solve_ivp RK45 (numpy RHS)", 1e-8, 20.0, 5e-7),
+            _row("six", "solve_ivp LSODA (numpy RHS)", 1e-8, 3.0, 8e-7),
+            _row("six", "solve_ivp Radau (numpy RHS)", 1e-8, 9.0, 2e-7)]
+    got = bt.elastic_against_scipy(rows)
+    assert len(got["each"]) == 3
+    assert got["best"]["baseline"] == "solve_ivp LSODA (numpy RHS)"
+    assert got["best"]["ratio"] == pytest.approx(3.0 / 0.01)

@@ -70,7 +70,7 @@ def test_the_energy_balance_holds_with_the_w_method(runs):
 
 
 def test_a_start_from_rest_switches_to_crank_angle_where_dop853_does():
-    """From rest on a starter: in time the Jacobian is the time form's (T11); the switch to crank
+    """From rest on a starter: in time the Jacobian is the time form's (T12); the switch to crank
     angle (a speed event located on the cubic Hermite dense output) at DOP853's instant to the
     tolerance, and the balance across it."""
     sc = _case(revolutions=2.0, rtol=1e-8)

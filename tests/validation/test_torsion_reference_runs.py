@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 from engines import SIX_OWN, inline_six_line, inline_six_mech
-from scipy.integrate import solve_ivp
+from hill import hill_monodromy
 from scipy.optimize import brentq
 
 from transient.mechanisms.twins import CrankSliderNumpy
@@ -125,17 +125,8 @@ W_N = math.sqrt(K / J0)
 
 
 def monodromy(eps: float, c: float, Om: float) -> np.ndarray:
-    """Hill's equation (T8) of the twist x = θ₁ − Ωt of a mass J₀(1 + ε cos 2θ₁) on a
-    section (K, c) to a mass turning at Ω: J ẍ + (c + Ω J′) ẋ + (K + ½ Ω² J″) x = 0, its
-    fundamental matrix over one period π/Ω of the parametric excitation."""
-    def f(t, z):
-        co, s = math.cos(2 * Om * t), math.sin(2 * Om * t)
-        J, dJ, ddJ = J0 * (1 + eps * co), -2 * J0 * eps * s, -4 * J0 * eps * co
-        A = np.array([[0.0, 1.0], [-(K + 0.5 * Om ** 2 * ddJ) / J, -(c + Om * dJ) / J]])
-        return (A @ z.reshape(2, 2)).ravel()
-    sol = solve_ivp(f, (0.0, math.pi / Om), np.eye(2).ravel(), method="DOP853", rtol=1e-12,
-                    atol=1e-14)
-    return sol.y[:, -1].reshape(2, 2)
+    """Hill's two-mass monodromy (:func:`hill.hill_monodromy`) of this module's J₀ and K."""
+    return hill_monodromy(J0, K, eps, c, Om)
 
 
 def principal_region(eps: float) -> tuple[float, float]:

@@ -1,7 +1,9 @@
 """``transient modes``: the torsional modes and critical speeds of a scene's shaft line, without
 running it (:mod:`transient.analysis.torsion`), and its Campbell diagram; with ``--response``
 its steady forced response to the engine's orders over the speed range
-(:mod:`transient.analysis.torsional_response`)."""
+(:mod:`transient.analysis.torsional_response`); with ``--floquet`` its parametric stability,
+the Floquet multipliers of the variable-inertia line over the speed range
+(:mod:`transient.analysis.floquet`)."""
 from __future__ import annotations
 
 import math
@@ -25,6 +27,9 @@ from .common import (
 #: Speeds of ``--response`` by default: 5 rpm apart over the case's 800–4400 rpm, fine enough
 #: for a resonance of a few per cent damping.
 RESPONSE_SPEEDS = 721
+#: Speeds of ``--floquet`` by default: 20 rpm apart over the case's 800–4400 rpm; a principal
+#: region a few per cent of its speed wide spans several of them.
+FLOQUET_SPEEDS = 181
 
 
 def register(sub) -> None:
@@ -41,9 +46,14 @@ def register(sub) -> None:
     m.add_argument("--response", action="store_true",
                    help="also the steady forced response at constant inertia over the speed "
                         "range: a table (CSV) and a figure of each element's vibratory torque")
+    m.add_argument("--floquet", action="store_true",
+                   help="also the parametric stability over the speed range: the Floquet "
+                        "multipliers of the line with each station's varying inertia, a table "
+                        "(CSV) and a chart of the twist's growth per revolution")
     m.add_argument("--speeds", type=whole(2, 100_000), default=None, metavar="N",
-                   help=f"speeds of the response, evenly over the range, the critical speeds "
-                        f"added (default {RESPONSE_SPEEDS})")
+                   help=f"speeds of the response and of the stability chart, evenly over the "
+                        f"range (default {RESPONSE_SPEEDS} for the response, the critical "
+                        f"speeds added; {FLOQUET_SPEEDS} for the chart)")
     add_force(m)
     m.set_defaults(func=cmd_modes)
 
@@ -68,13 +78,16 @@ def cmd_modes(args) -> int:
     paths = {"figure": out / f"{stem}_campbell.png"}
     if args.csv:
         paths.update(modes=out / f"{stem}_modes.csv", criticals=out / f"{stem}_criticals.csv")
-    if args.speeds is not None and not args.response:
-        raise SceneError("--speeds", "sets the speeds of the forced response; add --response or "
-                                     "leave --speeds out")
+    if args.speeds is not None and not (args.response or args.floquet):
+        raise SceneError("--speeds", "sets the speeds of the forced response and the stability "
+                                     "chart; add --response or --floquet, or leave --speeds out")
     if args.response:
         check_steady(scene)
         paths.update(response=out / f"{stem}_response.csv",
                      response_figure=out / f"{stem}_response.png")
+    if args.floquet:
+        paths.update(floquet=out / f"{stem}_floquet.csv",
+                     floquet_figure=out / f"{stem}_floquet.png")
     for path in paths.values():  # (before any work: nothing is overwritten without --force)
         check_output_file(path, args.force)
 
@@ -109,6 +122,8 @@ def cmd_modes(args) -> int:
         written.append(paths["criticals"])
     if args.response:
         written += _response(line, orders, rpm_range, criticals, args, paths)
+    if args.floquet:
+        written += _floquet(line, modal, rpm_range, args, paths)
     for path in written:
         print(f"wrote {path}")
     return EXIT_OK
@@ -196,3 +211,48 @@ def _print_response(res) -> None:
         if label.startswith("damper") and np.any(total):
             k = int(np.argmax(total))
             print(f"  {'':<34} dissipates at most {total[k]:.5g} W, at {res.rpm[k]:.1f} rpm")
+
+
+def _floquet(line, modal, rpm_range, args, paths) -> list[Path]:
+    """The stability chart over ``rpm_range``: its summary printed, its table and figure
+    written; returns their paths."""
+    import numpy as np
+
+    from .. import plots
+    from ..analysis.floquet import floquet_chart, parametric_resonances
+    from ..analysis.torsional_response import speed_grid
+
+    res = floquet_chart(line, speed_grid(rpm_range, args.speeds or FLOQUET_SPEEDS))
+    marks = parametric_resonances(line, [m.f for m in modal.modes], rpm_range)
+    _print_floquet(res)
+    cols = {"rpm": res.rpm, "mu_max": res.mu_max, "growth_per_rev": res.growth_per_rev,
+            "unstable": res.unstable.astype(float)}
+    cols.update({f"mu_abs_{i + 1}": np.abs(res.multipliers[:, i])
+                 for i in range(res.multipliers.shape[1])})
+    write_columns(paths["floquet"], cols, args.force)
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(11, 5.5))
+    plots.floquet_chart(ax, res, marks)
+    ax.set_title(f"{line.scene.name}: parametric stability of the shaft line (Floquet, inertias "
+                 f"varying with each station's angle)")
+    return [paths["floquet"], save(fig, paths["floquet_figure"], args.force)]
+
+
+def _print_floquet(res) -> None:
+    import numpy as np
+
+    period = 360.0 / res.g
+    print(f"parametric stability at {res.rpm.size} speeds from {res.rpm[0]:.6g} to "
+          f"{res.rpm[-1]:.6g} rpm (Floquet multipliers over the inertias' period, {period:g}°, "
+          f"the line's rigid motion held at the mean speed):")
+    worst = int(np.argmax(res.mu_max))
+    ranges = res.unstable_ranges()
+    if not ranges:
+        print(f"  stable at every speed; largest |μ| {res.mu_max[worst]:.6f} at "
+              f"{res.rpm[worst]:.1f} rpm")
+    for lo, hi in ranges:
+        sel = (res.rpm >= lo) & (res.rpm <= hi)
+        k = int(np.argmax(np.where(sel, res.mu_max, -np.inf)))
+        print(f"  unstable from {lo:.1f} to {hi:.1f} rpm: largest |μ| {res.mu_max[k]:.6f} at "
+              f"{res.rpm[k]:.1f} rpm, the twist growing {res.growth_per_rev[k]:.3g} e-folds per "
+              f"revolution")

@@ -27,6 +27,7 @@ samples interpolated by a cubic spline — solve_ivp's from its dense output, ei
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses as dc
 import json
@@ -191,32 +192,61 @@ def _compiled(name, base, ref, label, settings, rtol, revolutions, repeat, step=
                 first.solver["compile_s"], repeat, data.solver, (phase, w_err, l2), step)
 
 
+#: Settings of the targets' timed runs (:mod:`.targets`): rtol 1e-8, atol 1e-11.
+RUN_RTOL, RUN_ATOL = 1e-8, 1e-11
+
+
+def timed_scene(base, revolutions=1000.0, samples_per_rev=1):
+    """``base`` as the overhead and bare-scene runs time it (RUN_RTOL, RUN_ATOL)."""
+    return dc.replace(base, run=dc.replace(base.run, revolutions=revolutions, t_end=math.inf),
+                      solver=dc.replace(base.solver, rtol=RUN_RTOL, atol=RUN_ATOL),
+                      output=dc.replace(base.output, samples_per_rev=samples_per_rev))
+
+
+def median_walls(*scenes, repeat=5):
+    """Median integration wall time of each scene, their runs alternating, after a warm-up each;
+    with the solver's counts of each scene's last run."""
+    walls, counts = [[] for _ in scenes], [None] * len(scenes)
+    for i in range(repeat + 1):
+        for k, scene in enumerate(scenes):
+            counts[k] = integrate(scene, keep=False).solver
+            if i:
+                walls[k].append(counts[k]["wall_s"])
+    return [statistics.median(w) for w in walls], walls, counts
+
+
 class OverBudget(Exception):
     """A baseline run took longer than its budget and was stopped."""
 
 
-def _solve_ivp(name, base, ref, rtol, revolutions, method, budget):
-    """One solve_ivp run, or None if it was stopped after ``budget`` seconds (checked after every
-    segment between breakpoints)."""
-    from ..reference import run_reference
-
-    scene = _scene(base, f"scipy-{method}", rtol, revolutions)
-
+@contextlib.contextmanager
+def budget(seconds: float):
+    """Raise :class:`OverBudget` in the block after ``seconds``: a timer signal, not a check
+    between segments, since one segment of a baseline can take arbitrarily long."""
     def stop(signum, frame):
         raise OverBudget
 
-    # A timer signal, not a check between segments: one segment can take arbitrarily long.
     previous = signal.signal(signal.SIGALRM, stop)
-    signal.setitimer(signal.ITIMER_REAL, budget)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
-        data = run_reference(scene, state_only=True, dense_tail=base.mechanism.cycle + 0.5)
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _solve_ivp(name, base, ref, rtol, revolutions, method, seconds):
+    """One solve_ivp run, or None if it was stopped after ``seconds``."""
+    from ..reference import run_reference
+
+    scene = _scene(base, f"scipy-{method}", rtol, revolutions)
+    try:
+        with budget(seconds):
+            data = run_reference(scene, state_only=True, dense_tail=base.mechanism.cycle + 0.5)
     except OverBudget:
         return None
     except (ValueError, FloatingPointError, SimulationError) as exc:  # e.g. a stage overflowed
         return f"failed: {exc}"
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, previous)
     tr = data.trajectory
     return _row(name, f"solve_ivp {method} (numpy RHS)", rtol, data.solver["wall_s"], 0.0, 1,
                 data.solver, _errors(ref, tr["t"][-1], tr["omega"][-1], tr["phi"], tr["omega"]))

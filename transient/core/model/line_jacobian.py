@@ -1,5 +1,5 @@
 """The elastic shaft line's Jacobian for the W-method (:mod:`transient.core.integrator.rosenbrock`;
-theory, *Stiff shaft lines: the W-method*, (T10)–(T11)): the part of ∂f/∂y that makes the line
+theory, *Stiff lines: the W-method*, (T11)–(T12)): the part of ∂f/∂y that makes the line
 stiff, its elements' stiffness and damping couplings of the twists and energies (speeds in time)
 of the dofs other than the reference, in band storage over the line's block of the state.
 
@@ -94,7 +94,7 @@ def _speed_partials(angle_mode, J, dJ, w):
 @kernel(inline=True)
 def line_jacobian(m, angle_mode, y, f0, wk, band):
     """The line's Jacobian at ``y`` into ``band`` (the derivative there ``f0``); returns the
-    state index of the block's first component. In crank angle (T10), time (T11)."""
+    state index of the block's first component. In crank angle (T11), time (T12)."""
     lo = line_index(m)
     for r in range(band.shape[0]):
         for c in range(band.shape[1]):
