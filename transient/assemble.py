@@ -17,7 +17,7 @@ from .core.model import elastic, tabulated
 from .core.model import governor as gv
 from .core.model import shaft as line_kernels
 from .core.model import variation as var
-from .core.model.forcing import applied_value, fuel, governor_branch, select_pieces
+from .core.model.forcing import applied_value, fuel, governor_branch, rigid_inertia, select_pieces
 from .core.model.layout import (
     LINK_FIXED,
     LINK_PISTONS,
@@ -301,7 +301,9 @@ def line_fields(scene, tabulated_kinematics: bool) -> dict:
     :mod:`transient.core.model.shaft` on a rigid shaft."""
     if scene.shaft is None:
         return dict(line=line_kernels.RIGID_LINE, shares=line_kernels.no_shares,
-                    line_model=line_kernels.no_line_model)
+                    line_model=line_kernels.no_line_model,
+                    line_switch=line_kernels.no_line_switch,
+                    reference_inertia=rigid_inertia)
     line = ShaftLine(scene)
     shaft = scene.shaft
     carrier = np.zeros(scene.mechanism.n_cylinders, dtype=np.int64)
@@ -312,7 +314,8 @@ def line_fields(scene, tabulated_kinematics: bool) -> dict:
                                     line.names.index(shaft.load_at), carrier, dofs,
                                     line.element_rows())
     shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
-    return dict(line=packed, shares=shares, line_model=elastic.elastic_model)
+    return dict(line=packed, shares=shares, line_model=elastic.elastic_model,
+                line_switch=line_kernels.line_mode, reference_inertia=line_kernels.ref_inertia)
 
 
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:

@@ -44,9 +44,7 @@ from .layout import (
     cyl_index,
     gov_index,
     latch_index,
-    line_dofs,
 )
-from .shaft import ref_inertia
 from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
@@ -182,11 +180,15 @@ def cylinder_rates(m, angle_mode, y, sel, w, f, wk, out):
 
 @kernel(inline=True)
 def inertia(m, phi, wk):
-    """Total reduced inertia J(φ), (19); fills the row u of ``wk``. On an elastic shaft line
-    the reference dof's J_ref(φ) (its own and its cylinders'), the
-    inertia of the third state's K = ½Jω² (:func:`.shaft.ref_inertia`)."""
-    if line_dofs(m) > 0:
-        return ref_inertia(m, phi, wk)
+    """The inertia of the third state's K = ½Jω² at φ (``Model.reference_inertia``, a
+    compile-time choice): on a rigid shaft J(φ) (:func:`rigid_inertia`), on an elastic shaft line
+    the reference dof's J_ref(φ) (:func:`.shaft.ref_inertia`); fills the row u of ``wk``."""
+    return m.reference_inertia(m, phi, wk)
+
+
+@kernel(inline=True)
+def rigid_inertia(m, phi, wk):
+    """Total reduced inertia J(φ), (19); fills the row u of ``wk``."""
     J, _ = mechanism_terms(m, phi, wk[WK_U], wk[WK_DU], False)
     return J + m.J0
 

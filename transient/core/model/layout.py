@@ -397,11 +397,13 @@ Model = namedtuple(
         "et_eta",  # float64[n_pairs, 2, nw_max, ns_max]: η_fwd, η_bwd on pair k's grid [1]
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
         # the elastic shaft line (transient.shaft.ShaftLine; theory, The elastic shaft line),
-        # packed: every field of the Model costs a rigid scene's run time, so the line is one
-        # array and two kernels; a rigid shaft's is a row of zeros (no dofs) and no-ops
+        # packed in one array, with its kernels as fields so that a rigid shaft's stepper, whose
+        # line is a row of zeros (no dofs) and whose kernels are no-ops, compiles none of them
         "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
         "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
         "line_model",  # kernel: the line's derivative or output row; True if it did them
+        "line_switch",  # kernel: each other dof's speed state to K_d or back (m, y, to_angle, wk)
+        "reference_inertia",  # kernel: J of the third state's K = ½Jω² at φ (m, phi, wk)
     ],
 )
 typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)

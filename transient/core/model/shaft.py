@@ -212,6 +212,11 @@ def no_shares(mp, kin_coef, angles, Jc, dJc, u, du):
 
 
 @kernel(inline=True)
+def no_line_switch(m, y, to_angle, wk):
+    """``Model.line_switch`` of a rigid shaft: no dofs to convert."""
+
+
+@kernel(inline=True)
 def no_line_model(m, row, angle_mode, y, sw, wk, out):
     """``Model.line_model`` of a rigid shaft: nothing done, as its False says."""
     return False

@@ -94,7 +94,6 @@ from ..model.rhs import (
     reset_kinks,
     watches_kinks,
 )
-from ..model.shaft import line_mode
 from ..model.work import work_array
 from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .events import (
@@ -792,11 +791,11 @@ def _switch_at_event(m, extras, io, angle_mode, event, h_next, y, wk):
 @kernel
 def _to_angle_mode(m, y, ist, wk):
     """Crank angle becomes the independent variable; the third state becomes K = ½ J ω², and
-    on an elastic shaft line each dof's speed its K_d (:func:`~.shaft.line_mode`)."""
+    on an elastic shaft line each dof's speed its K_d (``Model.line_switch``,
+    :func:`~transient.core.model.shaft.line_mode`)."""
     J = inertia(m, y[PHI], wk)
     y[KINETIC] = 0.5 * J * y[OMEGA] * y[OMEGA]
-    if line_dofs(m) > 0:  # the shaft line's other dofs alike
-        line_mode(m, y, True, wk)
+    m.line_switch(m, y, True, wk)  # an elastic shaft line's other dofs alike
     ist[I_ANGLE_MODE] = 1
 
 
@@ -806,8 +805,7 @@ def _to_time_mode(m, y, ist, wk):
     dof's K_d its ω_d."""
     J = inertia(m, y[PHI], wk)
     y[OMEGA] = speed(J, True, y)
-    if line_dofs(m) > 0:
-        line_mode(m, y, False, wk)
+    m.line_switch(m, y, False, wk)
     ist[I_ANGLE_MODE] = 0
 
 
