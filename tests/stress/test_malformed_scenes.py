@@ -228,8 +228,8 @@ CASES = [
      'solver.fixed_step: fixed steps are crank-angle steps; use domain = "auto" or fixed_step = 0'),
     ("tables-on-reference-path", add("atol = 1e-8", 'kinematics = "tabulated"\n'
                                                     'method = "scipy-DOP853"'),
-     "solver.kinematics: tables are for the compiled methods (dop853, dopri5); the reference path "
-     "'scipy-DOP853' is exact by design"),
+     "solver.kinematics: tables are for the compiled methods (dop853, dopri5, ros34pw2, auto); the "
+     "reference path 'scipy-DOP853' is exact by design"),
     ("unknown-domain", add("atol = 1e-8", 'domain = "angle"'),
      "solver.domain: unknown value 'angle'; allowed: 'auto', 'time'"),
     ("unknown-interpolation", table_gas('phi_deg = [0, 360, 720]\np_bar = [1, 60, 1]\n'

@@ -2,7 +2,7 @@
 :mod:`transient.core.integrator.rosenbrock` with the line's Jacobian,
 :mod:`transient.core.model.line_jacobian`), against what is independent of it: DOP853's run of
 the same scene at a tolerance 100 times tighter, the energy balance (T4) written out from the
-output columns (``test_elastic_runs._balance``, numpy), the sample grid and the switch from time
+output columns (``elastic_checks.line_balance``, numpy), the sample grid and the switch from time
 to crank angle where DOP853 puts them; and, on the same line with a stiff front end, the hint an
 explicit run gives where stability holds its step."""
 from __future__ import annotations
@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_elastic_runs import _balance, _case
+from elastic_checks import line_balance
+from test_elastic_runs import _case
 
 import transient
 from transient.errors import SceneError
@@ -63,7 +64,7 @@ def test_the_energy_balance_holds_with_the_w_method(runs):
     """(T4) within 1e2·rtol of the gas work at every sample, as for DOP853."""
     scene, res, _ = runs
     tr = res.trajectory
-    balance, energy = _balance(scene, tr)
+    balance, energy = line_balance(scene, tr)
     np.testing.assert_allclose(tr["E_line"], energy, rtol=1e-12)
     assert tr["W_line_loss"][-1] > 0.0 and np.all(np.diff(tr["W_line_loss"]) >= 0.0)
     assert np.max(np.abs(balance)) <= 1e2 * scene.solver.rtol * np.max(np.abs(tr["W_gas"]))
@@ -85,7 +86,7 @@ def test_a_start_from_rest_switches_to_crank_angle_where_dop853_does():
     assert tw.size == td.size >= 1
     # (the event's time: the speed's error over the run from rest, relative, times its time)
     assert np.max(np.abs(tw - td)) <= 10 * scene.solver.rtol * td[-1]
-    balance, _ = _balance(scene, w.trajectory)
+    balance, _ = line_balance(scene, w.trajectory)
     assert np.max(np.abs(balance)) <= 1e2 * scene.solver.rtol * np.max(
         np.abs(w.trajectory["W_gas"]))
 

@@ -3,10 +3,10 @@ rigid ones (:mod:`transient.verify.targets`):
 
 * **against the rigid model**: the in-line six with its damper (:data:`ELASTIC_SCENE`: eight
   stations and the damper's ring, nine degrees of freedom) run up from its initial speed costs at
-  most :data:`RIGID_TARGET` times its rigid equivalent (:func:`transient.shaft.rigid_equivalent`)
-  per cycle, both at the targets' tolerance (``targets.RUN_RTOL``, ``RUN_ATOL``); the steps and
-  right-hand-side calls of each are kept, so that a miss says whether the steps or the calls
-  cost it;
+  most :data:`RIGID_TARGET` times its rigid equivalent
+  (:func:`transient.shaft.line.rigid_equivalent`) per cycle, both at the targets' tolerance
+  (``targets.RUN_RTOL``, ``RUN_ATOL``); the steps and right-hand-side calls of each are kept,
+  so that a miss says whether the steps or the calls cost it;
 * **linear in the line's length**: a generated line of N equal stations and sections (the six's
   cylinders spread over all but the last, a flywheel last) for N = 3 … 30 — its highest natural
   frequency, which bounds an explicit step, does not grow with N — its wall per cycle fitted
@@ -221,7 +221,7 @@ def measure(quick=False, progress=print) -> dict:
 
 def verdicts(res, missed) -> list[tuple[str, str, str, str]]:
     """(target, case, measured, verdict) of each elastic target; ``missed``: the targets'
-    verdict of a value against a target (:func:`.targets._missed`)."""
+    verdict of a value against a target (``targets._missed``)."""
     r, s, sp = res["rigid"], res["scaling"], res["scipy"]
     lines = [(f"elastic run-up ≤ {RIGID_TARGET:g}× its rigid equivalent per cycle (equal "
               "tolerance)", f"{r['scene']} ({r['stations']} stations, {r['dofs']} dofs)",

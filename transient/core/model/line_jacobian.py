@@ -117,7 +117,8 @@ def _rate_factor(angle_mode, J, w, w_ref):
 @kernel(inline=True)
 def _own_terms(m, angle_mode, y, f0, wk, lo, band):
     """Each dof's own block: its twist's rate, the absolute damping's diagonal and the
-    dependence of the rate of its energy on its own speed (after :func:`line_speeds`)."""
+    dependence of the rate of its energy on its own speed (after
+    :func:`~transient.core.model.elastic.line_speeds`)."""
     n = line_dofs(m)
     kb = (band.shape[1] - 1) // 2
     dofs = line_parts(m.line)[1]
@@ -161,7 +162,8 @@ def _own_terms(m, angle_mode, y, f0, wk, lo, band):
 def _element_terms(m, angle_mode, wk, lo, band):
     """The elements' couplings: T_i −= τ and T_j += rτ with τ = k(θ_i − rθ_j) + c(ω_i − rω_j),
     so ∂T_a/∂θ_b = −s_a s_b k and ∂T_a/∂ω_b = −s_a s_b c (s_i = 1, s_j = −r), into the energy
-    (speed) rows of a and b against the states of a and b (after :func:`line_speeds`)."""
+    (speed) rows of a and b against the states of a and b (after
+    :func:`~transient.core.model.elastic.line_speeds`)."""
     n = line_dofs(m)
     kb = (band.shape[1] - 1) // 2
     elements = line_parts(m.line)[2]
