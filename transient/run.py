@@ -288,6 +288,7 @@ class _AutoMethod:
         self.saved: tuple = ()  # S: y, fst, ist, and the chunk's steps
         self.implicit = 0.0  # the W-method's progress over its trial
         self.at = (0.0, 0)
+        self.t = ""  # where the trials began
 
     def mark(self, y, ist) -> None:
         """A chunk starts at ``y``."""

@@ -1,6 +1,6 @@
 """A linearly implicit Rosenbrock–W method for stiff problems: ROS34PW2 (Rang & Angermann, *BIT*
-45 (2005) 761–787), one banded LU factorisation per step attempt (docs/theory.md, *Stiff shaft
-lines: the W-method*).
+45 (2005) 761–787), one banded LU factorisation per step attempt (docs/theory.md, *The elastic
+shaft line*, *Stiff lines: the W-method*).
 
 A Rosenbrock method solves, per stage, a linear system with W = I − hγJ in place of the Newton
 iterations of an implicit Runge–Kutta method; a **W-method** keeps its order with any matrix in

@@ -26,7 +26,7 @@ import numpy as np
 from ..jit import kernel
 from . import cylinder as cyl
 from . import governor as gv
-from .forcing import applied_value, command, governor_rates, load_moment, starter_moment
+from .forcing import command, cylinder_value, governor_rates, load_moment, shifted, starter_moment
 from .layout import (
     EL_C,
     EL_I,
@@ -117,20 +117,17 @@ def cylinder_pressure(m, c, theta, y, f, wk):
     """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel f
     (:func:`cylinder_fuel`): the table's piece found at its own angle in its cycle (WK_LOCAL,
     WK_PIECE; with a combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT,
-    WK_PIECE_SHIFT), then the rigid model's :func:`~.forcing.applied_value` there; in its closed
-    part with wall heat its pressure state; with a pressure factor β_c, p0 + β_c(p − p0), as it
-    acts on the piston."""
+    WK_PIECE_SHIFT), then the rigid model's :func:`~.forcing.cylinder_value` at ``theta`` (in
+    its closed part with wall heat, its pressure state); with a pressure factor β_c,
+    p0 + β_c(p − p0), as it acts on the piston."""
     local = (theta - m.gas_phase[c]) % m.period
     wk[WK_LOCAL, c] = local
     wk[WK_PIECE, c] = find_piece(m.knots, m.piece_knot, local)
-    if m.woschni and cyl.closed_angle(m.cyl_par, local, m.period) >= 0.0:
-        p = y[cyl_index(m) + c]
-    else:
-        if m.var_shifted:
-            shifted = (local - m.var_par[c, SHIFT]) % m.period
-            wk[WK_LOCAL_SHIFT, c] = shifted
-            wk[WK_PIECE_SHIFT, c] = find_piece(m.knots, m.piece_knot, shifted)
-        p = applied_value(m, True, c, theta, theta, f, wk)
+    if shifted(m):
+        local_shift = (local - m.var_par[c, SHIFT]) % m.period
+        wk[WK_LOCAL_SHIFT, c] = local_shift
+        wk[WK_PIECE_SHIFT, c] = find_piece(m.knots, m.piece_knot, local_shift)
+    p = cylinder_value(m, True, c, y, theta, theta, f, wk)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p

@@ -144,13 +144,14 @@ def applied_value(m, extras, k, phi, sel, f, wk):
 
 
 @kernel(inline=True)
-def cylinder_value(m, extras, k, y, sel, f, wk):
-    """The pressure on piston k: its state in the closed part with wall heat transfer
-    (``m.woschni``, :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
+def cylinder_value(m, extras, k, y, phi, sel, f, wk):
+    """The pressure on piston k at its angle ``phi`` (the shaft's, or on an elastic line its
+    station's): its state in the closed part with wall heat transfer (``m.woschni``,
+    :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
     if extras is not None and m.woschni:
         if cyl.closed_angle(m.cyl_par, wk[WK_LOCAL, k], m.period) >= 0.0:
             return y[cyl_index(m) + k]
-    return applied_value(m, extras, k, y[PHI], sel, f, wk)
+    return applied_value(m, extras, k, phi, sel, f, wk)
 
 
 @kernel(inline=True)
@@ -420,7 +421,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                 f_k = y[c + k] if extras is not None and m.latch else f
                 if extras is not None and m.var_on:
                     f_k *= wk[WK_FUEL, k]
-                p_k = cylinder_value(m, extras, k, y, sel, f_k, wk)
+                p_k = cylinder_value(m, extras, k, y, phi, sel, f_k, wk)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
                 if extras is not None and m.var_on:
                     M_k *= m.var_par[k, PRESSURE]

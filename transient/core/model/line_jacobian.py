@@ -34,9 +34,7 @@ from .layout import (
     LD_ABS,
     LD_GEAR,
     LD_WEIGHT,
-    LM_CYLINDERS,
     LM_DOFS,
-    LM_ELEMENTS,
     LM_REF,
     WK_LINE_DJ,
     WK_LINE_J,
@@ -55,7 +53,7 @@ def line_band(line) -> tuple[int, int]:
     if n == 0:
         return 0, 0
     ref = int(line[0, LM_REF])
-    elements = _elements(line)
+    elements = line_parts.py_func(line)[2]  # (the kernel's Python, on the Model's array)
     kb = 1
     for i, j in elements[:, [EL_I, EL_J]].astype(int):
         if i != ref and j != ref:
@@ -66,12 +64,6 @@ def line_band(line) -> tuple[int, int]:
 
 def _place(d: int, ref: int) -> int:
     return d if d < ref else d - 1
-
-
-def _elements(line):
-    """The element table of the packed ``line`` (:func:`.shaft.line_parts`'s, in Python)."""
-    e0 = 1 + int(line[0, LM_CYLINDERS]) + int(line[0, LM_DOFS])
-    return line[e0:e0 + int(line[0, LM_ELEMENTS]), :]
 
 
 @kernel(inline=True)

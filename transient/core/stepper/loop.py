@@ -282,8 +282,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
     while True:
         if (ist[I_NOUT] + margin >= outbuf.shape[0] or ist[I_NEV] + 8 >= evbuf.shape[0]
                 or steps_here >= cfg[C_CHUNK_STEPS]):
-            _carry(fst, f, gs, m.n_pairs, True)
-            ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
+            _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected)
             return RUNNING
         angle_mode = ist[I_ANGLE_MODE] == 1
         sw = ist[:N_SWITCHES]
@@ -377,8 +376,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
             # from this step's start, which is left as a chunk's end leaves it.
             ist[I_NSTIFF_STEPS] += 1
             if cfg[C_STIFF_SWITCH] > 0.0:
-                _carry(fst, f, gs, m.n_pairs, True)
-                ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
+                _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected)
                 return STIFF
         if not angle_mode and abs(y_new[PHI] - y[PHI]) > MAX_OUTPUT_INTERVALS * cfg[C_DPHI_OUT]:
             # (a step in time writes a sample at each crossing of the angle grid: no more of
@@ -428,6 +426,14 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
             return status
         _switch_at_event(m, extras, io, angle_mode, (ev_code, ev_comp, ev_level, ev_rising),
                          h_next, y, wk)
+
+
+@kernel(inline=True)
+def _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected):
+    """What a chunk leaves for the next: the derivative and the margins at the state, and the
+    counters of the retaken attempts, so that where a chunk ends changes nothing in the run."""
+    _carry(fst, f, gs, m.n_pairs, True)
+    ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
 
 
 @kernel(inline=True)
