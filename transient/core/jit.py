@@ -405,9 +405,9 @@ def kernel(fn=None, *, inline=False, **options):
     typing it, which made the cold compile grow with the nesting of calls."""
     if fn is None:
         return lambda f: kernel(f, inline=inline, **options)
-    if not REPLACEMENTS_ON:  # (numba's inliner: the same machine code, a slower compile)
-        dispatcher = compiled(fn, _nrt=False, **({"inline": "always"} if inline else {}),
-                              **options)
+    if not REPLACEMENTS_ON:  # a plain call: numba's inliner would defeat the pruning of a
+        # branch on an argument typed None (:func:`.rosenbrock.method_step` relies on it)
+        dispatcher = compiled(fn, _nrt=False, **options)
         if not config.DISABLE_JIT:
             dispatcher.__class__ = _Kernel
         return dispatcher
