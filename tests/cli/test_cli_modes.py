@@ -19,7 +19,7 @@ def test_modes_prints_the_table_and_writes_the_figure_and_tables(tmp_path, capsy
     assert "2 rigid mode(s) at 0 Hz" in out and "critical speeds from 800 to 4400 rpm" in out
     names = {p.name for p in tmp_path.iterdir()}
     assert names == {"inline6_damper_campbell.png", "inline6_damper_modes.csv",
-                     "inline6_damper_criticals.csv"}
+                     "inline6_damper_criticals.csv", "inline6_damper_damped_criticals.csv"}
     assert (tmp_path / "inline6_damper_campbell.png").read_bytes()[:4] == b"\x89PNG"
     with open(tmp_path / "inline6_damper_criticals.csv", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
@@ -30,6 +30,17 @@ def test_modes_prints_the_table_and_writes_the_figure_and_tables(tmp_path, capsy
     for r in rows:
         assert float(r["rpm"]) == pytest.approx(60 * f[int(float(r["mode"]))]
                                                 / float(r["order"]), rel=1e-10)
+    # the damped line's: each its damped mode's f_n over its order, below the undamped one's
+    with open(tmp_path / "inline6_damper_damped_criticals.csv", encoding="utf-8") as fh:
+        damped = list(csv.DictReader(fh))
+    f_n = [float(r.split()[0]) for r in
+           out[out.index("damped: "):out.index("critical speeds")].splitlines()[1:]]
+    assert damped and f_n
+    for r in damped:
+        assert float(r["rpm"]) == pytest.approx(60 * f_n[int(float(r["mode"])) - 1]
+                                                / float(r["order"]), rel=1e-3)  # (4 digits)
+    first = {float(r["order"]): float(r["rpm"]) for r in damped if float(r["mode"]) == 1}
+    assert first and all(rpm < 60 * f[1] / q for q, rpm in first.items())
 
 
 def test_nothing_is_overwritten_without_force(tmp_path, capsys):
@@ -47,9 +58,12 @@ def test_speed_range_and_orders_from_the_options(tmp_path, capsys):
     assert main(["modes", str(CASE), "-o", str(tmp_path), "--speed-range", "2600,2700",
                  "--max-order", "6"]) == 0
     out = capsys.readouterr().out
-    table = out[out.index("critical speeds"):].splitlines()[2:]
-    rows = [line.split() for line in table if line.strip() and not line.startswith("wrote")]
+    table = out[out.index("critical speeds"):out.index("critical speeds of the damped")]
+    rows = [line.split() for line in table.splitlines()[2:] if line.strip()]
     assert [(r[1], r[2], r[3]) for r in rows] == [("1", "6", "major")]
+    # (the damper lowers the first mode: its order 6 critical falls below 2600 rpm)
+    damped = out[out.index("critical speeds of the damped"):].splitlines()
+    assert damped[1].strip() == "none"
 
 
 @pytest.mark.parametrize("args, words", [

@@ -28,7 +28,9 @@ n_cyl/2, for a two-stroke of n_cyl); the other orders are *integer* or *half* or
 *relative excitation* of a critical is the vector sum of the mode's amplitudes at the
 cylinders' stations with the order's phases, |Σ_k φ_j(s_k) e^{iqφ_k}| / Σ_k |φ_j(s_k)|, in
 [0, 1]: how far the cylinders' excitations add up in that mode (the classical phase-vector
-sum).
+sum). The damped line's criticals are where an order meets a damped mode's natural frequency
+|λ|/2π, its excitation summed with the mode's complex amplitudes: a viscous damper's ring then
+moves partly with its hub, which the undamped line (the ring left free) does not show.
 """
 from __future__ import annotations
 
@@ -63,11 +65,14 @@ def natural_modes(K, M_diag, rigid: int = 0) -> tuple[NDArray[np.float64], NDArr
 @dataclass(frozen=True)
 class DampedMode:
     """An oscillating mode of the damped line: natural frequency ``omega_n`` = |λ| and damped
-    frequency ``omega_d`` = |Im λ| [rad/s], damping ratio ``zeta`` = −Re λ/|λ| [1]."""
+    frequency ``omega_d`` = |Im λ| [rad/s], damping ratio ``zeta`` = −Re λ/|λ| [1], and its
+    complex ``shape`` over the dofs (the eigenvector's displacements, the largest of modulus 1:
+    with non-proportional damping, as a viscous damper's, the dofs do not move in phase)."""
 
     omega_n: float
     omega_d: float
     zeta: float
+    shape: NDArray[np.complex128]
 
 
 def damped_modes(K, C, M_diag) -> tuple[list[DampedMode], int]:
@@ -79,14 +84,20 @@ def damped_modes(K, C, M_diag) -> tuple[list[DampedMode], int]:
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -inv[:, None] * np.asarray(K)
     A[n:, n:] = -inv[:, None] * np.asarray(C)
-    lam = scipy.linalg.eigvals(A)
+    lam, vectors = scipy.linalg.eig(A)
     scale = max(float(np.max(np.abs(lam))), 1.0)
     # (a free line's rigid mode is a double zero eigenvalue without a second eigenvector, which
     # rounding splits by about √ε·|A|: below 1e-6 of the largest it is taken as zero)
-    oscillating = lam[(lam.imag > 1e-9 * scale) & (np.abs(lam) > 1e-6 * scale)]
-    modes = sorted((DampedMode(float(abs(v)), float(v.imag), float(-v.real / abs(v)))
-                    for v in oscillating), key=lambda m: m.omega_n)
+    oscillating = np.flatnonzero((lam.imag > 1e-9 * scale) & (np.abs(lam) > 1e-6 * scale))
+    modes = sorted((DampedMode(float(abs(lam[i])), float(lam[i].imag),
+                               float(-lam[i].real / abs(lam[i])), _unit_shape(vectors[:n, i]))
+                    for i in oscillating), key=lambda m: m.omega_n)
     return modes, 2 * n - 2 * len(modes)
+
+
+def _unit_shape(x) -> NDArray[np.complex128]:
+    """``x`` scaled so that its largest component is 1 (modulus and phase)."""
+    return np.asarray(x / x[int(np.argmax(np.abs(x)))], dtype=np.complex128)
 
 
 @dataclass(frozen=True)
@@ -192,9 +203,12 @@ def order_kind(order: float, firing_angles) -> str:
     return "integer" if abs(order - round(order)) < 1e-9 else "half"
 
 
-def critical_speeds(modal: Modal, orders, speed_range: tuple[float, float]) -> list[Critical]:
+def critical_speeds(modal: Modal, orders, speed_range: tuple[float, float],
+                    damped: bool = False) -> list[Critical]:
     """The criticals of every elastic mode and order within ``speed_range`` [rpm] (inclusive),
-    by rising speed."""
+    by rising speed; with ``damped`` those of the damped line's modes (``modal.damped``,
+    numbered from 1 by rising f_n), where the order meets the natural frequency f_n = |λ|/2π
+    and the excitation sums the complex shape's amplitudes (for real shapes the same sum)."""
     scene = modal.line.scene
     firing = np.asarray(scene.mechanism.firing_angles, dtype=float)
     line = modal.line
@@ -202,15 +216,17 @@ def critical_speeds(modal: Modal, orders, speed_range: tuple[float, float]) -> l
     for s, st in enumerate(line.shaft.stations):
         for k in st.cylinders:
             dof_of[k - 1] = line.station_dof[s]
+    modes = ([(i + 1, d.omega_n / (2 * math.pi), d.shape) for i, d in enumerate(modal.damped)]
+             if damped else [(m.number, m.f, m.shape) for m in modal.modes])
     lo, hi = speed_range
     out = []
-    for mode in modal.modes:
-        amp = mode.shape[dof_of]
+    for number, f, shape in modes:
+        amp = shape[dof_of]
         for q in orders:
-            rpm = 60.0 * mode.f / q
+            rpm = 60.0 * f / q
             if lo <= rpm <= hi:
                 vector = abs(np.sum(amp * np.exp(1j * q * firing)))
-                out.append(Critical(mode.number, float(q), order_kind(q, firing), float(rpm),
+                out.append(Critical(number, float(q), order_kind(q, firing), float(rpm),
                                     float(vector / np.sum(np.abs(amp)))))
     return sorted(out, key=lambda c: c.rpm)
 

@@ -73,11 +73,14 @@ def cmd_modes(args) -> int:
                                   "torsional modes; describe the shaft line (docs: Torsion)",
                          file=args.scene)
     rpm_range = _speed_range(args.speed_range) if args.speed_range else speed_range(scene)
+    line = ShaftLine(scene)
     out = output_folder(args.output, Path("results"))
     stem = Path(args.scene).stem
     paths = {"figure": out / f"{stem}_campbell.png"}
     if args.csv:
         paths.update(modes=out / f"{stem}_modes.csv", criticals=out / f"{stem}_criticals.csv")
+        if np.any(line.C):
+            paths.update(damped_criticals=out / f"{stem}_damped_criticals.csv")
     if args.speeds is not None and not (args.response or args.floquet):
         raise SceneError("--speeds", "sets the speeds of the forced response and the stability "
                                      "chart; add --response or --floquet, or leave --speeds out")
@@ -91,12 +94,15 @@ def cmd_modes(args) -> int:
     for path in paths.values():  # (before any work: nothing is overwritten without --force)
         check_output_file(path, args.force)
 
-    line = ShaftLine(scene)
     modal = modal_analysis(line)
     orders = engine_orders(scene.mechanism.cycle, args.max_order)
     criticals = critical_speeds(modal, orders, rpm_range)
+    damped = critical_speeds(modal, orders, rpm_range, damped=True)
     _print_modes(scene, modal)
     _print_criticals(criticals, rpm_range)
+    if modal.damped:
+        _print_criticals(damped, rpm_range, "of the damped line (mode: its number among the "
+                                            "damped modes, at f_n)")
 
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 6))
@@ -112,14 +118,10 @@ def cmd_modes(args) -> int:
                      for i, name in enumerate(line.names)})
         write_columns(paths["modes"], cols, args.force)
         written.append(paths["modes"])
-        kinds = {"major": 0, "integer": 1, "half": 2}
-        write_columns(paths["criticals"], {
-            "mode": np.array([c.mode for c in criticals]),
-            "order": np.array([c.order for c in criticals]),
-            "kind_major0_integer1_half2": np.array([kinds[c.kind] for c in criticals]),
-            "rpm": np.array([c.rpm for c in criticals]),
-            "relative_excitation": np.array([c.excitation for c in criticals])}, args.force)
-        written.append(paths["criticals"])
+        for name, listed in (("criticals", criticals), ("damped_criticals", damped)):
+            if name in paths:
+                _write_criticals(paths[name], listed, args.force)
+                written.append(paths[name])
     if args.response:
         written += _response(line, orders, rpm_range, criticals, args, paths)
     if args.floquet:
@@ -154,10 +156,22 @@ def _print_modes(scene, modal) -> None:
                   f"{d.omega_d / (2 * math.pi):10.4g}")
 
 
-def _print_criticals(criticals, rpm_range) -> None:
+def _write_criticals(path, criticals, force: bool) -> None:
+    import numpy as np
+
+    kinds = {"major": 0, "integer": 1, "half": 2}
+    write_columns(path, {
+        "mode": np.array([c.mode for c in criticals]),
+        "order": np.array([c.order for c in criticals]),
+        "kind_major0_integer1_half2": np.array([kinds[c.kind] for c in criticals]),
+        "rpm": np.array([c.rpm for c in criticals]),
+        "relative_excitation": np.array([c.excitation for c in criticals])}, force)
+
+
+def _print_criticals(criticals, rpm_range, which: str = "") -> None:
     lo, hi = rpm_range
-    print(f"critical speeds from {lo:g} to {hi:g} rpm (relative excitation: the vector sum of "
-          f"the mode's amplitudes at the cylinders, 0 … 1):")
+    print(f"critical speeds {which + ' ' if which else ''}from {lo:g} to {hi:g} rpm (relative "
+          f"excitation: the vector sum of the mode's amplitudes at the cylinders, 0 … 1):")
     if not criticals:
         print("  none")
     print(f"  {'rpm':>9} {'mode':>4} {'order':>6} {'kind':>8} {'excitation':>10}")
