@@ -32,7 +32,8 @@ result → analysis, and each layer imports only those below it (the contracts i
 - ``cli``            the ``transient`` command
 
 Public API: :func:`load_scene` and :class:`Scene` (``Scene.from_dict``, ``scene.replace``,
-``scene.to_toml``), :func:`simulate` → :class:`Result`, :func:`open_result`, :func:`sweep`, and
+``scene.to_toml``), :func:`simulate` → :class:`Result`, :func:`steady` (the periodic steady
+state) → :class:`Result`, :func:`open_result`, :func:`sweep`, and
 the errors :class:`SceneError` (invalid input) and :class:`SimulationError` (a run that
 failed).
 """
@@ -40,13 +41,15 @@ from . import errors
 from .errors import SceneError, SimulationError
 from .version import __version__
 
-__all__ = ["load_scene", "Scene", "simulate", "Result", "open_result", "sweep", "SceneError",
+__all__ = ["load_scene", "Scene", "simulate", "steady", "Result", "open_result", "sweep",
+           "SceneError",
            "SimulationError", "errors", "__version__"]
 
 #: The public names imported when first used (PEP 562), each from its module: importing a part
 #: of the package (``transient.core.integrator`` alone, say) does not import the rest, and a
 #: tool that needs only the scene reader does not start the stepper's modules.
-_LAZY = {"load_scene": "scene", "Scene": "scene", "simulate": "run", "Result": "results",
+_LAZY = {"load_scene": "scene", "Scene": "scene", "simulate": "run", "steady": "shooting",
+         "Result": "results",
          "open_result": "results", "sweep": "sweeps.api"}
 
 

@@ -5,7 +5,7 @@ Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulatio
 partial result is kept and marked incomplete).
 
 Each command group is a module that registers its subparsers and parses, calls the library,
-draws and prints: ``run`` (run, check, info), ``plot``, ``kinematics``, ``modes``, ``verify`` (bench,
+draws and prints: ``run`` (run, check, info), ``steady``, ``plot``, ``kinematics``, ``modes``, ``verify`` (bench,
 stress), ``efficiency``, ``loads``, ``orders``, ``sweep`` (sweep, sweep-plot); ``common`` holds
 what they share. Errors become exit codes here only, in :func:`main`.
 """
@@ -18,7 +18,7 @@ import sys
 
 from ..errors import SceneError, SimulationError, WriteFailed
 from ..stopping import interrupting
-from . import efficiency, kinematics, loads, modes, orders, plot, run, sweep, verify
+from . import efficiency, kinematics, loads, modes, orders, plot, run, steady, sweep, verify
 from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE, OptionParser
 
 __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", "main"]
@@ -27,7 +27,7 @@ __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", 
 _BROKEN_WRITE: WriteFailed | None = None
 
 #: The subcommands' registrations, in the order ``transient --help`` lists them.
-_COMMANDS = (run.register, plot.register, kinematics.register, modes.register,
+_COMMANDS = (run.register, steady.register, plot.register, kinematics.register, modes.register,
              verify.register_bench,
              efficiency.register, loads.register, orders.register, verify.register_stress,
              sweep.register)
@@ -40,6 +40,7 @@ EXIT_BROKEN_PIPE = 128 + 13
 #: ``transient --help`` lists them all, and each command's own help ends with its own.
 EXAMPLES = {
     "run": "transient run cases/swash_plate_4cyl.toml -o results",
+    "steady": "transient steady cases/gots_diesel_friction.toml --cycles 2",
     "check": "transient check cases/gots_diesel_4400.toml",
     "info": "transient info results/swash_plate_4cyl.h5",
     "warmup": "transient warmup cases/radial_9cyl.toml",
