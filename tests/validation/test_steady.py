@@ -53,6 +53,53 @@ STEADY_CASES = {
 }
 
 
+#: How far the direct run's cycle-start speed may still move from cycle to cycle once settled:
+#: rounding, but for reaction friction, whose jumps (the slider's Coulomb friction turning at
+#: the dead centres, the pairs' side forces changing side; located by retaken steps) make the
+#: cycle map itself noisy at rtol 1e-12: there the direct run is a reference only to its own
+#: scatter from cycle to cycle, which then sets the agreement where it exceeds AGREE (it does
+#: nowhere else).
+SETTLED = {"reaction-friction": 1e-9}
+#: The direct run's last cycles whose scatter is measured.
+SCATTER_CYCLES = 6
+
+
+def direct_cycles(scene, n: int) -> list[dict[str, np.ndarray]]:
+    """The last SCATTER_CYCLES + 1 cycles of a direct run of ``n`` cycles, each its samples
+    from its start to its end (the end's sample and row, which coincide, once)."""
+    direct = transient.simulate(cycles_of(scene, n)).trajectory
+    phi = np.asarray(direct["phi"])
+    starts = np.searchsorted(phi, scene.initial.phi + scene.mechanism.cycle * np.arange(n + 1)
+                             - 1e-9)
+    cycles = []
+    for j in range(n - SCATTER_CYCLES - 1, n):
+        rows = np.arange(starts[j], starts[j + 1] + 1)
+        cycles.append({k: np.asarray(v)[rows] for k, v in direct.items()})
+    return cycles, np.asarray(direct["omega"])[starts]
+
+
+def on_corners(scene, phi) -> np.ndarray:
+    """The samples where a column may jump, and either side's value is right: a table's corner
+    (a pressure table's point) and each piston's dead centres, where it stops (the slider's
+    Coulomb friction turns there, and so ε and the losses of reaction friction jump)."""
+    cycle = scene.mechanism.cycle
+    model, bp, _ = build_model(scene)
+    corners = np.mod(np.r_[bp, model.gas_phase, model.gas_phase + math.pi], cycle)
+    gap = np.abs(np.mod(phi, cycle)[:, None] - corners[None, :])
+    return np.min(np.minimum(gap, cycle - gap), axis=1) < 1e-9
+
+
+def compared(scene, cycle: dict, mask) -> dict[str, np.ndarray]:
+    """A cycle's columns as compared: the accumulated ones (t, φ, the works and losses) from
+    zero at its start, the samples on a corner left out."""
+    out = {}
+    for k, v in cycle.items():
+        if k in ("t", "phi") or k.startswith("W_"):
+            v = v - v[0]
+        out[k] = v[~mask]
+    return out
+
+
 @pytest.mark.parametrize("label", STEADY_CASES)
 def test_steady_cycle_is_the_settled_run_last_cycle(label):
     scene = case(STEADY_CASES[label])
@@ -61,34 +108,29 @@ def test_steady_cycle_is_the_settled_run_last_cycle(label):
     assert mu < 1.0
     # long enough for a disturbance of order 1 to die to rounding, at the rate the direct run
     # itself must show below
-    n = int(math.ceil(math.log(1e-15) / math.log(max(mu, 1e-3)))) + 10
-    direct = transient.simulate(cycles_of(scene, n)).trajectory
-    cycle, p0 = scene.mechanism.cycle, scene.initial.phi
-    phi = np.asarray(direct["phi"])
-    starts = np.searchsorted(phi, p0 + cycle * np.arange(n + 1) - 1e-9)
-    w = np.asarray(direct["omega"])[starts]
-    change = np.abs(np.diff(w)) / w[-1]
-    assert change[-3:].max() <= 1e-12, "the direct run has not settled"
-    settled = int(np.flatnonzero(change > 1e-12)[-1]) + 2 if (change > 1e-12).any() else 1
+    n = max(int(math.ceil(math.log(1e-15) / math.log(max(mu, 1e-3)))), 20) + 10
+    cycles, starts = direct_cycles(scene, n)
+    change = np.abs(np.diff(starts)) / starts[-1]
+    floor = SETTLED.get(label, 1e-12)
+    assert change[-SCATTER_CYCLES:].max() <= floor, "the direct run has not settled"
+    settled = int(np.flatnonzero(change > floor)[-1]) + 2 if (change > floor).any() else 1
     print(f"{label}: the direct run settles in {settled} cycles, shooting integrated "
           f"{res.analysis['steady_cycles_integrated'][0]} (multiplier {mu:.4g})")
-    i0 = starts[-2]
-    keep = np.r_[True, np.diff(phi[i0:]) > 1e-9]  # (the end's sample and row coincide)
-    last = {k: np.asarray(v[i0:])[keep] for k, v in direct.items()}
-    steady = res.trajectory
-    assert last["t"].size == steady["t"].size
-    _, bp, _ = build_model(scene)
-    local = np.mod(np.asarray(steady["phi"]), scene.mechanism.cycle)
-    on_corner = np.min(np.abs(local[:, None] - np.r_[bp, scene.mechanism.cycle]), axis=1) < 1e-9
-    accumulated = ("t", "phi") + tuple(k for k in steady if k.startswith("W_"))
+    steady = {k: np.asarray(v) for k, v in res.trajectory.items()}
+    assert cycles[-1]["t"].size == steady["t"].size
+    mask = on_corners(scene, steady["phi"])
+    assert np.count_nonzero(~mask) >= 0.7 * mask.size  # (most samples compared)
+    ours = compared(scene, steady, mask)
+    theirs = [compared(scene, c, mask) for c in cycles]
     for k in steady:
-        a, b = np.asarray(steady[k]), last[k]
-        if k in accumulated:  # (from zero at the steady cycle's start)
-            a, b = a - a[0], b - b[0]
-        if k.startswith("p_"):  # a pressure jumps at a table's corner: either side's value
-            a, b = a[~on_corner], b[~on_corner]
-        err = np.abs(a - b).max()
-        assert err <= AGREE * np.abs(b).max() + FLOOR, (k, err, np.abs(b).max())
+        scale = np.abs(theirs[-1][k]).max()
+        scatter = max(np.abs(a[k] - b[k]).max() for a, b in zip(theirs[1:], theirs[:-1]))
+        err = np.abs(ours[k] - theirs[-1][k]).max()
+        # (a disturbance the size of the run's own scatter in every cycle, each dying by μ a
+        # cycle, adds up to scatter/(1 − μ): as far as either can be from the other)
+        assert err <= max(AGREE * scale, scatter / (1.0 - mu)) + FLOOR, (k, err, scale, scatter)
+        if label not in SETTLED:  # (settled to rounding: the agreement is AGREE's)
+            assert scatter / (1.0 - mu) <= AGREE * scale + FLOOR, (k, scatter)
 
 
 def one_cycle_speed(scene, omega: float) -> float:
@@ -176,7 +218,7 @@ def test_refuses_a_scene_that_decelerates_for_ever(tmp_path):
 @pytest.mark.parametrize("table, key", [
     ("[load]\nschedule_time = [0.0, 1.0]\nschedule_scale = [1.0, 2.0]\n",
      "load.schedule_time"),
-    ("[starter]\ntorque = 50\nnoload_speed_rpm = 300\ncutout_speed_rpm = 2000\n",
+    ("[starter]\ntorque = 50\nnoload_speed_rpm = 3000\ncutout_speed_rpm = 2000\n",
      "starter.torque"),
 ])
 def test_refuses_a_time_dependent_scene_before_any_work(tmp_path, capsys, table, key):

@@ -5,10 +5,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from .common import EXIT_OK, KERNELS_NOTICE, whole
-from .run import _print_summary, _said, pair_names
+from .common import KERNELS_NOTICE, whole
+from .run import pair_names, print_steady, print_summary, said
 
 
 def register(sub) -> None:
@@ -31,11 +29,14 @@ def register(sub) -> None:
 
 
 def cmd_steady(args) -> int:
+    from ..results import check_writable
     from ..scene import load_scene
-    from ..shooting import steady
+    from ..shooting import refuse_nonperiodic, steady
 
     scene = load_scene(args.scene)
     path = Path(args.output or Path("results") / f"{Path(args.scene).stem}_steady.h5")
+    refuse_nonperiodic(scene)  # (before any work or word of it)
+    check_writable(path, args.force)
 
     def progress(iteration: int, residual: float, cycles: int) -> None:
         if not args.quiet:
@@ -47,12 +48,7 @@ def cmd_steady(args) -> int:
               file=sys.stderr, flush=True)
     res = steady(scene, path, cycles=args.cycles, force=args.force, progress=progress)
     if not args.quiet:
-        a = {k: v for k, (v, _) in res.analysis.items()}
         print(f"wrote {path}")
-        print(f"  steady after {a['steady_iterations']} Newton iteration(s), "
-              f"{a['steady_cycles_integrated']} cycle(s) integrated; multipliers "
-              + ", ".join(f"{complex(r, i):.6g}" if i else f"{r:.6g}"
-                          for r, i in zip(np.atleast_1d(a["steady_multipliers_real"]),
-                                          np.atleast_1d(a["steady_multipliers_imag"]))))
-        _print_summary(res.analysis, res.solver, pair_names(scene))
-    return _said(res, None)
+        print_steady({k: v for k, (v, _) in res.analysis.items()})
+        print_summary(res.analysis, res.solver, pair_names(scene))
+    return said(res, None)
