@@ -253,7 +253,10 @@ def _no_state(rec: Shooting, phi: CycleMap, what: str) -> NoSteadyState:
     if rec.seen:
         speeds = [w for w, _ in rec.seen]
         works = [e for _, e in rec.seen]
-        if all(e > 0 for e in works) or all(e < 0 for e in works):
+        # one sign at every state seen, and the speed gone that way (with a governor the work
+        # depends on its states too: a speed gone against the work's sign is no runaway)
+        if all(e > 0 for e in works) and speeds[-1] >= speeds[0] or (
+                all(e < 0 for e in works) and speeds[-1] <= speeds[0]):
             how = "accelerates" if works[0] > 0 else "decelerates"
             return NoSteadyState(
                 f"no periodic steady state: the scene {how} for ever ({what}); the cycle's net "
@@ -271,7 +274,8 @@ def _unstable(rec: Shooting, phi: CycleMap) -> str:
     """Which periodic state an unstable multiplier moves most, and the multipliers."""
     w, v = np.linalg.eig(rec.monodromy)
     k = int(np.argmax(np.abs(w)))
-    worst = rec.names[int(np.argmax(np.abs(v[:, k])))]
+    # (each component relative to its state's size: a speed and a rack position compared)
+    worst = rec.names[int(np.argmax(np.abs(v[:, k]) / np.maximum(np.abs(rec.x), 1e-3)))]
     shown = ", ".join(f"{m:.6g}" for m in rec.multipliers)
     return (f"the periodic steady state at ω = {rec.x[phi.speed_at[0]]:.9g} rad/s is unstable: "
             f"the multiplier {rec.multipliers[0]:.6g} (|μ| = {abs(rec.multipliers[0]):.6g} ≥ 1) "

@@ -246,3 +246,17 @@ def test_cli_writes_the_steady_cycles_and_refuses_to_overwrite(tmp_path, capsys)
     assert "--force" in capsys.readouterr().err
     assert main(["info", str(out)]) == 0
     assert "steady_multiplier_max" in capsys.readouterr().out
+
+
+def test_refuses_an_unstable_steady_state_a_governor_that_hunts():
+    """A PI governor with a large integral gain and a slow actuator: Newton finds the periodic
+    state, the multipliers put it outside the unit circle, and the direct run indeed never
+    settles there (its cycle-start speed still swings after 100 cycles)."""
+    scene = case("gots_diesel_pi")
+    scene = dataclasses.replace(scene, governor=dataclasses.replace(
+        scene.governor, gain_i=400.0, actuator_time=0.05))
+    with pytest.raises(NoSteadyState, match=r"is unstable: the multiplier .* ≥ 1\) .*hunts") as e:
+        transient.steady(scene)
+    assert abs(e.value.record.multipliers[0]) > 1.0
+    _, starts = direct_cycles(scene, 100)
+    assert np.abs(np.diff(starts[-10:])).max() > 1e-3 * starts[-1]
