@@ -21,6 +21,7 @@ from .core.integrator.tableaus import TABLEAUS
 from .core.model import forcing, layout, work
 from .core.model.inverse import inverse_dynamics
 from .core.model.layout import n_outputs, n_state
+from .core.model.shaft import line_parts
 from .core.stepper import io as sio
 from .core.stepper.loop import CHATTER_COUNT, STIFF_COUNT
 from .errors import SceneError, SimulationError
@@ -263,6 +264,7 @@ class CycleMap:
     last, whose speeds give the state at the cycle's end back in the start's form (the speeds,
     not the energies K = ½Jω² the stepper holds in crank angle).
 
+    ``neutral_at``: the places in x of the twists nothing depends on (:func:`_free_dofs`).
     ``start(x)``: the stepper's state (y, fst, ist) at the cycle's start with the periodic
     states ``x``; ``__call__(x)``: the periodic states after one cycle, or a
     :class:`~transient.errors.SimulationError` saying where the cycle failed."""
@@ -294,6 +296,10 @@ class CycleMap:
         where = {int(i): k for k, i in enumerate(self.index)}
         self.speed_at = np.array([where[i] for i, _ in speeds], dtype=np.int64)
         self.speed_column = np.array([c for _, c in speeds], dtype=np.int64)
+        self.neutral_at = np.array([where[at[layout.B_LINE] + 2 * j]
+                                    for j in _free_dofs(model)], dtype=np.int64)
+        self.free = np.ones(self.index.size, dtype=bool)  # the unknowns of the shooting
+        self.free[self.neutral_at] = False
         self.outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
         self.evbuf = np.empty((EVENT_ROWS, 4))
         self.nfev = 0
@@ -336,6 +342,24 @@ class CycleMap:
         out = y[self.index].copy()
         out[self.speed_at] = last[self.speed_column]
         return out
+
+
+def _free_dofs(model) -> list[int]:
+    """The shaft line's dofs other than the reference (numbered as their states) that turn
+    freely against it: no cylinder, not the load's, and only dampers to the rest (a damper's
+    ring). Nothing depends on such a dof's twist, so any value of it repeats: a periodic
+    state's neutral direction, multiplier 1."""
+    n = layout.line_dofs(model)
+    if n == 0:
+        return []
+    cylinders, _, elements = getattr(line_parts, "py_func", line_parts)(model.line)
+    meta = model.line[0]
+    others = [d for d in range(n) if d != int(meta[layout.LM_REF])]
+    held = {int(c) for c in cylinders} | {int(meta[layout.LM_LOAD])}
+    for e in elements:
+        if e[layout.EL_K] != 0.0:
+            held |= {int(e[layout.EL_I]), int(e[layout.EL_J])}
+    return [j for j, d in enumerate(others) if d not in held]
 
 
 #: How a cycle of :class:`CycleMap` that did not reach its end stopped, by the stepper's code.

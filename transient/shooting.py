@@ -40,6 +40,9 @@ TOLERANCE = 1.0
 #: Where Newton stalls for STALLED_ITERATIONS iterations with its best ‖F‖ at most NOISE_FLOOR
 #: (in the same units), that is the cycle map's own noise: the best iterate is the solution.
 NOISE_FLOOR, STALLED_ITERATIONS = 1e3, 3
+#: A monodromy (of more than one unknown) is kept for the next step while its step reduced ‖F‖
+#: at least this much: a step on it costs one cycle, a fresh one a cycle per unknown more.
+CHORD_RATE = 0.25
 #: A speed beyond which a scene runs away (no piston machine turns at 10⁴ rad/s, 95 000 rpm).
 RUNAWAY_SPEED = 1e4
 
@@ -58,7 +61,8 @@ class NoSteadyState(SimulationError):
 class Shooting:
     """The convergence record: the periodic states' names, the residual ‖F‖ (in units of the
     solver's error weight) at each iterate, the cycles integrated, the solution ``x`` and the
-    multipliers (the monodromy's eigenvalues there, largest modulus first)."""
+    multipliers (the monodromy's eigenvalues there, largest modulus first), the neutral twists
+    left out of them (:attr:`~transient.run.CycleMap.neutral_at`), and the (speed, net work) of every cycle run."""
 
     names: list[str]
     residuals: list[float] = dataclasses.field(default_factory=list)
@@ -66,6 +70,7 @@ class Shooting:
     x: np.ndarray | None = None
     multipliers: np.ndarray | None = None
     monodromy: np.ndarray | None = None
+    neutral: list[str] = dataclasses.field(default_factory=list)
     seen: list[tuple[float, float]] = dataclasses.field(default_factory=list)
 
     def analysis(self) -> dict[str, tuple]:
@@ -77,7 +82,9 @@ class Shooting:
                 "steady_cycles_integrated": (self.cycles, "1"),
                 "steady_multiplier_max": (float(np.abs(mu).max()), "1"),
                 "steady_multipliers_real": (mu.real.copy(), "1"),
-                "steady_multipliers_imag": (mu.imag.copy(), "1")}
+                "steady_multipliers_imag": (mu.imag.copy(), "1"),
+                **({"steady_neutral_states": (", ".join(self.neutral), "")}
+                   if self.neutral else {})}
 
 
 def refuse_nonperiodic(scene) -> None:
@@ -155,6 +162,7 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
     rec.residuals.append(r)
     _said(progress, rec, phi)
     best, since = (x, end, r), 0
+    M = None  # the monodromy, kept while the steps it gives reduce ‖F‖ fast (a chord step)
     while r > TOLERANCE:
         if best[2] <= NOISE_FLOOR and since >= STALLED_ITERATIONS:
             # the map's own noise (kinks located by step retakes, reaction friction's) holds
@@ -164,37 +172,55 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
             break
         if len(rec.residuals) > MAX_ITERATIONS:
             raise _no_state(rec, phi, f"no convergence in {MAX_ITERATIONS} iterations")
-        J = _jacobian(phi, x, end - x, forward=True) - np.eye(x.size)
-        try:
-            dx = np.linalg.solve(J, -(end - x))
-        except np.linalg.LinAlgError:
-            dx = end - x  # (a singular J: a direct cycle's step)
-        lam = _speed_limited(x, dx, phi.speed_at)
-        for _ in range(MAX_HALVINGS + 1):
-            new_end, new_r = residual(x + lam * dx)
-            if new_end is not None and new_r < r:
-                x, end, r = x + lam * dx, new_end, new_r
-                break
-            lam *= 0.5
-        else:  # Newton failed to reduce ‖F‖: direct cycles (the map contracts)
+        fresh = M is None
+        if fresh:
+            M = _jacobian(phi, x, end - x, forward=True)
+        dx = np.zeros_like(x)  # (a neutral twist stays as it is: any value repeats)
+        dx[phi.free] = np.linalg.lstsq((M - np.eye(x.size))[:, phi.free], -(end - x),
+                                       rcond=None)[0]
+        step = _damped(residual, x, dx, r, phi.speed_at, MAX_HALVINGS if fresh else 0)
+        if step is None and not fresh:  # (the kept monodromy's step failed: a fresh one)
+            M = None
+            continue
+        if step is None:  # Newton failed to reduce ‖F‖: direct cycles (the map contracts)
             for _ in range(DIRECT_CYCLES):
                 new_end, new_r = residual(end)
                 if new_end is None:
                     raise _no_state(rec, phi, "a direct cycle failed")
                 x, end, r = end, new_end, new_r
+            M = None
+        else:
+            if step[2] > CHORD_RATE * r or np.count_nonzero(phi.free) == 1:
+                M = None  # (with one unknown a fresh monodromy costs one cycle: Newton's)
+            x, end, r = step
         if x[phi.speed_at[0]] > RUNAWAY_SPEED:
             raise _no_state(rec, phi, f"the speed ran away past {RUNAWAY_SPEED:g} rad/s")
         rec.residuals.append(r)
         _said(progress, rec, phi)
         best, since = ((x, end, r), 0) if r < best[2] else (best, since + 1)
     rec.x = x
-    rec.monodromy = _jacobian(phi, x, None, forward=False)
+    M = _jacobian(phi, x, None, forward=False)
+    free = phi.free
+    rec.neutral = [n for n, f in zip(rec.names, free) if not f]
+    rec.monodromy = M[np.ix_(free, free)]
     rec.cycles = phi.cycles
     mu = np.linalg.eigvals(rec.monodromy)
     rec.multipliers = mu[np.argsort(-np.abs(mu), kind="stable")]
     if np.abs(rec.multipliers[0]) >= 1.0:
         raise NoSteadyState(_unstable(rec, phi), rec)
     return rec, phi
+
+
+def _damped(residual, x, dx, r, speed_at, halvings: int):
+    """The Newton step λ·dx from ``x`` (λ as :func:`_speed_limited` allows, halved up to
+    ``halvings`` times) that reduces ‖F‖ below ``r``: (x, Φ(x), ‖F‖) there, or None."""
+    lam = _speed_limited(x, dx, speed_at)
+    for _ in range(halvings + 1):
+        end, new_r = residual(x + lam * dx)
+        if end is not None and new_r < r:
+            return x + lam * dx, end, new_r
+        lam *= 0.5
+    return None
 
 
 def _said(progress, rec: Shooting, phi: CycleMap) -> None:
@@ -205,11 +231,12 @@ def _said(progress, rec: Shooting, phi: CycleMap) -> None:
 def _jacobian(phi: CycleMap, x, fx, forward: bool) -> np.ndarray:
     """∂Φ/∂x by differences: forward from Φ(x) = x + ``fx`` (one cycle a state; for Newton's
     step) or central (two; for the multipliers), each state's step sized to the rounding of the
-    cycle (√rtol forward, rtol^⅓ central, of the state's scale)."""
+    cycle (√rtol forward, rtol^⅓ central, of the state's scale); a neutral twist's column is
+    the unit one, without a cycle."""
     rtol = max(phi.cfg[sio.C_RTOL], np.finfo(float).eps)
     rel = math.sqrt(rtol) if forward else rtol ** (1.0 / 3.0)
-    M = np.empty((x.size, x.size))
-    for i in range(x.size):
+    M = np.eye(x.size)  # (a neutral twist's column: carried over as it is)
+    for i in np.flatnonzero(phi.free):
         h = rel * max(abs(x[i]), 1e-3)
         up = x.copy()
         up[i] += h
