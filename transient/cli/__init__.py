@@ -40,10 +40,10 @@ EXIT_BROKEN_PIPE = 128 + 13
 #: ``transient --help`` lists them all, and each command's own help ends with its own.
 EXAMPLES = {
     "run": "transient run cases/swash_plate_4cyl.toml -o results",
-    "steady": "transient steady cases/gots_diesel_friction.toml --cycles 2",
     "check": "transient check cases/gots_diesel_4400.toml",
     "info": "transient info results/swash_plate_4cyl.h5",
     "warmup": "transient warmup cases/radial_9cyl.toml",
+    "steady": "transient steady cases/gots_diesel_friction.toml --cycles 2",
     "plot": "transient plot results/swash_plate_4cyl.h5 -o results",
     "kinematics": "transient kinematics cases/radial_5cyl.toml --points 721 -o results",
     "modes": "transient modes cases/inline6_damper.toml -o results",
