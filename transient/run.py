@@ -255,7 +255,7 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
 
 class CycleMap:
     """One engine cycle of the compiled stepper, φ₀ → φ₀ + the mechanism's cycle, from a given
-    state: the cycle map Φ of a periodic steady state (:mod:`transient.steady`). The scene's
+    state: the cycle map Φ of a periodic steady state (:mod:`transient.shooting`). The scene's
     settings, breakpoints and output grid are the run's (so that Φ is the map a run applies
     cycle after cycle, to the step), compiled once; each cycle starts the stepper afresh at φ₀,
     t = 0, with the works and losses zero and the switches chosen at the state as a run's start
@@ -318,6 +318,10 @@ class CycleMap:
         return y, fst, ist
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
+        if not x[self.speed_at[0]] >= self.cfg[sio.C_W_HI]:  # (also NaN)
+            self.net_work = math.nan
+            raise SimulationError(f"the cycle from ω = {x[self.speed_at[0]]:.9g} rad/s would "
+                                  f"start in time, below 1.5 × solver.switch_speed")
         y, fst, ist = self.start(x)
         status = sio.RUNNING
         last = None

@@ -27,6 +27,7 @@ from .errors import SceneError, SimulationError
 from .results import Checkpoint, Result
 from .run import CycleMap, simulate_from
 from .scene.records import COMPILED_METHODS
+from .shaft import refuse_elastic_run
 
 #: Newton iterations (each a cycle for ‖F‖ and one per periodic state for the monodromy).
 MAX_ITERATIONS = 30
@@ -60,13 +61,15 @@ class NoSteadyState(SimulationError):
 @dataclass
 class Shooting:
     """The convergence record: the periodic states' names, the residual ‖F‖ (in units of the
-    solver's error weight) at each iterate, the cycles integrated, the solution ``x`` and the
+    solver's error weight) at each iterate, the cycles integrated and their right-hand sides'
+    evaluations, the solution ``x`` and the
     multipliers (the monodromy's eigenvalues there, largest modulus first), the neutral twists
     left out of them (:attr:`~transient.run.CycleMap.neutral_at`), and the (speed, net work) of every cycle run."""
 
     names: list[str]
     residuals: list[float] = dataclasses.field(default_factory=list)
     cycles: int = 0
+    nfev: int = 0
     x: np.ndarray | None = None
     multipliers: np.ndarray | None = None
     monodromy: np.ndarray | None = None
@@ -80,6 +83,7 @@ class Shooting:
                 "steady_iterations": (len(self.residuals) - 1, "1"),
                 "steady_residuals": (np.array(self.residuals), "1"),
                 "steady_cycles_integrated": (self.cycles, "1"),
+                "steady_rhs_evaluations": (self.nfev, "1"),
                 "steady_multiplier_max": (float(np.abs(mu).max()), "1"),
                 "steady_multipliers_real": (mu.real.copy(), "1"),
                 "steady_multipliers_imag": (mu.imag.copy(), "1"),
@@ -90,6 +94,7 @@ class Shooting:
 def refuse_nonperiodic(scene) -> None:
     """Raise :class:`~transient.errors.SceneError` for a scene that cannot be periodic by
     construction (something in it depends on time or on the cycle's number), before any work."""
+    refuse_elastic_run(scene)
     file = scene.source_file
     why = _nonperiodic(scene)
     if why:
@@ -115,6 +120,11 @@ def _nonperiodic(scene) -> tuple[str, str] | None:
         return "load.table.time", "a load tabulated against time"
     if load.inertia > 0.0:
         return "load.inertia", "an inertia switched in at load.inertia_time"
+    w_hi = 1.5 * scene.solver.switch_speed
+    if scene.initial.omega < w_hi:
+        return "initial.omega", (f"{scene.initial.omega:.6g} rad/s starts the run in time, below "
+                                 f"1.5 × solver.switch_speed = {w_hi:.6g} rad/s; the cycle map "
+                                 f"starts at a running speed")
     st = scene.starter
     if st.torque > 0.0 and scene.initial.omega < st.cutout_speed:
         return "starter.torque", (f"the starter is engaged until its cut-out speed "
@@ -203,7 +213,7 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
     free = phi.free
     rec.neutral = [n for n, f in zip(rec.names, free) if not f]
     rec.monodromy = M[np.ix_(free, free)]
-    rec.cycles = phi.cycles
+    rec.cycles, rec.nfev = phi.cycles, phi.nfev
     mu = np.linalg.eigvals(rec.monodromy)
     rec.multipliers = mu[np.argsort(-np.abs(mu), kind="stable")]
     if np.abs(rec.multipliers[0]) >= 1.0:
@@ -278,8 +288,9 @@ def _no_state(rec: Shooting, phi: CycleMap, what: str) -> NoSteadyState:
     residuals."""
     rec.cycles = phi.cycles
     if rec.seen:
-        speeds = [w for w, _ in rec.seen]
-        works = [e for _, e in rec.seen]
+        seen = [(w, e) for w, e in rec.seen if math.isfinite(e)]
+        speeds = [w for w, _ in seen] or [math.nan]
+        works = [e for _, e in seen] or [math.nan]
         # one sign at every state seen, and the speed gone that way (with a governor the work
         # depends on its states too: a speed gone against the work's sign is no runaway)
         if all(e > 0 for e in works) and speeds[-1] >= speeds[0] or (

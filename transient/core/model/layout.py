@@ -153,7 +153,7 @@ CONTROL = {"phi": BY_INCREMENT, "t": BY_INCREMENT, "omega": BY_SIZE, "work": NOT
            "loss": NOT_CONTROLLED, "governor": BY_SIZE, "latched": NOT_CONTROLLED,
            "pressure": BY_SIZE, "line": BY_SIZE, "line_loss": NOT_CONTROLLED}
 #: Which blocks repeat from one engine cycle to the next in a periodic steady state
-#: (``transient.steady``): the speed (the third state), the governor's states, the latched fuels,
+#: (:mod:`transient.shooting`): the speed (the third state), the governor's states, the latched fuels,
 #: the closed parts' pressures and the shaft line's twists and speeds. φ advances by the cycle;
 #: t, the works and the losses accumulate, so they are no part of it.
 PERIODIC = {"phi": False, "t": False, "omega": True, "work": False, "loss": False,
