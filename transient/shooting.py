@@ -38,12 +38,15 @@ DIRECT_CYCLES = 3
 #: ‖F‖ counts as converged at this multiple of the solver's own error weight atol + rtol·|x|:
 #: the periodic states then repeat to the accuracy one step of the stepper keeps.
 TOLERANCE = 1.0
-#: Where Newton stalls for STALLED_ITERATIONS iterations with its best ‖F‖ at most NOISE_FLOOR
-#: (in the same units), that is the cycle map's own noise: the best iterate is the solution.
+#: Where Newton stalls for STALLED_ITERATIONS iterations, or a fresh monodromy's step fails,
+#: with its best ‖F‖ at most NOISE_FLOOR (in the same units), that is the cycle map's own noise
+#: (kinks and jumps located by retaken steps, a cycle's many steps' errors): the best iterate is
+#: the solution, its residual the last recorded.
 NOISE_FLOOR, STALLED_ITERATIONS = 1e3, 3
-#: A monodromy (of more than one unknown) is kept for the next step while its step reduced ‖F‖
-#: at least this much: a step on it costs one cycle, a fresh one a cycle per unknown more.
-CHORD_RATE = 0.25
+#: A monodromy (of more than one unknown) is kept, updated by Broyden's rank-one formula, while
+#: its step reduced ‖F‖ at least this much: a step on it costs one cycle, a fresh one a cycle per
+#: unknown more.
+CHORD_RATE = 0.5
 #: A speed beyond which a scene runs away (no piston machine turns at 10⁴ rad/s, 95 000 rpm).
 RUNAWAY_SPEED = 1e4
 
@@ -172,7 +175,7 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
     rec.residuals.append(r)
     _said(progress, rec, phi)
     best, since = (x, end, r), 0
-    M = None  # the monodromy, kept while the steps it gives reduce ‖F‖ fast (a chord step)
+    M = None  # the monodromy, kept (Broyden-updated) while its steps reduce ‖F‖ fast
     while r > TOLERANCE:
         if best[2] <= NOISE_FLOOR and since >= STALLED_ITERATIONS:
             # the map's own noise (kinks located by step retakes, reaction friction's) holds
@@ -192,6 +195,11 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
         if step is None and not fresh:  # (the kept monodromy's step failed: a fresh one)
             M = None
             continue
+        if step is None and best[2] <= NOISE_FLOOR:
+            # a fresh monodromy's step reduces ‖F‖ no more: the map's own noise
+            x, end, r = best
+            rec.residuals.append(r)
+            break
         if step is None:  # Newton failed to reduce ‖F‖: direct cycles (the map contracts)
             for _ in range(DIRECT_CYCLES):
                 new_end, new_r = residual(end)
@@ -202,6 +210,8 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
         else:
             if step[2] > CHORD_RATE * r or np.count_nonzero(phi.free) == 1:
                 M = None  # (with one unknown a fresh monodromy costs one cycle: Newton's)
+            else:
+                M = _broyden(M, step[0] - x, (step[1] - step[0]) - (end - x))
             x, end, r = step
         if x[phi.speed_at[0]] > RUNAWAY_SPEED:
             raise _no_state(rec, phi, f"the speed ran away past {RUNAWAY_SPEED:g} rad/s")
@@ -219,6 +229,13 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
     if np.abs(rec.multipliers[0]) >= 1.0:
         raise NoSteadyState(_unstable(rec, phi), rec)
     return rec, phi
+
+
+def _broyden(M: np.ndarray, dx: np.ndarray, dF: np.ndarray) -> np.ndarray:
+    """The monodromy ``M`` updated along the step ``dx`` that changed F by ``dF`` (Broyden's
+    rank-one update of M − I: the least change that meets the secant condition)."""
+    J = M - np.eye(M.shape[0])
+    return M + np.outer(dF - J @ dx, dx) / (dx @ dx)
 
 
 def _damped(residual, x, dx, r, speed_at, halvings: int):
