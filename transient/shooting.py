@@ -5,8 +5,9 @@ In crank angle the engine's right-hand side repeats over one cycle, so the perio
 cycle's start (:func:`~transient.core.model.layout.periodic_states`) follow a map
 x_{n+1} = Φ(x_n) (:class:`~transient.run.CycleMap`). A steady state is a fixed point,
 F(x) = Φ(x) − x = 0, found here by Newton's method with the monodromy ∂Φ/∂x by finite
-differences (one cycle per periodic state), damped by backtracking on ‖F‖ and falling back to
-direct cycles where a Newton step does not reduce it (the map contracts). Its eigenvalues at
+differences (one cycle per periodic state; with several, kept and updated by Broyden's formula
+while it serves), damped by backtracking on ‖F‖ and falling back to direct cycles where a
+Newton step does not reduce it (the map contracts). Its eigenvalues at
 the solution, the multipliers, say how fast a disturbance of the steady cycle dies per cycle.
 :func:`steady` then runs the steady cycle(s) with output, a :class:`~transient.Result` like a
 run's, with the convergence record and the multipliers in its analysis.
@@ -24,7 +25,7 @@ import numpy as np
 from .core.model import layout
 from .core.stepper import io as sio
 from .errors import SceneError, SimulationError
-from .results import Checkpoint, Result
+from .results import Checkpoint, Result, check_writable
 from .run import CycleMap, simulate_from
 from .scene.records import COMPILED_METHODS
 from .shaft import refuse_elastic_run
@@ -65,9 +66,9 @@ class NoSteadyState(SimulationError):
 class Shooting:
     """The convergence record: the periodic states' names, the residual ‖F‖ (in units of the
     solver's error weight) at each iterate, the cycles integrated and their right-hand sides'
-    evaluations, the solution ``x`` and the
-    multipliers (the monodromy's eigenvalues there, largest modulus first), the neutral twists
-    left out of them (:attr:`~transient.run.CycleMap.neutral_at`), and the (speed, net work) of every cycle run."""
+    evaluations, the solution ``x``, the multipliers (the monodromy's eigenvalues there, largest
+    modulus first), the neutral twists left out of them (``CycleMap.neutral_at``), and the
+    (speed, net work) of every cycle run."""
 
     names: list[str]
     residuals: list[float] = dataclasses.field(default_factory=list)
@@ -99,11 +100,18 @@ def refuse_nonperiodic(scene) -> None:
     construction (something in it depends on time or on the cycle's number), before any work."""
     refuse_elastic_run(scene)
     file = scene.source_file
+    w_hi = 1.5 * scene.solver.switch_speed
+    if scene.initial.omega < w_hi:
+        raise SceneError("initial.omega", f"{scene.initial.omega:.6g} rad/s starts in time, below "
+                                          f"1.5 × solver.switch_speed = {w_hi:.6g} rad/s; the "
+                                          f"cycle map starts in crank angle: give a running "
+                                          f"speed", file=file)
     why = _nonperiodic(scene)
     if why:
         key, what = why
-        raise SceneError(key, f"{what}: the scene has no periodic steady state by construction; "
-                              f"`transient run` follows it in time", file=file)
+        raise SceneError(key, f"{what}: the scene has no periodic steady state (shooting needs "
+                              f"every input to repeat from cycle to cycle); `transient run` "
+                              f"follows it in time", file=file)
 
 
 def _nonperiodic(scene) -> tuple[str, str] | None:
@@ -123,11 +131,6 @@ def _nonperiodic(scene) -> tuple[str, str] | None:
         return "load.table.time", "a load tabulated against time"
     if load.inertia > 0.0:
         return "load.inertia", "an inertia switched in at load.inertia_time"
-    w_hi = 1.5 * scene.solver.switch_speed
-    if scene.initial.omega < w_hi:
-        return "initial.omega", (f"{scene.initial.omega:.6g} rad/s starts the run in time, below "
-                                 f"1.5 × solver.switch_speed = {w_hi:.6g} rad/s; the cycle map "
-                                 f"starts at a running speed")
     st = scene.starter
     if st.torque > 0.0 and scene.initial.omega < st.cutout_speed:
         return "starter.torque", (f"the starter is engaged until its cut-out speed "
@@ -405,8 +408,6 @@ def steady(scene, path: str | Path | None = None, *, cycles: int = 1, force: boo
         raise SceneError("cycles", f"{cycles!r}: a whole number of cycles ≥ 1")
     refuse_nonperiodic(scene)
     if path is not None:
-        from .results import check_writable
-
         check_writable(Path(path), force)
     rec, phi = shoot(scene, progress)
     y, fst, ist = phi.start(rec.x)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_texts import SMALL
 
 import transient
 from transient.assemble import build_model
@@ -166,35 +167,9 @@ def test_multiplier_is_the_direct_map_derivative(label):
     assert abs(one_cycle_speed(scene, w) - w) <= 1e-10 * w
 
 
-LINEAR = """\
-[scene]
-name = "linear-load"
-[mechanism]
-type = "crank-slider"
-crank_radius_mm = 47
-rod_length_mm = 148
-bore_mm = 88
-piston_mass = 1.52
-crank_mass = 0.912
-[mechanism.rod]
-model = "two-mass"
-mass = 1.752
-cg_from_pin_mm = 107.3
-[inertia]
-shaft = 0.05
-[load]
-torque = -20.0
-linear = 0.1
-[initial]
-omega_rpm = 1000
-[run]
-revolutions = 4
-[solver]
-rtol = 1e-12
-atol = 1e-14
-[output]
-samples_per_rev = 360
-"""
+#: A single cylinder, unfired, driven by a constant torque against a load linear in ω.
+LINEAR = SMALL.replace("rtol = 1e-6\natol = 1e-8", "rtol = 1e-12\natol = 1e-14").replace(
+    "samples_per_rev = 12", "samples_per_rev = 360") + "\n[load]\ntorque = -20.0\nlinear = 0.1\n"
 
 
 def test_linear_load_mean_speed_closed_form(tmp_path):
