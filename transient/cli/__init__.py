@@ -5,9 +5,9 @@ Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulatio
 partial result is kept and marked incomplete).
 
 Each command group is a module that registers its subparsers and parses, calls the library,
-draws and prints: ``run`` (run, check, info), ``steady``, ``plot``, ``kinematics``, ``modes``, ``verify`` (bench,
-stress), ``efficiency``, ``loads``, ``orders``, ``sweep`` (sweep, sweep-plot); ``common`` holds
-what they share. Errors become exit codes here only, in :func:`main`.
+draws and prints: ``run`` (run, check, info), ``steady``, ``plot``, ``kinematics``, ``modes``,
+``verify`` (bench, stress), ``efficiency``, ``loads``, ``orders``, ``sweep`` (sweep,
+sweep-plot); ``common`` holds what they share. Errors become exit codes here only, in :func:`main`.
 """
 from __future__ import annotations
 
