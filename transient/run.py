@@ -21,6 +21,7 @@ from .core.integrator.tableaus import TABLEAUS
 from .core.model import forcing, layout, work
 from .core.model.inverse import inverse_dynamics
 from .core.model.layout import n_outputs, n_state
+from .core.model.shaft import line_parts
 from .core.stepper import io as sio
 from .core.stepper.loop import CHATTER_COUNT, STIFF_COUNT
 from .errors import SceneError, SimulationError
@@ -28,7 +29,7 @@ from .outcome import FINISHED, RunStopped, Watch, code_status, failure_cause, ju
 from .precompile import start_helper, stop_helper
 from .prescribed_work import Motion, work_columns
 from .results import NOT_RESUMABLE, Result, RunData, open_result, result_in_memory
-from .scene.outputs import output_columns
+from .scene.outputs import column_name, output_columns
 from .scene.queries import part_load_refusal
 from .scene.records import AUTO_METHODS, COMPILED_METHODS, runs_compiled
 from .shaft import refuse_elastic_run
@@ -250,6 +251,125 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
     return RunData(traj, {k: np.concatenate(v) for k, v in events.items() if v},
                    solver, complete=status == sio.FINISHED, message=message,
                    status=code_status(status))
+
+
+class CycleMap:
+    """One engine cycle of the compiled stepper, φ₀ → φ₀ + the mechanism's cycle, from a given
+    state: the cycle map Φ of a periodic steady state (:mod:`transient.shooting`). The scene's
+    settings, breakpoints and output grid are the run's (so that Φ is the map a run applies
+    cycle after cycle, to the step), compiled once; each cycle starts the stepper afresh at φ₀,
+    t = 0, with the works and losses zero and the switches chosen at the state as a run's start
+    chooses them, so that Φ is a function of the periodic states alone
+    (:func:`~transient.core.model.layout.periodic_states`). Its output rows are dropped, bar the
+    last, whose speeds give the state at the cycle's end back in the start's form (the speeds,
+    not the energies K = ½Jω² the stepper holds in crank angle).
+
+    ``neutral_at``: the places in x of the twists nothing depends on (:func:`_free_dofs`).
+    ``start(x)``: the stepper's state (y, fst, ist) at the cycle's start with the periodic
+    states ``x``; ``__call__(x)``: the periodic states after one cycle, or a
+    :class:`~transient.errors.SimulationError` saying where the cycle failed."""
+
+    def __init__(self, scene) -> None:
+        model, self.bp, _ = build_model(scene)
+        self.model = model
+        self.cfg = _config(scene)
+        self.cfg[sio.C_T_END] = math.inf
+        self.cfg[sio.C_STIFF_SWITCH] = 0.0  # (one method throughout: Φ must be one function)
+        self.cycle = scene.mechanism.cycle
+        self.cfg[sio.C_PHI_END] = scene.initial.phi + self.cycle
+        self.tab = TABLEAUS[_AutoMethod(scene, model).method]
+        self.extras = layout.extras_of(model)
+        self.compile_s = _compile(model, self.tab, self.cfg, self.bp)
+        self.y0, self.fst0, self.ist0 = _initial_state(scene, model)
+        self.index = layout.periodic_states(model)
+        at = self.offsets = layout.STATE.offsets_for(model)
+        columns = list(output_columns(scene))
+        # the periodic states that are speeds (the shaft's, each other line dof's), and the
+        # output column that holds each at the cycle's end
+        speeds = [(layout.OMEGA, columns.index("omega"))]
+        if scene.shaft is not None:
+            ref = int(model.line[0, layout.LM_REF])
+            others = [name for d, (name, _, _) in enumerate(scene.shaft.line_dofs()) if d != ref]
+            speeds += [(at[layout.B_LINE] + 2 * j + 1,
+                        columns.index(f"omega_{column_name(name)}"))
+                       for j, name in enumerate(others)]
+        where = {int(i): k for k, i in enumerate(self.index)}
+        self.speed_at = np.array([where[i] for i, _ in speeds], dtype=np.int64)
+        self.speed_column = np.array([c for _, c in speeds], dtype=np.int64)
+        self.neutral_at = np.array([where[at[layout.B_LINE] + 2 * j]
+                                    for j in _free_dofs(model)], dtype=np.int64)
+        self.free = np.ones(self.index.size, dtype=bool)  # the unknowns of the shooting
+        self.free[self.neutral_at] = False
+        self.outbuf = np.empty((BUFFER_ROWS, n_outputs(model)))
+        self.evbuf = np.empty((EVENT_ROWS, 4))
+        self.nfev = 0
+        self.cycles = 0
+        self.net_work = math.nan  # the last cycle's W_gas + W_load + W_starter − losses [J]
+        # (up to where it stopped, if it failed)
+
+    def initial(self) -> np.ndarray:
+        """The scene's initial state's periodic states."""
+        return self.y0[self.index].copy()
+
+    def start(self, x: np.ndarray):
+        """The stepper's state at the cycle's start with the periodic states ``x``."""
+        y, fst, ist = self.y0.copy(), self.fst0.copy(), self.ist0.copy()
+        y[self.index] = x
+        return y, fst, ist
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        if not x[self.speed_at[0]] >= self.cfg[sio.C_W_HI]:  # (also NaN)
+            self.net_work = math.nan
+            raise SimulationError(f"the cycle from ω = {x[self.speed_at[0]]:.9g} rad/s would "
+                                  f"start in time, below 1.5 × solver.switch_speed")
+        y, fst, ist = self.start(x)
+        status = sio.RUNNING
+        last = None
+        while status == sio.RUNNING:
+            status = stepper.advance(self.model, self.extras, self.tab, self.cfg, self.bp, y, fst,
+                                     ist, self.outbuf, self.evbuf,
+                                     stepper.buffers(self.model, self.tab, y.shape[0]))
+            if ist[sio.I_NOUT]:
+                last = self.outbuf[ist[sio.I_NOUT] - 1].copy()
+            ist[sio.I_NOUT] = ist[sio.I_NEV] = 0
+        self.nfev += int(ist[sio.I_NFEV])
+        self.cycles += 1
+        at = self.offsets
+        self.net_work = float(y[layout.W_GAS] + y[layout.W_LOAD] + y[layout.W_STARTER]
+                              - y[at[layout.B_LOSS]:at[layout.B_LOSS + 1]].sum()
+                              - y[at[layout.B_LINE_LOSS]:at[layout.B_LINE_LOSS + 1]].sum())
+        if status != sio.FINISHED:
+            raise SimulationError(
+                f"the cycle from ω = {x[self.speed_at[0]]:.9g} rad/s stopped "
+                f"{_CYCLE_ENDS.get(status, 'failing')} at t = {y[layout.T]:.9g} s, "
+                f"φ = {y[layout.PHI]:.9g} rad")
+        out = y[self.index].copy()
+        out[self.speed_at] = last[self.speed_column]
+        return out
+
+
+def _free_dofs(model) -> list[int]:
+    """The shaft line's dofs other than the reference (numbered as their states) that turn
+    freely against it: no cylinder, not the load's, and only dampers to the rest (a damper's
+    ring). Nothing depends on such a dof's twist, so any value of it repeats: a periodic
+    state's neutral direction, multiplier 1."""
+    n = layout.line_dofs(model)
+    if n == 0:
+        return []
+    cylinders, _, elements = getattr(line_parts, "py_func", line_parts)(model.line)
+    meta = model.line[0]
+    others = [d for d in range(n) if d != int(meta[layout.LM_REF])]
+    held = {int(c) for c in cylinders} | {int(meta[layout.LM_LOAD])}
+    for e in elements:
+        if e[layout.EL_K] != 0.0:
+            held |= {int(e[layout.EL_I]), int(e[layout.EL_J])}
+    return [j for j, d in enumerate(others) if d not in held]
+
+
+#: How a cycle of :class:`CycleMap` that did not reach its end stopped, by the stepper's code.
+_CYCLE_ENDS = {sio.STALLED: "stalled", sio.LOCKED: "locked", sio.CHATTERING: "chattering",
+               sio.STIFF: "stiff", sio.FAIL_NONFINITE: "with non-finite values",
+               sio.FAIL_STEP: "with a step below rounding"}
 
 
 #: The share of an elastic run's explicit steps held by stability from which the run says so.
@@ -595,13 +715,22 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
     >>> math.isclose(omega0, 1000 * 2 * math.pi / 60)
     True
     """
+    return simulate_from(scene, None, path, force=force, resume=resume, progress=progress)
+
+
+def simulate_from(scene, start, path: str | Path | None = None, *, force: bool = False,
+                  resume: bool = False, progress: Callable[[float], None] | None = None,
+                  analysis: dict[str, tuple] | None = None) -> Result:
+    """:func:`simulate` from the stepper's state ``start`` (a :class:`~transient.results.
+    Checkpoint`; None: the scene's initial state), with ``analysis`` (name → (value, unit))
+    stored beside the run's own."""
     refuse_elastic_run(scene)  # (before any file is made)
     if path is None:
         if force or resume:
             raise SceneError("path", "force and resume apply to a result file: give its path")
-        return _in_memory(scene, progress)
+        return _in_memory(scene, progress, start, analysis or {})
     try:
-        _write(scene, Path(path), force, resume, progress)
+        _write(scene, Path(path), force, resume, progress, start, analysis or {})
     except RunStopped as exc:  # (written as far as it went)
         raise _with_result(exc, open_result(path), path) from None
     res = open_result(path)
@@ -618,14 +747,14 @@ def _with_result(exc: SimulationError, res: Result, path: str | Path) -> Simulat
     return exc
 
 
-def _in_memory(scene, progress) -> Result:
+def _in_memory(scene, progress, start, analysis) -> Result:
     """A run kept in memory, with its summary, as a Result."""
     from .analysis.summary import summarize
     from .scene import to_toml
 
-    data = integrate(scene, progress=progress)
+    data = integrate(scene, progress=progress, start=start)
     summary = {**(summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
-                  else {}), **data.summary}
+                  else {}), **data.summary, **analysis}
     res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary,
                            (scene.source_file, scene.source_text))
     if res.status != FINISHED:
@@ -633,7 +762,7 @@ def _in_memory(scene, progress) -> Result:
     return res
 
 
-def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
+def _write(scene, path: Path, force: bool, resume: bool, progress, start, analysis) -> None:
     """Stream a run into the result file ``path`` (:class:`~transient.results.ResultWriter`),
     its summary from the end of the run."""
     from .analysis.summary import summarize
@@ -658,7 +787,7 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
             writes.start(writer.block, block, ev, *state)
 
         data = integrate(scene, on_block=on_block, progress=progress, keep=False,
-                         start=writer.checkpoint, before=writer.written_blocks())
+                         start=writer.checkpoint or start, before=writer.written_blocks())
         writes.wait()
         if not streamed or "stiff_rerun" in data.solver:  # written whole, not resumable
             writer.block(data.trajectory, data.events, np.zeros(0), np.zeros(0, np.int64), False,
@@ -667,7 +796,8 @@ def _write(scene, path: Path, force: bool, resume: bool, progress) -> None:
         # memory stays bounded however long the run (steady state, efficiency are found there).
         tail = writer.read_trajectory(last=SUMMARY_SAMPLES)
         events = writer.read_events(t_from=tail["t"][0] if tail["t"].size else -math.inf)
-        summary = {**(summarize(scene, tail, events) if tail["t"].size else {}), **data.summary}
+        summary = {**(summarize(scene, tail, events) if tail["t"].size else {}), **data.summary,
+                   **analysis}
     except BaseException as exc:
         writes.settle()
         msg = data.message if data is not None and data.message else (

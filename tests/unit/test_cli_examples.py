@@ -21,7 +21,7 @@ def commands() -> dict[str, argparse.ArgumentParser]:
 
 def test_every_command_has_one_example_in_the_listed_order():
     assert list(EXAMPLES) == list(commands())
-    assert len(EXAMPLES) == 14
+    assert len(EXAMPLES) == 15
 
 
 @pytest.mark.parametrize("name", list(EXAMPLES))

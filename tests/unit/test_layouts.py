@@ -81,6 +81,13 @@ def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
     assert np.all(control[at[layout.B_GOVERNOR]:at[layout.B_GOVERNOR + 1]] == BY_SIZE)
     assert np.all(control[at[layout.B_PRESSURE]:at[layout.B_LINE_LOSS]] == BY_SIZE)
     assert np.all(control[at[layout.B_LINE_LOSS]:] == NOT_CONTROLLED)
+    # the states that repeat in a periodic steady state: the speed, the governor's, the latched
+    # fuels, the pressures and the line's twists and speeds, counted from the scene
+    periodic = layout.periodic_states(model)
+    assert periodic.size == expected - 6 - len(scene.friction.pairs) + 1 - (1 if dofs else 0)
+    assert periodic[0] == layout.OMEGA and np.all(np.diff(periodic) > 0)
+    assert at[layout.B_LOSS + 1] <= periodic[1:].min(initial=at[-1])
+    assert periodic.max(initial=0) < at[layout.B_LINE_LOSS]
     # the output row: as long as the trajectory's columns that the scene names
     out = layout.OUTPUT.offsets_for(model)
     assert [layout.pair_col(model), layout.governor_col(model), layout.cylinder_loss_col(model),

@@ -5,9 +5,9 @@ Exit codes: 0 success; 2 invalid input (one line, no traceback); 1 the simulatio
 partial result is kept and marked incomplete).
 
 Each command group is a module that registers its subparsers and parses, calls the library,
-draws and prints: ``run`` (run, check, info), ``plot``, ``kinematics``, ``modes``, ``verify`` (bench,
-stress), ``efficiency``, ``loads``, ``orders``, ``sweep`` (sweep, sweep-plot); ``common`` holds
-what they share. Errors become exit codes here only, in :func:`main`.
+draws and prints: ``run`` (run, check, info), ``steady``, ``plot``, ``kinematics``, ``modes``,
+``verify`` (bench, stress), ``efficiency``, ``loads``, ``orders``, ``sweep`` (sweep,
+sweep-plot); ``common`` holds what they share. Errors become exit codes here only, in :func:`main`.
 """
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ import sys
 
 from ..errors import SceneError, SimulationError, WriteFailed
 from ..stopping import interrupting
-from . import efficiency, kinematics, loads, modes, orders, plot, run, sweep, verify
+from . import efficiency, kinematics, loads, modes, orders, plot, run, steady, sweep, verify
 from .common import EXIT_FAILED, EXIT_INVALID, EXIT_OK, KERNELS_NOTICE, OptionParser
 
 __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", "main"]
@@ -27,7 +27,7 @@ __all__ = ["EXIT_FAILED", "EXIT_INVALID", "EXIT_OK", "KERNELS_NOTICE", "entry", 
 _BROKEN_WRITE: WriteFailed | None = None
 
 #: The subcommands' registrations, in the order ``transient --help`` lists them.
-_COMMANDS = (run.register, plot.register, kinematics.register, modes.register,
+_COMMANDS = (run.register, steady.register, plot.register, kinematics.register, modes.register,
              verify.register_bench,
              efficiency.register, loads.register, orders.register, verify.register_stress,
              sweep.register)
@@ -43,6 +43,7 @@ EXAMPLES = {
     "check": "transient check cases/gots_diesel_4400.toml",
     "info": "transient info results/swash_plate_4cyl.h5",
     "warmup": "transient warmup cases/radial_9cyl.toml",
+    "steady": "transient steady cases/gots_diesel_friction.toml --cycles 2",
     "plot": "transient plot results/swash_plate_4cyl.h5 -o results",
     "kinematics": "transient kinematics cases/radial_5cyl.toml --points 721 -o results",
     "modes": "transient modes cases/inline6_damper.toml -o results",

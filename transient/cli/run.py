@@ -129,11 +129,11 @@ def cmd_run(args) -> int:
         print(f"wrote {path}")
         if res.status != FINISHED:
             print(f"  status: {res.message}")
-        _print_summary(res.analysis, res.solver, pair_names(scene))
-    return _said(res, failed)
+        print_summary(res.analysis, res.solver, pair_names(scene))
+    return said(res, failed)
 
 
-def _said(res, failed) -> int:
+def said(res, failed) -> int:
     """Warnings and a run that did not do what its scene describes, one line each on standard
     error; the exit code (1 for any status but finished)."""
     for warning in res.warnings:
@@ -144,7 +144,7 @@ def _said(res, failed) -> int:
     return EXIT_FAILED
 
 
-def _print_summary(summary, solver, names=()) -> None:
+def print_summary(summary, solver, names=()) -> None:
     rpm = 30.0 / math.pi
     v = {k: val for k, (val, _) in summary.items()}
     print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
@@ -173,7 +173,7 @@ def _print_summary(summary, solver, names=()) -> None:
     _print_response(v)
     _print_efficiency(v, names)
     _print_thermodynamics(v)
-    asked = [k for k, val in v.items() if np.ndim(val) > 0]
+    asked = [k for k, val in v.items() if np.ndim(val) > 0 and not k.startswith("steady_")]
     if asked:
         print(f"  stored {len(asked)} arrays the scene's [analysis] asks for (listed by "
               f"`transient info`)")
@@ -263,6 +263,19 @@ def _print_efficiency(v: dict, names=()) -> None:
         print(f"    pair mode switches: {v['pair_mode_switches_per_cycle']:.4g} per cycle")
 
 
+def print_steady(v: dict) -> None:
+    """The shooting's record of a steady result (:func:`transient.steady`): its iterations,
+    the cycles it integrated, the residuals and the multipliers."""
+    if "steady_iterations" not in v:
+        return
+    mu = [complex(r, i) if i else r for r, i in zip(np.atleast_1d(v["steady_multipliers_real"]),
+                                                    np.atleast_1d(v["steady_multipliers_imag"]))]
+    print(f"  periodic steady state by shooting: {v['steady_iterations']} Newton iteration(s), "
+          f"{v['steady_cycles_integrated']} cycle(s) integrated; residuals ‖Φ(x) − x‖/(atol + "
+          f"rtol·|x|) " + ", ".join(f"{r:.3g}" for r in np.atleast_1d(v["steady_residuals"])))
+    print("    multipliers (per cycle): " + ", ".join(f"{m:.6g}" for m in mu))
+
+
 def _print_thermodynamics(v: dict) -> None:
     """The last whole cycle's mean effective pressures and powers (``analysis.thermo``)."""
     if "thermo_last_imep_engine" not in v:
@@ -320,8 +333,11 @@ def cmd_info(args) -> int:
     # (the pairs' names are in the resolved scene, read only when there are pairs)
     _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())
     _print_thermodynamics(values)
+    print_steady(values)
     arrays = []
     for k, (v, unit) in res.analysis.items():
+        if k.startswith("steady_") and np.ndim(v) > 0:
+            continue  # (print_steady's)
         if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped
             arrays.append(f"{k} {'×'.join(map(str, np.shape(v)))} [{unit}]")
         else:

@@ -152,6 +152,13 @@ STATE_NAMES = ("phi", "t", "omega", "W_gas", "W_load", "W_starter")
 CONTROL = {"phi": BY_INCREMENT, "t": BY_INCREMENT, "omega": BY_SIZE, "work": NOT_CONTROLLED,
            "loss": NOT_CONTROLLED, "governor": BY_SIZE, "latched": NOT_CONTROLLED,
            "pressure": BY_SIZE, "line": BY_SIZE, "line_loss": NOT_CONTROLLED}
+#: Which blocks repeat from one engine cycle to the next in a periodic steady state
+#: (:mod:`transient.shooting`): the speed (the third state), the governor's states, the latched fuels,
+#: the closed parts' pressures and the shaft line's twists and speeds. φ advances by the cycle;
+#: t, the works and the losses accumulate, so they are no part of it.
+PERIODIC = {"phi": False, "t": False, "omega": True, "work": False, "loss": False,
+            "governor": True, "latched": True, "pressure": True, "line": True,
+            "line_loss": False}
 
 
 def state_control(m) -> np.ndarray:
@@ -159,6 +166,14 @@ def state_control(m) -> np.ndarray:
     argument ``control`` of the integrator's error norm (the stepper's ``Work.control``)."""
     return np.concatenate([np.full(n, CONTROL[b.name], dtype=np.int64)
                            for b, n in zip(STATE.blocks, STATE.sizes_for(m))])
+
+
+def periodic_states(m) -> np.ndarray:
+    """The indices of model ``m``'s state components that repeat in a periodic steady state
+    (:data:`PERIODIC`), in the state's order."""
+    at = STATE.offsets_for(m)
+    return np.concatenate([np.arange(at[k], at[k + 1]) for k, b in enumerate(STATE.blocks)
+                           if PERIODIC[b.name]]).astype(np.int64)
 
 
 #: Discrete switches held constant over a step (an int array ``sw``, the first block of the
