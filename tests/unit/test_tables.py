@@ -10,7 +10,13 @@ import math
 import numpy as np
 import pytest
 
-from transient.core.model.tables import find_piece, table_eval, table_value, wrap_angle
+from transient.core.model.tables import (
+    find_piece,
+    find_piece_near,
+    table_eval,
+    table_value,
+    wrap_angle,
+)
 from transient.errors import SceneError
 from transient.forces.gas import PressureTable, table_from_function, table_from_points
 
@@ -30,6 +36,24 @@ def jumpy_table(interpolation: str) -> PressureTable:
     # Corner at 500°: no sample there, both neighbours extrapolate to it.
     return table_from_points(phi_deg * DEG, p, P4, corners=np.array([200, 360, 500]) * DEG,
                              interpolation=interpolation)
+
+
+def test_the_piece_searched_from_a_kept_one_is_the_piece_the_corners_bound():
+    """find_piece_near against the numpy twin's piece_of (a search of its own): for every kept
+    value, a piece (the right one, a neighbour, the farthest) or none (NaN, negative, too large,
+    between two indices), at angles on every corner, an ulp either side, inside the cycle and at
+    its ends."""
+    t = jumpy_table("pchip")
+    rng = np.random.default_rng(3)
+    corners = np.concatenate([t.corners, [P4]])
+    x = np.concatenate([rng.uniform(0.0, P4, 300), corners, np.nextafter(corners, 0.0),
+                        np.nextafter(corners, P4), [0.0]])
+    x = x[x < P4]
+    kept = [float(j) for j in range(t.n_pieces)] + [math.nan, -1.0, 1e300, float(t.n_pieces), 1.5]
+    for xi, want in zip(x, t.piece_of(x), strict=True):
+        assert find_piece(t.knots, t.piece_knot, xi) == want
+        for held in kept:
+            assert find_piece_near(t.knots, t.piece_knot, xi, held) == want
 
 
 @pytest.mark.parametrize("interpolation", ["linear", "pchip", "spline"])

@@ -400,7 +400,7 @@ Model = namedtuple(
         # packed in one array, with its kernels as fields so that a rigid shaft's stepper, whose
         # line is a row of zeros (no dofs) and whose kernels are no-ops, compiles none of them
         "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
-        "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
+        "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ)
         "line_model",  # kernel: the line's derivative or output row; True if it did them
         "line_switch",  # kernel: each other dof's speed state to K_d or back (m, y, to_angle, wk)
         "reference_inertia",  # kernel: J of the third state's K = ½Jω² at φ (m, phi, wk)

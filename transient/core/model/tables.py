@@ -68,6 +68,20 @@ def find_piece(knots, piece_knot, x):
 
 
 @kernel(inline=True)
+def find_piece_near(knots, piece_knot, x, held):
+    """:func:`find_piece`'s piece for `x`, tried first in the piece ``held`` (a float: what
+    the caller kept from its last search; a value that is no piece index, NaN or garbage, is
+    skipped): two comparisons where `x` is still in it, which it is at most evaluations of a
+    cylinder that a step's stages move by a fraction of a piece. The same piece as
+    :func:`find_piece` for every `x` and ``held``, since the corners increase strictly."""
+    if 0.0 <= held < piece_knot.shape[0] - 1:
+        j = int(held)
+        if knots[piece_knot[j]] <= x < knots[piece_knot[j + 1]]:
+            return j
+    return find_piece(knots, piece_knot, x)
+
+
+@kernel(inline=True)
 def _interval(knots, piece_knot, piece, x):
     """The knot interval of ``piece`` that holds x (bisection). Only the piece's own intervals
     are searched: the same result as a global search clamped into the piece, and fewer
