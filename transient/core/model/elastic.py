@@ -130,7 +130,7 @@ def cylinder_pressure(m, c, theta, y, f, wk):
         wk[WK_LOCAL_SHIFT, c] = local_shift
         wk[WK_PIECE_SHIFT, c] = find_piece_near(m.knots, m.piece_knot, local_shift,
                                                 wk[WK_PIECE_SHIFT, c])
-    p = cylinder_value(m, True, c, y, theta, theta, f, wk)
+    p = cylinder_value(m, True, c, y, theta, theta, f, wk, True)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p
