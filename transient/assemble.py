@@ -466,7 +466,7 @@ def initial_cylinders(scene, model: Model, f0: float) -> list[float]:
         local = (phi0 - model.gas_phase[k]) % model.period
         closed = cyl.closed_angle(model.cyl_par, local, model.period) >= 0.0
         f_k = f0 * cycle_fuel(model, k, sel) if model.var_on else f0
-        out.append(applied_value(model, extras_of(model), k, phi0, sel, f_k, wk) if closed
+        out.append(applied_value(model, extras_of(model), k, phi0, sel, f_k, wk, False) if closed
                    else model.cyl_par[cyl.P_A])
     return out
 

@@ -14,7 +14,7 @@ import pytest
 from engines import inline_six_mech
 
 from transient.assemble import kinematics_table
-from transient.core.model import tabulated
+from transient.core.model import crank_slider, tabulated
 from transient.reference.torsion import CrankSliderCylinders
 from transient.scene import load_scene
 
@@ -40,10 +40,10 @@ def _groups(mech) -> list[list[int]]:
     return [[k] for k in range(n)]
 
 
-def _shares(kernel, mp, coef, angles):
+def _shares(kernel, mp, coef, angles, with_dJ=True):
     n = angles.size
     Jc, dJc, u, du = (np.zeros(n) for _ in range(4))
-    kernel(mp, coef, angles, Jc, dJc, u, du)
+    kernel(mp, coef, angles, Jc, dJc, u, du, with_dJ)
     return Jc, dJc, u, du
 
 
@@ -73,6 +73,35 @@ def test_the_shares_at_one_angle_add_up_to_the_whole_mechanism(mech):
         assert abs(dJc.sum() - dJ) <= RTOL * scale
         np.testing.assert_allclose(u, u_all, rtol=RTOL, atol=RTOL * np.abs(u_all).max())
         np.testing.assert_allclose(du, du_all, rtol=RTOL, atol=RTOL * np.abs(du_all).max())
+
+
+def test_the_shares_without_their_derivatives_are_the_same_shares(mech):
+    """What the derivative in crank angle asks for (``with_dJ`` False): J_c and u as with the
+    derivatives, which the tests around check against the whole mechanism and a separate
+    crank-slider."""
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        angles = rng.uniform(-2 * np.pi, 6 * np.pi, mech.n_cylinders)
+        Jc, _, u, _ = _shares(mech.shares_kernel, mech.pack(), NO_TABLE, angles)
+        Jc_only, _, u_only, _ = _shares(mech.shares_kernel, mech.pack(), NO_TABLE, angles, False)
+        np.testing.assert_allclose(Jc_only, Jc, rtol=RTOL, atol=RTOL * np.abs(Jc).max())
+        np.testing.assert_allclose(u_only, u, rtol=RTOL, atol=RTOL * np.abs(u).max())
+
+
+def test_a_turned_sine_and_cosine_are_those_of_the_sum():
+    """crank_slider.turned against numpy's sine and cosine of a + d: d up to and past the
+    polynomials' bound (NEAR), a up to a thousand turns, where the rounding of a + d itself
+    (half an ulp of |a| + |d|) bounds the agreement."""
+    rng = np.random.default_rng(13)
+    near = crank_slider.NEAR
+    d = np.concatenate([rng.uniform(-near, near, 200), [near, -near, np.nextafter(near, 1.0),
+                                                        0.0, 1e-300, 0.5, -3.0, 40.0]])
+    for a in (0.3, 7.1, 2.0e3, 6.0e3 + 0.77):
+        for di in d:
+            s, c = crank_slider.turned(np.sin(a), np.cos(a), di)
+            tol = 4 * np.finfo(float).eps + np.spacing(abs(a) + abs(di))
+            assert abs(s - np.sin(a + di)) <= tol
+            assert abs(c - np.cos(a + di)) <= tol
 
 
 def test_a_group_takes_its_share_from_its_own_angle_alone(mech):

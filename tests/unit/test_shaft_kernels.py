@@ -65,7 +65,8 @@ def test_the_lines_accelerations_and_losses_are_the_references():
 
         n_cyl = mech.n_cylinders
         Jc, dJc, u, du = (np.zeros(n_cyl) for _ in range(4))
-        mech.shares_kernel(mech.pack(), np.zeros((1, 1, 6)), theta[carrier], Jc, dJc, u, du)
+        mech.shares_kernel(mech.pack(), np.zeros((1, 1, 6)), theta[carrier], Jc, dJc, u, du,
+                           True)
         J, dJ = np.zeros(n_dof), np.zeros(n_dof)
         shaft.line_inertia(carrier, J_own, Jc, dJc, J, dJ)
         M = np.zeros(n_dof)
@@ -106,7 +107,7 @@ def test_the_crank_angle_rates_are_the_time_rates_over_the_references_speed():
     dq_want = gear * omega / omega[ref] - 1.0
 
     Jc, dJc, u, du = (np.zeros(mech.n_cylinders) for _ in range(4))
-    mech.shares_kernel(mech.pack(), np.zeros((1, 1, 6)), theta[carrier], Jc, dJc, u, du)
+    mech.shares_kernel(mech.pack(), np.zeros((1, 1, 6)), theta[carrier], Jc, dJc, u, du, True)
     M = np.zeros(n_dof)
     M[: model.line.n] = model.gas_moments(th, w, 0.0)
     M[driven] = load(thd, wd, 0.0)

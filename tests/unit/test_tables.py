@@ -10,7 +10,17 @@ import math
 import numpy as np
 import pytest
 
-from transient.core.model.tables import find_piece, table_eval, table_value, wrap_angle
+from transient.core.model.tables import (
+    NEAR_STEPS,
+    find_piece,
+    find_piece_near,
+    table_eval,
+    table_eval_near,
+    table_eval_pair,
+    table_eval_pair_near,
+    table_value,
+    wrap_angle,
+)
 from transient.errors import SceneError
 from transient.forces.gas import PressureTable, table_from_function, table_from_points
 
@@ -30,6 +40,55 @@ def jumpy_table(interpolation: str) -> PressureTable:
     # Corner at 500°: no sample there, both neighbours extrapolate to it.
     return table_from_points(phi_deg * DEG, p, P4, corners=np.array([200, 360, 500]) * DEG,
                              interpolation=interpolation)
+
+
+def test_the_piece_searched_from_a_kept_one_is_the_piece_the_corners_bound():
+    """find_piece_near against the numpy twin's piece_of (a search of its own): for every kept
+    value, a piece (the right one, a neighbour, the farthest) or none (NaN, negative, too large,
+    between two indices), at angles on every corner, an ulp either side, inside the cycle and at
+    its ends."""
+    t = jumpy_table("pchip")
+    rng = np.random.default_rng(3)
+    corners = np.concatenate([t.corners, [P4]])
+    x = np.concatenate([rng.uniform(0.0, P4, 300), corners, np.nextafter(corners, 0.0),
+                        np.nextafter(corners, P4), [0.0]])
+    x = x[x < P4]
+    kept = [float(j) for j in range(t.n_pieces)] + [math.nan, -1.0, 1e300, float(t.n_pieces), 1.5]
+    for xi, want in zip(x, t.piece_of(x), strict=True):
+        assert find_piece(t.knots, t.piece_knot, xi) == want
+        for held in kept:
+            assert find_piece_near(t.knots, t.piece_knot, xi, held) == want
+
+
+@pytest.mark.parametrize("interpolation", ["linear", "spline"])
+def test_the_interval_searched_from_a_kept_one_gives_the_bisections_values(interpolation):
+    """table_eval_near and table_eval_pair_near against table_eval and table_eval_pair (the same
+    interval, so the same bits) and against the numpy twin, for every piece, at angles inside,
+    on every knot, an ulp either side and outside the piece, from kept intervals near (within
+    the walk), far (a bisection), in another piece, NaN and garbage."""
+    t = jumpy_table(interpolation)
+    paired = np.hstack([t.coef, 0.5 * t.coef[:, ::-1]])  # (a second curve on the same knots)
+    rng = np.random.default_rng(4)
+    x = np.concatenate([rng.uniform(-0.3, P4 + 0.3, 150), t.knots, np.nextafter(t.knots, -1.0),
+                        np.nextafter(t.knots, 2 * P4)])
+    for j in range(t.n_pieces):
+        lo, hi = t.piece_knot[j], t.piece_knot[j + 1] - 1
+        kept = [float(i) for i in (lo, hi, (lo + hi) // 2)] + [math.nan, -5.0, 1e300, lo + 0.5]
+        for xi in x:
+            want, _ = table_eval(t.knots, t.coef, t.piece_knot, j, xi)
+            pair = table_eval_pair(t.knots, paired, t.piece_knot, j, xi)
+            found = int(np.clip(np.searchsorted(t.knots, xi, side="right") - 1, lo, hi))
+            near = [float(np.clip(found + d, lo, hi)) for d in (-NEAR_STEPS - 1, -1, 0, 2,
+                                                                 NEAR_STEPS, NEAR_STEPS + 3)]
+            for held in kept + near:
+                value, i = table_eval_near(t.knots, t.coef, t.piece_knot, j, xi, held)
+                assert (value, i) == (want, found)
+                assert table_eval_pair_near(t.knots, paired, t.piece_knot, j, xi, held) == (
+                    *pair, found)
+        inside = x[(x >= t.corners[j]) & (x < np.append(t.corners, P4)[j + 1])]
+        np.testing.assert_allclose(
+            [table_eval_near(t.knots, t.coef, t.piece_knot, j, xi, float(lo))[0] for xi in inside],
+            t.evaluate(inside, np.full(inside.size, j))[0], rtol=1e-13, atol=1e-6)
 
 
 @pytest.mark.parametrize("interpolation", ["linear", "pchip", "spline"])

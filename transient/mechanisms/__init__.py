@@ -48,10 +48,11 @@ class Mechanism(Protocol):
     #: compiled for it, and the kinematics tables sample it.
     kernel: ClassVar[Any]
     #: Its compiled kernel of each cylinder's share of J(φ) at the angle of the station that
-    #: carries it, ``shares(mp, kin_coef, angles, J_c, J′_c, u, u′)``
-    #: (:func:`transient.core.model.crank_slider.shares`): the elastic shaft line's per-station
-    #: inertia. Cylinders that move together (a row of master and articulated rods, a swash
-    #: plate's) ride one station, and the first of them takes their whole share.
+    #: carries it, ``shares(mp, kin_coef, angles, J_c, J′_c, u, u′, with_dJ)``
+    #: (:func:`transient.core.model.crank_slider.shares`; without ``with_dJ`` J′_c and u′ may be
+    #: left NaN): the elastic shaft line's per-station inertia. Cylinders that move together (a
+    #: row of master and articulated rods, a swash plate's) ride one station, and the first of
+    #: them takes their whole share.
     shares_kernel: ClassVar[Any]
     #: What it provides beyond this Protocol, names of :data:`CAPABILITIES`.
     capabilities: ClassVar[frozenset[str]]

@@ -159,7 +159,7 @@ def row_terms(mp, j, alpha, u, du):
 
 
 @kernel(inline=True)
-def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of master and articulated rods: a row's master and slaves move with its
     crank throw, so they ride one station, whose angle is that of the row's master,
     ``angles[j(1 + z′)]``; the master's share is the whole row's J, the slaves' nothing."""

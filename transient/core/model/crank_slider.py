@@ -121,20 +121,45 @@ def crank_slider_terms(mp, phi, u, du, with_dJ=True):
     return J, dJ
 
 
+#: The largest |d| for which :func:`turned` takes sin d and cos d from polynomials [rad].
+NEAR = 1.0 / 16.0
+
+
 @kernel(inline=True)
-def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+def turned(s, c, d):
+    """sin(a + d) and cos(a + d) from s = sin a, c = cos a: by the sum formulas, with sin d and
+    cos d from their Taylor polynomials where |d| ≤ :data:`NEAR` (the truncation, below
+    d¹¹/11! and d¹⁰/10!, is about a thousandth of an ulp at most), else from ``sin``, ``cos``.
+    Accurate to a few ulps of 1, as the sine of a large angle is; a call into the maths library
+    costs more than the polynomials."""
+    if abs(d) <= NEAR:
+        d2 = d * d
+        sd = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0
+                                                                      + d2 / 362880.0))))
+        cd = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 / 40320.0)))
+    else:
+        sd = sin(d)
+        cd = cos(d)
+    return s * cd + c * sd, c * cd - s * sd
+
+
+@kernel(inline=True)
+def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of the crank-slider: each cylinder's own reduced inertia J_c, J′_c and
     transfer functions at ``angles[k]``, the angle of the station that carries it (theory (T1a)):
     on an elastic shaft line each throw turns at its own angle, so each cylinder takes its own
-    sine and cosine."""
+    sine and cosine — turned from the first cylinder's by the twist between them
+    (:func:`turned`), one call of the maths library in all. Without ``with_dJ`` J′_c and u′
+    are NaN (:func:`cylinder_terms_sc`)."""
     n = int(mp[N_CYL])
+    s_first = sin(angles[0])
+    c_first = cos(angles[0])
     for k in range(n):
-        sp = sin(angles[k])
-        cp = cos(angles[k])
+        sp, cp = turned(s_first, c_first, angles[k] - angles[0])
         s0 = mp[SIN0 + k]
         c0 = mp[SIN0 + n + k]
         Jc[k], dJc[k], u[k], du[k] = cylinder_terms_sc(sp * c0 - cp * s0, cp * c0 + sp * s0, mp,
-                                                       True)
+                                                       with_dJ)
 
 
 @kernel(inline=True)

@@ -75,7 +75,7 @@ from .shaft import (
     line_torques,
     twist_index,
 )
-from .tables import find_piece
+from .tables import find_piece_near, wrap_angle
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
@@ -119,15 +119,18 @@ def cylinder_pressure(m, c, theta, y, f, wk):
     WK_PIECE; with a combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT,
     WK_PIECE_SHIFT), then the rigid model's :func:`~.forcing.cylinder_value` at ``theta`` (in
     its closed part with wall heat, its pressure state); with a pressure factor β_c,
-    p0 + β_c(p − p0), as it acts on the piston."""
-    local = (theta - m.gas_phase[c]) % m.period
+    p0 + β_c(p − p0), as it acts on the piston. The piece is searched from the one this
+    cylinder's last evaluation left (:func:`~.tables.find_piece_near`): the same piece, found
+    with two comparisons at most evaluations."""
+    local = wrap_angle(theta - m.gas_phase[c], m.period)
     wk[WK_LOCAL, c] = local
-    wk[WK_PIECE, c] = find_piece(m.knots, m.piece_knot, local)
+    wk[WK_PIECE, c] = find_piece_near(m.knots, m.piece_knot, local, wk[WK_PIECE, c])
     if shifted(m):
-        local_shift = (local - m.var_par[c, SHIFT]) % m.period
+        local_shift = wrap_angle(local - m.var_par[c, SHIFT], m.period)
         wk[WK_LOCAL_SHIFT, c] = local_shift
-        wk[WK_PIECE_SHIFT, c] = find_piece(m.knots, m.piece_knot, local_shift)
-    p = cylinder_value(m, True, c, y, theta, theta, f, wk)
+        wk[WK_PIECE_SHIFT, c] = find_piece_near(m.knots, m.piece_knot, local_shift,
+                                                wk[WK_PIECE_SHIFT, c])
+    p = cylinder_value(m, True, c, y, theta, theta, f, wk, True)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p
@@ -184,10 +187,11 @@ def line_forces(m, y, sw, wk):
 
 
 @kernel(inline=True)
-def line_at(m, angle_mode, y, sw, wk):
+def line_at(m, angle_mode, y, sw, wk, with_dJ):
     """Every dof's inertia, speed, applied moments and the line's torques at ``y`` into ``wk``
-    (what the derivative and the output row both start from); returns :func:`line_forces`'."""
-    line_inertias(m, y, wk)
+    (what the derivative and the output row both start from; J′_d only ``with_dJ``); returns
+    :func:`line_forces`'."""
+    line_inertias(m, y, wk, with_dJ)
     line_speeds(m, angle_mode, y, wk)
     return line_forces(m, y, sw, wk)
 
@@ -198,7 +202,8 @@ def elastic_rates(m, angle_mode, y, sw, wk, out):
     form of :func:`.rhs.derivative`."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sw, wk)
+    # (in crank angle the rates are the work–energy law's, (T5): no J′_d)
+    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sw, wk, not angle_mode)
     w = wk[WK_LINE_OMEGA, :n]
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
@@ -256,7 +261,7 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
     damping took."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk)
+    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk, True)
     acc = wk[WK_LINE_RATE, :n]
     line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                        wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)

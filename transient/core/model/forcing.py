@@ -30,6 +30,8 @@ from .layout import (
     SW_LOAD,
     SW_SLEEVE,
     SW_STARTER,
+    WK_CYL_KNOT,
+    WK_CYL_KNOT_SHIFT,
     WK_DEMAND,
     WK_DU,
     WK_FUEL,
@@ -45,7 +47,15 @@ from .layout import (
     gov_index,
     latch_index,
 )
-from .tables import find_piece, held_curve_value, table_eval, table_eval_pair, wrap_angle
+from .tables import (
+    find_piece,
+    held_curve_value,
+    table_eval,
+    table_eval_near,
+    table_eval_pair,
+    table_eval_pair_near,
+    wrap_angle,
+)
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
@@ -81,23 +91,50 @@ def select_pieces(m, extras, sel, wk):
 
 
 @kernel(inline=True)
-def gas_value(m, extras, k, phi, sel, wk):
+def gas_value(m, extras, k, phi, sel, wk, kept):
     """Full-load table value (pressure or force) of cylinder k at shaft angle ``phi``.
 
     ``sel`` is a shaft angle inside the current step: it picks the table piece, so that a step that
     ends exactly on a corner keeps using the piece it integrates over (docs/theory.md, Events and
     breakpoints).
     The piece is the one :func:`select_pieces` left in ``wk`` for it. With combustion offsets
-    the value is the curve's δ_k later, p_full(x − δ_k) (:func:`shifted`).
+    the value is the curve's δ_k later, p_full(x − δ_k) (:func:`shifted`). ``kept``: see
+    :func:`piece_value`.
     """
     if extras is not None and shifted(m):
-        local_sel = wk[WK_LOCAL_SHIFT, k]
-        piece = int(wk[WK_PIECE_SHIFT, k])
-    else:
-        local_sel = wk[WK_LOCAL, k]
-        piece = int(wk[WK_PIECE, k])
-    value, _ = table_eval(m.knots, m.coef, m.piece_knot, piece, local_sel + (phi - sel))
+        return piece_value(m, kept, k, True, wk[WK_LOCAL_SHIFT, k] + (phi - sel), wk)
+    return piece_value(m, kept, k, False, wk[WK_LOCAL, k] + (phi - sel), wk)
+
+
+@kernel(inline=True)
+def piece_value(m, kept, k, shift, x, wk):
+    """The table's (first curve's) value at x on cylinder k's piece, WK_PIECE (``shift``: on
+    the curve its combustion offset shifts, WK_PIECE_SHIFT). ``kept``, on an elastic shaft
+    line, where each cylinder is read at its own angle at every evaluation: the knot interval
+    searched from the one its last evaluation left in ``wk`` (WK_CYL_KNOT, WK_CYL_KNOT_SHIFT;
+    :func:`.tables.interval_near`, the same interval), and left there; else by bisection."""
+    piece = int(wk[WK_PIECE_SHIFT, k]) if shift else int(wk[WK_PIECE, k])
+    if kept:
+        row = WK_CYL_KNOT_SHIFT if shift else WK_CYL_KNOT
+        value, i = table_eval_near(m.knots, m.coef, m.piece_knot, piece, x, wk[row, k])
+        wk[row, k] = i
+        return value
+    value, _ = table_eval(m.knots, m.coef, m.piece_knot, piece, x)
     return value
+
+
+@kernel(inline=True)
+def piece_pair(m, kept, k, shift, x, wk):
+    """Both curves of a paired table at x on cylinder k's piece, as :func:`piece_value` reads
+    the first."""
+    piece = int(wk[WK_PIECE_SHIFT, k]) if shift else int(wk[WK_PIECE, k])
+    if kept:
+        row = WK_CYL_KNOT_SHIFT if shift else WK_CYL_KNOT
+        first, second, i = table_eval_pair_near(m.knots, m.coef, m.piece_knot, piece, x,
+                                                wk[row, k])
+        wk[row, k] = i
+        return first, second
+    return table_eval_pair(m.knots, m.coef, m.piece_knot, piece, x)
 
 
 @kernel(inline=True)
@@ -109,49 +146,45 @@ def shifted(m):
 
 
 @kernel(inline=True)
-def gas_pair(m, k, phi, sel, wk):
+def gas_pair(m, k, phi, sel, wk, kept):
     """Full-load and motored table values of cylinder k at shaft angle ``phi`` (``m.has_motored``
-    only: ``m.coef`` pairs the two curves on common knots); ``sel``, ``wk`` as in
+    only: ``m.coef`` pairs the two curves on common knots); ``sel``, ``wk``, ``kept`` as in
     :func:`gas_value`."""
-    local_sel = wk[WK_LOCAL, k]
-    return table_eval_pair(m.knots, m.coef, m.piece_knot, int(wk[WK_PIECE, k]),
-                           local_sel + (phi - sel))
+    return piece_pair(m, kept, k, False, wk[WK_LOCAL, k] + (phi - sel), wk)
 
 
 @kernel(inline=True)
-def applied_value(m, extras, k, phi, sel, f, wk):
+def applied_value(m, extras, k, phi, sel, f, wk, kept):
     """The pressure (or force) acting on piston k at fuel ``f``: p_mot + f·(p_full − p_mot), so
     that the fuel scales the combustion, never the compression.
 
     Without a paired motored table either the scene burns full-load fuel throughout (f = 1,
     ``transient.scene.queries.burns_part_load``) or the model is a force pulse whose motored force is
     ``gas_offset`` = 0; the value is then gas_offset + f·(p − gas_offset), at f = 1 the table's
-    to the last bit.
+    to the last bit. ``kept``: see :func:`piece_value`.
     """
     if m.has_motored:
-        p, p_mot = gas_pair(m, k, phi, sel, wk)
+        p, p_mot = gas_pair(m, k, phi, sel, wk, kept)
         if extras is not None and shifted(m):
             # the combustion's part δ_k later, the motored curve with the piston
-            p, p_mot_shift = table_eval_pair(m.knots, m.coef, m.piece_knot,
-                                             int(wk[WK_PIECE_SHIFT, k]),
-                                             wk[WK_LOCAL_SHIFT, k] + (phi - sel))
+            p, p_mot_shift = piece_pair(m, kept, k, True, wk[WK_LOCAL_SHIFT, k] + (phi - sel), wk)
             return p_mot + f * (p - p_mot_shift)
         return p_mot + f * (p - p_mot)
-    p = gas_value(m, extras, k, phi, sel, wk)
+    p = gas_value(m, extras, k, phi, sel, wk, kept)
     if f == 1.0:
         return p
     return m.gas_offset + f * (p - m.gas_offset)
 
 
 @kernel(inline=True)
-def cylinder_value(m, extras, k, y, phi, sel, f, wk):
+def cylinder_value(m, extras, k, y, phi, sel, f, wk, kept):
     """The pressure on piston k at its angle ``phi`` (the shaft's, or on an elastic line its
-    station's): its state in the closed part with wall heat transfer (``m.woschni``,
+    station's, ``kept``): its state in the closed part with wall heat transfer (``m.woschni``,
     :mod:`.cylinder`), else the table's at fuel ``f`` (:func:`applied_value`)."""
     if extras is not None and m.woschni:
         if cyl.closed_angle(m.cyl_par, wk[WK_LOCAL, k], m.period) >= 0.0:
             return y[cyl_index(m) + k]
-    return applied_value(m, extras, k, phi, sel, f, wk)
+    return applied_value(m, extras, k, phi, sel, f, wk, kept)
 
 
 @kernel(inline=True)
@@ -421,7 +454,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                 f_k = y[c + k] if extras is not None and m.latch else f
                 if extras is not None and m.var_on:
                     f_k *= wk[WK_FUEL, k]
-                p_k = cylinder_value(m, extras, k, y, phi, sel, f_k, wk)
+                p_k = cylinder_value(m, extras, k, y, phi, sel, f_k, wk, False)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
                 if extras is not None and m.var_on:
                     M_k *= m.var_par[k, PRESSURE]
@@ -431,7 +464,7 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
                                              * (m.var_par[k, PRESSURE] if m.var_on else 1.0))
         else:  # f = 1, or a force pulse (motored force 0): f·Σ(p − p0)F_p u, one multiplication
             for k in range(m.ncyl):
-                p_k = gas_value(m, extras, k, phi, sel, wk)
+                p_k = gas_value(m, extras, k, phi, sel, wk, False)
                 M_k = m.gas_scale[k] * (p_k - m.gas_offset) * u[k]
                 if extras is not None and m.var_on:  # (factors of 1 leave M_k to the last bit)
                     M_k *= wk[WK_FUEL, k] * m.var_par[k, PRESSURE]

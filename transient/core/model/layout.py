@@ -302,11 +302,14 @@ WORK = Layout(
     ("cyl_angle", 1, "each cylinder's angle, its station's"),
     ("cyl_J", 1, "each cylinder's share of J at its angle"),
     ("cyl_dJ", 1, "its derivative"),
+    ("cyl_knot", 1, "each cylinder's gas-table knot interval at its last evaluation"),
+    ("cyl_knot_shift", 1, "its knot interval on the curve its combustion offset shifts"),
 )
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
  WK_SCRATCH, WK_CYL_LOSS, WK_LINE_THETA, WK_LINE_OMEGA, WK_LINE_J, WK_LINE_DJ, WK_LINE_M,
- WK_LINE_T, WK_LINE_RATE, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ) = WORK
+ WK_LINE_T, WK_LINE_RATE, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ, WK_CYL_KNOT,
+ WK_CYL_KNOT_SHIFT) = WORK
 N_SCRATCH = WORK.size_of("scratch")
 WK_RX = WORK.end
 
@@ -415,7 +418,7 @@ Model = namedtuple(
         # packed in one array, with its kernels as fields so that a rigid shaft's stepper, whose
         # line is a row of zeros (no dofs) and whose kernels are no-ops, compiles none of them
         "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
-        "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
+        "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ)
         "line_model",  # kernel: the line's derivative or output row; True if it did them
         "line_switch",  # kernel: each other dof's speed state to K_d or back (m, y, to_angle, wk)
         "reference_inertia",  # kernel: J of the third state's K = ½Jω² at φ (m, phi, wk)

@@ -92,7 +92,7 @@ def line_jacobian(m, angle_mode, y, f0, wk, band):
         for c in range(band.shape[1]):
             band[r, c] = 0.0
     if line_dofs(m) > 0:
-        line_inertias(m, y, wk)
+        line_inertias(m, y, wk, True)
         line_speeds(m, angle_mode, y, wk)
         _own_terms(m, angle_mode, y, f0, wk, lo, band)
         _element_terms(m, angle_mode, wk, lo, band)

@@ -72,7 +72,7 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
         f_k = y[c + k] if extras is not None and m.latch else f
         if extras is not None and m.var_on:
             f_k *= wk[WK_FUEL, k]
-        p_k = cylinder_value(m, extras, k, y, y[PHI], sel, f_k, wk) if m.has_gas else 0.0
+        p_k = cylinder_value(m, extras, k, y, y[PHI], sel, f_k, wk, False) if m.has_gas else 0.0
         beta = m.var_par[k, PRESSURE] if extras is not None and m.var_on else 1.0
         if beta != 1.0:  # (as it acts on the piston: p0 + β_k(p − p0))
             p_k = m.gas_offset + beta * (p_k - m.gas_offset)

@@ -34,7 +34,7 @@ def scotch_yoke_terms(mp, phi, u, du):
 
 
 @kernel(inline=True)
-def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of the Scotch yoke: its one cylinder's J and J′ at its station's angle."""
     Jc[0], dJc[0] = scotch_yoke_terms(mp, angles[0], u, du)
 

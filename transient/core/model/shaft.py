@@ -112,8 +112,9 @@ def line_torques(elements, absolute, weights, gear, theta, omega, T):
         T[d] = -gear[d] * r
         resultant += r
         taken += r * slip
+    per_weight = resultant / total  # (one division, not one per dof)
     for d in range(T.shape[0]):
-        T[d] += gear[d] * weights[d] / total * resultant
+        T[d] += gear[d] * weights[d] * per_weight
     for e in range(elements.shape[0]):
         i = int(elements[e, EL_I])
         j = int(elements[e, EL_J])
@@ -155,9 +156,10 @@ def twist_index(m, d):
 
 
 @kernel(inline=True)
-def line_inertias(m, y, wk):
+def line_inertias(m, y, wk, with_dJ):
     """Each dof's angle θ_d (WK_LINE_THETA), J_d and J′_d (WK_LINE_J, WK_LINE_DJ) at state
-    ``y``, (T1); each cylinder's transfer functions at its dof's angle in the rows u, u′."""
+    ``y``, (T1); each cylinder's transfer functions at its dof's angle in the rows u, u′. Without
+    ``with_dJ`` J′_d and u′ may be left NaN: the derivative in crank angle needs neither (T5)."""
     carrier, dofs, _ = line_parts(m.line)
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
@@ -166,7 +168,7 @@ def line_inertias(m, y, wk):
     for c in range(m.ncyl):
         wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, int(carrier[c])]
     m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
-             wk[WK_U], wk[WK_DU])
+             wk[WK_U], wk[WK_DU], with_dJ)
     line_inertia(carrier, dofs[:, LD_OWN], wk[WK_CYL_J, :m.ncyl], wk[WK_CYL_DJ, :m.ncyl],
                  wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n])
 
@@ -176,7 +178,7 @@ def line_mode(m, y, to_angle, wk):
     """Each dof but the reference from ω_d to K_d = ½J_d(θ_d)ω_d² (``to_angle``) or back, where
     the independent variable changes (the stepper converts the reference's own with
     :func:`ref_inertia`, through ``forcing.inertia``)."""
-    line_inertias(m, y, wk)
+    line_inertias(m, y, wk, False)
     ref = int(m.line[0, LM_REF])
     for d in range(line_dofs(m)):
         if d != ref:
@@ -189,13 +191,13 @@ def line_mode(m, y, to_angle, wk):
 def ref_inertia(m, phi, wk):
     """J_ref(φ), the reference dof's own inertia and its cylinders' shares at φ, summed as
     :func:`line_inertia` sums them (so that K_ref = ½J_ref ω_ref² converts both ways to the same
-    bits); fills the rows u, u′ at φ."""
+    bits); fills the row u at φ."""
     carrier, dofs, _ = line_parts(m.line)
     ref = int(m.line[0, LM_REF])
     for c in range(m.ncyl):
         wk[WK_CYL_ANGLE, c] = phi
     m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
-             wk[WK_U], wk[WK_DU])
+             wk[WK_U], wk[WK_DU], False)
     J = dofs[ref, LD_OWN]
     for c in range(m.ncyl):
         if int(carrier[c]) == ref:
@@ -207,7 +209,7 @@ def ref_inertia(m, phi, wk):
 
 
 @kernel(inline=True)
-def no_shares(mp, kin_coef, angles, Jc, dJc, u, du):
+def no_shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of a rigid shaft."""
 
 

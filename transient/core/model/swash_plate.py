@@ -235,7 +235,7 @@ def swash_terms(mp, phi, u, du):
 
 
 @kernel(inline=True)
-def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of the swash plate: its plate, links, rods and pistons move together, so
     they ride one station, whose angle is ``angles[0]``; the first cylinder's share is the whole
     J, the others' nothing."""

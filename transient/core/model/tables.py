@@ -68,6 +68,20 @@ def find_piece(knots, piece_knot, x):
 
 
 @kernel(inline=True)
+def find_piece_near(knots, piece_knot, x, held):
+    """:func:`find_piece`'s piece for `x`, tried first in the piece ``held`` (a float: what
+    the caller kept from its last search; a value that is no piece index, NaN or garbage, is
+    skipped): two comparisons where `x` is still in it, which it is at most evaluations of a
+    cylinder that a step's stages move by a fraction of a piece. The same piece as
+    :func:`find_piece` for every `x` and ``held``, since the corners increase strictly."""
+    if 0.0 <= held < piece_knot.shape[0] - 1:
+        j = int(held)
+        if knots[piece_knot[j]] <= x < knots[piece_knot[j + 1]]:
+            return j
+    return find_piece(knots, piece_knot, x)
+
+
+@kernel(inline=True)
 def _interval(knots, piece_knot, piece, x):
     """The knot interval of ``piece`` that holds x (bisection). Only the piece's own intervals
     are searched: the same result as a global search clamped into the piece, and fewer
@@ -118,7 +132,12 @@ def table_eval(knots, coef, piece_knot, piece, x):
     slope : float
         Derivative with respect to the angle (Pa/rad).
     """
-    lo = _interval(knots, piece_knot, piece, x)
+    return _cubic(knots, coef, _interval(knots, piece_knot, piece, x), x)
+
+
+@kernel(inline=True)
+def _cubic(knots, coef, lo, x):
+    """Value and slope at x of knot interval ``lo``'s cubic."""
     d = x - knots[lo]
     c0 = coef[lo, 0]
     c1 = coef[lo, 1]
@@ -139,11 +158,60 @@ def table_eval_pair(knots, coef, piece_knot, piece, x):
     first, second : float
         The curves of columns 0–3 and 4–7 (full-load and motored pressure) [Pa].
     """
-    lo = _interval(knots, piece_knot, piece, x)
+    return _cubic_pair(knots, coef, _interval(knots, piece_knot, piece, x), x)
+
+
+@kernel(inline=True)
+def _cubic_pair(knots, coef, lo, x):
+    """Both curves' values at x on knot interval ``lo`` of a paired table."""
     d = x - knots[lo]
     first = coef[lo, 0] + d * (coef[lo, 1] + d * (coef[lo, 2] + d * coef[lo, 3]))
     second = coef[lo, 4] + d * (coef[lo, 5] + d * (coef[lo, 6] + d * coef[lo, 7]))
     return first, second
+
+
+#: How many knot intervals :func:`interval_near` walks from the kept one before it bisects.
+NEAR_STEPS = 4
+
+
+@kernel(inline=True)
+def interval_near(knots, piece_knot, piece, x, held):
+    """:func:`_interval`'s knot interval of ``piece`` for x — the largest i of the piece's with
+    knots[i] ≤ x, its first where none is — walked to from ``held`` (a float: the interval the
+    caller kept from its last search; one outside the piece, NaN or garbage, is skipped) in at
+    most :data:`NEAR_STEPS` steps, else found by bisection. A cylinder's successive evaluations
+    lie a few intervals apart, where a bisection over a piece of a thousand knots takes ten
+    data-dependent branches; the interval is the same either way, the only one whose ends
+    bracket x (the piece's first and last open below and above)."""
+    lo = piece_knot[piece]
+    hi = piece_knot[piece + 1] - 1
+    if lo <= held <= hi:
+        i = int(held)
+        for _ in range(NEAR_STEPS):
+            if i > lo and x < knots[i]:
+                i -= 1
+            elif i < hi and knots[i + 1] <= x:
+                i += 1
+            else:
+                return i
+    return last_knot_at_or_below(knots, lo, hi, x)
+
+
+@kernel(inline=True)
+def table_eval_near(knots, coef, piece_knot, piece, x, held):
+    """:func:`table_eval`'s value at x, its interval searched from ``held``
+    (:func:`interval_near`); returns (value, the interval)."""
+    i = interval_near(knots, piece_knot, piece, x, held)
+    return _cubic(knots, coef, i, x)[0], i
+
+
+@kernel(inline=True)
+def table_eval_pair_near(knots, coef, piece_knot, piece, x, held):
+    """:func:`table_eval_pair`'s values at x, the interval searched from ``held``
+    (:func:`interval_near`); returns (first, second, the interval)."""
+    i = interval_near(knots, piece_knot, piece, x, held)
+    first, second = _cubic_pair(knots, coef, i, x)
+    return first, second, i
 
 
 @kernel

@@ -55,7 +55,7 @@ def tabulated_terms(coef, phi, u, du):
 
 
 @kernel(inline=True)
-def shares(mp, kin_coef, angles, Jc, dJc, u, du):
+def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of tabulated kinematics: the tables hold the mechanism's J(φ) whole, so
     every cylinder rides one station, whose angle is ``angles[0]``; the first cylinder's share
     is the whole J, the others' nothing."""
