@@ -96,6 +96,7 @@ def test_the_energy_balance_holds_with_the_pairs_losses(main_bearings):
     lost = sum(tr[f"W_loss_1_{t}"] for t in throws(scene))
     rtol = scene.solver.rtol
     assert np.max(np.abs(balance)) > 1e3 * rtol * np.max(tr["W_gas"])  # (the pairs take a share)
+    assert np.all(tr["W_starter"] == 0.0)  # (no starter: nothing else writes its rate)
     assert np.max(np.abs(balance + lost)) <= 1e2 * rtol * np.max(np.abs(tr["W_gas"]))
     for t in throws(scene):
         assert np.all(np.diff(tr[f"W_loss_1_{t}"]) >= -1e-9 * np.max(lost)), t

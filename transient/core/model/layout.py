@@ -176,6 +176,9 @@ def state_control(m) -> np.ndarray:
                            for b, n in zip(STATE.blocks, STATE.sizes_for(m))])
 
 
+#: The most modes of non-ideal pairs a Model may have (:func:`n_margins`): each a bit of the
+#: switch ``modes``, an int64.
+MAX_MARGINS = 62
 #: Discrete switches held constant over a step (an int array ``sw``, the first block of the
 #: stepper's integer state, ``stepper.io.INTS``): starter engaged (0/1), the governor's branch
 #: (see :func:`.forcing.governor_branch`), the modes of the non-ideal pairs (bit k set: pair k
@@ -186,9 +189,6 @@ def state_control(m) -> np.ndarray:
 #: (:func:`.forcing.generator_branch`), the flyweight governor's sleeve, moving or on a stop
 #: (``governor.FREE``, ``ON_LOW_STOP``, ``ON_HIGH_STOP``), and the interval of a tabulated load
 #: against speed (:func:`.forcing.speed_knot_segment`).
-#: The most modes of non-ideal pairs a Model may have (:func:`n_margins`): each a bit of the
-#: switch ``modes``, an int64.
-MAX_MARGINS = 62
 SWITCHES = Layout("switches", "starter", "governor", "modes", "direction", "load", "generator",
                   "sleeve", "load_table")
 (SW_STARTER, SW_GOVERNOR, SW_MODES, SW_DIRECTION, SW_LOAD, SW_GENERATOR, SW_SLEEVE,
@@ -418,10 +418,10 @@ Model = namedtuple(
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
         # the elastic shaft line (transient.shaft.ShaftLine; theory, The elastic shaft line),
         # packed in one array, with its kernels as fields so that a rigid shaft's stepper, whose
-        # line is a row of zeros (no dofs) and whose kernels are no-ops, compiles none of them
+        # line has no dofs and whose kernels are no-ops, compiles none of them
         "line",  # float64[rows, N_LINE_COLUMNS]: the line packed (LINE_META, LINE_DOF, ELEMENT)
         "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du)
-        "line_model",  # kernel: the line's derivative or output row; True if it did them
+        "line_model",  # kernel: the line's derivative, output row, pairs' margins or modes
         "line_switch",  # kernel: each other dof's speed state to K_d or back (m, y, to_angle, wk)
         "reference_inertia",  # kernel: J of the third state's K = ½Jω² at φ (m, phi, wk)
     ],

@@ -141,8 +141,10 @@ def throw_loss_rates(m, q, wk, out):
     n = m.n_pairs
     for d in range(line_dofs(m)):
         c = int(dofs[d, LD_CHAIN])
+        if c < 0:
+            continue
         w = wk[WK_LINE_OMEGA, d]
-        for j in range(c * n, c * n + n if c >= 0 else 0):
+        for j in range(c * n, c * n + n):
             out[W_LOSS0 + j] = (1.0 - wk[WK_ETA, j]) * wk[WK_S, j] * w * q
             wk[WK_G_MIN, j] = min(wk[WK_G_MIN, j], wk[WK_G, j])
 
