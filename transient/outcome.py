@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from .errors import SimulationError
+from .scene.outputs import pair_columns
 from .scene.records import RUNAWAY_SPEED
 
 #: Every status a run ends with, and what it means (user guide, Result files: Statuses); a run
@@ -297,13 +298,17 @@ class Watch:
             out.append(f"the shaft stopped on the way and ran again: {self._stops_said('')}")
         if self.scene.friction.policy != "paper":  # (the power-flow policy has none by design)
             return out
-        for k, pair in enumerate(self.scene.friction.pairs):
-            least, largest = self.loss_range.get(f"P_loss_{k + 1}", (0.0, 0.0))
-            if least < -LOSS_ROUNDING * largest:
-                out.append(f"pair {k + 1} ({pair.name}) reported negative losses (P_loss down to "
-                           f"{least:.4g} W): under policy {self.scene.friction.policy!r} its "
-                           f"mode can stand against the power it transmits; policy "
-                           f"\"power-flow\" keeps every loss ≥ 0")
+        for k, (pair, chains) in enumerate(zip(self.scene.friction.pairs,
+                                               pair_columns(self.scene))):
+            for s, _ in chains:  # (the pair itself; on an elastic line in each throw)
+                least, largest = self.loss_range.get(f"P_loss_{s}", (0.0, 0.0))
+                where = s[len(f"{k + 1}_"):]  # (the throw's station on an elastic line)
+                if least < -LOSS_ROUNDING * largest:
+                    out.append(f"pair {k + 1} ({pair.name}){f' at {where}' if where else ''} "
+                               f"reported negative losses (P_loss down to {least:.4g} W): "
+                               f"under policy {self.scene.friction.policy!r} its mode can "
+                               f"stand against the power it transmits; policy \"power-flow\" "
+                               f"keeps every loss ≥ 0")
         return out
 
     def summary(self) -> dict[str, tuple[float, str]]:

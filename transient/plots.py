@@ -555,18 +555,20 @@ def reduced_inertia(ax, table):
     return a + b
 
 
-def pair_power(ax, traj, names, cycle):
+def pair_power(ax, traj, pairs, cycle):
     """Power each non-ideal pair transmits, S_k ω [kW] (> 0: the shaft side drives), and the
-    power it loses, over the last cycle against the crank angle in that cycle."""
+    power it loses, over the last cycle against the crank angle in that cycle. ``pairs``:
+    (label, columns' suffix, speed column) of each (on an elastic line of each pair in each
+    throw, :func:`transient.scene.outputs.pair_columns`)."""
     traj = _columns(traj)
     sel = last_cycle(traj, cycle)
     phi = np.degrees(traj["phi"][sel] - traj["phi"][sel][0])
-    w = traj["omega"][sel]
     artists = []
-    for k, name in enumerate(names, start=1):
-        line = ax.plot(phi, traj[f"S_{k}"][sel] * w / 1e3, lw=1.0, label=f"{name}: transmitted")[0]
+    for name, s, speed in pairs:
+        line = ax.plot(phi, traj[f"S_{s}"][sel] * traj[speed][sel] / 1e3, lw=1.0,
+                       label=f"{name}: transmitted")[0]
         artists.append(line)
-        artists += ax.plot(phi, traj[f"P_loss_{k}"][sel] / 1e3, lw=1.0, ls="--",
+        artists += ax.plot(phi, traj[f"P_loss_{s}"][sel] / 1e3, lw=1.0, ls="--",
                            color=line.get_color(), label=f"{name}: lost")
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_xlabel("crank angle in the last cycle [deg]")

@@ -214,6 +214,9 @@ def run_compiled(scene, on_block: Callable[[dict, dict, tuple], None] | None = N
                if math.isfinite(scene.run.t_end) else
                "the run ends by revolutions only; give run.t_end to follow it stuck until the "
                "drive exceeds the friction")
+        if scene.shaft is not None:  # (a throw's chain: the line has no stuck state per throw)
+            why = ("on a throw of the elastic line, whose throws cannot stay stuck in this "
+                   "version")
         message = (f"locked: at rest at {at} the friction of the non-ideal pairs holds the "
                    f"applied moments in both directions ({why})")
     if status == sio.CHATTERING:

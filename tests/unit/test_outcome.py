@@ -30,7 +30,7 @@ def scene(omega0=100.0, budget=4e9, policy="power-flow", pairs=(), revolutions=m
                            run=SimpleNamespace(max_output_bytes=budget, revolutions=revolutions,
                                                t_end=t_end, time=time),
                            solver=SimpleNamespace(switch_speed=WS, rtol=1e-8),
-                           friction=SimpleNamespace(policy=policy, pairs=pairs))
+                           friction=SimpleNamespace(policy=policy, pairs=pairs), shaft=None)
 
 
 #: The switch speed of the scenes above [rad/s] (10 rpm).

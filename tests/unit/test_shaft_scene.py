@@ -175,9 +175,12 @@ def _without_inertia(text: str) -> str:
 
 #: (the key refused, what the scene adds to BASE + LINE): one of each of
 #: transient.shaft.line.UNSUPPORTED
+PAIR = '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\neta_backward = 0.9\n'
 UNSUPPORTED = [
-    ("friction.pairs", '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\n'
-                       "eta_backward = 0.9\n"),
+    ("friction.pairs", '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\nmodel = "reaction"\n'
+                       "mu = 0.01\nradius_mm = 20\n"),
+    ("friction.policy", '\n[friction]\npolicy = "paper"\n' + PAIR),
+    ("initial.omega", PAIR + "[starter]\ntorque = 50\nnoload_speed_rpm = 300\n"),
     ("load.table", '[shaft]\nload_at = "front"\n[load.table]\nphi_deg = [0, 360, 720]\n'
                    "torque = [1, -1, 1]\n"),
     ("load.inertia", "\n[load]\ninertia = 0.1\ninertia_time = 0.01\n"),
@@ -193,6 +196,8 @@ def _unsupported(key: str, extra: str | None) -> str:
                                                 "t_end = 0.1")
     if key == "solver.method":
         return text.replace("[solver]\n", '[solver]\nmethod = "scipy-Radau"\n')
+    if key == "initial.omega":
+        return text.replace("omega_rpm = 1000", "omega_rpm = 0")
     return text
 
 

@@ -21,7 +21,10 @@ Per pair k, over the same cycles: the energy lost, its share of W_in, the net en
 and comes back within the cycle (inertia driving part of the cycle), on which the pair loses too.
 This is why η_mech falls with speed. And how often the pair's mode runs against the power it
 transmits (negative loss): the share of the time and the number of such intervals per cycle — zero
-for the ``power-flow`` policy, the measure of disagreement for ``paper``.
+for the ``power-flow`` policy, the measure of disagreement for ``paper``. On an elastic shaft line
+a pair acts in every throw (theory, (T7)): its loss, FMEP and share of W_in are summed over the
+throws, and the rest is given per throw (``<k>_<station>`` in place of ``<k>``, its power at
+the station's speed, :func:`~transient.scene.outputs.pair_columns`).
 
 The friction budget
 -------------------
@@ -59,7 +62,7 @@ import re
 import numpy as np
 from numpy.typing import NDArray
 
-from ..scene.outputs import cylinder_loss_column
+from ..scene.outputs import cylinder_loss_column, pair_columns
 from .irregularity import cycle_boundaries, cycle_means, steady_state_time
 
 #: |P_in| below this fraction of its mean is left out of (30) as printed.
@@ -69,7 +72,7 @@ PRINTED_GUARD = 1e-3
 EFFICIENCY_VALUES = re.compile(
     r"(steady_phi_start|steady_cycles|W_(in|out)_per_cycle|eta_mech_\w+|"
     r"energy_balance_residual|displacement|[ib]mep|fmep(_\w+)?|pair_mode_switches_per_cycle|"
-    r"W_(loss|transmitted|circulated)_\w+|loss_share_\d+|backward_share_\d+|"
+    r"W_(loss|transmitted|circulated)_\w+|loss_share_\d+|backward_share_\w+|"
     r"mode_against_power_\w+|cylinder_split_residual_\d+)")
 
 
@@ -158,13 +161,15 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
     window = window or steady_window(scene, traj)
     if window is None:
         return {}
-    n_pairs = len(scene.friction.pairs)
+    by_pair = pair_columns(scene)
+    n_pairs = len(by_pair)
     a, b, n_cyc = window
     W_gas = _delta(traj, "W_gas", a, b) + _delta(traj, "W_starter", a, b)
     W_shaft = -(_delta(traj, "W_load", a, b) + _delta(traj, "W_drive", a, b))
     driven = W_gas < 0.0 and W_shaft < 0.0  # (the power flows from the load or drive to the gas)
     W_in, W_out = (-W_shaft, -W_gas) if driven else (W_gas, W_shaft)
-    losses = [_delta(traj, f"W_loss_{k + 1}", a, b) for k in range(n_pairs)]
+    chain_loss = {s: _delta(traj, f"W_loss_{s}", a, b) for chains in by_pair for s, _ in chains}
+    losses = [sum(chain_loss[s] for s, _ in chains) for chains in by_pair]
     # an elastic shaft line: its energy, and what its damping took (0 without one)
     line_loss = _delta(traj, "W_line_loss", a, b)
     if "E_line" in traj:
@@ -193,24 +198,26 @@ def mechanical_efficiency(scene, traj: dict[str, NDArray[np.float64]], events=No
         out["pair_mode_switches_per_cycle"] = (float(np.sum(inside)) / n_cyc, "1")
     sel = (traj["phi"] >= a - 1e-12) & (traj["phi"] <= b + 1e-12)
     out.update(_printed(traj, sel, guard, driven))
-    t, w = traj["t"][sel], traj["omega"][sel]
+    t = traj["t"][sel]
     for k in range(n_pairs):
-        P = traj[f"S_{k + 1}"][sel] * w
-        net = float(np.trapezoid(P, t))
-        gross = float(np.trapezoid(np.abs(P), t))
         out[f"W_loss_{k + 1}_per_cycle"] = (losses[k] / n_cyc, "J")
         out[f"fmep_{k + 1}"] = (losses[k] / n_cyc / v_d, "Pa")
         out[f"loss_share_{k + 1}"] = (losses[k] / W_in if W_in > 0 else math.nan, "1")
-        out[f"W_transmitted_{k + 1}_per_cycle"] = (net / n_cyc, "J")
-        out[f"W_circulated_{k + 1}_per_cycle"] = ((gross - abs(net)) / n_cyc, "J")
-        out[f"backward_share_{k + 1}"] = (_time_share(t, traj[f"eta_{k + 1}"][sel] > 1.0), "1")
-        # A mode against the transmitted power has a negative loss (the paper's criterion can
-        # pick one when inertia drives; the power-flow policy never does).
-        loss = traj[f"P_loss_{k + 1}"][sel]
-        against = loss < -1e-9 * max(float(np.max(np.abs(loss))), 1e-300)
-        out[f"mode_against_power_share_{k + 1}"] = (_time_share(t, against), "1")
-        out[f"mode_against_power_per_cycle_{k + 1}"] = (
-            float(np.count_nonzero(against[1:] & ~against[:-1]) + against[0]) / n_cyc, "1")
+        for s, speed in by_pair[k]:  # (the pair itself; on an elastic line in each throw)
+            P = traj[f"S_{s}"][sel] * traj[speed][sel]
+            net = float(np.trapezoid(P, t))
+            gross = float(np.trapezoid(np.abs(P), t))
+            out[f"W_loss_{s}_per_cycle"] = (chain_loss[s] / n_cyc, "J")
+            out[f"W_transmitted_{s}_per_cycle"] = (net / n_cyc, "J")
+            out[f"W_circulated_{s}_per_cycle"] = ((gross - abs(net)) / n_cyc, "J")
+            out[f"backward_share_{s}"] = (_time_share(t, traj[f"eta_{s}"][sel] > 1.0), "1")
+            # A mode against the transmitted power has a negative loss (the paper's criterion
+            # can pick one when inertia drives; the power-flow policy never does).
+            loss = traj[f"P_loss_{s}"][sel]
+            against = loss < -1e-9 * max(float(np.max(np.abs(loss))), 1e-300)
+            out[f"mode_against_power_share_{s}"] = (_time_share(t, against), "1")
+            out[f"mode_against_power_per_cycle_{s}"] = (
+                float(np.count_nonzero(against[1:] & ~against[:-1]) + against[0]) / n_cyc, "1")
     n_cyl = scene.mechanism.n_cylinders
     out.update(_cylinder_budget(traj, sel, losses, n_cyc, n_cyl, v_d / n_cyl))
     return out

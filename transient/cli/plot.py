@@ -66,7 +66,7 @@ def figures(res, cylinders=None, cycles=None, held=None):
         yield "response", fig
     if scene.friction.pairs:
         fig, ax = plt.subplots(figsize=(9, 4.5))
-        plots.pair_power(ax, traj, [p.name for p in scene.friction.pairs], scene.mechanism.cycle)
+        plots.pair_power(ax, traj, pair_curves(scene), scene.mechanism.cycle)
         ax.set_title(f"{scene.name}: power through the non-ideal pairs ({scene.friction.policy})")
         yield "pairs", fig
     if "fmep_1" in res.analysis:  # the friction budget of the steady cycles
@@ -122,6 +122,17 @@ def figures(res, cylinders=None, cycles=None, held=None):
             yield "heat_release", fig
         else:
             plt.close(fig)
+
+
+def pair_curves(scene) -> list[tuple[str, str, str]]:
+    """(label, columns' suffix, speed column) of each pair's power curves: the pair's name, on
+    an elastic line with the station of each throw it acts in."""
+    from ..scene.outputs import pair_columns
+
+    line = scene.shaft is not None
+    return [(f"{p.name} at {st}" if line else p.name, s, speed)
+            for p, chains in zip(scene.friction.pairs, pair_columns(scene))
+            for st, (s, speed) in zip(scene.shaft.throws if line else [""], chains)]
 
 
 def _has_whole_cycle(scene, traj) -> bool:

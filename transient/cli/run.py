@@ -219,6 +219,13 @@ def pair_names(scene) -> list[str]:
     return [f"pair {k} ({p.name})" for k, p in enumerate(scene.friction.pairs, start=1)]
 
 
+def _pair_flow(v: dict, s: str) -> str:
+    """How the power went through the pair (or the pair in a throw) ``s`` per cycle."""
+    return (f"circulated {v[f'W_circulated_{s}_per_cycle']:.6g} J/cycle, far side driving "
+            f"{100 * v[f'backward_share_{s}']:.3g} % of the time, mode against the power "
+            f"{100 * v[f'mode_against_power_share_{s}']:.3g} % of the time")
+
+
 def _print_efficiency(v: dict, names=()) -> None:
     """η_mech in both forms and each pair's budget per cycle (``analysis.efficiency``), the
     pairs labelled by ``names`` (default: their numbers)."""
@@ -243,12 +250,17 @@ def _print_efficiency(v: dict, names=()) -> None:
     k = 1
     label = dict(enumerate(names, start=1))
     while f"W_loss_{k}_per_cycle" in v:
-        print(f"    {label.get(k, f'pair {k}')}: loss {v[f'W_loss_{k}_per_cycle']:.6g} "
-              f"J/cycle, fmep {v[f'fmep_{k}'] / 1e3:.6g} kPa "
-              f"({100 * v[f'loss_share_{k}']:.4g} % of W_in), circulated "
-              f"{v[f'W_circulated_{k}_per_cycle']:.6g} J/cycle, far side driving "
-              f"{100 * v[f'backward_share_{k}']:.3g} % of the time, mode against the power "
-              f"{100 * v[f'mode_against_power_share_{k}']:.3g} % of the time")
+        head = (f"    {label.get(k, f'pair {k}')}: loss {v[f'W_loss_{k}_per_cycle']:.6g} "
+                f"J/cycle, fmep {v[f'fmep_{k}'] / 1e3:.6g} kPa "
+                f"({100 * v[f'loss_share_{k}']:.4g} % of W_in)")
+        if f"W_circulated_{k}_per_cycle" in v:
+            print(f"{head}, {_pair_flow(v, str(k))}")
+        else:  # an elastic line's pair, in each throw
+            print(f"{head}; in each throw:")
+            for key in (key for key in v if key.startswith(f"W_circulated_{k}_")):
+                s = key[len("W_circulated_"):-len("_per_cycle")]  # "<k>_<station>"
+                print(f"      {s[len(str(k)) + 1:]}: loss {v[f'W_loss_{s}_per_cycle']:.6g} "
+                      f"J/cycle, {_pair_flow(v, s)}")
         k += 1
     if k > 2:
         most = max(range(1, k), key=lambda j: v[f"W_loss_{j}_per_cycle"])

@@ -315,15 +315,13 @@ class TorsionModel:
         line = self.line
         th, w, _, rw, thd, wd = self.split(y)
         J, dJ, Jm = self.station_inertia(th)
-        M_gas = self.gas_moments(th, w, t, y)
-        M_ext = (np.asarray(self.external(th, w, t), dtype=float) if self.external is not None
-                 else np.zeros(line.n))
+        M_gas, M_ext = self.applied_moments(t, y)
         T, T_ring, T_driven, dissipated = self.element_torques(y)
         if line.eta is None:
             acc = (M_gas + M_ext + T - 0.5 * dJ * w * w) / J
             p_pairs = 0.0
         else:
-            acc, p_pairs = self.through_pairs(J - Jm, Jm, dJ, M_ext + T, M_gas, w)
+            acc, p_pairs, _, _ = self.through_pairs(J - Jm, Jm, dJ, M_ext + T, M_gas, w)
         ring_acc = np.array([T_ring[j] / ring.inertia for j, ring in enumerate(line.rings)])
         M_load = 0.0
         driven_acc = 0.0
@@ -334,13 +332,13 @@ class TorsionModel:
         return acc, ring_acc, driven_acc, applied, (*dissipated, p_pairs)
 
     def through_pairs(self, J0: Array, Jm: Array, dJm: Array, M0: Array, Mm: Array,
-                      w: Array) -> tuple[Array, float]:
+                      w: Array) -> tuple[Array, float, Array, Array]:
         """θ̈ per station with a constant-η pair between each station's shaft (J0, the moments
         M0 of sections, elements and loads) and its throw's mechanism (Jm, J′m, the gas moment
         Mm), (T7): (η* J0 + Jm) θ̈ = η* M0 + Mm − ½ J′m ω², with η* = η_fwd where the shaft's
         moment into the pair S = M0 − J0 θ̈ has the sign of ω and 1/η_bwd where it has the
-        other (the power-flow policy, one station at a time); and the pairs' loss
-        Σ (1 − η*) S ω."""
+        other (the power-flow policy, one station at a time); the pairs' loss
+        Σ (1 − η*) S ω, and per station S and η*."""
         assert self.line.eta is not None
         fwd, bwd = (np.asarray(e, dtype=float) for e in self.line.eta)
         sigma = np.where(w >= 0.0, 1.0, -1.0)
@@ -356,7 +354,22 @@ class TorsionModel:
         acc = np.where(backward, a_b, a_f)
         S = np.where(backward, S_b, S_f)
         eta = np.where(backward, 1.0 / bwd, fwd)
-        return acc, float(np.sum((1.0 - eta) * S * w))
+        return acc, float(np.sum((1.0 - eta) * S * w)), S, eta
+
+    def applied_moments(self, t: float, y: Array) -> tuple[Array, Array]:
+        """(M_gas, M_ext) on each station at state ``y``."""
+        th, w = self.split(y)[:2]
+        M_ext = (np.asarray(self.external(th, w, t), dtype=float) if self.external is not None
+                 else np.zeros(self.line.n))
+        return self.gas_moments(th, w, t, y), M_ext
+
+    def pairs_at(self, t: float, y: Array) -> tuple[Array, Array]:
+        """(S, η*) of each station's pair at state ``y`` (:meth:`through_pairs`)."""
+        th, w = self.split(y)[:2]
+        J, dJ, Jm = self.station_inertia(th)
+        M_gas, M_ext = self.applied_moments(t, y)
+        T = self.element_torques(y)[0]
+        return self.through_pairs(J - Jm, Jm, dJ, M_ext + T, M_gas, w)[2:]
 
     def rhs(self, t: float, y: Array) -> Array:
         self.nfev += 1
@@ -713,6 +726,22 @@ class SceneEngine:
         return out
 
 
+def _throw_efficiencies(scene) -> tuple[Array, Array] | None:
+    """Per station the (forward, backward) efficiency of a scene's one constant-η pair
+    ``["shaft", "crank"]`` (power-flow policy) in each station that carries cylinders, 1 on
+    the others; None without pairs."""
+    pairs, friction = scene.friction.pairs, scene.friction
+    if not pairs:
+        return None
+    if (len(pairs) != 1 or tuple(pairs[0].between) != ("shaft", "crank")
+            or pairs[0].model != "constant-eta" or friction.policy != "power-flow"):
+        raise ValueError("from_scene: one constant-η pair [\"shaft\", \"crank\"] under the "
+                         "power-flow policy only")
+    carries = np.array([bool(st.cylinders) for st in scene.shaft.stations])
+    return (np.where(carries, pairs[0].eta_forward, 1.0),
+            np.where(carries, pairs[0].eta_backward, 1.0))
+
+
 # -- the rigid limit ---------------------------------------------------------------------------
 
 def rigid_run(J_rest: float, terms, gas: Callable[[float], float],
@@ -754,9 +783,10 @@ def from_scene(scene) -> tuple[TorsionModel, int]:
     time) acting where ``load_at`` says. What it shares with the compiled path: the scene's
     records, the pressure tables, the load's curve and the sections' viscous c of a loss
     factor or damping ratio (:class:`transient.shaft.line.ShaftLine`, which needs the line's
-    ω₁). A starter,
-    generator, schedule, a force model of the gas or a mechanism other than the crank-slider is
-    beyond it (ValueError)."""
+    ω₁); a constant-η pair between the shaft and the crank, under the power-flow policy, in each
+    station that carries cylinders (:meth:`TorsionModel.through_pairs`). A starter,
+    generator, schedule, a force model of the gas, other pairs or a mechanism other than the
+    crank-slider is beyond it (ValueError)."""
     from ..assemble import load_table_curve
     from ..shaft import ShaftLine as CompiledLine
 
@@ -781,7 +811,8 @@ def from_scene(scene) -> tuple[TorsionModel, int]:
     line = ShaftLine(inertia=np.array([st.inertia for st in shaft.stations]),
                      stiffness=np.array([s.stiffness for s in shaft.sections]),
                      damping=c_sections, absolute=np.array([st.damping for st in shaft.stations]),
-                     station_of_cylinder=carrier, rings=rings, coupling=coupling)
+                     station_of_cylinder=carrier, rings=rings, coupling=coupling,
+                     eta=_throw_efficiencies(scene))
     ref = names.index(shaft.reference)
     cylinders = CrankSliderCylinders(mech)
     engine = SceneEngine(scene, cylinders, carrier, ref) if scene.gas.model != "none" else None

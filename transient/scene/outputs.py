@@ -20,9 +20,9 @@ def output_columns(scene) -> dict[str, str]:
     for k in range(scene.mechanism.n_cylinders):
         # p_k: cylinder pressure, or the force per piston for force-pulse models
         cols[f"p_{k + 1}"] = "N" if gas_is_force(scene) else "Pa"
-    for k in range(len(scene.friction.pairs)):
+    for suffix in pair_suffixes(scene):
         for name, unit in zip(PAIR_OUTPUTS, PAIR_OUTPUT_UNITS):
-            cols[f"{name}_{k + 1}"] = unit
+            cols[f"{name}_{suffix}"] = unit
     kind = governor_kind(scene.governor)
     cols.update(zip(gv.STATE_NAMES[kind], gv.STATE_UNITS[kind]))
     if scene.gas.injection is not None:  # the fuel each cylinder latched at its last injection
@@ -48,6 +48,27 @@ def column_name(name: str) -> str:
     """A shaft-line dof's name as part of a column's: each run of characters other than
     letters, digits and ``_`` one ``_`` (``"throw 1"`` → ``throw_1``)."""
     return re.sub(r"\W+", "_", name).strip("_")
+
+
+def pair_columns(scene) -> list[list[tuple[str, str]]]:
+    """Per non-ideal pair, the (suffix, speed column) of each of its sets of columns
+    ``S_<suffix>``, ``eta_<suffix>``, ``P_loss_<suffix>``, ``W_loss_<suffix>``, with the column of
+    the speed its chain turns at: pair k's one set ``"<k>"`` at ``omega``; on an elastic line
+    one in each station that carries cylinders (:attr:`~transient.scene.records.Shaft.throws`),
+    ``"<k>_<station>"`` at ``omega_<station>``."""
+    n = len(scene.friction.pairs)
+    if scene.shaft is None:
+        return [[(f"{k + 1}", "omega")] for k in range(n)]
+    return [[(f"{k + 1}_{column_name(st)}", f"omega_{column_name(st)}")
+             for st in scene.shaft.throws] for k in range(n)]
+
+
+def pair_suffixes(scene) -> list[str]:
+    """The suffixes of :func:`pair_columns` in the order the run writes them: pair by pair, on
+    an elastic line station by station (each station's pairs together)."""
+    by_pair = pair_columns(scene)
+    return [by_pair[k][c][0] for c in range(len(by_pair[0]) if by_pair else 0)
+            for k in range(len(by_pair))]
 
 
 def cylinder_loss_column(pair: int, cylinder: int) -> str:
@@ -81,6 +102,16 @@ DESCRIPTIONS = {
                "1/η_backward (> 1) when it flows back",
     "P_loss_{k}": "power lost in pair {k}, (1 − eta_{k})·S_{k}·ω",
     "W_loss_{k}": "energy lost in pair {k} since the start, ∫P_loss_{k} dt",
+    "S_{k}_{d}": "moment that non-ideal pair {k} takes from its shaft side in the throw of "
+                 "shaft-line station {d}, reduced to the station's angle; the far side receives "
+                 "eta_{k}_{d}·S_{k}_{d} (elastic [shaft])",
+    "eta_{k}_{d}": "efficiency in use in pair {k} of station {d}: η_forward (< 1) when power "
+                   "flows forward through it, 1/η_backward (> 1) when it flows back (elastic "
+                   "[shaft])",
+    "P_loss_{k}_{d}": "power lost in pair {k} of station {d}, (1 − eta_{k}_{d})·S_{k}_{d}·"
+                      "omega_{d} (elastic [shaft])",
+    "W_loss_{k}_{d}": "energy lost in pair {k} of station {d} since the start, "
+                      "∫P_loss_{k}_{d} dt (elastic [shaft])",
     "P_loss_{k}_cyl{c}": "power lost in reaction pair {k} at the joints of cylinder {c}; over "
                          "the cylinders it sums to P_loss_{k}",
     "gov_integral": "the PI(D) governor's integral state",
@@ -111,6 +142,10 @@ def describe(column: str) -> str:
     if split:
         k, c = split.groups()
         return DESCRIPTIONS["P_loss_{k}_cyl{c}"].replace("{k}", k).replace("{c}", c)
+    throw = re.fullmatch(r"(S|eta|P_loss|W_loss)_(\d+)_(\w+)", column)
+    if throw:
+        name, k, d = throw.groups()
+        return DESCRIPTIONS[f"{name}_{{k}}_{{d}}"].replace("{k}", k).replace("{d}", d)
     for prefix, pattern in (("twist_", "twist_{d}"), ("omega_", "omega_{d}")):
         if column.startswith(prefix):
             return DESCRIPTIONS[pattern].replace("{d}", column[len(prefix):])

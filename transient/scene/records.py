@@ -524,6 +524,13 @@ class Pair:
     – ``cylinder`` (its ball joints, ``["link", "rod"]`` and ``["rod", "piston"]``, stay ideal),
     the articulated mechanism's joints by their links. ``eta_forward`` = η_ba, the efficiency
     while a (the shaft side) drives; ``eta_backward`` = η_ab, while b drives; both in (0, 1] [1].
+
+    On an elastic ``[shaft]`` line each pair acts in every station that carries cylinders, in
+    that throw's chain (theory, (T7)): its ``shaft`` is the station's own inertia, which the
+    sections, dampers and the load there act on, and its other links are the parts of the
+    station's cylinders. A one-pair ``["shaft", "crank"]`` is then the main bearing of every
+    throw, each with its own mode and its own columns (``S_<k>_<station>``, …); constant-eta
+    and table pairs, not the reaction model.
     """
 
     between: tuple[str, str]
@@ -565,7 +572,10 @@ class Friction:
     """Non-ideal pairs and how their modes are chosen (``transient.core.model.chain``).
 
     ``policy``: ``"power-flow"`` (each pair's mode agrees with the power it transmits) or
-    ``"paper"`` (criterion (25), the sign of the shaft-side moments' power).
+    ``"paper"`` (criterion (25), the sign of the shaft-side moments' power). On an elastic
+    ``[shaft]`` line each throw's pairs follow the power they transmit at the station's own
+    speed (``"power-flow"`` only: a throw's shaft side carries the sections' torques, which
+    criterion (25) would count as applied moments).
     """
 
     policy: str = "power-flow"
@@ -728,6 +738,13 @@ class Shaft:
         driven = self.coupling.referred_inertia if self.coupling else 0.0
         return (sum(s.inertia for s in self.stations) + sum(d.inertia for d in self.dampers)
                 + driven)
+
+    @property
+    def throws(self) -> tuple[str, ...]:
+        """The names of the stations that carry cylinders, in order: on each, its cylinders'
+        mechanism is a chain of the non-ideal pairs of its own (``[[friction.pairs]]``,
+        theory (T7))."""
+        return tuple(s.name for s in self.stations if s.cylinders)
 
     def station_index(self, name: str) -> int:
         """The position (0-based) of the station called ``name``."""

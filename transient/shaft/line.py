@@ -30,6 +30,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
+from ..core.model.layout import MAX_MARGINS
 from ..errors import SceneError
 from ..mechanisms import CylinderInertia, provides
 from ..scene.records import COMPILED_METHODS, Inertia, Scene, Shaft
@@ -212,7 +213,20 @@ def _lowest_elastic(K, M_diag, rigid: int) -> float:
 #: What the elastic run does not support yet: (the scene's key, whether the scene uses it, what
 #: to do instead). Each is refused before any work (:func:`refuse_elastic_run`).
 UNSUPPORTED = (
-    ("friction.pairs", lambda s: bool(s.friction.pairs), "leave out [[friction.pairs]]"),
+    ("friction.pairs", lambda s: any(p.model == "reaction" for p in s.friction.pairs),
+     "friction on the joints' reactions per throw is not available yet: give these pairs "
+     "constant efficiencies (eta_forward, eta_backward) or mapped ones (model = \"table\")"),
+    ("friction.pairs", lambda s: len(s.friction.pairs) * len(s.shaft.throws) > MAX_MARGINS,
+     f"every pair acts in every station that carries cylinders, each with a mode of its own, "
+     f"and a line holds at most {MAX_MARGINS} such modes: give fewer pairs, or fewer stations "
+     f"with cylinders"),
+    ("friction.policy", lambda s: bool(s.friction.pairs) and s.friction.policy == "paper",
+     "on a throw the paper's criterion (25) would count the sections' torques among the moments "
+     "applied on a pair's shaft side: use \"power-flow\", whose modes follow the power each "
+     "pair transmits"),
+    ("initial.omega", lambda s: bool(s.friction.pairs) and s.initial.omega == 0.0,
+     "from rest with [[friction.pairs]] a throw whose pairs' friction holds it would need a "
+     "stuck state of its own: start the line turning (initial omega ≠ 0)"),
     ("load.table", lambda s: s.load.table is not None and s.load.table.abscissa == "angle"
      and s.shaft.load_at != s.shaft.reference,
      "a load tabulated against the angle acts at the reference station only (its angle is the "

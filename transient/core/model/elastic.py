@@ -26,6 +26,7 @@ import numpy as np
 from ..jit import kernel
 from . import cylinder as cyl
 from . import governor as gv
+from .chain import UNIQUE
 from .forcing import command, cylinder_value, governor_rates, load_moment, shifted, starter_moment
 from .layout import (
     EL_C,
@@ -66,8 +67,12 @@ from .layout import (
     line_dofs,
     line_loss_index,
 )
+from .line_pairs import throw_chains, throw_loss_rates, throw_modes, throw_pair_rows
 from .outputs import governor_rows
 from .shaft import (
+    LINE_MODES,
+    LINE_RATES,
+    LINE_ROW,
     line_accelerations,
     line_angle_rates,
     line_inertias,
@@ -80,14 +85,29 @@ from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
-def elastic_model(m, row, angle_mode, y, sw, wk, out):
-    """``Model.line_model``: the output row at ``y`` into ``out`` (``row``) or the derivative
-    (:func:`elastic_rates`); True, the rigid model's own left undone."""
-    if row:
-        elastic_row(m, angle_mode, y, sw, wk, out)
-    else:
-        elastic_rates(m, angle_mode, y, sw, wk, out)
-    return True
+def elastic_model(m, extras, what, angle_mode, y, sw, wk, out):
+    """``Model.line_model``: the derivative (:func:`elastic_rates`) or the output row at ``y``
+    into ``out``, or the non-ideal pairs' margins or modes chosen afresh (``what``:
+    ``shaft.LINE_RATES`` …, the pairs' :mod:`.line_pairs`); the status of what it did
+    (``chain.UNIQUE``, the modes' status), the rigid model's own left undone."""
+    if what == LINE_ROW:
+        elastic_row(m, extras, angle_mode, y, sw, wk, out)
+    elif what == LINE_RATES:
+        elastic_rates(m, extras, angle_mode, y, sw, wk, out)
+    elif extras is not None:
+        return pairs_at(m, what, angle_mode, y, sw, wk)
+    return UNIQUE
+
+
+@kernel
+def pairs_at(m, what, angle_mode, y, sw, wk):
+    """The non-ideal pairs' margins (``shaft.LINE_MARGINS``) or modes chosen afresh
+    (``LINE_MODES``) at ``y``, each throw's chain's (:mod:`.line_pairs`); the status."""
+    _, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk, True)
+    if what == LINE_MODES:
+        return throw_modes(m, M_load, M_starter, sw, wk)
+    throw_chains(m, M_load, M_starter, sw, wk)
+    return UNIQUE
 
 
 @kernel(inline=True)
@@ -197,13 +217,18 @@ def line_at(m, angle_mode, y, sw, wk, with_dJ):
 
 
 @kernel(inline=True)
-def elastic_rates(m, angle_mode, y, sw, wk, out):
+def elastic_rates(m, extras, angle_mode, y, sw, wk, out):
     """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
-    form of :func:`.rhs.derivative`."""
+    form of :func:`.rhs.derivative`; with non-ideal pairs each throw's chain (T7)."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    # (in crank angle the rates are the work–energy law's, (T5): no J′_d)
-    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sw, wk, not angle_mode)
+    pairs = extras is not None and m.n_pairs > 0
+    # (in crank angle the rates are the work–energy law's, (T5): no J′_d, unless the throws'
+    # chains split their moments, (T7))
+    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sw, wk,
+                                                     pairs or not angle_mode)
+    if pairs:
+        throw_chains(m, M_load, M_starter, sw, wk)
     w = wk[WK_LINE_OMEGA, :n]
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
@@ -234,6 +259,8 @@ def elastic_rates(m, angle_mode, y, sw, wk, out):
     out[W_LOAD] = M_load * w[int(m.line[0, LM_LOAD])] * q
     out[W_STARTER] = M_starter * w_ref * q
     out[line_loss_index(m)] = taken * q
+    if extras is not None and m.n_pairs > 0:
+        throw_loss_rates(m, q, wk, out)
     if m.gov_dyn != gv.NONE or m.latch:  # the reference's speed drives the governor
         governor_rates(m, w_ref, y, q, sw, wk, out)
     if m.woschni:
@@ -253,7 +280,7 @@ def pressure_rates(m, y, sw, w, q, wk, out):
 
 
 @kernel
-def elastic_row(m, angle_mode, y, sw, wk, row):
+def elastic_row(m, extras, angle_mode, y, sw, wk, row):
     """An elastic scene's output row: the fixed columns of the reference
     dof (ω, ε, J, J′ its own; M_gas all cylinders', M_load at its dof), each cylinder's
     pressure at its own angle, then per dof its twist θ_d − φ and speed, per element its torque
@@ -262,6 +289,8 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
     M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk, True)
+    if extras is not None and m.n_pairs > 0:
+        throw_chains(m, M_load, M_starter, sw, wk)
     acc = wk[WK_LINE_RATE, :n]
     line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                        wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)
@@ -285,6 +314,8 @@ def elastic_row(m, angle_mode, y, sw, wk, row):
         row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, theta, y, cylinder_fuel(m, c, theta, y, f),
                                                   wk) if m.has_gas else 0.0)
     governor_rows(m, y, row)
+    if extras is not None and m.n_pairs > 0:
+        throw_pair_rows(m, y, wk, row)
     k = line_col(m)
     energy = 0.0
     for d in range(n):

@@ -146,6 +146,6 @@ def inverse_dynamics(m, extras, t, phi, omega, eps, rows, M_drive, n_consistent)
         else:
             split_subchains(m, phi[i], J, dJ, M_gas, M_load, wk)
             M_drive[i], n_consistent[i] = inverse_chain(m, eps[i], w, sigma, wk)
-        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, pair_col(m):])
+        pair_rows(m, w, 0, y[W_LOSS0: W_LOSS0 + n], wk, rows[i, pair_col(m):])
         if m.reaction:
             cylinder_loss_rows(m, w, wk, rows[i, cylinder_loss_col(m):])

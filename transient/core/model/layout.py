@@ -24,9 +24,18 @@ from . import governor as gv
 
 
 @kernel(inline=True)
+def n_margins(m):
+    """The pairs' modes, each a switch with its margin and its energy lost: one per non-ideal
+    pair in each chain the pairs act in, the machine on a rigid shaft, each station carrying
+    cylinders on an elastic line (``line`` :data:`LM_CHAINS`; theory, (T7)). Chain c's pair k
+    is number c·n_pairs + k."""
+    return m.n_pairs * int(m.line[0, LM_CHAINS])
+
+
+@kernel(inline=True)
 def n_losses(m):
-    """The state's energies lost: one per non-ideal pair."""
-    return m.n_pairs
+    """The state's energies lost: one per non-ideal pair in each chain (:func:`n_margins`)."""
+    return n_margins(m)
 
 
 @kernel(inline=True)
@@ -52,19 +61,25 @@ def n_pressures(m):
 ELEMENT = Layout("element", "i", "j", "stiffness", "damping", "ratio")
 EL_I, EL_J, EL_K, EL_C, EL_R = ELEMENT
 N_ELEMENT = ELEMENT.size
-#: The Model's ``line``, the elastic shaft line packed in one array of N_ELEMENT columns: row 0
-#: these counts and indices; then a row per cylinder, the dof that carries it in column 0; a
-#: row per dof (:data:`LINE_DOF`); a row per element (:data:`ELEMENT`). A rigid shaft's is one
-#: row of zeros: no dofs.
-LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylinders")
-LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS = LINE_META
+#: The Model's ``line``, the elastic shaft line packed in one array of N_LINE_COLUMNS columns:
+#: row 0 these counts and indices; then a row per cylinder, the dof that carries it in column 0;
+#: a row per dof (:data:`LINE_DOF`); a row per element (:data:`ELEMENT`). ``chains``: the chains
+#: the non-ideal pairs act in, each with its own modes (:func:`n_margins`), the stations that
+#: carry cylinders. A rigid shaft's is one row of zeros but one chain, the whole machine: no
+#: dofs.
+LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylinders", "chains")
+LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS, LM_CHAINS = LINE_META
 #: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
-#: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad]
-#: and its gear ratio to the reference [1]: 1 for every dof of a scene's line, whose driven
-#: inertia is referred to the shaft (:class:`transient.shaft.line.ShaftLine`), so that its angle is
-#: φ + q_d.
-LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear")
-LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR = LINE_DOF
+#: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad],
+#: its gear ratio to the reference [1] (1 for every dof of a scene's line, whose driven inertia
+#: is referred to the shaft, :class:`transient.shaft.line.ShaftLine`, so that its angle is
+#: φ + q_d), the chain of the pairs it carries (its cylinders' throw; −1 on a dof without
+#: cylinders) and its share of the cylinders, which is its share of the links' constant
+#: inertias (``Model.link_J``) [1].
+LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear", "chain", "share")
+LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR, LD_CHAIN, LD_SHARE = LINE_DOF
+#: Columns of the Model's packed ``line``: enough for each of its kinds of row.
+N_LINE_COLUMNS = max(LINE_META.size, LINE_DOF.size, N_ELEMENT)
 
 
 @kernel(inline=True)
@@ -119,7 +134,7 @@ STATE = Layout(
     Block("t", 1, "time t [s]"),
     Block("omega", 1, "shaft speed ω [rad/s] in time; kinetic energy K = ½Jω² [J] in crank angle"),
     Block("work", 3, "work of the gas forces, of the load, of the starter [J]"),
-    Block("loss", Sized(n_losses, "one per non-ideal pair"),
+    Block("loss", Sized(n_losses, "one per non-ideal pair (per pair and throw on a line)"),
           "energy lost in each non-ideal pair [J]"),
     Block("governor", Sized(n_governor_states, "the governor's states"),
           "the dynamic governor's states (governor.STATE_NAMES)"),
@@ -176,10 +191,14 @@ def periodic_states(m) -> np.ndarray:
                            if PERIODIC[b.name]]).astype(np.int64)
 
 
+#: The most modes of non-ideal pairs a Model may have (:func:`n_margins`): each a bit of the
+#: switch ``modes``, an int64.
+MAX_MARGINS = 62
 #: Discrete switches held constant over a step (an int array ``sw``, the first block of the
 #: stepper's integer state, ``stepper.io.INTS``): starter engaged (0/1), the governor's branch
 #: (see :func:`.forcing.governor_branch`), the modes of the non-ideal pairs (bit k set: pair k
-#: backward, its far side drives), the direction of motion σ = ±1 that the pair modes refer to
+#: backward, its far side drives; on an elastic line bit c·n_pairs + k for pair k of chain c,
+#: :func:`n_margins`), the direction of motion σ = ±1 that the pair modes refer to
 #: (sign of ω; changed only at a speed reversal, where the modes are chosen afresh), the segment
 #: of the load schedule (:func:`.forcing.load_segment`) and the generator's low-speed branch
 #: (:func:`.forcing.generator_branch`), the flyweight governor's sleeve, moving or on a stop
@@ -227,8 +246,8 @@ def n_gas_columns(m):
 
 @kernel(inline=True)
 def n_pair_columns(m):
-    """The output row's PAIR_OUTPUTS of every non-ideal pair."""
-    return len(PAIR_OUTPUTS) * m.n_pairs
+    """The output row's PAIR_OUTPUTS of every non-ideal pair (in each chain, :func:`n_margins`)."""
+    return len(PAIR_OUTPUTS) * n_margins(m)
 
 
 @kernel(inline=True)
@@ -268,7 +287,8 @@ OUTPUT = Layout(
 O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS, O_LINE = range(len(OUTPUT))
 
 #: Rows of the work array ``wk`` (:func:`.work.work_array`), one column per cylinder, pair or link:
-#: transfer functions u, u′ per cylinder; per sub-chain J_k, J′_k, M_k; per pair η*_k, S_k, the
+#: transfer functions u, u′ per cylinder; per sub-chain J_k, J′_k, M_k (on an elastic line of
+#: the chain being solved); per pair (per pair and chain, :func:`n_margins`) η*_k, S_k, the
 #: mode margins g_k, their least value over the right-hand sides evaluated since the stepper
 #: reset it, and η*, S of a trial mode vector; the least and largest speed ω over those
 #: right-hand sides ([0], [1] of WK_SPEED), and of the PI governor's demand u (WK_DEMAND); per
@@ -416,10 +436,10 @@ Model = namedtuple(
         "et_min",  # float64[n_pairs]: the least η of pair k's two maps [1]
         # the elastic shaft line (transient.shaft.ShaftLine; theory, The elastic shaft line),
         # packed in one array, with its kernels as fields so that a rigid shaft's stepper, whose
-        # line is a row of zeros (no dofs) and whose kernels are no-ops, compiles none of them
-        "line",  # float64[rows, N_ELEMENT]: the line packed (LINE_META, LINE_DOF, ELEMENT)
+        # line has no dofs and whose kernels are no-ops, compiles none of them
+        "line",  # float64[rows, N_LINE_COLUMNS]: the line packed (LINE_META, LINE_DOF, ELEMENT)
         "shares",  # kernel: the mechanism's shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ)
-        "line_model",  # kernel: the line's derivative or output row; True if it did them
+        "line_model",  # kernel: the line's derivative, output row, pairs' margins or modes
         "line_switch",  # kernel: each other dof's speed state to K_d or back (m, y, to_angle, wk)
         "reference_inertia",  # kernel: J of the third state's K = ½Jω² at φ (m, phi, wk)
     ],

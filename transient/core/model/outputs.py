@@ -32,6 +32,7 @@ from .layout import (
 )
 from .reactions import loss_moment
 from .rhs import acceleration
+from .shaft import LINE_ROW, NOT_A_LINE
 from .variation import PRESSURE
 
 
@@ -50,7 +51,7 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
     samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample.
     An elastic shaft line writes its own row (``Model.line_model``, :mod:`.elastic`)."""
-    if m.line_model(m, True, angle_mode, y, sw, wk, row):
+    if m.line_model(m, extras, LINE_ROW, angle_mode, y, sw, wk, row) != NOT_A_LINE:
         return
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     row[0] = y[T]
@@ -78,7 +79,7 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
             p_k = m.gas_offset + beta * (p_k - m.gas_offset)
         row[N_OUT_FIXED + k] = p_k
     if extras is not None:
-        pair_rows(m, w, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[pair_col(m):])
+        pair_rows(m, w, 0, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[pair_col(m):])
     governor_rows(m, y, row)
     if extras is not None and m.reaction:
         cylinder_loss_rows(m, w, wk, row[cylinder_loss_col(m):])
@@ -103,15 +104,17 @@ def cylinder_loss_rows(m, w, wk, out):
 
 
 @kernel(inline=True)
-def pair_rows(m, w, w_loss, wk, out):
-    """``PAIR_OUTPUTS`` of each pair from the rows η*, S of ``wk`` (with reaction friction its
-    loss moment, :mod:`.reactions`); ``w_loss``: energy lost so far."""
+def pair_rows(m, w, first, w_loss, wk, out):
+    """``PAIR_OUTPUTS`` of the pairs ``first`` … ``first`` + n_pairs − 1 (a chain's, turning at
+    ω = ``w``: the machine's, or on an elastic line a throw's, ``layout.n_margins``) from the
+    rows η*, S of ``wk`` (with reaction friction its loss moment, :mod:`.reactions`);
+    ``w_loss``: every pair's energy lost so far."""
     np_ = len(PAIR_OUTPUTS)
-    for k in range(m.n_pairs):
-        out[np_ * k] = wk[WK_S, k]
-        out[np_ * k + 1] = wk[WK_ETA, k]
+    for j in range(first, first + m.n_pairs):
+        out[np_ * j] = wk[WK_S, j]
+        out[np_ * j + 1] = wk[WK_ETA, j]
         if m.reaction:
-            out[np_ * k + 2] = loss_moment(wk, k) * w
+            out[np_ * j + 2] = loss_moment(wk, j) * w
         else:
-            out[np_ * k + 2] = (1.0 - wk[WK_ETA, k]) * wk[WK_S, k] * w
-        out[np_ * k + 3] = w_loss[k]
+            out[np_ * j + 2] = (1.0 - wk[WK_ETA, j]) * wk[WK_S, j] * w
+        out[np_ * j + 3] = w_loss[j]

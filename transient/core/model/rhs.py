@@ -45,21 +45,33 @@ from .layout import (
     WK_U,
     T,
 )
+from .shaft import LINE_MARGINS, LINE_MODES, LINE_RATES, NOT_A_LINE
 from .swash_plate import link_terms as swash_link_terms
 
 
 @kernel(inline=True)
 def split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk):
-    """J_k, J′_k and M_k of every sub-chain into ``wk`` (docs/theory.md, The serial chain;
-    :mod:`transient.core.model.chain`).
+    """J_k, J′_k and M_k of every sub-chain of the machine into ``wk`` (docs/theory.md, The
+    serial chain; :mod:`transient.core.model.chain`): :func:`split_chain` of its whole J(φ),
+    its shaft link J0 and every cylinder."""
+    split_chain(m, phi, J, dJ, M_gas, M_shaft, m.J0, 1.0, wk[WK_U, :m.ncyl],
+                wk[WK_DU, :m.ncyl], wk)
+
+
+@kernel(inline=True)
+def split_chain(m, phi, J, dJ, M_gas, M_shaft, J_shaft, share, u, du, wk):
+    """J_k, J′_k and M_k of every sub-chain of a chain into ``wk``: the machine's, or on an
+    elastic line a throw's (:mod:`.line_pairs`), of inertia J(φ), J′(φ) with ``J_shaft`` on its
+    shaft link, ``share`` of the constant links' inertias and the transfer functions ``u``,
+    ``u′`` of its cylinders.
 
     Links in order (the mechanism's ``links``): the shaft (J0 with flywheel and load; load and
-    starter act on it), links of constant reduced inertia ``link_J`` (the crank), the link
-    ``link_rest`` with what J(φ) holds beyond the others (the rods), and last the cylinders,
-    whose gas forces do their work on the pistons through the pistons' pair with them. A link
-    whose inertia varies with φ (the pistons, the swash plate's link 9) has it computed on its
-    own only where a pair cuts it from ``link_rest`` (``link_own``); elsewhere it is in the rest.
-    Links between ideal pairs share a sub-chain.
+    starter act on it, ``M_shaft``), links of constant reduced inertia ``link_J`` (the crank),
+    the link ``link_rest`` with what J(φ) holds beyond the others (the rods), and last the
+    cylinders, whose gas forces (``M_gas``) do their work on the pistons through the pistons'
+    pair with them. A link whose inertia varies with φ (the pistons, the swash plate's link 9)
+    has it computed on its own only where a pair cuts it from ``link_rest`` (``link_own``);
+    elsewhere it is in the rest. Links between ideal pairs share a sub-chain.
     """
     for k in range(m.n_pairs + 1):
         wk[WK_J, k] = 0.0
@@ -69,12 +81,11 @@ def split_subchains(m, phi, J, dJ, M_gas, M_shaft, wk):
     J_rest = J
     dJ_rest = dJ
     for i in range(last + 1):
-        c = m.J0 if i == 0 else m.link_J[i]
+        c = J_shaft if i == 0 else share * m.link_J[i]
         wk[WK_J, m.link_sub[i]] += c
         J_rest -= c
         if m.link_own[i] != LINK_FIXED:
-            J_i, dJ_i = own_inertia(m.link_own[i], m.link_mass[i], m.mech, phi,
-                                    wk[WK_U, :m.ncyl], wk[WK_DU, :m.ncyl])
+            J_i, dJ_i = own_inertia(m.link_own[i], m.link_mass[i], m.mech, phi, u, du)
             wk[WK_J, m.link_sub[i]] += J_i
             wk[WK_DJ, m.link_sub[i]] += dJ_i
             J_rest -= J_i
@@ -152,9 +163,9 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     ``extras``: the kernels' variant for ``m`` (:func:`.layout.extras_of`), as for every kernel
     that reaches a feature only some scenes use. An elastic shaft line's state has its own
     derivative (``Model.line_model``, :mod:`.elastic`; in a rigid scene's Model a kernel that
-    returns False, a constant the compiler folds: the rigid path tests nothing at run time).
+    returns NOT_A_LINE, a constant the compiler folds: the rigid path tests nothing at run time).
     """
-    if m.line_model(m, False, angle_mode, y, sw, wk, out):
+    if m.line_model(m, extras, LINE_RATES, angle_mode, y, sw, wk, out) != NOT_A_LINE:
         return
     # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
     with_dJ = not angle_mode or (extras is not None and m.n_pairs > 0)
@@ -263,6 +274,8 @@ def margins_inline(m, extras, angle_mode, y, sel, sw, wk):
     """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``; inlined into the
     stepper's root finder, whose iterations evaluate them most: there a call would copy the Model
     at every iteration."""
+    if m.line_model(m, extras, LINE_MARGINS, angle_mode, y, sw, wk, wk[WK_G]) != NOT_A_LINE:
+        return  # (an elastic line's chains, one per throw)
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     acceleration(m, extras, y[PHI], J, dJ, w, M_gas, M_load, M_starter, sw, wk)
     mode_margins(m, sw, wk)
@@ -284,8 +297,13 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
     σ is the direction the chain starts to move in; if the pairs' friction holds the applied
     moments in both directions the chain is locked. Sets ``sw[SW_DIRECTION]`` and
     ``sw[SW_MODES]``. Returns the status of ``chain.modes_power_flow``: UNIQUE, LOCKED, or (a
-    rounding tie S_k ≈ 0, resolved by its documented rule) AMBIGUOUS or NONE_CONSISTENT.
+    rounding tie S_k ≈ 0, resolved by its documented rule) AMBIGUOUS or NONE_CONSISTENT. On an
+    elastic line each throw's chain chooses its own (``Model.line_model``, :mod:`.line_pairs`).
     """
+    if extras is not None and m.n_pairs > 0:
+        status = m.line_model(m, extras, LINE_MODES, angle_mode, y, sw, wk, wk[WK_G])
+        if status != NOT_A_LINE:
+            return status
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     n = m.n_pairs
     if extras is None or n == 0:
@@ -299,7 +317,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         return status
     split_subchains(m, y[PHI], J, dJ, M_gas, M_load + M_starter, wk)
     if m.eta_table:
-        a, status = _table_modes(m, w, wk)
+        a, status = table_modes(m, w, wk, wk[WK_ETA, :n], wk[WK_S, :n])
     else:
         a, status, _ = modes_power_flow_into(wk[WK_J, : n + 1], wk[WK_DJ, : n + 1],
                                              wk[WK_M, : n + 1], m.eta_fwd, m.eta_bwd, w,
@@ -311,7 +329,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
         sw[SW_DIRECTION] = 1 if w > 0.0 else -1
     else:
         sw[SW_DIRECTION] = 1 if a > 0.0 else -1
-    sw[SW_MODES] = _mode_mask(m, sw[SW_DIRECTION], wk)
+    sw[SW_MODES] = mode_mask(m, sw[SW_DIRECTION], wk[WK_ETA, :n], wk[WK_S, :n], wk)
     return status
 
 
@@ -325,22 +343,23 @@ def release(m, extras, y, sel, sw, wk):
     sigma = st.release_direction(m, J, M_gas, M_load + M_starter, wk)
     sw[SW_DIRECTION] = 1 if sigma > 0.0 else -1
     sw[SW_MODES] = (rx.mode_mask(m, sigma, wk) if m.reaction
-                    else _mode_mask(m, sw[SW_DIRECTION], wk))
+                    else mode_mask(m, sw[SW_DIRECTION], wk[WK_ETA], wk[WK_S], wk))
 
 
 @kernel
-def _mode_mask(m, sigma, wk):
-    """The pairs' mode bits (bit k set: pair k backward) in direction σ from the η* the chain's
-    solve left in ``wk``: ``power-flow`` its modes, ``paper`` criterion (25)."""
+def mode_mask(m, sigma, eta, S, wk):
+    """The pairs' mode bits (bit k set: pair k backward) in direction σ from the η* and S that
+    the chain's solve left in ``eta``, ``S`` (its sub-chains in ``wk``): ``power-flow`` its
+    modes, ``paper`` criterion (25)."""
     n = m.n_pairs
     modes = 0
     upstream = 0.0
     for k in range(n):
         upstream += wk[WK_M, k]
         if m.policy == POWER_FLOW and m.eta_table:
-            backward = wk[WK_S, k] * sigma < 0.0
+            backward = S[k] * sigma < 0.0
         elif m.policy == POWER_FLOW:
-            backward = wk[WK_ETA, k] != m.eta_fwd[k]
+            backward = eta[k] != m.eta_fwd[k]
         else:
             backward = upstream * sigma < 0.0
         if backward:
@@ -349,24 +368,24 @@ def _mode_mask(m, sigma, wk):
 
 
 @kernel
-def _table_modes(m, w, wk):
+def table_modes(m, w, wk, eta, S):
     """(φ̈, status) with mapped efficiencies and every pair's mode given by its transmitted power
     (``eta_table.solve_auto``, unique for ω ≠ 0); at rest the incipient motion decides, as in
     ``chain.modes_power_flow``: σ = +1 if it accelerates forward, σ = −1 if backward, else
-    locked. Fills the rows η*, S of ``wk``."""
+    locked. The sub-chains from the rows of ``wk``; fills η*, S into ``eta``, ``S``."""
     n = m.n_pairs
     J, dJ, M = wk[WK_J, : n + 1], wk[WK_DJ, : n + 1], wk[WK_M, : n + 1]
     sigma = -1.0 if w < 0.0 else 1.0
     a = et.solve_auto(J, dJ, M, w, sigma, m.et_speed, m.et_torque, m.et_size, m.et_eta,
-                      m.et_min, wk[WK_ETA, :n], wk[WK_S, :n])
+                      m.et_min, eta, S)
     if w != 0.0 or a > 0.0:
         return a, UNIQUE
     a = et.solve_auto(J, dJ, M, w, -1.0, m.et_speed, m.et_torque, m.et_size, m.et_eta,
-                      m.et_min, wk[WK_ETA, :n], wk[WK_S, :n])
+                      m.et_min, eta, S)
     if a < 0.0:
         return a, UNIQUE
     for k in range(n):  # held by the pairs' friction (``chain.modes_power_flow``)
-        wk[WK_ETA, k] = np.nan
-        wk[WK_S, k] = np.nan
-    wk[WK_S, 0] = wk[WK_M, 0]
+        eta[k] = np.nan
+        S[k] = np.nan
+    S[0] = wk[WK_M, 0]
     return 0.0, LOCKED

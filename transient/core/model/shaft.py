@@ -25,12 +25,18 @@ from .layout import (
     EL_J,
     EL_K,
     EL_R,
+    LD_CHAIN,
     LD_OWN,
+    LD_SHARE,
+    LINE_DOF,
+    LINE_META,
+    LM_CHAINS,
     LM_CYLINDERS,
     LM_DOFS,
     LM_ELEMENTS,
     LM_REF,
     N_ELEMENT,
+    N_LINE_COLUMNS,
     PHI,
     WK_CYL_ANGLE,
     WK_CYL_DJ,
@@ -47,21 +53,39 @@ from .layout import (
 
 def pack_line(ref: int, load: int, carrier, dofs, elements) -> np.ndarray:
     """The Model's ``line`` (:data:`.layout.LINE_META`): the reference's and the load's dof, the
-    dof of each cylinder (``carrier``), the rows of the dofs (``dofs``, :data:`.layout.LINE_DOF`)
-    and of the elements (:data:`.layout.ELEMENT`)."""
-    carrier = np.asarray(carrier, dtype=float)
+    dof of each cylinder (``carrier``), the rows of the dofs (``dofs``, :data:`.layout.LINE_DOF`:
+    its first four columns; each dof that carries cylinders is a chain of the pairs, in order,
+    with its share of them) and of the elements (:data:`.layout.ELEMENT`)."""
+    carrier = np.asarray(carrier, dtype=np.int64)
     dofs = np.asarray(dofs, dtype=float)
     elements = np.asarray(elements, dtype=float).reshape(-1, N_ELEMENT)
-    out = np.zeros((1 + carrier.size + len(dofs) + len(elements), N_ELEMENT))
-    out[0, :] = (len(dofs), ref, load, len(elements), carrier.size)
+    rows = np.zeros((len(dofs), LINE_DOF.size))
+    rows[:, :dofs.shape[1]] = dofs
+    carried = np.bincount(carrier, minlength=len(dofs))
+    rows[:, LD_CHAIN] = np.where(carried > 0, np.cumsum(carried > 0) - 1, -1)
+    rows[:, LD_SHARE] = carried / max(carrier.size, 1)
+    out = np.zeros((1 + carrier.size + len(dofs) + len(elements), N_LINE_COLUMNS))
+    out[0, :LINE_META.size] = (len(dofs), ref, load, len(elements), carrier.size,
+                               np.count_nonzero(carried))
     out[1:1 + carrier.size, 0] = carrier
-    out[1 + carrier.size:1 + carrier.size + len(dofs), :dofs.shape[1]] = dofs
-    out[1 + carrier.size + len(dofs):, :] = elements
+    out[1 + carrier.size:1 + carrier.size + len(dofs), :LINE_DOF.size] = rows
+    out[1 + carrier.size + len(dofs):, :N_ELEMENT] = elements
     return out
 
 
-#: The ``line`` of a rigid shaft's Model: no dofs.
-RIGID_LINE = np.zeros((1, N_ELEMENT))
+#: What ``Model.line_model`` is asked for (``what``): the derivative into ``out``, the output
+#: row into ``out``, the pairs' mode margins into the work array, or the pairs' modes chosen
+#: afresh into the switches (:mod:`.elastic`, :mod:`.line_pairs`).
+LINE_RATES, LINE_ROW, LINE_MARGINS, LINE_MODES = range(4)
+#: ``Model.line_model``'s answer where it did nothing (a rigid shaft's: the rigid model does
+#: it); an elastic line's is the status of what it did (``chain.UNIQUE``, or where it chose
+#: the modes the worst of its chains', ``chain.LOCKED`` where one is held by its pairs).
+NOT_A_LINE = -1
+
+
+#: The ``line`` of a rigid shaft's Model: no dofs, and one chain of the pairs, the machine.
+RIGID_LINE = np.zeros((1, N_LINE_COLUMNS))
+RIGID_LINE[0, LM_CHAINS] = 1.0
 
 
 @kernel(inline=True)
@@ -219,6 +243,6 @@ def no_line_switch(m, y, to_angle, wk):
 
 
 @kernel(inline=True)
-def no_line_model(m, row, angle_mode, y, sw, wk, out):
-    """``Model.line_model`` of a rigid shaft: nothing done, as its False says."""
-    return False
+def no_line_model(m, extras, what, angle_mode, y, sw, wk, out):
+    """``Model.line_model`` of a rigid shaft: nothing done, as its NOT_A_LINE says."""
+    return NOT_A_LINE

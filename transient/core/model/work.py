@@ -10,7 +10,7 @@ from ..jit import compiled
 from . import articulated_friction as af
 from . import joint_friction as jf
 from . import swash_friction as sf
-from .layout import WK_RX, WK_SEL, line_dofs
+from .layout import WK_RX, WK_SEL, line_dofs, n_margins
 
 #: Rows of the work array: enough for any mechanism's reaction solver.
 N_WK = WK_RX + max(jf.ROWS.end, sf.ROWS.end, af.ROWS.end)
@@ -19,7 +19,8 @@ N_WK = WK_RX + max(jf.ROWS.end, sf.ROWS.end, af.ROWS.end)
 @compiled
 def work_array(m):
     """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
-    wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, m.link_sub.shape[0], 2, line_dofs(m))))
+    wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, n_margins(m), m.link_sub.shape[0], 2,
+                             line_dofs(m))))
     wk[WK_SEL, 0] = np.nan  # no pieces selected yet
     wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
     return wk

@@ -19,7 +19,6 @@ from ..integrator.rk import dense, dense_state
 from ..integrator.roots import crosses, crossing_inside, fall_after_rise, root
 from ..jit import kernel
 from ..model import governor as gv
-from ..model.chain import MAX_PAIRS
 from ..model.forcing import demand, inertia, is_pi, speed
 from ..model.layout import (
     LT_SPEED,
@@ -34,6 +33,7 @@ from ..model.layout import (
     WK_G_MIN,
     T,
     gov_index,
+    n_margins,
 )
 from ..model.rhs import margins_at, margins_inline, model_rhs
 from .io import (
@@ -140,7 +140,7 @@ def _sample_margins(m, extras, at, y, work):
     for j in range(1, N_MARGIN_SAMPLES):
         dense_state(work.F, y, at.x, at.h, j / N_MARGIN_SAMPLES, at.ix, work.tmp)
         margins_at(m, extras, at.angle_mode, work.tmp, at.sel, at.sw, work.wk)
-        for k in range(m.n_pairs):
+        for k in range(n_margins(m)):
             work.gs[j, k] = work.wk[WK_G, k]
 
 
@@ -187,9 +187,10 @@ def _pair_crossing(m, extras, at, y, work, k):
 
 
 #: The state events watched on every step (:func:`_event_spec`), each with its slots (the event
-#: functions it may need at once: a corner above and one below, both stops of the sleeve, one
-#: per pair), in the order that breaks a tie between two events at one instant (the first slot
-#: wins). The events themselves, with their names and codes, are ``io.EVENTS``.
+#: functions it may need at once: a corner above and one below, both stops of the sleeve), in
+#: the order that breaks a tie between two events at one instant (the first slot wins); last
+#: the pairs' mode margins, as many as the scene has (``layout.n_margins``), each in turn. The
+#: events themselves, with their names and codes, are ``io.EVENTS``.
 WATCHED = Layout(
     "watched events",
     ("starter_cutout", 1, "the speed rising to the starter's cut-out"),
@@ -202,7 +203,8 @@ WATCHED = Layout(
     ("generator", 1, "the generator's minimum speed"),
     ("sleeve", 4, "the sleeve reaching its low, its high stop; leaving the low, the high"),
     ("load_knot", 2, "a speed map's knot above ω, and the one below"),
-    ("pair_mode", MAX_PAIRS, "each pair's mode margin falling to zero"),
+    ("pair_mode", 1, "each pair's mode margin falling to zero, pair by pair (per pair and "
+                     "throw on an elastic line)"),
 )
 (W_STARTER_CUTOUT, W_TO_TIME, W_TO_ANGLE, W_REVERSAL, W_END, W_GOVERNOR, W_LOAD_SCHEDULE,
  W_GENERATOR, W_SLEEVE, W_LOAD_KNOT, W_PAIR_MODE) = WATCHED
@@ -260,9 +262,6 @@ def _event_spec(m, extras, cfg, e, angle_mode, sw):
     if (extras is not None and e == W_LOAD_KNOT + 1 and m.lt_kind == LT_SPEED
             and sw[SW_LOAD_TABLE] > 0):
         return EV_LOAD_KNOT, OMEGA, m.lt_x[sw[SW_LOAD_TABLE] - 1], -1  # and the one below
-    if extras is not None and e >= W_PAIR_MODE and e - W_PAIR_MODE < m.n_pairs:
-        # the mode margin of pair e − W_PAIR_MODE falls to zero
-        return EV_PAIR_MODE, PAIR_COMP + e - W_PAIR_MODE, 0.0, -1
     return -1, OMEGA, 0.0, 0
 
 
@@ -336,21 +335,9 @@ def _locate_events(tab, m, extras, cfg, at, y, work, ist, seen, dense_ready):
         dense_ready = _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
         _sample_margins(m, extras, at, y, work)
         ist[I_NFEV] += N_MARGIN_SAMPLES - 1
-    # (the plain variant watches no pair: its events end before the pairs')
-    n_kinds = FIRST_PAIR_EVENT
-    if extras is not None:
-        n_kinds = N_EVENT_KINDS
-    for e in range(n_kinds):
+    for e in range(FIRST_PAIR_EVENT):
         code, comp, level, direction = _event_spec(m, extras, cfg, e, at.angle_mode, at.sw)
         if code < 0:
-            continue
-        if extras is not None and comp >= PAIR_COMP:
-            if not dip:
-                continue
-            theta, only_stages = _pair_event(m, extras, at, y, work, comp - PAIR_COMP, ist)
-            unseen = unseen or only_stages
-            if theta < ev_theta:
-                ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
             continue
         theta, rising, dense_ready = _level_event(tab, m, extras, at, y, work,
                                                   (code, comp, level, direction),
@@ -358,6 +345,13 @@ def _locate_events(tab, m, extras, cfg, at, y, work, ist, seen, dense_ready):
         if theta < ev_theta:
             ev_theta, ev_code, ev_comp, ev_level = theta, code, comp, level
             ev_rising = rising
+    # (the plain variant watches no pair)
+    if extras is not None and dip:
+        for k in range(n_margins(m)):  # each mode margin falling to zero
+            theta, only_stages = _pair_event(m, extras, at, y, work, k, ist)
+            unseen = unseen or only_stages
+            if theta < ev_theta:
+                ev_theta, ev_code, ev_comp, ev_level = theta, EV_PAIR_MODE, PAIR_COMP + k, 0.0
     return ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready
 
 

@@ -31,6 +31,7 @@ from ..model.layout import (
     SW_SLEEVE,
     SW_STARTER,
     T,
+    n_margins,
 )
 from ..model.outputs import output_row, output_row_inline
 
@@ -60,7 +61,8 @@ FLOATS = Layout(
     "last_switch", "err_old",
     Block("deriv", Sized(lambda m: STATE.offsets_for(m)[-1], "the state's length"),
           "the carried derivative"),
-    Block("margins", Sized(lambda m: max(m.n_pairs, 1), "one per pair, at least one"),
+    Block("margins", Sized(lambda m: max(n_margins(m), 1),
+                           "one per pair (per pair and throw on a line), at least one"),
           "the pairs' margins at y"),
 )
 (F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH,
@@ -165,7 +167,7 @@ def _retake(fst, ist, h):
 
 
 @kernel(inline=True)
-def _carry(fst, f, gs, n_pairs, keep):
+def _carry(fst, f, gs, n_margins, keep):
     """The derivative ``f`` at the state and the pairs' margins there (``gs[0]``) into the stepper's
     state ``fst`` (``keep``) or back from it (F_DERIV): what a chunk leaves valid, the next takes
     up as it is, so that where chunks end changes nothing in the run."""
@@ -175,7 +177,7 @@ def _carry(fst, f, gs, n_pairs, keep):
             fst[F_DERIV + i] = f[i]
         else:
             f[i] = fst[F_DERIV + i]
-    for k in range(n_pairs):
+    for k in range(n_margins):
         if keep:
             fst[F_DERIV + n + k] = gs[0, k]
         else:

@@ -81,6 +81,7 @@ from ..model.layout import (
     T,
     gov_index,
     line_dofs,
+    n_margins,
     state_control,
 )
 from ..model.line_jacobian import line_band, model_jacobian
@@ -218,7 +219,7 @@ def buffers(m, tab, n: int) -> Work:
         band = np.zeros((rows, 2 * kb + 1))
     return Work(np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
                 np.empty(n), np.empty(n), np.empty(n), work_array(m),
-                np.zeros((N_MARGIN_SAMPLES + 1, max(m.n_pairs, 1))), state_control(m), band)
+                np.zeros((N_MARGIN_SAMPLES + 1, max(n_margins(m), 1))), state_control(m), band)
 
 
 @compiled(nogil=True, _nrt=False)  # (nogil: the previous block is written meanwhile, simulate)
@@ -274,7 +275,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
     # As the last chunk left them: its derivative and margins (F_DERIV), if valid, and the
     # counters of the retaken attempts; kept again where this chunk ends.
     if ist[I_F_VALID] == 1:
-        _carry(fst, f, gs, m.n_pairs, False)
+        _carry(fst, f, gs, n_margins(m), False)
     n_bad = ist[I_NBAD]  # consecutive non-finite step attempts
     n_unseen = ist[I_NUNSEEN]  # consecutive attempts retaken for a crossing no sample found
     rejected = ist[I_REJECTED] == 1  # the last attempt was rejected by the error test
@@ -432,7 +433,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
 def _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected):
     """What a chunk leaves for the next: the derivative and the margins at the state, and the
     counters of the retaken attempts, so that where a chunk ends changes nothing in the run."""
-    _carry(fst, f, gs, m.n_pairs, True)
+    _carry(fst, f, gs, n_margins(m), True)
     ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
 
 
@@ -542,7 +543,7 @@ def _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner, corner):
     w_lo, w_hi = wk[WK_SPEED, 0], wk[WK_SPEED, 1]
     # (the step's last right-hand side is at y_new: WK_G holds the margins there)
     dip = False
-    for k in range(m.n_pairs):
+    for k in range(n_margins(m)):
         gs[N_MARGIN_SAMPLES, k] = wk[WK_G, k]
         # a margin that starts at or above zero and dips below, or above and reaches it
         g_min = wk[WK_G_MIN, k]
@@ -831,7 +832,7 @@ def _settle_modes(m, extras, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     flipped = ist[I_FLIPPED] - 1
     ist[I_FLIPPED] = 0
     changed = False
-    for k in range(m.n_pairs):
+    for k in range(n_margins(m)):
         if k != flipped and wk[WK_G, k] < 0.0:
             sw[SW_MODES] ^= 1 << k
             ist[I_NSWITCH] += 1
@@ -840,7 +841,7 @@ def _settle_modes(m, extras, angle_mode, y, sel, sw, wk, gs, ist, evbuf):
     if changed:
         margins_at(m, extras, angle_mode, y, sel, sw, wk)
         ist[I_NFEV] += 1
-    for k in range(m.n_pairs):
+    for k in range(n_margins(m)):
         gs[0, k] = 0.0 if k == flipped else wk[WK_G, k]
 
 
@@ -849,8 +850,9 @@ def _stick(m, extras, cfg, y, evbuf, ist, wk):
     """At rest with the pairs holding the applied moments: the machine is stuck (``stuck``) if
     the run ends by time and something can still change the moments, so that the drive may come
     to exceed the friction; returns False where the run is to end *locked* instead (nothing
-    would ever release it, or no end in time would end the wait)."""
-    if (extras is not None and np.isfinite(cfg[C_T_END])
+    would ever release it, or no end in time would end the wait; on an elastic line, whose
+    throws have no stuck state of their own)."""
+    if (extras is not None and np.isfinite(cfg[C_T_END]) and line_dofs(m) == 0
             and st.can_change(m, y, ist[:N_SWITCHES])):
         ist[I_DIRECTION] = st.STUCK
         ist[I_MODES] = 0
