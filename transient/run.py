@@ -267,7 +267,7 @@ class CycleMap:
     last, whose speeds give the state at the cycle's end back in the start's form (the speeds,
     not the energies K = ½Jω² the stepper holds in crank angle).
 
-    ``neutral_at``: the places in x of the twists nothing depends on (:func:`_free_dofs`).
+    ``neutral_at``: the places in x of the twists nothing depends on (``_free_dofs``).
     ``start(x)``: the stepper's state (y, fst, ist) at the cycle's start with the periodic
     states ``x``; ``__call__(x)``: the periodic states after one cycle, or a
     :class:`~transient.errors.SimulationError` saying where the cycle failed."""
@@ -346,6 +346,8 @@ class CycleMap:
                 f"the cycle from ω = {x[self.speed_at[0]]:.9g} rad/s stopped "
                 f"{_CYCLE_ENDS.get(status, 'failing')} at t = {y[layout.T]:.9g} s, "
                 f"φ = {y[layout.PHI]:.9g} rad")
+        if last is None:  # (the output grid puts a row at the cycle's end)
+            raise SimulationError("the cycle wrote no output row at its end")
         out = y[self.index].copy()
         out[self.speed_at] = last[self.speed_column]
         return out
@@ -724,8 +726,8 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
 def simulate_from(scene, start, path: str | Path | None = None, *, force: bool = False,
                   resume: bool = False, progress: Callable[[float], None] | None = None,
                   analysis: dict[str, tuple] | None = None) -> Result:
-    """:func:`simulate` from the stepper's state ``start`` (a :class:`~transient.results.
-    Checkpoint`; None: the scene's initial state), with ``analysis`` (name → (value, unit))
+    """:func:`transient.simulate` from the stepper's state ``start`` (a
+    :class:`~transient.results.Checkpoint`; None: the scene's initial state), with ``analysis`` (name → (value, unit))
     stored beside the run's own."""
     refuse_elastic_run(scene)  # (before any file is made)
     if path is None:

@@ -9,7 +9,7 @@ differences (one cycle per periodic state; with several, kept and updated by Bro
 while it serves), damped by backtracking on ‖F‖ and falling back to direct cycles where a
 Newton step does not reduce it (the map contracts). Its eigenvalues at
 the solution, the multipliers, say how fast a disturbance of the steady cycle dies per cycle.
-:func:`steady` then runs the steady cycle(s) with output, a :class:`~transient.Result` like a
+:func:`transient.steady` then runs the steady cycle(s) with output, a :class:`~transient.Result` like a
 run's, with the convergence record and the multipliers in its analysis.
 """
 from __future__ import annotations
@@ -83,6 +83,7 @@ class Shooting:
     def analysis(self) -> dict[str, tuple]:
         """The record as a result's analysis entries (name → (value, unit))."""
         mu = self.multipliers
+        assert mu is not None, "the record of a shooting that found its state"
         return {"steady_state_t": (0.0, "s"),  # (the whole result is the steady cycle)
                 "steady_iterations": (len(self.residuals) - 1, "1"),
                 "steady_residuals": (np.array(self.residuals), "1"),
@@ -189,7 +190,7 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
         if len(rec.residuals) > MAX_ITERATIONS:
             raise _no_state(rec, phi, f"no convergence in {MAX_ITERATIONS} iterations")
         fresh = M is None
-        if fresh:
+        if M is None:
             M = _jacobian(phi, x, end - x, forward=True)
         dx = np.zeros_like(x)  # (a neutral twist stays as it is: any value repeats)
         dx[phi.free] = np.linalg.lstsq((M - np.eye(x.size))[:, phi.free], -(end - x),
@@ -330,13 +331,15 @@ def _no_state(rec: Shooting, phi: CycleMap, what: str) -> NoSteadyState:
 
 def _unstable(rec: Shooting, phi: CycleMap) -> str:
     """Which periodic state an unstable multiplier moves most, and the multipliers."""
-    w, v = np.linalg.eig(rec.monodromy)
+    M, x, mu = rec.monodromy, rec.x, rec.multipliers
+    assert M is not None and x is not None and mu is not None, "a shooting's final record"
+    w, v = np.linalg.eig(M)
     k = int(np.argmax(np.abs(w)))
     # (each component relative to its state's size: a speed and a rack position compared)
-    worst = rec.names[int(np.argmax(np.abs(v[:, k]) / np.maximum(np.abs(rec.x), 1e-3)))]
-    shown = ", ".join(f"{m:.6g}" for m in rec.multipliers)
-    return (f"the periodic steady state at ω = {rec.x[phi.speed_at[0]]:.9g} rad/s is unstable: "
-            f"the multiplier {rec.multipliers[0]:.6g} (|μ| = {abs(rec.multipliers[0]):.6g} ≥ 1) "
+    worst = rec.names[int(np.argmax(np.abs(v[:, k]) / np.maximum(np.abs(x), 1e-3)))]
+    shown = ", ".join(f"{m:.6g}" for m in mu)
+    return (f"the periodic steady state at ω = {x[phi.speed_at[0]]:.9g} rad/s is unstable: "
+            f"the multiplier {mu[0]:.6g} (|μ| = {abs(mu[0]):.6g} ≥ 1) "
             f"grows a disturbance each cycle, mostly of {worst} (a governor that hunts?); "
             f"multipliers {shown}; `transient run` follows the motion")
 
@@ -410,11 +413,13 @@ def steady(scene, path: str | Path | None = None, *, cycles: int = 1, force: boo
     if path is not None:
         check_writable(Path(path), force)
     rec, phi = shoot(scene, progress)
-    y, fst, ist = phi.start(rec.x)
+    x = rec.x
+    assert x is not None, "shoot returns the state it found"
+    y, fst, ist = phi.start(x)
     start = Checkpoint(rows=0, events=0, switched=False, code=sio.RUNNING,
                        floats=np.concatenate([y, fst]), ints=ist)
     run = dataclasses.replace(scene.run, t_end=math.inf,
                               revolutions=cycles * phi.cycle / (2.0 * math.pi))
-    initial = dataclasses.replace(scene.initial, omega=float(rec.x[phi.speed_at[0]]))
+    initial = dataclasses.replace(scene.initial, omega=float(x[phi.speed_at[0]]))
     cycle_scene = dataclasses.replace(scene, run=run, initial=initial)
     return simulate_from(cycle_scene, start, path, force=force, analysis=rec.analysis())

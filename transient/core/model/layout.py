@@ -27,7 +27,7 @@ from . import governor as gv
 def n_margins(m):
     """The pairs' modes, each a switch with its margin and its energy lost: one per non-ideal
     pair in each chain the pairs act in, the machine on a rigid shaft, each station carrying
-    cylinders on an elastic line (``line`` :data:`LM_CHAINS`; theory, (T7)). Chain c's pair k
+    cylinders on an elastic line (``line`` :data:`LINE_META`; theory, (T7)). Chain c's pair k
     is number c·n_pairs + k."""
     return m.n_pairs * int(m.line[0, LM_CHAINS])
 
