@@ -343,7 +343,7 @@ SPC = "--samples-per-cycle: must be 16 … 1000000, got"
 MAX_ORDER = "--max-order: must be finite and > 0, got"
 REVS = "--revolutions: must be finite and > 0 and ≤ 1e+06, got"
 BUDGET = "--baseline-budget: must be finite and > 0, got"
-COMMANDS = ("'run', 'check', 'info', 'warmup', 'plot', 'kinematics', 'modes', 'bench', "
+COMMANDS = ("'run', 'check', 'info', 'warmup', 'steady', 'plot', 'kinematics', 'modes', 'bench', "
             "'efficiency', 'loads', 'orders', 'stress', 'sweep', 'sweep-plot'")
 
 OPTION_CASES = [
