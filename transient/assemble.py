@@ -47,6 +47,7 @@ from .core.model.reactions import NO_REACTIONS
 from .core.model.tabulated import terms as tabulated_kernel
 from .core.model.variation import cycle_fuel
 from .core.model.work import work_array
+from .core.stepper.breakpoints import LINE_BREAKPOINTS, NO_LINE_BREAKPOINTS
 from .forces.gas import PressureTable, shift_cubic
 from .forces.load_table import SCHEDULE_MIN_GAP, LoadCurve, load_curve
 from .mechanisms import provides, reaction_joints
@@ -245,23 +246,14 @@ def build_model(scene, part_load: bool = False
     tabulated = kin is not None and kin.coef is not None
     load_x, load_s, load_comp = load_schedule(scene)
     variation = variation_fields(scene, phases)
-    begin = cycle_begin(mech) if variation["var_on"] else None
-    # with combustion offsets a cylinder's tables are read at its angle less δ_k too: their
-    # corners there are breakpoints as well (cylinder ``owner[j]`` for each phase j)
-    shift = variation["var_par"][:, var.SHIFT]
-    moved = np.flatnonzero(shift != 0.0)
-    all_phases = np.concatenate([phases, np.mod(phases[moved] + shift[moved], period)])
-    owner = np.concatenate([np.arange(n), moved])
-    bp = breakpoints(table, all_phases, period, motored, scene.gas.injection, begin)
-    curve = load_table_curve(scene)
-    if curve is not None and curve.abscissa == "angle":  # its knots are kinks in φ
-        bp = union_of_angles(bp, curve.corners, period)
-    if reaction_friction(scene):
-        bp = union_of_angles(bp, reaction_breakpoints(scene), period)
     cylinders = cylinder_fields(scene)
-    if cylinders["woschni"] and scene.shaft is not None:  # where the pressure states restart
-        # (a rigid scene's at its intake closings, the tables' corners already)
-        bp = union_of_angles(bp, phases + cylinders["cyl_par"][cyl.RESTART], period)
+    curve = load_table_curve(scene)
+    # on the shaft's (the reference's) own angle: a load's knots in φ, which are kinks, and the
+    # reversals of reaction friction, where the derivative jumps
+    on_shaft = (curve.corners if curve is not None and curve.abscissa == "angle" else np.zeros(0),
+                reaction_breakpoints(scene) if reaction_friction(scene) else np.zeros(0))
+    bp, jump, starts = shaft_breakpoints(scene, (table, motored), variation, cylinders["cyl_par"],
+                                         on_shaft)
     model = Model(
         terms=tabulated_kernel if tabulated else mech.kernel, mech=mech.pack(),
         kin_coef=kin.coef if tabulated else np.zeros((1, 1, 6)), ncyl=n,
@@ -270,8 +262,7 @@ def build_model(scene, part_load: bool = False
         gas_scale=np.full(n, 1.0 if gas_is_force(scene) else mech.piston_area),
         gas_offset=0.0 if gas_is_force(scene) else scene.gas.p0, period=period, knots=knots, coef=coef,
         piece_knot=piece_knot.astype(np.int64), has_motored=motored is not None,
-        breakpoints=bp, bp_jump=breakpoint_jumps(bp, (table, motored), all_phases, period, mech,
-                                                 owner),
+        breakpoints=bp, bp_jump=jump,
         load_const=scene.load.torque, load_linear=scene.load.linear, load_fan=scene.load.fan,
         load_x=load_x, load_s=load_s, load_comp=load_comp,
         **load_table_fields(scene), gen_power=scene.load.generator_power,
@@ -280,42 +271,109 @@ def build_model(scene, part_load: bool = False
         starter_cutout=scene.starter.cutout_speed, gov_on=scene.governor.model == "droop",
         gov_full=scene.governor.speed_full, gov_zero=scene.governor.speed_zero,
         **governor_fields(scene), **chain_fields(scene), **cylinders, **variation,
-        **line_fields(scene, tabulated))
-    if model.woschni:
-        model.bp_jump[:] |= _on_closed_part_corner(bp, phases, model)
-        if moved.size:  # the combustion's start and end, δ_k later
-            model.bp_jump[:] |= _on_closed_part_corner(bp, all_phases[n:], model)
+        **line_fields(scene, tabulated, starts))
+    # (the stepper's own breakpoints are the shaft's; an elastic line's are each dof's, which
+    # its Model holds and the stepper reads there)
+    return model, (bp if scene.shaft is None else np.zeros(0)), table
+
+
+def shaft_breakpoints(scene, tables, variation: dict, cyl_par: NDArray[np.float64], on_shaft
+                      ) -> tuple[NDArray[np.float64], NDArray[np.bool_], list[int]]:
+    """The Model's ``breakpoints`` and ``bp_jump``, and where each dof's begin in them.
+
+    On a rigid shaft one sorted list on the shaft's angle: every cylinder's
+    (:func:`cylinder_breakpoints`) and the angles ``on_shaft`` (a load's knots in φ, kinks; the
+    reversals of reaction friction, where the derivative jumps). On an elastic line each dof's
+    own, on its angle, one list after another: those of the cylinders it carries, and on the
+    reference dof, whose angle is the run's crank angle, ``on_shaft`` too; ``starts`` the index
+    of each dof's first (none on a rigid shaft)."""
+    knots, reversals = on_shaft
+    n = scene.mechanism.n_cylinders
+    if scene.shaft is None:
+        bp, jump = cylinder_breakpoints(scene, np.arange(n), tables, variation, cyl_par,
+                                        knots, reversals)
+        return bp, jump, []
+    line = ShaftLine(scene)
+    shaft = scene.shaft
+    ref = line.station_dof[shaft.station_index(shaft.reference)]
+    carried = [np.zeros(0, dtype=np.int64) for _ in range(line.n)]
+    for i, st in enumerate(shaft.stations):
+        carried[line.station_dof[i]] = np.asarray(st.cylinders, dtype=np.int64) - 1
+    lists = [cylinder_breakpoints(scene, carried[d], tables, variation, cyl_par,
+                                  *(on_shaft if d == ref else (np.zeros(0), np.zeros(0))))
+             for d in range(line.n)]
+    starts = np.cumsum([0] + [bp.size for bp, _ in lists])[:-1].tolist()
+    return (np.concatenate([bp for bp, _ in lists]),
+            np.concatenate([jump for _, jump in lists]), starts)
+
+
+def cylinder_breakpoints(scene, which: NDArray[np.int64], tables, variation: dict,
+                         cyl_par: NDArray[np.float64], knots: NDArray[np.float64],
+                         reversals: NDArray[np.float64]
+                         ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """The sorted breakpoints of the cylinders ``which`` on one angle, with the angles
+    ``knots`` (kinks) and ``reversals`` (jumps of the derivative), and whether the derivative
+    jumps at each: :func:`breakpoints` of their phases (with combustion offsets also δ_k
+    later, where a cylinder's tables are read too), the jumps of :func:`breakpoint_jumps`,
+    of the closed part's corners (wall heat) and of a cycle's begin."""
+    mech = scene.mechanism
+    period = mech.cycle
+    table, motored = tables
+    phases = gas_phases(scene)
+    shift = variation["var_par"][:, var.SHIFT]
+    moved = which[shift[which] != 0.0]
+    all_phases = np.concatenate([phases[which], np.mod(phases[moved] + shift[moved], period)])
+    owner = np.concatenate([which, moved])
+    begin = cycle_begin(mech) if variation["var_on"] else None
+    bp = (breakpoints(table, all_phases, period, motored, scene.gas.injection, begin)
+          if which.size else np.zeros(0))
+    for extra in (knots, reversals):
+        if extra.size:
+            bp = union_of_angles(bp, extra, period)
+    jump = breakpoint_jumps(bp, tables, all_phases, period, mech, owner)
+    if cyl_par[cyl.CLOSED] > 0.0:  # (wall heat; its combustion's start and end δ_k later too)
+        jump |= _on_closed_part_corner(bp, all_phases, cyl_par, period)
     if begin is not None:
-        model.bp_jump[:] |= _on_cycle_begin(bp, phases, model, mech, begin)
-    if model.reaction:  # a friction force reverses there: the derivative jumps
-        gap = np.abs(bp[:, None] - reaction_breakpoints(scene)[None, :])
-        model.bp_jump[:] |= np.any(np.minimum(gap, period - gap) <= 1e-12 * period, axis=1)
-    return model, model.breakpoints, table
+        jump |= _on_cycle_begin(bp, phases[which], which, period, mech, begin)
+    if reversals.size:  # a friction force reverses there: the derivative jumps
+        gap = np.abs(bp[:, None] - reversals[None, :])
+        jump |= np.any(np.minimum(gap, period - gap) <= 1e-12 * period, axis=1)
+    return bp, jump
 
 
-def line_fields(scene, tabulated_kinematics: bool) -> dict:
+#: The Model's fields of the breakpoints on each dof's own angle, in the order of the stepper's
+#: kernels (``LINE_BREAKPOINTS``, ``NO_LINE_BREAKPOINTS``).
+LINE_BREAKPOINT_FIELDS = ("line_segment_end", "line_retake", "line_passed")
+
+
+def line_fields(scene, tabulated_kinematics: bool, starts: list[int]) -> dict:
     """The elastic shaft line's part of the Model (:class:`~transient.shaft.line.ShaftLine`: its
-    dofs, inertias, elements and absolute damping packed by
-    :func:`~transient.core.model.shaft.pack_line`; the mechanism's shares and
-    :func:`transient.core.model.elastic.elastic_model`), or no dofs and the no-op kernels of
-    :mod:`transient.core.model.shaft` on a rigid shaft."""
+    dofs, inertias, elements, absolute damping and where each dof's breakpoints begin
+    (``starts``, :func:`shaft_breakpoints`) packed by
+    :func:`~transient.core.model.shaft.pack_line`; the mechanism's shares,
+    :func:`transient.core.model.elastic.elastic_model` and the stepper's kernels of the dofs'
+    breakpoints), or no dofs and the no-op kernels of :mod:`transient.core.model.shaft` and
+    the stepper on a rigid shaft."""
     if scene.shaft is None:
         return dict(line=line_kernels.RIGID_LINE, shares=line_kernels.no_shares,
                     line_model=line_kernels.no_line_model,
                     line_switch=line_kernels.no_line_switch,
-                    reference_inertia=rigid_inertia)
+                    reference_inertia=rigid_inertia,
+                    **dict(zip(LINE_BREAKPOINT_FIELDS, NO_LINE_BREAKPOINTS)))
     line = ShaftLine(scene)
     shaft = scene.shaft
     carrier = np.zeros(scene.mechanism.n_cylinders, dtype=np.int64)
     for i, st in enumerate(shaft.stations):
         carrier[np.asarray(st.cylinders, dtype=np.int64) - 1] = line.station_dof[i]
-    dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n)])
+    dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n),
+                            starts])
     packed = line_kernels.pack_line(line.station_dof[shaft.station_index(shaft.reference)],
                                     line.names.index(shaft.load_at), carrier, dofs,
                                     line.element_rows())
     shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
     return dict(line=packed, shares=shares, line_model=elastic.elastic_model,
-                line_switch=line_kernels.line_mode, reference_inertia=line_kernels.ref_inertia)
+                line_switch=line_kernels.line_mode, reference_inertia=line_kernels.ref_inertia,
+                **dict(zip(LINE_BREAKPOINT_FIELDS, LINE_BREAKPOINTS)))
 
 
 def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
@@ -342,17 +400,19 @@ def variation_fields(scene, phases: NDArray[np.float64]) -> dict:
                 var_par=par, var_int=ints)
 
 
-def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64], model, mech,
-                    begin: float) -> NDArray[np.bool_]:
-    """Breakpoints where a cylinder begins a cycle while its piston moves: its fuel factor may
-    change there, and with it its gas torque (at a dead centre, where every crank-slider's cycle
-    begins, the torque stays continuous and the stepper's carried-over stage stays valid)."""
+def _on_cycle_begin(bp: NDArray[np.float64], phases: NDArray[np.float64],
+                    owner: NDArray[np.int64], period: float, mech, begin: float
+                    ) -> NDArray[np.bool_]:
+    """Breakpoints where a cylinder (``owner[j]`` of phase j) begins a cycle while its piston
+    moves: its fuel factor may change there, and with it its gas torque (at a dead centre, where
+    every crank-slider's cycle begins, the torque stays continuous and the stepper's
+    carried-over stage stays valid)."""
     out = np.zeros(bp.size, dtype=np.bool_)
-    for k, phase in enumerate(phases):
-        angle = (phase + begin) % model.period
+    for k, phase in zip(owner, phases):
+        angle = (phase + begin) % period
         gap = np.abs(bp - angle)
-        j = np.flatnonzero(np.minimum(gap, model.period - gap) <= 1e-12 * model.period)
-        out[j] |= _piston_moves(mech, k, angle)
+        j = np.flatnonzero(np.minimum(gap, period - gap) <= 1e-12 * period)
+        out[j] |= _piston_moves(mech, int(k), angle)
     return out
 
 
@@ -378,24 +438,19 @@ def cylinder_fields(scene) -> dict:
         clearance_volume(scene), area, mech.bore, cycle.v_h / area, cycle.v_h)
     par[[cyl.C1, cyl.C2, cyl.T_WALL]] = h.c1, h.c2, h.wall_temperature
     par[cyl.GAMMA_A] = w.gamma + w.gamma_slope * (w.t_a - w.gamma_t_ref)
-    # restarted at p_a where its intake closes; on an elastic line, whose breakpoints are the
-    # reference's angles, half its open part away from either end, which no twist reaches
-    par[cyl.RESTART] = (closed.start if scene.shaft is None
-                        else closed.end + 0.5 * (mech.cycle - (closed.end - closed.start)))
     return dict(woschni=True, cyl_par=par)
 
 
-def _on_closed_part_corner(bp: NDArray[np.float64], phases: NDArray[np.float64], model
-                           ) -> NDArray[np.bool_]:
+def _on_closed_part_corner(bp: NDArray[np.float64], phases: NDArray[np.float64],
+                           par: NDArray[np.float64], period: float) -> NDArray[np.bool_]:
     """Breakpoints where a cylinder-pressure state's derivative jumps: its intake closing and
     exhaust opening, and its combustion's start and end (the heat release and Woschni's
     combustion term switch there), so that the stepper evaluates the first stage beyond them
     afresh instead of carrying it over from the step that ended there (FSAL)."""
-    par = model.cyl_par
     corners = par[cyl.IVC] + np.array([0.0, par[cyl.CLOSED], par[cyl.START],
                                        par[cyl.START] + par[cyl.DURATION]])
-    d = np.mod(np.subtract.outer(bp, np.add.outer(phases, corners).ravel()), model.period)
-    return np.any(np.minimum(d, model.period - d) <= 1e-9, axis=1)
+    d = np.mod(np.subtract.outer(bp, np.add.outer(phases, corners).ravel()), period)
+    return np.any(np.minimum(d, period - d) <= 1e-9, axis=1)
 
 
 def governor_fields(scene) -> dict:

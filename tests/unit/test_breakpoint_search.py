@@ -8,7 +8,6 @@ answers, to the bit, at and around breakpoints and across the cycle's ends.
 from __future__ import annotations
 
 import math
-from collections import namedtuple
 
 import numpy as np
 
@@ -55,13 +54,11 @@ def test_next_breakpoint_is_the_scan():
 def test_jump_flag_near_the_shaft_only():
     """The flag of any breakpoint the shaft is on (to BP_LANDING), across the cycle's ends, as a
     scan over all of them finds it."""
-    M = namedtuple("M", "period bp_jump")
     rng = np.random.default_rng(5)
     bp = np.sort(np.concatenate([rng.uniform(0.0, PERIOD, 300), [0.0, PERIOD - 5e-8]]))
     jump = rng.random(bp.size) < 0.3
     jump[0] = jump[-1] = True
-    m = M(PERIOD, jump)
     for phi in angles_to_try(bp, rng):
         d = np.mod(phi - bp, PERIOD)
         on = np.minimum(d, PERIOD - d) <= BP_LANDING
-        assert _jumps_at(m, bp, phi) == bool(np.any(jump & on))
+        assert _jumps_at(bp, jump, PERIOD, phi) == bool(np.any(jump & on))

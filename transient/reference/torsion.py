@@ -558,7 +558,7 @@ class SceneEngine:
     :func:`~transient.reference.twins.misfire_draw`); the governor (droop, PI(D), flyweight:
     the rigid reference's :class:`~transient.reference.twins.GovernorNumpy`) reading the
     reference station's speed;
-    each cylinder latching the command where the reference passes its injection angle
+    each cylinder latching the command where its own station passes its injection angle
     (``gas.injection``); with ``[gas.woschni]`` each cylinder's closed part a pressure state
     (the rigid reference's :class:`~transient.reference.twins.CylindersNumpy`) at its own
     station's angle and speed, set to p_a where its own angle closes the intake.
@@ -715,8 +715,8 @@ class SceneEngine:
                 def latch(yv, k=k):
                     w_ref = yv[self.i_speed + self.ref]
                     yv[self.i_latch + k] = self.command(w_ref, yv)
-                level = ahead(y[self.ref], self.phase[k] + self.latch)
-                out.append((self.ref, level, latch))
+                s = int(self.carrier[k])
+                out.append((s, ahead(y[s], self.phase[k] + self.latch), latch))
         if self.closed is not None:
             for k in range(self.n):
                 def close(yv, k=k):

@@ -4,10 +4,8 @@ transfer (``[gas.woschni]`` of ``model = "wiebe"``).
 With heat transfer the pressure depends on the time spent per degree, i.e. on the shaft speed
 and on the cylinder's own history, so it cannot be an angle-only table. From intake closing (IVC)
 to exhaust opening (EVO) the pressure p_k of cylinder k is then a state, set to p_a at its IVC
-(a breakpoint, where the stepper sets it as it latches fuels; on an elastic shaft line, where
-the breakpoint is at the reference's angle and the cylinder's own is a twist away, in the middle
-of its open part, so that the state waits at p_a until its own angle closes the intake) and
-integrated with the dynamics:
+(a breakpoint, where the stepper sets it as it latches fuels; on an elastic shaft line one on
+the angle of the cylinder's own station) and integrated with the dynamics:
 
     dp/dx = A − B/ω,   A = (γ − 1)/V · dQ_b/dx − γ p/V · dV/dx,   B = (γ − 1)/V · Q̇_w,
 
@@ -40,11 +38,10 @@ from .crank_slider import E, L, R, slider
 #: [rad]; Wiebe a, m; heat released by a full-load cycle m_f·LHV·η_c [J]; γ_ref, γ′ [1/K],
 #: T_ref [K]; T_a [K], p_a [Pa], V_a [m³] at IVC; clearance V_c [m³], piston area F_p [m²], bore
 #: B [m], stroke S [m], swept volume V_h [m³]; Woschni c1 [1], c2 [m/(s K)], wall temperature
-#: T_w [K]; γ(T_a) [1]; the local angle where the stepper sets the state to p_a (a breakpoint,
-#: ``transient.assemble.cylinder_fields``) [rad].
+#: T_w [K]; γ(T_a) [1].
 (IVC, CLOSED, START, DURATION, WA, WM, Q_FULL, GAMMA, GAMMA_SLOPE, GAMMA_TREF, T_A, P_A, V_A,
- V_C, AREA, BORE, STROKE, V_H, C1, C2, T_WALL, GAMMA_A, RESTART) = range(23)
-N_PAR = 23
+ V_C, AREA, BORE, STROKE, V_H, C1, C2, T_WALL, GAMMA_A) = range(22)
+N_PAR = 22
 
 
 @kernel(inline=True)

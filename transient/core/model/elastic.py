@@ -8,16 +8,18 @@ K_ref = ½J_ref ω_ref² in crank angle, ω_ref in time), the works W_gas (all c
 fuels and the cylinders' pressure states as in the rigid model; then per other dof d in order
 its twist q_d = θ_d − φ and K_d (ω_d in time), and the energy the line's damping took. Each
 cylinder's share of J, its transfer function and its gas pressure are taken at the angle of the
-dof that carries it (theory, (T1)–(T5)): its table's piece, its cycle (fuel factor, misfire),
-its combustion offset's curve and its closed part (pressure state with wall heat) are all found
-at that angle at every evaluation, since the stepper's piece selection (``sel``) and its
-breakpoints are the reference's: a corner of a cylinder's table crossed inside a step is a kink
-the step's error control handles. The governor (droop, PI(D), flyweight) reads the reference's
-speed, and a cylinder latches its fuel where the reference passes its injection angle (a
-breakpoint); the load acts at its own dof's speed, a tabulated one at that speed too (the
-generator's low-speed branch and the map's knots are switched on the reference's speed, as every
-speed event: a knot crossed at another dof is a kink inside a step, the value always the
-curve's); a cylinder's pressure state evolves at its own station's angle and speed.
+dof that carries it (theory, (T1)–(T5)). Its table's piece, its cycle (fuel factor, misfire),
+its combustion offset's curve and whether it is in its closed part (pressure state with wall
+heat) are held for a step as the rigid model holds them: found at the stepper's angle ``sel``
+inside the step moved by the dof's twist, θ_sel = sel + θ_d − φ, a point of the dof's own
+angle inside the step. The stepper ends a step on each breakpoint of a dof's own cylinders on
+that dof's angle (:mod:`transient.core.stepper.breakpoints`), so no step crosses a corner of
+its tables and the piece held is the one the dof's angle is in. The governor (droop, PI(D),
+flyweight) reads the reference's speed, and a cylinder latches its fuel where its own angle
+passes its injection angle; the load acts at its own dof's speed, a tabulated one at that speed
+too (the generator's low-speed branch and the map's knots are switched on the reference's
+speed, as every speed event: a knot crossed at another dof is a kink inside a step, the value
+always the curve's); a cylinder's pressure state evolves at its own station's angle and speed.
 """
 from __future__ import annotations
 
@@ -85,29 +87,15 @@ from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
-def elastic_model(m, extras, what, angle_mode, y, sw, wk, out):
-    """``Model.line_model``: the derivative (:func:`elastic_rates`) or the output row at ``y``
-    into ``out``, or the non-ideal pairs' margins or modes chosen afresh (``what``:
-    ``shaft.LINE_RATES`` …, the pairs' :mod:`.line_pairs`); the status of what it did
-    (``chain.UNIQUE``, the modes' status), the rigid model's own left undone."""
-    if what == LINE_ROW:
-        elastic_row(m, extras, angle_mode, y, sw, wk, out)
-    elif what == LINE_RATES:
-        elastic_rates(m, extras, angle_mode, y, sw, wk, out)
-    elif extras is not None:
-        return pairs_at(m, what, angle_mode, y, sw, wk)
-    return UNIQUE
-
-
-@kernel
-def pairs_at(m, what, angle_mode, y, sw, wk):
-    """The non-ideal pairs' margins (``shaft.LINE_MARGINS``) or modes chosen afresh
-    (``LINE_MODES``) at ``y``, each throw's chain's (:mod:`.line_pairs`); the status."""
-    _, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk, True)
-    if what == LINE_MODES:
-        return throw_modes(m, M_load, M_starter, sw, wk)
-    throw_chains(m, M_load, M_starter, sw, wk)
-    return UNIQUE
+def elastic_model(m, row, angle_mode, y, sel, sw, wk, out):
+    """``Model.line_model``: the output row at ``y`` into ``out`` (``row``) or the derivative
+    (:func:`elastic_rates`), the tables' pieces held by ``sel``; True, the rigid model's own left
+    undone."""
+    if row:
+        elastic_row(m, angle_mode, y, sel, sw, wk, out)
+    else:
+        elastic_rates(m, angle_mode, y, sel, sw, wk, out)
+    return True
 
 
 @kernel(inline=True)
@@ -133,51 +121,49 @@ def cylinder_fuel(m, c, theta, y, f):
 
 
 @kernel(inline=True)
-def cylinder_pressure(m, c, theta, y, f, wk):
+def cylinder_pressure(m, c, theta, theta_sel, y, f, wk):
     """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel f
-    (:func:`cylinder_fuel`): the table's piece found at its own angle in its cycle (WK_LOCAL,
-    WK_PIECE; with a combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT,
-    WK_PIECE_SHIFT), then the rigid model's :func:`~.forcing.cylinder_value` at ``theta`` (in
-    its closed part with wall heat, its pressure state); with a pressure factor β_c,
-    p0 + β_c(p − p0), as it acts on the piston. The piece is searched from the one this
-    cylinder's last evaluation left (:func:`~.tables.find_piece_near`): the same piece, found
-    with two comparisons at most evaluations."""
-    local = wrap_angle(theta - m.gas_phase[c], m.period)
+    (:func:`cylinder_fuel`): the table's piece found at the dof's angle ``theta_sel`` that holds
+    the step's pieces (WK_LOCAL, the cylinder's own angle there, and WK_PIECE; with a combustion
+    offset also on the curve δ_c later, WK_LOCAL_SHIFT, WK_PIECE_SHIFT), then the rigid model's
+    :func:`~.forcing.cylinder_value` at ``theta`` (in its closed part with wall heat, its
+    pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on the piston."""
+    local = (theta_sel - m.gas_phase[c]) % m.period
     wk[WK_LOCAL, c] = local
     wk[WK_PIECE, c] = find_piece_near(m.knots, m.piece_knot, local, wk[WK_PIECE, c])
     if shifted(m):
         local_shift = wrap_angle(local - m.var_par[c, SHIFT], m.period)
         wk[WK_LOCAL_SHIFT, c] = local_shift
-        wk[WK_PIECE_SHIFT, c] = find_piece_near(m.knots, m.piece_knot, local_shift,
-                                                wk[WK_PIECE_SHIFT, c])
-    p = cylinder_value(m, True, c, y, theta, theta, f, wk, True)
+        wk[WK_PIECE_SHIFT, c] = find_piece(m.knots, m.piece_knot, local_shift)
+    p = cylinder_value(m, True, c, y, theta, theta_sel, f, wk)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p
 
 
 @kernel(inline=True)
-def cylinder_pressure_rate(m, c, y, w, f_c, wk):
+def cylinder_pressure_rate(m, c, y, shift, w, f_c, wk):
     """dp_c/dt of cylinder c's pressure state (wall heat, ``m.woschni``) at its own angle in its
-    cycle (WK_LOCAL, left by :func:`cylinder_pressure`) and its station's speed w: the rigid
-    model's first law (:func:`.cylinder.pressure_rate`), the combustion on or off as its own
-    angle (less its combustion offset) says; 0 outside its closed part."""
+    cycle, WK_LOCAL (the step's, left by :func:`cylinder_pressure`) + ``shift`` (φ − sel), and
+    its station's speed w: the rigid model's first law (:func:`.cylinder.pressure_rate`), its
+    closed part and the combustion on or off as the step's angle (less its combustion offset)
+    says, as :func:`.forcing.cylinder_rates` holds them; 0 outside its closed part."""
     local = wk[WK_LOCAL, c]
     x = cyl.closed_angle(m.cyl_par, local, m.period)
     if x < 0.0:
         return 0.0
     if m.var_on:
         x -= m.var_par[c, SHIFT]
-    A, B = cyl.pressure_rate(m.mech, m.cyl_par, x, x, local, y[cyl_index(m) + c],
+    A, B = cyl.pressure_rate(m.mech, m.cyl_par, x + shift, x, local + shift, y[cyl_index(m) + c],
                              m.gas_scale[c] * wk[WK_U, c], w, f_c)
     return w * A - B
 
 
 @kernel(inline=True)
-def line_forces(m, y, sw, wk):
+def line_forces(m, y, sel, sw, wk):
     """The applied moments on each dof (WK_LINE_M) and the line's torques (WK_LINE_T), after
-    :func:`line_speeds`. Returns (M_gas, its power, M_load, M_starter, the power the line's
-    damping takes)."""
+    :func:`line_speeds`, each cylinder's table pieces held by ``sel`` moved by its dof's twist.
+    Returns (M_gas, its power, M_load, M_starter, the power the line's damping takes)."""
     carrier, dofs, elements = line_parts(m.line)
     n = line_dofs(m)
     for d in range(n):
@@ -192,7 +178,9 @@ def line_forces(m, y, sw, wk):
         for c in range(m.ncyl):
             d = int(carrier[c])
             theta = wk[WK_LINE_THETA, d]
-            p = cylinder_pressure(m, c, theta, y, cylinder_fuel(m, c, theta, y, f), wk)
+            theta_sel = sel + (theta - y[PHI])
+            p = cylinder_pressure(m, c, theta, theta_sel, y, cylinder_fuel(m, c, theta_sel, y, f),
+                                  wk)
             M_c = m.gas_scale[c] * (p - m.gas_offset) * wk[WK_U, c]
             wk[WK_LINE_M, d] += M_c
             M_gas += M_c
@@ -207,28 +195,22 @@ def line_forces(m, y, sw, wk):
 
 
 @kernel(inline=True)
-def line_at(m, angle_mode, y, sw, wk, with_dJ):
+def line_at(m, angle_mode, y, sel, sw, wk):
     """Every dof's inertia, speed, applied moments and the line's torques at ``y`` into ``wk``
     (what the derivative and the output row both start from; J′_d only ``with_dJ``); returns
     :func:`line_forces`'."""
     line_inertias(m, y, wk, with_dJ)
     line_speeds(m, angle_mode, y, wk)
-    return line_forces(m, y, sw, wk)
+    return line_forces(m, y, sel, sw, wk)
 
 
 @kernel(inline=True)
-def elastic_rates(m, extras, angle_mode, y, sw, wk, out):
+def elastic_rates(m, angle_mode, y, sel, sw, wk, out):
     """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
     form of :func:`.rhs.derivative`; with non-ideal pairs each throw's chain (T7)."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    pairs = extras is not None and m.n_pairs > 0
-    # (in crank angle the rates are the work–energy law's, (T5): no J′_d, unless the throws'
-    # chains split their moments, (T7))
-    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sw, wk,
-                                                     pairs or not angle_mode)
-    if pairs:
-        throw_chains(m, M_load, M_starter, sw, wk)
+    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sel, sw, wk)
     w = wk[WK_LINE_OMEGA, :n]
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
@@ -264,23 +246,24 @@ def elastic_rates(m, extras, angle_mode, y, sw, wk, out):
     if m.gov_dyn != gv.NONE or m.latch:  # the reference's speed drives the governor
         governor_rates(m, w_ref, y, q, sw, wk, out)
     if m.woschni:
-        pressure_rates(m, y, sw, w, q, wk, out)
+        pressure_rates(m, y, sel, sw, w, q, wk, out)
 
 
 @kernel(inline=True)
-def pressure_rates(m, y, sw, w, q, wk, out):
+def pressure_rates(m, y, sel, sw, w, q, wk, out):
     """The cylinders' pressure states' rates (× ``q``: 1/ω_ref in crank angle), each at its
     station's angle and speed ``w[d]`` (after :func:`line_forces`)."""
     carrier = line_parts(m.line)[0]
     f = command(m, True, w[int(m.line[0, LM_REF])], y, sw)
+    shift = y[PHI] - sel
     for c in range(m.ncyl):
         d = int(carrier[c])
-        f_c = cylinder_fuel(m, c, wk[WK_LINE_THETA, d], y, f)
-        out[cyl_index(m) + c] = q * cylinder_pressure_rate(m, c, y, w[d], f_c, wk)
+        f_c = cylinder_fuel(m, c, wk[WK_LINE_THETA, d] - shift, y, f)
+        out[cyl_index(m) + c] = q * cylinder_pressure_rate(m, c, y, shift, w[d], f_c, wk)
 
 
 @kernel
-def elastic_row(m, extras, angle_mode, y, sw, wk, row):
+def elastic_row(m, angle_mode, y, sel, sw, wk, row):
     """An elastic scene's output row: the fixed columns of the reference
     dof (ω, ε, J, J′ its own; M_gas all cylinders', M_load at its dof), each cylinder's
     pressure at its own angle, then per dof its twist θ_d − φ and speed, per element its torque
@@ -288,9 +271,7 @@ def elastic_row(m, extras, angle_mode, y, sw, wk, row):
     damping took."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sw, wk, True)
-    if extras is not None and m.n_pairs > 0:
-        throw_chains(m, M_load, M_starter, sw, wk)
+    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk)
     acc = wk[WK_LINE_RATE, :n]
     line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                        wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)
@@ -311,8 +292,10 @@ def elastic_row(m, extras, angle_mode, y, sw, wk, row):
     row[12] = y[W_STARTER]
     for c in range(m.ncyl):
         theta = wk[WK_CYL_ANGLE, c]
-        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, theta, y, cylinder_fuel(m, c, theta, y, f),
-                                                  wk) if m.has_gas else 0.0)
+        theta_sel = sel + (theta - y[PHI])
+        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, theta, theta_sel, y,
+                                                  cylinder_fuel(m, c, theta_sel, y, f), wk)
+                                if m.has_gas else 0.0)
     governor_rows(m, y, row)
     if extras is not None and m.n_pairs > 0:
         throw_pair_rows(m, y, wk, row)

@@ -71,15 +71,12 @@ LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylind
 LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS, LM_CHAINS = LINE_META
 #: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
 #: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad],
-#: its gear ratio to the reference [1] (1 for every dof of a scene's line, whose driven inertia
-#: is referred to the shaft, :class:`transient.shaft.line.ShaftLine`, so that its angle is
-#: φ + q_d), the chain of the pairs it carries (its cylinders' throw; −1 on a dof without
-#: cylinders) and its share of the cylinders, which is its share of the links' constant
-#: inertias (``Model.link_J``) [1].
-LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear", "chain", "share")
-LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR, LD_CHAIN, LD_SHARE = LINE_DOF
-#: Columns of the Model's packed ``line``: enough for each of its kinds of row.
-N_LINE_COLUMNS = max(LINE_META.size, LINE_DOF.size, N_ELEMENT)
+#: its gear ratio to the reference [1]: 1 for every dof of a scene's line, whose driven
+#: inertia is referred to the shaft (:class:`transient.shaft.line.ShaftLine`), so that its angle is
+#: φ + q_d; and where its breakpoints begin in ``Model.breakpoints`` (its own, on its angle; they
+#: end where the next dof's begin).
+LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear", "breakpoints")
+LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR, LD_BREAKPOINTS = LINE_DOF
 
 
 @kernel(inline=True)
@@ -371,7 +368,8 @@ Model = namedtuple(
         "coef",  # float64[:, 4], or [:, 8] with has_motored (full-load, then motored cubic)
         "piece_knot",  # int64[:]
         "has_motored",  # bool: coef pairs a motored curve; else it is the constant gas_offset
-        "breakpoints",  # float64[:]: sorted shaft angles in [0, period) where a table has a corner
+        "breakpoints",  # float64[:]: sorted shaft angles in [0, period) where a table has a corner;
+        #   on an elastic line each dof's own angles in turn, sorted each (LD_BREAKPOINTS)
         "bp_jump",  # bool[:]: whether a cylinder's pressure jumps at each breakpoint
         "load_const",  # float: constant resisting torque [N m]
         "load_linear",  # float: c in −c·ω [N m s]
@@ -442,6 +440,14 @@ Model = namedtuple(
         "line_model",  # kernel: the line's derivative, output row, pairs' margins or modes
         "line_switch",  # kernel: each other dof's speed state to K_d or back (m, y, to_angle, wk)
         "reference_inertia",  # kernel: J of the third state's K = ½Jω² at φ (m, phi, wk)
+        # the breakpoints on each dof's own angle (transient.core.stepper.breakpoints; a rigid
+        # shaft's, whose breakpoints are the shaft's, the stepper's bp, are no-ops)
+        "line_segment_end",  # kernel: where the next step ends for one (m, fst, f, angle_mode,
+        #   x, y, x_end, tol_end)
+        "line_retake",  # kernel: a step that crossed one retaken (tab, m, extras, at, y, work,
+        #   fst, ist, min_step, dense_ready)
+        "line_passed",  # kernel: what those a move of the state reached do (m, extras, y, y_to,
+        #   sw, evbuf, ist, wk)
     ],
 )
 typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)

@@ -165,7 +165,7 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     derivative (``Model.line_model``, :mod:`.elastic`; in a rigid scene's Model a kernel that
     returns NOT_A_LINE, a constant the compiler folds: the rigid path tests nothing at run time).
     """
-    if m.line_model(m, extras, LINE_RATES, angle_mode, y, sw, wk, out) != NOT_A_LINE:
+    if m.line_model(m, False, angle_mode, y, sel, sw, wk, out):
         return
     # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
     with_dJ = not angle_mode or (extras is not None and m.n_pairs > 0)

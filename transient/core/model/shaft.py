@@ -25,7 +25,7 @@ from .layout import (
     EL_J,
     EL_K,
     EL_R,
-    LD_CHAIN,
+    LD_BREAKPOINTS,
     LD_OWN,
     LD_SHARE,
     LINE_DOF,
@@ -229,6 +229,24 @@ def ref_inertia(m, phi, wk):
     return J
 
 
+@kernel(inline=True)
+def dof_angle(m, y, d):
+    """θ_d of dof d at state ``y``: the reference's φ, any other's φ + q_d."""
+    if d == int(m.line[0, LM_REF]):
+        return y[PHI]
+    return y[PHI] + y[twist_index(m, d)]
+
+
+@kernel(inline=True)
+def dof_breakpoints(m, d):
+    """Dof d's own breakpoints, sorted angles of its cycle on its angle θ_d (a view of
+    ``Model.breakpoints``), and the index of the first in it (``Model.bp_jump`` alike)."""
+    dofs = line_parts(m.line)[1]
+    first = int(dofs[d, LD_BREAKPOINTS])
+    end = int(dofs[d + 1, LD_BREAKPOINTS]) if d + 1 < dofs.shape[0] else m.breakpoints.shape[0]
+    return m.breakpoints[first:end], first
+
+
 # -- a rigid shaft's kernels in the Model's line fields (never called: there are no dofs)
 
 
@@ -243,6 +261,6 @@ def no_line_switch(m, y, to_angle, wk):
 
 
 @kernel(inline=True)
-def no_line_model(m, extras, what, angle_mode, y, sw, wk, out):
-    """``Model.line_model`` of a rigid shaft: nothing done, as its NOT_A_LINE says."""
-    return NOT_A_LINE
+def no_line_model(m, row, angle_mode, y, sel, sw, wk, out):
+    """``Model.line_model`` of a rigid shaft: nothing done, as its False says."""
+    return False

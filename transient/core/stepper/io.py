@@ -19,6 +19,7 @@ from ..integrator.rk import dense_eval
 from ..jit import kernel
 from ..model.forcing import inertia, speed
 from ..model.layout import (
+    LM_DOFS,
     N_SWITCHES,
     PHI,
     STATE,
@@ -31,7 +32,7 @@ from ..model.layout import (
     SW_SLEEVE,
     SW_STARTER,
     T,
-    n_margins,
+    n_state,
 )
 from ..model.outputs import output_row, output_row_inline
 
@@ -55,7 +56,9 @@ N_CFG = SETTINGS.size
 #: that the last step carried over (FSAL), then the pairs' margins there (``F_DERIV``, kept where
 #: a chunk ends with them valid, ``ist[I_F_VALID]``: recomputed at a chunk's start instead, with
 #: the table piece ahead of the shaft, not the step's, they would make the run depend in its last
-#: bits on where the output buffer fills, i.e. on the samples per turn).
+#: bits on where the output buffer fills, i.e. on the samples per turn); on an elastic line then
+#: the size of the step a retake aims at a breakpoint on a dof's own angle with (0: none) and
+#: the retakes so aimed in a row (:func:`line_fst`).
 FLOATS = Layout(
     "stepper floats", "h", "sel", "next_out", "last_t", "last_phi", "passed_bp", "redo_level",
     "last_switch", "err_old",
@@ -64,6 +67,9 @@ FLOATS = Layout(
     Block("margins", Sized(lambda m: max(n_margins(m), 1),
                            "one per pair (per pair and throw on a line), at least one"),
           "the pairs' margins at y"),
+    Block("line", Sized(lambda m: 2 if int(m.line[0, LM_DOFS]) > 0 else 0,
+                        "two on an elastic line"),
+          "the step a retake aims at a dof's breakpoint with, the retakes in a row"),
 )
 (F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH,
  F_ERR_OLD) = (FLOATS.fixed_offset(n) for n in FLOATS.names[:9])
@@ -157,6 +163,12 @@ EVENT_NAMES = tuple(name for name, _ in EVENTS)
 def fst_size(m) -> int:
     """Length of the float stepper state ``fst`` of model ``m`` (:data:`FLOATS`)."""
     return FLOATS.offsets_for(m)[-1]
+
+
+@kernel(inline=True)
+def line_fst(m):
+    """Index in ``fst`` of an elastic line's block (:data:`FLOATS`), after the margins."""
+    return F_DERIV + n_state(m) + max(m.n_pairs, 1)
 
 
 @kernel(inline=True)

@@ -96,7 +96,7 @@ from ..model.rhs import (
     watches_kinks,
 )
 from ..model.work import work_array
-from .breakpoints import _aim_at_breakpoint, _at_breakpoint, _segment_end
+from .breakpoints import AHEAD, _aim_at_breakpoint, _at_breakpoint, _segment_end
 from .events import (
     DEMAND_COMP,
     MAX_UNSEEN,
@@ -302,7 +302,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
             _restarted(cfg, angle_mode, fst, ist)
 
         # The segment and the step size.
-        seg = _segment_end(m, cfg, bp, angle_mode, ix, x, y, sw, fst)
+        seg = _segment_end(m, cfg, bp, angle_mode, ix, x, y, f, sw, fst)
         if seg.x_end - x <= seg.tol_end:
             return _finish(m, extras, y, fst[F_SEL], sw, outbuf, evbuf, ist, fst, wk)
         fixed = angle_mode and cfg[C_FIXED_STEP] > 0.0
@@ -393,6 +393,12 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
             continue
         redo_hit_breakpoint = ist[I_NREDO] > 0 or dense_ready
         ist[I_NREDO] = 0
+        # (on an elastic line the breakpoints on each dof's own angle, in either domain)
+        retake, dense_ready = m.line_retake(tab, m, extras, at, y, work, fst, ist, min_step,
+                                            dense_ready)
+        if retake:
+            steps_here += 1
+            continue
 
         # State events on this step: the earliest one truncates it.
         ev_code, ev_theta, ev_comp, ev_level, ev_rising, unseen, dense_ready = _locate_events(
@@ -420,7 +426,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         if extras is not None and ev_code == EV_PAIR_MODE and ist[I_DIRECTION] == st.STUCK:
             ev_code = EV_RELEASED  # (the holding margin, in pair 0's slot, fell to zero)
         x_stop, on_breakpoint = _move_to_event(m, extras, at, seg, at_segment_end, x_stop,
-                                               (ev_theta, ev_comp, ev_level), y, work, ist)
+                                               (ev_theta, ev_comp, ev_level), y, work, ist, evbuf)
         status = _record_event(m, extras, io, angle_mode, on_breakpoint, x_stop, ev_code, y, sel,
                                sw, wk)
         if status != RUNNING:
@@ -481,7 +487,7 @@ def _settle_at_restart(m, extras, angle_mode, y, sw, wk, gs, ist, evbuf):
     for the derivative there."""
     # (the table piece just ahead in the direction of motion: on a breakpoint, rounding of the
     # shaft angle must not pick the piece behind it)
-    ahead = y[PHI] + (1e-9 if angle_mode or y[OMEGA] >= 0.0 else -1e-9)
+    ahead = y[PHI] + (AHEAD if angle_mode or y[OMEGA] >= 0.0 else -AHEAD)
     if extras is not None and m.n_pairs > 0:
         _settle_modes(m, extras, angle_mode, y, ahead, sw, wk, gs, ist, evbuf)
         ist[I_NFEV] += 1
@@ -656,6 +662,7 @@ def _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint,
     angle_mode, sel, sw = at.angle_mode, at.sel, at.sw
     n = y.shape[0]
     ist[I_AT_EVENT] = 0
+    stale = m.line_passed(m, extras, y, y_new, sw, evbuf, ist, wk)
     for i in range(n):
         y[i] = y_new[i]
         f[i] = K[tab.n_stages, i]
@@ -666,6 +673,8 @@ def _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint,
             # rounding on its far side) would never be seen falling: the next step settles the
             # modes first (_settle_modes).
             ist[I_F_VALID] = 0
+    if stale:  # (a breakpoint on a dof's own angle changed the state, or a pressure jumps there)
+        ist[I_F_VALID] = 0
     if angle_mode and at_segment_end and seg.x_end == seg.up:
         _emit_event(m, evbuf, ist, EV_BREAKPOINT, y, wk)
         if _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
@@ -683,9 +692,10 @@ def _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint,
 
 
 @kernel(inline=True)
-def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work, ist):
+def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work, ist, evbuf):
     """The state at the event (``crossing``: its θ in the step, its component and level; the
-    independent variable ``x_stop``), put exactly on the event's level, becomes the state.
+    independent variable ``x_stop``), put exactly on the event's level, becomes the state
+    (what a breakpoint on a dof's own angle that it reaches does, done).
     Returns ``(x_stop, on_breakpoint)``: an event within rounding of the breakpoint the step ends on (a pair whose
     power changes sign at a pressure corner, a load corner there) is on it, and the state goes
     exactly there, so that both are recorded (else the next step would take the breakpoint as
@@ -712,6 +722,7 @@ def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work
         y_evt[KINETIC] = 0.5 * J * ev_level * ev_level
     else:
         y_evt[OMEGA] = ev_level
+    m.line_passed(m, extras, y, y_evt, sw, evbuf, ist, wk)  # (the derivative is taken anew)
     for i in range(y.shape[0]):
         y[i] = y_evt[i]
     ist[I_F_VALID] = 0
