@@ -103,7 +103,8 @@ def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
             assert names[out[layout.O_LINE]] == f"twist_{scene.shaft.stations[0].name}"
             assert names[-1] == "W_line_loss"
     assert work_array(model).shape[0] == N_WK
-    assert sio.fst_size(model) == sio.N_FST + at[-1] + max(model.n_pairs, 1) + (2 if dofs else 0)
+    assert sio.fst_size(model) == (sio.N_FST + at[-1] + max(model.n_pairs, 1)
+                                   + (2 + 2 * dofs if dofs else 0))
     if dofs:  # (the kernels' index of the elastic line's block, as the layout's)
         assert sio.line_fst(model) == sio.FLOATS.offsets_for(model)[-2]
 

@@ -10,10 +10,20 @@ import numpy as np
 from ..jit import kernel
 
 
+@kernel(inline=True)
+def reached(level, phi, upward):
+    """Whether φ has reached the breakpoint at ``level`` (the shaft angle it is at) moving up
+    (``upward``) or down: it is within the search's tolerance of φ or behind it, so that
+    :func:`next_breakpoint` from φ looks beyond it."""
+    tol = 1e-13 * max(1.0, abs(phi))
+    return level <= phi + tol if upward else level >= phi - tol
+
+
 @kernel
 def next_breakpoint(bp, period, phi, upward):
-    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle; by
-    bisection, as a table from points makes every knot of every cylinder a breakpoint."""
+    """The breakpoint strictly above (``upward``) or below φ, as an absolute shaft angle (the
+    first not :func:`reached` from φ); by bisection, as a table from points makes every knot of
+    every cylinder a breakpoint."""
     tol = 1e-13 * max(1.0, abs(phi))
     k = np.floor(phi / period)
     n = bp.shape[0]

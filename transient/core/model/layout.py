@@ -447,7 +447,7 @@ Model = namedtuple(
         "line_retake",  # kernel: a step that crossed one retaken (tab, m, extras, at, y, work,
         #   fst, ist, min_step, dense_ready)
         "line_passed",  # kernel: what those a move of the state reached do (m, extras, y, y_to,
-        #   sw, evbuf, ist, wk)
+        #   sw, evbuf, ist, wk, fst)
     ],
 )
 typed_by_fingerprint(Model)  # (its kernels have no numba fingerprint)

@@ -18,7 +18,9 @@ them.
 """
 from __future__ import annotations
 
-from ..integrator.breakpoints import count_below, next_breakpoint
+import numpy as np
+
+from ..integrator.breakpoints import count_below, next_breakpoint, reached
 from ..integrator.roots import root
 from ..jit import kernel
 from ..model import cylinder as cyl
@@ -191,11 +193,26 @@ def _at_breakpoint(m, extras, bp, y, sw, evbuf, ist, wk):
 def _next_dof_breakpoint(m, d, theta, upward):
     """The breakpoint of dof d's own next beyond its angle θ by more than SHORT (absolute, on
     its angle): one a step ended within SHORT of is behind it, reached
-    (:func:`_pass_dof_breakpoints`)."""
+    (:func:`_pass_dof_breakpoints`). Upward, the one kept in ``fst`` (:func:`_next_up`) is
+    the same, found without a search."""
     bps = dof_breakpoints(m, d)[0]
     if upward:
         return next_breakpoint(bps, m.period, theta + SHORT, True)
     return next_breakpoint(bps, m.period, theta - SHORT, False)
+
+
+@kernel(inline=True)
+def _next_up(m, fst, d, theta):
+    """:func:`_next_dof_breakpoint` upward, kept in ``fst`` with the angle it was found from
+    (its pair in the elastic line's block): still the next at any angle from there up to where
+    it is reached, so that a step searches only past a breakpoint. Found afresh where θ is
+    below that angle (zeros, before the first search, or a dof turning back in time) or has
+    reached it."""
+    i = line_fst(m) + 2 + 2 * d
+    if theta < fst[i] or reached(fst[i + 1], theta + SHORT, True):
+        fst[i] = theta
+        fst[i + 1] = _next_dof_breakpoint(m, d, theta, True)
+    return fst[i + 1]
 
 
 @kernel(inline=True)
@@ -214,15 +231,13 @@ def _dof_segment_end(m, fst, f, angle_mode, x, y, x_end, tol_end):
     if angle_mode:
         ref = int(m.line[0, LM_REF])
         for d in range(line_dofs(m)):
-            if dof_breakpoints(m, d)[0].shape[0] == 0:
-                continue
             theta = dof_angle(m, y, d)
-            level = _next_dof_breakpoint(m, d, theta, True)
+            level = _next_up(m, fst, d, theta)
             if d == ref:
                 x_end = min(x_end, level)
             else:
                 rate = 1.0 + f[twist_index(m, d)]
-                if rate > 0.0:
+                if rate > 0.0 and level < np.inf:
                     x_end = min(x_end, max(x + (level - theta) / rate, least))
     return x_end
 
@@ -246,9 +261,9 @@ def _aim_at_dof_breakpoints(tab, m, extras, at, y, work, fst, ist, min_step, den
     for d in range(line_dofs(m)):
         a = dof_angle(m, y, d)
         b = dof_angle(m, y_new, d)
-        if b == a or dof_breakpoints(m, d)[0].shape[0] == 0:
+        if b == a:
             continue
-        level = _next_dof_breakpoint(m, d, a, b > a)
+        level = _next_up(m, fst, d, a) if b > a else _next_dof_breakpoint(m, d, a, False)
         if (b - level if b > a else level - b) > BP_LANDING:
             dense_ready = _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
             found = root(_dof_angle_value, (m, d, level), work.F, y, work.tmp, 0.0, 1.0,
@@ -266,7 +281,7 @@ def _aim_at_dof_breakpoints(tab, m, extras, at, y, work, fst, ist, min_step, den
 
 
 @kernel(inline=True)
-def _pass_dof_breakpoints(m, extras, y, y_to, sw, evbuf, ist, wk):
+def _pass_dof_breakpoints(m, extras, y, y_to, sw, evbuf, ist, wk, fst):
     """``Model.line_passed``, where the state moves from y to ``y_to`` (a step taken, or the
     state moved to an event in it): each breakpoint on a dof's own angle the move reached (to
     within SHORT) acts on ``y_to`` (:func:`_at_dof_breakpoint`). Returns whether the derivative
@@ -275,12 +290,11 @@ def _pass_dof_breakpoints(m, extras, y, y_to, sw, evbuf, ist, wk):
     for d in range(line_dofs(m)):
         a = dof_angle(m, y, d)
         b = dof_angle(m, y_to, d)
-        if b == a or dof_breakpoints(m, d)[0].shape[0] == 0:
+        if b == a:
             continue
         up = b > a
-        level = _next_dof_breakpoint(m, d, a, up)
-        beyond = _next_dof_breakpoint(m, d, b, up)  # (the first not reached)
-        while level < beyond if up else level > beyond:
+        level = _next_up(m, fst, d, a) if up else _next_dof_breakpoint(m, d, a, False)
+        while reached(level, b + SHORT if up else b - SHORT, up):
             stale = _at_dof_breakpoint(m, extras, d, level, up, y_to, sw, evbuf, ist, wk) or stale
             level = next_breakpoint(dof_breakpoints(m, d)[0], m.period, level, up)
     return stale
@@ -318,7 +332,7 @@ def no_retake(tab, m, extras, at, y, work, fst, ist, min_step, dense_ready):
 
 
 @kernel(inline=True)
-def no_passed(m, extras, y, y_to, sw, evbuf, ist, wk):
+def no_passed(m, extras, y, y_to, sw, evbuf, ist, wk, fst):
     """``Model.line_passed`` of a rigid shaft: the derivative stays valid."""
     return False
 

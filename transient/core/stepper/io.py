@@ -57,8 +57,9 @@ N_CFG = SETTINGS.size
 #: a chunk ends with them valid, ``ist[I_F_VALID]``: recomputed at a chunk's start instead, with
 #: the table piece ahead of the shaft, not the step's, they would make the run depend in its last
 #: bits on where the output buffer fills, i.e. on the samples per turn); on an elastic line then
-#: the size of the step a retake aims at a breakpoint on a dof's own angle with (0: none) and
-#: the retakes so aimed in a row (:func:`line_fst`).
+#: the size of the step a retake aims at a breakpoint on a dof's own angle with (0: none), the
+#: retakes so aimed in a row, and per dof an angle and its next breakpoint above it
+#: (:func:`line_fst`, ``breakpoints._next_up``).
 FLOATS = Layout(
     "stepper floats", "h", "sel", "next_out", "last_t", "last_phi", "passed_bp", "redo_level",
     "last_switch", "err_old",
@@ -67,9 +68,10 @@ FLOATS = Layout(
     Block("margins", Sized(lambda m: max(n_margins(m), 1),
                            "one per pair (per pair and throw on a line), at least one"),
           "the pairs' margins at y"),
-    Block("line", Sized(lambda m: 2 if int(m.line[0, LM_DOFS]) > 0 else 0,
-                        "two on an elastic line"),
-          "the step a retake aims at a dof's breakpoint with, the retakes in a row"),
+    Block("line", Sized(lambda m: 2 + 2 * int(m.line[0, LM_DOFS]) if m.line[0, LM_DOFS] else 0,
+                        "on an elastic line two, and two per dof"),
+          "the step a retake aims at a dof's breakpoint with, the retakes in a row; per dof "
+          "an angle and the next breakpoint above it"),
 )
 (F_H, F_SEL, F_NEXT_OUT, F_LAST_T, F_LAST_PHI, F_PASSED_BP, F_REDO_LEVEL, F_LAST_SWITCH,
  F_ERR_OLD) = (FLOATS.fixed_offset(n) for n in FLOATS.names[:9])

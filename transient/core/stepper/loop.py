@@ -426,7 +426,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         if extras is not None and ev_code == EV_PAIR_MODE and ist[I_DIRECTION] == st.STUCK:
             ev_code = EV_RELEASED  # (the holding margin, in pair 0's slot, fell to zero)
         x_stop, on_breakpoint = _move_to_event(m, extras, at, seg, at_segment_end, x_stop,
-                                               (ev_theta, ev_comp, ev_level), y, work, ist, evbuf)
+                                               (ev_theta, ev_comp, ev_level), y, work, io)
         status = _record_event(m, extras, io, angle_mode, on_breakpoint, x_stop, ev_code, y, sel,
                                sw, wk)
         if status != RUNNING:
@@ -662,7 +662,7 @@ def _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint,
     angle_mode, sel, sw = at.angle_mode, at.sel, at.sw
     n = y.shape[0]
     ist[I_AT_EVENT] = 0
-    stale = m.line_passed(m, extras, y, y_new, sw, evbuf, ist, wk)
+    stale = m.line_passed(m, extras, y, y_new, sw, evbuf, ist, wk, fst)
     for i in range(n):
         y[i] = y_new[i]
         f[i] = K[tab.n_stages, i]
@@ -692,7 +692,7 @@ def _take_step(tab, m, extras, io, at, seg, at_segment_end, redo_hit_breakpoint,
 
 
 @kernel(inline=True)
-def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work, ist, evbuf):
+def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work, io):
     """The state at the event (``crossing``: its θ in the step, its component and level; the
     independent variable ``x_stop``), put exactly on the event's level, becomes the state
     (what a breakpoint on a dof's own angle that it reaches does, done).
@@ -702,6 +702,7 @@ def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work
     passed, unseen)."""
     ev_theta, ev_comp, ev_level = crossing
     angle_mode, sel, sw, wk, y_evt = at.angle_mode, at.sel, at.sw, work.wk, work.y_evt
+    fst, ist, evbuf = io.fst, io.ist, io.evbuf
     dense_eval(work.F, y, ev_theta, y_evt)
     ends_on_breakpoint = at_segment_end and seg.x_end == seg.up
     on_breakpoint = angle_mode and ends_on_breakpoint and seg.x_end - x_stop <= seg.tol_end
@@ -722,7 +723,7 @@ def _move_to_event(m, extras, at, seg, at_segment_end, x_stop, crossing, y, work
         y_evt[KINETIC] = 0.5 * J * ev_level * ev_level
     else:
         y_evt[OMEGA] = ev_level
-    m.line_passed(m, extras, y, y_evt, sw, evbuf, ist, wk)  # (the derivative is taken anew)
+    m.line_passed(m, extras, y, y_evt, sw, evbuf, ist, wk, fst)  # (the derivative anew)
     for i in range(y.shape[0]):
         y[i] = y_evt[i]
     ist[I_F_VALID] = 0
