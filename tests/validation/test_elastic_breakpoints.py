@@ -5,18 +5,19 @@ a line whose twist is known in closed form, where each breakpoint must be met at
 any station's own; and the times at which the reference path's separately written line
 (:class:`transient.reference.torsion.SceneEngine`, scipy) has each cylinder's own angle pass its
 injection and its intake closing, where the compiled run must latch its fuel and restart its
-closed part."""
+closed part (the six, its PI governor and Wiebe cycle with wall heat as
+``test_elastic_features`` builds them)."""
 from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 from elastic_checks import line_balance
 from scipy.optimize import brentq
+from test_elastic_features import PI, WIEBE, six
 
 import transient
 from transient.assemble import build_model
@@ -193,45 +194,6 @@ def _crossings(sol, t_end, index, level, period):
     return np.array(out)
 
 
-PI = """
-[governor]
-model = "pi"
-speed_rpm = 850
-gain_p = 0.02
-gain_i = 0.2
-fuel_min = 0.0
-fuel_max = 1.0
-fuel_initial = 0.8
-"""
-
-WOSCHNI = """[gas]
-model = "wiebe"
-p0_MPa = 0.1
-compression_ratio = 18
-p_a_MPa = 0.1436
-p_intake_MPa = 0.165
-p_exhaust_MPa = 0.182
-
-[gas.wiebe]
-start_deg = 358
-duration_deg = 50
-a = 6.908
-m = 0.5
-fuel_mass = 0.031e-3
-lhv = 42.5e6
-efficiency = 1.0
-gamma = 1.368
-gamma_slope = 0.0
-t_a = 329.9
-
-[gas.woschni]
-c1 = 2.28
-c2 = 3.24e-3
-wall_temperature = 450
-
-"""
-
-
 @pytest.mark.slow
 def test_latching_and_the_closed_parts_restart_at_each_cylinders_own_angle():
     """The six with a PI governor and fuel latched at 20° before each firing TDC, with the Wiebe
@@ -239,12 +201,7 @@ def test_latching_and_the_closed_parts_restart_at_each_cylinders_own_angle():
     intake closes (its closed part restarts at p_a) at the times at which its own station's
     angle passes them in the reference line, to 1e-7 s, where the reference's angle passes
     them a twist's worth (some µs) apart; and the run against the reference line."""
-    text = (CASES / "inline6_damper.toml").read_text(encoding="utf-8")
-    text = re.sub(r"\[gas\]\n.*?\n(?=\[load\])", WOSCHNI, text, flags=re.S)
-    text = text.replace("[gas]\n", "[gas]\ninjection_deg = 340\n", 1)
-    sc = load_scene("six.toml", text=text + PI)
-    scene = dataclasses.replace(sc, run=dataclasses.replace(sc.run, revolutions=2.0),
-                                solver=dataclasses.replace(sc.solver, rtol=1e-8, atol=1e-10))
+    scene = six(PI, gas=WIEBE, injection=340)
     res = transient.simulate(scene)
     tr = res.trajectory
     model, ref = from_scene(scene)
