@@ -106,7 +106,8 @@ def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
     assert sio.fst_size(model) == (sio.N_FST + at[-1] + max(model.n_pairs, 1)
                                    + (2 + 2 * dofs if dofs else 0))
     if dofs:  # (the kernels' index of the elastic line's block, as the layout's)
-        assert sio.line_fst(model) == sio.FLOATS.offsets_for(model)[-2]
+        assert sio.line_fst(model, np.zeros(sio.fst_size(model))) == sio.FLOATS.offsets_for(
+            model)[-2]
 
 
 @pytest.mark.parametrize("solver", [jf, sf, af], ids=["crank-slider", "swash plate", "articulated"])

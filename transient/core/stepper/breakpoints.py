@@ -208,7 +208,7 @@ def _next_up(m, fst, d, theta):
     it is reached, so that a step searches only past a breakpoint. Found afresh where θ is
     below that angle (zeros, before the first search, or a dof turning back in time) or has
     reached it."""
-    i = line_fst(m) + 2 + 2 * d
+    i = line_fst(m, fst) + 2 + 2 * d
     if theta < fst[i] or reached(fst[i + 1], theta + SHORT, True):
         fst[i] = theta
         fst[i + 1] = _next_dof_breakpoint(m, d, theta, True)
@@ -225,7 +225,7 @@ def _dof_segment_end(m, fst, f, angle_mode, x, y, x_end, tol_end):
     one that crosses it is retaken. At least twice ``tol_end`` ahead of x: a segment that ends
     within it of x is the run's end."""
     least = x + 2.0 * tol_end
-    aim = fst[line_fst(m)]
+    aim = fst[line_fst(m, fst)]
     if aim > 0.0:
         return min(x_end, max(x + aim, least))
     if angle_mode:
@@ -269,7 +269,7 @@ def _aim_at_dof_breakpoints(tab, m, extras, at, y, work, fst, ist, min_step, den
             found = root(_dof_angle_value, (m, d, level), work.F, y, work.tmp, 0.0, 1.0,
                          a - level, b - level)[0]
             theta = min(theta, found)
-    i = line_fst(m)
+    i = line_fst(m, fst)
     if theta <= 1.0 and theta * at.h > min_step and fst[i + 1] < MAX_RETAKES:
         fst[i] = theta * at.h
         fst[i + 1] += 1.0

@@ -32,7 +32,7 @@ from ..model.layout import (
     SW_SLEEVE,
     SW_STARTER,
     T,
-    n_state,
+    line_dofs,
 )
 from ..model.outputs import output_row, output_row_inline
 
@@ -168,9 +168,10 @@ def fst_size(m) -> int:
 
 
 @kernel(inline=True)
-def line_fst(m):
-    """Index in ``fst`` of an elastic line's block (:data:`FLOATS`), after the margins."""
-    return F_DERIV + n_state(m) + max(m.n_pairs, 1)
+def line_fst(m, fst):
+    """Index in ``fst`` of an elastic line's block (:data:`FLOATS`): its last, two and two
+    per dof."""
+    return fst.shape[0] - 2 - 2 * line_dofs(m)
 
 
 @kernel(inline=True)
