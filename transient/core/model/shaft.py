@@ -176,7 +176,14 @@ def line_angle_rates(ref, gear, M, T, omega, d_twist, d_energy):
 @kernel(inline=True)
 def twist_index(m, d):
     """Index in the state of dof d's twist q_d (d not the reference); its K_d (ω_d) follows."""
-    return line_index(m) + 2 * (d if d < int(m.line[0, LM_REF]) else d - 1)
+    return twist_at(line_index(m), int(m.line[0, LM_REF]), d)
+
+
+@kernel(inline=True)
+def twist_at(first, ref, d):
+    """:func:`twist_index` from the line's first state (``layout.line_index``) and the reference
+    dof, for a loop over the dofs that reads them once."""
+    return first + 2 * (d if d < ref else d - 1)
 
 
 @kernel(inline=True)
@@ -232,9 +239,13 @@ def ref_inertia(m, phi, wk):
 @kernel(inline=True)
 def dof_angle(m, y, d):
     """θ_d of dof d at state ``y``: the reference's φ, any other's φ + q_d."""
-    if d == int(m.line[0, LM_REF]):
-        return y[PHI]
-    return y[PHI] + y[twist_index(m, d)]
+    return angle_at(y, d, line_index(m), int(m.line[0, LM_REF]))
+
+
+@kernel(inline=True)
+def angle_at(y, d, first, ref):
+    """:func:`dof_angle` from the line's first state and the reference dof (:func:`twist_at`)."""
+    return y[PHI] if d == ref else y[PHI] + y[twist_at(first, ref, d)]
 
 
 @kernel(inline=True)

@@ -25,8 +25,8 @@ from ..integrator.roots import root
 from ..jit import kernel
 from ..model import cylinder as cyl
 from ..model.forcing import command, inertia, speed
-from ..model.layout import LM_REF, OMEGA, PHI, cyl_index, latch_index, line_dofs
-from ..model.shaft import dof_angle, dof_breakpoints, line_parts, twist_index
+from ..model.layout import LM_REF, OMEGA, PHI, cyl_index, latch_index, line_dofs, line_index
+from ..model.shaft import angle_at, dof_angle, dof_breakpoints, line_parts, twist_at
 from .events import _crossing, _dense_once, _load_corner
 from .io import (
     C_DPHI_OUT,
@@ -202,13 +202,13 @@ def _next_dof_breakpoint(m, d, theta, upward):
 
 
 @kernel(inline=True)
-def _next_up(m, fst, d, theta):
+def _next_up(m, fst, block, d, theta):
     """:func:`_next_dof_breakpoint` upward, kept in ``fst`` with the angle it was found from
-    (its pair in the elastic line's block): still the next at any angle from there up to where
-    it is reached, so that a step searches only past a breakpoint. Found afresh where θ is
-    below that angle (zeros, before the first search, or a dof turning back in time) or has
-    reached it."""
-    i = line_fst(m, fst) + 2 + 2 * d
+    (its pair in the elastic line's block, from index ``block``, :func:`.io.line_fst`): still
+    the next at any angle from there up to where it is reached, so that a step searches only
+    past a breakpoint. Found afresh where θ is below that angle (zeros, before the first
+    search, or a dof turning back in time) or has reached it."""
+    i = block + 2 + 2 * d
     if theta < fst[i] or reached(fst[i + 1], theta + SHORT, True):
         fst[i] = theta
         fst[i + 1] = _next_dof_breakpoint(m, d, theta, True)
@@ -225,18 +225,19 @@ def _dof_segment_end(m, fst, f, angle_mode, x, y, x_end, tol_end):
     one that crosses it is retaken. At least twice ``tol_end`` ahead of x: a segment that ends
     within it of x is the run's end."""
     least = x + 2.0 * tol_end
-    aim = fst[line_fst(m, fst)]
+    block = line_fst(m, fst)
+    aim = fst[block]
     if aim > 0.0:
         return min(x_end, max(x + aim, least))
     if angle_mode:
-        ref = int(m.line[0, LM_REF])
+        ref, first = int(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
         for d in range(line_dofs(m)):
-            theta = dof_angle(m, y, d)
-            level = _next_up(m, fst, d, theta)
+            theta = angle_at(y, d, first, ref)
+            level = _next_up(m, fst, block, d, theta)
             if d == ref:
                 x_end = min(x_end, level)
             else:
-                rate = 1.0 + f[twist_index(m, d)]
+                rate = 1.0 + f[twist_at(first, ref, d)]
                 if rate > 0.0 and level < np.inf:
                     x_end = min(x_end, max(x + (level - theta) / rate, least))
     return x_end
@@ -258,25 +259,27 @@ def _aim_at_dof_breakpoints(tab, m, extras, at, y, work, fst, ist, min_step, den
     dense_ready)``."""
     y_new = work.y_new
     theta = 2.0
+    block = line_fst(m, fst)
+    ref, first = int(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
     for d in range(line_dofs(m)):
-        a = dof_angle(m, y, d)
-        b = dof_angle(m, y_new, d)
+        a = angle_at(y, d, first, ref)
+        b = angle_at(y_new, d, first, ref)
         if b == a:
             continue
-        level = _next_up(m, fst, d, a) if b > a else _next_dof_breakpoint(m, d, a, False)
+        level = (_next_up(m, fst, block, d, a) if b > a
+                 else _next_dof_breakpoint(m, d, a, False))
         if (b - level if b > a else level - b) > BP_LANDING:
             dense_ready = _dense_once(dense_ready, tab, m, extras, at, y, work, ist)
             found = root(_dof_angle_value, (m, d, level), work.F, y, work.tmp, 0.0, 1.0,
                          a - level, b - level)[0]
             theta = min(theta, found)
-    i = line_fst(m, fst)
-    if theta <= 1.0 and theta * at.h > min_step and fst[i + 1] < MAX_RETAKES:
-        fst[i] = theta * at.h
-        fst[i + 1] += 1.0
+    if theta <= 1.0 and theta * at.h > min_step and fst[block + 1] < MAX_RETAKES:
+        fst[block] = theta * at.h
+        fst[block + 1] += 1.0
         ist[I_NREJECT] += 1
         return True, dense_ready
-    fst[i] = 0.0
-    fst[i + 1] = 0.0
+    fst[block] = 0.0
+    fst[block + 1] = 0.0
     return False, dense_ready
 
 
@@ -287,13 +290,15 @@ def _pass_dof_breakpoints(m, extras, y, y_to, sw, evbuf, ist, wk, fst):
     within SHORT) acts on ``y_to`` (:func:`_at_dof_breakpoint`). Returns whether the derivative
     at ``y_to`` is stale."""
     stale = False
+    block = line_fst(m, fst)
+    ref, first = int(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
     for d in range(line_dofs(m)):
-        a = dof_angle(m, y, d)
-        b = dof_angle(m, y_to, d)
+        a = angle_at(y, d, first, ref)
+        b = angle_at(y_to, d, first, ref)
         if b == a:
             continue
         up = b > a
-        level = _next_up(m, fst, d, a) if up else _next_dof_breakpoint(m, d, a, False)
+        level = _next_up(m, fst, block, d, a) if up else _next_dof_breakpoint(m, d, a, False)
         while reached(level, b + SHORT if up else b - SHORT, up):
             stale = _at_dof_breakpoint(m, extras, d, level, up, y_to, sw, evbuf, ist, wk) or stale
             level = next_breakpoint(dof_breakpoints(m, d)[0], m.period, level, up)
