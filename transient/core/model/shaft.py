@@ -193,9 +193,9 @@ def line_inertias(m, y, wk, with_dJ):
     ``with_dJ`` J′_d and u′ may be left NaN: the derivative in crank angle needs neither (T5)."""
     carrier, dofs, _ = line_parts(m.line)
     n = line_dofs(m)
-    ref = int(m.line[0, LM_REF])
+    ref, first = int(m.line[0, LM_REF]), line_index(m)
     for d in range(n):
-        wk[WK_LINE_THETA, d] = y[PHI] if d == ref else y[PHI] + y[twist_index(m, d)]
+        wk[WK_LINE_THETA, d] = angle_at(y, d, first, ref)
     for c in range(m.ncyl):
         wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, int(carrier[c])]
     m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
