@@ -365,11 +365,10 @@ def line_fields(scene, tabulated_kinematics: bool, starts: list[int]) -> dict:
     carrier = np.zeros(scene.mechanism.n_cylinders, dtype=np.int64)
     for i, st in enumerate(shaft.stations):
         carrier[np.asarray(st.cylinders, dtype=np.int64) - 1] = line.station_dof[i]
-    dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n),
-                            starts])
+    dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n)])
     packed = line_kernels.pack_line(line.station_dof[shaft.station_index(shaft.reference)],
                                     line.names.index(shaft.load_at), carrier, dofs,
-                                    line.element_rows())
+                                    line.element_rows(), starts)
     shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
     return dict(line=packed, shares=shares, line_model=elastic.elastic_model,
                 line_switch=line_kernels.line_mode, reference_inertia=line_kernels.ref_inertia,

@@ -87,15 +87,30 @@ from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
 @kernel(inline=True)
-def elastic_model(m, row, angle_mode, y, sel, sw, wk, out):
-    """``Model.line_model``: the output row at ``y`` into ``out`` (``row``) or the derivative
-    (:func:`elastic_rates`), the tables' pieces held by ``sel``; True, the rigid model's own left
+def elastic_model(m, extras, what, angle_mode, y, sel, sw, wk, out):
+    """``Model.line_model``: the derivative (:func:`elastic_rates`) or the output row at ``y``
+    into ``out``, or the non-ideal pairs' margins or modes chosen afresh (``what``:
+    ``shaft.LINE_RATES`` …, the pairs' :mod:`.line_pairs`), the tables' pieces held by ``sel``;
+    the status of what it did (``chain.UNIQUE``, the modes' status), the rigid model's own left
     undone."""
-    if row:
-        elastic_row(m, angle_mode, y, sel, sw, wk, out)
-    else:
-        elastic_rates(m, angle_mode, y, sel, sw, wk, out)
-    return True
+    if what == LINE_ROW:
+        elastic_row(m, extras, angle_mode, y, sel, sw, wk, out)
+    elif what == LINE_RATES:
+        elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out)
+    elif extras is not None:
+        return pairs_at(m, what, angle_mode, y, sel, sw, wk)
+    return UNIQUE
+
+
+@kernel
+def pairs_at(m, what, angle_mode, y, sel, sw, wk):
+    """The non-ideal pairs' margins (``shaft.LINE_MARGINS``) or modes chosen afresh
+    (``LINE_MODES``) at ``y``, each throw's chain's (:mod:`.line_pairs`); the status."""
+    _, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk, True)
+    if what == LINE_MODES:
+        return throw_modes(m, M_load, M_starter, sw, wk)
+    throw_chains(m, M_load, M_starter, sw, wk)
+    return UNIQUE
 
 
 @kernel(inline=True)
@@ -127,15 +142,19 @@ def cylinder_pressure(m, c, theta, theta_sel, y, f, wk):
     the step's pieces (WK_LOCAL, the cylinder's own angle there, and WK_PIECE; with a combustion
     offset also on the curve δ_c later, WK_LOCAL_SHIFT, WK_PIECE_SHIFT), then the rigid model's
     :func:`~.forcing.cylinder_value` at ``theta`` (in its closed part with wall heat, its
-    pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on the piston."""
-    local = (theta_sel - m.gas_phase[c]) % m.period
+    pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on the piston.
+    The piece is searched from the one this cylinder's last evaluation left
+    (:func:`~.tables.find_piece_near`): the same piece, found with two comparisons at most
+    evaluations."""
+    local = wrap_angle(theta_sel - m.gas_phase[c], m.period)
     wk[WK_LOCAL, c] = local
     wk[WK_PIECE, c] = find_piece_near(m.knots, m.piece_knot, local, wk[WK_PIECE, c])
     if shifted(m):
         local_shift = wrap_angle(local - m.var_par[c, SHIFT], m.period)
         wk[WK_LOCAL_SHIFT, c] = local_shift
-        wk[WK_PIECE_SHIFT, c] = find_piece(m.knots, m.piece_knot, local_shift)
-    p = cylinder_value(m, True, c, y, theta, theta_sel, f, wk)
+        wk[WK_PIECE_SHIFT, c] = find_piece_near(m.knots, m.piece_knot, local_shift,
+                                                wk[WK_PIECE_SHIFT, c])
+    p = cylinder_value(m, True, c, y, theta, theta_sel, f, wk, True)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p
@@ -195,7 +214,7 @@ def line_forces(m, y, sel, sw, wk):
 
 
 @kernel(inline=True)
-def line_at(m, angle_mode, y, sel, sw, wk):
+def line_at(m, angle_mode, y, sel, sw, wk, with_dJ):
     """Every dof's inertia, speed, applied moments and the line's torques at ``y`` into ``wk``
     (what the derivative and the output row both start from; J′_d only ``with_dJ``); returns
     :func:`line_forces`'."""
@@ -205,12 +224,18 @@ def line_at(m, angle_mode, y, sel, sw, wk):
 
 
 @kernel(inline=True)
-def elastic_rates(m, angle_mode, y, sel, sw, wk, out):
+def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
     """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
     form of :func:`.rhs.derivative`; with non-ideal pairs each throw's chain (T7)."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sel, sw, wk)
+    pairs = extras is not None and m.n_pairs > 0
+    # (in crank angle the rates are the work–energy law's, (T5): no J′_d, unless the throws'
+    # chains split their moments, (T7))
+    M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sel, sw, wk,
+                                                     pairs or not angle_mode)
+    if pairs:
+        throw_chains(m, M_load, M_starter, sw, wk)
     w = wk[WK_LINE_OMEGA, :n]
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
@@ -263,7 +288,7 @@ def pressure_rates(m, y, sel, sw, w, q, wk, out):
 
 
 @kernel
-def elastic_row(m, angle_mode, y, sel, sw, wk, row):
+def elastic_row(m, extras, angle_mode, y, sel, sw, wk, row):
     """An elastic scene's output row: the fixed columns of the reference
     dof (ω, ε, J, J′ its own; M_gas all cylinders', M_load at its dof), each cylinder's
     pressure at its own angle, then per dof its twist θ_d − φ and speed, per element its torque
@@ -271,7 +296,9 @@ def elastic_row(m, angle_mode, y, sel, sw, wk, row):
     damping took."""
     n = line_dofs(m)
     ref = int(m.line[0, LM_REF])
-    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk)
+    M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk, True)
+    if extras is not None and m.n_pairs > 0:
+        throw_chains(m, M_load, M_starter, sw, wk)
     acc = wk[WK_LINE_RATE, :n]
     line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                        wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)

@@ -71,12 +71,17 @@ LINE_META = Layout("line meta", "dofs", "reference", "load", "elements", "cylind
 LM_DOFS, LM_REF, LM_LOAD, LM_ELEMENTS, LM_CYLINDERS, LM_CHAINS = LINE_META
 #: A dof's row of the Model's ``line``: its own constant inertia [kg m²], its cycle-mean inertia
 #: (the weight of its speed in the line's mean speed) [kg m²], its absolute damping [N m s/rad],
-#: its gear ratio to the reference [1]: 1 for every dof of a scene's line, whose driven
-#: inertia is referred to the shaft (:class:`transient.shaft.line.ShaftLine`), so that its angle is
-#: φ + q_d; and where its breakpoints begin in ``Model.breakpoints`` (its own, on its angle; they
-#: end where the next dof's begin).
-LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear", "breakpoints")
-LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR, LD_BREAKPOINTS = LINE_DOF
+#: its gear ratio to the reference [1] (1 for every dof of a scene's line, whose driven inertia
+#: is referred to the shaft, :class:`transient.shaft.line.ShaftLine`, so that its angle is
+#: φ + q_d), the chain of the pairs it carries (its cylinders' throw; −1 on a dof without
+#: cylinders), its share of the cylinders, which is its share of the links' constant
+#: inertias (``Model.link_J``) [1], and where its breakpoints begin in ``Model.breakpoints``
+#: (its own, on its angle; they end where the next dof's begin).
+LINE_DOF = Layout("line dof", "own", "weight", "absolute", "gear", "chain", "share",
+                  "breakpoints")
+LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR, LD_CHAIN, LD_SHARE, LD_BREAKPOINTS = LINE_DOF
+#: Columns of the Model's packed ``line``: enough for each of its kinds of row.
+N_LINE_COLUMNS = max(LINE_META.size, LINE_DOF.size, N_ELEMENT)
 
 
 @kernel(inline=True)

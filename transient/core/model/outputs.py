@@ -51,7 +51,7 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     dynamic governor's states and the latched fuels. Inlined where the stepper writes the grid's
     samples (``stepper_io._emit_samples``): there a call would copy the Model for every sample.
     An elastic shaft line writes its own row (``Model.line_model``, :mod:`.elastic`)."""
-    if m.line_model(m, True, angle_mode, y, sel, sw, wk, row):
+    if m.line_model(m, extras, LINE_ROW, angle_mode, y, sel, sw, wk, row) != NOT_A_LINE:
         return
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     row[0] = y[T]

@@ -165,7 +165,7 @@ def derivative(m, extras, angle_mode, y, sel, sw, wk, out):
     derivative (``Model.line_model``, :mod:`.elastic`; in a rigid scene's Model a kernel that
     returns NOT_A_LINE, a constant the compiler folds: the rigid path tests nothing at run time).
     """
-    if m.line_model(m, False, angle_mode, y, sel, sw, wk, out):
+    if m.line_model(m, extras, LINE_RATES, angle_mode, y, sel, sw, wk, out) != NOT_A_LINE:
         return
     # (18) in crank angle is dK/dφ = M: without pairs no term needs dJ/dφ
     with_dJ = not angle_mode or (extras is not None and m.n_pairs > 0)
@@ -274,7 +274,7 @@ def margins_inline(m, extras, angle_mode, y, sel, sw, wk):
     """Mode margins at state ``y`` (see :func:`mode_margins`), in ``wk[WK_G]``; inlined into the
     stepper's root finder, whose iterations evaluate them most: there a call would copy the Model
     at every iteration."""
-    if m.line_model(m, extras, LINE_MARGINS, angle_mode, y, sw, wk, wk[WK_G]) != NOT_A_LINE:
+    if m.line_model(m, extras, LINE_MARGINS, angle_mode, y, sel, sw, wk, wk[WK_G]) != NOT_A_LINE:
         return  # (an elastic line's chains, one per throw)
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)
     acceleration(m, extras, y[PHI], J, dJ, w, M_gas, M_load, M_starter, sw, wk)
@@ -301,7 +301,7 @@ def choose_modes(m, extras, angle_mode, y, sel, sw, wk):
     elastic line each throw's chain chooses its own (``Model.line_model``, :mod:`.line_pairs`).
     """
     if extras is not None and m.n_pairs > 0:
-        status = m.line_model(m, extras, LINE_MODES, angle_mode, y, sw, wk, wk[WK_G])
+        status = m.line_model(m, extras, LINE_MODES, angle_mode, y, sel, sw, wk, wk[WK_G])
         if status != NOT_A_LINE:
             return status
     J, dJ, w, M_gas, M_load, M_starter = moments(m, extras, angle_mode, y, sel, sw, wk, True)

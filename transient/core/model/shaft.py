@@ -26,6 +26,7 @@ from .layout import (
     EL_K,
     EL_R,
     LD_BREAKPOINTS,
+    LD_CHAIN,
     LD_OWN,
     LD_SHARE,
     LINE_DOF,
@@ -51,11 +52,12 @@ from .layout import (
 )
 
 
-def pack_line(ref: int, load: int, carrier, dofs, elements) -> np.ndarray:
+def pack_line(ref: int, load: int, carrier, dofs, elements, starts) -> np.ndarray:
     """The Model's ``line`` (:data:`.layout.LINE_META`): the reference's and the load's dof, the
     dof of each cylinder (``carrier``), the rows of the dofs (``dofs``, :data:`.layout.LINE_DOF`:
     its first four columns; each dof that carries cylinders is a chain of the pairs, in order,
-    with its share of them) and of the elements (:data:`.layout.ELEMENT`)."""
+    with its share of them; ``starts``, where each dof's breakpoints begin in
+    ``Model.breakpoints``) and of the elements (:data:`.layout.ELEMENT`)."""
     carrier = np.asarray(carrier, dtype=np.int64)
     dofs = np.asarray(dofs, dtype=float)
     elements = np.asarray(elements, dtype=float).reshape(-1, N_ELEMENT)
@@ -64,6 +66,7 @@ def pack_line(ref: int, load: int, carrier, dofs, elements) -> np.ndarray:
     carried = np.bincount(carrier, minlength=len(dofs))
     rows[:, LD_CHAIN] = np.where(carried > 0, np.cumsum(carried > 0) - 1, -1)
     rows[:, LD_SHARE] = carried / max(carrier.size, 1)
+    rows[:, LD_BREAKPOINTS] = starts
     out = np.zeros((1 + carrier.size + len(dofs) + len(elements), N_LINE_COLUMNS))
     out[0, :LINE_META.size] = (len(dofs), ref, load, len(elements), carrier.size,
                                np.count_nonzero(carried))
@@ -272,6 +275,6 @@ def no_line_switch(m, y, to_angle, wk):
 
 
 @kernel(inline=True)
-def no_line_model(m, row, angle_mode, y, sel, sw, wk, out):
-    """``Model.line_model`` of a rigid shaft: nothing done, as its False says."""
-    return False
+def no_line_model(m, extras, what, angle_mode, y, sel, sw, wk, out):
+    """``Model.line_model`` of a rigid shaft: nothing done, as its NOT_A_LINE says."""
+    return NOT_A_LINE

@@ -33,6 +33,7 @@ from ..model.layout import (
     SW_STARTER,
     T,
     line_dofs,
+    n_margins,
 )
 from ..model.outputs import output_row, output_row_inline
 
