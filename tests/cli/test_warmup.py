@@ -44,7 +44,8 @@ FEATURE_KERNELS = {
     "tabulated loads": ("forcing.table_load", "forcing.speed_knot_segment"),
     "reaction friction": ("joint_friction.prepare", "joint_friction.solve",
                           "swash_friction.prepare", "swash_friction.solve",
-                          "reactions.acceleration"),
+                          "reactions.acceleration", "rhs.watches_kinks", "rhs.reset_kinks",
+                          "rhs.kink_in_attempt"),
 }
 
 
