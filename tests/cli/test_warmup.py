@@ -36,14 +36,16 @@ FEATURE_KERNELS = {
                        "rhs.chain_acceleration", "events._pair_event", "events._sample_margins",
                        "loop._settle_modes", "outputs.pair_rows"),
     "governor states": ("forcing.governor_rates", "governor.pi_rates", "governor.flyweight_rates",
-                        "forcing.demand", "events._sleeve_event", "events._sleeve_stops"),
+                        "forcing.demand", "events._sleeve_event", "events._sleeve_stops",
+                        "outputs.governor_rows"),
     "latched fuel": ("breakpoints._cylinder_on",),
     "cylinder states": ("forcing.cylinder_rates", "cylinder.pressure_rate"),
     "per-cylinder variation": ("variation.cycle_fuel", "variation.misfire_draw"),
     "tabulated loads": ("forcing.table_load", "forcing.speed_knot_segment"),
     "reaction friction": ("joint_friction.prepare", "joint_friction.solve",
                           "swash_friction.prepare", "swash_friction.solve",
-                          "reactions.acceleration"),
+                          "reactions.acceleration", "rhs.watches_kinks", "rhs.reset_kinks",
+                          "rhs.kink_in_attempt"),
 }
 
 

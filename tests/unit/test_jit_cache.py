@@ -198,3 +198,60 @@ def test_a_function_taking_kernels_as_arguments_is_cached_across_processes(tmp_p
     index = [n for n in os.listdir(tmp_path / "numba" / "kernarg") if n.startswith("kernarg.apply")
              and n.endswith(".nbc")]
     assert len(index) == 2  # (one entry per kernel, not one per process)
+
+
+FORMULAS = """
+from transient.core.jit import compiled, formula, kernel
+
+
+@formula
+def half(x):
+    return 0.5 * x
+
+
+@formula
+def quarter(x):  # (a formula of a formula: both copied)
+    return half(half(x))
+
+
+@kernel(inline=True, python=lambda x: ("from Python", x))
+def three_quarters(x):
+    return quarter(x) + half(x)
+
+
+@compiled
+def caller(x):
+    return three_quarters(x) + quarter(x)
+"""
+
+RUN_FORMULAS = """
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("formulas", sys.argv[1])
+module = sys.modules["formulas"] = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(module)
+assert module.quarter(2.0) == 0.5  # (from Python: run as Python)
+assert module.three_quarters(2.0) == ("from Python", 2.0)  # (kernel(python=…))
+assert module.caller(2.0) == 2.0
+assert module.three_quarters.python_entry(2.0) == 1.5  # (the compiled twin)
+print(len(module.half.overloads), len(module.quarter.overloads),
+      sum(module.caller.stats.cache_hits.values()))
+"""
+
+
+def test_a_formula_is_copied_into_its_callers_and_runs_as_python_from_python(tmp_path):
+    """``jit.formula``: no compile unit of its own — its callers compile with its code copied in,
+    and a caller loaded from the cache needs none either; called from Python it runs as Python.
+    A kernel given ``python`` runs that from Python, its compiled twin still at hand."""
+    source = tmp_path / "formulas.py"
+    source.write_text(FORMULAS)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+
+    def run():
+        done = subprocess.run([sys.executable, "-W", "error::numba.NumbaWarning", "-c",
+                               RUN_FORMULAS, str(source)], env=env, capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        return done.stdout.split()
+
+    assert run() == ["0", "0", "0"]  # compiled, the formulas never
+    assert run() == ["0", "0", "1"]  # loaded

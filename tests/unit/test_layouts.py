@@ -59,12 +59,13 @@ def test_bad_declarations_are_refused():
 
 @pytest.mark.parametrize("case", CASES, ids=[c.stem for c in CASES])
 def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
-    """The compiled index kernels (the chain the kernels index by) and the declaration's offsets
-    (what the Python side lays out) agree, and both with what the scene counts otherwise (an
-    elastic shaft line: two states per dof but the reference's, and its loss)."""
+    """The compiled offsets (the chain the kernels index by) and the declaration's offsets (what
+    the Python side lays out) agree, and both with what the scene counts otherwise (an elastic
+    shaft line: two states per dof but the reference's, and its loss)."""
     scene = load_scene(case)
     model, _, _ = build_model(scene)
     at = layout.STATE.offsets_for(model)
+    assert layout.state_offsets.python_entry(model) == tuple(at) == layout.state_offsets(model)
     assert [layout.gov_index(model), layout.latch_index(model), layout.cyl_index(model),
             layout.line_index(model), layout.line_loss_index(model),
             layout.n_state(model)] == at[layout.B_GOVERNOR:]
@@ -90,6 +91,7 @@ def test_a_scenes_layouts_match_what_its_columns_and_states_count(case):
     assert periodic.max(initial=0) < at[layout.B_LINE_LOSS]
     # the output row: as long as the trajectory's columns that the scene names
     out = layout.OUTPUT.offsets_for(model)
+    assert layout.output_offsets.python_entry(model) == tuple(out) == layout.output_offsets(model)
     assert [layout.pair_col(model), layout.governor_col(model), layout.cylinder_loss_col(model),
             layout.line_col(model), layout.n_outputs(model)] == [
         out[layout.O_PAIRS], out[layout.O_GOVERNOR], out[layout.O_CYL_LOSS], out[layout.O_LINE],

@@ -13,11 +13,11 @@ here as a :class:`Layout`, and the integer constants the kernels index with are 
 
 An unpacking that names more or fewer blocks than the layout holds fails at import. A block's
 size is a number of entries known at import; a block whose length depends on the scene (per
-cylinder, per pair, per shaft station) is declared with a :class:`Sized` rule instead, a kernel
-of the Model: the compiled code chains the rules in the declared order (an offset is the one
-before it plus that block's size), and the Python side runs the same rules
-(:meth:`Layout.offsets_for`). The blocks before the first sized one keep offsets known at import
-(:meth:`Layout.fixed_offset`).
+cylinder, per pair, per shaft station) is declared with a :class:`Sized` rule instead, a formula
+of the Model (:func:`transient.core.jit.formula`): the compiled code chains the rules in the
+declared order (an offset is the one before it plus that block's size), and the Python side
+runs the same rules (:meth:`Layout.offsets_for`). The blocks before the first sized one keep
+offsets known at import (:meth:`Layout.fixed_offset`).
 
 Pure Python; nothing here is compiled.
 """
@@ -30,8 +30,8 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class Sized:
     """The length of a block that depends on the scene: ``rule`` of the object the layout is
-    laid out for (the compiled Model; a kernel, whose compiled code indexes the array), ``what``
-    says it in words (for the developer's tables)."""
+    laid out for (the compiled Model; a formula, whose code the compiled code that indexes the
+    array runs too), ``what`` says it in words (for the developer's tables)."""
 
     rule: Callable[[object], int]
     what: str
@@ -118,7 +118,8 @@ class Layout:
 
     def sizes_for(self, obj) -> list[int]:
         """Each block's size for ``obj`` (the Model its sized blocks' rules read; a rule that is
-        a kernel runs as Python, its ``py_func``, the same code the compiled kernels run)."""
+        a formula or a kernel runs as Python, its ``py_func``, the same code the compiled code
+        runs)."""
         sizes = []
         for b in self.blocks:
             n = (getattr(b.size.rule, "py_func", b.size.rule)(obj) if isinstance(b.size, Sized)

@@ -17,6 +17,8 @@ an indirect call. Kernels under ``kernel`` must not allocate arrays (they work i
 caller allocated); the few that allocate (work arrays) are ``compiled``. A kernel passed to
 another as an argument (the model's derivative to the integrator) is a compile-time constant typed
 by its module and name (:class:`_KernelArgument`), so that what is compiled for it is cached.
+``formula`` is for functions of a few operations (a layout's size rules): no compile unit at
+all, numba's own inliner copies them into their callers, and Python runs them as Python.
 
 The replacements rely on numba internals, so they are on only under the numba release they were
 checked against (:data:`NUMBA_CHECKED`, pinned in pyproject.toml;
@@ -199,6 +201,41 @@ class _CalledFromCompiledCode(_Kernel):
             entry = self.__dict__["_python_entry"] = compiled(
                 self.py_func, _cache=_PythonEntryCache, **options)
         return entry
+
+
+class _CalledAsPythonFromPython(_CalledFromCompiledCode):
+    """A kernel whose calls from Python run the Python function given for it
+    (``kernel(python=…)``) instead of a compiled twin: for a kernel as cheap as a Python call
+    that the Python side needs before any run (the state's length), whose twin's compile would
+    cost a first run more than it saves. :attr:`python_entry` is still the compiled twin, for
+    the tests that check the two agree."""
+
+    def __call__(self, *args, **kwargs):
+        return self.__dict__["_python"](*args, **kwargs)
+
+
+class _Formula(CPUDispatcher):
+    """A :func:`formula`'s dispatcher: a call from Python runs its Python code."""
+
+    def __call__(self, *args, **kwargs):
+        return self.py_func(*args, **kwargs)
+
+
+def formula(fn):
+    """``@formula``: a function of a few operations on its arguments (a layout's size rule, an
+    offset read from the layout's kernel), which is no compile unit of its own.
+
+    numba copies its code into the code of each kernel that calls it, before typing (its own
+    inliner, ``inline="always"``); a call from Python runs it as Python. A compile unit costs a
+    fixed share of a cold compile (typing, lowering, its module linked into each caller) that is
+    all of what a few operations cost; a larger function copied so would be typed anew at every
+    call site, and nested ones once per level, so formulas stay small and call kernels, not
+    chains of formulas. Nothing is pruned inside a formula on an argument typed None (numba's
+    inliner runs after the pruning), so a formula takes no ``extras``."""
+    dispatcher = njit(fn, inline="always")
+    if not config.DISABLE_JIT:
+        dispatcher.__class__ = _Formula
+    return dispatcher
 
 
 class _KernelArgument(types.Dispatcher):
@@ -389,9 +426,10 @@ def _compile_per_type(dispatcher):
     dispatcher.get_call_template = get_call_template
 
 
-def kernel(fn=None, *, inline=False, **options):
+def kernel(fn=None, *, inline=False, python=None, **options):
     """``@kernel`` or ``@kernel(inline=True)``: compiled for calls from compiled code, no
-    reference counting.
+    reference counting; ``python``: a function that calls from Python run instead
+    (:class:`_CalledAsPythonFromPython`).
 
     A kernel is a compile unit of its own, compiled without numba's Python wrappers; a call from
     Python goes to a twin compiled with them (:class:`_CalledFromCompiledCode`). Its library is
@@ -404,20 +442,22 @@ def kernel(fn=None, *, inline=False, **options):
     numba's own inlining (``inline="always"``) copies the callee's IR into every caller before
     typing it, which made the cold compile grow with the nesting of calls."""
     if fn is None:
-        return lambda f: kernel(f, inline=inline, **options)
+        return lambda f: kernel(f, inline=inline, python=python, **options)
     if not REPLACEMENTS_ON:  # a plain call: numba's inliner would defeat the pruning of a
         # branch on an argument typed None (:func:`.rosenbrock.method_step` relies on it)
         dispatcher = compiled(fn, _nrt=False, **options)
-        if not config.DISABLE_JIT:
-            dispatcher.__class__ = _Kernel
-        return dispatcher
-    if inline:
-        _INLINED_BY_LLVM.add(_symbol_prefix(fn))
-    _LINKED_ONLY.add(_symbol_prefix(fn))
-    dispatcher = compiled(fn, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
-                          **options)
+        kind = _Kernel
+    else:
+        if inline:
+            _INLINED_BY_LLVM.add(_symbol_prefix(fn))
+        _LINKED_ONLY.add(_symbol_prefix(fn))
+        dispatcher = compiled(fn, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+                              **options)
+        kind = _CalledFromCompiledCode
     if not config.DISABLE_JIT:
-        dispatcher.__class__ = _CalledFromCompiledCode
+        dispatcher.__class__ = kind if python is None else _CalledAsPythonFromPython
+        if python is not None:
+            dispatcher.__dict__["_python"] = python
     return dispatcher
 
 

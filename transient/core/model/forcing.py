@@ -449,9 +449,8 @@ def moments(m, extras, angle_mode, y, sel, sw, wk, with_dJ):
         select_pieces(m, extras, sel, wk)
         if (extras is not None and m.latch) or m.has_motored:
             # p = p_mot + f_k·(p_full − p_mot), per cylinder
-            c = latch_index(m)
             for k in range(m.ncyl):
-                f_k = y[c + k] if extras is not None and m.latch else f
+                f_k = y[latch_index(m) + k] if extras is not None and m.latch else f
                 if extras is not None and m.var_on:
                     f_k *= wk[WK_FUEL, k]
                 p_k = cylinder_value(m, extras, k, y, phi, sel, f_k, wk, False)

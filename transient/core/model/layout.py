@@ -19,11 +19,11 @@ from collections import namedtuple
 import numpy as np
 
 from ..declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED, Block, Layout, Sized
-from ..jit import kernel, typed_by_fingerprint
+from ..jit import formula, kernel, typed_by_fingerprint
 from . import governor as gv
 
 
-@kernel(inline=True)
+@formula
 def n_margins(m):
     """The pairs' modes, each a switch with its margin and its energy lost: one per non-ideal
     pair in each chain the pairs act in, the machine on a rigid shaft, each station carrying
@@ -32,25 +32,25 @@ def n_margins(m):
     return m.n_pairs * int(m.line[0, LM_CHAINS])
 
 
-@kernel(inline=True)
+@formula
 def n_losses(m):
     """The state's energies lost: one per non-ideal pair in each chain (:func:`n_margins`)."""
     return n_margins(m)
 
 
-@kernel(inline=True)
+@formula
 def n_governor_states(m):
     """The dynamic governor's states (:data:`.governor.N_STATES`)."""
     return gv.N_STATES[m.gov_dyn]
 
 
-@kernel(inline=True)
+@formula
 def n_latched(m):
     """The latched fuels: one per cylinder with fuel latching."""
     return m.ncyl if m.latch else 0
 
 
-@kernel(inline=True)
+@formula
 def n_pressures(m):
     """The pressures of the cylinders' closed parts: one per cylinder with wall heat."""
     return m.ncyl if m.woschni else 0
@@ -84,13 +84,13 @@ LD_OWN, LD_WEIGHT, LD_ABS, LD_GEAR, LD_CHAIN, LD_SHARE, LD_BREAKPOINTS = LINE_DO
 N_LINE_COLUMNS = max(LINE_META.size, LINE_DOF.size, N_ELEMENT)
 
 
-@kernel(inline=True)
+@formula
 def line_dofs(m):
     """The elastic shaft line's degrees of freedom; 0 on a rigid shaft."""
     return int(m.line[0, LM_DOFS])
 
 
-@kernel(inline=True)
+@formula
 def n_line_states(m):
     """The elastic shaft line's states: a twist and an energy (or speed) per degree of freedom
     other than the reference; none on a rigid shaft."""
@@ -98,7 +98,7 @@ def n_line_states(m):
     return 2 * (n - 1) if n > 0 else 0
 
 
-@kernel(inline=True)
+@formula
 def n_line_loss(m):
     """The energy the shaft line's damping took: one on an elastic line."""
     return 1 if line_dofs(m) > 0 else 0
@@ -120,16 +120,17 @@ def n_line_loss(m):
 #: time (:mod:`.elastic`), and the energy the line's damping took.
 #:
 #: A block whose length depends on the scene is :class:`~transient.core.declare.Sized` by a
-#: kernel of the Model (:func:`n_losses` …). The kernels index the state through
-#: :func:`gov_index`, :func:`latch_index`, :func:`cyl_index` and :func:`n_state`: each the
-#: offset of the block before it plus that block's size kernel, in the declared order. The
-#: Python side lays the state out with the same kernels' code
-#: (:meth:`~transient.core.declare.Layout.offsets_for`), and ``tests/unit/test_layouts.py``
-#: checks the two on every case. The offsets are computed, never stored in the Model: a field
-#: more there would be copied at every call that passes the Model (a tenth of a bare scene's
-#: run time for four fields). A new block of states (per cylinder, per shaft station) is one
-#: more entry here with its size kernel and its error control (:data:`CONTROL`), and one more
-#: index kernel in the chain.
+#: formula of the Model (:func:`n_losses` …; :func:`transient.core.jit.formula`: copied into
+#: the code that calls it, no compile unit of its own). The kernels index the state through
+#: :func:`state_offsets`, one kernel that chains the size formulas in the declared order (each
+#: offset the one before plus that block's size), by the formulas :func:`gov_index`,
+#: :func:`latch_index`, :func:`cyl_index`, …, :func:`n_state`. The Python side lays the state
+#: out with the same formulas' code (:meth:`~transient.core.declare.Layout.offsets_for`), and
+#: ``tests/unit/test_layouts.py`` checks the two on every case. The offsets are computed, never
+#: stored in the Model: a field more there would be copied at every call that passes the Model
+#: (a tenth of a bare scene's run time for four fields). A new block of states (per cylinder,
+#: per shaft station) is one more entry here with its size formula and its error control
+#: (:data:`CONTROL`), its place in :func:`state_offsets`' chain and an index formula.
 STATE = Layout(
     "state",
     Block("phi", 1, "shaft angle φ [rad]"),
@@ -240,25 +241,25 @@ COL_M_GAS, COL_M_LOAD = OUTPUTS.index("M_gas"), OUTPUTS.index("M_load")
 #: η*_k S_k), η*_k in use, the power lost (1 − η*_k) S_k ω and the energy lost so far.
 PAIR_OUTPUTS = ("S", "eta", "P_loss", "W_loss")
 PAIR_OUTPUT_UNITS = ("N m", "1", "W", "J")
-@kernel(inline=True)
+@formula
 def n_gas_columns(m):
     """The output row's applied pressures (forces): one per cylinder."""
     return m.ncyl
 
 
-@kernel(inline=True)
+@formula
 def n_pair_columns(m):
     """The output row's PAIR_OUTPUTS of every non-ideal pair (in each chain, :func:`n_margins`)."""
     return len(PAIR_OUTPUTS) * n_margins(m)
 
 
-@kernel(inline=True)
+@formula
 def n_cylinder_loss_columns(m):
     """The output row's losses of every reaction pair in every cylinder."""
     return m.n_pairs * m.ncyl if m.reaction else 0
 
 
-@kernel(inline=True)
+@formula
 def n_line_columns(m):
     """The output row's shaft-line columns: per dof its twist and speed, per element its
     torque, the line's energy and the energy its damping took; none on a rigid shaft."""
@@ -267,8 +268,9 @@ def n_line_columns(m):
 
 
 #: The output row's blocks (``transient.scene.outputs.output_columns`` names the columns in this
-#: order), sized per scene as the state's and indexed through the chained kernels
-#: :func:`pair_col`, :func:`governor_col`, :func:`cylinder_loss_col` and :func:`n_outputs`.
+#: order), sized per scene as the state's and indexed through :func:`output_offsets` by the
+#: formulas :func:`pair_col`, :func:`governor_col`, :func:`cylinder_loss_col`, :func:`line_col`
+#: and :func:`n_outputs`.
 OUTPUT = Layout(
     "output row",
     Block("fixed", len(OUTPUTS), "the columns OUTPUTS"),
@@ -475,68 +477,99 @@ def extras_of(m):
     return None if plain else True
 
 
-@kernel(inline=True)
+@kernel(inline=True, python=lambda m: tuple(STATE.offsets_for(m)))
+def state_offsets(m):
+    """The offset of every block of :data:`STATE` in model ``m``'s state, then its length: each
+    the one before plus that block's size, in the declared order.
+
+    The kernels index the state through it (by the formulas below), one compile unit for the
+    whole layout; inlined by LLVM, what a caller does not read is left out of its code. Called
+    from Python it is the declaration's own :meth:`~transient.core.declare.Layout.offsets_for`
+    (``tests/unit/test_layouts.py`` checks the compiled chain against it on every case)."""
+    gov = W_LOSS0 + n_losses(m)
+    latched = gov + n_governor_states(m)
+    pressure = latched + n_latched(m)
+    line = pressure + n_pressures(m)
+    line_loss = line + n_line_states(m)
+    return (PHI, T, OMEGA, W_GAS, W_LOSS0, gov, latched, pressure, line, line_loss,
+            line_loss + n_line_loss(m))
+
+
+@formula
 def gov_index(m):
     """Index of the dynamic governor's first state (:data:`STATE`: after the losses)."""
-    return W_LOSS0 + n_losses(m)
+    return state_offsets(m)[B_GOVERNOR]
 
 
-@kernel(inline=True)
+@formula
 def latch_index(m):
     """Index of cylinder 0's latched fuel (with ``m.latch``), after the governor's states."""
-    return gov_index(m) + n_governor_states(m)
+    return state_offsets(m)[B_LATCHED]
 
 
-@kernel(inline=True)
+@formula
 def cyl_index(m):
     """Index of cylinder 0's pressure state (with ``m.woschni``), after the latched fuels."""
-    return latch_index(m) + n_latched(m)
+    return state_offsets(m)[B_PRESSURE]
 
 
-@kernel(inline=True)
+@formula
 def line_index(m):
     """Index of the shaft line's first state (on an elastic line), after the pressures."""
-    return cyl_index(m) + n_pressures(m)
+    return state_offsets(m)[B_LINE]
 
 
-@kernel(inline=True)
+@formula
 def line_loss_index(m):
     """Index of the energy the shaft line's damping took (on an elastic line)."""
-    return line_index(m) + n_line_states(m)
+    return state_offsets(m)[B_LINE_LOSS]
 
 
-@kernel
+@formula
 def n_state(m):
     """Length of the state vector of model ``m``: after the line's loss."""
-    return line_loss_index(m) + n_line_loss(m)
+    return state_offsets(m)[-1]
 
 
-@kernel(inline=True)
+@kernel(inline=True, python=lambda m: tuple(OUTPUT.offsets_for(m)))
+def output_offsets(m):
+    """The column of an output row where each block of :data:`OUTPUT` starts, then the row's
+    length: as :func:`state_offsets` for the state."""
+    pairs = N_OUT_FIXED + n_gas_columns(m)
+    governor = pairs + n_pair_columns(m)
+    latched = governor + n_governor_states(m)
+    cyl_loss = latched + n_latched(m)
+    line = cyl_loss + n_cylinder_loss_columns(m)
+    return (O_FIXED, N_OUT_FIXED, pairs, governor, latched, cyl_loss, line,
+            line + n_line_columns(m))
+
+
+@formula
 def pair_col(m):
     """Column of an output row where the pairs' PAIR_OUTPUTS start (:data:`OUTPUT`)."""
-    return N_OUT_FIXED + n_gas_columns(m)
+    return output_offsets(m)[O_PAIRS]
 
 
-@kernel(inline=True)
+@formula
 def governor_col(m):
     """Column of an output row where the governor's states start, then the latched fuels."""
-    return pair_col(m) + n_pair_columns(m)
+    return output_offsets(m)[O_GOVERNOR]
 
 
-@kernel(inline=True)
+@formula
 def cylinder_loss_col(m):
-    """Column of an output row where the reaction pairs' losses per cylinder start (the last
-    columns: pair 1 in cylinders 1 … n, then pair 2, …)."""
-    return governor_col(m) + n_governor_states(m) + n_latched(m)
+    """Column of an output row where the reaction pairs' losses per cylinder start (pair 1 in
+    cylinders 1 … n, then pair 2, …)."""
+    return output_offsets(m)[O_CYL_LOSS]
 
 
-@kernel(inline=True)
+@formula
 def line_col(m):
     """Column of an output row where the shaft line's columns start (on an elastic line)."""
-    return cylinder_loss_col(m) + n_cylinder_loss_columns(m)
+    return output_offsets(m)[O_LINE]
 
 
-@kernel
+@formula
 def n_outputs(m):
     """Columns of an output row of model ``m``."""
-    return line_col(m) + n_line_columns(m)
+    return output_offsets(m)[-1]

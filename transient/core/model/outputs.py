@@ -68,9 +68,8 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
     row[10] = y[W_GAS]
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
-    c = latch_index(m)
     for k in range(m.ncyl):  # the pressure (force) applied, at the cylinder's fuel
-        f_k = y[c + k] if extras is not None and m.latch else f
+        f_k = y[latch_index(m) + k] if extras is not None and m.latch else f
         if extras is not None and m.var_on:
             f_k *= wk[WK_FUEL, k]
         p_k = cylinder_value(m, extras, k, y, y[PHI], sel, f_k, wk, False) if m.has_gas else 0.0
@@ -78,9 +77,9 @@ def output_row_inline(m, extras, angle_mode, y, sel, sw, wk, row):
         if beta != 1.0:  # (as it acts on the piston: p0 + β_k(p − p0))
             p_k = m.gas_offset + beta * (p_k - m.gas_offset)
         row[N_OUT_FIXED + k] = p_k
-    if extras is not None:
+    if extras is not None:  # (a plain scene has no pairs, governor states or latched fuels)
         pair_rows(m, w, 0, y[W_LOSS0: W_LOSS0 + m.n_pairs], wk, row[pair_col(m):])
-    governor_rows(m, y, row)
+        governor_rows(m, y, row)
     if extras is not None and m.reaction:
         cylinder_loss_rows(m, w, wk, row[cylinder_loss_col(m):])
 

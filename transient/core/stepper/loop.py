@@ -283,7 +283,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
     while True:
         if (ist[I_NOUT] + margin >= outbuf.shape[0] or ist[I_NEV] + 8 >= evbuf.shape[0]
                 or steps_here >= cfg[C_CHUNK_STEPS]):
-            _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected)
+            _leave_chunk(n_margins(m), f, gs, fst, ist, n_bad, n_unseen, rejected)
             return RUNNING
         angle_mode = ist[I_ANGLE_MODE] == 1
         sw = ist[:N_SWITCHES]
@@ -316,19 +316,22 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
         else:
             sel = y[PHI] + 0.5 * h * y[OMEGA]
 
-        # The step attempt, its acceptance and the next step size.
-        retakes_at_kinks = watches_kinks(m, extras, angle_mode) and not fixed
+        # The step attempt, its acceptance and the next step size. (The model's hooks for a kink
+        # are the full variant's: a plain scene's compile leaves them out.)
+        retakes_at_kinks = False
+        if extras is not None:
+            retakes_at_kinks = watches_kinks(m, extras, angle_mode) and not fixed
         on_corner = at_segment_end and seg.x_end == seg.corner
         cut = at_segment_end
         for attempt in range(2):
-            if retakes_at_kinks:
+            if extras is not None and retakes_at_kinks:
                 reset_kinks(m, extras, wk)
             _start_attempt(f, K, wk)
             method_step(tab, model_rhs, model_jacobian, (m, extras, angle_mode, sel, sw, wk), ix,
                         x, y, f, h, K, y_new, tmp, work.band)
             finite, err, seen = _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner,
                                                seg.corner)
-            if attempt > 0 or not (retakes_at_kinks and finite and err > 1.0):
+            if extras is None or attempt > 0 or not (retakes_at_kinks and finite and err > 1.0):
                 break
             # A kink of the derivative inside the step (the model's hook: a side force changing
             # side, the kink of the pistons' μ|N|): the step is retaken at once to end where the
@@ -377,7 +380,7 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
             # from this step's start, which is left as a chunk's end leaves it.
             ist[I_NSTIFF_STEPS] += 1
             if cfg[C_STIFF_SWITCH] > 0.0:
-                _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected)
+                _leave_chunk(n_margins(m), f, gs, fst, ist, n_bad, n_unseen, rejected)
                 return STIFF
         if not angle_mode and abs(y_new[PHI] - y[PHI]) > MAX_OUTPUT_INTERVALS * cfg[C_DPHI_OUT]:
             # (a step in time writes a sample at each crossing of the angle grid: no more of
@@ -436,10 +439,10 @@ def advance(m, extras, tab, cfg, bp, y, fst, ist, outbuf, evbuf, work):
 
 
 @kernel(inline=True)
-def _leave_chunk(m, f, gs, fst, ist, n_bad, n_unseen, rejected):
+def _leave_chunk(n_pairs, f, gs, fst, ist, n_bad, n_unseen, rejected):
     """What a chunk leaves for the next: the derivative and the margins at the state, and the
     counters of the retaken attempts, so that where a chunk ends changes nothing in the run."""
-    _carry(fst, f, gs, n_margins(m), True)
+    _carry(fst, f, gs, n_pairs, True)
     ist[I_NBAD], ist[I_NUNSEEN], ist[I_REJECTED] = n_bad, n_unseen, rejected
 
 
