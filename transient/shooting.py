@@ -4,10 +4,11 @@ map and shooting"; docs/guide/steady.md).
 In crank angle the engine's right-hand side repeats over one cycle, so the periodic states at a
 cycle's start (:func:`~transient.core.model.layout.periodic_states`) follow a map
 x_{n+1} = Φ(x_n) (:class:`~transient.run.CycleMap`). A steady state is a fixed point,
-F(x) = Φ(x) − x = 0, found here by Newton's method with the monodromy ∂Φ/∂x by finite
-differences (one cycle per periodic state; with several, kept and updated by Broyden's formula
-while it serves), damped by backtracking on ‖F‖ and falling back to direct cycles where a
-Newton step does not reduce it (the map contracts). Its eigenvalues at
+F(x) = Φ(x) − x = 0, found here by Newton's method in the speeds' squares (where a cycle's work
+is nearly linear) with the monodromy ∂Φ/∂x by finite differences (one cycle per periodic
+state; kept and updated by Broyden's formula while it serves: with the speed alone, the
+secant), damped by backtracking on ‖F‖ and falling back to direct cycles where a Newton step
+does not reduce it (the map contracts). Its eigenvalues at
 the solution, the multipliers, say how fast a disturbance of the steady cycle dies per cycle.
 :func:`transient.steady` then runs the steady cycle(s) with output, a :class:`~transient.Result` like a
 run's, with the convergence record and the multipliers in its analysis.
@@ -44,10 +45,11 @@ TOLERANCE = 1.0
 #: (kinks and jumps located by retaken steps, a cycle's many steps' errors): the best iterate is
 #: the solution, its residual the last recorded.
 NOISE_FLOOR, STALLED_ITERATIONS = 1e3, 3
-#: A monodromy (of more than one unknown) is kept, updated by Broyden's rank-one formula, while
-#: its step reduced ‖F‖ at least this much: a step on it costs one cycle, a fresh one a cycle per
-#: unknown more.
+#: A monodromy is kept, updated by Broyden's rank-one formula, while its step reduced ‖F‖ at
+#: least this much: a step on it costs one cycle, a fresh one a cycle per unknown more.
 CHORD_RATE = 0.5
+#: The most a Newton step may change a speed by, either way (:func:`_speed_limited`).
+SPEED_FACTOR = 4.0
 #: A speed beyond which a scene runs away (no piston machine turns at 10⁴ rad/s, 95 000 rpm).
 RUNAWAY_SPEED = 1e4
 
@@ -179,7 +181,8 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
     rec.residuals.append(r)
     _said(progress, rec, phi)
     best, since = (x, end, r), 0
-    M = None  # the monodromy, kept (Broyden-updated) while its steps reduce ‖F‖ fast
+    to_z, from_z, slope = _energy_coordinates(phi.speed_at)
+    Mz = None  # the monodromy in z, kept (Broyden-updated) while its steps reduce ‖F‖ fast
     while r > TOLERANCE:
         if best[2] <= NOISE_FLOOR and since >= STALLED_ITERATIONS:
             # the map's own noise (kinks located by step retakes, reaction friction's) holds
@@ -189,15 +192,18 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
             break
         if len(rec.residuals) > MAX_ITERATIONS:
             raise _no_state(rec, phi, f"no convergence in {MAX_ITERATIONS} iterations")
-        fresh = M is None
-        if M is None:
+        fresh = Mz is None
+        if Mz is None:
             M = _jacobian(phi, x, end - x, forward=True)
-        dx = np.zeros_like(x)  # (a neutral twist stays as it is: any value repeats)
-        dx[phi.free] = np.linalg.lstsq((M - np.eye(x.size))[:, phi.free], -(end - x),
-                                       rcond=None)[0]
-        step = _damped(residual, x, dx, r, phi.speed_at, MAX_HALVINGS if fresh else 0)
+            Mz = slope(end)[:, None] * M / slope(x)[None, :]
+        z, Fz = to_z(x), to_z(end) - to_z(x)
+        dz = np.zeros_like(x)  # (a neutral twist stays as it is: any value repeats)
+        dz[phi.free] = np.linalg.lstsq((Mz - np.eye(x.size))[:, phi.free], -Fz, rcond=None)[0]
+        # (halving a step within the map's own noise finds nothing but noise)
+        halvings = MAX_HALVINGS if fresh and r > NOISE_FLOOR else 0
+        step = _damped(residual, z, dz, r, phi.speed_at, from_z, halvings)
         if step is None and not fresh:  # (the kept monodromy's step failed: a fresh one)
-            M = None
+            Mz = None
             continue
         if step is None and best[2] <= NOISE_FLOOR:
             # a fresh monodromy's step reduces ‖F‖ no more: the map's own noise
@@ -210,12 +216,12 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
                 if new_end is None:
                     raise _no_state(rec, phi, "a direct cycle failed")
                 x, end, r = end, new_end, new_r
-            M = None
+            Mz = None
         else:
-            if step[2] > CHORD_RATE * r or np.count_nonzero(phi.free) == 1:
-                M = None  # (with one unknown a fresh monodromy costs one cycle: Newton's)
-            else:
-                M = _broyden(M, step[0] - x, (step[1] - step[0]) - (end - x))
+            if step[2] > CHORD_RATE * r:
+                Mz = None
+            else:  # (with one unknown, the secant)
+                Mz = _broyden(Mz, to_z(step[0]) - z, (to_z(step[1]) - to_z(step[0])) - Fz)
             x, end, r = step
         if x[phi.speed_at[0]] > RUNAWAY_SPEED:
             raise _no_state(rec, phi, f"the speed ran away past {RUNAWAY_SPEED:g} rad/s")
@@ -242,16 +248,43 @@ def _broyden(M: np.ndarray, dx: np.ndarray, dF: np.ndarray) -> np.ndarray:
     return M + np.outer(dF - J @ dx, dx) / (dx @ dx)
 
 
-def _damped(residual, x, dx, r, speed_at, halvings: int):
-    """The Newton step λ·dx from ``x`` (λ as :func:`_speed_limited` allows, halved up to
+def _damped(residual, z, dz, r, speed_at, from_z, halvings: int):
+    """The Newton step λ·dz from ``z`` (λ as :func:`_speed_limited` allows, halved up to
     ``halvings`` times) that reduces ‖F‖ below ``r``: (x, Φ(x), ‖F‖) there, or None."""
-    lam = _speed_limited(x, dx, speed_at)
+    lam = _speed_limited(z, dz, speed_at)
     for _ in range(halvings + 1):
-        end, new_r = residual(x + lam * dx)
+        x = from_z(z + lam * dz)
+        end, new_r = residual(x)
         if end is not None and new_r < r:
-            return x + lam * dx, end, new_r
+            return x, end, new_r
         lam *= 0.5
     return None
+
+
+def _energy_coordinates(speed_at):
+    """The unknowns Newton steps in: each speed ω as ω|ω|, every other state as it is; and
+    the derivative of that change, per state.
+
+    The work of a cycle is what moves the speed: the gas's and friction's change little with
+    the speed, a fan's is ∝ ω², so F in ω² (the kinetic energy's measure) is close to linear
+    and Newton's step from far away lands close; in ω it is not. A fixed point is one in either
+    coordinate, and so are the multipliers (the two monodromies are similar there)."""
+    def to_z(x):
+        z = x.copy()
+        z[speed_at] = x[speed_at] * np.abs(x[speed_at])
+        return z
+
+    def from_z(z):
+        x = z.copy()
+        x[speed_at] = np.sign(z[speed_at]) * np.sqrt(np.abs(z[speed_at]))
+        return x
+
+    def slope(x):
+        d = np.ones_like(x)
+        d[speed_at] = 2.0 * np.abs(x[speed_at])
+        return d
+
+    return to_z, from_z, slope
 
 
 def _said(progress, rec: Shooting, phi: CycleMap) -> None:
@@ -280,15 +313,17 @@ def _jacobian(phi: CycleMap, x, fx, forward: bool) -> np.ndarray:
     return M
 
 
-def _speed_limited(x, dx, speed_at) -> float:
-    """The largest λ ≤ 1 with which the step λ·dx at most doubles, and at most halves, each
-    speed (a Newton step from far away must not reverse the shaft)."""
+def _speed_limited(z, dz, speed_at) -> float:
+    """The largest λ ≤ 1 with which the step λ·dz changes no speed by more than a factor
+    SPEED_FACTOR (its z = ω|ω| by its square) either way: a Newton step from far away must not
+    reverse the shaft, nor leave for speeds where nothing was seen."""
+    grow, shrink = SPEED_FACTOR ** 2 - 1.0, 1.0 - SPEED_FACTOR ** -2
     lam = 1.0
     for i in speed_at:
-        if dx[i] > x[i]:
-            lam = min(lam, x[i] / dx[i])
-        elif dx[i] < -0.5 * x[i]:
-            lam = min(lam, -0.5 * x[i] / dx[i])
+        if dz[i] > grow * z[i]:
+            lam = min(lam, grow * z[i] / dz[i])
+        elif dz[i] < -shrink * z[i]:
+            lam = min(lam, -shrink * z[i] / dz[i])
     return lam
 
 

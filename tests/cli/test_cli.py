@@ -978,7 +978,7 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert "(quick: caches warm)" in targets and "## Cold compile profile" in targets
     lines = verdicts(res)
     assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 1 + 1 + 2 \
-        + len(BENCH_SCENES) * len(ADAPTIVE) + 2 + 4  # (the elastic line's four)
+        + len(BENCH_SCENES) * len(ADAPTIVE) + 2 + 4 + 1  # (the elastic line's four, steady)
     tors = res["torsion"]  # (quick: 4 revolutions, lines of 3 and 4 stations, RK45 only)
     assert tors["rigid"]["elastic_s"] > 0 and tors["rigid"]["rigid_s"] > 0
     assert tors["scaling"]["stations"] == [3, 4] and all(
@@ -987,6 +987,10 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
                                                      "solve_ivp RK45 (numpy RHS)"}
     assert all(np.isfinite(r["phase_err_rad"]) for r in tors["rows"])
     assert "## Elastic shaft line" in targets
+    (steady,) = res["steady"]  # (quick: the first case only)
+    assert steady["shooting_cycles"] >= 2 and steady["direct_cycles"] > 0
+    assert steady["speed_difference"] <= 1e-9  # (the settled run's speed, by either way)
+    assert "## Steady state against a settling direct run" in targets
     assert res["reaction"]["constant_s"] > 0 and res["reaction"]["reaction_s"] > 0
     (models,) = res["models"]  # (quick: the plain scene only)
     assert models["this_s"] > 0 and models["left_out_s"] > 0

@@ -53,7 +53,7 @@ from ..core.model.rhs import derivative
 from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
-from . import torsion
+from . import steady, torsion
 from .bench import (
     ADAPTIVE,
     BASELINE_BUDGET_S,
@@ -586,6 +586,7 @@ def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     progress("targets: cold start")
     res["torsion"] = torsion.measure(quick, progress)
     res["torsion"]["scipy"] = elastic_against_scipy(res["torsion"]["rows"])
+    res["steady"] = steady.measure(quick, progress)
     return res
 
 
@@ -648,6 +649,8 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
                       "met" if not m["rises"] else "**missed**"))
     if "torsion" in res:  # (none in a record from before it was measured)
         lines += torsion.verdicts(res["torsion"], _missed)
+    if "steady" in res:  # (none in a record from before it was measured)
+        lines += steady.verdicts(res["steady"], _missed)
     first, last = res["scale"][0], res["scale"][-1]
     growth = last["wall_per_1000_s"] / first["wall_per_1000_s"] - 1.0
     lines.append((f"wall per revolution within {SCALE_TARGET:.0%} from {first['revolutions']:g} "
@@ -751,6 +754,8 @@ def write_targets(res, out: Path) -> Path:
     md += _profile_section(res.get("cold_start"))
     if "torsion" in res:
         md += torsion.section(res["torsion"])
+    if "steady" in res:
+        md += steady.section(res["steady"])
     path = out / "targets.md"
     path.write_text("\n".join(md) + "\n", encoding="utf-8")
     return path
