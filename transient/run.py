@@ -268,8 +268,9 @@ class CycleMap:
     not the energies K = ½Jω² the stepper holds in crank angle).
 
     ``neutral_at``: the places in x of the twists nothing depends on (``_free_dofs``).
-    ``start(x)``: the stepper's state (y, fst, ist) at the cycle's start with the periodic
-    states ``x``; ``__call__(x)``: the periodic states after one cycle, or a
+    ``start(x, t)``: the stepper's state (y, fst, ist) at the cycle's start with the periodic
+    states ``x`` at time ``t`` (0 by default); ``__call__(x, t)``: the periodic states after one
+    cycle (and ``elapsed``, its duration), or a
     :class:`~transient.errors.SimulationError` saying where the cycle failed."""
 
     def __init__(self, scene) -> None:
@@ -307,6 +308,7 @@ class CycleMap:
         self.evbuf = np.empty((EVENT_ROWS, 4))
         self.nfev = 0
         self.cycles = 0
+        self.elapsed = math.nan  # the last cycle's duration [s]
         self.net_work = math.nan  # the last cycle's W_gas + W_load + W_starter − losses [J]
         # (up to where it stopped, if it failed)
 
@@ -314,18 +316,30 @@ class CycleMap:
         """The scene's initial state's periodic states."""
         return self.y0[self.index].copy()
 
-    def start(self, x: np.ndarray):
-        """The stepper's state at the cycle's start with the periodic states ``x``."""
+    def state_names(self) -> list[str]:
+        """The periodic states' names (the state's blocks, numbered within each)."""
+        at = self.offsets
+        names = []
+        for k, b in enumerate(layout.STATE.blocks):
+            if layout.PERIODIC[b.name]:
+                n = at[k + 1] - at[k]
+                names += [b.name] if n == 1 else [f"{b.name}[{j}]" for j in range(n)]
+        return names
+
+    def start(self, x: np.ndarray, t: float = 0.0):
+        """The stepper's state at the cycle's start with the periodic states ``x``, at time
+        ``t`` (a load schedule's place; the switches are chosen there as a run's start does)."""
         y, fst, ist = self.y0.copy(), self.fst0.copy(), self.ist0.copy()
         y[self.index] = x
+        y[layout.T] = t
         return y, fst, ist
 
-    def __call__(self, x: np.ndarray) -> np.ndarray:
+    def __call__(self, x: np.ndarray, t: float = 0.0) -> np.ndarray:
         if not x[self.speed_at[0]] >= self.cfg[sio.C_W_HI]:  # (also NaN)
             self.net_work = math.nan
             raise SimulationError(f"the cycle from ω = {x[self.speed_at[0]]:.9g} rad/s would "
                                   f"start in time, below 1.5 × solver.switch_speed")
-        y, fst, ist = self.start(x)
+        y, fst, ist = self.start(x, t)
         status = sio.RUNNING
         last = None
         while status == sio.RUNNING:
@@ -337,6 +351,7 @@ class CycleMap:
             ist[sio.I_NOUT] = ist[sio.I_NEV] = 0
         self.nfev += int(ist[sio.I_NFEV])
         self.cycles += 1
+        self.elapsed = float(y[layout.T] - t)
         at = self.offsets
         self.net_work = float(y[layout.W_GAS] + y[layout.W_LOAD] + y[layout.W_STARTER]
                               - y[at[layout.B_LOSS]:at[layout.B_LOSS + 1]].sum()

@@ -23,7 +23,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.model import layout
 from .core.stepper import io as sio
 from .errors import SceneError, SimulationError
 from .results import Checkpoint, Result, check_writable
@@ -158,7 +157,7 @@ def shoot(scene, progress: Callable[[int, float, int], None] | None = None,
     refuse_nonperiodic(scene)
     phi = cycle_map or CycleMap(scene)
     sv = scene.solver
-    rec = Shooting(_names(scene, phi))
+    rec = Shooting(phi.state_names())
     x = phi.initial()
 
     def weight(x):
@@ -325,17 +324,6 @@ def _speed_limited(z, dz, speed_at) -> float:
         elif dz[i] < -shrink * z[i]:
             lam = min(lam, -shrink * z[i] / dz[i])
     return lam
-
-
-def _names(scene, phi: CycleMap) -> list[str]:
-    """The periodic states' names (the state's blocks, numbered within each)."""
-    at = layout.STATE.offsets_for(phi.model)
-    names = []
-    for k, b in enumerate(layout.STATE.blocks):
-        if layout.PERIODIC[b.name]:
-            n = at[k + 1] - at[k]
-            names += [b.name] if n == 1 else [f"{b.name}[{j}]" for j in range(n)]
-    return names
 
 
 def _no_state(rec: Shooting, phi: CycleMap, what: str) -> NoSteadyState:

@@ -978,7 +978,7 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert "(quick: caches warm)" in targets and "## Cold compile profile" in targets
     lines = verdicts(res)
     assert len(lines) == n_speed + len(BENCH_SCENES) + 2 + 1 + 1 + 1 + 1 + 2 \
-        + len(BENCH_SCENES) * len(ADAPTIVE) + 2 + 4 + 1  # (the elastic line's four, steady)
+        + len(BENCH_SCENES) * len(ADAPTIVE) + 2 + 4 + 1 + 5  # (the elastic line's four, steady, multirevolution's five)
     tors = res["torsion"]  # (quick: 4 revolutions, lines of 3 and 4 stations, RK45 only)
     assert tors["rigid"]["elastic_s"] > 0 and tors["rigid"]["rigid_s"] > 0
     assert tors["scaling"]["stations"] == [3, 4] and all(
@@ -991,6 +991,9 @@ def test_bench_quick_writes_a_consistent_record(tmp_path):
     assert steady["shooting_cycles"] >= 2 and steady["direct_cycles"] > 0
     assert steady["speed_difference"] <= 1e-9  # (the settled run's speed, by either way)
     assert "## Steady state against a settling direct run" in targets
+    mr = res["multirevolution"]  # (quick: a short run, the harness only)
+    assert mr["cycles"] == 400 and mr["cycles_integrated"] > 0 and mr["direct_s"] > 0
+    assert "## Multirevolution" in targets
     assert res["reaction"]["constant_s"] > 0 and res["reaction"]["reaction_s"] > 0
     (models,) = res["models"]  # (quick: the plain scene only)
     assert models["this_s"] > 0 and models["left_out_s"] > 0

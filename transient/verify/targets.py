@@ -53,7 +53,7 @@ from ..core.model.rhs import derivative
 from ..results import open_result
 from ..run import SUMMARY_SAMPLES, integrate
 from ..scene import Governor, Starter, load_scene
-from . import steady, torsion
+from . import multirev, steady, torsion
 from .bench import (
     ADAPTIVE,
     BASELINE_BUDGET_S,
@@ -587,6 +587,8 @@ def measure_targets(rows, floors, quick=False, progress=print) -> dict:
     res["torsion"] = torsion.measure(quick, progress)
     res["torsion"]["scipy"] = elastic_against_scipy(res["torsion"]["rows"])
     res["steady"] = steady.measure(quick, progress)
+    res["multirevolution"] = multirev.measure(quick)
+    progress("targets: multirevolution")
     return res
 
 
@@ -651,6 +653,8 @@ def verdicts(res) -> list[tuple[str, str, str, str]]:
         lines += torsion.verdicts(res["torsion"], _missed)
     if "steady" in res:  # (none in a record from before it was measured)
         lines += steady.verdicts(res["steady"], _missed)
+    if "multirevolution" in res:
+        lines += multirev.verdicts(res["multirevolution"], _missed)
     first, last = res["scale"][0], res["scale"][-1]
     growth = last["wall_per_1000_s"] / first["wall_per_1000_s"] - 1.0
     lines.append((f"wall per revolution within {SCALE_TARGET:.0%} from {first['revolutions']:g} "
@@ -756,6 +760,8 @@ def write_targets(res, out: Path) -> Path:
         md += torsion.section(res["torsion"])
     if "steady" in res:
         md += steady.section(res["steady"])
+    if "multirevolution" in res:
+        md += multirev.section(res["multirevolution"])
     path = out / "targets.md"
     path.write_text("\n".join(md) + "\n", encoding="utf-8")
     return path

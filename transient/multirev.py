@@ -1,0 +1,211 @@
+"""Long runs in a fraction of their cycles: multirevolution (envelope-following) steps on the
+cycle map (docs/theory.md, "Multirevolution steps"; docs/guide/steady.md).
+
+In crank angle the state at each cycle's start follows the cycle map, X_{n+1} = Φ(X_n), X the
+periodic states and the time t (:class:`~transient.run.CycleMap`, started at the time it is
+given). Where the inputs change slowly against a cycle (a heavy flywheel's spin-up, a load
+programme over minutes) the sequence X_n lies on a smooth *envelope* X(n) through the nodes,
+whose derivative at a node follows from the three resolved cycles after it (the third-order
+one-sided difference of X_n … X_{n+3}):
+
+    X′(n) ≈ F(X_n) = −11/6 X_n + 3 X_{n+1} − 3/2 X_{n+2} + 1/3 X_{n+3}.
+
+The envelope is then integrated in n, the cycle number, by an embedded Runge–Kutta pair with
+step control (scipy's RK45: a step of many cycles costs six F, eighteen resolved cycles), and
+again at ten times the tolerance: the difference of the two is the error estimate (the looser
+one's error, which bounds the tighter one's where the method converges). It is the envelope's
+error, not the stepper's: each cycle is integrated at the scene's tolerance, as a direct run's
+is, and the two differ by about that a cycle, which a heavy flywheel's map adds up. A load schedule's corners are
+crossed in resolved cycles (:data:`CORNER_CYCLES` on either side), so that a corner falls in
+the cycle where the direct run has it; so are the run's last cycles where fewer are left than a
+macro step saves.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .errors import SceneError, SimulationError
+from .run import CycleMap
+from .shooting import _nonperiodic, refuse_nonperiodic
+
+#: Weights of the one-sided difference of X_n … X_{n+3} for X′(n) (third order).
+DIFFERENCE = (-11.0 / 6.0, 3.0, -1.5, 1.0 / 3.0)
+#: Resolved cycles kept on either side of a schedule corner.
+CORNER_CYCLES = 3
+#: The share of the time to the next corner a macro segment spans at the present cycle's
+#: period (the speed may rise and shorten it); the corner's event stops it if the speed falls.
+CORNER_REACH = 0.9
+#: Fewer cycles left than this are integrated one by one (a macro step's stages cost more).
+MIN_MACRO = 60
+#: The envelope integrator's own relative tolerance, its least: the envelope's is put in its
+#: absolute one, per state (:meth:`_Follower._macro`).
+SOLVER_RTOL = 100 * np.finfo(float).eps
+#: The time's error is held relative to this many cycles' duration: what places a corner in
+#: its cycle to a small part of one over the run.
+TIME_SCALE = 100.0
+#: The envelope's default tolerance, relative.
+ENVELOPE_RTOL = 1e-7
+#: The second integration's tolerance, a multiple of the first's: their difference estimates
+#: the second's error, which bounds the first's where the method converges.
+ESTIMATE_RATIO = 10.0
+
+
+@dataclass
+class Envelope:
+    """The run's state at every cycle start (the periodic states, then t): ``integrated`` says
+    which cycles were integrated as the direct run would (the rest are the envelope's, from its
+    dense output); ``error`` the estimate of each state's error at the last cycle (the
+    difference of the integrations at rtol and at ten times it); the cycles integrated (the
+    estimate's too) and their right-hand sides' evaluations."""
+
+    names: list[str]
+    states: np.ndarray
+    integrated: np.ndarray
+    error: np.ndarray
+    cycles_integrated: int
+    nfev: int
+
+    def column(self, name: str) -> np.ndarray:
+        """One state at every cycle start, cycle 0 to the last."""
+        return self.states[:, self.names.index(name)]
+
+
+def refuse(scene) -> None:
+    """Raise :class:`~transient.errors.SceneError` for a scene the envelope cannot follow:
+    shooting's refusals but a load schedule in time, whose corners are crossed cycle by cycle."""
+    why = _nonperiodic(scene)
+    if why is not None and why[0] == "load.schedule_time":
+        scene = dataclasses.replace(scene, load=dataclasses.replace(
+            scene.load, schedule_time=(), schedule_scale=()))
+    refuse_nonperiodic(scene)
+
+
+class _Follower:
+    """One integration of the envelope at one tolerance over a run of ``cycles`` cycles."""
+
+    def __init__(self, phi: CycleMap, corners: np.ndarray, cycles: int, rtol: float,
+                 atol: float, progress) -> None:
+        self.phi, self.corners, self.cycles = phi, corners, cycles
+        self.rtol, self.atol, self.progress = rtol, atol, progress
+        width = phi.initial().size + 1
+        self.states = np.full((cycles + 1, width), np.nan)
+        self.integrated = np.zeros(cycles + 1, dtype=bool)
+
+    def cycle(self, X: np.ndarray) -> np.ndarray:
+        """The state after one resolved cycle from ``X``."""
+        end = self.phi(X[:-1], float(X[-1]))
+        return np.append(end, X[-1] + self.phi.elapsed)
+
+    def slope(self, _n: float, X: np.ndarray) -> np.ndarray:
+        """F(X): the envelope's derivative by the cycle number, from three resolved cycles."""
+        seq = [X]
+        for _ in DIFFERENCE[1:]:
+            seq.append(self.cycle(seq[-1]))
+        return np.tensordot(DIFFERENCE, np.array(seq), axes=1)
+
+    def resolve(self, n: int, X: np.ndarray) -> np.ndarray:
+        """Cycle ``n`` integrated from ``X``: the state at cycle n + 1."""
+        self.states[n], self.integrated[n] = X, True
+        return self.cycle(X)
+
+    def run(self) -> np.ndarray:
+        n, X = 0, np.append(self.phi.initial(), 0.0)
+        while n < self.cycles:
+            period = self.phi.cycle / abs(X[self.phi.speed_at[0]])
+            corner = self._next_corner(X[-1])
+            stop = self._reach(n, X[-1], corner, period)
+            if self._near_corner(X[-1], corner, period) or stop - n < MIN_MACRO:
+                X, n = self.resolve(n, X), n + 1
+                continue
+            n, X = self._macro(n, X, stop, corner, period)
+            if self.progress is not None:
+                self.progress(n, self.cycles, self.phi.cycles)
+        self.states[self.cycles] = X
+        return self.states
+
+    def _near_corner(self, t: float, ahead: float | None, period: float) -> bool:
+        """Within CORNER_CYCLES cycles (and one for the cycle that holds it) of a corner."""
+        behind = self.corners[self.corners <= t]
+        return bool((ahead is not None and ahead - t < (CORNER_CYCLES + 1) * period)
+                    or (behind.size and t - behind[-1] < CORNER_CYCLES * period))
+
+    def _next_corner(self, t: float) -> float | None:
+        ahead = self.corners[self.corners > t]
+        return float(ahead[0]) if ahead.size else None
+
+    def _reach(self, n: int, t: float, corner: float | None, period: float) -> int:
+        """Where a macro segment from cycle ``n`` may end: the run's end, or short of the next
+        corner (no stage's cycles may reach it: they would see it)."""
+        if corner is None:
+            return self.cycles
+        return min(self.cycles, n + int(CORNER_REACH * (corner - t) / period))
+
+    def _macro(self, n: int, X: np.ndarray, stop: int, corner: float | None, period: float):
+        """The envelope from cycle ``n`` to ``stop``, or to the last whole cycle that ends
+        CORNER_CYCLES cycles before the next corner: its nodes filled from the dense output."""
+        events = []
+        if corner is not None:
+            def before_corner(_n, Y):
+                return Y[-1] - (corner - CORNER_CYCLES * period)
+            before_corner.terminal = True  # type: ignore[attr-defined]
+            events.append(before_corner)
+        # each state's error held to rtol of its size at the segment's start, t's to rtol of
+        # TIME_SCALE cycles' duration: relative to t itself, a long run's would grow with its
+        # length
+        scale = np.abs(X)
+        scale[-1] = TIME_SCALE * period
+        sol = solve_ivp(self.slope, (n, stop), X, method="RK45", rtol=SOLVER_RTOL,
+                        atol=self.atol + self.rtol * scale, dense_output=True,
+                        events=events or None)
+        if sol.status == -1:
+            raise SimulationError(f"the envelope from cycle {n} failed: {sol.message}")
+        end = int(math.floor(sol.t[-1] + 1e-9))
+        if end <= n:  # (the corner came before a whole cycle: resolve one)
+            return n + 1, self.resolve(n, X)
+        nodes = np.arange(n, end + 1)
+        self.states[n:end + 1] = sol.sol(nodes).T
+        self.states[n] = X
+        return end, self.states[end].copy()
+
+
+def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
+                    progress: Callable[[int, int, int], None] | None = None) -> Envelope:
+    """Follow ``scene`` over ``cycles`` engine cycles on the envelope of its cycle map.
+
+    Parameters
+    ----------
+    scene : Scene
+        A dynamic scene of the compiled stepper in crank angle whose only input that changes
+        with time is a load schedule in time (``load.schedule_time``).
+    cycles : int
+        The engine cycles to follow (≥ 1).
+    rtol : float
+        The envelope's relative tolerance (its absolute one the scene's ``solver.atol``).
+    progress : callable, optional
+        Called with (cycle reached, cycles, cycles integrated) as the envelope advances.
+
+    Returns
+    -------
+    Envelope
+        The state at every cycle start, which cycles were integrated, the error estimate.
+    """
+    if not (isinstance(cycles, int) and cycles >= 1):
+        raise SceneError("cycles", f"{cycles!r}: a whole number of cycles ≥ 1")
+    if not (isinstance(rtol, float) and 0.0 < rtol < 1.0):
+        raise SceneError("rtol", f"{rtol!r}: the envelope's relative tolerance, in (0, 1)")
+    refuse(scene)
+    phi = CycleMap(scene)
+    corners = np.unique(np.asarray(scene.load.schedule_time, dtype=float))
+    atol = scene.solver.atol
+    run = _Follower(phi, corners, cycles, rtol, atol, progress)
+    states = run.run()
+    coarse = _Follower(phi, corners, cycles, rtol * ESTIMATE_RATIO, atol, None)
+    coarse.run()
+    return Envelope([*phi.state_names(), "t"], states, run.integrated,
+                    np.abs(states[-1] - coarse.states[-1]), phi.cycles, phi.nfev)
