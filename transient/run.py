@@ -309,6 +309,7 @@ class CycleMap:
         self.cycles = 0
         self.net_work = math.nan  # the last cycle's W_gas + W_load + W_starter − losses [J]
         # (up to where it stopped, if it failed)
+        self.period = math.nan  # the last cycle's duration [s]: its time-mean speed cycle/period
 
     def initial(self) -> np.ndarray:
         """The scene's initial state's periodic states."""
@@ -337,6 +338,7 @@ class CycleMap:
             ist[sio.I_NOUT] = ist[sio.I_NEV] = 0
         self.nfev += int(ist[sio.I_NFEV])
         self.cycles += 1
+        self.period = float(y[layout.T])  # (t starts at 0: the cycle's duration)
         at = self.offsets
         self.net_work = float(y[layout.W_GAS] + y[layout.W_LOAD] + y[layout.W_STARTER]
                               - y[at[layout.B_LOSS]:at[layout.B_LOSS + 1]].sum()

@@ -158,27 +158,42 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
 def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int | None
              ) -> Generator[tuple[RunSpec, dict], None, None]:
     """(spec, result) of each run as it finishes."""
-    if not todo:
+    for i, res in map_tasks(run_one, [(s.scene, columns) for s in todo], scheduler, workers,
+                            _lost):
+        yield todo[i], res
+
+
+def map_tasks(fn: Callable, tasks: list[tuple], scheduler: str | None = None,
+              workers: int | None = None,
+              lost: Callable[[BaseException], Any] | None = None
+              ) -> Generator[tuple[int, Any], None, None]:
+    """(i, fn(*tasks[i])) as each task finishes: on the workers of a new local cluster
+    (``scheduler`` None, ``workers`` processes), of a running scheduler (``tcp://host:port``)
+    or, with ``"serial"``, in this process in order. ``lost(exc)`` stands for the result of a
+    task whose worker was lost (None: the exception goes on)."""
+    if not tasks:
         return
     if scheduler == "serial":
-        for spec in todo:
-            yield spec, run_one(spec.scene, columns)
+        for i, task in enumerate(tasks):
+            yield i, fn(*task)
         return
     from dask.distributed import as_completed
 
     with _client(scheduler, workers) as client:
-        futures = {client.submit(run_one, s.scene, columns, pure=False,
-                                 key=f"transient-run-{s.index}-{os.urandom(4).hex()}"): s
-                   for s in todo}
+        futures = {client.submit(fn, *task, pure=False,
+                                 key=f"transient-{fn.__name__}-{i}-{os.urandom(4).hex()}"): i
+                   for i, task in enumerate(tasks)}
         try:
             for fut in as_completed(futures):
-                spec = futures.pop(fut)
+                i = futures.pop(fut)
                 try:
                     res = fut.result()
                 except Exception as exc:
-                    res = _lost(exc)
+                    if lost is None:
+                        raise
+                    res = lost(exc)
                 fut.release()
-                yield spec, res
+                yield i, res
         finally:
             client.cancel(list(futures))
 
