@@ -92,13 +92,16 @@ def cmd_efficiency(args) -> int:
           f"{'fmep':>6}{steady}  "
           + "  ".join(f"{n}: loss [J/cycle] (circulated), fmep" for n in names))
     for r in rows:
-        pairs = "  ".join(f"{r[f'W_loss_{k + 1}_per_cycle']:10.4g} "
-                          f"({r[f'W_circulated_{k + 1}_per_cycle']:.4g}) "
-                          f"{r[f'fmep_{k + 1}'] / 1e3:6.4g}" for k in range(len(names)))
-        steady = f" {r['delta']:8.5f} {r['brake_torque']:8.4g}" if args.steady else ""
-        print(f"{r['policy']:>10} {r['fuel']:5.3g} {r['rpm']:7.0f} {r['eta_mech_work']:9.5f} "
-              f"{r.get('eta_mech_printed', math.nan):9.5f} {r['imep'] / 1e3:7.5g} "
-              f"{r['fmep'] / 1e3:6.4g}{steady}  {pairs}")
+        def v(key, r=r):  # (NaN where a point has no value)
+            return r.get(key, math.nan)
+
+        pairs = "  ".join(f"{v(f'W_loss_{k + 1}_per_cycle'):10.4g} "
+                          f"({v(f'W_circulated_{k + 1}_per_cycle'):.4g}) "
+                          f"{v(f'fmep_{k + 1}') / 1e3:6.4g}" for k in range(len(names)))
+        steady = f" {v('delta'):8.5f} {v('brake_torque'):8.4g}" if args.steady else ""
+        print(f"{r['policy']:>10} {r['fuel']:5.3g} {r['rpm']:7.0f} {v('eta_mech_work'):9.5f} "
+              f"{v('eta_mech_printed'):9.5f} {v('imep') / 1e3:7.5g} "
+              f"{v('fmep') / 1e3:6.4g}{steady}  {pairs}")
     print("  (mean effective pressures in kPa: imep = W_in/V_d, fmep = Σ W_loss/V_d"
           + ("; δ the cyclic irregularity, brake the torque [N m] that holds the mean speed)"
              if args.steady else ")"))
@@ -151,7 +154,7 @@ def _check_steady(scene, rpm, file) -> None:
         raise SceneError("--rpm", f"{min(rpm):g} rpm is below 1.5 × solver.switch_speed = "
                                   f"{w_hi * 30.0 / math.pi:.6g} rpm, where the steady cycle "
                                   f"starts in time; --steady needs running speeds", file=file)
-    refuse_nonperiodic(bench_scene(scene, max(rpm) * math.pi / 30.0, 1.0))
+    refuse_nonperiodic(bench_scene(scene, min(rpm) * math.pi / 30.0, 1.0))
 
 
 def _study(scene, rpm, fuels, policies, args, scheduler) -> list[dict]:

@@ -115,6 +115,7 @@ def _solve(scene, phi: CycleMap, omega: float) -> tuple[np.ndarray, float, list[
     free = np.flatnonzero(phi.free)
     x0 = phi.initial()
     target_weight = sv.atol + sv.rtol * omega
+    failures: list[str] = []  # (what stopped the cycles that failed)
 
     def cycle(z):
         """G(z) and the cycle's net work, z = (x's free states, T); None where it failed."""
@@ -123,7 +124,8 @@ def _solve(scene, phi: CycleMap, omega: float) -> tuple[np.ndarray, float, list[
         phi.model = base._replace(load_const=float(z[-1]))
         try:
             end = phi(x)
-        except SimulationError:
+        except SimulationError as exc:
+            failures.append(str(exc))
             return None, phi.net_work
         f = (end - x)[free] / (sv.atol + sv.rtol * np.abs(x[free]))
         g = (phi.cycle / phi.period - omega) / target_weight
@@ -131,15 +133,13 @@ def _solve(scene, phi: CycleMap, omega: float) -> tuple[np.ndarray, float, list[
 
     z = np.append(x0[free], 0.0)
     G, work = cycle(z)
-    if not math.isfinite(work):
-        raise NoOperatingPoint(f"the cycle at {_rpm(omega)} failed before its end without a "
-                               f"brake")
     z1 = z.copy()
     z1[-1] = work / phi.cycle  # (in steady state W_gas − losses = T·cycle)
-    G1, _ = cycle(z1)
+    G1, _ = cycle(z1) if G is not None else (None, None)
     if G is None or G1 is None:
-        raise NoOperatingPoint(f"the first cycles at {_rpm(omega)} failed (a stall, or the "
-                               f"speed left crank angle)")
+        raise NoOperatingPoint(f"no steady state at {_rpm(omega)}: a first cycle from it, "
+                               f"{'with' if G is not None else 'without'} a brake, failed: "
+                               f"{failures[-1]}")
     rel = math.sqrt(max(sv.rtol, np.finfo(float).eps))
     J = _differences(cycle, z1, G1, rel, skip=z.size - 1)
     J[:, -1] = (G1 - G) / (z1[-1] - z[-1])  # (the first two cycles' secant in T)

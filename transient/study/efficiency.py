@@ -55,7 +55,7 @@ def study_point(scene, policy: str, fuel: float, rpm: float, samples_per_rev: in
     """The study's row of one point: at the prescribed constant speed, or with ``steady`` the
     periodic steady state on a dynamometer with the scene's inertias
     (:func:`~transient.study.dynamometer.held_point`), δ and the brake torque besides; a point
-    with no steady state has its reason in ``note`` and its values left out (NaN)."""
+    with no steady state has its reason in ``note`` and no values (NaN in the table)."""
     omega = rpm * math.pi / 30.0
     row: dict = {"policy": policy, "fuel": fuel, "rpm": rpm}
     if steady:
@@ -96,8 +96,7 @@ def efficiency_study(scene, rpm, fuels=(1.0,), policies=None, samples_per_rev: i
         rows[i] = row
         if progress:
             progress((done + 1) / len(points))
-    values = {k for r in rows for k, v in r.items() if not isinstance(v, str)}
-    return [{**dict.fromkeys(values, math.nan), **r} for r in rows]  # (NaN where left out)
+    return rows
 
 
 def write_csv(rows: list[dict], fh) -> None:
@@ -124,7 +123,7 @@ def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
     for policy, fuel in keys:
         sel = [r for r in rows if r["policy"] == policy and r["fuel"] == fuel]
         marker, line = styles.get(policy, ("o", "-"))
-        artists += ax_eta.plot([r["rpm"] for r in sel], [r["eta_mech_work"] for r in sel],
+        artists += ax_eta.plot([r["rpm"] for r in sel], [_value(r, "eta_mech_work") for r in sel],
                                marker=marker, linestyle=line, label=f"{policy}, fuel {fuel:g}")
     ax_eta.set_ylabel("η_mech = W_out / W_in")
     ax_eta.legend(fontsize=8)
@@ -134,11 +133,12 @@ def plot_study(ax_eta, ax_loss, rows: list[dict], n_pairs: int, names) -> list:
     n = [r["rpm"] for r in sel]
     twin = ax_loss.twinx()
     for k in range(n_pairs):
-        artists += ax_loss.plot(n, [100 * r[f"loss_share_{k + 1}"] for r in sel], "o-",
+        artists += ax_loss.plot(n, [100 * _value(r, f"loss_share_{k + 1}") for r in sel], "o-",
                                 label=f"loss, {names[k]}")
         # (no work in, above a governor's cut-off: no share to plot there)
-        artists += twin.plot(n, [r[f"W_circulated_{k + 1}_per_cycle"] / r["W_in_per_cycle"]
-                                 if r["W_in_per_cycle"] > 0.0 else math.nan for r in sel], "s:",
+        artists += twin.plot(n, [_value(r, f"W_circulated_{k + 1}_per_cycle")
+                                 / r["W_in_per_cycle"] if _value(r, "W_in_per_cycle") > 0.0
+                                 else math.nan for r in sel], "s:",
                              label=f"circulated, {names[k]}")
     ax_loss.set_xlabel("speed [rpm]")
     ax_loss.set_ylabel(f"loss [% of W_in] ({policy}, fuel {fuel:g})")
@@ -162,6 +162,11 @@ def _first_policy(rows: list[dict]) -> tuple[str, list[float], list[float]]:
     return policy, fuels, rpm
 
 
+def _value(row: dict, key: str) -> float:
+    """A row's value, NaN where its point has none (no steady state: every value left out)."""
+    return row.get(key, math.nan)
+
+
 def _row(rows, policy, fuel, rpm) -> dict:
     return next(r for r in rows if (r["policy"], r["fuel"], r["rpm"]) == (policy, fuel, rpm))
 
@@ -171,7 +176,7 @@ def plot_budget(ax, rows: list[dict], names) -> list:
     (:func:`transient.plots.friction_budget`). Returns the bars."""
     policy, fuels, rpm = _first_policy(rows)
     sel = [_row(rows, policy, fuels[0], n) for n in rpm]
-    fmep = [[r[f"fmep_{k + 1}"] for r in sel] for k in range(len(names))]
+    fmep = [[_value(r, f"fmep_{k + 1}") for r in sel] for k in range(len(names))]
     bars = friction_budget(ax, [f"{n:g}" for n in rpm], fmep, names)
     ax.set_xlabel(f"speed [rpm] ({policy}, fuel {fuels[0]:g})")
     return bars
@@ -182,7 +187,7 @@ def plot_map(ax, rows: list[dict]):
     (:func:`transient.plots.sweep_heatmap`). Returns the mesh."""
     policy, fuels, rpm = _first_policy(rows)
     fuels = fuels[::-1]  # the lowest load at the bottom
-    eta = [[_row(rows, policy, f, n)["eta_mech_work"] for n in rpm] for f in fuels]
+    eta = [[_value(_row(rows, policy, f, n), "eta_mech_work") for n in rpm] for f in fuels]
     mesh = sweep_heatmap(ax, rpm, fuels, eta, "speed [rpm]", "fuel (gas-force fraction)",
                          "η_mech = W_out / W_in")
     ax.set_title(f"η_mech over speed and load ({policy})")
