@@ -141,7 +141,7 @@ def _solve(scene, phi: CycleMap, omega: float) -> tuple[np.ndarray, float, list[
                                f"{'with' if G is not None else 'without'} a brake, failed: "
                                f"{failures[-1]}")
     rel = math.sqrt(max(sv.rtol, np.finfo(float).eps))
-    J = _differences(cycle, z1, G1, rel, skip=z.size - 1)
+    J = _differences(cycle, z1, G1, rel, failures, skip=z.size - 1)
     J[:, -1] = (G1 - G) / (z1[-1] - z[-1])  # (the first two cycles' secant in T)
     z, G = z1, G1
     r = float(np.max(np.abs(G)))
@@ -168,17 +168,22 @@ def _solve(scene, phi: CycleMap, omega: float) -> tuple[np.ndarray, float, list[
                 step = z + lam * dz, G_new
                 break
             lam *= 0.5
+        if step is None and fresh and best[1] <= NOISE_FLOOR:
+            z, r = best  # (a fresh derivative's step reduces it no more: the map's noise)
+            residuals.append(r)
+            break
         if step is None:
             if fresh:
                 raise NoOperatingPoint(f"Newton's step at {_rpm(omega)} reduces the residual "
                                        f"no more; residuals {_shown(residuals)}")
-            J, fresh = _differences(cycle, z, G, rel), True  # (the kept derivative failed)
+            # (the kept derivative's step failed: a fresh one)
+            J, fresh = _differences(cycle, z, G, rel, failures), True
             continue
         z_new, G_new = step
         r_new = float(np.max(np.abs(G_new)))
         if r_new > CHORD_RATE * r:
-            J, fresh = _differences(cycle, z_new, G_new, rel), True
-        else:
+            J, fresh = _differences(cycle, z_new, G_new, rel, failures), True
+        else:  # (Broyden's rank-one update: the least change that meets the secant)
             dz_taken = z_new - z
             J = J + np.outer((G_new - G) - J @ dz_taken, dz_taken) / (dz_taken @ dz_taken)
             fresh = False
@@ -197,9 +202,11 @@ def _solve(scene, phi: CycleMap, omega: float) -> tuple[np.ndarray, float, list[
     return x, T, residuals
 
 
-def _differences(cycle, z, G, rel: float, skip: int | None = None) -> np.ndarray:
+def _differences(cycle, z, G, rel: float, failures: list[str], skip: int | None = None
+                 ) -> np.ndarray:
     """∂G/∂z by forward differences from G(z) = ``G``, a cycle per unknown but ``skip``, each
-    step ``rel`` (√rtol: the rounding of a cycle) of the unknown's scale."""
+    step ``rel`` (√rtol: the rounding of a cycle) of the unknown's scale; a cycle that fails
+    says why by the last of ``failures``."""
     J = np.zeros((z.size, z.size))
     for i in range(z.size):
         if i == skip:
@@ -209,7 +216,8 @@ def _differences(cycle, z, G, rel: float, skip: int | None = None) -> np.ndarray
         up[i] += h
         G_up, _ = cycle(up)
         if G_up is None:
-            raise NoOperatingPoint("a cycle of the difference derivative failed")
+            raise NoOperatingPoint(f"a cycle of the derivative by differences failed: "
+                                   f"{failures[-1]}")
         J[:, i] = (G_up - G) / h
     return J
 
