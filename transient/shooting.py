@@ -436,8 +436,15 @@ def steady(scene, path: str | Path | None = None, *, cycles: int = 1, force: boo
     if path is not None:
         check_writable(Path(path), force)
     rec, phi = shoot(scene, progress)
-    x = rec.x
-    assert x is not None, "shoot returns the state it found"
+    assert rec.x is not None, "shoot returns the state it found"
+    return cycles_from(scene, phi, rec.x, cycles, path, force, rec.analysis())
+
+
+def cycles_from(scene, phi: CycleMap, x: np.ndarray, cycles: int = 1,
+                path: str | Path | None = None, force: bool = False,
+                analysis: dict[str, tuple] | None = None) -> Result:
+    """``cycles`` cycles of ``scene`` run with output from the periodic states ``x`` at its
+    cycle start (``phi``'s), a :class:`~transient.Result` with ``analysis`` beside its own."""
     y, fst, ist = phi.start(x)
     start = Checkpoint(rows=0, events=0, switched=False, code=sio.RUNNING,
                        floats=np.concatenate([y, fst]), ints=ist)
@@ -445,4 +452,4 @@ def steady(scene, path: str | Path | None = None, *, cycles: int = 1, force: boo
                               revolutions=cycles * phi.cycle / (2.0 * math.pi))
     initial = dataclasses.replace(scene.initial, omega=float(x[phi.speed_at[0]]))
     cycle_scene = dataclasses.replace(scene, run=run, initial=initial)
-    return simulate_from(cycle_scene, start, path, force=force, analysis=rec.analysis())
+    return simulate_from(cycle_scene, start, path, force=force, analysis=analysis)

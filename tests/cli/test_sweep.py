@@ -392,3 +392,25 @@ def test_sweep_plot(sweep_file, tmp_path, capsys):
     capsys.readouterr()
     assert main(["sweep-plot", str(out / "small.h5"), "--quantity", "nope"]) == 2
     assert "'nope' is not in the summary" in capsys.readouterr().err
+
+
+def test_steady_efficiency_points_on_the_cluster(tmp_path, cluster, capsys):
+    """`transient efficiency --steady --scheduler ADDRESS` runs its points on the workers
+    (map_tasks, as a sweep's runs) and writes the same table as in this process, row for row:
+    the same points, the same state to the solver's rounding."""
+    scene = CASES / "gots_diesel_friction.toml"
+    argv = ["efficiency", str(scene), "--steady", "--rpm", "2000,4000", "--fuel", "1,0.5",
+            "--samples-per-rev", "72"]
+    tables = []
+    for where in ("serial", cluster):
+        out = tmp_path / where.replace(":", "_").replace("/", "_")
+        assert main([*argv, "--scheduler", where, "-o", str(out)]) == 0
+        with open(out / "gots_diesel_friction_steady_efficiency.csv") as fh:
+            tables.append(list(csv.DictReader(fh)))
+    capsys.readouterr()
+    serial, cluster_rows = tables
+    assert [(r["fuel"], r["rpm"]) for r in cluster_rows] == [(r["fuel"], r["rpm"])
+                                                            for r in serial]
+    for a, b in zip(serial, cluster_rows):
+        for key in ("eta_mech_work", "fmep", "delta", "brake_torque", "rpm_mean"):
+            assert float(b[key]) == pytest.approx(float(a[key]), rel=1e-9), key

@@ -55,7 +55,8 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
           method: str = "grid", name: str | None = None, columns: Sequence[str] | None = None,
           output: str | Path | None = None, client=None, scheduler: str | None = None,
           workers: int | None = None, force: bool = False,
-          progress: Callable[[int, int], None] | None = None) -> SweepResult:
+          progress: Callable[[int, int], None] | None = None,
+          steady: bool = False) -> SweepResult:
     """Run ``base`` (a :class:`~transient.Scene`) over ``axes`` and collect quantities of
     every run, as ``transient sweep`` does.
 
@@ -85,6 +86,9 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
         Replace a sweep file of another sweep of this name.
     progress : callable, optional
         Called with (runs done, runs in all) after each run.
+    steady : bool
+        Each run the scene's periodic steady state (:func:`transient.steady`, one cycle) in
+        place of its run from the initial state; every scene must be periodic.
 
     Returns
     -------
@@ -127,7 +131,7 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
     name = name or base.name
     spec_file = folder / f"{name}.sweep.toml"  # (the sweep's own definition: rewritten each time)
     with create_exclusive(spec_file, replace=True) as fh:
-        fh.write(sweep_toml(base, axes, collect, method, name, columns).encode("utf-8"))
+        fh.write(sweep_toml(base, axes, collect, method, name, columns, steady).encode("utf-8"))
     spec = load_sweep(spec_file)
     if client is not None:
         scheduler = client.scheduler.address
@@ -137,13 +141,15 @@ def sweep(base, axes: dict[str, Sequence], *, collect: Sequence[str] = DEFAULT_C
 
 
 def sweep_toml(base, axes: dict[str, Sequence], collect: Sequence[str], method: str, name: str,
-               columns: Sequence[str] | None) -> str:
+               columns: Sequence[str] | None, steady: bool = False) -> str:
     """The sweep file of a sweep from code: the base scene inline (its resolved TOML under
     ``[base]``), one ``[[axis]]`` per key."""
     head = [f"name = {toml_value(name)}", f"method = {toml_value(method)}",
             f"collect = {toml_value(list(collect))}"]
     if columns is not None:
         head.append(f"columns = {toml_value(list(columns))}")
+    if steady:
+        head.append("steady = true")
     lines = ["[sweep]", *head, ""]
     for key, values in axes.items():
         try:

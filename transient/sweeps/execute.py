@@ -31,10 +31,11 @@ from .store import SweepStore
 # A worker's part: one run, arrays back to the client
 
 
-def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
+def run_one(scene, columns: tuple[str, ...] | None, steady: bool = False) -> dict[str, Any]:
     """Integrate one scene and summarise it (on a worker); never raises: its ``status`` is the
     run's (:data:`transient.outcome.STATUSES`: ``finished``, or what stopped it, with its
-    message and the partial trajectory, if any), ``failed`` for an exception.
+    message and the partial trajectory, if any), ``failed`` for an exception. ``steady``: the
+    scene's periodic steady state (:func:`steady_run`) in place of the run.
 
     The imports stay in this process (a Dask worker runs many tasks), so numba loads each kernel
     once per worker, from its on-disk cache; ``compile_s`` shows it (≈ 0 after the first run).
@@ -49,7 +50,7 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
                            "units": output_columns(scene),
                            "worker": f"{socket.gethostname()}:{os.getpid()}"}
     try:
-        data = integrate(scene, keep=True)
+        data = steady_run(scene) if steady else integrate(scene, keep=True)
         out["solver"] = data.solver
         out["events"] = data.events
         keep = data.trajectory if columns is None else {c: data.trajectory[c] for c in columns}
@@ -63,6 +64,27 @@ def run_one(scene, columns: tuple[str, ...] | None) -> dict[str, Any]:
         out["message"] = f"{type(exc).__name__}: {exc}"
     out["wall_s"] = time.perf_counter() - t0
     return out
+
+
+def steady_run(scene):
+    """The steady cycle of ``scene`` (:func:`transient.steady`) as a run's data, its summary
+    the result's analysis with η_mech and the friction budget over that cycle (a run's summary
+    takes them over steady cycles after a settle, which one cycle has not)."""
+    import numpy as np
+
+    from ..analysis.efficiency import mechanical_efficiency
+    from ..results import RunData
+    from ..shooting import steady
+
+    res = steady(scene)
+    traj = dict(res.trajectory)
+    events = {k: np.column_stack([e["t"], e["phi"]]) for k, e in res.events.items()}
+    phi0 = scene.initial.phi
+    window = (phi0, phi0 + scene.mechanism.cycle, 1)
+    summary = {**res.analysis, **(mechanical_efficiency(scene, traj, events, window)
+                                  if scene.gas.model != "none" else {})}
+    return RunData(traj, events, dict(res.solver), complete=True, status=res.status,
+                   summary=summary)
 
 
 def worker_info() -> dict[str, str]:
@@ -139,7 +161,7 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
     try:
         # closing(): an interrupt here shuts the cluster down at once, not when the generator
         # is collected
-        with contextlib.closing(_execute(todo, sweep.columns, scheduler, workers)) as arriving:
+        with contextlib.closing(_execute(todo, sweep.columns, scheduler, workers, sweep.steady)) as arriving:
             for spec, res in arriving:
                 store.write_run(spec, res)
                 computed.append(spec.index)
@@ -155,30 +177,45 @@ def run_sweep(sweep: Sweep, out_dir: str | Path = "results", scheduler: str | No
     return Outcome(path, csv_path, computed, reused, sorted(store.recomputed), unused, rows)
 
 
-def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int | None
-             ) -> Generator[tuple[RunSpec, dict], None, None]:
+def _execute(todo: list[RunSpec], columns, scheduler: str | None, workers: int | None,
+             steady: bool = False) -> Generator[tuple[RunSpec, dict], None, None]:
     """(spec, result) of each run as it finishes."""
-    if not todo:
+    for i, res in map_tasks(run_one, [(s.scene, columns, steady) for s in todo], scheduler,
+                            workers, _lost):
+        yield todo[i], res
+
+
+def map_tasks(fn: Callable, tasks: list[tuple], scheduler: str | None = None,
+              workers: int | None = None,
+              lost: Callable[[BaseException], Any] | None = None
+              ) -> Generator[tuple[int, Any], None, None]:
+    """(i, fn(*tasks[i])) as each task finishes: on the workers of a new local cluster
+    (``scheduler`` None, ``workers`` processes), of a running scheduler (``tcp://host:port``)
+    or, with ``"serial"``, in this process in order. ``lost(exc)`` stands for the result of a
+    task whose worker was lost (None: the exception goes on)."""
+    if not tasks:
         return
     if scheduler == "serial":
-        for spec in todo:
-            yield spec, run_one(spec.scene, columns)
+        for i, task in enumerate(tasks):
+            yield i, fn(*task)
         return
     from dask.distributed import as_completed
 
     with _client(scheduler, workers) as client:
-        futures = {client.submit(run_one, s.scene, columns, pure=False,
-                                 key=f"transient-run-{s.index}-{os.urandom(4).hex()}"): s
-                   for s in todo}
+        futures = {client.submit(fn, *task, pure=False,
+                                 key=f"transient-{fn.__name__}-{i}-{os.urandom(4).hex()}"): i
+                   for i, task in enumerate(tasks)}
         try:
             for fut in as_completed(futures):
-                spec = futures.pop(fut)
+                i = futures.pop(fut)
                 try:
                     res = fut.result()
                 except Exception as exc:
-                    res = _lost(exc)
+                    if lost is None:
+                        raise
+                    res = lost(exc)
                 fut.release()
-                yield spec, res
+                yield i, res
         finally:
             client.cancel(list(futures))
 

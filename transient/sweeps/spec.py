@@ -8,6 +8,7 @@ A **sweep file** (TOML; examples in ``cases/sweeps/``)::
     method = "grid"                        # grid | list | random
     collect = ["mean_speed_rpm", "eta_mech"]
     columns = ["t", "phi", "omega"]        # trajectory columns to store (default all; [] none)
+    steady = false                         # true: each run the scene's periodic steady state
 
     [set]                                  # constant changes to the base scene
     "run.revolutions" = 200
@@ -24,7 +25,12 @@ values together. ``random`` draws ``samples`` points with ``seed``, uniformly in
 (log-uniform with ``spacing = "log"``) or from ``values``.
 
 Every resolved scene is validated here, before any work, so that a bad point stops the sweep
-with one line instead of failing on a worker.
+with one line instead of failing on a worker. With ``steady = true`` each run is the scene's
+periodic steady state (:func:`transient.steady`: one steady cycle, found in a few cycles)
+instead of its run from the initial state, and every scene must be periodic (refused here
+otherwise, with the run and the key); its resolved TOML, which identifies a stored run when a
+sweep is mended, then begins with :data:`STEADY_MARK`, so that a stored run of the other kind
+is never taken for it.
 """
 from __future__ import annotations
 
@@ -46,6 +52,8 @@ from ..scene.reader import finite_number
 from ..units import ALL_SUFFIXES
 
 METHODS = ("grid", "list", "random")
+#: The first line of a steady run's resolved TOML (``sweep.steady``; the module docstring).
+STEADY_MARK = "# the periodic steady state (sweep.steady = true)\n"
 SPACINGS = ("linear", "log")
 RPM = 30.0 / math.pi
 
@@ -118,6 +126,7 @@ class Sweep:
     collect: tuple[str, ...]
     columns: tuple[str, ...] | None  # None: every trajectory column
     runs: tuple[RunSpec, ...]
+    steady: bool = False  # each run the scene's periodic steady state
 
     @property
     def groups(self) -> list[list[Axis]]:
@@ -190,6 +199,7 @@ def load_sweep(source: str | Path) -> Sweep:
     columns = head.get("columns", (list,), None, "a list of trajectory column names")
     if columns is not None and not all(isinstance(c, str) for c in columns):
         raise head.error("columns", f"must be a list of strings, got {show_value(columns)}")
+    steady = head.get("steady", (bool,), False, "true or false")
     head.finish()
     changes = _flatten(root.get("set", (dict,), {}, "a table of dotted scene keys and values"))
     for key in changes:
@@ -205,7 +215,7 @@ def load_sweep(source: str | Path) -> Sweep:
         base_file = path.parent / base_path
         base, base_dir = _read_base(base_file, base_path, file), base_file.parent
     sweep = Sweep(name, path, text, method, axes, collect,
-                  None if columns is None else tuple(columns), ())
+                  None if columns is None else tuple(columns), (), steady)
     runs = tuple(_resolve(sweep, base, changes, params, i, str(base_file), base_dir)
                  for i, params in enumerate(_points(sweep)))
     _check_columns(sweep, runs)
@@ -400,6 +410,7 @@ def _resolve(sweep: Sweep, base: dict, changes: dict, params: dict, i: int, base
              base_dir: Path) -> RunSpec:
     """Run i's scene: the base with the constant changes and the axis values, validated."""
     from ..scene import scene_from_dict, to_toml
+    from ..shooting import refuse_nonperiodic
 
     data = copy.deepcopy(base)
     shown = ", ".join(f"{clip(k)} = {show_value(v)}" for k, v in params.items())
@@ -407,11 +418,13 @@ def _resolve(sweep: Sweep, base: dict, changes: dict, params: dict, i: int, base
         for key, value in itertools.chain(changes.items(), params.items()):
             set_key(data, key, value)
         scene = scene_from_dict(data, file=base_file, base_dir=base_dir)
+        if sweep.steady:
+            refuse_nonperiodic(scene)
     except SceneError as exc:
         raise SceneError(f"run {i} ({shown})", f"scene {clip(exc.key, 4 * QUOTE_LIMIT)}: "
                                                f"{exc.message}",
                          file=str(sweep.path)) from None
-    return RunSpec(i, params, scene, to_toml(scene))
+    return RunSpec(i, params, scene, STEADY_MARK * sweep.steady + to_toml(scene))
 
 
 def _check_columns(sweep: Sweep, runs: tuple[RunSpec, ...]) -> None:
