@@ -207,8 +207,8 @@ class _CalledAsPythonFromPython(_CalledFromCompiledCode):
     """A kernel whose calls from Python run the Python function given for it
     (``kernel(python=…)``) instead of a compiled twin: for a kernel as cheap as a Python call
     that the Python side needs before any run (the state's length), whose twin's compile would
-    cost a first run more than it saves. :attr:`python_entry` is still the compiled twin, for
-    the tests that check the two agree."""
+    cost a first run more than it saves. :attr:`_CalledFromCompiledCode.python_entry` is still
+    the compiled twin, for the tests that check the two agree."""
 
     def __call__(self, *args, **kwargs):
         return self.__dict__["_python"](*args, **kwargs)
