@@ -12,8 +12,9 @@ one-sided difference of X_n … X_{n+3}):
 
 The envelope is then integrated in n, the cycle number, by an embedded Runge–Kutta pair with
 step control (scipy's RK45: a step of many cycles costs six F, eighteen resolved cycles), and
-again at ten times the tolerance: the difference of the two is the error estimate (the looser
-one's error, which bounds the tighter one's where the method converges). It is the envelope's
+again at ten times the tolerance with the second-order difference: the difference of the two
+is the error estimate (the looser one's error, its derivative's included, which bounds the
+tighter one's where the method converges). It is the envelope's
 error, not the stepper's: each cycle is integrated at the scene's tolerance, as a direct run's
 is, and the two differ by about that a cycle, which a heavy flywheel's map adds up. A load schedule's corners are
 crossed in resolved cycles (:data:`CORNER_CYCLES` on either side), so that a corner falls in
@@ -34,8 +35,11 @@ from .errors import SceneError, SimulationError
 from .run import CycleMap
 from .shooting import _nonperiodic, refuse_nonperiodic
 
-#: Weights of the one-sided difference of X_n … X_{n+3} for X′(n) (third order).
+#: Weights of the one-sided difference of X_n … X_{n+3} for X′(n) (third order), and of
+#: X_n … X_{n+2} (second order: the error estimate's integration, whose difference from the
+#: run's then holds the derivative's error too, which no tolerance changes).
 DIFFERENCE = (-11.0 / 6.0, 3.0, -1.5, 1.0 / 3.0)
+DIFFERENCE_ESTIMATE = (-1.5, 2.0, -0.5)
 #: Resolved cycles kept on either side of a schedule corner.
 CORNER_CYCLES = 3
 #: The share of the time to the next corner a macro segment spans at the present cycle's
@@ -90,8 +94,9 @@ class _Follower:
     """One integration of the envelope at one tolerance over a run of ``cycles`` cycles."""
 
     def __init__(self, phi: CycleMap, corners: np.ndarray, cycles: int, rtol: float,
-                 atol: float, progress) -> None:
+                 atol: float, progress, difference=DIFFERENCE) -> None:
         self.phi, self.corners, self.cycles = phi, corners, cycles
+        self.difference = np.asarray(difference)
         self.rtol, self.atol, self.progress = rtol, atol, progress
         width = phi.initial().size + 1
         self.states = np.full((cycles + 1, width), np.nan)
@@ -103,11 +108,11 @@ class _Follower:
         return np.append(end, X[-1] + self.phi.elapsed)
 
     def slope(self, _n: float, X: np.ndarray) -> np.ndarray:
-        """F(X): the envelope's derivative by the cycle number, from three resolved cycles."""
+        """F(X): the envelope's derivative by the cycle number, from resolved cycles."""
         seq = [X]
-        for _ in DIFFERENCE[1:]:
+        for _ in self.difference[1:]:
             seq.append(self.cycle(seq[-1]))
-        return np.tensordot(DIFFERENCE, np.array(seq), axes=1)
+        return np.tensordot(self.difference, np.array(seq), axes=1)
 
     def resolve(self, n: int, X: np.ndarray) -> np.ndarray:
         """Cycle ``n`` integrated from ``X``: the state at cycle n + 1."""
@@ -205,7 +210,8 @@ def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
     atol = scene.solver.atol
     run = _Follower(phi, corners, cycles, rtol, atol, progress)
     states = run.run()
-    coarse = _Follower(phi, corners, cycles, rtol * ESTIMATE_RATIO, atol, None)
+    coarse = _Follower(phi, corners, cycles, rtol * ESTIMATE_RATIO, atol, None,
+                       DIFFERENCE_ESTIMATE)
     coarse.run()
     return Envelope([*phi.state_names(), "t"], states, run.integrated,
                     np.abs(states[-1] - coarse.states[-1]), phi.cycles, phi.nfev)
