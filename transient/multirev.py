@@ -29,7 +29,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
+from scipy.integrate import RK45
+from scipy.optimize import brentq
 
 from .errors import SceneError, SimulationError
 from .run import CycleMap
@@ -45,6 +46,9 @@ CORNER_CYCLES = 3
 #: The share of the time to the next corner a macro segment spans at the present cycle's
 #: period (the speed may rise and shorten it); the corner's event stops it if the speed falls.
 CORNER_REACH = 0.9
+#: Steps a macro segment takes before its step size, still below what a step costs in
+#: cycles, says that the envelope is stiff.
+STIFF_STEPS = 4
 #: Fewer cycles left than this are integrated one by one (a macro step's stages cost more).
 MIN_MACRO = 60
 #: The envelope integrator's own relative tolerance, its least: the envelope's is put in its
@@ -100,6 +104,9 @@ class _Follower:
         self.rtol, self.atol, self.progress = rtol, atol, progress
         width = phi.initial().size + 1
         self.states = np.full((cycles + 1, width), np.nan)
+        # cycles to integrate one by one after a macro step that cost more than it covered,
+        # doubled each time it recurs, and those of them left
+        self.direct, self.direct_left = 0, 0
         self.integrated = np.zeros(cycles + 1, dtype=bool)
 
     def cycle(self, X: np.ndarray) -> np.ndarray:
@@ -128,7 +135,11 @@ class _Follower:
             if self._near_corner(X[-1], corner, period) or stop - n < MIN_MACRO:
                 X, n = self.resolve(n, X), n + 1
                 continue
+            if self.direct_left > 0:  # (after a step that cost more than it covered)
+                X, n, self.direct_left = self.resolve(n, X), n + 1, self.direct_left - 1
+                continue
             n, X = self._macro(n, X, stop, corner, period)
+            self.direct_left = self.direct
             if self.progress is not None:
                 self.progress(n, self.cycles, self.phi.cycles)
         self.states[self.cycles] = X
@@ -152,31 +163,49 @@ class _Follower:
         return min(self.cycles, n + int(CORNER_REACH * (corner - t) / period))
 
     def _macro(self, n: int, X: np.ndarray, stop: int, corner: float | None, period: float):
-        """The envelope from cycle ``n`` to ``stop``, or to the last whole cycle that ends
-        CORNER_CYCLES cycles before the next corner: its nodes filled from the dense output."""
-        events = []
-        if corner is not None:
-            def before_corner(_n, Y):
-                return Y[-1] - (corner - CORNER_CYCLES * period)
-            before_corner.terminal = True  # type: ignore[attr-defined]
-            events.append(before_corner)
+        """The envelope from cycle ``n`` to ``stop``, to the last whole cycle that ends
+        CORNER_CYCLES cycles before the next corner, or to where the steps stay shorter than
+        the cycles they integrate (then the next cycles are integrated one by one, twice as
+        many each time it recurs): its nodes filled from each step's dense output."""
         # each state's error held to rtol of its size at the segment's start, t's to rtol of
         # TIME_SCALE cycles' duration: relative to t itself, a long run's would grow with its
         # length
         scale = np.abs(X)
         scale[-1] = TIME_SCALE * period
-        sol = solve_ivp(self.slope, (n, stop), X, method="RK45", rtol=SOLVER_RTOL,
-                        atol=self.atol + self.rtol * scale, dense_output=True,
-                        events=events or None)
-        if sol.status == -1:
-            raise SimulationError(f"the envelope from cycle {n} failed: {sol.message}")
-        end = int(math.floor(sol.t[-1] + 1e-9))
-        if end <= n:  # (the corner came before a whole cycle: resolve one)
+        rk = RK45(self.slope, n, X, stop, rtol=SOLVER_RTOL, atol=self.atol + self.rtol * scale)
+        limit = None if corner is None else corner - CORNER_CYCLES * period
+        self.states[n], last, steps, stiff = X, n, 0, False
+        while rk.status == "running":
+            spent = self.phi.cycles
+            rk.step()
+            steps += 1
+            if rk.status == "failed":
+                raise SimulationError(f"the envelope from cycle {n} failed at cycle "
+                                      f"{rk.t:.6g}: {rk.message}")
+            dense = rk.dense_output()
+            reach, crossed = rk.t, limit is not None and rk.y[-1] >= limit
+            if crossed:  # (where t reaches the limit, on this step's interpolant)
+                reach = brentq(_time_past, rk.t_old, rk.t, args=(dense, limit))
+            nodes = np.arange(last + 1, int(math.floor(reach + 1e-9)) + 1)
+            if nodes.size:
+                self.states[nodes] = dense(nodes).T
+                last = int(nodes[-1])
+            if rk.t == stop and not crossed:
+                self.states[stop] = rk.y
+            # (held below what a step costs once the controller has had steps to grow it:
+            # the envelope is stiff, and an explicit macro step no gain)
+            stiff = steps >= STIFF_STEPS and rk.h_abs < self.phi.cycles - spent
+            if crossed or stiff:
+                break
+        self.direct = max(2 * self.direct, MIN_MACRO // 2) if stiff else 0
+        if last == n:  # (no whole cycle reached: integrate one)
             return n + 1, self.resolve(n, X)
-        nodes = np.arange(n, end + 1)
-        self.states[n:end + 1] = sol.sol(nodes).T
-        self.states[n] = X
-        return end, self.states[end].copy()
+        return last, self.states[last].copy()
+
+
+def _time_past(m: float, dense, limit: float) -> float:
+    """How far the envelope's time at cycle ``m`` (on a step's interpolant) is past ``limit``."""
+    return float(dense(m)[-1] - limit)
 
 
 def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
