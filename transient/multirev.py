@@ -52,7 +52,7 @@ STIFF_STEPS = 4
 #: Fewer cycles left than this are integrated one by one (a macro step's stages cost more).
 MIN_MACRO = 60
 #: The envelope integrator's own relative tolerance, its least: the envelope's is put in its
-#: absolute one, per state (:meth:`_Follower._macro`).
+#: absolute one, per state (``_Follower._macro``).
 SOLVER_RTOL = 100 * np.finfo(float).eps
 #: The time's error is held relative to this many cycles' duration: what places a corner in
 #: its cycle to a small part of one over the run.

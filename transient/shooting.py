@@ -47,7 +47,7 @@ NOISE_FLOOR, STALLED_ITERATIONS = 1e3, 3
 #: A monodromy is kept, updated by Broyden's rank-one formula, while its step reduced ‖F‖ at
 #: least this much: a step on it costs one cycle, a fresh one a cycle per unknown more.
 CHORD_RATE = 0.5
-#: The most a Newton step may change a speed by, either way (:func:`_speed_limited`).
+#: The most a Newton step may change a speed by, either way (``_speed_limited``).
 SPEED_FACTOR = 4.0
 #: A speed beyond which a scene runs away (no piston machine turns at 10⁴ rad/s, 95 000 rpm).
 RUNAWAY_SPEED = 1e4
