@@ -104,8 +104,8 @@ class _Follower:
         self.rtol, self.atol, self.progress = rtol, atol, progress
         width = phi.initial().size + 1
         self.states = np.full((cycles + 1, width), np.nan)
-        # cycles to integrate one by one after a macro step that cost more than it covered,
-        # doubled each time it recurs, and those of them left
+        # cycles to integrate one by one after a macro segment the envelope's stiffness held
+        # short, doubled each time it recurs, and those of them left
         self.direct, self.direct_left = 0, 0
         self.integrated = np.zeros(cycles + 1, dtype=bool)
 
@@ -132,14 +132,13 @@ class _Follower:
             period = self.phi.cycle / abs(X[self.phi.speed_at[0]])
             corner = self._next_corner(X[-1])
             stop = self._reach(n, X[-1], corner, period)
-            if self._near_corner(X[-1], corner, period) or stop - n < MIN_MACRO:
+            if (self._near_corner(X[-1], corner, period) or stop - n < MIN_MACRO
+                    or self.direct_left > 0):
                 X, n = self.resolve(n, X), n + 1
-                continue
-            if self.direct_left > 0:  # (after a step that cost more than it covered)
-                X, n, self.direct_left = self.resolve(n, X), n + 1, self.direct_left - 1
-                continue
-            n, X = self._macro(n, X, stop, corner, period)
-            self.direct_left = self.direct
+                self.direct_left = max(self.direct_left - 1, 0)
+            else:
+                n, X = self._macro(n, X, stop, corner, period)
+                self.direct_left = self.direct
             if self.progress is not None:
                 self.progress(n, self.cycles, self.phi.cycles)
         self.states[self.cycles] = X
