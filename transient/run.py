@@ -740,17 +740,18 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
 
 def simulate_from(scene, start, path: str | Path | None = None, *, force: bool = False,
                   resume: bool = False, progress: Callable[[float], None] | None = None,
-                  analysis: dict[str, tuple] | None = None) -> Result:
+                  analysis: dict[str, tuple] | None = None, periodic: bool = False) -> Result:
     """:func:`transient.simulate` from the stepper's state ``start`` (a
-    :class:`~transient.results.Checkpoint`; None: the scene's initial state), with ``analysis`` (name → (value, unit))
-    stored beside the run's own."""
+    :class:`~transient.results.Checkpoint`; None: the scene's initial state), with ``analysis``
+    (name → (value, unit)) stored beside the run's own; a ``periodic`` run (steady cycles) is
+    summarised as steady from its start."""
     refuse_elastic_run(scene)  # (before any file is made)
     if path is None:
         if force or resume:
             raise SceneError("path", "force and resume apply to a result file: give its path")
-        return _in_memory(scene, progress, start, analysis or {})
+        return _in_memory(scene, progress, start, analysis or {}, periodic)
     try:
-        _write(scene, Path(path), force, resume, progress, start, analysis or {})
+        _write(scene, Path(path), force, resume, progress, start, analysis or {}, periodic)
     except RunStopped as exc:  # (written as far as it went)
         raise _with_result(exc, open_result(path), path) from None
     res = open_result(path)
@@ -767,14 +768,14 @@ def _with_result(exc: SimulationError, res: Result, path: str | Path) -> Simulat
     return exc
 
 
-def _in_memory(scene, progress, start, analysis) -> Result:
+def _in_memory(scene, progress, start, analysis, periodic=False) -> Result:
     """A run kept in memory, with its summary, as a Result."""
     from .analysis.summary import summarize
     from .scene import to_toml
 
     data = integrate(scene, progress=progress, start=start)
-    summary = {**(summarize(scene, data.trajectory, data.events) if data.trajectory["t"].size
-                  else {}), **data.summary, **analysis}
+    summary = {**(summarize(scene, data.trajectory, data.events, periodic)
+                  if data.trajectory["t"].size else {}), **data.summary, **analysis}
     res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), summary,
                            (scene.source_file, scene.source_text))
     if res.status != FINISHED:
@@ -782,7 +783,8 @@ def _in_memory(scene, progress, start, analysis) -> Result:
     return res
 
 
-def _write(scene, path: Path, force: bool, resume: bool, progress, start, analysis) -> None:
+def _write(scene, path: Path, force: bool, resume: bool, progress, start, analysis,
+           periodic=False) -> None:
     """Stream a run into the result file ``path`` (:class:`~transient.results.ResultWriter`),
     its summary from the end of the run."""
     from .analysis.summary import summarize
@@ -816,8 +818,8 @@ def _write(scene, path: Path, force: bool, resume: bool, progress, start, analys
         # memory stays bounded however long the run (steady state, efficiency are found there).
         tail = writer.read_trajectory(last=SUMMARY_SAMPLES)
         events = writer.read_events(t_from=tail["t"][0] if tail["t"].size else -math.inf)
-        summary = {**(summarize(scene, tail, events) if tail["t"].size else {}), **data.summary,
-                   **analysis}
+        summary = {**(summarize(scene, tail, events, periodic) if tail["t"].size else {}),
+                   **data.summary, **analysis}
     except BaseException as exc:
         writes.settle()
         msg = data.message if data is not None and data.message else (

@@ -452,4 +452,5 @@ def cycles_from(scene, phi: CycleMap, x: np.ndarray, cycles: int = 1,
                               revolutions=cycles * phi.cycle / (2.0 * math.pi))
     initial = dataclasses.replace(scene.initial, omega=float(x[phi.speed_at[0]]))
     cycle_scene = dataclasses.replace(scene, run=run, initial=initial)
-    return simulate_from(cycle_scene, start, path, force=force, analysis=analysis)
+    return simulate_from(cycle_scene, start, path, force=force, analysis=analysis,
+                         periodic=True)

@@ -13,6 +13,7 @@ import pytest
 from scene_texts import SMALL
 
 import transient
+from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
 from transient.cli import main
 from transient.shooting import NoSteadyState
@@ -128,6 +129,14 @@ def test_steady_cycle_is_the_settled_run_last_cycle(label):
           f"{res.analysis['steady_cycles_integrated'][0]} (multiplier {mu:.4g})")
     steady = {k: np.asarray(v) for k, v in res.trajectory.items()}
     assert cycles[-1]["t"].size == steady["t"].size
+    if "eta_mech_work" in res.analysis or scene.friction.pairs:
+        # the summary's η_mech over the steady cycle, as the settled run's last cycle has it
+        last = cycles[-1]
+        theirs_eta = mechanical_efficiency(scene, last, window=(float(last["phi"][0]),
+                                                                float(last["phi"][-1]), 1))
+        eta = res.analysis["eta_mech_work"][0]
+        assert abs(eta - theirs_eta["eta_mech_work"][0]) <= max(AGREE, SETTLED.get(label, 0.0))
+
     mask = on_corners(scene, steady["phi"])
     assert np.count_nonzero(~mask) >= 0.7 * mask.size  # (most samples compared)
     ours = compared(scene, steady, mask, neutral)

@@ -76,19 +76,20 @@ EFFICIENCY_VALUES = re.compile(
     r"mode_against_power_\w+|cylinder_split_residual_\d+)")
 
 
-def steady_window(scene, traj, rtol: float = 1e-4, cycles: int = 3):
+def steady_window(scene, traj, rtol: float = 1e-4, cycles: int = 3, periodic: bool = False):
     """(φ_start, φ_end, n_cycles) of the whole cycles after steady state, or None.
 
     Steady state: the cycle-mean speed changes by less than ``rtol`` for ``cycles`` cycles in a
     row (:func:`~transient.analysis.irregularity.steady_state_time`). A prescribed constant speed
-    is steady from the start.
+    is steady from the start, and so is a ``periodic`` run (the steady cycles that shooting
+    found, :func:`transient.steady`).
     """
     t, phi = traj["t"], traj["phi"]
     cycle, phi0 = scene.mechanism.cycle, scene.initial.phi
     tb, marks = cycle_boundaries(t, phi, cycle, phi0)
     if marks.size < 2:
         return None
-    if scene.run.mode == "prescribed-speed" and not scene.run.time:
+    if periodic or (scene.run.mode == "prescribed-speed" and not scene.run.time):
         return float(marks[0]), float(marks[-1]), int(marks.size - 1)
     means, ends = cycle_means(t, phi, cycle, phi0)
     t_steady = steady_state_time(means, ends, rtol, cycles)

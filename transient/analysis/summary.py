@@ -6,7 +6,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from .efficiency import EFFICIENCY_VALUES, mechanical_efficiency
+from .efficiency import EFFICIENCY_VALUES, mechanical_efficiency, steady_window
 from .irregularity import (
     cycle_boundaries,
     cycle_means,
@@ -20,14 +20,15 @@ from .torsion_run import damper_power_summary
 from .transient_response import load_step_times, run_response
 
 
-def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
+def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None, periodic: bool = False
               ) -> dict[str, tuple[float, str]]:
     """The end-of-run summary, as (value, unit) pairs stored under ``/analysis``: speed, its
     fluctuation, steady state, the mechanical efficiency over the steady cycles, an elastic
     line's damper power over the last cycle, and the
     ISO 8528-5 measures of each load step and of a spin-up (``transient_response``), and what
     the scene's ``[analysis]`` table asks for (:mod:`.requested`). With load steps, the steady
-    state and the efficiency are looked for after the last one."""
+    state and the efficiency are looked for after the last one. A ``periodic`` run (steady
+    cycles from :func:`transient.steady`) is steady throughout."""
     # what the scene's [analysis] table asks for, over the whole stored run (before the cut below)
     requested = requested_analyses(scene, traj, events) if scene.analysis.requested else {}
     stuck = stuck_phases(events or {}, float(traj["t"][-1]))
@@ -58,7 +59,8 @@ def summarize(scene, traj: dict[str, NDArray[np.float64]], events=None
         work = resample_angle(phi, traj["W_drive"], marks, traj["M_drive"])
         out["mean_drive_torque_last_cycle"] = (float(work[1] - work[0]) / cycle, "N m")
     if scene.gas.model != "none":
-        out.update(mechanical_efficiency(scene, traj, events))
+        out.update(mechanical_efficiency(scene, traj, events,
+                                         steady_window(scene, traj, periodic=periodic)))
     if scene.shaft is not None:  # the line's damping: what a damper is sized by
         out.update(damper_power_summary(scene, traj))
     out.update(stuck)
