@@ -34,7 +34,8 @@ print(len(log.compiled), *(c.name for c in log.compiled))
 FEATURE_KERNELS = {
     "friction pairs": ("chain.modes_power_flow_into", "chain._best_candidate", "rhs.margins_at",
                        "rhs.chain_acceleration", "events._pair_event", "events._sample_margins",
-                       "loop._settle_modes", "outputs.pair_rows"),
+                       "loop._settle_modes", "outputs.pair_rows", "events._iterated_g",
+                       "events.iterated_value"),
     "governor states": ("forcing.governor_rates", "governor.pi_rates", "governor.flyweight_rates",
                         "forcing.demand", "events._sleeve_event", "events._sleeve_stops",
                         "outputs.governor_rows"),
