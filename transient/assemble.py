@@ -499,7 +499,10 @@ def initial_governor(scene, model: Model) -> tuple[NDArray[np.float64], int]:
         f0 = gv.rack_of_lift(model.gov_par, z)
     else:
         states = []
-        f0 = fuel(model, w0, governor_branch(model, w0, True))
+        # (the kernels' Python: compiled to be called from Python, once, they would cost a
+        # first run a compile of their own besides the stepper's)
+        branch = getattr(governor_branch, "py_func", governor_branch)(model, w0, True)
+        f0 = getattr(fuel, "py_func", fuel)(model, w0, branch)
     latched = [f0] * model.ncyl if model.latch else []
     return np.array(states + latched + initial_cylinders(scene, model, f0), dtype=np.float64), sleeve
 

@@ -26,6 +26,8 @@ from __future__ import annotations
 
 from math import cos, sin, sqrt
 
+import numpy as np
+
 from ..jit import kernel
 from .crank_slider import L, R, cylinder_terms, slider
 
@@ -45,7 +47,7 @@ SLAVE_STRIDE = 9
 @kernel
 def row0(mp):
     """Index in ``mp`` of row 0's phase."""
-    return SLAVE0 + SLAVE_STRIDE * int(mp[N_SLAVES])
+    return SLAVE0 + SLAVE_STRIDE * np.int64(mp[N_SLAVES])
 
 
 @kernel
@@ -130,7 +132,7 @@ def articulated_terms(mp, phi, u, du):
     j0 = row0(mp)
     J = 0.0
     dJ = 0.0
-    for j in range(int(mp[N_ROWS])):
+    for j in range(np.int64(mp[N_ROWS])):
         Jj, dJj = row_terms(mp, j, phi - mp[j0 + j], u, du)
         J += Jj
         dJ += dJj
@@ -143,7 +145,7 @@ def row_terms(mp, j, alpha, u, du):
     α; fills the row's u, u′ (:func:`articulated_terms`)."""
     r = mp[R]
     l = mp[L]
-    ns = int(mp[N_SLAVES])
+    ns = np.int64(mp[N_SLAVES])
     base = j * (1 + ns)
     # Master piston, master rod (as a body: its centre of mass and β′) and the crank throw.
     J, dJ, u[base], du[base] = cylinder_terms(alpha, mp)
@@ -163,9 +165,9 @@ def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     """``Model.shares`` of master and articulated rods: a row's master and slaves move with its
     crank throw, so they ride one station, whose angle is that of the row's master,
     ``angles[j(1 + z′)]``; the master's share is the whole row's J, the slaves' nothing."""
-    ns = int(mp[N_SLAVES])
+    ns = np.int64(mp[N_SLAVES])
     j0 = row0(mp)
-    for j in range(int(mp[N_ROWS])):
+    for j in range(np.int64(mp[N_ROWS])):
         base = j * (1 + ns)
         Jc[base], dJc[base] = row_terms(mp, j, angles[base] - mp[j0 + j], u, du)
         for i in range(ns):
@@ -184,7 +186,7 @@ def axial_positions(mp, alpha, x, dx, ddx):
     dx[0] = -ds
     ddx[0] = -dds
     ca, sa, cb, sb, db, ddb = master_rod(alpha, r, l)
-    for i in range(int(mp[N_SLAVES])):
+    for i in range(np.int64(mp[N_SLAVES])):
         x[1 + i], dx[1 + i], ddx[1 + i], _, _, _, _, _, _ = slave(mp, i, r, ca, sa, cb, sb, db,
                                                                   ddb)
 

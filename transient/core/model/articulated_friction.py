@@ -166,12 +166,12 @@ def prepare(mp, phi, w, sel, wk):
     ``sel`` has changed (:func:`_directions`)."""
     c = WK_RX
     r, l = mp[R], mp[L]
-    ns = int(mp[N_SLAVES])
+    ns = np.int64(mp[N_SLAVES])
     j0 = row0(mp)
     f = mp[ROD_CG] / l
     m_pin, m_cp, m_rod, i_rod = mp[M_PIN], mp[M_CRANKPIN], mp[M_ROD], mp[I_ROD]
     w2 = w * w
-    for j in range(int(mp[N_ROWS])):
+    for j in range(np.int64(mp[N_ROWS])):
         k0 = j * (1 + ns)
         ca, sa, cb, sb, db, ddb = master_rod(phi - mp[j0 + j], r, l)
         x1 = -r * sa - l * sb * db  # X₀′ = −s′ (Semenov (31), Gots (12))
@@ -238,9 +238,9 @@ def _directions(mp, sel, wk):
     big end's (crankpin or link pin) relative rate, per unit σ."""
     c = WK_RX
     r, l = mp[R], mp[L]
-    ns = int(mp[N_SLAVES])
+    ns = np.int64(mp[N_SLAVES])
     j0 = row0(mp)
-    for j in range(int(mp[N_ROWS])):
+    for j in range(np.int64(mp[N_ROWS])):
         k0 = j * (1 + ns)
         ca, sa, cb, sb, db, ddb = master_rod(sel - mp[j0 + j], r, l)
         wk[c + A_SS, k0] = _sign(-r * sa - l * sb * db)
@@ -262,7 +262,7 @@ def _row(mp, jp, pair_of, wk, j, eps, w, sigma, mu_on, out):
     ``(T, Σ ∂T/∂N_k r_k, ∂T/∂ε − Σ ∂T/∂N_k q_k, converged)``, converged when every |r_k| is
     within TOL of its forces' scale."""
     c = WK_RX
-    ns = int(mp[N_SLAVES])
+    ns = np.int64(mp[N_SLAVES])
     k0 = j * (1 + ns)
     on = 1.0 if mu_on else 0.0
     mu_s = jp[J_SLIDER, RX_MU] * on
@@ -413,8 +413,8 @@ def _add(pair_of, wk, joint, k, S, L):
 def _start(mp, jp, pair_of, wk, eps, w, sigma):
     """The side forces at φ̈ = ``eps`` without the terms in |·|, where the rods' equations are
     linear in them: one elimination from N = 0 solves them."""
-    ns = int(mp[N_SLAVES])
-    for j in range(int(mp[N_ROWS])):
+    ns = np.int64(mp[N_SLAVES])
+    for j in range(np.int64(mp[N_ROWS])):
         for k in range(j * (1 + ns), (j + 1) * (1 + ns)):
             wk[WK_RX + A_N, k] = 0.0
         _row(mp, jp, pair_of, wk, j, eps, w, sigma, False, False)
@@ -427,8 +427,8 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
     """φ̈ with the joints' friction on their reactions, and per pair η*, S, L into ``wk``, by
     Newton's method on (φ̈, every N_k) from ``eps0`` (module docstring); the rows of
     :func:`prepare` and each cylinder's gas force must be filled. NaN if it does not converge."""
-    ns = int(mp[N_SLAVES])
-    n = int(mp[N_ROWS]) * (1 + ns)
+    ns = np.int64(mp[N_SLAVES])
+    n = np.int64(mp[N_ROWS]) * (1 + ns)
     eps = eps0
     _start(mp, jp, pair_of, wk, eps, w, sigma)
     for _ in range(MAX_ITER):
@@ -436,7 +436,7 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
         den = J0
         scale = abs(M_shaft) + J0 * abs(eps)
         small = True
-        for j in range(int(mp[N_ROWS])):
+        for j in range(np.int64(mp[N_ROWS])):
             T, T_r, T_q, conv = _row(mp, jp, pair_of, wk, j, eps, w, sigma, True, False)
             H += T_r - T
             den -= T_q
@@ -455,10 +455,10 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
 def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     """S, L and η* = 1 − L/S of each pair, summed over the rows, and each cylinder's share of
     L in the rows ``WK_CYL_LOSS``; returns Σ T."""
-    n = int(mp[N_ROWS]) * (1 + int(mp[N_SLAVES]))
+    n = np.int64(mp[N_ROWS]) * (1 + np.int64(mp[N_SLAVES]))
     clear_pairs(wk, n_pairs, n, 0.0)
     total = 0.0
-    for j in range(int(mp[N_ROWS])):
+    for j in range(np.int64(mp[N_ROWS])):
         total += _row(mp, jp, pair_of, wk, j, eps, w, sigma, True, True)[0]
     pair_efficiencies(wk, n_pairs)
     return total
@@ -471,8 +471,8 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     elimination, δε = 0); fills η*, S, L of the pairs. NaN if it does not converge."""
     mp, jp, pair_of = m.mech, m.rx_par, m.rx_pair
     _start(mp, jp, pair_of, wk, eps, w, sigma)
-    ns = int(mp[N_SLAVES])
-    for j in range(int(mp[N_ROWS])):
+    ns = np.int64(mp[N_SLAVES])
+    for j in range(np.int64(mp[N_ROWS])):
         done = False
         for _ in range(MAX_ITER):
             conv = _row(mp, jp, pair_of, wk, j, eps, w, sigma, True, False)[3]

@@ -106,7 +106,7 @@ def crank_slider_terms(mp, phi, u, du, with_dJ=True):
     The local angle's sine and cosine come from φ's by the angle-difference formulas: one sincos
     per call, not one per cylinder (3 sincos were 16 % of the diesel's samples under ``perf``).
     """
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     sp = sin(phi)
     cp = cos(phi)
     J = 0.0
@@ -151,7 +151,7 @@ def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     sine and cosine — turned from the first cylinder's by the twist between them
     (:func:`turned`), one call of the maths library in all. Without ``with_dJ`` J′_c and u′
     are NaN (:func:`cylinder_terms_sc`)."""
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     s_first = sin(angles[0])
     c_first = cos(angles[0])
     for k in range(n):

@@ -118,7 +118,7 @@ def line_speeds(m, angle_mode, y, wk):
     """Each dof's speed ω_d (WK_LINE_OMEGA): √(2K_d/J_d) in crank angle (NaN where K_d < 0,
     which the stepper reports as a non-finite state), the state itself in time; after
     :func:`~transient.core.model.shaft.line_inertias`."""
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     for d in range(line_dofs(m)):
         v = y[KINETIC] if d == ref else y[twist_index(m, d) + 1]
         wk[WK_LINE_OMEGA, d] = np.sqrt(2.0 * v / wk[WK_LINE_J, d]) if angle_mode else v
@@ -187,15 +187,15 @@ def line_forces(m, y, sel, sw, wk):
     n = line_dofs(m)
     for d in range(n):
         wk[WK_LINE_M, d] = 0.0
-    ref = int(m.line[0, LM_REF])
-    load = int(m.line[0, LM_LOAD])
+    ref = np.int64(m.line[0, LM_REF])
+    load = np.int64(m.line[0, LM_LOAD])
     w_ref = wk[WK_LINE_OMEGA, ref]
     M_gas = 0.0
     P_gas = 0.0
     if m.has_gas:
         f = command(m, True, w_ref, y, sw)
         for c in range(m.ncyl):
-            d = int(carrier[c])
+            d = np.int64(carrier[c])
             theta = wk[WK_LINE_THETA, d]
             theta_sel = sel + (theta - y[PHI])
             p = cylinder_pressure(m, c, theta, theta_sel, y, cylinder_fuel(m, c, theta_sel, y, f),
@@ -228,7 +228,7 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
     """dy/dt, or dy/dφ in the reference's crank angle (T5), of an elastic scene's state, in the
     form of :func:`.rhs.derivative`; with non-ideal pairs each throw's chain (T7)."""
     n = line_dofs(m)
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     pairs = extras is not None and m.n_pairs > 0
     # (in crank angle the rates are the work–energy law's, (T5): no J′_d, unless the throws'
     # chains split their moments, (T7))
@@ -263,7 +263,7 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
             out[twist_index(m, d)] = first[d]
             out[twist_index(m, d) + 1] = second[d]
     out[W_GAS] = P_gas * q
-    out[W_LOAD] = M_load * w[int(m.line[0, LM_LOAD])] * q
+    out[W_LOAD] = M_load * w[np.int64(m.line[0, LM_LOAD])] * q
     out[W_STARTER] = M_starter * w_ref * q
     out[line_loss_index(m)] = taken * q
     if extras is not None and m.n_pairs > 0:
@@ -279,10 +279,10 @@ def pressure_rates(m, y, sel, sw, w, q, wk, out):
     """The cylinders' pressure states' rates (× ``q``: 1/ω_ref in crank angle), each at its
     station's angle and speed ``w[d]`` (after :func:`line_forces`)."""
     carrier = line_parts(m.line)[0]
-    f = command(m, True, w[int(m.line[0, LM_REF])], y, sw)
+    f = command(m, True, w[np.int64(m.line[0, LM_REF])], y, sw)
     shift = y[PHI] - sel
     for c in range(m.ncyl):
-        d = int(carrier[c])
+        d = np.int64(carrier[c])
         f_c = cylinder_fuel(m, c, wk[WK_LINE_THETA, d] - shift, y, f)
         out[cyl_index(m) + c] = q * cylinder_pressure_rate(m, c, y, shift, w[d], f_c, wk)
 
@@ -295,7 +295,7 @@ def elastic_row(m, extras, angle_mode, y, sel, sw, wk, row):
     k δ + c δ̇ (δ = θ_a − r θ_b), the line's energy Σ ½J_d ω_d² + Σ ½k δ² and the energy its
     damping took."""
     n = line_dofs(m)
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk, True)
     if extras is not None and m.n_pairs > 0:
         throw_chains(m, M_load, M_starter, sw, wk)
@@ -337,8 +337,8 @@ def elastic_row(m, extras, angle_mode, y, sel, sw, wk, row):
     w = wk[WK_LINE_OMEGA]
     elements = line_parts(m.line)[2]
     for e in range(elements.shape[0]):
-        i = int(elements[e, EL_I])
-        j = int(elements[e, EL_J])
+        i = np.int64(elements[e, EL_I])
+        j = np.int64(elements[e, EL_J])
         r = elements[e, EL_R]
         twist = th[i] - r * th[j]
         row[k] = elements[e, EL_K] * twist + elements[e, EL_C] * (w[i] - r * w[j])

@@ -113,7 +113,7 @@ def piece_value(m, kept, k, shift, x, wk):
     line, where each cylinder is read at its own angle at every evaluation: the knot interval
     searched from the one its last evaluation left in ``wk`` (WK_CYL_KNOT, WK_CYL_KNOT_SHIFT;
     :func:`.tables.interval_near`, the same interval), and left there; else by bisection."""
-    piece = int(wk[WK_PIECE_SHIFT, k]) if shift else int(wk[WK_PIECE, k])
+    piece = np.int64(wk[WK_PIECE_SHIFT, k]) if shift else np.int64(wk[WK_PIECE, k])
     if kept:
         row = WK_CYL_KNOT_SHIFT if shift else WK_CYL_KNOT
         value, i = table_eval_near(m.knots, m.coef, m.piece_knot, piece, x, wk[row, k])
@@ -127,7 +127,7 @@ def piece_value(m, kept, k, shift, x, wk):
 def piece_pair(m, kept, k, shift, x, wk):
     """Both curves of a paired table at x on cylinder k's piece, as :func:`piece_value` reads
     the first."""
-    piece = int(wk[WK_PIECE_SHIFT, k]) if shift else int(wk[WK_PIECE, k])
+    piece = np.int64(wk[WK_PIECE_SHIFT, k]) if shift else np.int64(wk[WK_PIECE, k])
     if kept:
         row = WK_CYL_KNOT_SHIFT if shift else WK_CYL_KNOT
         first, second, i = table_eval_pair_near(m.knots, m.coef, m.piece_knot, piece, x,

@@ -159,7 +159,7 @@ def prepare(mp, phi, w, sel, wk):
     r = mp[R]
     l = mp[L]
     e = mp[E]
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     f = mp[ROD_CG] / l
     m_pin, m_cp, m_rod, i_rod = mp[M_PIN], mp[M_CRANKPIN], mp[M_ROD], mp[I_ROD]
     w2 = w * w
@@ -369,7 +369,7 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
     ∂T_k/∂N q_k)). ``eps0`` starts it (the frictionless φ̈), N from 0; ``pair_of`` =
     ``Model.rx_pair``; the rows of :func:`prepare` and each cylinder's gas force (row R_P) must be
     filled. Returns NaN if it does not converge (module docstring)."""
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     c = WK_RX
     eps = eps0
     for k in range(n):
@@ -403,7 +403,7 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
 def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     """S, L and η* = 1 − L/S of each pair, summed over the cylinders, into ``wk``; each
     cylinder's share of L in the rows ``WK_CYL_LOSS``."""
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     clear_pairs(wk, n_pairs, n, 0.0)
     for k in range(n):
         t = joint_terms(mp, jp, wk, k, eps, w, sigma, wk[WK_RX + R_N, k])
@@ -511,7 +511,7 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     not converge."""
     mp = m.mech
     total = 0.0
-    for k in range(int(mp[N_CYL])):
+    for k in range(np.int64(mp[N_CYL])):
         if not solve_cylinder(mp, m.rx_par, wk, k, eps, w, sigma):
             return np.nan
         total -= joint_terms(mp, m.rx_par, wk, k, eps, w, sigma, wk[WK_RX + R_N, k])[0]

@@ -29,7 +29,7 @@ def n_margins(m):
     pair in each chain the pairs act in, the machine on a rigid shaft, each station carrying
     cylinders on an elastic line (``line`` :data:`LINE_META`; theory, (T7)). Chain c's pair k
     is number c·n_pairs + k."""
-    return m.n_pairs * int(m.line[0, LM_CHAINS])
+    return m.n_pairs * np.int64(m.line[0, LM_CHAINS])
 
 
 @formula
@@ -87,7 +87,7 @@ N_LINE_COLUMNS = max(LINE_META.size, LINE_DOF.size, N_ELEMENT)
 @formula
 def line_dofs(m):
     """The elastic shaft line's degrees of freedom; 0 on a rigid shaft."""
-    return int(m.line[0, LM_DOFS])
+    return np.int64(m.line[0, LM_DOFS])
 
 
 @formula
@@ -264,7 +264,7 @@ def n_line_columns(m):
     """The output row's shaft-line columns: per dof its twist and speed, per element its
     torque, the line's energy and the energy its damping took; none on a rigid shaft."""
     n = line_dofs(m)
-    return 2 * n + int(m.line[0, LM_ELEMENTS]) + 2 if n > 0 else 0
+    return 2 * n + np.int64(m.line[0, LM_ELEMENTS]) + 2 if n > 0 else 0
 
 
 #: The output row's blocks (``transient.scene.outputs.output_columns`` names the columns in this

@@ -23,6 +23,8 @@ factorisation is O(N).
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..jit import kernel
 from .elastic import line_speeds
 from .layout import (
@@ -114,7 +116,7 @@ def _own_terms(m, angle_mode, y, f0, wk, lo, band):
     n = line_dofs(m)
     kb = (band.shape[1] - 1) // 2
     dofs = line_parts(m.line)[1]
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     J, dJ, w = wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_OMEGA, :n]
     total = 0.0
     absolute = 0.0
@@ -159,11 +161,11 @@ def _element_terms(m, angle_mode, wk, lo, band):
     n = line_dofs(m)
     kb = (band.shape[1] - 1) // 2
     elements = line_parts(m.line)[2]
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     J, dJ, w = wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_OMEGA, :n]
     for e in range(elements.shape[0]):
-        i = int(elements[e, EL_I])
-        j = int(elements[e, EL_J])
+        i = np.int64(elements[e, EL_I])
+        j = np.int64(elements[e, EL_J])
         ratio = elements[e, EL_R]
         k = elements[e, EL_K]
         c = elements[e, EL_C]

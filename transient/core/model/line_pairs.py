@@ -33,6 +33,8 @@ line's own kernels then serve unchanged. Each pair's loss power is (1 − η*_k)
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..jit import kernel
 from . import eta_table as et
 from .chain import LOCKED, UNIQUE, chain_solve, modes_power_flow_into
@@ -79,21 +81,21 @@ def throw_chain(m, d, M_load, M_starter, wk):
     they act and the line's torque T_d, on the last the gas moment of its cylinders. Returns the
     chain's number, −1 (nothing set up) for a dof without cylinders."""
     carrier, dofs, _ = line_parts(m.line)
-    c = int(dofs[d, LD_CHAIN])
+    c = np.int64(dofs[d, LD_CHAIN])
     if c < 0:
         return c
     u = wk[WK_SCRATCH]
     du = wk[WK_SCRATCH + 1]
     n_own = 0
     for i in range(m.ncyl):
-        if int(carrier[i]) == d:
+        if np.int64(carrier[i]) == d:
             u[n_own] = wk[WK_U, i]
             du[n_own] = wk[WK_DU, i]
             n_own += 1
     M_ext = 0.0
-    if d == int(m.line[0, LM_LOAD]):
+    if d == np.int64(m.line[0, LM_LOAD]):
         M_ext += M_load
-    if d == int(m.line[0, LM_REF]):
+    if d == np.int64(m.line[0, LM_REF]):
         M_ext += M_starter
     split_chain(m, wk[WK_LINE_THETA, d], wk[WK_LINE_J, d], wk[WK_LINE_DJ, d],
                 wk[WK_LINE_M, d] - M_ext, M_ext + wk[WK_LINE_T, d], dofs[d, LD_OWN],
@@ -140,7 +142,7 @@ def throw_loss_rates(m, q, wk, out):
     dofs = line_parts(m.line)[1]
     n = m.n_pairs
     for d in range(line_dofs(m)):
-        c = int(dofs[d, LD_CHAIN])
+        c = np.int64(dofs[d, LD_CHAIN])
         if c < 0:
             continue
         w = wk[WK_LINE_OMEGA, d]
@@ -155,7 +157,7 @@ def throw_pair_rows(m, y, wk, row):
     after :func:`throw_chains`."""
     dofs = line_parts(m.line)[1]
     for d in range(line_dofs(m)):
-        c = int(dofs[d, LD_CHAIN])
+        c = np.int64(dofs[d, LD_CHAIN])
         if c >= 0:
             pair_rows(m, wk[WK_LINE_OMEGA, d], c * m.n_pairs, y[W_LOSS0:], wk, row[pair_col(m):])
 
@@ -190,6 +192,6 @@ def throw_modes(m, M_load, M_starter, sw, wk):
         sigma = 1 if w > 0.0 or (w == 0.0 and a > 0.0) else -1
         modes |= mode_mask(m, sigma, eta, S, wk) << (c * n)
     sw[SW_MODES] = modes
-    sw[SW_DIRECTION] = 1 if wk[WK_LINE_OMEGA, int(m.line[0, LM_REF])] >= 0.0 else -1
+    sw[SW_DIRECTION] = 1 if wk[WK_LINE_OMEGA, np.int64(m.line[0, LM_REF])] >= 0.0 else -1
     return status
 

@@ -95,10 +95,10 @@ RIGID_LINE[0, LM_CHAINS] = 1.0
 def line_parts(line):
     """Views of the Model's packed ``line``: each cylinder's dof (a column of floats), the
     dofs' rows and the element table."""
-    n = int(line[0, LM_DOFS])
-    d0 = 1 + int(line[0, LM_CYLINDERS])
+    n = np.int64(line[0, LM_DOFS])
+    d0 = 1 + np.int64(line[0, LM_CYLINDERS])
     e0 = d0 + n
-    return line[1:d0, 0], line[d0:e0, :], line[e0:e0 + int(line[0, LM_ELEMENTS]), :]
+    return line[1:d0, 0], line[d0:e0, :], line[e0:e0 + np.int64(line[0, LM_ELEMENTS]), :]
 
 
 @kernel(inline=True)
@@ -110,8 +110,8 @@ def line_inertia(carrier, J_own, Jc, dJc, J, dJ):
         J[d] = J_own[d]
         dJ[d] = 0.0
     for c in range(carrier.shape[0]):
-        J[int(carrier[c])] += Jc[c]
-        dJ[int(carrier[c])] += dJc[c]
+        J[np.int64(carrier[c])] += Jc[c]
+        dJ[np.int64(carrier[c])] += dJc[c]
 
 
 @kernel(inline=True)
@@ -143,8 +143,8 @@ def line_torques(elements, absolute, weights, gear, theta, omega, T):
     for d in range(T.shape[0]):
         T[d] += gear[d] * weights[d] * per_weight
     for e in range(elements.shape[0]):
-        i = int(elements[e, EL_I])
-        j = int(elements[e, EL_J])
+        i = np.int64(elements[e, EL_I])
+        j = np.int64(elements[e, EL_J])
         r = elements[e, EL_R]
         rate = omega[i] - r * omega[j]
         torque = elements[e, EL_K] * (theta[i] - r * theta[j]) + elements[e, EL_C] * rate
@@ -179,7 +179,7 @@ def line_angle_rates(ref, gear, M, T, omega, d_twist, d_energy):
 @kernel(inline=True)
 def twist_index(m, d):
     """Index in the state of dof d's twist q_d (d not the reference); its K_d (ω_d) follows."""
-    return twist_at(line_index(m), int(m.line[0, LM_REF]), d)
+    return twist_at(line_index(m), np.int64(m.line[0, LM_REF]), d)
 
 
 @kernel(inline=True)
@@ -196,11 +196,11 @@ def line_inertias(m, y, wk, with_dJ):
     ``with_dJ`` J′_d and u′ may be left NaN: the derivative in crank angle needs neither (T5)."""
     carrier, dofs, _ = line_parts(m.line)
     n = line_dofs(m)
-    ref, first = int(m.line[0, LM_REF]), line_index(m)
+    ref, first = np.int64(m.line[0, LM_REF]), line_index(m)
     for d in range(n):
         wk[WK_LINE_THETA, d] = angle_at(y, d, first, ref)
     for c in range(m.ncyl):
-        wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, int(carrier[c])]
+        wk[WK_CYL_ANGLE, c] = wk[WK_LINE_THETA, np.int64(carrier[c])]
     m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
              wk[WK_U], wk[WK_DU], with_dJ)
     line_inertia(carrier, dofs[:, LD_OWN], wk[WK_CYL_J, :m.ncyl], wk[WK_CYL_DJ, :m.ncyl],
@@ -213,7 +213,7 @@ def line_mode(m, y, to_angle, wk):
     the independent variable changes (the stepper converts the reference's own with
     :func:`ref_inertia`, through ``forcing.inertia``)."""
     line_inertias(m, y, wk, False)
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     for d in range(line_dofs(m)):
         if d != ref:
             i = twist_index(m, d) + 1
@@ -227,14 +227,14 @@ def ref_inertia(m, phi, wk):
     :func:`line_inertia` sums them (so that K_ref = ½J_ref ω_ref² converts both ways to the same
     bits); fills the row u at φ."""
     carrier, dofs, _ = line_parts(m.line)
-    ref = int(m.line[0, LM_REF])
+    ref = np.int64(m.line[0, LM_REF])
     for c in range(m.ncyl):
         wk[WK_CYL_ANGLE, c] = phi
     m.shares(m.mech, m.kin_coef, wk[WK_CYL_ANGLE, :m.ncyl], wk[WK_CYL_J], wk[WK_CYL_DJ],
              wk[WK_U], wk[WK_DU], False)
     J = dofs[ref, LD_OWN]
     for c in range(m.ncyl):
-        if int(carrier[c]) == ref:
+        if np.int64(carrier[c]) == ref:
             J += wk[WK_CYL_J, c]
     return J
 
@@ -242,7 +242,7 @@ def ref_inertia(m, phi, wk):
 @kernel(inline=True)
 def dof_angle(m, y, d):
     """θ_d of dof d at state ``y``: the reference's φ, any other's φ + q_d."""
-    return angle_at(y, d, line_index(m), int(m.line[0, LM_REF]))
+    return angle_at(y, d, line_index(m), np.int64(m.line[0, LM_REF]))
 
 
 @kernel(inline=True)
@@ -256,8 +256,8 @@ def dof_breakpoints(m, d):
     """Dof d's own breakpoints, sorted angles of its cycle on its angle θ_d (a view of
     ``Model.breakpoints``), and the index of the first in it (``Model.bp_jump`` alike)."""
     dofs = line_parts(m.line)[1]
-    first = int(dofs[d, LD_BREAKPOINTS])
-    end = int(dofs[d + 1, LD_BREAKPOINTS]) if d + 1 < dofs.shape[0] else m.breakpoints.shape[0]
+    first = np.int64(dofs[d, LD_BREAKPOINTS])
+    end = np.int64(dofs[d + 1, LD_BREAKPOINTS]) if d + 1 < dofs.shape[0] else m.breakpoints.shape[0]
     return m.breakpoints[first:end], first
 
 

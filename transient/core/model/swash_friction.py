@@ -229,7 +229,7 @@ def prepare(mp, phi, w, sel, wk):
     wk[c + S_GX1, 0] = -(_dot(xi, h1) + ic * u13 * _dot(xi, a))
     wk[c + S_GKAPPA, 0] = kappa
     wk[c + S_GDTH, 0] = d1
-    for k in range(int(mp[N_CYL])):
+    for k in range(np.int64(mp[N_CYL])):
         b, _, _, x1, x2, e, e1, e2 = rod_motion(mp, k, c_phi, s_phi, c_th, s_th, wv, dw)
         cb = _cross3(xi, b)
         rho = _dot(cb, e)
@@ -263,7 +263,7 @@ def prepare(mp, phi, w, sel, wk):
             wk[c + (S_TAU0 if part == 0 else S_TAU1), k] = -_dot(cb, kk)
     if wk[c + R_SEL, 0] != sel:
         c_phi, s_phi, c_th, s_th, n, wv, dw, _, _, _, _ = link_motion(mp, sel)
-        for k in range(int(mp[N_CYL])):
+        for k in range(np.int64(mp[N_CYL])):
             x1 = rod_motion(mp, k, c_phi, s_phi, c_th, s_th, wv, dw)[3]
             wk[c + S_SS, k] = np.sign(x1)
         wk[c + R_SEL, 0] = sel
@@ -287,7 +287,7 @@ def shaft(mp, jp, wk, eps, w, sigma):
     tt_e = wk[c + S_GX1, 0]
     fx = fy = fz = 0.0
     gx = gy = gz = 0.0
-    for k in range(int(mp[N_CYL])):
+    for k in range(np.int64(mp[N_CYL])):
         t = _axial(wk, k, eps)
         t1 = wk[c + S_T1, k]
         ex, ey, ez = wk[c + S_EX, k], wk[c + S_EY, k], wk[c + S_EZ, k]
@@ -357,7 +357,7 @@ def solve(mp, jp, pair_of, J0, M_shaft, eps0, w, sigma, n_pairs, wk):
     frictionless φ̈); ``pair_of`` = ``Model.rx_pair``; the rows of :func:`prepare` and each
     piston's gas force (row R_P) must be filled. NaN if it does not converge."""
     c = WK_RX
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     h = mp[HALVES]
     mu = jp[J_SLIDER, RX_MU]
     k_o = sigma * jp[J_MAIN, RX_MU] * jp[J_MAIN, RX_RADIUS]
@@ -411,7 +411,7 @@ def joint_terms(mp, jp, wk, eps, w, sigma):
     h = mp[HALVES]
     T, _, _, _, _, _, m_o, m_f, _ = shaft(mp, jp, wk, eps, w, sigma)
     ls = 0.0
-    for k in range(int(mp[N_CYL])):
+    for k in range(np.int64(mp[N_CYL])):
         ls -= wk[WK_RX + S_F, k] * wk[WK_RX + S_X1, k]
     ls *= h
     return (m_o - h * T, -h * T, ls, m_o, -h * m_f * wk[WK_RX + S_GDTH, 0], ls)
@@ -422,7 +422,7 @@ def _pair_terms(mp, jp, pair_of, wk, eps, w, sigma, n_pairs):
     """S, L and η* = 1 − L/S of each pair into ``wk``; the pistons' L per cylinder (both halves'
     piston) in the rows ``WK_CYL_LOSS``, NaN for the bearings, which every cylinder loads
     (their loss is the engine's, no cylinder's)."""
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     clear_pairs(wk, n_pairs, n, np.nan)
     t = joint_terms(mp, jp, wk, eps, w, sigma)
     for i in range(3):
@@ -445,7 +445,7 @@ def inverse_drive(m, eps, w, sigma, M_shaft, wk):
     mp, jp = m.mech, m.rx_par
     c = WK_RX
     mu = jp[J_SLIDER, RX_MU]
-    n = int(mp[N_CYL])
+    n = np.int64(mp[N_CYL])
     start_f(jp, wk, eps, w, sigma, n)
     for k in range(n):
         done = False

@@ -30,6 +30,8 @@ from __future__ import annotations
 
 from math import atan2, cos, sin, sqrt
 
+import numpy as np
+
 from ..jit import kernel
 
 #: Layout of the parameter array ``mp``, filled by
@@ -109,7 +111,7 @@ def swash_points(mp, phi, theta, pts):
     for j in range(phi.shape[0]):
         th = hooke(mp, phi[j])[0]
         theta[j] = th
-        for k in range(int(mp[N_CYL])):
+        for k in range(np.int64(mp[N_CYL])):
             bx, by, bz = joint_b(mp, k, cos(phi[j]), sin(phi[j]), cos(th), sin(th))
             yd = mp[CYL0 + CYL_STRIDE * k + Y_D]
             zd = mp[CYL0 + CYL_STRIDE * k + Z_D]
@@ -219,7 +221,7 @@ def swash_terms(mp, phi, u, du):
     c_phi, s_phi, c_theta, s_theta, n, w, dw, d1, d2, u13, du13 = link_motion(mp, phi)
     J, dJ = link_inertia(mp, d1, d2, u13, du13)
     halves = mp[HALVES]
-    for k in range(int(mp[N_CYL])):
+    for k in range(np.int64(mp[N_CYL])):
         _, _, _, x1, x2, _, e1, e2 = rod_motion(mp, k, c_phi, s_phi, c_theta, s_theta, w, dw)
         # The rod's centre of mass G = D + cg·e; D moves along x only.
         g1x, g2x = x1 + cg * e1[0], x2 + cg * e2[0]
@@ -240,7 +242,7 @@ def shares(mp, kin_coef, angles, Jc, dJc, u, du, with_dJ):
     they ride one station, whose angle is ``angles[0]``; the first cylinder's share is the whole
     J, the others' nothing."""
     Jc[0], dJc[0] = swash_terms(mp, angles[0], u, du)
-    for k in range(1, int(mp[N_CYL])):
+    for k in range(1, np.int64(mp[N_CYL])):
         Jc[k] = 0.0
         dJc[k] = 0.0
 

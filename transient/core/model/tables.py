@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..jit import kernel
 
 
@@ -75,7 +77,7 @@ def find_piece_near(knots, piece_knot, x, held):
     cylinder that a step's stages move by a fraction of a piece. The same piece as
     :func:`find_piece` for every `x` and ``held``, since the corners increase strictly."""
     if 0.0 <= held < piece_knot.shape[0] - 1:
-        j = int(held)
+        j = np.int64(held)
         if knots[piece_knot[j]] <= x < knots[piece_knot[j + 1]]:
             return j
     return find_piece(knots, piece_knot, x)
@@ -186,7 +188,7 @@ def interval_near(knots, piece_knot, piece, x, held):
     lo = piece_knot[piece]
     hi = piece_knot[piece + 1] - 1
     if lo <= held <= hi:
-        i = int(held)
+        i = np.int64(held)
         for _ in range(NEAR_STEPS):
             if i > lo and x < knots[i]:
                 i -= 1

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..jit import kernel
 
 TWO_PI = 2.0 * math.pi
@@ -44,7 +46,7 @@ def tabulated_terms(coef, phi, u, du):
     n = coef.shape[1]
     h = TWO_PI / n
     x = phi - TWO_PI * math.floor(phi / TWO_PI)
-    i = int(x / h)
+    i = np.int64(x / h)
     if i >= n:  # x within rounding of 2π
         i = n - 1
     x -= i * h

@@ -57,7 +57,7 @@ def misfire_draw(seed, k, n):
 def cycle_number(m, k, sel):
     """The cycle of cylinder k that the shaft angle ``sel`` lies in (1: the one in progress at
     the initial angle; a cycle includes its first angle)."""
-    return int(math.floor((sel - m.var_par[k, START]) / m.period)) + 1
+    return np.int64(math.floor((sel - m.var_par[k, START]) / m.period)) + 1
 
 
 @kernel(inline=True)

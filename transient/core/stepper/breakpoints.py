@@ -230,7 +230,7 @@ def _dof_segment_end(m, fst, f, angle_mode, x, y, x_end, tol_end):
     if aim > 0.0:
         return min(x_end, max(x + aim, least))
     if angle_mode:
-        ref, first = int(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
+        ref, first = np.int64(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
         for d in range(line_dofs(m)):
             theta = angle_at(y, d, first, ref)
             level = _next_up(m, fst, block, d, theta)
@@ -260,7 +260,7 @@ def _aim_at_dof_breakpoints(tab, m, extras, at, y, work, fst, ist, min_step, den
     y_new = work.y_new
     theta = 2.0
     block = line_fst(m, fst)
-    ref, first = int(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
+    ref, first = np.int64(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
     for d in range(line_dofs(m)):
         a = angle_at(y, d, first, ref)
         b = angle_at(y_new, d, first, ref)
@@ -291,7 +291,7 @@ def _pass_dof_breakpoints(m, extras, y, y_to, sw, evbuf, ist, wk, fst):
     at ``y_to`` is stale."""
     stale = False
     block = line_fst(m, fst)
-    ref, first = int(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
+    ref, first = np.int64(m.line[0, LM_REF]), line_index(m)  # (read once for every dof)
     for d in range(line_dofs(m)):
         a = angle_at(y, d, first, ref)
         b = angle_at(y_to, d, first, ref)
@@ -316,7 +316,7 @@ def _at_dof_breakpoint(m, extras, d, level, rising, y, sw, evbuf, ist, wk):
     if extras is not None:
         carrier = line_parts(m.line)[0]
         for k in range(m.ncyl):
-            if int(carrier[k]) == d:
+            if np.int64(carrier[k]) == d:
                 stale = _cylinder_on(m, extras, k, level, rising, y, sw, evbuf, ist, wk) or stale
     return stale
 

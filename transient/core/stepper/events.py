@@ -92,7 +92,9 @@ def event_value(ctx, yv):
 @kernel(inline=True)
 def _iterated_g(m, extras, angle_mode, yv, comp, level, sel, sw, wk):
     """:func:`_event_g` with a pair's margins inlined: the root finder's iterations evaluate
-    them most, and there a call would copy the Model at every iteration."""
+    them most, and there a call would copy the Model at every iteration. Only the full variant
+    has pairs: a plain scene's root finder iterates :func:`event_value` itself (:func:`_root`),
+    so that its compile has neither this nor :func:`iterated_value`."""
     if extras is not None and comp >= PAIR_COMP:
         margins_inline(m, extras, angle_mode, yv, sel, sw, wk)
         return wk[WK_G, comp - PAIR_COMP]
@@ -109,6 +111,9 @@ def iterated_value(ctx, yv):
 def _root(m, extras, angle_mode, F, y, comp, level, sel, sw, tmp, wk, a, b, ga, gb):
     """The root of event ``comp`` at ``level`` in the bracket θ ∈ [a, b] (values ga, gb) on the
     dense output (:func:`transient.core.integrator.roots.root`). Returns (θ, evaluations)."""
+    if extras is None:  # (no pairs: the iterated form is the event function itself)
+        return root(event_value, (m, extras, angle_mode, comp, level, sel, sw, wk), F, y, tmp,
+                    a, b, ga, gb)
     return root(iterated_value, (m, extras, angle_mode, comp, level, sel, sw, wk), F, y, tmp, a,
                 b, ga, gb)
 
@@ -157,9 +162,12 @@ def _crossing_inside(m, extras, at, y, work, comp, level, direction, ga, n_sampl
     θ = j/n_samples on the dense output; 2 if the samples see no crossing (it was only in a
     stage, or between samples). ``ga``: the event function at the step's start. Returns (θ,
     evaluations)."""
-    return crossing_inside(event_value, iterated_value,
-                           (m, extras, at.angle_mode, comp, level, at.sel, at.sw, work.wk), work.F,
-                           y, at.x, at.h, at.ix, direction, ga, work.tmp, n_samples)
+    ctx = (m, extras, at.angle_mode, comp, level, at.sel, at.sw, work.wk)
+    if extras is None:  # (as in _root)
+        return crossing_inside(event_value, event_value, ctx, work.F, y, at.x, at.h, at.ix,
+                               direction, ga, work.tmp, n_samples)
+    return crossing_inside(event_value, iterated_value, ctx, work.F, y, at.x, at.h, at.ix,
+                           direction, ga, work.tmp, n_samples)
 
 
 @kernel(inline=True)

@@ -212,13 +212,15 @@ def buffers(m, tab, n: int) -> Work:
     ``control`` (:func:`~transient.core.model.layout.state_control`), and for a W-method the
     storage of its band over the shaft line's states (:func:`.line_jacobian.line_band`).
     Allocated by the caller, so that the stepper is one compile unit of its own, without
-    reference counting. ``n``: the length of the state."""
+    reference counting; the work array by ``work_array``'s Python (compiled for a call from
+    Python, once a run, it would cost a first run a compile of its own). ``n``: the length of
+    the state."""
     band = None
     if is_w_method(tab):
         rows, kb = line_band(m.line)
         band = np.zeros((rows, 2 * kb + 1))
     return Work(np.empty((tab.n_ext, n)), np.empty((3 + tab.D.shape[0], n)), np.empty(n),
-                np.empty(n), np.empty(n), np.empty(n), work_array(m),
+                np.empty(n), np.empty(n), np.empty(n), getattr(work_array, "py_func", work_array)(m),
                 np.zeros((N_MARGIN_SAMPLES + 1, max(n_margins(m), 1))), state_control(m), band)
 
 
