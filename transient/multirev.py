@@ -164,19 +164,29 @@ class _Follower:
     def _macro(self, n: int, X: np.ndarray, stop: int, corner: float | None, period: float):
         """The envelope from cycle ``n`` to ``stop``, to the last whole cycle that ends
         CORNER_CYCLES cycles before the next corner, or to where the steps stay shorter than
-        the cycles they integrate (then the next cycles are integrated one by one, twice as
-        many each time it recurs): its nodes filled from each step's dense output."""
+        the cycles they integrate or a stage lands where no cycle runs (a speed too low, or
+        reversed: an explicit step on a stiff envelope); then the next cycles are integrated
+        one by one, twice as many each time it recurs. Its nodes are filled from each step's
+        dense output."""
         # each state's error held to rtol of its size at the segment's start, t's to rtol of
         # TIME_SCALE cycles' duration: relative to t itself, a long run's would grow with its
         # length
         scale = np.abs(X)
         scale[-1] = TIME_SCALE * period
-        rk = RK45(self.slope, n, X, stop, rtol=SOLVER_RTOL, atol=self.atol + self.rtol * scale)
         limit = None if corner is None else corner - CORNER_CYCLES * period
         self.states[n], last, steps, stiff = X, n, 0, False
-        while rk.status == "running":
+        try:  # (its first step's size is tried on the envelope too)
+            rk = RK45(self.slope, n, X, stop, rtol=SOLVER_RTOL,
+                      atol=self.atol + self.rtol * scale)
+        except SimulationError:  # (a stage's state no cycle starts from: stiff, as below)
+            rk, stiff = None, True
+        while rk is not None and rk.status == "running":
             spent = self.phi.cycles
-            rk.step()
+            try:
+                rk.step()
+            except SimulationError:
+                stiff = True
+                break
             steps += 1
             if rk.status == "failed":
                 raise SimulationError(f"the envelope from cycle {n} failed at cycle "

@@ -425,7 +425,7 @@ def steady(scene, path: str | Path | None = None, *, cycles: int = 1, force: boo
     >>> res = transient.steady(scene)
     >>> import numpy as np
     >>> phi, omega = res.trajectory["phi"], res.trajectory["omega"]
-    >>> round(float(np.trapezoid(omega, phi) / (phi[-1] - phi[0])), 6)
+    >>> round(float(np.trapezoid(omega, phi) / (phi[-1] - phi[0])), 4)
     200.0
     >>> bool(abs(res.analysis["steady_multiplier_max"][0]) < 1)
     True
