@@ -130,12 +130,15 @@ def test_steady_cycle_is_the_settled_run_last_cycle(label):
     steady = {k: np.asarray(v) for k, v in res.trajectory.items()}
     assert cycles[-1]["t"].size == steady["t"].size
     if "eta_mech_work" in res.analysis or scene.friction.pairs:
-        # the summary's η_mech over the steady cycle, as the settled run's last cycle has it
-        last = cycles[-1]
-        theirs_eta = mechanical_efficiency(scene, last, window=(float(last["phi"][0]),
-                                                                float(last["phi"][-1]), 1))
+        # the summary's η_mech over the steady cycle, as the settled run's last cycles have it
+        # (to their own scatter, added up as the columns' below)
+        etas = [mechanical_efficiency(scene, c, window=(float(c["phi"][0]),
+                                                        float(c["phi"][-1]), 1))
+                ["eta_mech_work"][0] for c in cycles]
+        eta_scatter = float(np.abs(np.diff(etas)).max())
         eta = res.analysis["eta_mech_work"][0]
-        assert abs(eta - theirs_eta["eta_mech_work"][0]) <= max(AGREE, SETTLED.get(label, 0.0))
+        assert abs(eta - etas[-1]) <= max(AGREE, eta_scatter / (1.0 - mu)) + FLOOR, (
+            eta, etas[-1], eta_scatter)
 
     mask = on_corners(scene, steady["phi"])
     assert np.count_nonzero(~mask) >= 0.7 * mask.size  # (most samples compared)
