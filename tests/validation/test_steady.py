@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,33 +16,13 @@ from transient.analysis.efficiency import mechanical_efficiency
 from transient.assemble import build_model
 from transient.cli import main
 from transient.shooting import NoSteadyState
+from transient.verify.steady import bench_scene, cycle_starts, cycles_of
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
 RTOL = 1e-12
 #: Every column of the steady cycle against the settled run's last cycle, relative to the
 #: column's largest magnitude over the cycle, with an absolute floor for a column that is zero
 #: in exact arithmetic.
 AGREE, FLOOR = 1e-9, 1e-12
-
-
-def tight(scene, rtol=RTOL):
-    return dataclasses.replace(scene, solver=dataclasses.replace(scene.solver, rtol=rtol,
-                                                                 atol=rtol * 1e-2))
-
-
-def case(name: str, rtol: float = RTOL):
-    scene = transient.load_scene(CASES / f"{name}.toml")
-    if scene.load.schedule_time:  # (the PI case's load programme: its full load, constant)
-        scene = dataclasses.replace(scene, load=dataclasses.replace(
-            scene.load, schedule_time=(), schedule_scale=()))
-    return tight(scene, rtol)
-
-
-def cycles_of(scene, n: float):
-    """``scene`` run for ``n`` engine cycles from its initial state."""
-    run = dataclasses.replace(scene.run, revolutions=n * scene.mechanism.cycle / (2 * math.pi),
-                              t_end=math.inf)
-    return dataclasses.replace(scene, run=run)
 
 
 STEADY_CASES = {
@@ -77,9 +56,7 @@ def direct_cycles(scene, n: int) -> list[dict[str, np.ndarray]]:
     """The last SCATTER_CYCLES + 1 cycles of a direct run of ``n`` cycles, each its samples
     from its start to its end (the end's sample and row, which coincide, once)."""
     direct = transient.simulate(cycles_of(scene, n)).trajectory
-    phi = np.asarray(direct["phi"])
-    starts = np.searchsorted(phi, scene.initial.phi + scene.mechanism.cycle * np.arange(n + 1)
-                             - 1e-9)
+    starts = cycle_starts(scene, direct, n)
     cycles = []
     for j in range(n - SCATTER_CYCLES - 1, n):
         rows = np.arange(starts[j], starts[j + 1] + 1)
@@ -111,7 +88,7 @@ def compared(scene, cycle: dict, mask, neutral=()) -> dict[str, np.ndarray]:
 
 @pytest.mark.parametrize("label", STEADY_CASES)
 def test_steady_cycle_is_the_settled_run_last_cycle(label):
-    scene = case(STEADY_CASES[label], RTOLS.get(label, RTOL))
+    scene = bench_scene(STEADY_CASES[label], RTOLS.get(label, RTOL))
     res = transient.steady(scene)
     mu = abs(res.analysis["steady_multiplier_max"][0])
     assert mu < 1.0
@@ -166,7 +143,7 @@ def one_cycle_speed(scene, omega: float) -> float:
 def test_multiplier_is_the_direct_map_derivative(label):
     """A scene whose one periodic state is the speed: the multiplier is dΦ/dω of the direct
     run's own one-cycle map, by central differences of its own step."""
-    scene = case(STEADY_CASES[label])
+    scene = bench_scene(STEADY_CASES[label])
     res = transient.steady(scene)
     assert res.analysis["steady_multipliers_real"][0].size == 1
     mu = res.analysis["steady_multipliers_real"][0][0]
@@ -248,7 +225,7 @@ def test_refuses_an_unstable_steady_state_a_governor_that_hunts():
     """A PI governor with a large integral gain and a slow actuator: Newton finds the periodic
     state, the multipliers put it outside the unit circle, and the direct run indeed never
     settles there (its cycle-start speed still swings after 100 cycles)."""
-    scene = case("gots_diesel_pi")
+    scene = bench_scene("gots_diesel_pi")
     scene = dataclasses.replace(scene, governor=dataclasses.replace(
         scene.governor, gain_i=400.0, actuator_time=0.05))
     with pytest.raises(NoSteadyState, match=r"is unstable: the multiplier .* ≥ 1\) .*hunts") as e:
