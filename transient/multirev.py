@@ -194,6 +194,7 @@ class _Follower:
         # or a latched fuel may pass through zero), t's to rtol of TIME_SCALE cycles'
         # duration: relative to t itself, a long run's would grow with its length
         self.states[n], last, steps, stiff = X, n, 0, False
+        begun = self.phi.cycles
         scale = np.nanmax(np.abs(self.states[:n + 1]), axis=0)
         scale[-1] = TIME_SCALE * period
         limit = None if corner is None else corner - CORNER_CYCLES * period
@@ -228,9 +229,13 @@ class _Follower:
                 last = int(nodes[-1])
             if rk.t == stop and not crossed:
                 self.states[stop] = rk.y
-            # (held below what a step costs once the controller has had steps to grow it:
-            # the envelope is stiff, and an explicit macro step no gain)
-            stiff = steps >= STIFF_STEPS and rk.h_abs < self.phi.cycles - spent
+            # (an explicit step held below what it costs once the controller has had steps to
+            # grow it: the envelope is stiff; implicit steps that have covered fewer cycles
+            # than they cost: no gain, where a step cut short by Newton's iteration on F's
+            # rounding, at a size where that reaches the tolerance, grows again)
+            short = (rk.t - n < self.phi.cycles - begun if self.implicit
+                     else rk.h_abs < self.phi.cycles - spent)
+            stiff = steps >= STIFF_STEPS and short
             if crossed or stiff:
                 break
         if rk is not None:  # (the next segment's first step: this one's last)
