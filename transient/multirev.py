@@ -34,6 +34,7 @@ from scipy.optimize import brentq
 
 from .errors import SceneError, SimulationError
 from .run import CycleMap
+from .scene.records import ENVELOPE_RTOL
 from .shooting import _nonperiodic, refuse_nonperiodic
 
 #: Weights of the one-sided difference of X_n … X_{n+3} for X′(n) (third order), and of
@@ -57,8 +58,6 @@ SOLVER_RTOL = 100 * np.finfo(float).eps
 #: The time's error is held relative to this many cycles' duration: what places a corner in
 #: its cycle to a small part of one over the run.
 TIME_SCALE = 100.0
-#: The envelope's default tolerance, relative.
-ENVELOPE_RTOL = 1e-7
 #: The second integration's tolerance, a multiple of the first's: their difference estimates
 #: the second's error, which bounds the first's where the method converges.
 ESTIMATE_RATIO = 10.0
@@ -108,6 +107,9 @@ class _Follower:
         # short, doubled each time it recurs, and those of them left
         self.direct, self.direct_left = 0, 0
         self.integrated = np.zeros(cycles + 1, dtype=bool)
+        # called with (cycle reached, states, integrated) as the envelope advances: the states
+        # of the cycles before the one reached are final
+        self.watch: Callable[[int, np.ndarray, np.ndarray], None] | None = None
 
     def cycle(self, X: np.ndarray) -> np.ndarray:
         """The state after one resolved cycle from ``X``."""
@@ -141,6 +143,8 @@ class _Follower:
                 self.direct_left = self.direct
             if self.progress is not None:
                 self.progress(n, self.cycles, self.phi.cycles)
+            if self.watch is not None:
+                self.watch(n, self.states, self.integrated)
         self.states[self.cycles] = X
         return self.states
 
@@ -218,7 +222,9 @@ def _time_past(m: float, dense, limit: float) -> float:
 
 
 def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
-                    progress: Callable[[int, int, int], None] | None = None) -> Envelope:
+                    progress: Callable[[int, int, int], None] | None = None,
+                    watch: Callable[[int, np.ndarray, np.ndarray], None] | None = None
+                    ) -> Envelope:
     """Follow ``scene`` over ``cycles`` engine cycles on the envelope of its cycle map.
 
     Parameters
@@ -232,6 +238,10 @@ def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
         The envelope's relative tolerance (its absolute one the scene's ``solver.atol``).
     progress : callable, optional
         Called with (cycle reached, cycles, cycles integrated) as the envelope advances.
+    watch : callable, optional
+        Called with (cycle reached, states, integrated) as the envelope advances (the arrays
+        of :class:`Envelope`, final before the cycle reached): what a long run's result
+        writes as it goes (:mod:`transient.longrun`).
 
     Returns
     -------
@@ -247,6 +257,7 @@ def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
     corners = np.unique(np.asarray(scene.load.schedule_time, dtype=float))
     atol = scene.solver.atol
     run = _Follower(phi, corners, cycles, rtol, atol, progress)
+    run.watch = watch
     states = run.run()
     coarse = _Follower(phi, corners, cycles, rtol * ESTIMATE_RATIO, atol, None,
                        DIFFERENCE_ESTIMATE)
