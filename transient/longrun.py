@@ -31,6 +31,7 @@ from .analysis.irregularity import fluctuation
 from .core.model import governor as gv
 from .errors import SceneError, SimulationError
 from .multirev import Envelope, multirevolution, refuse
+from .outcome import status_of
 from .results import (
     ENVELOPE_CYCLES,
     NOT_RESUMABLE,
@@ -46,6 +47,7 @@ from .run import CycleMap
 from .scene import to_toml
 from .scene.outputs import output_columns
 from .scene.queries import governor_kind
+from .stopping import deferred
 
 #: Agreement with a whole number of cycles that a run's revolutions must reach (relative).
 WHOLE = 1e-9
@@ -128,6 +130,8 @@ class _Recorder:
         self.memory: dict[str, list] = {name: [] for name in (
             "states", *ENVELOPE_CYCLES, "resolved", "resolved_end", "trajectory")}
         self.datasets = None if writer is None else writer.envelope
+        # the first cycle start: each cycle written adds the start of the next
+        self._states(np.append(out.initial(), 0.0)[None, :])
 
     def watch(self, n: int, states: np.ndarray, integrated: np.ndarray) -> None:
         """The envelope reached cycle ``n``: the cycles before n − 1 are final, with the state
@@ -157,7 +161,7 @@ class _Recorder:
             self.rows += rows.shape[0]
             resolved.append(int(k))
             ends.append(self.rows)
-        self._store(states[ks], per_cycle, blocks, resolved, ends)
+        self._store(states[ks + 1], per_cycle, blocks, resolved, ends)
         self.done = upto
 
     def _cycle(self, k: int, X: np.ndarray) -> np.ndarray:
@@ -169,34 +173,39 @@ class _Recorder:
         rows[:, self.phi_at] += k * self.scene.mechanism.cycle
         return rows
 
-    def _store(self, states, per_cycle, blocks, resolved, ends) -> None:
+    def _states(self, states: np.ndarray) -> None:
+        """Cycle starts into memory and the file."""
+        self.memory["states"].append(states)
+        if self.writer is not None and self.datasets is not None:
+            self.writer.extend([(self.datasets["states"], states)])
+
+    def _store(self, ends_of, per_cycle, blocks, resolved, ends) -> None:
         """The cycles' rows into memory, or the file: the trajectory's block first, with its
-        checkpoint, so that a resolved cycle is never listed without its rows."""
+        checkpoint, so that a resolved cycle is never listed without its rows; the state at
+        each one's end (``ends_of``) last."""
         m = self.memory
-        m["states"].append(states)
         for name, values in per_cycle.items():
             m[name].append(values)
         m["resolved"] += resolved
         m["resolved_end"] += ends
         if self.writer is None:
             m["trajectory"] += blocks
+            self._states(ends_of)
             return
         rows = np.concatenate(blocks) if blocks else np.zeros((0, len(self.columns)))
         self.writer.block({c: rows[:, j] for j, c in enumerate(self.columns)}, {},
                           np.zeros(0), np.zeros(0, np.int64), False, NOT_RESUMABLE)
         ds, writer = self.datasets, self.writer
         assert ds is not None, "a recorder with a writer has its datasets"
-        writer.extend([(ds["states"], states),
-                            *((ds[name], values) for name, values in per_cycle.items()),
-                            (ds["resolved"], np.asarray(resolved, dtype=np.int64)),
-                            (ds["resolved_end"], np.asarray(ends, dtype=np.int64))])
+        writer.extend([*((ds[name], values) for name, values in per_cycle.items()),
+                       (ds["resolved"], np.asarray(resolved, dtype=np.int64)),
+                       (ds["resolved_end"], np.asarray(ends, dtype=np.int64))])
+        self._states(ends_of)
 
     def finish(self, env: Envelope) -> None:
-        """The cycles left, the last cycle start and the error estimate."""
+        """The cycles left and the error estimate."""
         self.write(self.cycles, env.states, env.integrated)
-        self.memory["states"].append(env.states[-1:])
-        if self.writer is not None and self.datasets is not None:
-            self.writer.extend([(self.datasets["states"], env.states[-1:])])
+        if self.datasets is not None:
             self.datasets["error"][:] = env.error  # (flushed as the file is finished)
 
     def trajectory(self) -> dict[str, np.ndarray]:
@@ -278,8 +287,15 @@ def run_multirevolution(scene, path: str | Path | None = None, *, force: bool = 
         recorder = _Recorder(scene, cycles, out, writer)
         env = multirevolution(scene, cycles, rtol, progress, recorder.watch)
         recorder.finish(env)
-    except (SimulationError, KeyboardInterrupt) as exc:
-        raise _stopped(scene, path, writer, recorder, exc) from None
+    except BaseException as exc:
+        message = "interrupted" if isinstance(exc, KeyboardInterrupt) else (
+            str(exc) if isinstance(exc, SimulationError) else f"{type(exc).__name__}: {exc}")
+        if writer is not None:  # (published marked incomplete, whatever stopped it)
+            with deferred():
+                writer.finish(False, message=message, status=status_of(exc))
+        if isinstance(exc, (SimulationError, KeyboardInterrupt)):
+            raise _stopped(scene, writer, recorder, message, exc) from None
+        raise
     solver = {"method": scene.solver.method, "ran": f"multirevolution ({scene.solver.method})",
               "rtol": scene.solver.rtol, "atol": scene.solver.atol, "envelope_rtol": rtol,
               "nfev": env.nfev + recorder.out.nfev, "wall_s": time.perf_counter() - t0}
@@ -291,7 +307,8 @@ def run_multirevolution(scene, path: str | Path | None = None, *, force: bool = 
                                analysis, (scene.source_file, scene.source_text))
         res.envelope = recorder.record(env.error)
         return res
-    writer.finish(True, solver=solver, analysis=analysis)
+    with deferred():  # (a stop while the file takes its name would leave neither)
+        writer.finish(True, solver=solver, analysis=analysis)
     return open_result(writer.path)
 
 
@@ -311,20 +328,16 @@ def _analysis(scene, env: Envelope, recorder: _Recorder) -> dict[str, tuple]:
             "multirev_error_t": (float(env.error[-1]), "s")}
 
 
-def _stopped(scene, path, writer: ResultWriter | None, recorder: _Recorder | None,
+def _stopped(scene, writer: ResultWriter | None, recorder: _Recorder | None, message: str,
              exc: BaseException) -> SimulationError:
     """The error of a run that failed or was interrupted, carrying what it computed: the file
-    written so far, published marked incomplete (a failed write leaves the partial file)."""
-    interrupted = isinstance(exc, KeyboardInterrupt)
-    message = "interrupted" if interrupted else str(exc)
-    status = "interrupted" if interrupted else "failed"
+    it published marked incomplete, or what it kept in memory."""
     if writer is not None:
-        writer.finish(False, message=message, status=status)
         res = open_result(writer.path)
-        where = f"partial result kept in {path} (complete = false)"
+        where = f"partial result kept in {writer.path} (complete = false)"
     else:
         data = RunData(trajectory=recorder.trajectory() if recorder else {}, events={},
-                       solver={}, complete=False, message=message, status=status)
+                       solver={}, complete=False, message=message, status=status_of(exc))
         res = result_in_memory(scene.name, to_toml(scene), data, output_columns(scene), {},
                                (scene.source_file, scene.source_text))
         if recorder is not None:
