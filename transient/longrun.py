@@ -269,6 +269,37 @@ def run_multirevolution(scene, path: str | Path | None = None, *, force: bool = 
     transient.SimulationError
         A cycle or the envelope failed, or the run was interrupted; its ``result`` holds what
         was computed (marked incomplete).
+
+    Examples
+    --------
+    A single cylinder, unfired, with a heavy shaft (2 kg m²), driven by a constant 20 N m
+    against a load of 0.1 N m s/rad: it spins up from 1000 rpm towards 200 rad/s over 500
+    cycles, which the envelope follows in macro steps; its end agrees with the direct run's
+    within the error estimate.
+
+    >>> import transient
+    >>> rod = {"model": "two-mass", "mass": 1.752,
+    ...        "cg_from_pin_mm": 107.3}
+    >>> scene = transient.Scene.from_dict({
+    ...     "mechanism": {
+    ...         "type": "crank-slider", "crank_radius_mm": 47,
+    ...         "rod_length_mm": 148, "bore_mm": 88,
+    ...         "piston_mass": 1.52, "crank_mass": 0.912,
+    ...         "rod": rod},
+    ...     "inertia": {"shaft": 2.0},
+    ...     "load": {"torque": -20.0, "linear": 0.1},
+    ...     "initial": {"omega_rpm": 1000},
+    ...     "run": {"revolutions": 1000},
+    ...     "solver": {"rtol": 1e-10, "atol": 1e-12,
+    ...                "multirevolution": True}})
+    >>> res = transient.run_multirevolution(scene)
+    >>> e = res.envelope
+    >>> e.cycles, int(e.integrated.sum())  # none integrated: no corner, a slow envelope
+    (500, 0)
+    >>> direct = transient.simulate(scene.replace(solver={"multirevolution": False}))
+    >>> w_end = direct.trajectory["omega"][-1]
+    >>> bool(abs(e.column("omega")[-1] - w_end) <= e.error[e.names.index("omega")])
+    True
     """
     cycles = refuse_long_run(scene)
     rtol = scene.solver.envelope_rtol
