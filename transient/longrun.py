@@ -31,7 +31,7 @@ from .analysis.irregularity import fluctuation
 from .core.model import governor as gv
 from .errors import SceneError, SimulationError
 from .multirev import Envelope, multirevolution, refuse
-from .outcome import status_of
+from .outcome import RunStopped, status_of
 from .results import (
     ENVELOPE_CYCLES,
     NOT_RESUMABLE,
@@ -45,6 +45,7 @@ from .results import (
 )
 from .run import CycleMap
 from .scene import to_toml
+from .scene.budget import VALUE_BYTES
 from .scene.outputs import output_columns
 from .scene.queries import governor_kind
 from .stopping import deferred
@@ -114,7 +115,7 @@ def state_units(scene, names: list[str]) -> list[str]:
 
 class _Recorder:
     """Writes the envelope's cycles as they become final (:meth:`watch`), resolving the ones
-    :func:`resolved` picks, into the writer (a file) or memory."""
+    :func:`resolved_cycle` picks, into the writer (a file) or memory."""
 
     def __init__(self, scene, cycles: int, out: CycleMap, writer: ResultWriter | None
                  ) -> None:
@@ -153,16 +154,27 @@ class _Recorder:
             if not resolved_cycle(int(k), integrated, self.cycles):
                 continue
             rows = self._cycle(int(k), states[k])
+            c = self.columns.index
             per_cycle["delta"][j] = fluctuation(
-                rows[:, 0], rows[:, self.phi_at], rows[:, self.columns.index("omega")],
+                rows[:, c("t")], rows[:, self.phi_at], rows[:, c("omega")],
                 self.scene.mechanism.cycle, rows[0, self.phi_at])
             per_cycle["work"][j] = self.out.net_work
             blocks.append(rows)
             self.rows += rows.shape[0]
+            self._budget()
             resolved.append(int(k))
             ends.append(self.rows)
         self._store(states[ks + 1], per_cycle, blocks, resolved, ends)
         self.done = upto
+
+    def _budget(self) -> None:
+        """Stop the run (``over-budget``) where its resolved cycles outgrow
+        ``run.max_output_bytes``, as a direct run's trajectory is stopped."""
+        written = self.rows * len(self.columns) * VALUE_BYTES
+        if written > self.scene.run.max_output_bytes:
+            raise RunStopped("over-budget", f"over budget: {self.rows} samples of the resolved "
+                                            f"cycles, more than run.max_output_bytes = "
+                                            f"{self.scene.run.max_output_bytes:.6g} bytes allow")
 
     def _cycle(self, k: int, X: np.ndarray) -> np.ndarray:
         """Cycle ``k`` run with output from the envelope's state ``X`` at its start: its rows,

@@ -229,6 +229,34 @@ def test_what_the_method_cannot_follow_is_refused_before_any_work(key, tmp_path,
     assert not out.exists() or not any(out.iterdir())  # (no work, no file)
 
 
+@pytest.mark.parametrize("key", ["run.t_end", "analysis.loads"])
+def test_check_refuses_what_run_would(key, tmp_path, capsys):
+    scene_file = write_scene(tmp_path, scene_text(**REFUSED[key]))
+    code, stdout, err = run(capsys, "check", scene_file)
+    assert code == 2 and key in err and err.count("\n") == 1
+    code, stdout, err = run(capsys, "check", write_scene(tmp_path, scene_text(), "good"))
+    assert code == 0, err
+
+
+def test_the_output_budget_counts_the_cycles_written(tmp_path, capsys):
+    # a million cycles: a direct run's least output is refused, the envelope's is not
+    many = scene_text(cycles=1_000_000)
+    with pytest.raises(transient.SceneError, match="run.revolutions"):
+        transient.load_scene(write_scene(tmp_path, many.replace("multirevolution = true",
+                                                                "multirevolution = false")))
+    assert transient.load_scene(write_scene(tmp_path, many)).solver.multirevolution
+    # the resolved cycles outgrowing it stop the run, the result kept and marked
+    small = scene_text(extra_run="\nmax_output_bytes = 200000")
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "run", write_scene(tmp_path, small, "small"), "-o", out, "-q")
+    assert code == 1 and "over budget" in err
+    res = transient.open_result(out / "small.h5")
+    assert not res.complete and res.status == "over-budget"
+    # (written up to the cycles before the one that would outgrow it)
+    assert 0 < res.trajectory["t"].size * len(res.trajectory) * 8 <= 200000
+    assert 0 < res.envelope.integrated.size < CYCLES
+
+
 def test_simulate_refuses_a_scene_that_asks_for_the_envelope(tmp_path):
     scene = transient.load_scene(write_scene(tmp_path, scene_text(cycles=4)))
     with pytest.raises(transient.SceneError, match="solver.multirevolution"):

@@ -52,6 +52,10 @@ def cmd_check(args) -> int:
         scene = load_scene(args.scene)
     except SweepNotScene:
         return _check_sweep(args.scene)
+    if scene.solver.multirevolution:  # (what `run` would refuse of it, refused here too)
+        from ..longrun import refuse_long_run
+
+        refuse_long_run(scene)
     pairs = scene.friction.pairs
     friction = (f", {len(pairs)} non-ideal pair(s) ({', '.join(p.name for p in pairs)}; "
                 f"policy {scene.friction.policy})" if pairs else "")
