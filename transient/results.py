@@ -386,7 +386,7 @@ def read_envelope(node: h5py.Group, trajectory_rows: int) -> EnvelopeRecord | No
     st = g["states"]
     return EnvelopeRecord(
         names=[str(v) for v in st.attrs["names"]], units=[str(v) for v in st.attrs["units"]],
-        states=st[:n + 1] if n else st[:0], integrated=g["integrated"][:n].astype(bool),
+        states=st[:n + 1], integrated=g["integrated"][:n].astype(bool),
         mean_omega=g["mean_omega"][:n], delta=g["delta"][:n], work=g["work"][:n],
         resolved=g["resolved"][:m], resolved_end=ends[:m], error=g["error"][()],
         cycles=int(g.attrs["cycles"]))

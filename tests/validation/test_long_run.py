@@ -7,6 +7,7 @@ against a direct run of the same scene, the per-cycle work against the kinetic e
 envelope."""
 from __future__ import annotations
 
+import dataclasses
 import math
 import signal
 import subprocess
@@ -21,9 +22,11 @@ from terminal import terminal_run
 
 import transient
 from transient.cli import main
+from transient.core.stepper import io as sio
 from transient.longrun import run_multirevolution
 from transient.multirev import multirevolution
-from transient.results import partial_path
+from transient.results import Checkpoint, partial_path
+from transient.run import CycleMap, simulate_from
 
 REPO = Path(__file__).resolve().parents[2]
 #: The stepper's tolerance (atol = rtol/100): the resolved cycles and the direct run's then
@@ -138,6 +141,37 @@ def test_resolved_cycles_agree_with_the_direct_run(written):
         assert np.abs(w - w_d[at]).max() <= tol, (int(k), np.abs(w - w_d[at]).max())
         # t: the envelope's time error, which places each corner in its cycle (TIME_SCALE)
         assert np.abs(t - t_d[at]).max() <= (100 * RTOL if k == 0 else 1e-5), int(k)
+
+
+def test_resolved_cycles_are_runs_from_the_envelope_s_state(written):
+    # each resolved cycle against a run of that one cycle by transient's own run path
+    # (simulate_from, its output written as any run's) from the envelope's state at its start:
+    # every column to the stepper's tolerance
+    scene, res, env, _ = written
+    e = res.envelope
+    one_scene = scene.replace(solver={"multirevolution": False})
+    phi = CycleMap(one_scene)
+    picks = {int(e.resolved[0]), int(np.flatnonzero(e.integrated)[0]), int(e.resolved[-1])}
+    for k in sorted(picks):
+        X = env.states[k]
+        y, fst, ist = phi.start(X[:-1], float(X[-1]))
+        start = Checkpoint(rows=0, events=0, switched=False, code=sio.RUNNING,
+                           floats=np.concatenate([y, fst]), ints=ist)
+        cycle = dataclasses.replace(
+            one_scene, run=dataclasses.replace(one_scene.run, t_end=math.inf,
+                                               revolutions=scene.mechanism.cycle / (2 * math.pi)),
+            initial=dataclasses.replace(one_scene.initial,
+                                        omega=float(X[env.names.index("omega")])))
+        ran = simulate_from(cycle, start).trajectory
+        rows = e.rows(k)
+        for name in res.trajectory:
+            ours = np.asarray(res.trajectory[name][rows], dtype=float)
+            theirs = np.asarray(ran[name], dtype=float)
+            if name == "phi":
+                theirs = theirs + k * scene.mechanism.cycle
+            assert ours.shape == theirs.shape, (k, name)
+            scale = max(float(np.abs(theirs).max()), 1e-300)
+            assert np.abs(ours - theirs).max() <= 100 * RTOL * scale, (k, name)
 
 
 def test_an_integrated_cycle_ends_where_the_envelope_goes_on(written):
