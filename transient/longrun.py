@@ -2,7 +2,7 @@
 "Long runs: multirevolution steps"), written as a result.
 
 :func:`transient.multirev.multirevolution` gives the state at every cycle start and which cycles
-it integrated; :func:`run_multirevolution` writes them as they come into a result of the usual
+it integrated; :func:`transient.run_multirevolution` writes them as they come into a result of the usual
 layout (:mod:`transient.results`) with an ``envelope`` group (:data:`~transient.results.ENVELOPE`):
 every state at every cycle start, per cycle whether it was integrated or interpolated, its
 mean speed Δφ/Δt, and δ and the net work where the file holds the cycle's trajectory; the

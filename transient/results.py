@@ -843,8 +843,9 @@ class Result:
         The file the scene was read from and its text, comments included (``("", "")`` for a
         scene built in code).
     envelope
-        A multirevolution run's per-cycle envelope (:class:`EnvelopeRecord`; which cycles were
-        integrated, which interpolated, the error estimate); None for any other run.
+        A multirevolution run's per-cycle envelope
+        (:class:`~transient.results.EnvelopeRecord`: which cycles were integrated, which
+        interpolated, the error estimate); None for any other run.
 
     Examples
     --------
