@@ -2,16 +2,17 @@
 "Long runs: multirevolution steps"), written as a result.
 
 :func:`transient.multirev.multirevolution` gives the state at every cycle start and which cycles
-it integrated; :func:`transient.run_multirevolution` writes them as they come into a result of the usual
-layout (:mod:`transient.results`) with an ``envelope`` group (:data:`~transient.results.ENVELOPE`):
-every state at every cycle start, per cycle whether it was integrated or interpolated, its
-mean speed Δφ/Δt, and δ and the net work where the file holds the cycle's trajectory; the
-error estimate per state at the end. The trajectory holds the *resolved* cycles: every cycle
-the envelope integrated (around a load schedule's corners, after a stiff stretch, the run's
-last) and the first and last of each stretch it interpolated (the macro segments' ends), each
-run with output from the envelope's state at its start (by a cycle map of its own, whose
-cycles are not the envelope's cost; an integrated cycle is the very cycle the envelope took).
-Their t and φ are the run's; their works and losses count from the cycle's start.
+it integrated; :func:`transient.run_multirevolution` writes them as they come into a result of
+the usual layout (:mod:`transient.results`) with an ``envelope`` group
+(:data:`~transient.results.ENVELOPE`): every state at every cycle start, per cycle whether it
+was integrated or interpolated, its mean speed Δφ/Δt, and δ and the net work where the file
+holds the cycle's trajectory; the error estimate per state at the end. The trajectory holds the
+*resolved* cycles: every cycle the envelope integrated (around a load schedule's corners, after
+a stiff stretch, the run's last), the cycles at its macro segments' ends, the first and last
+of each stretch it interpolated and :data:`~transient.longrun.RESOLVED_ALONG` cycles spread over the run, each
+run with output from the envelope's state at its start (by a cycle map of its own, whose cycles
+are not the envelope's cost; an integrated cycle is the very cycle the envelope took). Their t
+and φ are the run's; their works and losses count from the cycle's start.
 
 The file streams as a run's does (SWMR, a checkpoint after each block of resolved cycles), so
 that a kill or an interrupt leaves it readable, marked incomplete, holding the envelope as far
@@ -52,6 +53,9 @@ from .stopping import deferred
 
 #: Agreement with a whole number of cycles that a run's revolutions must reach (relative).
 WHOLE = 1e-9
+#: Cycles spread evenly over the run that are resolved besides (every cycles/RESOLVED_ALONG-th):
+#: the trajectory's δ and work along a macro segment, not at its ends only.
+RESOLVED_ALONG = 64
 #: The [analysis] requests a multirevolution result cannot answer: they analyse a run's whole
 #: trajectory, which it holds for its resolved cycles only.
 TRAJECTORY_ANALYSES = ("loads", "orders", "irregularity", "thermodynamics")
@@ -115,7 +119,8 @@ def state_units(scene, names: list[str]) -> list[str]:
 
 class _Recorder:
     """Writes the envelope's cycles as they become final (:meth:`watch`), resolving the ones
-    :func:`resolved_cycle` picks, into the writer (a file) or memory."""
+    :func:`resolved_cycle` picks, those at the macro segments' ends and every ``every``-th,
+    into the writer (a file) or memory."""
 
     def __init__(self, scene, cycles: int, out: CycleMap, writer: ResultWriter | None
                  ) -> None:
@@ -127,6 +132,9 @@ class _Recorder:
         self.columns = list(output_columns(scene))
         self.phi_at = self.columns.index("phi")
         self.done = 0  # the cycles written
+        # the cycle reached at the last watch, and the macro segments' ends (its nodes)
+        self.reached, self.nodes = 0, {0}
+        self.every = max(1, math.ceil(cycles / RESOLVED_ALONG))
         self.rows = 0  # the trajectory's rows written
         self.memory: dict[str, list] = {name: [] for name in (
             "states", *ENVELOPE_CYCLES, "resolved", "resolved_end", "trajectory")}
@@ -136,7 +144,11 @@ class _Recorder:
 
     def watch(self, n: int, states: np.ndarray, integrated: np.ndarray) -> None:
         """The envelope reached cycle ``n``: the cycles before n − 1 are final, with the state
-        that ends each and whether the next one was integrated."""
+        that ends each and whether the next one was integrated; a jump of more than one cycle
+        was a macro segment, whose ends are resolved."""
+        if n - self.reached > 1:
+            self.nodes.update((self.reached, n))
+        self.reached = n
         self.write(n - 1, states, integrated)
 
     def write(self, upto: int, states: np.ndarray, integrated: np.ndarray) -> None:
@@ -151,7 +163,8 @@ class _Recorder:
                      "delta": np.full(ks.size, np.nan), "work": np.full(ks.size, np.nan)}
         blocks, resolved, ends = [], [], []
         for j, k in enumerate(ks):
-            if not resolved_cycle(int(k), integrated, self.cycles):
+            if not (k in self.nodes or k % self.every == 0
+                    or resolved_cycle(int(k), integrated, self.cycles)):
                 continue
             rows = self._cycle(int(k), states[k])
             c = self.columns.index

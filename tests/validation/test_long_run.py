@@ -23,7 +23,7 @@ from terminal import terminal_run
 import transient
 from transient.cli import main
 from transient.core.stepper import io as sio
-from transient.longrun import run_multirevolution
+from transient.longrun import RESOLVED_ALONG, run_multirevolution
 from transient.multirev import multirevolution
 from transient.results import Checkpoint, partial_path
 from transient.run import CycleMap, simulate_from
@@ -80,7 +80,11 @@ def written(tmp_path_factory):
     assert code == 0
     res = transient.open_result(folder / "out" / "long.h5")
     scene = transient.load_scene(scene_file)
-    env = multirevolution(scene, CYCLES, ENVELOPE_RTOL)
+    reached = [0]
+    env = multirevolution(scene, CYCLES, ENVELOPE_RTOL,
+                          watch=lambda n, states, integrated: reached.append(n))
+    # the macro segments' ends: where the envelope advanced by more than a cycle at once
+    env.nodes = {m for a, b in zip(reached, reached[1:]) if b - a > 1 for m in (a, b)}
     direct_scene = scene.replace(solver={"multirevolution": False})
     direct = transient.simulate(direct_scene).trajectory
     return scene, res, env, direct
@@ -106,12 +110,13 @@ def test_the_file_holds_the_envelope_of_the_call(written):
     assert np.allclose(e.mean_omega, scene.mechanism.cycle / np.diff(t), rtol=1e-12)
 
 
-def test_resolved_cycles_are_the_integrated_ones_and_the_stretches_ends(written):
+def test_resolved_cycles_are_the_integrated_ones_the_nodes_and_the_stretches_ends(written):
     _, res, env, _ = written
     e = res.envelope
     flags = env.integrated[:-1]
+    every = math.ceil(CYCLES / RESOLVED_ALONG)
     expect = [k for k in range(CYCLES) if flags[k] or k in (0, CYCLES - 1)
-              or flags[k - 1] or flags[k + 1]]
+              or flags[k - 1] or flags[k + 1] or k in env.nodes or k % every == 0]
     assert list(e.resolved) == expect
     assert e.resolved_end[-1] == res.trajectory["t"].size
     assert np.all(np.isfinite(e.delta[e.resolved])) and np.all(np.isfinite(e.work[e.resolved]))
