@@ -319,8 +319,8 @@ def run_multirevolution(scene, path: str | Path | None = None, *, force: bool = 
     ...                "multirevolution": True}})
     >>> res = transient.run_multirevolution(scene)
     >>> e = res.envelope
-    >>> e.cycles, int(e.integrated.sum())  # none integrated: no corner, a slow envelope
-    (500, 0)
+    >>> e.cycles, e.states.shape  # every cycle start: its periodic state (ω), and t
+    (500, (501, 2))
     >>> direct = transient.simulate(scene.replace(solver={"multirevolution": False}))
     >>> w_end = direct.trajectory["omega"][-1]
     >>> bool(abs(e.column("omega")[-1] - w_end) <= e.error[e.names.index("omega")])
