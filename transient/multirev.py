@@ -19,7 +19,10 @@ error, not the stepper's: each cycle is integrated at the scene's tolerance, as 
 is, and the two differ by about that a cycle, which a heavy flywheel's map adds up. A load schedule's corners are
 crossed in resolved cycles (:data:`CORNER_CYCLES` on either side), so that a corner falls in
 the cycle where the direct run has it; so are the run's last cycles where fewer are left than a
-macro step saves.
+macro step saves, the first cycles, and those where the cycles' switching events change (a
+pair's modes, a governor's limits: the envelope is not smooth there). A stiff envelope (a
+multiplier well below 1) is integrated from where an explicit step proves too short by BDF,
+implicit.
 """
 from __future__ import annotations
 
@@ -29,7 +32,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import RK45
+from scipy.integrate import BDF, RK45
 from scipy.optimize import brentq
 
 from .errors import SceneError, SimulationError
@@ -106,10 +109,19 @@ class _Follower:
         # cycles to integrate one by one after a macro segment the envelope's stiffness held
         # short, doubled each time it recurs, and those of them left
         self.direct, self.direct_left = 0, 0
+        # the envelope found stiff (its steps implicit from then on); a segment's first step
+        self.implicit, self.first_step = False, None
         self.integrated = np.zeros(cycles + 1, dtype=bool)
         # called with (cycle reached, states, integrated) as the envelope advances: the states
         # of the cycles before the one reached are final
         self.watch: Callable[[int, np.ndarray, np.ndarray], None] | None = None
+        # the switching events of the last resolved cycle, how many resolved cycles in a row
+        # have had the same; each F's cycle number and whether its cycles switched otherwise,
+        # since ``seen`` was emptied; the cycle up to which the envelope may go before a switch
+        self.regime: tuple[int, ...] | None = None
+        self.calm = 0
+        self.seen: list[tuple[float, bool]] = []
+        self.switch_near: int | None = None
 
     def cycle(self, X: np.ndarray) -> np.ndarray:
         """The state after one resolved cycle from ``X``."""
@@ -118,24 +130,33 @@ class _Follower:
 
     def slope(self, _n: float, X: np.ndarray) -> np.ndarray:
         """F(X): the envelope's derivative by the cycle number, from resolved cycles."""
-        seq = [X]
+        seq, other = [X], False
         for _ in self.difference[1:]:
             seq.append(self.cycle(seq[-1]))
+            other |= self.phi.events != self.regime
+        self.seen.append((_n, other))
         return np.tensordot(self.difference, np.array(seq), axes=1)
 
     def resolve(self, n: int, X: np.ndarray) -> np.ndarray:
         """Cycle ``n`` integrated from ``X``: the state at cycle n + 1."""
         self.states[n], self.integrated[n] = X, True
-        return self.cycle(X)
+        end = self.cycle(X)
+        same = self.phi.events == self.regime
+        self.regime, self.calm = self.phi.events, self.calm + 1 if same else 1
+        return end
 
     def run(self) -> np.ndarray:
         n, X = 0, np.append(self.phi.initial(), 0.0)
         while n < self.cycles:
+            if self.switch_near is not None and n >= self.switch_near:
+                self.calm, self.switch_near = 0, None  # (resolved until the switches repeat)
             period = self.phi.cycle / abs(X[self.phi.speed_at[0]])
             corner = self._next_corner(X[-1])
             stop = self._reach(n, X[-1], corner, period)
+            if self.switch_near is not None:
+                stop = min(stop, self.switch_near)
             if (self._near_corner(X[-1], corner, period) or stop - n < MIN_MACRO
-                    or self.direct_left > 0):
+                    or self.direct_left > 0 or self.calm < CORNER_CYCLES):
                 X, n = self.resolve(n, X), n + 1
                 self.direct_left = max(self.direct_left - 1, 0)
             else:
@@ -167,29 +188,35 @@ class _Follower:
 
     def _macro(self, n: int, X: np.ndarray, stop: int, corner: float | None, period: float):
         """The envelope from cycle ``n`` to ``stop``, to the last whole cycle that ends
-        CORNER_CYCLES cycles before the next corner, or to where the steps stay shorter than
-        the cycles they integrate or a stage lands where no cycle runs (a speed too low, or
-        reversed: an explicit step on a stiff envelope); then the next cycles are integrated
-        one by one, twice as many each time it recurs. Its nodes are filled from each step's
-        dense output."""
-        # each state's error held to rtol of its size at the segment's start, t's to rtol of
-        # TIME_SCALE cycles' duration: relative to t itself, a long run's would grow with its
-        # length
-        scale = np.abs(X)
+        CORNER_CYCLES cycles before the next corner, to before a step whose cycles switched
+        otherwise (``_switched``), or to where the steps stay shorter than the cycles they
+        integrate or a stage lands where no cycle runs (a speed too low, or reversed): the
+        envelope is stiff, and the next segments are BDF's; if they were already, the next
+        cycles are integrated one by one, twice as many each time it recurs. Its nodes are
+        filled from each step's dense output."""
+        # each state's error held to rtol of the largest size it has had (a governor's state
+        # or a latched fuel may pass through zero), t's to rtol of TIME_SCALE cycles'
+        # duration: relative to t itself, a long run's would grow with its length
+        self.states[n], last, steps, stiff = X, n, 0, False
+        scale = np.nanmax(np.abs(self.states[:n + 1]), axis=0)
         scale[-1] = TIME_SCALE * period
         limit = None if corner is None else corner - CORNER_CYCLES * period
-        self.states[n], last, steps, stiff = X, n, 0, False
+        self.seen = []
         try:  # (its first step's size is tried on the envelope too)
-            rk = RK45(self.slope, n, X, stop, rtol=SOLVER_RTOL,
-                      atol=self.atol + self.rtol * scale)
+            rk = self._stepper(n, X, stop, self.atol + self.rtol * scale)
         except SimulationError:  # (a stage's state no cycle starts from: stiff, as below)
             rk, stiff = None, True
-        while rk is not None and rk.status == "running":
+        switched = self._switched(n)
+        while rk is not None and not switched and rk.status == "running":
             spent = self.phi.cycles
+            self.seen = []
             try:
                 rk.step()
             except SimulationError:
                 stiff = True
+                break
+            switched = self._switched(rk.t_old)
+            if switched:  # (none of the step kept: its cycles cross the switch)
                 break
             steps += 1
             if rk.status == "failed":
@@ -210,10 +237,35 @@ class _Follower:
             stiff = steps >= STIFF_STEPS and rk.h_abs < self.phi.cycles - spent
             if crossed or stiff:
                 break
-        self.direct = max(2 * self.direct, MIN_MACRO // 2) if stiff else 0
+        if rk is not None:  # (the next segment's first step: this one's last)
+            self.first_step = max(1.0, rk.h_abs)
+        if stiff and not self.implicit:  # (BDF's steps from here on)
+            self.implicit = True
+        else:
+            self.direct = max(2 * self.direct, MIN_MACRO // 2) if stiff else 0
         if last == n:  # (no whole cycle reached: integrate one)
             return n + 1, self.resolve(n, X)
         return last, self.states[last].copy()
+
+    def _stepper(self, n: int, X: np.ndarray, stop: int, atol: np.ndarray):
+        """The envelope's integrator from cycle ``n``: RK45, or BDF (its Jacobian by differences of
+        F, a cycle map's evaluations per state) once the envelope has been found stiff."""
+        first = None if self.first_step is None else min(self.first_step, stop - n)
+        method = BDF if self.implicit else RK45
+        return method(self.slope, n, X, stop, rtol=SOLVER_RTOL, atol=atol, first_step=first)
+
+    def _switched(self, start: float) -> bool:
+        """Whether a cycle of a step from ``start`` switched otherwise than the last resolved
+        one (a governor reaching or leaving a limit, a pair's modes, a speed-table knot); if so
+        ``switch_near`` is halfway from the last cycle whose F's cycles switched as before to
+        the first whose did not (the switch lies between them: a step to there either sees it
+        again, nearer, or leaves fewer cycles to resolve before it)."""
+        other = [m for m, o in self.seen if o]
+        if not other:
+            return False
+        same = max([m for m, o in self.seen if not o and m < min(other)], default=start)
+        self.switch_near = int(math.floor(0.5 * (same + min(other))))
+        return True
 
 
 def _time_past(m: float, dense, limit: float) -> float:

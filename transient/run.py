@@ -311,6 +311,7 @@ class CycleMap:
         self.nfev = 0
         self.cycles = 0
         self.elapsed = math.nan  # the last cycle's duration [s]
+        self.events: tuple[int, ...] = ()  # the last cycle's switching events (``_switches``)
         self.net_work = math.nan  # the last cycle's W_gas + W_load + W_starter − losses [J]
         # (up to where it stopped, if it failed)
         # a list to collect the cycles' output rows in (the columns of ``output_columns``),
@@ -347,6 +348,7 @@ class CycleMap:
         y, fst, ist = self.start(x, t)
         status = sio.RUNNING
         last = None
+        events: list[int] = []
         while status == sio.RUNNING:
             status = stepper.advance(self.model, self.extras, self.tab, self.cfg, self.bp, y, fst,
                                      ist, self.outbuf, self.evbuf,
@@ -355,7 +357,9 @@ class CycleMap:
                 last = self.outbuf[ist[sio.I_NOUT] - 1].copy()
                 if self.rows is not None:
                     self.rows.append(self.outbuf[:ist[sio.I_NOUT]].copy())
+            events += _switches(self.evbuf[:ist[sio.I_NEV], 0])
             ist[sio.I_NOUT] = ist[sio.I_NEV] = 0
+        self.events = tuple(events)
         self.nfev += int(ist[sio.I_NFEV])
         self.cycles += 1
         self.elapsed = float(y[layout.T] - t)
@@ -373,6 +377,13 @@ class CycleMap:
         out = y[self.index].copy()
         out[self.speed_at] = last[self.speed_column]
         return out
+
+
+def _switches(codes: np.ndarray) -> list[int]:
+    """The codes of the events that switch something (a pair's mode, the governor's branch, a
+    load segment, …), in their order: a cycle's breakpoints and its end come every cycle alike,
+    and say nothing of a change of regime."""
+    return [int(c) for c in codes if c != sio.EV_BREAKPOINT and c != sio.EV_END]
 
 
 def _free_dofs(model) -> list[int]:

@@ -13,6 +13,7 @@ from scene_texts import SMALL
 
 import transient
 from transient.analysis.efficiency import mechanical_efficiency
+from transient.analysis.orders import run_orders
 from transient.assemble import build_model
 from transient.cli import main
 from transient.shooting import NoSteadyState
@@ -233,3 +234,23 @@ def test_refuses_an_unstable_steady_state_a_governor_that_hunts():
     assert abs(e.value.record.multipliers[0]) > 1.0
     _, starts = direct_cycles(scene, 100)
     assert np.abs(np.diff(starts[-10:])).max() > 1e-3 * starts[-1]
+
+
+def test_orders_and_loads_at_the_point_read_the_steady_cycle(tmp_path, capsys):
+    """The analyses of an operating point from the steady cycle, not a long settle: its order
+    spectrum of ω is the settled direct run's last cycle's, and ``transient orders`` and
+    ``transient loads`` read the steady result file as a run's."""
+    scene = bench_scene(STEADY_CASES["constant-eta"], RTOL)
+    res = transient.steady(scene, tmp_path / "point.h5")
+    settled = transient.simulate(cycles_of(scene, 200))  # (μ²⁰⁰ < 1e-11)
+    ours = run_orders(scene, res.trajectory, 720).omega.coef[-1]
+    theirs = run_orders(scene, settled.trajectory, 720).omega.coef[-1]
+    assert abs(ours[0] - theirs[0]) <= AGREE * abs(theirs[0])  # (the cycle's mean speed)
+    # (the harmonics to the stepper's tolerance of the speed they ride on)
+    assert np.abs(ours[1:] - theirs[1:]).max() <= 100 * RTOL * abs(theirs[0])
+    assert np.abs(theirs[1:]).max() > 1e-3 * abs(theirs[0])  # (there are harmonics to compare)
+    for command in ("orders", "loads"):
+        assert main([command, str(tmp_path / "point.h5"), "-o", str(tmp_path)]) == 0
+    capsys.readouterr()
+    assert (tmp_path / "point_orders.csv").stat().st_size > 0
+    assert (tmp_path / "point_loads.csv").stat().st_size > 0

@@ -134,7 +134,7 @@ def test_steady_study_writes_its_table_and_figures(tmp_path, capsys):
     assert len(low) == 2 and all(r["eta_mech_work"] == "nan" for r in low)
     assert all("would have to drive" in r["note"] for r in low)
     assert "NaN at 1500 rpm, fuel 0.02" in out
-    for figure in ("efficiency", "friction_budget", "efficiency_map"):
+    for figure in ("efficiency", "friction_budget", "efficiency_map", "delta_map"):
         assert (tmp_path / f"gots_diesel_friction_steady_{figure}.png").stat().st_size > 10_000
     # nothing overwritten without --force, refused before any work
     code, out, err = cli(capsys, "efficiency", GOTS, "--steady", "--rpm", "1500",

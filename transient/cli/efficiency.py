@@ -78,7 +78,8 @@ def cmd_efficiency(args) -> int:
     stem = Path(args.scene).stem + "_steady" * args.steady
     names = [p.name for p in scene.friction.pairs]
     figures = ["efficiency"] + ["friction_budget"] * bool(names)
-    figures += ["efficiency_map"] * (len(set(rpm)) > 1 and len(set(fuels)) > 1)
+    figures += ["efficiency_map", "delta_map"][:1 + args.steady] * (len(set(rpm)) > 1
+                                                                   and len(set(fuels)) > 1)
     for path in [out / f"{stem}_efficiency.csv"] + [out / f"{stem}_{f}.png" for f in figures]:
         check_output_file(path, args.force)  # refused before the study, not after it
     if scene.governor.model != "none":
@@ -124,6 +125,10 @@ def cmd_efficiency(args) -> int:
         fig, ax = plt.subplots(figsize=(8, 4.5))
         plot_map(ax, rows)
         written.append(save(fig, out / f"{stem}_efficiency_map.png", args.force))
+    if "delta_map" in figures:
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        plot_map(ax, rows, "delta", "δ = (ω_max − ω_min) / ω_mean")
+        written.append(save(fig, out / f"{stem}_delta_map.png", args.force))
     for w in written:
         print(f"wrote {w}")
     return EXIT_OK

@@ -182,13 +182,13 @@ def plot_budget(ax, rows: list[dict], names) -> list:
     return bars
 
 
-def plot_map(ax, rows: list[dict]):
-    """η_mech over speed × fuel for the first policy, each cell labelled
-    (:func:`transient.plots.sweep_heatmap`). Returns the mesh."""
+def plot_map(ax, rows: list[dict], key: str = "eta_mech_work",
+             label: str = "η_mech = W_out / W_in"):
+    """A column (η_mech unless ``key`` says) over speed × fuel for the first policy, each cell
+    labelled (:func:`transient.plots.sweep_heatmap`). Returns the mesh."""
     policy, fuels, rpm = _first_policy(rows)
     fuels = fuels[::-1]  # the lowest load at the bottom
-    eta = [[_value(_row(rows, policy, f, n), "eta_mech_work") for n in rpm] for f in fuels]
-    mesh = sweep_heatmap(ax, rpm, fuels, eta, "speed [rpm]", "fuel (gas-force fraction)",
-                         "η_mech = W_out / W_in")
-    ax.set_title(f"η_mech over speed and load ({policy})")
+    z = [[_value(_row(rows, policy, f, n), key) for n in rpm] for f in fuels]
+    mesh = sweep_heatmap(ax, rpm, fuels, z, "speed [rpm]", "fuel (gas-force fraction)", label)
+    ax.set_title(f"{label.split(' = ')[0]} over speed and load ({policy})")
     return mesh
