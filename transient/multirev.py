@@ -26,7 +26,6 @@ implicit.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -38,7 +37,7 @@ from scipy.optimize import brentq
 from .errors import SceneError, SimulationError
 from .run import CycleMap
 from .scene.records import ENVELOPE_RTOL
-from .shooting import _nonperiodic, refuse_nonperiodic
+from .shooting import refuse_nonperiodic
 
 #: Weights of the one-sided difference of X_n … X_{n+3} for X′(n) (third order), and of
 #: X_n … X_{n+2} (second order: the error estimate's integration, whose difference from the
@@ -89,11 +88,7 @@ class Envelope:
 def refuse(scene) -> None:
     """Raise :class:`~transient.errors.SceneError` for a scene the envelope cannot follow:
     shooting's refusals but a load schedule in time, whose corners are crossed cycle by cycle."""
-    why = _nonperiodic(scene)
-    if why is not None and why[0] == "load.schedule_time":
-        scene = dataclasses.replace(scene, load=dataclasses.replace(
-            scene.load, schedule_time=(), schedule_scale=()))
-    refuse_nonperiodic(scene)
+    refuse_nonperiodic(scene, allowed=("load.schedule_time",))
 
 
 class _Follower:
