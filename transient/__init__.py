@@ -28,6 +28,9 @@ result → analysis, and each layer imports only those below it (the contracts i
 - ``plots``          ax-first plotting helpers
 - ``shooting``       the periodic steady state by Newton's method on the cycle map,
                      :func:`steady`
+- ``multirev``, ``longrun``
+                     long runs on the envelope of the cycle map (multirevolution steps),
+                     :func:`run_multirevolution` and its result
 - ``study``, ``sweeps``
                      many runs: efficiency and flywheel studies; parameter sweeps on Dask
 - ``verify``         the work–precision benchmark, its targets, the stress catalogue
@@ -35,20 +38,22 @@ result → analysis, and each layer imports only those below it (the contracts i
 
 Public API: :func:`load_scene` and :class:`Scene` (``Scene.from_dict``, ``scene.replace``,
 ``scene.to_toml``), :func:`simulate` → :class:`Result`, :func:`steady` (the periodic steady
-state) → :class:`Result`, :func:`open_result`, :func:`sweep`, and the errors
+state) → :class:`Result`, :func:`run_multirevolution` (a long run on its envelope) →
+:class:`Result`, :func:`open_result`, :func:`sweep`, and the errors
 :class:`SceneError` (invalid input) and :class:`SimulationError` (a run that failed).
 """
 from . import errors
 from .errors import SceneError, SimulationError
 from .version import __version__
 
-__all__ = ["load_scene", "Scene", "simulate", "steady", "Result", "open_result", "sweep",
+__all__ = ["load_scene", "Scene", "simulate", "steady", "run_multirevolution", "Result", "open_result", "sweep",
            "SceneError", "SimulationError", "errors", "__version__"]
 
 #: The public names imported when first used (PEP 562), each from its module: importing a part
 #: of the package (``transient.core.integrator`` alone, say) does not import the rest, and a
 #: tool that needs only the scene reader does not start the stepper's modules.
 _LAZY = {"load_scene": "scene", "Scene": "scene", "simulate": "run", "steady": "shooting",
+         "run_multirevolution": "longrun",
          "Result": "results", "open_result": "results", "sweep": "sweeps.api"}
 
 

@@ -284,9 +284,10 @@ def shaft_breakpoints(scene, tables, variation: dict, cyl_par: NDArray[np.float6
     On a rigid shaft one sorted list on the shaft's angle: every cylinder's
     (:func:`cylinder_breakpoints`) and the angles ``on_shaft`` (a load's knots in φ, kinks; the
     reversals of reaction friction, where the derivative jumps). On an elastic line each dof's
-    own, on its angle, one list after another: those of the cylinders it carries, and on the
-    reference dof, whose angle is the run's crank angle, ``on_shaft`` too; ``starts`` the index
-    of each dof's first (none on a rigid shaft)."""
+    own, on its angle, one list after another: those of the cylinders it carries with, under
+    reaction friction, the reversals of their joints (:func:`throw_reversals`), and on the
+    reference dof, whose angle is the run's crank angle, a load's knots too; ``starts`` the
+    index of each dof's first (none on a rigid shaft)."""
     knots, reversals = on_shaft
     n = scene.mechanism.n_cylinders
     if scene.shaft is None:
@@ -300,11 +301,44 @@ def shaft_breakpoints(scene, tables, variation: dict, cyl_par: NDArray[np.float6
     for i, st in enumerate(shaft.stations):
         carried[line.station_dof[i]] = np.asarray(st.cylinders, dtype=np.int64) - 1
     lists = [cylinder_breakpoints(scene, carried[d], tables, variation, cyl_par,
-                                  *(on_shaft if d == ref else (np.zeros(0), np.zeros(0))))
+                                  knots if d == ref else np.zeros(0),
+                                  throw_reversals(scene, carried[d]) if reversals.size
+                                  else np.zeros(0))
              for d in range(line.n)]
     starts = np.cumsum([0] + [bp.size for bp, _ in lists])[:-1].tolist()
     return (np.concatenate([bp for bp, _ in lists]),
             np.concatenate([jump for _, jump in lists]), starts)
+
+
+def throw_reversals(scene, cylinders: NDArray[np.int64]) -> NDArray[np.float64]:
+    """The reversals of reaction friction in the joints of the ``cylinders`` (0-based) that a
+    station of an elastic line carries, on its own angle: the mechanism's for those cylinders
+    where it splits its cylinders over stations (``"cylinder-inertia"``), else all of its
+    (its cylinders are then on one station); none on a station without cylinders."""
+    if cylinders.size == 0:
+        return np.zeros(0)
+    mech = scene.mechanism
+    if provides(mech, "cylinder-inertia"):
+        return mech.reaction_reversals(cylinders)
+    return mech.reaction_reversals()
+
+
+def throw_mechanisms(scene, carrier: NDArray[np.int64], n_dofs: int) -> NDArray[np.float64]:
+    """Under reaction friction on an elastic line, one row per station that carries cylinders,
+    in order: the compiled parameters of the mechanism of its cylinders alone (the mechanism's
+    ``pack_cylinders``; its whole ``pack`` where its cylinders all ride on one station), which
+    its throw's reaction solve takes (:mod:`transient.core.model.line_pairs`); no rows
+    otherwise."""
+    if not reaction_friction(scene):
+        return np.zeros((0, 1))
+    mech = scene.mechanism
+    split = provides(mech, "cylinder-inertia")
+    packs = [mech.pack_cylinders(np.flatnonzero(carrier == d)) if split else mech.pack()
+             for d in range(n_dofs) if np.any(carrier == d)]
+    out = np.zeros((len(packs), max(p.size for p in packs)))
+    for i, p in enumerate(packs):
+        out[i, :p.size] = p
+    return out
 
 
 def cylinder_breakpoints(scene, which: NDArray[np.int64], tables, variation: dict,
@@ -368,7 +402,8 @@ def line_fields(scene, tabulated_kinematics: bool, starts: list[int]) -> dict:
     dofs = np.column_stack([line.own_inertia, line.weights, line.absolute, np.ones(line.n)])
     packed = line_kernels.pack_line(line.station_dof[shaft.station_index(shaft.reference)],
                                     line.names.index(shaft.load_at), carrier, dofs,
-                                    line.element_rows(), starts)
+                                    line.element_rows(), starts,
+                                    throw_mechanisms(scene, carrier, line.n))
     shares = tabulated.shares if tabulated_kinematics else scene.mechanism.shares_kernel
     return dict(line=packed, shares=shares, line_model=elastic.elastic_model,
                 line_switch=line_kernels.line_mode, reference_inertia=line_kernels.ref_inertia,
@@ -647,10 +682,13 @@ def reaction_fields(scene) -> dict:
         rx_par[j, RX_RING_FORCE] = p.ring_force
         rx_par[j, RX_RING_PRESSURE] = p.ring_pressure
     n = len(pairs)
+    kernels = reaction_kernel_fields(mech)
+    if scene.shaft is not None:  # (the throws' solves share the side forces' rows: an elastic
+        kernels["rx_sides"] = False  # line leaves the kinks of μ|N| to the error control)
     return dict(n_pairs=n, eta_fwd=np.ones(n), eta_bwd=np.ones(n),
                 policy=PAPER if scene.friction.policy == "paper" else POWER_FLOW,
                 **link_fields(mech, [0] * len(mech.links)),
-                reaction=True, rx_par=rx_par, rx_pair=rx_pair, **reaction_kernel_fields(mech),
+                reaction=True, rx_par=rx_par, rx_pair=rx_pair, **kernels,
                 **eta_table_fields(pairs))
 
 

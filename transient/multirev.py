@@ -26,7 +26,6 @@ implicit.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -37,7 +36,8 @@ from scipy.optimize import brentq
 
 from .errors import SceneError, SimulationError
 from .run import CycleMap
-from .shooting import _nonperiodic, refuse_nonperiodic
+from .scene.records import ENVELOPE_RTOL
+from .shooting import refuse_nonperiodic
 
 #: Weights of the one-sided difference of X_n … X_{n+3} for X′(n) (third order), and of
 #: X_n … X_{n+2} (second order: the error estimate's integration, whose difference from the
@@ -60,8 +60,6 @@ SOLVER_RTOL = 100 * np.finfo(float).eps
 #: The time's error is held relative to this many cycles' duration: what places a corner in
 #: its cycle to a small part of one over the run.
 TIME_SCALE = 100.0
-#: The envelope's default tolerance, relative.
-ENVELOPE_RTOL = 1e-7
 #: The second integration's tolerance, a multiple of the first's: their difference estimates
 #: the second's error, which bounds the first's where the method converges.
 ESTIMATE_RATIO = 10.0
@@ -90,11 +88,7 @@ class Envelope:
 def refuse(scene) -> None:
     """Raise :class:`~transient.errors.SceneError` for a scene the envelope cannot follow:
     shooting's refusals but a load schedule in time, whose corners are crossed cycle by cycle."""
-    why = _nonperiodic(scene)
-    if why is not None and why[0] == "load.schedule_time":
-        scene = dataclasses.replace(scene, load=dataclasses.replace(
-            scene.load, schedule_time=(), schedule_scale=()))
-    refuse_nonperiodic(scene)
+    refuse_nonperiodic(scene, allowed=("load.schedule_time",))
 
 
 class _Follower:
@@ -113,6 +107,9 @@ class _Follower:
         # the envelope found stiff (its steps implicit from then on); a segment's first step
         self.implicit, self.first_step = False, None
         self.integrated = np.zeros(cycles + 1, dtype=bool)
+        # called with (cycle reached, states, integrated) as the envelope advances: the states
+        # of the cycles before the one reached are final
+        self.watch: Callable[[int, np.ndarray, np.ndarray], None] | None = None
         # the switching events of the last resolved cycle, how many resolved cycles in a row
         # have had the same; each F's cycle number and whether its cycles switched otherwise,
         # since ``seen`` was emptied; the cycle up to which the envelope may go before a switch
@@ -162,6 +159,8 @@ class _Follower:
                 self.direct_left = self.direct
             if self.progress is not None:
                 self.progress(n, self.cycles, self.phi.cycles)
+            if self.watch is not None:
+                self.watch(n, self.states, self.integrated)
         self.states[self.cycles] = X
         return self.states
 
@@ -275,7 +274,9 @@ def _time_past(m: float, dense, limit: float) -> float:
 
 
 def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
-                    progress: Callable[[int, int, int], None] | None = None) -> Envelope:
+                    progress: Callable[[int, int, int], None] | None = None,
+                    watch: Callable[[int, np.ndarray, np.ndarray], None] | None = None
+                    ) -> Envelope:
     """Follow ``scene`` over ``cycles`` engine cycles on the envelope of its cycle map.
 
     Parameters
@@ -289,6 +290,10 @@ def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
         The envelope's relative tolerance (its absolute one the scene's ``solver.atol``).
     progress : callable, optional
         Called with (cycle reached, cycles, cycles integrated) as the envelope advances.
+    watch : callable, optional
+        Called with (cycle reached, states, integrated) as the envelope advances (the arrays
+        of :class:`Envelope`, final before the cycle reached): what a long run's result
+        writes as it goes (:mod:`transient.longrun`).
 
     Returns
     -------
@@ -304,6 +309,7 @@ def multirevolution(scene, cycles: int, rtol: float = ENVELOPE_RTOL,
     corners = np.unique(np.asarray(scene.load.schedule_time, dtype=float))
     atol = scene.solver.atol
     run = _Follower(phi, corners, cycles, rtol, atol, progress)
+    run.watch = watch
     states = run.run()
     coarse = _Follower(phi, corners, cycles, rtol * ESTIMATE_RATIO, atol, None,
                        DIFFERENCE_ESTIMATE)

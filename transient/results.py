@@ -303,6 +303,95 @@ def write_run(node: h5py.Group, scene_name: str, scene_toml: str, data: RunData,
         write_analysis(node["analysis"], name, value, unit)
 
 
+#: The group of a multirevolution run's envelope (:mod:`transient.longrun`): per cycle start
+#: ``states`` (rows: cycles + 1, columns: its ``names``, the periodic states then t), per cycle
+#: ``integrated`` (1: integrated as a direct run would, 0: the envelope's), ``mean_omega`` (Δφ/Δt
+#: of the cycle), and where the file holds the cycle's trajectory ``delta`` and ``work`` (NaN
+#: elsewhere); the cycles whose trajectory it holds, ``resolved``, each ending at trajectory
+#: row ``resolved_end``; ``error``, the envelope's error estimate per state (NaN until known).
+ENVELOPE = "envelope"
+#: The envelope's per-cycle datasets and their units.
+ENVELOPE_CYCLES = {"integrated": "1", "mean_omega": "rad/s", "delta": "1", "work": "J"}
+
+
+def envelope_datasets(node: h5py.Group, names: list[str], units: list[str], cycles: int
+                      ) -> dict[str, h5py.Dataset]:
+    """The empty, extendable datasets of ``node``'s :data:`ENVELOPE` group (made before a
+    streamed file goes live: SWMR creates no objects)."""
+    g = node.create_group(ENVELOPE)
+    g.attrs["cycles"] = cycles
+    w = len(names)
+    ds = {"states": g.create_dataset("states", shape=(0, w), maxshape=(None, w), dtype="f8",
+                                     chunks=(256, w))}
+    ds["states"].attrs.update(names=names, units=units)
+    for name, unit in ENVELOPE_CYCLES.items():
+        ds[name] = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype="f8",
+                                    chunks=(1024,))
+        ds[name].attrs["unit"] = unit
+    for name in ("resolved", "resolved_end"):
+        ds[name] = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype="i8",
+                                    chunks=(256,))
+    ds["error"] = g.create_dataset("error", data=np.full(w, np.nan))
+    ds["error"].attrs["units"] = units
+    return ds
+
+
+@dataclass
+class EnvelopeRecord:
+    """A multirevolution run's envelope, as its result holds it (:data:`ENVELOPE`): ``names``
+    and ``units`` of the states at every cycle start, ``states`` (cycles + 1 rows), per cycle
+    ``integrated`` (bool), ``mean_omega``, ``delta`` and ``work`` (NaN where the result holds
+    no trajectory of the cycle), the cycles whose trajectory it holds (``resolved``, each
+    ending at trajectory row ``resolved_end``), the error estimate per state (``error``, NaN
+    where the run did not get that far) and the cycles the run was to follow."""
+
+    names: list[str]
+    units: list[str]
+    states: np.ndarray
+    integrated: np.ndarray
+    mean_omega: np.ndarray
+    delta: np.ndarray
+    work: np.ndarray
+    resolved: np.ndarray
+    resolved_end: np.ndarray
+    error: np.ndarray
+    cycles: int
+
+    def column(self, name: str) -> np.ndarray:
+        """One state at every cycle start written."""
+        return self.states[:, self.names.index(name)]
+
+    def rows(self, cycle: int) -> slice:
+        """The trajectory rows of a resolved ``cycle`` (a KeyError for one the result does not
+        hold)."""
+        at = np.flatnonzero(self.resolved == cycle)
+        if not at.size:
+            raise KeyError(f"cycle {cycle} is not resolved in this result (resolved: "
+                           f"{', '.join(map(str, self.resolved[:12]))}"
+                           f"{' …' if self.resolved.size > 12 else ''})")
+        k = int(at[0])
+        return slice(int(self.resolved_end[k - 1]) if k else 0, int(self.resolved_end[k]))
+
+
+def read_envelope(node: h5py.Group, trajectory_rows: int) -> EnvelopeRecord | None:
+    """The :data:`ENVELOPE` group under ``node`` (None if there is none), cut to what a kill
+    left whole: the cycles every per-cycle dataset holds, the resolved cycles whose rows are
+    within the ``trajectory_rows`` read."""
+    if ENVELOPE not in node:
+        return None
+    g = node[ENVELOPE]
+    n = min([g[name].shape[0] for name in ENVELOPE_CYCLES] + [max(g["states"].shape[0] - 1, 0)])
+    ends = g["resolved_end"][()]
+    m = min(g["resolved"].shape[0], int(np.searchsorted(ends, trajectory_rows, side="right")))
+    st = g["states"]
+    return EnvelopeRecord(
+        names=[str(v) for v in st.attrs["names"]], units=[str(v) for v in st.attrs["units"]],
+        states=st[:n + 1], integrated=g["integrated"][:n].astype(bool),
+        mean_omega=g["mean_omega"][:n], delta=g["delta"][:n], work=g["work"][:n],
+        resolved=g["resolved"][:m], resolved_end=ends[:m], error=g["error"][()],
+        cycles=int(g.attrs["cycles"]))
+
+
 def outcome_attrs(status: str, warnings: list[str]) -> dict[str, str]:
     """The root attributes that say what a run did: ``status``, and ``warnings`` if any (one a
     line)."""
@@ -410,8 +499,13 @@ class ResultWriter:
 
     def __init__(self, path: Path, scene_name: str, scene_toml: str,
                  columns: dict[str, str], event_names=(), force: bool = False,
-                 resume: bool = False, scene_source: tuple[str, str] = ("", "")) -> None:
+                 resume: bool = False, scene_source: tuple[str, str] = ("", ""),
+                 envelope: tuple[list[str], list[str], int] | None = None) -> None:
         self.path = Path(path)
+        # a multirevolution run's (names, units, cycles): its ENVELOPE group, made with the
+        # file (``self.envelope``, its datasets)
+        self.envelope_layout = envelope
+        self.envelope: dict[str, h5py.Dataset] = {}
         self.force = force
         self.tmp = partial_path(self.path)
         self.done = self.tmp.with_name(f".{self.path.name}.done")
@@ -448,6 +542,8 @@ class ResultWriter:
                                          scene_source=self.scene_source)
             # Opened once: a lookup by path per block would cost more than writing the block.
             self.checkpoints = _checkpoint_datasets(self.f, self.event_names)
+            if self.envelope_layout is not None:
+                self.envelope = envelope_datasets(self.f, *self.envelope_layout)
             self.f.flush()
         except (OSError, RuntimeError) as exc:  # h5py reports a failed write as either
             self._abandon(name)
@@ -518,6 +614,14 @@ class ResultWriter:
         """Append events (name → (n, 2) of t, φ) to the event log, flushed."""
         with self._writing():
             self._events(events)
+            self.f.flush()
+
+    def extend(self, datasets: list[tuple[h5py.Dataset, np.ndarray]]) -> None:
+        """Append each (dataset, values) pair along the dataset's first axis (datasets this
+        file made before it went live: a multirevolution run's envelope), flushed."""
+        with self._writing():
+            for ds, values in datasets:
+                _extend(ds, values)
             self.f.flush()
 
     def _columns(self, block: dict[str, np.ndarray]) -> None:
@@ -606,8 +710,9 @@ def _copy_result(src: h5py.File, dest: Path, keep_checkpoints: bool) -> None:
     copied whole (HDF5 copies a compressed chunk as it is), events that occurred only."""
     with create_file(dest) as f:
         f.attrs.update(dict(src.attrs))
-        for name in ("scene", "trajectory", "solver", "analysis"):
-            src.copy(src[name], f, name=name)
+        for name in ("scene", "trajectory", "solver", "analysis", ENVELOPE):
+            if name in src:  # (the envelope: a multirevolution run's only)
+                src.copy(src[name], f, name=name)
         append_events(f.create_group("events"), _logged_events(src[CHECKPOINTS]))
         if keep_checkpoints:
             src.copy(src[CHECKPOINTS], f, name=CHECKPOINTS)
@@ -737,6 +842,10 @@ class Result:
     scene_source
         The file the scene was read from and its text, comments included (``("", "")`` for a
         scene built in code).
+    envelope
+        A multirevolution run's per-cycle envelope
+        (:class:`~transient.results.EnvelopeRecord`: which cycles were integrated, which
+        interpolated, the error estimate); None for any other run.
 
     Examples
     --------
@@ -770,6 +879,7 @@ class Result:
     analysis: dict[str, tuple[Any, str]]
     scene_toml: str
     scene_source: tuple[str, str] = ("", "")
+    envelope: EnvelopeRecord | None = None
 
     @property
     def complete(self) -> bool:
@@ -914,11 +1024,13 @@ def read_run(node: h5py.Group, path: Path) -> Result:
     toml = node["scene"]["toml"][()]
     source = node["scene"].get("source")
     if attrs.get("status") == "running":
-        attrs["message"] = _stopped_message(node["trajectory"], rows)
+        attrs["message"] = _stopped_message(node["trajectory"], rows, ENVELOPE in node)
     return Result(path=path, attrs=attrs, trajectory=traj, units=units, events=events,
                   solver=dict(node["solver"].attrs), analysis=analysis, scene_toml=_text(toml),
                   scene_source=("", "") if source is None else (str(source.attrs.get("file", "")),
-                                                                _text(source[()])))
+                                                                _text(source[()])),
+                  envelope=read_envelope(node, len(range(*rows.indices(
+                      node["trajectory"]["t"].shape[0])))))
 
 
 def _text(value) -> str:
@@ -926,13 +1038,14 @@ def _text(value) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def _stopped_message(columns: h5py.Group, rows: slice) -> str:
+def _stopped_message(columns: h5py.Group, rows: slice, envelope: bool = False) -> str:
     """What a partial file says of its run: it stopped (killed) or still runs, and where its
-    last checkpoint is."""
+    last checkpoint is; how to go on (a multirevolution run's, ``envelope``, starts afresh)."""
     n = len(range(*rows.indices(columns["t"].shape[0])))
+    again = ("a multirevolution run is not resumed: `transient run SCENE --force` runs it again"
+             if envelope else "`transient run SCENE --resume` continues it")
     if not n:
-        return "stopped (killed?) or still running, before its first block was written"
+        return f"stopped (killed?) or still running, before its first block was written; {again}"
     t, phi, w = (float(columns[c][n - 1]) for c in ("t", "phi", "omega"))
     return (f"stopped (killed?) or still running; holds the run up to its last checkpoint, "
-            f"t = {t:.9g} s, φ = {phi:.9g} rad, ω = {w:.9g} rad/s; `transient run SCENE "
-            f"--resume` continues it")
+            f"t = {t:.9g} s, φ = {phi:.9g} rad, ω = {w:.9g} rad/s; {again}")

@@ -271,7 +271,9 @@ class CycleMap:
     ``start(x, t)``: the stepper's state (y, fst, ist) at the cycle's start with the periodic
     states ``x`` at time ``t`` (0 by default); ``__call__(x, t)``: the periodic states after one
     cycle (and ``elapsed``, its duration), or a
-    :class:`~transient.errors.SimulationError` saying where the cycle failed."""
+    :class:`~transient.errors.SimulationError` saying where the cycle failed. ``rows``: a list
+    that collects the output rows of the cycles run while it is set (a long run's resolved
+    cycles, :mod:`transient.longrun`)."""
 
     def __init__(self, scene) -> None:
         model, self.bp, _ = build_model(scene)
@@ -312,6 +314,9 @@ class CycleMap:
         self.events: tuple[int, ...] = ()  # the last cycle's switching events (``_switches``)
         self.net_work = math.nan  # the last cycle's W_gas + W_load + W_starter − losses [J]
         # (up to where it stopped, if it failed)
+        # a list to collect the cycles' output rows in (the columns of ``output_columns``),
+        # or None to drop them
+        self.rows: list[np.ndarray] | None = None
 
     def initial(self) -> np.ndarray:
         """The scene's initial state's periodic states."""
@@ -350,6 +355,8 @@ class CycleMap:
                                      stepper.buffers(self.model, self.tab, y.shape[0]))
             if ist[sio.I_NOUT]:
                 last = self.outbuf[ist[sio.I_NOUT] - 1].copy()
+                if self.rows is not None:
+                    self.rows.append(self.outbuf[:ist[sio.I_NOUT]].copy())
             events += _switches(self.evbuf[:ist[sio.I_NEV], 0])
             ist[sio.I_NOUT] = ist[sio.I_NEV] = 0
         self.events = tuple(events)
@@ -746,6 +753,12 @@ def simulate(scene, path: str | Path | None = None, *, force: bool = False, resu
     >>> math.isclose(omega0, 1000 * 2 * math.pi / 60)
     True
     """
+    if scene.solver.multirevolution:  # (what the scene asks is the envelope, not every cycle)
+        raise SceneError("solver.multirevolution", "true: transient.run_multirevolution(scene) "
+                                                   "(as `transient run`) follows the run on its "
+                                                   "envelope; simulate integrates every cycle: "
+                                                   "set it false for that",
+                         file=scene.source_file)
     return simulate_from(scene, None, path, force=force, resume=resume, progress=progress)
 
 

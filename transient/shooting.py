@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -97,9 +97,10 @@ class Shooting:
                    if self.neutral else {})}
 
 
-def refuse_nonperiodic(scene) -> None:
+def refuse_nonperiodic(scene, allowed: Collection[str] = ()) -> None:
     """Raise :class:`~transient.errors.SceneError` for a scene that cannot be periodic by
-    construction (something in it depends on time or on the cycle's number), before any work."""
+    construction (something in it depends on time or on the cycle's number), before any work;
+    the keys ``allowed`` are a caller's to follow."""
     refuse_elastic_run(scene)
     file = scene.source_file
     w_hi = 1.5 * scene.solver.switch_speed
@@ -108,7 +109,7 @@ def refuse_nonperiodic(scene) -> None:
                                           f"1.5 × solver.switch_speed = {w_hi:.6g} rad/s; the "
                                           f"cycle map starts in crank angle: give a running "
                                           f"speed", file=file)
-    why = _nonperiodic(scene)
+    why = _nonperiodic(scene, allowed)
     if why:
         key, what = why
         raise SceneError(key, f"{what}: the scene has no periodic steady state (shooting needs "
@@ -116,37 +117,43 @@ def refuse_nonperiodic(scene) -> None:
                               f"follows it in time", file=file)
 
 
-def _nonperiodic(scene) -> tuple[str, str] | None:
-    """(key, what) of the first thing in ``scene`` that makes it non-periodic, or None."""
+def _nonperiodic(scene, allowed: Collection[str] = ()) -> tuple[str, str] | None:
+    """(key, what) of the first thing in ``scene`` that makes it non-periodic, but those whose
+    key is ``allowed`` (a caller that follows them), or None."""
+    return next((why for why in _nonperiodic_parts(scene) if why[0] not in allowed), None)
+
+
+def _nonperiodic_parts(scene) -> Iterator[tuple[str, str]]:
+    """(key, what) of each thing in ``scene`` that makes it non-periodic, in the order they are
+    told."""
     load, run = scene.load, scene.run
     if run.mode != "dynamic":
-        return "run.mode", f"{run.mode!r} prescribes the speed"
+        yield "run.mode", f"{run.mode!r} prescribes the speed"
     if scene.solver.method not in COMPILED_METHODS:
-        return "solver.method", (f"{scene.solver.method!r} is a reference path; the cycle map "
-                                 f"is the compiled stepper's ({', '.join(COMPILED_METHODS)})")
+        yield "solver.method", (f"{scene.solver.method!r} is a reference path; the cycle map "
+                                f"is the compiled stepper's ({', '.join(COMPILED_METHODS)})")
     if scene.solver.domain == "time":
-        return "solver.domain", "\"time\" never turns to crank angle, the cycle map's variable"
-    if load.schedule_time or load.schedule_revolutions:
-        key = "load.schedule_time" if load.schedule_time else "load.schedule_revolutions"
-        return key, "a load schedule changes the load from cycle to cycle"
+        yield "solver.domain", "\"time\" never turns to crank angle, the cycle map's variable"
+    for key in ("load.schedule_time", "load.schedule_revolutions"):
+        if getattr(load, key.split(".")[1]):
+            yield key, "a load schedule changes the load from cycle to cycle"
     if load.table is not None and load.table.abscissa == "time":
-        return "load.table.time", "a load tabulated against time"
+        yield "load.table.time", "a load tabulated against time"
     if load.inertia > 0.0:
-        return "load.inertia", "an inertia switched in at load.inertia_time"
+        yield "load.inertia", "an inertia switched in at load.inertia_time"
     st = scene.starter
     if st.torque > 0.0 and scene.initial.omega < st.cutout_speed:
-        return "starter.torque", (f"the starter is engaged until its cut-out speed "
-                                  f"{st.cutout_speed:.6g} rad/s; start at or above it "
-                                  f"(initial.omega) or without the starter")
+        yield "starter.torque", (f"the starter is engaged until its cut-out speed "
+                                 f"{st.cutout_speed:.6g} rad/s; start at or above it "
+                                 f"(initial.omega) or without the starter")
     if scene.governor.model == "flyweight":
-        return "governor.model", ("\"flyweight\": its sleeve's stops are chosen once at the "
-                                  "start, not per cycle, in this version")
+        yield "governor.model", ("\"flyweight\": its sleeve's stops are chosen once at the "
+                                 "start, not per cycle, in this version")
     for c in scene.gas.cylinders:
         for key in ("misfire_cycles", "misfire_every", "misfire_rate"):
             if key in c.combustion_keys:
-                return f"gas.cylinders.{key}", (f"cylinder {c.cylinder} misfires in some cycles "
-                                                f"and not in others")
-    return None
+                yield f"gas.cylinders.{key}", (f"cylinder {c.cylinder} misfires in some cycles "
+                                               f"and not in others")
 
 
 def shoot(scene, progress: Callable[[int, float, int], None] | None = None,

@@ -177,8 +177,9 @@ def _without_inertia(text: str) -> str:
 #: transient.shaft.line.UNSUPPORTED
 PAIR = '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\neta_forward = 0.9\neta_backward = 0.9\n'
 UNSUPPORTED = [
-    ("friction.pairs", '\n[[friction.pairs]]\nbetween = ["crank", "rod"]\nmodel = "reaction"\n'
-                       "mu = 0.01\nradius_mm = 20\n"),
+    ("friction.pairs", '\n[[friction.pairs]]\nbetween = ["shaft", "crank"]\neta_forward = 0.95\n'
+                       'eta_backward = 0.95\n\n[[friction.pairs]]\nbetween = ["crank", "rod"]\n'
+                       'model = "reaction"\nmu = 0.01\nradius_mm = 20\n'),
     ("friction.policy", '\n[friction]\npolicy = "paper"\n' + PAIR),
     ("initial.omega", PAIR + "[starter]\ntorque = 50\nnoload_speed_rpm = 300\n"),
     ("load.table", '[shaft]\nload_at = "front"\n[load.table]\nphi_deg = [0, 360, 720]\n'

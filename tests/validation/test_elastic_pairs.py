@@ -62,6 +62,32 @@ def main_bearings():
     return scene, res
 
 
+#: friction on the reactions of each throw's main bearing and piston (theory, (T7b))
+REACTIONS = """
+[[friction.pairs]]
+name = "main bearings"
+between = ["shaft", "crank"]
+model = "reaction"
+mu = 0.02
+radius = 0.03
+viscous = 0.01
+
+[[friction.pairs]]
+name = "pistons"
+between = ["piston", "cylinder"]
+model = "reaction"
+mu = 0.05
+ring_force = 150.0
+"""
+
+
+@pytest.fixture(scope="module")
+def reactions():
+    scene = six(REACTIONS)
+    res = transient.simulate(scene)
+    return scene, res
+
+
 def test_the_run_is_the_reference_lines_with_a_pair_in_each_throw(main_bearings):
     """Over two cycles from 800 rpm with a main-bearing pair (η 0.95 forward, 0.90 backward)
     in each of the six throws: the reference station's ω(t) within 10·rtol of its largest and a
@@ -85,22 +111,34 @@ def test_the_run_is_the_reference_lines_with_a_pair_in_each_throw(main_bearings)
     assert np.max(np.abs(reference - lost)) <= 1e2 * rtol * np.max(lost)
 
 
-def test_the_energy_balance_holds_with_the_pairs_losses(main_bearings):
-    """(T4) with friction on: Σ ½J_d ω_d² + Σ ½k δ² − its start − the applied work + the
-    line's damping + every throw's pair losses within 1e2·rtol of the gas work at every sample;
-    each throw's loss never decreases (power-flow: (1 − η*) S ω ≥ 0), and the efficiency
-    analysis closes its balance with them."""
-    scene, res = main_bearings
+@pytest.mark.parametrize("case", ["main_bearings", "reactions"])
+def test_the_energy_balance_holds_with_the_pairs_losses(case, request):
+    """(T4) with friction on, a constant-η main bearing in each throw or friction on the
+    reactions of each throw's main bearing and piston: Σ ½J_d ω_d² + Σ ½k δ² − its start − the
+    applied work + the line's damping + every throw's pair losses within 1e2·rtol of the gas
+    work at every sample; each throw's loss never decreases (power-flow: (1 − η*) S ω ≥ 0;
+    the joints' friction opposes their motion), with reaction pairs each pair's loss split
+    over its cylinders adds up to its throws' to rounding, and the efficiency analysis closes
+    its balance with them."""
+    scene, res = request.getfixturevalue(case)
     tr = res.trajectory
     balance, _ = line_balance(scene, tr)
-    lost = sum(tr[f"W_loss_1_{t}"] for t in throws(scene))
+    n_pairs = len(scene.friction.pairs)
+    lost = sum(tr[f"W_loss_{k}_{t}"] for t in throws(scene) for k in range(1, n_pairs + 1))
     rtol = scene.solver.rtol
     assert np.max(np.abs(balance)) > 1e3 * rtol * np.max(tr["W_gas"])  # (the pairs take a share)
     assert np.all(tr["W_starter"] == 0.0)  # (no starter: nothing else writes its rate)
     assert np.max(np.abs(balance + lost)) <= 1e2 * rtol * np.max(np.abs(tr["W_gas"]))
     for t in throws(scene):
-        assert np.all(np.diff(tr[f"W_loss_1_{t}"]) >= -1e-9 * np.max(lost)), t
-        assert np.all(tr[f"P_loss_1_{t}"] >= 0.0), t
+        for k in range(1, n_pairs + 1):
+            assert np.all(np.diff(tr[f"W_loss_{k}_{t}"]) >= -1e-9 * np.max(lost)), (t, k)
+            assert np.all(tr[f"P_loss_{k}_{t}"] >= 0.0), (t, k)
+    if case == "reactions":
+        n = scene.mechanism.n_cylinders
+        for k in range(1, n_pairs + 1):
+            split = sum(tr[f"P_loss_{k}_cyl{c}"] for c in range(1, n + 1))
+            total = sum(tr[f"P_loss_{k}_{t}"] for t in throws(scene))
+            assert np.max(np.abs(split - total)) <= 1e-12 * np.max(total), k
     budget = mechanical_efficiency(scene, tr, window=(tr["phi"][0], tr["phi"][-1], 2))
     assert abs(budget["energy_balance_residual"][0]) <= 1e2 * rtol
     per_throw = sum(budget[f"W_loss_1_{t}_per_cycle"][0] for t in throws(scene))
@@ -270,13 +308,13 @@ def test_the_stiff_limit_is_the_rigid_chain():
 # -- what the line refuses ---------------------------------------------------------------------
 
 @pytest.mark.parametrize("extra, key", [
-    (MAIN_BEARINGS.replace('eta_forward = 0.95\neta_backward = 0.90',
-                           'model = "reaction"\nmu = 0.01\nradius = 0.03'), "friction.pairs"),
+    (MAIN_BEARINGS + '\n[[friction.pairs]]\nbetween = ["piston", "cylinder"]\n'
+     'model = "reaction"\nmu = 0.05\n', "friction.pairs"),
     ("[friction]\npolicy = \"paper\"\n" + MAIN_BEARINGS, "friction.policy"),
 ])
 def test_what_the_line_refuses(extra, key):
-    """Friction on the joints' reactions and the paper's criterion are refused with an elastic
-    line before any work, naming the key."""
+    """A constant-η pair at the main bearings among reaction pairs and the paper's criterion
+    are refused with an elastic line before any work, naming the key."""
     scene = six(extra)
     with pytest.raises(transient.SceneError, match=key.replace(".", r"\.")):
         transient.simulate(scene)

@@ -52,6 +52,10 @@ def cmd_check(args) -> int:
         scene = load_scene(args.scene)
     except SweepNotScene:
         return _check_sweep(args.scene)
+    if scene.solver.multirevolution:  # (what `run` would refuse of it, refused here too)
+        from ..longrun import refuse_long_run
+
+        refuse_long_run(scene)
     pairs = scene.friction.pairs
     friction = (f", {len(pairs)} non-ideal pair(s) ({', '.join(p.name for p in pairs)}; "
                 f"policy {scene.friction.policy})" if pairs else "")
@@ -101,6 +105,8 @@ def cmd_run(args) -> int:
     path = Path(args.output) / f"{Path(args.scene).stem}.h5"
     if args.resume and args.force:
         raise SceneError("--resume", "continues a run, --force replaces it: give one of them")
+    if scene.solver.multirevolution:
+        return _run_multirevolution(args, scene, path)
     if not args.resume:
         check_writable(path, args.force)
     bar = None
@@ -131,6 +137,81 @@ def cmd_run(args) -> int:
             print(f"  status: {res.message}")
         print_summary(res.analysis, res.solver, pair_names(scene))
     return said(res, failed)
+
+
+def _run_multirevolution(args, scene, path: Path) -> int:
+    """``transient run`` of a scene with ``solver.multirevolution``: its envelope followed and
+    written (:func:`transient.longrun.run_multirevolution`), a bar of the cycles reached."""
+    from ..longrun import refuse_long_run, run_multirevolution
+    from ..results import check_writable
+
+    if args.resume:
+        raise SceneError("--resume", "a multirevolution run (solver.multirevolution) is not "
+                                     "resumed; run it again with --force", file=args.scene)
+    cycles = refuse_long_run(scene)  # (before any work or word of it)
+    check_writable(path, args.force)
+    bar = None
+    if not args.quiet and sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(total=cycles, desc=f"{scene.name}: envelope ({KERNELS_NOTICE})",
+                   unit="cycle", file=sys.stderr, leave=False)
+
+    def progress(reached: int, total: int, integrated: int) -> None:
+        if bar is not None:
+            bar.set_description(f"{scene.name}: envelope, {integrated} cycle(s) integrated"
+                                if reached < total else f"{scene.name}: the error estimate")
+            bar.update(reached - bar.n)
+
+    try:
+        res = run_multirevolution(scene, path, force=args.force, progress=progress)
+    finally:
+        if bar:
+            bar.close()
+    if not args.quiet:
+        print(f"wrote {path}")
+        v = {k: val for k, (val, _) in res.analysis.items()}
+        rpm = 30.0 / math.pi
+        print(f"  end: t = {v['final_t']:.6g} s after {v['revolutions']:.6g} rev, "
+              f"ω = {v['final_omega']:.6g} rad/s ({v['final_omega'] * rpm:.6g} rpm)")
+        print_multirevolution(res.envelope, v)
+    return EXIT_OK
+
+
+def print_multirevolution(env, v: dict) -> None:
+    """Which cycles a multirevolution result integrated and which it interpolated, the cycles
+    it integrated in all and the envelope's error estimate (nothing for another result)."""
+    if env is None:
+        return
+    done = env.integrated.size
+    k = int(env.integrated.sum())
+    print(f"  multirevolution: {done} of {env.cycles} cycle(s) followed"
+          f"{'' if done == env.cycles else ' (the run stopped there)'}: {k} integrated "
+          f"(cycles {cycle_ranges(np.flatnonzero(env.integrated))}), {done - k} interpolated "
+          f"on the envelope; {v.get('multirev_cycles_integrated', '?')} cycle(s) integrated "
+          f"in all, the error estimate's included")
+    print(f"    resolved in the trajectory: {env.resolved.size} cycle(s) "
+          f"({cycle_ranges(env.resolved)})")
+    if np.isfinite(env.error).all():
+        print(f"    envelope error estimate at the last cycle (envelope_rtol "
+              f"{v.get('multirev_envelope_rtol', math.nan):.3g}): " + ", ".join(
+                  f"{name} {err:.3g} {unit}" for name, err, unit in
+                  zip(env.names, env.error, env.units)))
+    else:
+        print("    envelope error estimate: none (the run stopped before it)")
+
+
+def cycle_ranges(cycles, most: int = 8) -> str:
+    """Cycle numbers as ranges, ``0–3, 7, 12–40``, the first ``most`` of them."""
+    cycles = np.asarray(cycles, dtype=np.int64)
+    if not cycles.size:
+        return "none"
+    breaks = np.flatnonzero(np.diff(cycles) != 1)
+    starts = cycles[np.r_[0, breaks + 1]]
+    ends = cycles[np.r_[breaks, cycles.size - 1]]
+    shown = [f"{a}" if a == b else f"{a}–{b}" for a, b in zip(starts, ends)]
+    return ", ".join(shown[:most]) + (f", … ({len(shown)} stretches)" if len(shown) > most
+                                      else "")
 
 
 def said(res, failed) -> int:
@@ -327,7 +408,11 @@ def cmd_info(args) -> int:
     for name, ev in res.events.items():
         print(f"  events {name}: {ev['t'].size}")
     s = res.solver
-    if s:
+    if s and res.envelope is not None:
+        print(f"  solver {s.get('ran')}: rtol {s.get('rtol')}, atol {s.get('atol')}, envelope "
+              f"rtol {s.get('envelope_rtol')}, {s.get('nfev')} RHS calls, wall "
+              f"{s.get('wall_s', 0):.3g} s")
+    elif s:
         print(f"  solver {s.get('ran', s.get('method'))}: rtol {s.get('rtol')}, "
               f"atol {s.get('atol')}, "
               f"{s.get('nsteps')} steps, {s.get('nreject')} rejected, {s.get('nfev')} RHS calls, "
@@ -346,10 +431,11 @@ def cmd_info(args) -> int:
     _print_efficiency(values, pair_names(res.scene()) if "fmep_1" in values else ())
     _print_thermodynamics(values)
     print_steady(values)
+    print_multirevolution(res.envelope, values)
     arrays = []
     for k, (v, unit) in res.analysis.items():
-        if k.startswith("steady_") and np.ndim(v) > 0:
-            continue  # (print_steady's)
+        if k.startswith("steady_") and np.ndim(v) > 0 or k.startswith("multirev_"):
+            continue  # (print_steady's, print_multirevolution's)
         if np.ndim(v) > 0:  # the scene's [analysis] (analysis.requested): listed, not dumped
             arrays.append(f"{k} {'×'.join(map(str, np.shape(v)))} [{unit}]")
         else:

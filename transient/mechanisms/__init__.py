@@ -189,9 +189,11 @@ class ReactionFriction(Protocol):
         """Joints (by their shaft-side link) that cannot have friction on their reactions, each
         with why, for the scene's error."""
 
-    def reaction_reversals(self) -> NDArray[np.float64]:
+    def reaction_reversals(self, cylinders=None) -> NDArray[np.float64]:
         """Shaft angles [rad] in [0, cycle) where a joint's relative motion reverses while ω
-        keeps its sign: breakpoints, so that no step straddles a friction force's reversal."""
+        keeps its sign: breakpoints, so that no step straddles a friction force's reversal; of
+        the ``cylinders`` (0-based) only where given, with ``"cylinder-inertia"`` (an elastic
+        line's throw)."""
 
     def check_wedging(self, s: Section, pairs, raw) -> None:
         """Raise :class:`~transient.errors.SceneError` (naming the pair as the user wrote it,
@@ -225,6 +227,11 @@ class CylinderInertia(Protocol):
                                                                 NDArray[np.float64]]]:
         """θ ↦ (J_k(θ), dJ_k/dθ) of every cylinder k at shaft angle θ (each at its own phase)
         [kg m², kg m²/rad], whose sum over k is the mechanism's J(θ), dJ/dθ."""
+
+    def pack_cylinders(self, cylinders) -> NDArray[np.float64]:
+        """The compiled parameter array (``pack``) of the mechanism made of the ``cylinders``
+        (0-based) alone, each at its own phase: a throw of an elastic line, whose joints'
+        reaction friction its solver takes at the throw's own angle."""
 
 
 #: Every capability a mechanism may claim, and who provides it: a Protocol of this module (the

@@ -201,12 +201,16 @@ class CrankSlider:
                              "fork's big end, which carries both rods' forces"}
         return {}
 
-    def reaction_reversals(self) -> NDArray[np.float64]:
+    def reaction_reversals(self, cylinders=None) -> NDArray[np.float64]:
         """Shaft angles in [0, cycle) where a joint's relative motion reverses: each piston's
         dead centres (its speed) and its local 90° and 270° (the rod's rate β̇ ∝ cos α,
-        :mod:`transient.core.model.joint_friction`)."""
+        :mod:`transient.core.model.joint_friction`); of the ``cylinders`` (0-based) only where
+        given (an elastic line's throw, on its own angle)."""
         tdc, bdc = self.dead_centre_angles()
-        return at_phases([tdc, 0.5 * pi, bdc, 1.5 * pi], self.firing_angles, self.cycle)
+        phases = np.asarray(self.firing_angles, dtype=np.float64)
+        if cylinders is not None:
+            phases = phases[np.asarray(cylinders, dtype=np.int64)]
+        return at_phases([tdc, 0.5 * pi, bdc, 1.5 * pi], phases, self.cycle)
 
     def check_wedging(self, s: Section, pairs, raw) -> None:
         """Friction must not wedge the crank-slider: the rod's equation in the side force N has a
@@ -423,6 +427,20 @@ class CrankSlider:
         mp[core.SIN0:core.SIN0 + n] = np.sin(phase)
         mp[core.SIN0 + n:] = np.cos(phase)
         return mp
+
+    def pack_cylinders(self, cylinders) -> NDArray[np.float64]:
+        """:meth:`pack` of the mechanism made of the ``cylinders`` (0-based) alone, each at its
+        own phase: an elastic line's throw, whose joints its reaction solver solves at the
+        throw's own angle (capability ``"cylinder-inertia"``)."""
+        mp = self.pack()
+        n = self.n_cylinders
+        which = np.asarray(cylinders, dtype=np.int64)
+        out = np.zeros(core.SIN0 + 2 * which.size)
+        out[:core.SIN0] = mp[:core.SIN0]
+        out[core.N_CYL] = which.size
+        out[core.SIN0:core.SIN0 + which.size] = mp[core.SIN0 + which]
+        out[core.SIN0 + which.size:] = mp[core.SIN0 + n + which]
+        return out
 
     def toml_lines(self) -> list[str]:
         """The ``[mechanism]`` and ``[mechanism.rod]`` tables in SI, read back by

@@ -71,9 +71,13 @@ def estimate(scene: Scene) -> Work:
         samples = 2.0 + turns * scene.output.samples_per_rev
         steps = samples
     else:
+        # (a multirevolution run integrates and writes some of its cycles only: at least its
+        # first and its last)
+        counted = min(turns, scene.mechanism.cycle / math.pi) if (
+            scene.solver.multirevolution) else turns
         per_s, per_rev = _sample_rates(scene)
-        samples = 1.0 + min(_times(run.t_end, per_s), _times(turns, per_rev))
-        steps = _steps(scene)
+        samples = 1.0 + min(_times(run.t_end, per_s), _times(counted, per_rev))
+        steps = _steps(scene, counted)
     phi_end = abs(scene.initial.phi) + 2.0 * math.pi * turns
     return Work(samples=samples, bytes=samples * len(output_columns(scene)) * VALUE_BYTES,
                 steps=steps, analysis_bytes=_analysis_bytes(scene),
@@ -110,13 +114,14 @@ def _sample_rates(scene: Scene) -> tuple[float, float]:
     return min(ws * spr / (2.0 * math.pi), 1.0 / dt), min(spr, 2.0 * math.pi / (1.5 * ws * dt))
 
 
-def _steps(scene: Scene) -> float:
-    """Least steps the limits imply (``max_step``, ``fixed_step``) in the crank-angle domain."""
+def _steps(scene: Scene, turns: float) -> float:
+    """Least steps the limits imply (``max_step``, ``fixed_step``) in the crank-angle domain
+    over ``turns`` revolutions."""
     sv, run = scene.solver, scene.run
     if sv.domain == "time":
         return 0.0
     h = sv.fixed_step if sv.fixed_step > 0.0 else sv.max_step
-    angle = min(2.0 * math.pi * run.revolutions, _times(run.t_end, sv.switch_speed))
+    angle = min(2.0 * math.pi * turns, _times(run.t_end, sv.switch_speed))
     return angle / h
 
 

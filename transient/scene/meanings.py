@@ -269,6 +269,9 @@ MEANINGS: dict[str, dict[str, str]] = {
         "kinematics": "``exact``: the mechanism at every evaluation; ``tabulated``: periodic "
                       "splines of J(φ) and the transfer functions.",
         "table_tolerance": "Relative error the tabulated kinematics keep (0: 0.01·``rtol``).",
+        "multirevolution": "``transient run`` follows the run on its cycle map's envelope, "
+                           "macro steps over many cycles (a whole number of cycles).",
+        "envelope_rtol": "Relative tolerance of the multirevolution envelope.",
     },
     "output": {
         "samples_per_rev": "Trajectory samples per revolution (in crank angle).",

@@ -26,6 +26,7 @@ from .records import (
     DEFAULT_MAX_OUTPUT_BYTES,
     DEFAULT_MAX_STEPS,
     DETREND,
+    ENVELOPE_RTOL,
     GOVERNOR_KEYS,
     MAX_COMBUSTION_OFFSET,
     MAX_CYLINDER_FACTOR,
@@ -260,7 +261,9 @@ def scene_from_dict(data: dict, file: str = "", base_dir: Path | None = None) ->
             domain=sv.string("domain", "auto", choices=("auto", "time")),
             fixed_step=sv.number("fixed_step", "angle", 0.0, ge=0.0),
             kinematics=sv.string("kinematics", "exact", choices=("exact", "tabulated")),
-            table_tolerance=sv.number("table_tolerance", "1", 0.0, ge=0.0, lt=1.0))
+            table_tolerance=sv.number("table_tolerance", "1", 0.0, ge=0.0, lt=1.0),
+            multirevolution=sv.flag("multirevolution", False),
+            envelope_rtol=sv.number("envelope_rtol", "1", ENVELOPE_RTOL, gt=0.0, lt=1.0))
         sv.finish()
         so = root.sub("output")
         # (every sample is written: a run must stay finite)

@@ -423,6 +423,10 @@ class Run:
     max_steps: float = DEFAULT_MAX_STEPS
 
 
+#: The multirevolution envelope's relative tolerance by default (``solver.envelope_rtol``).
+ENVELOPE_RTOL = 1e-7
+
+
 @dataclass(frozen=True)
 class Solver:
     """Integration settings. ``method``: one of
@@ -444,7 +448,10 @@ class Solver:
     ``kinematics``: ``"exact"`` (the mechanism kernel at every evaluation) or ``"tabulated"``
     (periodic quintic splines of J(φ) and u_k(φ), :mod:`transient.tabulate`), whose relative error
     is kept ≤ ``table_tolerance`` (0: 0.01·rtol); if no table reaches it the run uses the exact
-    kernel and says so."""
+    kernel and says so.
+    ``multirevolution``: ``transient run`` follows the run on the envelope of its cycle map
+    (:mod:`transient.multirev`), macro steps over many cycles, to the envelope's relative
+    tolerance ``envelope_rtol`` [1]; the run must be a whole number of cycles."""
 
     method: str = "dop853"
     rtol: float = 1e-8
@@ -455,6 +462,8 @@ class Solver:
     fixed_step: float = 0.0
     kinematics: str = "exact"
     table_tolerance: float = 0.0
+    multirevolution: bool = False
+    envelope_rtol: float = ENVELOPE_RTOL
 
 
 @dataclass(frozen=True)

@@ -213,14 +213,18 @@ def _lowest_elastic(K, M_diag, rigid: int) -> float:
 #: What the elastic run does not support yet: (the scene's key, whether the scene uses it, what
 #: to do instead). Each is refused before any work (:func:`refuse_elastic_run`).
 UNSUPPORTED = (
-    ("friction.pairs", lambda s: any(p.model == "reaction" for p in s.friction.pairs),
-     "friction on the joints' reactions per throw is not available yet: give these pairs "
-     "constant efficiencies (eta_forward, eta_backward) or mapped ones (model = \"table\")"),
+    ("friction.pairs", lambda s: any(p.model == "reaction" for p in s.friction.pairs)
+     and any(p.model != "reaction" for p in s.friction.pairs),
+     "a pair of constant or mapped efficiency at the main bearings among reaction pairs "
+     "would hold a mode of its own in every throw, which the throws' joint solves do not "
+     "have: give the main bearings friction on their reactions too (model = \"reaction\"), "
+     "or every pair efficiencies"),
     ("friction.pairs", lambda s: len(s.friction.pairs) * len(s.shaft.throws) > MAX_MARGINS,
      f"every pair acts in every station that carries cylinders, each with a mode of its own, "
      f"and a line holds at most {MAX_MARGINS} such modes: give fewer pairs, or fewer stations "
      f"with cylinders"),
-    ("friction.policy", lambda s: bool(s.friction.pairs) and s.friction.policy == "paper",
+    ("friction.policy", lambda s: any(p.model != "reaction" for p in s.friction.pairs)
+     and s.friction.policy == "paper",
      "on a throw the paper's criterion (25) would count the sections' torques among the moments "
      "applied on a pair's shaft side: use \"power-flow\", whose modes follow the power each "
      "pair transmits"),

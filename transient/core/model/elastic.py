@@ -49,6 +49,7 @@ from .layout import (
     W_LOAD,
     W_STARTER,
     WK_CYL_ANGLE,
+    WK_CYL_FORCE,
     WK_LINE_DJ,
     WK_LINE_J,
     WK_LINE_M,
@@ -69,7 +70,13 @@ from .layout import (
     line_dofs,
     line_loss_index,
 )
-from .line_pairs import throw_chains, throw_loss_rates, throw_modes, throw_pair_rows
+from .line_pairs import (
+    throw_chains,
+    throw_loss_rates,
+    throw_modes,
+    throw_pair_rows,
+    throw_reactions,
+)
 from .outputs import governor_rows
 from .shaft import (
     LINE_MODES,
@@ -108,8 +115,8 @@ def pairs_at(m, what, angle_mode, y, sel, sw, wk):
     (``LINE_MODES``) at ``y``, each throw's chain's (:mod:`.line_pairs`); the status."""
     _, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk, True)
     if what == LINE_MODES:
-        return throw_modes(m, M_load, M_starter, sw, wk)
-    throw_chains(m, M_load, M_starter, sw, wk)
+        return throw_modes(m, y, sel, M_load, M_starter, sw, wk)
+    throw_chains(m, y, sel, M_load, M_starter, sw, wk)
     return UNIQUE
 
 
@@ -200,10 +207,16 @@ def line_forces(m, y, sel, sw, wk):
             theta_sel = sel + (theta - y[PHI])
             p = cylinder_pressure(m, c, theta, theta_sel, y, cylinder_fuel(m, c, theta_sel, y, f),
                                   wk)
-            M_c = m.gas_scale[c] * (p - m.gas_offset) * wk[WK_U, c]
+            P_c = m.gas_scale[c] * (p - m.gas_offset)
+            M_c = P_c * wk[WK_U, c]
+            if m.reaction:  # (the force on the piston, for its throw's joints)
+                wk[WK_CYL_FORCE, c] = P_c
             wk[WK_LINE_M, d] += M_c
             M_gas += M_c
             P_gas += M_c * wk[WK_LINE_OMEGA, d]
+    elif m.reaction:
+        for c in range(m.ncyl):
+            wk[WK_CYL_FORCE, c] = 0.0
     M_load = load_moment(m, True, wk[WK_LINE_OMEGA, load], y, sw)
     wk[WK_LINE_M, load] += M_load
     M_starter = starter_moment(m, w_ref, sw)
@@ -235,7 +248,7 @@ def elastic_rates(m, extras, angle_mode, y, sel, sw, wk, out):
     M_gas, P_gas, M_load, M_starter, taken = line_at(m, angle_mode, y, sel, sw, wk,
                                                      pairs or not angle_mode)
     if pairs:
-        throw_chains(m, M_load, M_starter, sw, wk)
+        throw_chains(m, y, sel, M_load, M_starter, sw, wk)
     w = wk[WK_LINE_OMEGA, :n]
     w_ref = w[ref]
     wk[WK_SPEED, 0] = min(wk[WK_SPEED, 0], w_ref)
@@ -297,8 +310,10 @@ def elastic_row(m, extras, angle_mode, y, sel, sw, wk, row):
     n = line_dofs(m)
     ref = np.int64(m.line[0, LM_REF])
     M_gas, _, M_load, M_starter, _ = line_at(m, angle_mode, y, sel, sw, wk, True)
-    if extras is not None and m.n_pairs > 0:
-        throw_chains(m, M_load, M_starter, sw, wk)
+    if extras is not None and m.reaction:  # (each cylinder's share of the losses too)
+        throw_reactions(m, y, sel, M_load, M_starter, sw, wk, row, True)
+    elif extras is not None and m.n_pairs > 0:
+        throw_chains(m, y, sel, M_load, M_starter, sw, wk)
     acc = wk[WK_LINE_RATE, :n]
     line_accelerations(wk[WK_LINE_J, :n], wk[WK_LINE_DJ, :n], wk[WK_LINE_M, :n],
                        wk[WK_LINE_T, :n], wk[WK_LINE_OMEGA, :n], acc)

@@ -328,12 +328,13 @@ WORK = Layout(
     ("cyl_dJ", 1, "its derivative"),
     ("cyl_knot", 1, "each cylinder's gas-table knot interval at its last evaluation"),
     ("cyl_knot_shift", 1, "its knot interval on the curve its combustion offset shifts"),
+    ("cyl_force", 1, "each piston's gas force at its station's angle, for its throw's joints"),
 )
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
  WK_SCRATCH, WK_CYL_LOSS, WK_LINE_THETA, WK_LINE_OMEGA, WK_LINE_J, WK_LINE_DJ, WK_LINE_M,
  WK_LINE_T, WK_LINE_RATE, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ, WK_CYL_KNOT,
- WK_CYL_KNOT_SHIFT) = WORK
+ WK_CYL_KNOT_SHIFT, WK_CYL_FORCE) = WORK
 N_SCRATCH = WORK.size_of("scratch")
 WK_RX = WORK.end
 

@@ -30,6 +30,11 @@ moment less the loss moment L_d = Σ_k (1 − η*_k) S_k, and its crank-angle fo
 K_d with dK_d/dφ = (M_d + T_d − L_d) ω_d/ω_ref, the work–energy law with the pairs' losses: the
 line's own kernels then serve unchanged. Each pair's loss power is (1 − η*_k) S_k ω_d, and
 (T4) balances with their integrals.
+
+With friction on the joints' reactions (``Model.reaction``; theory, (T7b)) nothing is cut:
+each throw's joints are solved by the mechanism's own solver, closed on the station's equation
+(:func:`throw_reaction`), and the chain's loss moment L_d, the sum of its pairs' joints' loss
+moments, enters the line's equations the same way (:func:`throw_reactions`).
 """
 from __future__ import annotations
 
@@ -45,9 +50,12 @@ from .layout import (
     LM_LOAD,
     LM_REF,
     N_SCRATCH,
+    PHI,
     SW_DIRECTION,
     SW_MODES,
     W_LOSS0,
+    WK_CYL_FORCE,
+    WK_CYL_LOSS,
     WK_DJ,
     WK_DU,
     WK_ETA,
@@ -61,15 +69,18 @@ from .layout import (
     WK_LINE_T,
     WK_LINE_THETA,
     WK_M,
+    WK_RX,
     WK_S,
     WK_SCRATCH,
     WK_U,
+    cylinder_loss_col,
     line_dofs,
     pair_col,
 )
 from .outputs import pair_rows
+from .reactions import R_P, R_SEL, loss_moment
 from .rhs import mode_mask, pair_etas, split_chain, table_modes
-from .shaft import line_parts
+from .shaft import line_parts, throw_mechanism
 
 
 @kernel(inline=True)
@@ -104,11 +115,15 @@ def throw_chain(m, d, M_load, M_starter, wk):
 
 
 @kernel(inline=True)
-def throw_chains(m, M_load, M_starter, sw, wk):
+def throw_chains(m, y, sel, M_load, M_starter, sw, wk):
     """Each throw's chain with its modes held by ``sw`` (module docstring): its pairs' η*, S and
     mode margins into the rows WK_ETA, WK_S, WK_G (column c·n_pairs + k), and each throw's
     applied moment (WK_LINE_M) less its pairs' loss moment, so that the line's equations (T2),
-    (T5) give the chain's. After ``elastic.line_at``; ``M_load``, ``M_starter`` its moments."""
+    (T5) give the chain's. After ``elastic.line_at``; ``M_load``, ``M_starter`` its moments.
+    Under reaction friction the throws' joints instead (:func:`throw_reactions`)."""
+    if m.reaction:
+        throw_reactions(m, y, sel, M_load, M_starter, sw, wk, wk[WK_SCRATCH], False)
+        return
     n = m.n_pairs
     for d in range(line_dofs(m)):
         c = throw_chain(m, d, M_load, M_starter, wk)
@@ -147,7 +162,8 @@ def throw_loss_rates(m, q, wk, out):
             continue
         w = wk[WK_LINE_OMEGA, d]
         for j in range(c * n, c * n + n):
-            out[W_LOSS0 + j] = (1.0 - wk[WK_ETA, j]) * wk[WK_S, j] * w * q
+            lost = loss_moment(wk, j) if m.reaction else (1.0 - wk[WK_ETA, j]) * wk[WK_S, j]
+            out[W_LOSS0 + j] = lost * w * q
             wk[WK_G_MIN, j] = min(wk[WK_G_MIN, j], wk[WK_G, j])
 
 
@@ -162,13 +178,124 @@ def throw_pair_rows(m, y, wk, row):
             pair_rows(m, wk[WK_LINE_OMEGA, d], c * m.n_pairs, y[W_LOSS0:], wk, row[pair_col(m):])
 
 
+@kernel(inline=True)
+def throw_reaction(m, d, c, sigma, theta_sel, M_load, M_starter, wk):
+    """θ̈_d of the throw at dof d (chain c) with the friction on its joints' reactions in
+    direction σ, theory (T7b): the mechanism's own solver (``Model.rx_prepare``, ``rx_solve``)
+    on the mechanism of the throw's cylinders (:func:`.shaft.throw_mechanism`) at its angle,
+    speed and the joints' directions at ``theta_sel``, closed on the station's equation
+    J_own,d θ̈_d = M_ext,d + T_d + Σ T_k(θ̈_d) in place of the shaft's (M_ext,d the load and
+    starter where they act there, T_d the line's torque on it, a pure couple about the axis).
+    It works in the columns from c·n_pairs on of ``wk``, where its pairs' η*, S, loss moments
+    land as chain c's (``layout.n_margins``), its cylinders' rows in the columns after (other
+    throws' too: nothing cached in them is trusted). After ``elastic.line_at``."""
+    carrier, dofs, _ = line_parts(m.line)
+    v = wk[:, c * m.n_pairs:]
+    n_own = 0
+    for i in range(m.ncyl):
+        if np.int64(carrier[i]) == d:
+            v[WK_RX + R_P, n_own] = wk[WK_CYL_FORCE, i]
+            n_own += 1
+    M_ext = 0.0
+    if d == np.int64(m.line[0, LM_LOAD]):
+        M_ext += M_load
+    if d == np.int64(m.line[0, LM_REF]):
+        M_ext += M_starter
+    mp = m.line[throw_mechanism(m.line, c)]
+    theta = wk[WK_LINE_THETA, d]
+    w = wk[WK_LINE_OMEGA, d]
+    v[WK_RX + R_SEL, 0] = np.nan
+    m.rx_prepare(mp, theta, w, theta_sel, v)
+    T = wk[WK_LINE_T, d]
+    eps0 = (wk[WK_LINE_M, d] + T - 0.5 * wk[WK_LINE_DJ, d] * w * w) / wk[WK_LINE_J, d]
+    return m.rx_solve(mp, m.rx_par, m.rx_pair, dofs[d, LD_OWN], M_ext + T, eps0, w, sigma,
+                      m.n_pairs, v)
+
+
+@kernel(inline=True)
+def throw_sigma(sw, j0):
+    """The direction σ a throw's joints' friction opposes, held in the mode bit of its chain's
+    first pair (``j0``; set: σ = −1), which switches where the throw's speed passes zero."""
+    return -1.0 if (sw[SW_MODES] >> j0) & 1 else 1.0
+
+
 @kernel
-def throw_modes(m, M_load, M_starter, sw, wk):
+def throw_reactions(m, y, sel, M_load, M_starter, sw, wk, row, with_row):
+    """Each throw's joints' friction (:func:`throw_reaction`) in its held direction σ
+    (:func:`throw_sigma`): its pairs' η*, S and loss moments as its chain's, its applied
+    moment (WK_LINE_M) less its pairs' loss moment, so that the line's equations (T2), (T5)
+    give its θ̈ (theory, (T7b): the throw's power balance), the margin σ ω_d on its first pair
+    (1 on the others: friction on the reactions has no modes); NaN as its moment where its
+    solve does not converge, which the stepper reports. ``with_row``: each cylinder's share of
+    every pair's loss power into the output ``row`` too."""
+    carrier, dofs, _ = line_parts(m.line)
+    n = m.n_pairs
+    shift = sel - y[PHI]
+    for d in range(line_dofs(m)):
+        c = np.int64(dofs[d, LD_CHAIN])
+        if c < 0:
+            continue
+        j0 = c * n
+        sigma = throw_sigma(sw, j0)
+        w = wk[WK_LINE_OMEGA, d]
+        eps = throw_reaction(m, d, c, sigma, wk[WK_LINE_THETA, d] + shift, M_load, M_starter,
+                             wk)
+        loss = 0.0
+        for k in range(n):
+            loss += loss_moment(wk, j0 + k)
+            wk[WK_G, j0 + k] = 1.0
+        wk[WK_G, j0] = sigma * w
+        wk[WK_LINE_M, d] = wk[WK_LINE_M, d] - loss if np.isfinite(eps) else np.nan
+        if with_row:
+            out = row[cylinder_loss_col(m):]
+            own = 0
+            for i in range(m.ncyl):
+                if np.int64(carrier[i]) == d:
+                    for p in range(n):
+                        out[p * m.ncyl + i] = wk[WK_CYL_LOSS + p, j0 + own] * w
+                    own += 1
+
+
+@kernel
+def throw_directions(m, y, sel, M_load, M_starter, sw, wk):
+    """Every throw's σ chosen afresh under reaction friction, as the rigid machine's
+    (``reactions.choose_direction``) at its own speed: its sign while it turns, at rest its
+    incipient motion (forward if θ̈ > 0 with the friction opposing σ = +1, backward if θ̈ < 0
+    with it opposing σ = −1, else held by its joints' friction: ``chain.LOCKED``); into the
+    modes' bits of ``sw`` (:func:`throw_sigma`)."""
+    dofs = line_parts(m.line)[1]
+    n = m.n_pairs
+    shift = sel - y[PHI]
+    modes = 0
+    for d in range(line_dofs(m)):
+        c = np.int64(dofs[d, LD_CHAIN])
+        if c < 0:
+            continue
+        w = wk[WK_LINE_OMEGA, d]
+        theta_sel = wk[WK_LINE_THETA, d] + shift
+        if w == 0.0:
+            if throw_reaction(m, d, c, 1.0, theta_sel, M_load, M_starter, wk) > 0.0:
+                w = 1.0
+            elif throw_reaction(m, d, c, -1.0, theta_sel, M_load, M_starter, wk) < 0.0:
+                w = -1.0
+            else:
+                return LOCKED
+        if w < 0.0:
+            modes |= 1 << (c * n)
+    sw[SW_MODES] = modes
+    sw[SW_DIRECTION] = 1 if wk[WK_LINE_OMEGA, np.int64(m.line[0, LM_REF])] >= 0.0 else -1
+    return UNIQUE
+
+
+@kernel
+def throw_modes(m, y, sel, M_load, M_starter, sw, wk):
     """Every throw's modes chosen afresh at a state (``rhs.choose_modes``): each chain's as the
     rigid chain's are chosen, at its station's speed (at rest, by its incipient motion), into
     the modes' bits of ``sw``; σ the reference's direction. After ``elastic.line_at``. Returns
     the worst of the chains' statuses (``chain.LOCKED`` where one is held at rest by its
-    pairs' friction)."""
+    pairs' friction); under reaction friction each throw's direction (:func:`throw_directions`)."""
+    if m.reaction:
+        return throw_directions(m, y, sel, M_load, M_starter, sw, wk)
     n = m.n_pairs
     modes = 0
     status = UNIQUE

@@ -58,8 +58,9 @@ from .chain import LOCKED, UNIQUE
 from .layout import RX_ETA_BWD, RX_ETA_FWD, WK_CYL_LOSS, WK_ETA, WK_RX, WK_S
 
 #: Rows (offsets from ``layout.WK_RX``) every mechanism's solver shares: the gas force on each
-#: piston, the pairs' loss moments (``joint_friction.SHARED``).
-R_P, R_LOSS = jf.R_P, jf.R_LOSS
+#: piston, the angle its joints' directions are cached for, the pairs' loss moments
+#: (``joint_friction.SHARED``).
+R_P, R_SEL, R_LOSS = jf.R_P, jf.R_SEL, jf.R_LOSS
 
 
 @kernel(inline=True)

@@ -52,12 +52,15 @@ from .layout import (
 )
 
 
-def pack_line(ref: int, load: int, carrier, dofs, elements, starts) -> np.ndarray:
+def pack_line(ref: int, load: int, carrier, dofs, elements, starts,
+              throws=None) -> np.ndarray:
     """The Model's ``line`` (:data:`.layout.LINE_META`): the reference's and the load's dof, the
     dof of each cylinder (``carrier``), the rows of the dofs (``dofs``, :data:`.layout.LINE_DOF`:
     its first four columns; each dof that carries cylinders is a chain of the pairs, in order,
     with its share of them; ``starts``, where each dof's breakpoints begin in
-    ``Model.breakpoints``) and of the elements (:data:`.layout.ELEMENT`)."""
+    ``Model.breakpoints``), of the elements (:data:`.layout.ELEMENT`) and, under reaction
+    friction, per chain the mechanism of its cylinders (``throws``, :func:`throw_mechanism`;
+    the array is then as wide as they are)."""
     carrier = np.asarray(carrier, dtype=np.int64)
     dofs = np.asarray(dofs, dtype=float)
     elements = np.asarray(elements, dtype=float).reshape(-1, N_ELEMENT)
@@ -67,12 +70,16 @@ def pack_line(ref: int, load: int, carrier, dofs, elements, starts) -> np.ndarra
     rows[:, LD_CHAIN] = np.where(carried > 0, np.cumsum(carried > 0) - 1, -1)
     rows[:, LD_SHARE] = carried / max(carrier.size, 1)
     rows[:, LD_BREAKPOINTS] = starts
-    out = np.zeros((1 + carrier.size + len(dofs) + len(elements), N_LINE_COLUMNS))
+    throws = np.zeros((0, 1)) if throws is None else np.asarray(throws, dtype=float)
+    out = np.zeros((1 + carrier.size + len(dofs) + len(elements) + len(throws),
+                    max(N_LINE_COLUMNS, throws.shape[1])))
     out[0, :LINE_META.size] = (len(dofs), ref, load, len(elements), carrier.size,
                                np.count_nonzero(carried))
     out[1:1 + carrier.size, 0] = carrier
     out[1 + carrier.size:1 + carrier.size + len(dofs), :LINE_DOF.size] = rows
-    out[1 + carrier.size + len(dofs):, :N_ELEMENT] = elements
+    e0 = 1 + carrier.size + len(dofs)
+    out[e0:e0 + len(elements), :N_ELEMENT] = elements
+    out[e0 + len(elements):, :throws.shape[1]] = throws
     return out
 
 
@@ -99,6 +106,15 @@ def line_parts(line):
     d0 = 1 + np.int64(line[0, LM_CYLINDERS])
     e0 = d0 + n
     return line[1:d0, 0], line[d0:e0, :], line[e0:e0 + np.int64(line[0, LM_ELEMENTS]), :]
+
+
+@kernel(inline=True)
+def throw_mechanism(line, c):
+    """The row of ``line`` with the compiled parameters of the mechanism made of chain c's
+    cylinders (under reaction friction, :func:`pack_line`): what its throw's reaction solve
+    takes for ``Model.mech``."""
+    return (1 + np.int64(line[0, LM_CYLINDERS]) + np.int64(line[0, LM_DOFS])
+            + np.int64(line[0, LM_ELEMENTS]) + c)
 
 
 @kernel(inline=True)

@@ -19,8 +19,11 @@ N_WK = WK_RX + max(jf.ROWS.end, sf.ROWS.end, af.ROWS.end)
 @compiled
 def work_array(m):
     """Scratch space of the right-hand side (rows ``WK_*``), allocated once per run."""
+    # (an elastic line's throws solve their joints in the columns from c·n_pairs on,
+    # ``line_pairs.throw_reactions``)
     wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, n_margins(m), m.link_sub.shape[0], 2,
-                             line_dofs(m))))
+                             line_dofs(m),
+                             n_margins(m) + m.ncyl if m.reaction and line_dofs(m) > 0 else 0)))
     wk[WK_SEL, 0] = np.nan  # no pieces selected yet
     wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
     return wk
