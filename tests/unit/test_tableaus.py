@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import DOP853, RK45
 
-from transient.core.integrator.rk import dense_eval
+from transient.core.integrator.rk import STAGEWISE_FROM, dense_eval, stage_state
 from transient.core.integrator.rosenbrock import is_w_method
 from transient.core.integrator.tableaus import TABLEAUS
 
@@ -89,3 +89,24 @@ def test_dense_output_order(name):
     print(f"{name}: midpoint errors {errs}, order {order:.2f}")
     assert errs[1] > 1e-14  # above round-off, so the slope means something
     assert q + 1 - 0.5 <= order <= q + 1 + 1.5, (errs, order)
+
+
+@pytest.mark.parametrize("name", PAIRS)
+def test_stage_states_match_numpy(name):
+    """Each stage's state y + h Σ_{j<s} a_sj K_j, the compiled sum against numpy's, for a state
+    summed component by component and one summed stage by stage (fewer and more components than
+    STAGEWISE_FROM); both sum each component in the same order, so the smaller state's
+    components are the larger one's first ones to the bit."""
+    tab = TABLEAUS[name]
+    rng = np.random.default_rng(3)
+    n_small, n_large = STAGEWISE_FROM - 3, STAGEWISE_FROM + 12
+    K = rng.standard_normal((tab.n_ext, n_large))
+    y = rng.standard_normal(n_large)
+    h = 0.37
+    small, large = np.empty(n_small), np.empty(n_large)
+    for s in range(1, tab.n_ext):
+        stage_state(tab.A[s], K, s, y, h, large)
+        np.testing.assert_allclose(large, y + h * tab.A[s, :s] @ K[:s], rtol=1e-14, atol=1e-14,
+                                   err_msg=f"{name} stage {s}")
+        stage_state(tab.A[s], np.ascontiguousarray(K[:, :n_small]), s, y[:n_small], h, small)
+        assert np.array_equal(small, large[:n_small]), (name, s)

@@ -136,11 +136,7 @@ def step(tab, rhs, ctx, ix, x, y, f, h, K, y_new, tmp):
     # Stage ns is the derivative at the new state (FSAL: row ns of A holds B). One call site,
     # because the derivative is inlined wherever it is called.
     for s in range(1, ns + 1):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += tab.A[s, j] * K[j, i]
-            tmp[i] = y[i] + h * acc
+        stage_state(tab.A[s], K, s, y, h, tmp)
         if s == ns:
             # The independent variable advances exactly (exact stops on breakpoints).
             if ix >= 0:
@@ -150,6 +146,41 @@ def step(tab, rhs, ctx, ix, x, y, f, h, K, y_new, tmp):
         rhs(ctx, tmp, K[s])
 
 
+#: The least state size summed stage by stage (:func:`stage_state`); a smaller state is summed
+#: component by component, which is faster where the state is less than a vector register or two.
+STAGEWISE_FROM = 8
+
+
+@kernel(inline=True)
+def stage_state(a, K, s, y, h, out):
+    """The state of stage s, y + h Σ_{j<s} a_j K_j, into ``out``. Each component's sum is taken
+    in the order j = 0, 1, …: from :data:`STAGEWISE_FROM` components on stage by stage over the
+    whole state (K's rows are contiguous, so the inner loops vectorise; the last stage's term
+    and y in one pass), for fewer component by component (K read down its columns)."""
+    n = y.shape[0]
+    if n < STAGEWISE_FROM:
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += a[j] * K[j, i]
+            out[i] = y[i] + h * acc
+        return
+    a_0 = a[0]
+    for i in range(n):
+        out[i] = a_0 * K[0, i]
+    for j in range(1, s - 1):
+        a_j = a[j]
+        for i in range(n):
+            out[i] += a_j * K[j, i]
+    if s == 1:
+        for i in range(n):
+            out[i] = y[i] + h * out[i]
+    else:
+        a_j = a[s - 1]
+        for i in range(n):
+            out[i] = y[i] + h * (out[i] + a_j * K[s - 1, i])
+
+
 @kernel
 def dense(tab, rhs, ctx, y, y_new, h, K, F, tmp):
     """Dense-output coefficients F (3 + tab.D rows × n) of the last step, after the extra stages
@@ -157,12 +188,7 @@ def dense(tab, rhs, ctx, y, y_new, h, K, F, tmp):
     n = y.shape[0]
     ns = tab.n_stages
     for s in range(ns + 1, tab.n_ext):
-        a = tab.A[s]
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += a[j] * K[j, i]
-            tmp[i] = y[i] + h * acc
+        stage_state(tab.A[s], K, s, y, h, tmp)
         rhs(ctx, tmp, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]
