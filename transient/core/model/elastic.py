@@ -151,14 +151,14 @@ def cylinders_at_sel(m, sel, wk):
 
 @kernel(inline=True)
 def cylinder_pressure(m, c, theta, sel, y, f, wk):
-    """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel f
-    (:func:`cylinder_fuel`): the table's piece found at the dof's angle θ_sel = sel + θ − φ
-    that holds the step's pieces (WK_LOCAL, the cylinder's own angle there — its angle at
-    ``sel`` moved by the twist, after :func:`cylinders_at_sel` — and WK_PIECE; with a
-    combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT, WK_PIECE_SHIFT), then the
-    rigid model's :func:`~.forcing.cylinder_value` at ``theta`` (in its closed part with wall
-    heat, its pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on the
-    piston. The piece is searched from the one this cylinder's last evaluation left
+    """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel (at the
+    governor's command f, :func:`cylinder_fuel`): the table's piece found at the dof's angle
+    θ_sel = sel + θ − φ that holds the step's pieces (WK_LOCAL, the cylinder's own angle there
+    — its angle at ``sel`` moved by the twist, after :func:`cylinders_at_sel` — and WK_PIECE;
+    with a combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT, WK_PIECE_SHIFT), then
+    the rigid model's :func:`~.forcing.cylinder_value` at ``theta`` (in its closed part with
+    wall heat, its pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on
+    the piston. The piece is searched from the one this cylinder's last evaluation left
     (:func:`~.tables.find_piece_near`): the same piece, found with two comparisons at most
     evaluations."""
     twist = theta - y[PHI]
@@ -171,7 +171,8 @@ def cylinder_pressure(m, c, theta, sel, y, f, wk):
         wk[WK_LOCAL_SHIFT, c] = local_shift
         wk[WK_PIECE_SHIFT, c] = find_piece_near(m.knots, m.piece_knot, local_shift,
                                                 wk[WK_PIECE_SHIFT, c])
-    p = cylinder_value(m, True, c, y, theta, theta_sel, f, wk, True)
+    p = cylinder_value(m, True, c, y, theta, theta_sel, cylinder_fuel(m, c, theta_sel, y, f), wk,
+                       True)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p
@@ -214,9 +215,7 @@ def line_forces(m, y, sel, sw, wk):
         cylinders_at_sel(m, sel, wk)
         for c in range(m.ncyl):
             d = np.int64(carrier[c])
-            theta = wk[WK_LINE_THETA, d]
-            theta_sel = sel + (theta - y[PHI])
-            p = cylinder_pressure(m, c, theta, sel, y, cylinder_fuel(m, c, theta_sel, y, f), wk)
+            p = cylinder_pressure(m, c, wk[WK_LINE_THETA, d], sel, y, f, wk)
             M_c = m.gas_scale[c] * (p - m.gas_offset) * wk[WK_U, c]
             wk[WK_LINE_M, d] += M_c
             M_gas += M_c
@@ -337,10 +336,7 @@ def elastic_row(m, extras, angle_mode, y, sel, sw, wk, row):
     if m.has_gas:
         cylinders_at_sel(m, sel, wk)
     for c in range(m.ncyl):
-        theta = wk[WK_CYL_ANGLE, c]
-        theta_sel = sel + (theta - y[PHI])
-        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, theta, sel, y,
-                                                  cylinder_fuel(m, c, theta_sel, y, f), wk)
+        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, wk[WK_CYL_ANGLE, c], sel, y, f, wk)
                                 if m.has_gas else 0.0)
     governor_rows(m, y, row)
     if extras is not None and m.n_pairs > 0:
