@@ -9,7 +9,13 @@ import numpy as np
 import pytest
 from scipy.integrate import DOP853, RK45
 
-from transient.core.integrator.rk import dense_eval
+from transient.core.integrator.rk import (
+    STAGEWISE_FROM,
+    combination,
+    dense_eval,
+    error_norm,
+    stage_state,
+)
 from transient.core.integrator.rosenbrock import is_w_method
 from transient.core.integrator.tableaus import TABLEAUS
 
@@ -89,3 +95,68 @@ def test_dense_output_order(name):
     print(f"{name}: midpoint errors {errs}, order {order:.2f}")
     assert errs[1] > 1e-14  # above round-off, so the slope means something
     assert q + 1 - 0.5 <= order <= q + 1 + 1.5, (errs, order)
+
+
+@pytest.mark.parametrize("name", PAIRS)
+def test_stage_states_match_numpy(name):
+    """Each stage's state y + h Σ_{j<s} a_sj K_j, the compiled sum against numpy's, for a state
+    summed component by component and one summed stage by stage (fewer and more components than
+    STAGEWISE_FROM); both sum each component in the same order, so the smaller state's
+    components are the larger one's first ones to the bit."""
+    tab = TABLEAUS[name]
+    rng = np.random.default_rng(3)
+    n_small, n_large = STAGEWISE_FROM - 3, STAGEWISE_FROM + 12
+    K = rng.standard_normal((tab.n_ext, n_large))
+    y = rng.standard_normal(n_large)
+    h = 0.37
+    small, large = np.empty(n_small), np.empty(n_large)
+    for s in range(1, tab.n_ext):
+        stage_state(tab.A[s], K, s, y, h, large)
+        np.testing.assert_allclose(large, y + h * tab.A[s, :s] @ K[:s], rtol=1e-14, atol=1e-14,
+                                   err_msg=f"{name} stage {s}")
+        stage_state(tab.A[s], np.ascontiguousarray(K[:, :n_small]), s, y[:n_small], h, small)
+        assert np.array_equal(small, large[:n_small]), (name, s)
+
+
+@pytest.mark.parametrize("name", PAIRS)
+def test_error_estimators_match_numpy(name):
+    """The estimators' combinations Σ_s E_s K_s and the error norm against numpy's, written
+    from the norm's definition (Hairer's blend of the two estimators, the RMS over the controlled
+    components; t scaled by its increment, the independent variable left out), for states
+    summed component by component and stage by stage; the smaller state's combinations are the
+    larger one's first components to the bit."""
+    from transient.core.declare import BY_INCREMENT, BY_SIZE, NOT_CONTROLLED
+
+    tab = TABLEAUS[name]
+    rng = np.random.default_rng(4)
+    m = tab.n_stages + 1
+    n_small, n_large = STAGEWISE_FROM - 3, STAGEWISE_FROM + 12
+    K = rng.standard_normal((tab.n_ext, n_large))
+    y, y_new = rng.standard_normal(n_large), rng.standard_normal(n_large)
+    control = np.full(n_large, BY_SIZE, dtype=np.int64)
+    control[1], control[3] = BY_INCREMENT, NOT_CONTROLLED
+    h, rtol, atol, ix = 0.37, 1e-6, 1e-9, 0
+    e5_np, e3_np = tab.E5[:m] @ K[:m], tab.E3[:m] @ K[:m]
+    keep = (control != NOT_CONTROLLED) & (np.arange(n_large) != ix)
+    sc = np.where(control == BY_INCREMENT, atol + rtol * np.abs(y_new - y),
+                  atol + rtol * np.maximum(np.abs(y), np.abs(y_new)))[keep]
+    err5, err3 = np.sum((e5_np[keep] / sc) ** 2), np.sum((e3_np[keep] / sc) ** 2)
+    expect = h * err5 / np.sqrt((err5 + 0.01 * err3) * keep.sum())
+    e5, e3 = np.empty(n_large), np.empty(n_large)
+    got = error_norm(tab, K, h, y, y_new, rtol, atol, ix, control, e5, e3)
+    assert got == pytest.approx(expect, rel=1e-13)
+    np.testing.assert_allclose(e5, e5_np, rtol=1e-13, atol=1e-14)
+    # a state under STAGEWISE_FROM components: its own sums, the same norm as numpy's
+    sl = slice(0, n_small)
+    keep_s = keep[sl]
+    sc_s = np.where(control[sl] == BY_INCREMENT, atol + rtol * np.abs(y_new[sl] - y[sl]),
+                    atol + rtol * np.maximum(np.abs(y[sl]), np.abs(y_new[sl])))[keep_s]
+    err5_s = np.sum((e5_np[sl][keep_s] / sc_s) ** 2)
+    err3_s = np.sum((e3_np[sl][keep_s] / sc_s) ** 2)
+    got_s = error_norm(tab, np.ascontiguousarray(K[:, sl]), h, y[sl].copy(), y_new[sl].copy(),
+                       rtol, atol, ix, control[sl].copy(), np.empty(n_small), np.empty(n_small))
+    assert got_s == pytest.approx(h * err5_s / np.sqrt((err5_s + 0.01 * err3_s) * keep_s.sum()),
+                                  rel=1e-13)
+    small = np.empty(n_small)
+    combination(tab.E5, np.ascontiguousarray(K[:, :n_small]), m, small)
+    assert np.array_equal(small, e5[:n_small])

@@ -20,6 +20,7 @@ from transient.core.model.tables import (
     table_eval_pair_near,
     table_value,
     wrap_angle,
+    wrap_near,
 )
 from transient.errors import SceneError
 from transient.forces.gas import PressureTable, table_from_function, table_from_points
@@ -345,3 +346,15 @@ def test_bisect_root_is_the_root_to_the_last_bit(sign):
     y = bisect_root(g, 2.0, 0.0)
     assert positive(y) == positive(0.0) != positive(np.nextafter(y, np.inf))
     assert abs(y - x) <= np.spacing(x)
+
+
+def test_wrap_near_is_wrap_angle():
+    """wrap_near reduces as wrap_angle does, the same values: angles inside the cycle, a hair and a
+    small twist outside either end, and far outside."""
+    rng = np.random.default_rng(2)
+    x = np.concatenate([rng.uniform(0.0, P4, 500), rng.uniform(-0.1, 0.0, 100),
+                        rng.uniform(P4, P4 + 0.1, 100), rng.uniform(-3 * P4, 5 * P4, 300),
+                        [0.0, -0.0, P4, np.nextafter(P4, 0.0), -1e-300, np.nextafter(0.0, -1.0)]])
+    got = np.array([wrap_near(xi, P4) for xi in x])
+    assert np.array_equal(got, np.array([wrap_angle(xi, P4) for xi in x]))
+    assert np.all((got >= 0.0) & (got < P4))

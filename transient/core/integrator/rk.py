@@ -31,15 +31,22 @@ ERR_OLD_FLOOR = 1e-4
 
 
 @kernel(inline=True)
-def error_norm(tab, K, h, y, y_new, rtol, atol, ix, control):
+def error_norm(tab, K, h, y, y_new, rtol, atol, ix, control, e5, e3):
     """Error norm: DOP853's blend of its 5th- and 3rd-order estimators (Hairer), the RMS norm of
     the one estimator for a pair without a second (``tab.E3 = 0``, DOPRI5), over the components
-    ``control`` controls, but the independent variable ``ix`` (which has no error).
+    ``control`` controls, but the independent variable ``ix`` (which has no error). ``e5``,
+    ``e3``: scratch of the state's length, where a state of :data:`STAGEWISE_FROM` components
+    or more has the two estimators' combinations of K summed (:func:`combination`).
 
     A component that accumulates (``BY_INCREMENT``: t in crank angle, φ in time) is scaled by
     its increment over the step, not by its size: relative to |t| the allowed error would grow
     with the run's length and a long run would lose phase for nothing."""
     n = y.shape[0]
+    m = tab.n_stages + 1
+    stagewise = n >= STAGEWISE_FROM  # (else each component's sums where it is scaled)
+    if stagewise:
+        combination(tab.E5, K, m, e5)
+        combination(tab.E3, K, m, e3)
     err5 = 0.0
     err3 = 0.0
     count = 0
@@ -52,13 +59,17 @@ def error_norm(tab, K, h, y, y_new, rtol, atol, ix, control):
             sc = atol + rtol * abs(y_new[i] - y[i])
         else:
             sc = atol + rtol * max(abs(y[i]), abs(y_new[i]))
-        e5 = 0.0
-        e3 = 0.0
-        for s in range(tab.n_stages + 1):
-            e5 += K[s, i] * tab.E5[s]
-            e3 += K[s, i] * tab.E3[s]
-        err5 += (e5 / sc) ** 2
-        err3 += (e3 / sc) ** 2
+        if stagewise:
+            e5_i = e5[i]
+            e3_i = e3[i]
+        else:
+            e5_i = 0.0
+            e3_i = 0.0
+            for s in range(m):
+                e5_i += K[s, i] * tab.E5[s]
+                e3_i += K[s, i] * tab.E3[s]
+        err5 += (e5_i / sc) ** 2
+        err3 += (e3_i / sc) ** 2
     if err5 == 0.0 and err3 == 0.0:
         return 0.0
     return abs(h) * err5 / np.sqrt((err5 + 0.01 * err3) * count)
@@ -136,11 +147,7 @@ def step(tab, rhs, ctx, ix, x, y, f, h, K, y_new, tmp):
     # Stage ns is the derivative at the new state (FSAL: row ns of A holds B). One call site,
     # because the derivative is inlined wherever it is called.
     for s in range(1, ns + 1):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += tab.A[s, j] * K[j, i]
-            tmp[i] = y[i] + h * acc
+        stage_state(tab.A[s], K, s, y, h, tmp)
         if s == ns:
             # The independent variable advances exactly (exact stops on breakpoints).
             if ix >= 0:
@@ -150,6 +157,63 @@ def step(tab, rhs, ctx, ix, x, y, f, h, K, y_new, tmp):
         rhs(ctx, tmp, K[s])
 
 
+#: The least state size summed stage by stage (:func:`stage_state`); a smaller state is summed
+#: component by component, which is faster where the state is less than a vector register or two.
+STAGEWISE_FROM = 8
+
+
+@kernel(inline=True)
+def combination(w, K, m, out):
+    """out = Σ_{s<m} w_s K_s, each component's sum in the order s = 0, 1, …: stage by stage
+    over the whole state from :data:`STAGEWISE_FROM` components on, as :func:`stage_state`
+    sums, for fewer component by component."""
+    n = out.shape[0]
+    if n < STAGEWISE_FROM:
+        for i in range(n):
+            acc = 0.0
+            for s in range(m):
+                acc += K[s, i] * w[s]
+            out[i] = acc
+        return
+    w_0 = w[0]
+    for i in range(n):
+        out[i] = K[0, i] * w_0
+    for s in range(1, m):
+        w_s = w[s]
+        for i in range(n):
+            out[i] += K[s, i] * w_s
+
+
+@kernel(inline=True)
+def stage_state(a, K, s, y, h, out):
+    """The state of stage s, y + h Σ_{j<s} a_j K_j, into ``out``. Each component's sum is taken
+    in the order j = 0, 1, …: from :data:`STAGEWISE_FROM` components on stage by stage over the
+    whole state (K's rows are contiguous, so the inner loops vectorise; the last stage's term
+    and y in one pass), for fewer component by component (K read down its columns)."""
+    n = y.shape[0]
+    if n < STAGEWISE_FROM:
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += a[j] * K[j, i]
+            out[i] = y[i] + h * acc
+        return
+    a_0 = a[0]
+    for i in range(n):
+        out[i] = a_0 * K[0, i]
+    for j in range(1, s - 1):
+        a_j = a[j]
+        for i in range(n):
+            out[i] += a_j * K[j, i]
+    if s == 1:
+        for i in range(n):
+            out[i] = y[i] + h * out[i]
+    else:
+        a_j = a[s - 1]
+        for i in range(n):
+            out[i] = y[i] + h * (out[i] + a_j * K[s - 1, i])
+
+
 @kernel
 def dense(tab, rhs, ctx, y, y_new, h, K, F, tmp):
     """Dense-output coefficients F (3 + tab.D rows × n) of the last step, after the extra stages
@@ -157,12 +221,7 @@ def dense(tab, rhs, ctx, y, y_new, h, K, F, tmp):
     n = y.shape[0]
     ns = tab.n_stages
     for s in range(ns + 1, tab.n_ext):
-        a = tab.A[s]
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += a[j] * K[j, i]
-            tmp[i] = y[i] + h * acc
+        stage_state(tab.A[s], K, s, y, h, tmp)
         rhs(ctx, tmp, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]

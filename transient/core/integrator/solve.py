@@ -48,6 +48,8 @@ def solve(tab, rhs, ctx, x0, y0, x_end, h0, rtol, atol, control, ix, x_out, g, d
     y_new = np.empty(n)
     tmp = np.empty(n)
     f = np.empty(n)
+    e5 = np.empty(n)
+    e3 = np.empty(n)
     y_out = np.full((x_out.shape[0], n), np.nan)
     rhs(ctx, y, f)
     n_rhs = 1
@@ -66,7 +68,7 @@ def solve(tab, rhs, ctx, x0, y0, x_end, h0, rtol, atol, control, ix, x_out, g, d
             K[0, i] = f[i]
         method_step(tab, rhs, jac, ctx, ix, x, y, f, h, K, y_new, tmp, band)
         n_rhs += ns
-        err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, control)
+        err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, control, e5, e3)
         if not (np.isfinite(err) and np.all(np.isfinite(y_new))):
             n_bad += 1
             if n_bad > MAX_NONFINITE:

@@ -134,9 +134,10 @@ def turned(s, c, d):
     costs more than the polynomials."""
     if abs(d) <= NEAR:
         d2 = d * d
+        # (each coefficient a constant the compiler folds: a product, not a division)
         sd = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0
-                                                                      + d2 / 362880.0))))
-        cd = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 / 40320.0)))
+                                                                      + d2 * (1.0 / 362880.0)))))
+        cd = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0))))
     else:
         sd = sin(d)
         cd = cos(d)

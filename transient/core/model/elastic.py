@@ -50,6 +50,7 @@ from .layout import (
     W_STARTER,
     WK_CYL_ANGLE,
     WK_CYL_FORCE,
+    WK_CYL_SEL,
     WK_LINE_DJ,
     WK_LINE_J,
     WK_LINE_M,
@@ -61,6 +62,7 @@ from .layout import (
     WK_LOCAL_SHIFT,
     WK_PIECE,
     WK_PIECE_SHIFT,
+    WK_SEL,
     WK_SPEED,
     WK_U,
     T,
@@ -89,7 +91,7 @@ from .shaft import (
     line_torques,
     twist_index,
 )
-from .tables import find_piece_near, wrap_angle
+from .tables import find_piece_near, wrap_angle, wrap_near
 from .variation import PRESSURE, SHIFT, cycle_fuel
 
 
@@ -143,17 +145,32 @@ def cylinder_fuel(m, c, theta, y, f):
 
 
 @kernel(inline=True)
-def cylinder_pressure(m, c, theta, theta_sel, y, f, wk):
-    """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel f
-    (:func:`cylinder_fuel`): the table's piece found at the dof's angle ``theta_sel`` that holds
-    the step's pieces (WK_LOCAL, the cylinder's own angle there, and WK_PIECE; with a combustion
-    offset also on the curve δ_c later, WK_LOCAL_SHIFT, WK_PIECE_SHIFT), then the rigid model's
-    :func:`~.forcing.cylinder_value` at ``theta`` (in its closed part with wall heat, its
-    pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on the piston.
-    The piece is searched from the one this cylinder's last evaluation left
+def cylinders_at_sel(m, sel, wk):
+    """Each cylinder's angle in its own cycle at the reference's angle ``sel`` (WK_CYL_SEL),
+    computed where ``sel`` changes (once a step; WK_SEL[1] the ``sel`` they are for), so that a
+    right-hand side moves each by its throw's twist instead of reducing an angle into the cycle
+    (a division) for every cylinder (:func:`cylinder_pressure`)."""
+    if wk[WK_SEL, 1] != sel:
+        for c in range(m.ncyl):
+            wk[WK_CYL_SEL, c] = wrap_angle(sel - m.gas_phase[c], m.period)
+        wk[WK_SEL, 1] = sel
+
+
+@kernel(inline=True)
+def cylinder_pressure(m, c, theta, sel, y, f, wk):
+    """The pressure (force) acting on piston c at its dof's angle ``theta`` and its fuel (at the
+    governor's command f, :func:`cylinder_fuel`): the table's piece found at the dof's angle
+    θ_sel = sel + θ − φ that holds the step's pieces (WK_LOCAL, the cylinder's own angle there
+    — its angle at ``sel`` moved by the twist, after :func:`cylinders_at_sel` — and WK_PIECE;
+    with a combustion offset also on the curve δ_c later, WK_LOCAL_SHIFT, WK_PIECE_SHIFT), then
+    the rigid model's :func:`~.forcing.cylinder_value` at ``theta`` (in its closed part with
+    wall heat, its pressure state); with a pressure factor β_c, p0 + β_c(p − p0), as it acts on
+    the piston. The piece is searched from the one this cylinder's last evaluation left
     (:func:`~.tables.find_piece_near`): the same piece, found with two comparisons at most
     evaluations."""
-    local = wrap_angle(theta_sel - m.gas_phase[c], m.period)
+    twist = theta - y[PHI]
+    theta_sel = sel + twist
+    local = wrap_near(wk[WK_CYL_SEL, c] + twist, m.period)
     wk[WK_LOCAL, c] = local
     wk[WK_PIECE, c] = find_piece_near(m.knots, m.piece_knot, local, wk[WK_PIECE, c])
     if shifted(m):
@@ -161,7 +178,8 @@ def cylinder_pressure(m, c, theta, theta_sel, y, f, wk):
         wk[WK_LOCAL_SHIFT, c] = local_shift
         wk[WK_PIECE_SHIFT, c] = find_piece_near(m.knots, m.piece_knot, local_shift,
                                                 wk[WK_PIECE_SHIFT, c])
-    p = cylinder_value(m, True, c, y, theta, theta_sel, f, wk, True)
+    p = cylinder_value(m, True, c, y, theta, theta_sel, cylinder_fuel(m, c, theta_sel, y, f), wk,
+                       True)
     if m.var_on:
         p = m.gas_offset + m.var_par[c, PRESSURE] * (p - m.gas_offset)
     return p
@@ -201,12 +219,10 @@ def line_forces(m, y, sel, sw, wk):
     P_gas = 0.0
     if m.has_gas:
         f = command(m, True, w_ref, y, sw)
+        cylinders_at_sel(m, sel, wk)
         for c in range(m.ncyl):
             d = np.int64(carrier[c])
-            theta = wk[WK_LINE_THETA, d]
-            theta_sel = sel + (theta - y[PHI])
-            p = cylinder_pressure(m, c, theta, theta_sel, y, cylinder_fuel(m, c, theta_sel, y, f),
-                                  wk)
+            p = cylinder_pressure(m, c, wk[WK_LINE_THETA, d], sel, y, f, wk)
             P_c = m.gas_scale[c] * (p - m.gas_offset)
             M_c = P_c * wk[WK_U, c]
             if m.reaction:  # (the force on the piston, for its throw's joints)
@@ -332,11 +348,10 @@ def elastic_row(m, extras, angle_mode, y, sel, sw, wk, row):
     row[10] = y[W_GAS]
     row[11] = y[W_LOAD]
     row[12] = y[W_STARTER]
+    if m.has_gas:
+        cylinders_at_sel(m, sel, wk)
     for c in range(m.ncyl):
-        theta = wk[WK_CYL_ANGLE, c]
-        theta_sel = sel + (theta - y[PHI])
-        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, theta, theta_sel, y,
-                                                  cylinder_fuel(m, c, theta_sel, y, f), wk)
+        row[N_OUT_FIXED + c] = (cylinder_pressure(m, c, wk[WK_CYL_ANGLE, c], sel, y, f, wk)
                                 if m.has_gas else 0.0)
     governor_rows(m, y, row)
     if extras is not None and m.n_pairs > 0:

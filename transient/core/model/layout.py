@@ -297,7 +297,9 @@ O_FIXED, O_GAS, O_PAIRS, O_GOVERNOR, O_LATCHED, O_CYL_LOSS, O_LINE = range(len(O
 #: reset it, and η*, S of a trial mode vector; the least and largest speed ω over those
 #: right-hand sides ([0], [1] of WK_SPEED), and of the PI governor's demand u (WK_DEMAND); per
 #: cylinder the angle ``sel`` in its own cycle and the gas table's piece there (WK_LOCAL,
-#: WK_PIECE), for the ``sel`` in WK_SEL[0] (:func:`.forcing.select_pieces`), with per-cylinder
+#: WK_PIECE), for the ``sel`` in WK_SEL[0] (:func:`.forcing.select_pieces`; on an elastic line
+#: the cylinder's angle at the reference's ``sel`` in WK_CYL_SEL, for the ``sel`` in WK_SEL[1],
+#: :func:`.elastic.cylinders_at_sel`), with per-cylinder
 #: variation its fuel factor in that cycle (WK_FUEL, :func:`.variation.cycle_fuel`) and, with
 #: combustion offsets, its angle and piece on the curve shifted by its offset (WK_LOCAL_SHIFT,
 #: WK_PIECE_SHIFT); scratch rows for ``chain.modes_power_flow_into``; with reaction friction,
@@ -329,12 +331,13 @@ WORK = Layout(
     ("cyl_knot", 1, "each cylinder's gas-table knot interval at its last evaluation"),
     ("cyl_knot_shift", 1, "its knot interval on the curve its combustion offset shifts"),
     ("cyl_force", 1, "each piston's gas force at its station's angle, for its throw's joints"),
+    ("cyl_sel", 1, "each cylinder's angle in its own cycle at the reference's sel"),
 )
 (WK_U, WK_DU, WK_J, WK_DJ, WK_M, WK_ETA, WK_S, WK_G, WK_G_MIN, WK_ETA_TRY, WK_S_TRY,
  WK_SPEED, WK_DEMAND, WK_LOCAL, WK_PIECE, WK_SEL, WK_FUEL, WK_LOCAL_SHIFT, WK_PIECE_SHIFT,
  WK_SCRATCH, WK_CYL_LOSS, WK_LINE_THETA, WK_LINE_OMEGA, WK_LINE_J, WK_LINE_DJ, WK_LINE_M,
  WK_LINE_T, WK_LINE_RATE, WK_CYL_ANGLE, WK_CYL_J, WK_CYL_DJ, WK_CYL_KNOT,
- WK_CYL_KNOT_SHIFT, WK_CYL_FORCE) = WORK
+ WK_CYL_KNOT_SHIFT, WK_CYL_FORCE, WK_CYL_SEL) = WORK
 N_SCRATCH = WORK.size_of("scratch")
 WK_RX = WORK.end
 

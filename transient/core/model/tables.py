@@ -241,6 +241,16 @@ def wrap_angle(x, period):
     return y
 
 
+@kernel(inline=True)
+def wrap_near(x, period):
+    """:func:`wrap_angle`'s x in ``[0, period)``, x itself where it is in it already: two
+    comparisons, not a division, for an angle that a small shift has moved from one already
+    reduced (a cylinder's angle at a throw's twist from its angle at the reference's)."""
+    if 0.0 <= x < period:
+        return x
+    return wrap_angle(x, period)
+
+
 @kernel
 def table_value(knots, coef, piece_knot, x):
     """Table value at any angle `x`: wrap into the cycle, find the piece, evaluate.

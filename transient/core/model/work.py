@@ -24,6 +24,6 @@ def work_array(m):
     wk = np.empty((N_WK, max(m.ncyl, m.n_pairs + 1, n_margins(m), m.link_sub.shape[0], 2,
                              line_dofs(m),
                              n_margins(m) + m.ncyl if m.reaction and line_dofs(m) > 0 else 0)))
-    wk[WK_SEL, 0] = np.nan  # no pieces selected yet
+    wk[WK_SEL, :2] = np.nan  # no pieces selected yet, no elastic line's angles at sel
     wk[WK_RX:, :] = np.nan  # (the reaction rows: no angle's directions cached yet)
     return wk

@@ -560,7 +560,8 @@ def _judge_attempt(tab, m, ix, h, y, work, ist, rtol, atol, on_corner, corner):
         g_min = wk[WK_G_MIN, k]
         dip = dip or g_min < 0.0 <= gs[0, k] or g_min <= 0.0 < gs[0, k]
     ist[I_NFEV] += tab.n_stages
-    err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, work.control)
+    # (tmp and y_evt are free until the step is taken: the estimators' scratch)
+    err = error_norm(tab, K, h, y, y_new, rtol, atol, ix, work.control, work.tmp, work.y_evt)
     finite = np.isfinite(err)
     for i in range(n):
         finite = finite and np.isfinite(y_new[i])
