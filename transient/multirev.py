@@ -21,8 +21,8 @@ crossed in resolved cycles (:data:`CORNER_CYCLES` on either side), so that a cor
 the cycle where the direct run has it; so are the run's last cycles where fewer are left than a
 macro step saves, the first cycles, and those where the cycles' switching events change (a
 pair's modes, a governor's limits: the envelope is not smooth there). A stiff envelope (a
-multiplier well below 1) is integrated from where an explicit step proves too short by BDF,
-implicit.
+multiplier well below 1) is integrated by BDF, implicit, from where an explicit step proves
+too short.
 """
 from __future__ import annotations
 
@@ -123,13 +123,13 @@ class _Follower:
         end = self.phi(X[:-1], float(X[-1]))
         return np.append(end, X[-1] + self.phi.elapsed)
 
-    def slope(self, _n: float, X: np.ndarray) -> np.ndarray:
+    def slope(self, n: float, X: np.ndarray) -> np.ndarray:
         """F(X): the envelope's derivative by the cycle number, from resolved cycles."""
         seq, other = [X], False
         for _ in self.difference[1:]:
             seq.append(self.cycle(seq[-1]))
             other |= self.phi.events != self.regime
-        self.seen.append((_n, other))
+        self.seen.append((n, other))
         return np.tensordot(self.difference, np.array(seq), axes=1)
 
     def resolve(self, n: int, X: np.ndarray) -> np.ndarray:
