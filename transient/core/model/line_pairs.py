@@ -84,6 +84,18 @@ from .shaft import line_parts, throw_mechanism
 
 
 @kernel(inline=True)
+def station_moment(m, d, M_load, M_starter):
+    """The moments applied on dof ``d`` from outside the mechanism: the load's where it acts,
+    the starter's on the reference dof."""
+    M_ext = 0.0
+    if d == np.int64(m.line[0, LM_LOAD]):
+        M_ext += M_load
+    if d == np.int64(m.line[0, LM_REF]):
+        M_ext += M_starter
+    return M_ext
+
+
+@kernel(inline=True)
 def throw_chain(m, d, M_load, M_starter, wk):
     """The chain of dof d, its sub-chains' J_k, J′_k and M_k set up in the rows WK_J, WK_DJ,
     WK_M (``rhs.split_chain`` of the station's J_d with its own inertia on the shaft link, its
@@ -103,11 +115,7 @@ def throw_chain(m, d, M_load, M_starter, wk):
             u[n_own] = wk[WK_U, i]
             du[n_own] = wk[WK_DU, i]
             n_own += 1
-    M_ext = 0.0
-    if d == np.int64(m.line[0, LM_LOAD]):
-        M_ext += M_load
-    if d == np.int64(m.line[0, LM_REF]):
-        M_ext += M_starter
+    M_ext = station_moment(m, d, M_load, M_starter)
     split_chain(m, wk[WK_LINE_THETA, d], wk[WK_LINE_J, d], wk[WK_LINE_DJ, d],
                 wk[WK_LINE_M, d] - M_ext, M_ext + wk[WK_LINE_T, d], dofs[d, LD_OWN],
                 dofs[d, LD_SHARE], u[:n_own], du[:n_own], wk)
@@ -196,11 +204,7 @@ def throw_reaction(m, d, c, sigma, theta_sel, M_load, M_starter, wk):
         if np.int64(carrier[i]) == d:
             v[WK_RX + R_P, n_own] = wk[WK_CYL_FORCE, i]
             n_own += 1
-    M_ext = 0.0
-    if d == np.int64(m.line[0, LM_LOAD]):
-        M_ext += M_load
-    if d == np.int64(m.line[0, LM_REF]):
-        M_ext += M_starter
+    M_ext = station_moment(m, d, M_load, M_starter)
     mp = m.line[throw_mechanism(m.line, c)]
     theta = wk[WK_LINE_THETA, d]
     w = wk[WK_LINE_OMEGA, d]
